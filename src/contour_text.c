@@ -1,0 +1,3 @@
+/* contour_text.c — placeholder until implemented. */
+#include "internal.h"
+typedef int amscr__placeholder_contour_text;

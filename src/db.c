@@ -1,0 +1,3 @@
+/* db.c — placeholder until implemented. */
+#include "internal.h"
+typedef int amscr__placeholder_db;

@@ -1,0 +1,3 @@
+/* descriptor.c — placeholder until implemented. */
+#include "internal.h"
+typedef int amscr__placeholder_descriptor;

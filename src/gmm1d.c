@@ -1,0 +1,3 @@
+/* gmm1d.c — placeholder until implemented. */
+#include "internal.h"
+typedef int amscr__placeholder_gmm1d;

@@ -1,0 +1,3 @@
+/* register.c — placeholder until implemented. */
+#include "internal.h"
+typedef int amscr__placeholder_register;

@@ -1,0 +1,22 @@
+/* suites.h — every Check suite of the project. */
+#ifndef AMSCR_TEST_SUITES_H
+#define AMSCR_TEST_SUITES_H
+#include <check.h>
+
+Suite *amscr_suite_version(void);
+Suite *amscr_suite_errors(void);
+Suite *amscr_suite_contour_io(void);
+Suite *amscr_suite_trace(void);
+Suite *amscr_suite_smooth(void);
+Suite *amscr_suite_arclength(void);
+Suite *amscr_suite_lstsq(void);
+Suite *amscr_suite_affine(void);
+Suite *amscr_suite_kmeans(void);
+Suite *amscr_suite_gmm1d(void);
+Suite *amscr_suite_params(void);
+Suite *amscr_suite_register(void);
+Suite *amscr_suite_accuracy(void);
+Suite *amscr_suite_db(void);
+Suite *amscr_suite_retrieval(void);
+
+#endif

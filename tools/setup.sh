@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs what the build needs when it is missing (idempotent, fast when all is there), then
+# configures and builds into ./build. Debian/Ubuntu packages via apt-get; Python packages via pip.
+#   tools/setup.sh            build only
+#   AMSCR_NO_INSTALL=1 ...    never install, just build
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+debs=(gcc g++ meson ninja-build pkg-config liblapacke-dev libopenblas-dev libpng-dev check python3 python3-pip)
+missing=()
+if command -v dpkg-query >/dev/null 2>&1; then
+  for p in "${debs[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+  done
+fi
+if [ ${#missing[@]} -gt 0 ] && [ -z "${AMSCR_NO_INSTALL:-}" ]; then
+  echo "setup: installing Debian packages: ${missing[*]}" >&2
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq >/dev/null
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# Python side (tests and bindings): numpy, cffi, pytest, scipy (test cross-checks only).
+PY=${PYTHON:-python3}
+if [ -z "${AMSCR_NO_INSTALL:-}" ] && ! "$PY" -c 'import numpy, cffi, pytest, scipy' >/dev/null 2>&1; then
+  echo "setup: installing Python packages: numpy cffi pytest scipy" >&2
+  "$PY" -m pip install -q numpy cffi pytest scipy 2>/dev/null \
+    || "$PY" -m pip install -q --break-system-packages numpy cffi pytest scipy
+fi
+
+if [ ! -f build/build.ninja ]; then
+  meson setup build --buildtype=release >/dev/null
+fi
+meson compile -C build >/dev/null
+echo "setup: built into ./build" >&2
