@@ -11,10 +11,13 @@
 #define AMSCR__STR2(x) #x
 #define AMSCR__STR(x) AMSCR__STR2(x)
 
-#if defined(AMSCR_HAVE_THREAD_LOCAL_KEYWORD)
+/* Thread-local error detail: GCC/Clang's __thread in C99 mode, C11's _Thread_local elsewhere. */
+#if defined(__GNUC__)
+#define AMSCR_TLS __thread
+#elif defined(AMSCR_HAVE_THREAD_LOCAL_KEYWORD)
 #define AMSCR_TLS _Thread_local
 #else
-#define AMSCR_TLS __thread
+#error "amscr needs thread-local storage (__thread or _Thread_local)"
 #endif
 
 static AMSCR_TLS char amscr__detail[512];
@@ -76,7 +79,7 @@ void *amscr__malloc_array(size_t n, size_t size)
 {
     if (size != 0 && n > SIZE_MAX / size)
         return NULL;
-    return malloc(n * size ? n * size : 1);
+    return malloc((n != 0 && size != 0) ? n * size : 1);
 }
 
 void *amscr__calloc_array(size_t n, size_t size)

@@ -1,3 +1,264 @@
-/* contour_text.c — placeholder until implemented. */
+/* contour_text.c — text point lists: reading, parsing from memory, atomic writing.
+ *
+ * Format: one point per line, "x y", "x,y", "x, y" or tab-separated; '#' starts a
+ * comment anywhere on a line; blank lines are ignored; CRLF line ends are accepted.
+ * Numbers are read with strtod (the "C" locale is assumed) and must be finite. */
 #include "internal.h"
-typedef int amscr__placeholder_contour_text;
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* Thread-safe strerror (XSI strerror_r) into buf. */
+static const char *ct_errstr(int err, char *buf, size_t len)
+{
+    if (strerror_r(err, buf, len) != 0)
+        snprintf(buf, len, "error %d", err);
+    return buf;
+}
+
+/* Horizontal white space inside a line ('\r' included so CRLF and stray CRs pass). */
+static int ct_is_space(char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\v' || ch == '\f'; }
+
+/* Parses one line [s, e) (NUL at *e is guaranteed by the caller).
+ * Returns 1 when it holds a point (written to p), 0 when it is blank or a comment,
+ * -1 when it is malformed. */
+static int ct_parse_line(char *s, char *e, double p[2])
+{
+    for (char *q = s; q < e; q++)
+        if (*q == '#') {
+            e = q;
+            break;
+        }
+    while (s < e && ct_is_space(*s))
+        s++;
+    while (e > s && ct_is_space(e[-1]))
+        e--;
+    if (s == e)
+        return 0;
+    char saved = *e;
+    *e = '\0'; /* strtod must not run past the line (the comment or trailing blanks) */
+    int ok = 0;
+    char *end = NULL;
+    double x = strtod(s, &end);
+    if (end != s && end < e) {
+        char *q = end;
+        int sep = 0;
+        while (q < e && ct_is_space(*q)) {
+            q++;
+            sep = 1;
+        }
+        if (q < e && *q == ',') {
+            q++;
+            sep = 1;
+            while (q < e && ct_is_space(*q))
+                q++;
+        }
+        /* A separator (blanks and/or one comma) is required, and the second number must
+         * follow it: "1-2", "1,,2" and "1, ,2" are rejected. */
+        if (sep && q < e && !ct_is_space(*q) && *q != ',') {
+            char *end2 = NULL;
+            double y = strtod(q, &end2);
+            if (end2 != q && end2 == e && isfinite(x) && isfinite(y)) {
+                p[0] = x;
+                p[1] = y;
+                ok = 1;
+            }
+        }
+    }
+    *e = saved;
+    return ok ? 1 : -1;
+}
+
+/* Parses a NUL-terminated, writable buffer of len bytes (the NUL at buf[len] is extra).
+ * `path` names the source in details ("path:line"); NULL gives "line N". */
+static amscr_status ct_parse_buffer(char *buf, size_t len, const char *path, amscr_contour **out)
+{
+    double *xy = NULL;
+    size_t n = 0, cap = 0;
+    size_t line = 0;
+    char *p = buf, *end = buf + len;
+    while (p < end) {
+        char *nl = memchr(p, '\n', (size_t)(end - p));
+        char *le = nl ? nl : end;
+        line++;
+        double pt[2];
+        int r = ct_parse_line(p, le, pt);
+        if (r < 0) {
+            free(xy);
+            if (path)
+                return amscr__fail(AMSCR_E_FORMAT, "%s:%zu: expected 2 numbers", path, line);
+            return amscr__fail(AMSCR_E_FORMAT, "line %zu: expected 2 numbers", line);
+        }
+        if (r > 0) {
+            if (n >= AMSCR_MAX_POINTS) {
+                free(xy);
+                if (path)
+                    return amscr__fail(AMSCR_E_LIMIT, "%s:%zu: more than %u points", path, line,
+                                       (unsigned)AMSCR_MAX_POINTS);
+                return amscr__fail(AMSCR_E_LIMIT, "line %zu: more than %u points", line,
+                                   (unsigned)AMSCR_MAX_POINTS);
+            }
+            if (n == cap) {
+                size_t ncap = cap ? 2 * cap : 256;
+                if (ncap > AMSCR_MAX_POINTS)
+                    ncap = AMSCR_MAX_POINTS;
+                double *nxy = realloc(xy, ncap * 2 * sizeof *nxy);
+                if (!nxy) {
+                    free(xy);
+                    return amscr__fail(AMSCR_E_NOMEM, "contour text: out of memory (%zu points)", ncap);
+                }
+                xy = nxy;
+                cap = ncap;
+            }
+            xy[2 * n] = pt[0];
+            xy[2 * n + 1] = pt[1];
+            n++;
+        }
+        if (!nl)
+            break;
+        p = nl + 1;
+    }
+    if (n == 0) {
+        free(xy);
+        if (path)
+            return amscr__fail(AMSCR_E_FORMAT, "%s: no points", path);
+        return amscr__fail(AMSCR_E_FORMAT, "no points");
+    }
+    if (n < cap) { /* give back the slack; failure to shrink is harmless */
+        double *nxy = realloc(xy, n * 2 * sizeof *nxy);
+        if (nxy)
+            xy = nxy;
+    }
+    /* amscr__contour_wrap takes ownership of xy (also on failure). */
+    return amscr__contour_wrap(xy, n, out);
+}
+
+amscr_status amscr_contour_parse_text(const char *text, size_t len, amscr_contour **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(out);
+    AMSCR_CHECK_NULL(text);
+    if (len == SIZE_MAX)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_contour_parse_text: len too large");
+    char *buf = malloc(len + 1);
+    if (!buf)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_parse_text: out of memory (%zu bytes)", len);
+    if (len)
+        memcpy(buf, text, len);
+    buf[len] = '\0';
+    amscr_status st = ct_parse_buffer(buf, len, NULL, out);
+    free(buf);
+    return st;
+}
+
+amscr_status amscr_contour_read_text(const char *path, amscr_contour **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(path);
+    AMSCR_CHECK_NULL(out);
+    char eb[128];
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return amscr__fail(AMSCR_E_IO, "%s: %s", path, ct_errstr(errno, eb, sizeof eb));
+    size_t cap = 1 << 16, len = 0;
+    char *buf = malloc(cap);
+    if (!buf) {
+        fclose(f);
+        return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", path);
+    }
+    for (;;) {
+        if (cap - len < 2) {
+            if (cap > SIZE_MAX / 2) {
+                free(buf);
+                fclose(f);
+                return amscr__fail(AMSCR_E_LIMIT, "%s: file too large", path);
+            }
+            char *nb = realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory (%zu bytes)", path, cap * 2);
+            }
+            buf = nb;
+            cap *= 2;
+        }
+        size_t got = fread(buf + len, 1, cap - len - 1, f);
+        len += got;
+        if (got == 0) {
+            if (ferror(f)) {
+                int e = errno;
+                free(buf);
+                fclose(f);
+                return amscr__fail(AMSCR_E_IO, "%s: read error: %s", path, ct_errstr(e, eb, sizeof eb));
+            }
+            break;
+        }
+    }
+    fclose(f);
+    buf[len] = '\0';
+    amscr_status st = ct_parse_buffer(buf, len, path, out);
+    free(buf);
+    return st;
+}
+
+amscr_status amscr_contour_write_text(const amscr_contour *c, const char *path)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(c);
+    AMSCR_CHECK_NULL(path);
+    if (c->n == 0 || c->xy == NULL)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_contour_write_text: empty contour");
+    if (!amscr__all_finite(c->xy, 2 * c->n))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_contour_write_text: non-finite coordinate");
+    size_t plen = strlen(path);
+    static const char suffix[] = ".tmp.XXXXXX";
+    char *tmp = malloc(plen + sizeof suffix);
+    if (!tmp)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_write_text: out of memory");
+    memcpy(tmp, path, plen);
+    memcpy(tmp + plen, suffix, sizeof suffix);
+
+    char eb[128];
+    int fd = mkstemp(tmp);
+    if (fd < 0) {
+        amscr_status st = amscr__fail(AMSCR_E_IO, "%s: cannot create temporary file: %s", path,
+                                      ct_errstr(errno, eb, sizeof eb));
+        free(tmp);
+        return st;
+    }
+    /* mkstemp creates 0600; give the file ordinary permissions (best effort). */
+    (void)fchmod(fd, 0644);
+    FILE *f = fdopen(fd, "w");
+    if (!f) {
+        int e = errno;
+        close(fd);
+        unlink(tmp);
+        free(tmp);
+        return amscr__fail(AMSCR_E_IO, "%s: %s", path, ct_errstr(e, eb, sizeof eb));
+    }
+    int err = 0;
+    errno = 0;
+    for (size_t i = 0; i < c->n && !err; i++)
+        if (fprintf(f, "%.17g %.17g\n", c->xy[2 * i], c->xy[2 * i + 1]) < 0)
+            err = errno ? errno : EIO;
+    if (!err && fflush(f) != 0)
+        err = errno ? errno : EIO;
+    if (!err && fsync(fileno(f)) != 0 && errno != EINVAL && errno != EROFS)
+        err = errno ? errno : EIO;
+    if (fclose(f) != 0 && !err)
+        err = errno ? errno : EIO;
+    if (!err && rename(tmp, path) != 0)
+        err = errno ? errno : EIO;
+    if (err) {
+        unlink(tmp);
+        free(tmp);
+        return amscr__fail(AMSCR_E_IO, "%s: write failed: %s", path, ct_errstr(err, eb, sizeof eb));
+    }
+    free(tmp);
+    return AMSCR_OK;
+}

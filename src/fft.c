@@ -1,3 +1,103 @@
-/* fft.c — placeholder until implemented. */
-#include "internal.h"
-typedef int amscr__placeholder_fft;
+/* fft.c — a small complex FFT for the start-point search: iterative radix-2 for powers of
+ * two, a direct DFT otherwise. A plan (twiddles, bit reversal) is made once per size and
+ * kept in the per-thread workspace or the descriptor: no global state. */
+#include "fft.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+int amscr__fft_plan_init(amscr__fft_plan *p, size_t n)
+{
+    p->n = n;
+    p->pow2 = n >= 2 && (n & (n - 1)) == 0;
+    p->tw = malloc(2 * n * sizeof *p->tw);
+    p->rev = p->pow2 ? malloc(n * sizeof *p->rev) : NULL;
+    p->tmp = p->pow2 ? NULL : malloc(2 * n * sizeof *p->tmp);
+    if (!p->tw || (p->pow2 && !p->rev) || (!p->pow2 && !p->tmp)) {
+        amscr__fft_plan_free(p);
+        return -1;
+    }
+    for (size_t k = 0; k < n; k++) {
+        double a = -2.0 * M_PI * (double)k / (double)n;
+        p->tw[2 * k] = cos(a);
+        p->tw[2 * k + 1] = sin(a);
+    }
+    if (p->pow2) {
+        size_t bits = 0;
+        while (((size_t)1 << bits) < n)
+            bits++;
+        for (size_t i = 0; i < n; i++) {
+            size_t r = 0;
+            for (size_t b = 0; b < bits; b++)
+                if (i & ((size_t)1 << b))
+                    r |= (size_t)1 << (bits - 1 - b);
+            p->rev[i] = r;
+        }
+    }
+    return 0;
+}
+
+void amscr__fft_plan_free(amscr__fft_plan *p)
+{
+    free(p->tw);
+    free(p->rev);
+    free(p->tmp);
+    p->tw = NULL;
+    p->rev = NULL;
+    p->tmp = NULL;
+}
+
+/* In-place transform of n interleaved complex values. inverse: e^{+i...}, unscaled. */
+void amscr__fft(const amscr__fft_plan *p, double *z, int inverse)
+{
+    size_t n = p->n;
+    double sgn = inverse ? -1.0 : 1.0;
+    if (!p->pow2) {
+        double *t = p->tmp; /* plan scratch: a plan is used by one thread at a time */
+        for (size_t k = 0; k < n; k++) {
+            double re = 0.0, im = 0.0;
+            size_t idx = 0;
+            for (size_t j = 0; j < n; j++) {
+                double c = p->tw[2 * idx], s = sgn * p->tw[2 * idx + 1];
+                re += z[2 * j] * c - z[2 * j + 1] * s;
+                im += z[2 * j] * s + z[2 * j + 1] * c;
+                idx += k;
+                if (idx >= n)
+                    idx -= n;
+            }
+            t[2 * k] = re;
+            t[2 * k + 1] = im;
+        }
+        for (size_t k = 0; k < 2 * n; k++)
+            z[k] = t[k];
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        size_t r = p->rev[i];
+        if (r > i) {
+            double tr = z[2 * i], ti = z[2 * i + 1];
+            z[2 * i] = z[2 * r];
+            z[2 * i + 1] = z[2 * r + 1];
+            z[2 * r] = tr;
+            z[2 * r + 1] = ti;
+        }
+    }
+    for (size_t len = 2; len <= n; len <<= 1) {
+        size_t half = len >> 1, step = n / len;
+        for (size_t i = 0; i < n; i += len) {
+            for (size_t j = 0; j < half; j++) {
+                double wr = p->tw[2 * j * step], wi = sgn * p->tw[2 * j * step + 1];
+                double *a = z + 2 * (i + j), *b = z + 2 * (i + j + half);
+                double xr = b[0] * wr - b[1] * wi, xi = b[0] * wi + b[1] * wr;
+                b[0] = a[0] - xr;
+                b[1] = a[1] - xi;
+                a[0] += xr;
+                a[1] += xi;
+            }
+        }
+    }
+}

@@ -62,6 +62,73 @@ struct amscr_params {
     double penalty;
 };
 
+
+/* ---- geometry internals (contour.c, smooth.c, resample.c, affine.c) ---- */
+double amscr__signed_area(const double *xy, size_t n);
+void amscr__reverse_points(double *xy, size_t n);
+/* Copies xy dropping repeated consecutive points (and, closed, a repeated closing point);
+ * returns the count. out: room for 2n doubles. */
+size_t amscr__dedupe_points(const double *xy, size_t n, int closed, double *out);
+amscr_status amscr__validate_points(const double *xy, size_t n, int closed, const char *what);
+size_t amscr__kernel_radius(double sigma);
+void amscr__kernel_fill(double sigma, size_t r, double *taps);
+void amscr__smooth_with_kernel(const double *xy, size_t n, int closed, const double *g, size_t r, double *wrapped,
+                               double *out);
+amscr_status amscr__smooth(const double *xy, size_t n, int closed, double sigma, double *out);
+amscr_status amscr__resample_euclid(const double *xy, size_t n, int closed, size_t m, double *out);
+amscr_status amscr__affine_cum(const double *xy, size_t n, int closed, double sigma0, double *cum, double *out_total);
+int amscr__sym2_invsqrt(const double cov[3], double W[4], double Winv[4]);
+amscr_status amscr__parametrize(const double *P0, size_t M, int closed, amscr_parametrization kind, double sigma0_frac,
+                                unsigned passes, size_t m, double *out);
+amscr_status amscr__whiten(const double *xy, size_t n, double *out_xy, double fwd[6], double inv[6]);
+void amscr__affine_compose(const double a[6], const double b[6], double out[6]);
+void amscr__params_defaults(amscr_params *p);
+
+/* ---- least squares (lstsq.c) ---- */
+size_t amscr__lstsq_work_size(size_t m, size_t n, size_t nrhs);
+amscr_status amscr__lstsq_colmajor(double *A, size_t m, size_t n, double *B, size_t nrhs, double *work, int *iwork,
+                                   double *x, double *resid);
+
+
+/* ---- 1-D mixture, small hot-path fit (gmm1d.c): no allocation, caller scratch ---- */
+size_t amscr__gmm1d_small_scratch(size_t n, size_t k);
+amscr_status amscr__gmm1d_fit_small(const double *x, size_t n, size_t k, unsigned max_iter, double tol, double var_floor_rel,
+                           double *w, double *mu, double *var, double *scratch, unsigned *out_iter,
+                           int *out_converged, double *out_loglik);
+
+/* ---- prepared shapes (descriptor.c) ---- */
+struct amscr_descriptor {
+    amscr_params params; /* as built */
+    size_t n;            /* N samples */
+    size_t p;            /* scales */
+    double *input;       /* 2N: samples in input coordinates */
+    double *base;        /* 2N: normalized, unsmoothed */
+    double *scaled;      /* p * 2N: normalized, smoothed at each scale */
+    double fwd[6], inv[6];
+    /* derived from the above (recomputed on load) */
+    double *mom;   /* (p+1) * 6: per level (0 = base, k+1 = scale k) sums sxx, sxy, syy, sx, sy, n */
+    double *minv;  /* (p+1) * 9: inverse of each level's 3x3 normal matrix */
+    double *spec;  /* 4N: DFT of base x then base y (complex interleaved), closed curves only */
+    double *gain;  /* (p+1) * N: |G_k(w)|^2 per scale (index k), and their sum (index p) */
+    double norm2;  /* sum |base|^2 */
+    size_t finest; /* index of the smallest scale */
+};
+
+/* Builds the derived arrays of a descriptor whose params, n, p, input, base, scaled, fwd,
+ * inv are set (used by amscr_descriptor_new and by db load). */
+amscr_status amscr__descriptor_finish(amscr_descriptor *d);
+/* Allocates an empty descriptor for n samples and p scales (arrays uninitialized). */
+amscr_status amscr__descriptor_alloc(size_t n, size_t p, amscr_descriptor **out);
+/* Non-zero when two params describe compatible prepared shapes (N, scales, closed,
+ * parametrization, invariance); fills a detail otherwise. */
+int amscr__params_compatible(const amscr_params *a, const amscr_params *b, const char *what);
+
+/* ---- matching (register.c) ---- */
+/* The distance with a caller workspace (batch path; symmetric honoured). p must be
+ * compatible with both descriptors (not checked here). */
+amscr_status amscr__distance_ws(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                                amscr_workspace *ws, double *out);
+
 /* ---- numerical internals ---------------------------------------------- */
 /* Exact 1-D K-means by dynamic programming on sorted data.
  * sorted: n ascending values; sse_out[k-1] = optimal SSE with k clusters for k = 1..kmax

@@ -1,3 +1,937 @@
-/* register.c — placeholder until implemented. */
+/* register.c — matching a prepared source onto a prepared target (DESIGN.md §3, §9).
+ *
+ * Start point: for closed curves the 2x2 cross-correlation R(s) = Σ_a h(a+s) f(a)^T over all N
+ * cyclic shifts comes from one FFT product (the reversed target is the conjugate spectrum);
+ * circular smoothing of both curves at σ_k multiplies its spectrum by |G_k|^2, so the stacked
+ * least-squares residual of every shift costs O(N log N) per pair (the search criterion). The
+ * best few shifts (local minima of that criterion) then get the whole method — per-scale
+ * solves, residuals on the unsmoothed curves, scale selection, stacked solve — and the lowest
+ * final distance wins. Per-scale solves use exact sums (the 3x3 normal matrices of the source
+ * are precomputed in the descriptor); amscr_register reports the final stacked solve from
+ * LAPACKE QR, amscr_distance (the batch path) from the closed form; tests check they agree.
+ */
+#include "fft.h"
 #include "internal.h"
-typedef int amscr__placeholder_register;
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define AMSCR__CANDIDATES 3
+#define AMSCR__KMAX 16
+
+struct amscr_workspace {
+    size_t n, p;
+    amscr__fft_plan plan;
+    double *z;       /* 4N: two complex arrays */
+    double *c0;      /* 4N: R_0(s) entries xx, xy, yx, yy for every s */
+    double *cs;      /* 4N: the criterion's filtered R(s) */
+    double *crit;    /* N */
+    double *P;       /* 8 (N/2+1): products H_i conj(F_j) for ij = xx, xy, yx, yy (complex) */
+    double *q;       /* 4 (N/2+1): their real parts at the current fractional shift */
+    double *curve;   /* 2N * (p+1): shifted target curves for the reported solve */
+    double *scratch; /* selection scratch */
+    size_t scratch_cap;
+    /* QR of the final stacked system */
+    double *qa, *qb, *qw;
+    int *qi;
+    size_t qcap;
+};
+
+typedef struct {
+    double X[6]; /* h ≈ A f + B in the normalized frames: {a11, a12, b1, a21, a22, b2} */
+    double dist;
+    size_t shift;
+    double fshift; /* continuous shift (closed curves) */
+    int reflected;
+    size_t p;
+    double resid[AMSCR__MAX_SCALES];
+    int kept[AMSCR__MAX_SCALES];
+    size_t nkept;
+    size_t k;
+    double sse[AMSCR__KMAX];
+    size_t nsse;
+    double w[AMSCR__KMAX], mu[AMSCR__KMAX], var[AMSCR__KMAX];
+    size_t ncomp;
+    double threshold;
+} match_t;
+
+struct amscr_result {
+    amscr_method method;
+    match_t m;
+    double affine_in[6];
+    double affine_norm[6];
+};
+
+/* ------------------------------------------------------------------ workspace */
+
+amscr_status amscr_workspace_new(amscr_workspace **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(out);
+    amscr_workspace *ws = calloc(1, sizeof *ws);
+    if (!ws)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_workspace_new: out of memory");
+    *out = ws;
+    return AMSCR_OK;
+}
+
+static void ws_release(amscr_workspace *ws)
+{
+    amscr__fft_plan_free(&ws->plan);
+    free(ws->z);
+    free(ws->scratch);
+    free(ws->qa);
+    free(ws->qi);
+    ws->z = ws->scratch = ws->qa = NULL;
+    ws->qi = NULL;
+    ws->n = ws->p = ws->qcap = ws->scratch_cap = 0;
+}
+
+void amscr_workspace_free(amscr_workspace *ws)
+{
+    if (!ws)
+        return;
+    ws_release(ws);
+    free(ws);
+}
+
+static amscr_status ws_reserve(amscr_workspace *ws, size_t n, size_t p)
+{
+    if (ws->n == n && ws->p >= p && ws->z)
+        return AMSCR_OK;
+    ws_release(ws);
+    size_t half = n / 2 + 1;
+    ws->z = amscr__malloc_array(17 * n + 12 * half + 2 * n * (p + 1) + 2 * n, sizeof(double));
+    size_t kmax = p < AMSCR__KMAX ? p : AMSCR__KMAX;
+    size_t s1 = amscr__kmeans1d_scratch(p, kmax), s2 = amscr__gmm1d_small_scratch(p, kmax);
+    ws->scratch_cap = (s1 > s2 ? s1 : s2) + 4 * p + 64;
+    ws->scratch = amscr__malloc_array(ws->scratch_cap, sizeof(double));
+    if (!ws->z || !ws->scratch || amscr__fft_plan_init(&ws->plan, n) != 0) {
+        ws_release(ws);
+        return amscr__fail(AMSCR_E_NOMEM, "workspace: out of memory");
+    }
+    ws->c0 = ws->z + 4 * n;
+    ws->cs = ws->z + 8 * n;
+    ws->crit = ws->z + 12 * n;
+    ws->P = ws->z + 17 * n;
+    ws->q = ws->P + 8 * half;
+    ws->curve = ws->q + 4 * half;
+    ws->n = n;
+    ws->p = p;
+    return AMSCR_OK;
+}
+
+static amscr_status ws_reserve_qr(amscr_workspace *ws, size_t rows)
+{
+    if (ws->qcap >= rows)
+        return AMSCR_OK;
+    free(ws->qa);
+    free(ws->qi);
+    size_t wsz = amscr__lstsq_work_size(rows, 3, 2);
+    ws->qa = amscr__malloc_array(5 * rows + wsz + 16, sizeof(double));
+    ws->qi = amscr__malloc_array(8, sizeof(int));
+    if (!ws->qa || !ws->qi) {
+        free(ws->qa);
+        free(ws->qi);
+        ws->qa = NULL;
+        ws->qi = NULL;
+        ws->qcap = 0;
+        return amscr__fail(AMSCR_E_NOMEM, "workspace: out of memory");
+    }
+    ws->qb = ws->qa + 3 * rows;
+    ws->qw = ws->qb + 2 * rows;
+    ws->qcap = rows;
+    return AMSCR_OK;
+}
+
+/* ------------------------------------------------------------ small algebra */
+
+/* Target index of source sample a under (shift s, orientation o): o = 0 -> (a+s) mod n;
+ * o = 1 (reversed target, closed) -> -(a+s) mod n; open: o = 1 -> n-1-a. */
+static inline size_t tgt_index(size_t a, size_t s, int o, int closed, size_t n)
+{
+    if (!closed)
+        return o ? n - 1 - a : a;
+    size_t b = a + s;
+    if (b >= n)
+        b -= n;
+    return o ? (b == 0 ? 0 : n - b) : b;
+}
+
+/* Cross sums of one level: R = Σ h [f, 1]^T (2x3 row-major). */
+static void cross_sums(const double *f, const double *h, size_t n, size_t s, int o, int closed, double R[6])
+{
+    double r0 = 0, r1 = 0, r2 = 0, r3 = 0, r4 = 0, r5 = 0;
+    for (size_t a = 0; a < n; a++) {
+        size_t b = tgt_index(a, s, o, closed, n);
+        double fx = f[2 * a], fy = f[2 * a + 1], hx = h[2 * b], hy = h[2 * b + 1];
+        r0 += hx * fx;
+        r1 += hx * fy;
+        r2 += hx;
+        r3 += hy * fx;
+        r4 += hy * fy;
+        r5 += hy;
+    }
+    R[0] = r0;
+    R[1] = r1;
+    R[2] = r2;
+    R[3] = r3;
+    R[4] = r4;
+    R[5] = r5;
+}
+
+/* X = R M^-1 with Minv 3x3 (row-major, symmetric). */
+static void solve_x(const double R[6], const double Minv[9], double X[6])
+{
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 3; j++)
+            X[3 * i + j] = R[3 * i] * Minv[j] + R[3 * i + 1] * Minv[3 + j] + R[3 * i + 2] * Minv[6 + j];
+}
+
+/* Σ_a |X [f;1] - h|^2 = tr(X M X^T) - 2 tr(X R^T) + |h|^2 with M the 3x3 moments of f. */
+static double resid_sum(const double X[6], const double mom[6], const double R[6], double hn2)
+{
+    const double M[9] = {mom[0], mom[1], mom[3], mom[1], mom[2], mom[4], mom[3], mom[4], mom[5]};
+    double q = 0, c = 0;
+    for (int i = 0; i < 2; i++) {
+        for (int j = 0; j < 3; j++) {
+            double mx = M[3 * j] * X[3 * i] + M[3 * j + 1] * X[3 * i + 1] + M[3 * j + 2] * X[3 * i + 2];
+            q += X[3 * i + j] * mx;
+            c += X[3 * i + j] * R[3 * i + j];
+        }
+    }
+    double v = q - 2.0 * c + hn2;
+    return v > 0.0 ? v : 0.0;
+}
+
+static int inv3_general(const double m[9], double out[9])
+{
+    double a = m[0], b = m[1], c = m[2], d = m[3], e = m[4], f = m[5], g = m[6], h = m[7], i = m[8];
+    double A = e * i - f * h, B = -(d * i - f * g), C = d * h - e * g;
+    double det = a * A + b * B + c * C;
+    double scale = fabs(a) + fabs(e) + fabs(i);
+    if (!(fabs(det) > 1e-13 * scale * scale * scale))
+        return 0;
+    out[0] = A / det;
+    out[3] = B / det;
+    out[6] = C / det;
+    out[1] = -(b * i - c * h) / det;
+    out[4] = (a * i - c * g) / det;
+    out[7] = -(a * h - b * g) / det;
+    out[2] = (b * f - c * e) / det;
+    out[5] = -(a * f - c * d) / det;
+    out[8] = (a * e - b * d) / det;
+    return 1;
+}
+
+/* ------------------------------------------------------------ scale selection */
+
+static void select_scales(const amscr_params *prm, amscr_method method, size_t finest, match_t *m, double *scratch)
+{
+    size_t p = m->p;
+    m->k = 0;
+    m->nsse = 0;
+    m->ncomp = 0;
+    m->threshold = INFINITY;
+    for (size_t k = 0; k < p; k++)
+        m->kept[k] = 0;
+    if (method == AMSCR_METHOD_ACMA) {
+        m->kept[finest] = 1;
+        m->nkept = 1;
+        return;
+    }
+    if (method == AMSCR_METHOD_AMSCR || p < 2) {
+        for (size_t k = 0; k < p; k++)
+            m->kept[k] = 1;
+        m->nkept = p;
+        return;
+    }
+    size_t kmax = prm->kmax < p ? prm->kmax : p;
+    if (kmax > AMSCR__KMAX)
+        kmax = AMSCR__KMAX;
+    size_t K;
+    if (method == AMSCR_METHOD_BINARY_EM) {
+        K = 2;
+    } else {
+        double *sorted = scratch;
+        double *dp = scratch + p;
+        for (size_t k = 0; k < p; k++)
+            sorted[k] = m->resid[k];
+        for (size_t i = 1; i < p; i++) { /* insertion sort: p is small */
+            double v = sorted[i];
+            size_t j = i;
+            while (j > 0 && sorted[j - 1] > v) {
+                sorted[j] = sorted[j - 1];
+                j--;
+            }
+            sorted[j] = v;
+        }
+        amscr__kmeans1d_dp(sorted, p, kmax, dp, m->sse, NULL);
+        m->nsse = kmax;
+        K = amscr__elbow_choose(m->sse, kmax, 1);
+    }
+    m->k = K;
+    if (K <= 1) {
+        for (size_t k = 0; k < p; k++)
+            m->kept[k] = 1;
+        m->nkept = p;
+        return;
+    }
+    unsigned it;
+    int conv;
+    double ll;
+    amscr__gmm1d_fit_small(m->resid, p, K, 200, 1e-10, 1e-6, m->w, m->mu, m->var, scratch, &it, &conv, &ll);
+    m->ncomp = K;
+    double s0;
+    amscr_status st = amscr_bayes_threshold(m->w[0], m->mu[0], m->var[0], m->w[1], m->mu[1], m->var[1], &s0);
+    if (st != AMSCR_OK && st != AMSCR_E_NOT_FOUND)
+        s0 = 0.5 * (m->mu[0] + m->mu[1]);
+    m->threshold = s0;
+    size_t best = 0;
+    m->nkept = 0;
+    for (size_t k = 0; k < p; k++) {
+        if (m->resid[k] < m->resid[best])
+            best = k;
+        if (m->resid[k] <= s0) {
+            m->kept[k] = 1;
+            m->nkept++;
+        }
+    }
+    if (m->nkept == 0) {
+        m->kept[best] = 1;
+        m->nkept = 1;
+    }
+}
+
+/* ---------------------------------------------------- spectral cross sums
+ * For closed curves every cross sum R_k(s) = Σ_a h_k(a+s) [f_k(a), 1]^T is a trigonometric
+ * polynomial in the shift s: R_k,ij(s) = (1/N) Σ_w |G_k(w)|^2 H_i(w) conj(F_j(w)) e^{2πiws/N}.
+ * Evaluated at integer s it equals the direct sum; between samples it is the band-limited
+ * interpolation, which makes the start point continuous instead of quantized to 1/N. */
+
+/* P_ij(w) = H_i(w) conj(F_j(w)) for w = 0..N/2 (reversed target: conj(H)). */
+static void spectral_prepare(const amscr_descriptor *f, const amscr_descriptor *h, int o, amscr_workspace *ws)
+{
+    size_t n = f->n, half = n / 2 + 1;
+    const double *Fx = f->spec, *Fy = f->spec + 2 * n, *Hx = h->spec, *Hy = h->spec + 2 * n;
+    double sg = o ? -1.0 : 1.0;
+    for (size_t w = 0; w < half; w++) {
+        double fxr = Fx[2 * w], fxi = -Fx[2 * w + 1], fyr = Fy[2 * w], fyi = -Fy[2 * w + 1];
+        double hr[2] = {Hx[2 * w], Hy[2 * w]}, hi[2] = {sg * Hx[2 * w + 1], sg * Hy[2 * w + 1]};
+        double *P = ws->P + 8 * w;
+        for (int i = 0; i < 2; i++) {
+            P[4 * i + 0] = hr[i] * fxr - hi[i] * fxi;
+            P[4 * i + 1] = hr[i] * fxi + hi[i] * fxr;
+            P[4 * i + 2] = hr[i] * fyr - hi[i] * fyi;
+            P[4 * i + 3] = hr[i] * fyi + hi[i] * fyr;
+        }
+    }
+}
+
+/* q_ij(w) = c_w Re(P_ij(w) e^{2πiws/N}) / N, c = 1 at w = 0 and N/2 (even N), else 2. */
+static void spectral_q(amscr_workspace *ws, size_t n, double s)
+{
+    size_t half = n / 2 + 1;
+    double th = 2.0 * 3.14159265358979323846 * s / (double)n;
+    double cs = cos(th), sn = sin(th), er = 1.0, ei = 0.0, inv_n = 1.0 / (double)n;
+    for (size_t w = 0; w < half; w++) {
+        if ((w & 31) == 0 && w > 0) { /* re-anchor the rotation recurrence */
+            er = cos(th * (double)w);
+            ei = sin(th * (double)w);
+        }
+        double c = (w == 0 || (2 * w == n)) ? inv_n : 2.0 * inv_n;
+        const double *P = ws->P + 8 * w;
+        double *q = ws->q + 4 * w;
+        for (int j = 0; j < 4; j++)
+            q[j] = c * (P[2 * j] * er - P[2 * j + 1] * ei);
+        double t = er * cs - ei * sn;
+        ei = er * sn + ei * cs;
+        er = t;
+    }
+}
+
+/* R (2x3) of one level from ws->q; gain NULL = unsmoothed. dc: Σ h_x, Σ h_y. */
+static void spectral_level(const amscr_workspace *ws, size_t n, const double *gain, const double dc[2], double R[6])
+{
+    size_t half = n / 2 + 1;
+    double r0 = 0, r1 = 0, r3 = 0, r4 = 0;
+    for (size_t w = 0; w < half; w++) {
+        const double *q = ws->q + 4 * w;
+        double g = gain ? gain[w] : 1.0;
+        r0 += g * q[0];
+        r1 += g * q[1];
+        r3 += g * q[2];
+        r4 += g * q[3];
+    }
+    R[0] = r0;
+    R[1] = r1;
+    R[2] = dc[0];
+    R[3] = r3;
+    R[4] = r4;
+    R[5] = dc[1];
+}
+
+/* Stacked-all-scales (or finest-scale) residual criterion at a continuous shift. */
+static double crit_at(const amscr_descriptor *f, const amscr_descriptor *h, int use_finest, amscr_workspace *ws,
+                      double s)
+{
+    size_t n = f->n;
+    double dc[2] = {h->spec[0], h->spec[2 * n]};
+    double R0[6], Rs[6], Ms[6] = {0, 0, 0, 0, 0, 0}, Minv[9], X[6];
+    spectral_q(ws, n, s);
+    spectral_level(ws, n, NULL, dc, R0);
+    const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
+    spectral_level(ws, n, gain, dc, Rs);
+    if (use_finest) {
+        memcpy(Minv, f->minv + 9 * (f->finest + 1), sizeof Minv);
+    } else {
+        for (size_t k = 0; k < f->p; k++)
+            for (int j = 0; j < 6; j++)
+                Ms[j] += f->mom[6 * (k + 1) + j];
+        /* Σ of the levels' moments: Rs must then be Σ_k R_k, which gain[p] = Σ_k gain_k gives
+         * for the first two columns; the third column (Σ h) adds up p times */
+        Rs[2] *= (double)f->p;
+        Rs[5] *= (double)f->p;
+        const double M9[9] = {Ms[0], Ms[1], Ms[3], Ms[1], Ms[2], Ms[4], Ms[3], Ms[4], Ms[5]};
+        if (!inv3_general(M9, Minv))
+            return INFINITY;
+    }
+    solve_x(Rs, Minv, X);
+    return resid_sum(X, f->mom, R0, h->norm2);
+}
+
+/* Refinement of the shift within [s-1, s+1]: golden section to ~0.02 samples, then
+ * finite-difference Newton steps (the criterion is a smooth trigonometric polynomial). */
+static double refine_shift(const amscr_descriptor *f, const amscr_descriptor *h, int use_finest, amscr_workspace *ws,
+                           double s)
+{
+    const double g = 0.6180339887498949;
+    double a = s - 1.0, b = s + 1.0;
+    double x1 = b - g * (b - a), x2 = a + g * (b - a);
+    double f1 = crit_at(f, h, use_finest, ws, x1), f2 = crit_at(f, h, use_finest, ws, x2);
+    for (int it = 0; it < 9; it++) {
+        if (f1 <= f2) {
+            b = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = b - g * (b - a);
+            f1 = crit_at(f, h, use_finest, ws, x1);
+        } else {
+            a = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = a + g * (b - a);
+            f2 = crit_at(f, h, use_finest, ws, x2);
+        }
+    }
+    double x = f1 <= f2 ? x1 : x2, fx = f1 <= f2 ? f1 : f2;
+    double delta = 2e-3;
+    for (int it = 0; it < 3; it++) {
+        double fm = crit_at(f, h, use_finest, ws, x - delta), fp = crit_at(f, h, use_finest, ws, x + delta);
+        double curv = fp - 2.0 * fx + fm;
+        if (!(curv > 0.0))
+            break;
+        double step = -0.5 * delta * (fp - fm) / curv;
+        if (fabs(step) > 0.05)
+            step = step > 0 ? 0.05 : -0.05;
+        double xn = x + step, fn = crit_at(f, h, use_finest, ws, xn);
+        if (!(fn < fx))
+            break;
+        x = xn;
+        fx = fn;
+        delta *= 0.1;
+    }
+    double fs = crit_at(f, h, use_finest, ws, s);
+    return fx < fs ? x : s;
+}
+
+/* The whole method at one (shift, orientation): fills m (normalized-frame solution by the
+ * closed form). Closed curves: continuous shift s through the spectra in ws->P (prepared
+ * for orientation o). Open curves: s is ignored (orientation only). */
+static void run_method(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h, double s,
+                       int o, amscr_workspace *ws, match_t *m)
+{
+    size_t n = f->n, p = f->p;
+    int closed = f->params.closed;
+    double R[AMSCR__MAX_SCALES + 1][6];
+    if (closed) {
+        double dc[2] = {h->spec[0], h->spec[2 * n]};
+        spectral_q(ws, n, s);
+        spectral_level(ws, n, NULL, dc, R[0]);
+        for (size_t k = 0; k < p; k++)
+            spectral_level(ws, n, f->gain + k * n, dc, R[k + 1]);
+        double r = fmod(s, (double)n);
+        if (r < 0)
+            r += (double)n;
+        m->fshift = r;
+        size_t si = (size_t)floor(r + 0.5);
+        m->shift = si >= n ? si - n : si;
+    } else {
+        cross_sums(f->base, h->base, n, 0, o, 0, R[0]);
+        for (size_t k = 0; k < p; k++)
+            cross_sums(f->scaled + 2 * n * k, h->scaled + 2 * n * k, n, 0, o, 0, R[k + 1]);
+        m->fshift = 0.0;
+        m->shift = 0;
+    }
+    m->p = p;
+    m->reflected = o;
+    for (size_t k = 0; k < p; k++) {
+        double X[6];
+        solve_x(R[k + 1], f->minv + 9 * (k + 1), X);
+        m->resid[k] = resid_sum(X, f->mom, R[0], h->norm2) / (double)n;
+    }
+    select_scales(prm, prm->method, f->finest, m, ws->scratch);
+    double Ms[6] = {0, 0, 0, 0, 0, 0}, Rs[6] = {0, 0, 0, 0, 0, 0}, Minv[9];
+    for (size_t k = 0; k < p; k++) {
+        if (!m->kept[k])
+            continue;
+        for (int j = 0; j < 6; j++) {
+            Ms[j] += f->mom[6 * (k + 1) + j];
+            Rs[j] += R[k + 1][j];
+        }
+    }
+    const double M9[9] = {Ms[0], Ms[1], Ms[3], Ms[1], Ms[2], Ms[4], Ms[3], Ms[4], Ms[5]};
+    if (!inv3_general(M9, Minv)) {
+        /* cannot happen for validated descriptors (each level is invertible); be safe */
+        memcpy(Minv, f->minv + 9 * (f->finest + 1), sizeof Minv);
+        memcpy(Rs, R[f->finest + 1], sizeof Rs);
+    }
+    solve_x(Rs, Minv, m->X);
+    m->dist = resid_sum(m->X, f->mom, R[0], h->norm2) / (double)n;
+}
+
+/* Criterion of every integer cyclic shift for one orientation (closed curves), by FFT;
+ * also leaves the spectral products of this orientation in ws->P. */
+static void shift_criterion(const amscr_descriptor *f, const amscr_descriptor *h, int o, int use_finest,
+                            amscr_workspace *ws)
+{
+    size_t n = f->n;
+    spectral_prepare(f, h, o, ws);
+    const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
+    double *z1 = ws->z, *z2 = ws->z + 2 * n;
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t w = 0; w < n; w++) {
+            size_t wf = w <= n / 2 ? w : n - w;
+            double cj = w <= n / 2 ? 1.0 : -1.0; /* Hermitian completion */
+            const double *P = ws->P + 8 * wf;
+            double g = pass ? gain[w] : 1.0;
+            /* z = (P_ix + i P_iy) g */
+            z1[2 * w] = g * (P[0] - cj * P[3]);
+            z1[2 * w + 1] = g * (cj * P[1] + P[2]);
+            z2[2 * w] = g * (P[4] - cj * P[7]);
+            z2[2 * w + 1] = g * (cj * P[5] + P[6]);
+        }
+        amscr__fft(&ws->plan, z1, 1);
+        amscr__fft(&ws->plan, z2, 1);
+        double *dst = pass ? ws->cs : ws->c0;
+        double inv_n = 1.0 / (double)n;
+        for (size_t s = 0; s < n; s++) {
+            dst[4 * s] = z1[2 * s] * inv_n;
+            dst[4 * s + 1] = z1[2 * s + 1] * inv_n;
+            dst[4 * s + 2] = z2[2 * s] * inv_n;
+            dst[4 * s + 3] = z2[2 * s + 1] * inv_n;
+        }
+    }
+    double Sxx = 0, Sxy = 0, Syy = 0;
+    size_t p = f->p;
+    if (use_finest) {
+        const double *mo = f->mom + 6 * (f->finest + 1);
+        Sxx = mo[0];
+        Sxy = mo[1];
+        Syy = mo[2];
+    } else {
+        for (size_t k = 0; k < p; k++) {
+            const double *mo = f->mom + 6 * (k + 1);
+            Sxx += mo[0];
+            Sxy += mo[1];
+            Syy += mo[2];
+        }
+    }
+    double det = Sxx * Syy - Sxy * Sxy;
+    double i00 = Syy / det, i01 = -Sxy / det, i11 = Sxx / det;
+    const double *m0 = f->mom;
+    for (size_t s = 0; s < n; s++) {
+        const double *C = ws->cs + 4 * s, *C0 = ws->c0 + 4 * s;
+        double A[4] = {C[0] * i00 + C[1] * i01, C[0] * i01 + C[1] * i11, C[2] * i00 + C[3] * i01,
+                       C[2] * i01 + C[3] * i11};
+        double q = 0, c = 0;
+        for (int i = 0; i < 2; i++) {
+            double ax = A[2 * i], ay = A[2 * i + 1];
+            q += ax * (m0[0] * ax + m0[1] * ay) + ay * (m0[1] * ax + m0[2] * ay);
+            c += ax * C0[2 * i] + ay * C0[2 * i + 1];
+        }
+        ws->crit[s] = q - 2.0 * c;
+    }
+}
+
+static int better(const match_t *a, const match_t *b)
+{
+    if (a->dist != b->dist)
+        return a->dist < b->dist;
+    if (a->reflected != b->reflected)
+        return a->reflected < b->reflected;
+    return a->shift < b->shift;
+}
+
+/* One direction f -> h: the best match over orientations and candidate shifts. */
+static amscr_status match_one(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                              amscr_workspace *ws, match_t *best)
+{
+    size_t n = f->n;
+    amscr_status st = ws_reserve(ws, n, f->p);
+    if (st != AMSCR_OK)
+        return st;
+    int norient = prm->reflections ? 2 : 1;
+    int have = 0;
+    match_t cur;
+    for (int o = 0; o < norient; o++) {
+        if (!f->params.closed) {
+            run_method(prm, f, h, 0.0, o, ws, &cur);
+            if (!have || better(&cur, best)) {
+                *best = cur;
+                have = 1;
+            }
+            continue;
+        }
+        int use_finest = prm->method == AMSCR_METHOD_ACMA;
+        shift_criterion(f, h, o, use_finest, ws);
+        /* candidates: the lowest local minima of the criterion (circular) */
+        size_t cand[AMSCR__CANDIDATES];
+        size_t nc = 0;
+        for (size_t s = 0; s < n; s++) {
+            double v = ws->crit[s];
+            double l = ws->crit[(s + n - 1) % n], r = ws->crit[(s + 1) % n];
+            if (!(v <= l && v <= r))
+                continue;
+            size_t pos = nc;
+            while (pos > 0 && ws->crit[cand[pos - 1]] > v)
+                pos--;
+            if (pos >= AMSCR__CANDIDATES)
+                continue;
+            size_t last = nc < AMSCR__CANDIDATES ? nc : AMSCR__CANDIDATES - 1;
+            for (size_t j = last; j > pos; j--)
+                cand[j] = cand[j - 1];
+            cand[pos] = s;
+            if (nc < AMSCR__CANDIDATES)
+                nc++;
+        }
+        if (nc == 0) { /* flat criterion: take shift 0 */
+            cand[0] = 0;
+            nc = 1;
+        }
+        for (size_t c = 0; c < nc; c++) {
+            double sc = refine_shift(f, h, use_finest, ws, (double)cand[c]);
+            run_method(prm, f, h, sc, o, ws, &cur);
+            if (!have || better(&cur, best)) {
+                *best = cur;
+                have = 1;
+            }
+        }
+    }
+    if (!isfinite(best->dist))
+        return amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
+    return AMSCR_OK;
+}
+
+static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor *src, const amscr_descriptor *tgt)
+{
+    if (!*prm)
+        *prm = &src->params;
+    if (!amscr__params_compatible(&src->params, &tgt->params, "registration (source vs target)"))
+        return AMSCR_E_INVALID_ARG;
+    if (!amscr__params_compatible(*prm, &src->params, "registration (params vs descriptors)"))
+        return AMSCR_E_INVALID_ARG;
+    return AMSCR_OK;
+}
+
+/* Distance (and match) honouring `symmetric`. */
+static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                               amscr_workspace *ws, match_t *m)
+{
+    amscr_status st = match_one(prm, src, tgt, ws, m);
+    if (st == AMSCR_OK && prm->symmetric) {
+        match_t back;
+        st = match_one(prm, tgt, src, ws, &back);
+        if (st == AMSCR_OK)
+            m->dist = 0.5 * (m->dist + back.dist);
+    }
+    return st;
+}
+
+amscr_status amscr__distance_ws(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                                amscr_workspace *ws, double *out)
+{
+    match_t m;
+    amscr_status st = match_pair(prm, src, tgt, ws, &m);
+    if (st == AMSCR_OK)
+        *out = m.dist;
+    return st;
+}
+
+amscr_status amscr_distance(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                            amscr_workspace *ws, double *out_distance)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(src);
+    AMSCR_CHECK_NULL(tgt);
+    AMSCR_CHECK_NULL(out_distance);
+    amscr_status st = check_pair(&p, src, tgt);
+    if (st != AMSCR_OK)
+        return st;
+    amscr_workspace local = {0};
+    amscr_workspace *w = ws ? ws : &local;
+    st = amscr__distance_ws(p, src, tgt, w, out_distance);
+    if (!ws)
+        ws_release(&local);
+    return st;
+}
+
+/* Target curve of one level shifted by a continuous s (closed curves): the band-limited
+ * interpolation y(a) = h_o(a + s), smoothed by G_k when gain is given. out: 2N. */
+static void shifted_target(const amscr_descriptor *h, int o, double s, const double *gain, amscr_workspace *ws,
+                           double *out)
+{
+    size_t n = h->n;
+    const double *Hx = h->spec, *Hy = h->spec + 2 * n;
+    double *z = ws->z;
+    double sg = o ? -1.0 : 1.0;
+    for (size_t w = 0; w < n; w++) {
+        size_t wf = w <= n / 2 ? w : n - w;
+        double cj = w <= n / 2 ? 1.0 : -1.0;
+        double g = gain ? sqrt(gain[wf]) : 1.0;
+        double xr = Hx[2 * wf], xi = cj * sg * Hx[2 * wf + 1], yr = Hy[2 * wf], yi = cj * sg * Hy[2 * wf + 1];
+        double er, ei;
+        if (2 * w == n) {
+            er = cos(3.14159265358979323846 * s);
+            ei = 0.0;
+            xi = yi = 0.0;
+        } else {
+            double wsym = w <= n / 2 ? (double)w : (double)w - (double)n;
+            double th = 2.0 * 3.14159265358979323846 * wsym * s / (double)n;
+            er = cos(th);
+            ei = sin(th);
+        }
+        double axr = g * (xr * er - xi * ei), axi = g * (xr * ei + xi * er);
+        double ayr = g * (yr * er - yi * ei), ayi = g * (yr * ei + yi * er);
+        /* pack x + i y */
+        z[2 * w] = axr - ayi;
+        z[2 * w + 1] = axi + ayr;
+    }
+    amscr__fft(&ws->plan, z, 1);
+    double inv_n = 1.0 / (double)n;
+    for (size_t a = 0; a < n; a++) {
+        out[2 * a] = z[2 * a] * inv_n;
+        out[2 * a + 1] = z[2 * a + 1] * inv_n;
+    }
+}
+
+/* The reported solve: the stacked system of the kept scales by LAPACKE QR, and the distance
+ * summed directly on the unsmoothed curves (closed curves: at the continuous shift). */
+static amscr_status final_qr(const amscr_descriptor *f, const amscr_descriptor *h, amscr_workspace *ws, match_t *m)
+{
+    size_t n = f->n, rows = n * m->nkept;
+    int closed = f->params.closed;
+    amscr_status st = ws_reserve_qr(ws, rows);
+    if (st != AMSCR_OK)
+        return st;
+    double *A = ws->qa, *B = ws->qb, *tc = ws->curve;
+    size_t r = 0;
+    for (size_t k = 0; k < f->p; k++) {
+        if (!m->kept[k])
+            continue;
+        const double *fk = f->scaled + 2 * n * k, *hk = h->scaled + 2 * n * k;
+        if (closed) {
+            shifted_target(h, m->reflected, m->fshift, f->gain + k * n, ws, tc);
+            hk = tc;
+        }
+        for (size_t a = 0; a < n; a++, r++) {
+            size_t b = closed ? a : tgt_index(a, 0, m->reflected, 0, n);
+            A[r] = fk[2 * a];
+            A[rows + r] = fk[2 * a + 1];
+            A[2 * rows + r] = 1.0;
+            B[r] = hk[2 * b];
+            B[rows + r] = hk[2 * b + 1];
+        }
+    }
+    double x[6];
+    st = amscr__lstsq_colmajor(A, rows, 3, B, 2, ws->qw, ws->qi, x, NULL);
+    if (st != AMSCR_OK)
+        return st;
+    /* x column-major 3 x 2: column 0 -> x' coefficients (a11, a12, b1) */
+    memcpy(m->X, x, sizeof m->X);
+    const double *hb = h->base;
+    if (closed) {
+        shifted_target(h, m->reflected, m->fshift, NULL, ws, tc);
+        hb = tc;
+    }
+    double sum = 0.0;
+    for (size_t a = 0; a < n; a++) {
+        size_t b = closed ? a : tgt_index(a, 0, m->reflected, 0, n);
+        double fx = f->base[2 * a], fy = f->base[2 * a + 1];
+        double dx = m->X[0] * fx + m->X[1] * fy + m->X[2] - hb[2 * b];
+        double dy = m->X[3] * fx + m->X[4] * fy + m->X[5] - hb[2 * b + 1];
+        sum += dx * dx + dy * dy;
+    }
+    m->dist = sum / (double)n;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                            amscr_workspace *ws, amscr_result **out_result)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(src);
+    AMSCR_CHECK_NULL(tgt);
+    AMSCR_CHECK_NULL(out_result);
+    amscr_status st = check_pair(&p, src, tgt);
+    if (st != AMSCR_OK)
+        return st;
+    amscr_workspace local = {0};
+    amscr_workspace *w = ws ? ws : &local;
+    amscr_result *r = calloc(1, sizeof *r);
+    if (!r)
+        st = amscr__fail(AMSCR_E_NOMEM, "amscr_register: out of memory");
+    if (st == AMSCR_OK)
+        st = match_one(p, src, tgt, w, &r->m);
+    if (st == AMSCR_OK)
+        st = final_qr(src, tgt, w, &r->m);
+    if (st == AMSCR_OK && p->symmetric) {
+        match_t back;
+        st = match_one(p, tgt, src, w, &back);
+        if (st == AMSCR_OK)
+            r->m.dist = 0.5 * (r->m.dist + back.dist);
+    }
+    if (!ws)
+        ws_release(&local);
+    if (st != AMSCR_OK) {
+        free(r);
+        return st;
+    }
+    r->method = p->method;
+    memcpy(r->affine_norm, r->m.X, sizeof r->affine_norm);
+    /* input coordinates: inv_h ∘ X ∘ fwd_f */
+    double t[6];
+    amscr__affine_compose(r->m.X, src->fwd, t);
+    amscr__affine_compose(tgt->inv, t, r->affine_in);
+    *out_result = r;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_register_contours(const amscr_params *p, const amscr_contour *src, const amscr_contour *tgt,
+                                     amscr_result **out_result)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(src);
+    AMSCR_CHECK_NULL(tgt);
+    AMSCR_CHECK_NULL(out_result);
+    amscr_descriptor *a = NULL, *b = NULL;
+    amscr_status st = amscr_descriptor_new(p, src, &a);
+    if (st == AMSCR_OK) {
+        st = amscr_descriptor_new(p, tgt, &b);
+        if (st != AMSCR_OK)
+            amscr__fail(st, "target: %s", amscr_last_error_detail());
+    } else {
+        amscr__fail(st, "source: %s", amscr_last_error_detail());
+    }
+    if (st == AMSCR_OK)
+        st = amscr_register(p, a, b, NULL, out_result);
+    amscr_descriptor_free(a);
+    amscr_descriptor_free(b);
+    return st;
+}
+
+/* ------------------------------------------------------------------ result */
+
+void amscr_result_free(amscr_result *r) { free(r); }
+
+double amscr_result_distance(const amscr_result *r) { return r ? r->m.dist : NAN; }
+
+amscr_status amscr_result_affine(const amscr_result *r, double out_m6[6])
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(out_m6);
+    memcpy(out_m6, r->affine_in, 6 * sizeof(double));
+    return AMSCR_OK;
+}
+
+amscr_status amscr_result_affine_normalized(const amscr_result *r, double out_m6[6])
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(out_m6);
+    memcpy(out_m6, r->affine_norm, 6 * sizeof(double));
+    return AMSCR_OK;
+}
+
+size_t amscr_result_shift(const amscr_result *r) { return r ? r->m.shift : 0; }
+int amscr_result_reflected(const amscr_result *r) { return r ? r->m.reflected : 0; }
+amscr_method amscr_result_method(const amscr_result *r) { return r ? r->method : AMSCR_METHOD_MULTICLASS_EM; }
+size_t amscr_result_num_scales(const amscr_result *r) { return r ? r->m.p : 0; }
+size_t amscr_result_num_kept(const amscr_result *r) { return r ? r->m.nkept : 0; }
+size_t amscr_result_k(const amscr_result *r) { return r ? r->m.k : 0; }
+double amscr_result_threshold(const amscr_result *r) { return r ? r->m.threshold : NAN; }
+
+static amscr_status copy_out(const double *src, size_t count, double *out, size_t *inout_n, const char *what)
+{
+    if (out) {
+        if (*inout_n < count)
+            return amscr__fail(AMSCR_E_INVALID_ARG, "%s: room for %zu values, %zu needed", what, *inout_n, count);
+        if (src)
+            memcpy(out, src, count * sizeof *out);
+    }
+    *inout_n = count;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_result_residuals(const amscr_result *r, double *out, size_t *inout_n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(inout_n);
+    return copy_out(r->m.resid, r->m.p, out, inout_n, "amscr_result_residuals");
+}
+
+amscr_status amscr_result_sse(const amscr_result *r, double *out, size_t *inout_n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(inout_n);
+    return copy_out(r->m.sse, r->m.nsse, out, inout_n, "amscr_result_sse");
+}
+
+amscr_status amscr_result_kept(const amscr_result *r, int *out, size_t *inout_n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(inout_n);
+    if (out) {
+        if (*inout_n < r->m.p)
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_result_kept: room for %zu values, %zu needed", *inout_n,
+                               r->m.p);
+        memcpy(out, r->m.kept, r->m.p * sizeof *out);
+    }
+    *inout_n = r->m.p;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_result_mixture(const amscr_result *r, double *out_weights, double *out_means,
+                                  double *out_variances, size_t *inout_n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(inout_n);
+    size_t k = r->m.ncomp;
+    if ((out_weights || out_means || out_variances) && *inout_n < k)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_result_mixture: room for %zu, %zu needed", *inout_n, k);
+    if (out_weights)
+        memcpy(out_weights, r->m.w, k * sizeof(double));
+    if (out_means)
+        memcpy(out_means, r->m.mu, k * sizeof(double));
+    if (out_variances)
+        memcpy(out_variances, r->m.var, k * sizeof(double));
+    *inout_n = k;
+    return AMSCR_OK;
+}
