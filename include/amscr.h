@@ -313,7 +313,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_resample_affine(const double *xy, s
 /**
  * @brief Whitening normalization: moves the centroid of the points to the origin and
  *        multiplies by Sigma^(-1/2) (Sigma the 2x2 covariance, 1/n), so the output has
- *        identity covariance.
+ *        identity covariance. n == 0 is AMSCR_E_INVALID_ARG, 1 or 2 points AMSCR_E_DEGENERATE.
  * @param[out] out_xy       2n doubles (may be NULL).
  * @param[out] out_forward  affine map input -> normalized (may be NULL).
  * @param[out] out_inverse  affine map normalized -> input (may be NULL).
@@ -516,13 +516,15 @@ AMSCR_API int amscr_params_get_closed(const amscr_params *p);
 /** Also try the reversed target (mirror matches); default 0. */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_reflections(amscr_params *p, int on);
 AMSCR_API int amscr_params_get_reflections(const amscr_params *p);
-/** Parametrization (default AMSCR_PARAM_AFFINE). */
+/** Parametrization (default AMSCR_PARAM_WHITENED: chosen by measurement, see the README;
+ *  AMSCR_PARAM_AFFINE is the paper's affine arc length). */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_parametrization(amscr_params *p, amscr_parametrization v);
 AMSCR_API amscr_parametrization amscr_params_get_parametrization(const amscr_params *p);
-/** Pre-smoothing sigma0 of the affine arc length, as a fraction of the curve length, 0..0.25. */
+/** Pre-smoothing sigma0 of the affine arc length, as a fraction of the curve length, 0..0.25
+ *  (default 0.005). */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_presmooth(amscr_params *p, double fraction);
 AMSCR_API double amscr_params_get_presmooth(const amscr_params *p);
-/** Affine arc-length passes, 1..10. */
+/** Affine arc-length passes, 1..10 (default 3). */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_arclength_passes(amscr_params *p, unsigned passes);
 AMSCR_API unsigned amscr_params_get_arclength_passes(const amscr_params *p);
 /** Dense resampling factor: the curve is first resampled to factor*N points, 1..64 (default 8). */

@@ -282,7 +282,7 @@ static void select_scales(const amscr_params *prm, amscr_method method, size_t f
     unsigned it;
     int conv;
     double ll;
-    amscr__gmm1d_fit_small(m->resid, p, K, 200, 1e-10, 1e-6, m->w, m->mu, m->var, scratch, &it, &conv, &ll);
+    amscr__gmm1d_fit_small(m->resid, p, K, 100, 1e-8, 1e-6, m->w, m->mu, m->var, scratch, &it, &conv, &ll);
     m->ncomp = K;
     double s0;
     amscr_status st = amscr_bayes_threshold(m->w[0], m->mu[0], m->var[0], m->w[1], m->mu[1], m->var[1], &s0);
@@ -337,7 +337,7 @@ static void spectral_q(amscr_workspace *ws, size_t n, double s)
     double th = 2.0 * 3.14159265358979323846 * s / (double)n;
     double cs = cos(th), sn = sin(th), er = 1.0, ei = 0.0, inv_n = 1.0 / (double)n;
     for (size_t w = 0; w < half; w++) {
-        if ((w & 31) == 0 && w > 0) { /* re-anchor the rotation recurrence */
+        if ((w & 255) == 0 && w > 0) { /* re-anchor the rotation recurrence (large N only) */
             er = cos(th * (double)w);
             ei = sin(th * (double)w);
         }
@@ -373,78 +373,158 @@ static void spectral_level(const amscr_workspace *ws, size_t n, const double *ga
     R[5] = dc[1];
 }
 
-/* Stacked-all-scales (or finest-scale) residual criterion at a continuous shift. */
-static double crit_at(const amscr_descriptor *f, const amscr_descriptor *h, int use_finest, amscr_workspace *ws,
-                      double s)
+/* The search criterion: minus the explained part of the stacked smoothed least-squares
+ * problem, -tr(C S^-1 C^T) with C = Σ_k R_k(s) (2x2) and S = Σ_k S_k over all scales (or the
+ * finest scale for acma). Minimizing it over s minimizes that least-squares residual. */
+static void crit_matrix(const amscr_descriptor *f, int use_finest, double Sinv[3])
 {
-    size_t n = f->n;
-    double dc[2] = {h->spec[0], h->spec[2 * n]};
-    double R0[6], Rs[6], Ms[6] = {0, 0, 0, 0, 0, 0}, Minv[9], X[6];
-    spectral_q(ws, n, s);
-    spectral_level(ws, n, NULL, dc, R0);
-    const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
-    spectral_level(ws, n, gain, dc, Rs);
+    double Sxx = 0, Sxy = 0, Syy = 0;
     if (use_finest) {
-        memcpy(Minv, f->minv + 9 * (f->finest + 1), sizeof Minv);
+        const double *mo = f->mom + 6 * (f->finest + 1);
+        Sxx = mo[0];
+        Sxy = mo[1];
+        Syy = mo[2];
     } else {
-        for (size_t k = 0; k < f->p; k++)
-            for (int j = 0; j < 6; j++)
-                Ms[j] += f->mom[6 * (k + 1) + j];
-        /* Σ of the levels' moments: Rs must then be Σ_k R_k, which gain[p] = Σ_k gain_k gives
-         * for the first two columns; the third column (Σ h) adds up p times */
-        Rs[2] *= (double)f->p;
-        Rs[5] *= (double)f->p;
-        const double M9[9] = {Ms[0], Ms[1], Ms[3], Ms[1], Ms[2], Ms[4], Ms[3], Ms[4], Ms[5]};
-        if (!inv3_general(M9, Minv))
-            return INFINITY;
-    }
-    solve_x(Rs, Minv, X);
-    return resid_sum(X, f->mom, R0, h->norm2);
-}
-
-/* Refinement of the shift within [s-1, s+1]: golden section to ~0.02 samples, then
- * finite-difference Newton steps (the criterion is a smooth trigonometric polynomial). */
-static double refine_shift(const amscr_descriptor *f, const amscr_descriptor *h, int use_finest, amscr_workspace *ws,
-                           double s)
-{
-    const double g = 0.6180339887498949;
-    double a = s - 1.0, b = s + 1.0;
-    double x1 = b - g * (b - a), x2 = a + g * (b - a);
-    double f1 = crit_at(f, h, use_finest, ws, x1), f2 = crit_at(f, h, use_finest, ws, x2);
-    for (int it = 0; it < 9; it++) {
-        if (f1 <= f2) {
-            b = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = b - g * (b - a);
-            f1 = crit_at(f, h, use_finest, ws, x1);
-        } else {
-            a = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = a + g * (b - a);
-            f2 = crit_at(f, h, use_finest, ws, x2);
+        for (size_t k = 0; k < f->p; k++) {
+            const double *mo = f->mom + 6 * (k + 1);
+            Sxx += mo[0];
+            Sxy += mo[1];
+            Syy += mo[2];
         }
     }
-    double x = f1 <= f2 ? x1 : x2, fx = f1 <= f2 ? f1 : f2;
-    double delta = 2e-3;
-    for (int it = 0; it < 3; it++) {
-        double fm = crit_at(f, h, use_finest, ws, x - delta), fp = crit_at(f, h, use_finest, ws, x + delta);
-        double curv = fp - 2.0 * fx + fm;
-        if (!(curv > 0.0))
-            break;
-        double step = -0.5 * delta * (fp - fm) / curv;
-        if (fabs(step) > 0.05)
-            step = step > 0 ? 0.05 : -0.05;
-        double xn = x + step, fn = crit_at(f, h, use_finest, ws, xn);
-        if (!(fn < fx))
-            break;
-        x = xn;
-        fx = fn;
-        delta *= 0.1;
+    double det = Sxx * Syy - Sxy * Sxy;
+    Sinv[0] = Syy / det;
+    Sinv[1] = -Sxy / det;
+    Sinv[2] = Sxx / det;
+}
+
+static inline double crit_value(const double C[4], const double Si[3])
+{
+    /* tr(C Si C^T) = Σ_i c_i^T Si c_i over the rows c_i of C */
+    double t = 0.0;
+    for (int i = 0; i < 2; i++) {
+        double x = C[2 * i], y = C[2 * i + 1];
+        t += x * (Si[0] * x + Si[1] * y) + y * (Si[1] * x + Si[2] * y);
     }
-    double fs = crit_at(f, h, use_finest, ws, s);
-    return fx < fs ? x : s;
+    return -t;
+}
+
+/* The criterion at a continuous shift s from the spectral products in ws->P (one fused pass). */
+static double crit_at(const amscr_descriptor *f, int use_finest, const double Si[3], amscr_workspace *ws, double s)
+{
+    size_t n = f->n, half = n / 2 + 1;
+    const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
+    double th = 2.0 * 3.14159265358979323846 * s / (double)n;
+    double cs = cos(th), sn = sin(th), er = 1.0, ei = 0.0;
+    double c0 = 0, c1 = 0, c2 = 0, c3 = 0;
+    for (size_t w = 0; w < half; w++) {
+        if ((w & 255) == 0 && w > 0) { /* re-anchor the rotation recurrence (large N only) */
+            er = cos(th * (double)w);
+            ei = sin(th * (double)w);
+        }
+        double g = (w == 0 || 2 * w == n) ? gain[w] : 2.0 * gain[w];
+        const double *P = ws->P + 8 * w;
+        c0 += g * (P[0] * er - P[1] * ei);
+        c1 += g * (P[2] * er - P[3] * ei);
+        c2 += g * (P[4] * er - P[5] * ei);
+        c3 += g * (P[6] * er - P[7] * ei);
+        double t = er * cs - ei * sn;
+        ei = er * sn + ei * cs;
+        er = t;
+    }
+    double inv_n = 1.0 / (double)n;
+    double C[4] = {c0 * inv_n, c1 * inv_n, c2 * inv_n, c3 * inv_n};
+    return crit_value(C, Si);
+}
+
+/* The criterion and its first two derivatives in s in one spectral pass:
+ * d/ds Re(P e^{iks}) = -k Im(P e^{iks}), d2/ds2 = -k^2 Re(P e^{iks}), k = 2πw/N. */
+static void crit_newton(const amscr_descriptor *f, int use_finest, const double Si[3], amscr_workspace *ws, double s,
+                        double *val, double *d1, double *d2)
+{
+    size_t n = f->n, half = n / 2 + 1;
+    const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
+    double base = 2.0 * 3.14159265358979323846 / (double)n, th = base * s;
+    double cs = cos(th), sn = sin(th), er = 1.0, ei = 0.0;
+    double C[4] = {0, 0, 0, 0}, D[4] = {0, 0, 0, 0}, E[4] = {0, 0, 0, 0};
+    for (size_t w = 0; w < half; w++) {
+        if ((w & 255) == 0 && w > 0) {
+            er = cos(th * (double)w);
+            ei = sin(th * (double)w);
+        }
+        double g = (w == 0 || 2 * w == n) ? gain[w] : 2.0 * gain[w];
+        double k = base * (double)w;
+        const double *P = ws->P + 8 * w;
+        for (int j = 0; j < 4; j++) {
+            double re = P[2 * j] * er - P[2 * j + 1] * ei, im = P[2 * j] * ei + P[2 * j + 1] * er;
+            C[j] += g * re;
+            D[j] -= g * k * im;
+            E[j] -= g * k * k * re;
+        }
+        double t = er * cs - ei * sn;
+        ei = er * sn + ei * cs;
+        er = t;
+    }
+    double inv_n = 1.0 / (double)n;
+    for (int j = 0; j < 4; j++) {
+        C[j] *= inv_n;
+        D[j] *= inv_n;
+        E[j] *= inv_n;
+    }
+    /* crit = -tr(C Si C^T); crit' = -2 tr(D Si C^T); crit'' = -2 [tr(E Si C^T) + tr(D Si D^T)] */
+    double t1 = 0, t2 = 0, t3 = 0;
+    for (int i = 0; i < 2; i++) {
+        double cx = C[2 * i], cy = C[2 * i + 1], dx = D[2 * i], dy = D[2 * i + 1], ex = E[2 * i], ey = E[2 * i + 1];
+        double scx = Si[0] * cx + Si[1] * cy, scy = Si[1] * cx + Si[2] * cy;
+        t1 += dx * scx + dy * scy;
+        t2 += ex * scx + ey * scy;
+        t3 += dx * (Si[0] * dx + Si[1] * dy) + dy * (Si[1] * dx + Si[2] * dy);
+    }
+    *val = crit_value(C, Si);
+    *d1 = -2.0 * t1;
+    *d2 = -2.0 * (t2 + t3);
+}
+
+/* Refinement of an integer shift s (a local minimum of the criterion) to a continuous one
+ * by Newton's method with exact derivatives (at most three passes, steps within ±0.5). */
+static double refine_shift(const amscr_descriptor *f, int use_finest, const double Si[3], amscr_workspace *ws,
+                           size_t s, double *out_crit)
+{
+    double x = (double)s, best_x = x, best_v = ws->crit[s];
+    for (int it = 0; it < 3; it++) {
+        double v, d1, d2;
+        crit_newton(f, use_finest, Si, ws, x, &v, &d1, &d2);
+        if (v < best_v || it == 0) {
+            if (it > 0 || v <= best_v) {
+                best_v = v;
+                best_x = x;
+            }
+        } else {
+            break; /* the last step went uphill: keep the best point */
+        }
+        if (!(d2 > 0.0))
+            break;
+        double step = -d1 / d2;
+        if (step > 0.5)
+            step = 0.5;
+        if (step < -0.5)
+            step = -0.5;
+        x += step;
+        if (fabs(step) < 1e-3) { /* converged to well below a sample: take the step as is */
+            best_v = v + 0.5 * d1 * step;
+            best_x = x;
+            break;
+        }
+        if (it == 2) { /* no pass left: accept the Newton prediction only if it is lower */
+            double pred = v + d1 * step + 0.5 * d2 * step * step;
+            if (pred < best_v) {
+                best_v = crit_at(f, use_finest, Si, ws, x);
+                best_x = x;
+            }
+        }
+    }
+    *out_crit = best_v;
+    return best_x;
 }
 
 /* The whole method at one (shift, orientation): fills m (normalized-frame solution by the
@@ -502,67 +582,33 @@ static void run_method(const amscr_params *prm, const amscr_descriptor *f, const
     m->dist = resid_sum(m->X, f->mom, R[0], h->norm2) / (double)n;
 }
 
-/* Criterion of every integer cyclic shift for one orientation (closed curves), by FFT;
- * also leaves the spectral products of this orientation in ws->P. */
+/* Criterion of every integer cyclic shift for one orientation (closed curves): one FFT
+ * product and two complex inverse FFTs (x and y rows packed as real + imaginary parts); also
+ * leaves the spectral products of this orientation in ws->P. */
 static void shift_criterion(const amscr_descriptor *f, const amscr_descriptor *h, int o, int use_finest,
-                            amscr_workspace *ws)
+                            const double Si[3], amscr_workspace *ws)
 {
     size_t n = f->n;
     spectral_prepare(f, h, o, ws);
     const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
     double *z1 = ws->z, *z2 = ws->z + 2 * n;
-    for (int pass = 0; pass < 2; pass++) {
-        for (size_t w = 0; w < n; w++) {
-            size_t wf = w <= n / 2 ? w : n - w;
-            double cj = w <= n / 2 ? 1.0 : -1.0; /* Hermitian completion */
-            const double *P = ws->P + 8 * wf;
-            double g = pass ? gain[w] : 1.0;
-            /* z = (P_ix + i P_iy) g */
-            z1[2 * w] = g * (P[0] - cj * P[3]);
-            z1[2 * w + 1] = g * (cj * P[1] + P[2]);
-            z2[2 * w] = g * (P[4] - cj * P[7]);
-            z2[2 * w + 1] = g * (cj * P[5] + P[6]);
-        }
-        amscr__fft(&ws->plan, z1, 1);
-        amscr__fft(&ws->plan, z2, 1);
-        double *dst = pass ? ws->cs : ws->c0;
-        double inv_n = 1.0 / (double)n;
-        for (size_t s = 0; s < n; s++) {
-            dst[4 * s] = z1[2 * s] * inv_n;
-            dst[4 * s + 1] = z1[2 * s + 1] * inv_n;
-            dst[4 * s + 2] = z2[2 * s] * inv_n;
-            dst[4 * s + 3] = z2[2 * s + 1] * inv_n;
-        }
+    for (size_t w = 0; w < n; w++) {
+        size_t wf = w <= n / 2 ? w : n - w;
+        double cj = w <= n / 2 ? 1.0 : -1.0; /* Hermitian completion */
+        const double *P = ws->P + 8 * wf;
+        double g = gain[w];
+        /* z = (P_ix + i P_iy) g */
+        z1[2 * w] = g * (P[0] - cj * P[3]);
+        z1[2 * w + 1] = g * (cj * P[1] + P[2]);
+        z2[2 * w] = g * (P[4] - cj * P[7]);
+        z2[2 * w + 1] = g * (cj * P[5] + P[6]);
     }
-    double Sxx = 0, Sxy = 0, Syy = 0;
-    size_t p = f->p;
-    if (use_finest) {
-        const double *mo = f->mom + 6 * (f->finest + 1);
-        Sxx = mo[0];
-        Sxy = mo[1];
-        Syy = mo[2];
-    } else {
-        for (size_t k = 0; k < p; k++) {
-            const double *mo = f->mom + 6 * (k + 1);
-            Sxx += mo[0];
-            Sxy += mo[1];
-            Syy += mo[2];
-        }
-    }
-    double det = Sxx * Syy - Sxy * Sxy;
-    double i00 = Syy / det, i01 = -Sxy / det, i11 = Sxx / det;
-    const double *m0 = f->mom;
+    amscr__fft(&ws->plan, z1, 1);
+    amscr__fft(&ws->plan, z2, 1);
+    double inv_n = 1.0 / (double)n;
     for (size_t s = 0; s < n; s++) {
-        const double *C = ws->cs + 4 * s, *C0 = ws->c0 + 4 * s;
-        double A[4] = {C[0] * i00 + C[1] * i01, C[0] * i01 + C[1] * i11, C[2] * i00 + C[3] * i01,
-                       C[2] * i01 + C[3] * i11};
-        double q = 0, c = 0;
-        for (int i = 0; i < 2; i++) {
-            double ax = A[2 * i], ay = A[2 * i + 1];
-            q += ax * (m0[0] * ax + m0[1] * ay) + ay * (m0[1] * ax + m0[2] * ay);
-            c += ax * C0[2 * i] + ay * C0[2 * i + 1];
-        }
-        ws->crit[s] = q - 2.0 * c;
+        double C[4] = {z1[2 * s] * inv_n, z1[2 * s + 1] * inv_n, z2[2 * s] * inv_n, z2[2 * s + 1] * inv_n};
+        ws->crit[s] = crit_value(C, Si);
     }
 }
 
@@ -584,20 +630,29 @@ static amscr_status match_one(const amscr_params *prm, const amscr_descriptor *f
     if (st != AMSCR_OK)
         return st;
     int norient = prm->reflections ? 2 : 1;
-    int have = 0;
-    match_t cur;
-    for (int o = 0; o < norient; o++) {
-        if (!f->params.closed) {
+    int use_finest = prm->method == AMSCR_METHOD_ACMA;
+    if (!f->params.closed) {
+        int have = 0;
+        match_t cur;
+        for (int o = 0; o < norient; o++) {
             run_method(prm, f, h, 0.0, o, ws, &cur);
             if (!have || better(&cur, best)) {
                 *best = cur;
                 have = 1;
             }
-            continue;
         }
-        int use_finest = prm->method == AMSCR_METHOD_ACMA;
-        shift_criterion(f, h, o, use_finest, ws);
-        /* candidates: the lowest local minima of the criterion (circular) */
+        if (!isfinite(best->dist))
+            return amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
+        return AMSCR_OK;
+    }
+    /* closed: for each orientation, the criterion of every integer shift by FFT; its lowest
+     * local minima are refined to a continuous shift; the best (orientation, shift) by the
+     * refined criterion gets the whole method. */
+    double best_s = 0.0, best_c = INFINITY, Si[3];
+    int best_o = 0;
+    crit_matrix(f, use_finest, Si);
+    for (int o = 0; o < norient; o++) {
+        shift_criterion(f, h, o, use_finest, Si, ws);
         size_t cand[AMSCR__CANDIDATES];
         size_t nc = 0;
         for (size_t s = 0; s < n; s++) {
@@ -621,15 +676,26 @@ static amscr_status match_one(const amscr_params *prm, const amscr_descriptor *f
             cand[0] = 0;
             nc = 1;
         }
+        /* a candidate is worth refining only when its residual is close to the best one's:
+         * refinement moves the residual by far less than a factor 1.25. The residual is
+         * Σ_k |h_k|^2 + criterion; Σ_k |h_k|^2 is bounded by p |h|^2. */
+        double hk2 = (use_finest ? 1.0 : (double)f->p) * h->norm2;
+        double r0 = ws->crit[cand[0]] + hk2;
         for (size_t c = 0; c < nc; c++) {
-            double sc = refine_shift(f, h, use_finest, ws, (double)cand[c]);
-            run_method(prm, f, h, sc, o, ws, &cur);
-            if (!have || better(&cur, best)) {
-                *best = cur;
-                have = 1;
+            if (c > 0 && ws->crit[cand[c]] + hk2 > 1.25 * r0 + 1e-12 * hk2)
+                break;
+            double cv;
+            double sc = refine_shift(f, use_finest, Si, ws, cand[c], &cv);
+            if (cv < best_c) {
+                best_c = cv;
+                best_s = sc;
+                best_o = o;
             }
         }
     }
+    if (best_o != norient - 1)
+        spectral_prepare(f, h, best_o, ws); /* ws->P holds the last orientation's products */
+    run_method(prm, f, h, best_s, best_o, ws, best);
     if (!isfinite(best->dist))
         return amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
     return AMSCR_OK;

@@ -423,6 +423,8 @@ amscr_status amscr_normalize_whiten(const double *xy, size_t n, double *out_xy, 
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(xy);
+    if (n == 0)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_normalize_whiten: no points");
     if (n < 3)
         return amscr__fail(AMSCR_E_DEGENERATE, "amscr_normalize_whiten: %zu points, at least 3 needed", n);
     if (!amscr__all_finite(xy, 2 * n))
