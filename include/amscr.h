@@ -520,11 +520,14 @@ AMSCR_API int amscr_params_get_reflections(const amscr_params *p);
  *  AMSCR_PARAM_AFFINE is the paper's affine arc length). */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_parametrization(amscr_params *p, amscr_parametrization v);
 AMSCR_API amscr_parametrization amscr_params_get_parametrization(const amscr_params *p);
-/** Pre-smoothing sigma0 of the affine arc length, as a fraction of the curve length, 0..0.25
- *  (default 0.005). */
+/** Pre-smoothing sigma0 of the parametrization (the parameter is measured on a copy smoothed
+ *  over the sample index, a linear hence affine-covariant filter), as a fraction of the curve
+ *  length, 0..0.25
+ *  (default 0.01). */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_presmooth(amscr_params *p, double fraction);
 AMSCR_API double amscr_params_get_presmooth(const amscr_params *p);
-/** Affine arc-length passes, 1..10 (default 3). */
+/** Parametrization passes, 1..10 (default 3): each pass measures the parameter over the
+ *  previous pass's parameter (DESIGN.md §2.3). */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_arclength_passes(amscr_params *p, unsigned passes);
 AMSCR_API unsigned amscr_params_get_arclength_passes(const amscr_params *p);
 /** Dense resampling factor: the curve is first resampled to factor*N points, 1..64 (default 8). */
@@ -536,7 +539,11 @@ AMSCR_API unsigned amscr_params_get_kmax(const amscr_params *p);
 /** Symmetric distance (average of both directions); default 0. */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_symmetric(amscr_params *p, int on);
 AMSCR_API int amscr_params_get_symmetric(const amscr_params *p);
-/** Refinement iterations in the aligned frame (DESIGN.md §3.8), 0..50; 0 = the paper. */
+/** Refinement iterations in the aligned frame (DESIGN.md §3.8), 0..50 (default 0 = the paper's
+ *  method, fastest for collections). Each iteration pairs every source sample with the closest
+ *  point of the target polygon, trims the worst 10 % of pairs and re-solves (trimmed ICP from
+ *  AMSCR's global estimate); the distance is then the mean squared closest-point residual.
+ *  10 is recommended for registering occluded or noisy contours (README: measurements). */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_refine(amscr_params *p, unsigned iterations);
 AMSCR_API unsigned amscr_params_get_refine(const amscr_params *p);
 /** Threads for batch calls: 0 = all cores (default), else 1..1024. */

@@ -103,6 +103,7 @@ static amscr_status descriptor_copy(const amscr_descriptor *s, amscr_descriptor 
     memcpy(d->fwd, s->fwd, sizeof d->fwd);
     memcpy(d->inv, s->inv, sizeof d->inv);
     d->norm2 = s->norm2;
+    d->nyq2 = s->nyq2;
     d->finest = s->finest;
     *out = d;
     return AMSCR_OK;

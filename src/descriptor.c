@@ -137,6 +137,11 @@ amscr_status amscr__descriptor_finish(amscr_descriptor *d)
         }
         amscr__fft(&plan, z, 0);
     }
+    d->nyq2 = 0.0;
+    if (n % 2 == 0) {
+        const double *X = d->spec + n, *Y = d->spec + 2 * n + n; /* element N/2 (complex) */
+        d->nyq2 = (X[0] * X[0] + X[1] * X[1] + Y[0] * Y[0] + Y[1] * Y[1]) / (double)n;
+    }
     double *tmp = amscr__malloc_array(2 * n + n, sizeof *tmp);
     if (!tmp) {
         amscr__fft_plan_free(&plan);
@@ -232,27 +237,18 @@ amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c,
     if (st != AMSCR_OK)
         return st;
     size_t M = (size_t)p->oversampling * N;
-    if (M < c->n && M < 8 * N)
-        M = 8 * N;
-    double *pts = amscr__malloc_array(2 * c->n + 2 * M, sizeof *pts);
+    double *pts = amscr__malloc_array(2 * c->n, sizeof *pts);
     if (!pts)
         return amscr__fail(AMSCR_E_NOMEM, "descriptor: out of memory");
-    double *P0 = pts + 2 * c->n;
     size_t m = amscr__dedupe_points(c->xy, c->n, closed, pts);
     if (closed && amscr__signed_area(pts, m) < 0.0)
         amscr__reverse_points(pts, m);
     amscr_descriptor *d = NULL;
-    st = amscr__resample_euclid(pts, m, closed, M, P0);
-    if (st == AMSCR_OK)
-        st = amscr__descriptor_alloc(N, p->num_scales, &d);
+    st = amscr__descriptor_alloc(N, p->num_scales, &d);
     if (st == AMSCR_OK) {
         d->params = *p;
-        if (p->parametrization == AMSCR_PARAM_AFFINE)
-            st = amscr__parametrize(P0, M, closed, p->parametrization, p->presmooth, p->arclength_passes, N,
-                                    d->input);
-        else /* arc lengths of straight edges are exact on the input polygon itself: no densification */
-            st = amscr__parametrize(pts, m, closed, p->parametrization, p->presmooth, p->arclength_passes, N,
-                                    d->input);
+        st = amscr__parametrize(pts, m, closed, p->parametrization, p->presmooth, p->arclength_passes, M, N,
+                                d->input);
     }
     if (st == AMSCR_OK) {
         if (p->invariance == AMSCR_INVARIANCE_AFFINE)

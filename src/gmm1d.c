@@ -22,12 +22,6 @@
 #define GMM_WEIGHT_FLOOR 1e-12
 #define GMM_LOG_2PI 1.8378770664093454835606594728112
 
-/* Prototypes of the internal hot-path API (to be moved to internal.h). */
-size_t amscr__gmm1d_small_scratch(size_t n, size_t k);
-amscr_status amscr__gmm1d_fit_small(const double *x, size_t n, size_t k, unsigned max_iter, double tol,
-                                    double var_floor_rel, double *w, double *mu, double *var, double *scratch,
-                                    unsigned *out_iter, int *out_converged, double *out_loglik);
-
 /* Scratch (doubles) of one fit: the sorted copy, the K-means DP scratch, k SSE values
  * and 6k EM work values. */
 size_t amscr__gmm1d_small_scratch(size_t n, size_t k)

@@ -78,8 +78,8 @@ amscr_status amscr__smooth(const double *xy, size_t n, int closed, double sigma,
 amscr_status amscr__resample_euclid(const double *xy, size_t n, int closed, size_t m, double *out);
 amscr_status amscr__affine_cum(const double *xy, size_t n, int closed, double sigma0, double *cum, double *out_total);
 int amscr__sym2_invsqrt(const double cov[3], double W[4], double Winv[4]);
-amscr_status amscr__parametrize(const double *P0, size_t M, int closed, amscr_parametrization kind, double sigma0_frac,
-                                unsigned passes, size_t m, double *out);
+amscr_status amscr__parametrize(const double *P, size_t np, int closed, amscr_parametrization kind, double sigma0_frac,
+                                unsigned passes, size_t M, size_t m, double *out);
 amscr_status amscr__whiten(const double *xy, size_t n, double *out_xy, double fwd[6], double inv[6]);
 void amscr__affine_compose(const double a[6], const double b[6], double out[6]);
 void amscr__params_defaults(amscr_params *p);
@@ -111,6 +111,7 @@ struct amscr_descriptor {
     double *spec;  /* 4N: DFT of base x then base y (complex interleaved), closed curves only */
     double *gain;  /* (p+1) * N: |G_k(w)|^2 per scale (index k), and their sum (index p) */
     double norm2;  /* sum |base|^2 */
+    double nyq2;   /* even N: (|X(N/2)|^2 + |Y(N/2)|^2) / N, the Nyquist term's energy */
     size_t finest; /* index of the smallest scale */
 };
 

@@ -17,26 +17,27 @@
 
 /* Scratch layout (doubles), with m = n + 1:
  *   s1[m], s2[m]   prefix sums of (x - shift) and (x - shift)^2
+ *   rc[m]          rc[c] = 1/c (cluster sizes)
  *   prev[m], cur[m] DP rows D[k-1][.], D[k][.]
  *   arg[kmax * m]   arg[(k-1)*m + j] = start of the last cluster in the optimal
  *                   k-clustering of the first j values (stored as a double, exact). */
 size_t amscr__kmeans1d_scratch(size_t n, size_t kmax)
 {
-    return (4 + kmax) * (n + 1);
+    return (5 + kmax) * (n + 1);
 }
 
 /* SSE of sorted values i..j-1 from the prefix sums (clamped at 0). */
-static inline double km_cost(const double *s1, const double *s2, size_t i, size_t j)
+static inline double km_cost(const double *s1, const double *s2, const double *rc, size_t i, size_t j)
 {
     double a = s1[j] - s1[i];
-    double c = (s2[j] - s2[i]) - a * a / (double)(j - i);
+    double c = (s2[j] - s2[i]) - a * a * rc[j - i];
     return c > 0.0 ? c : 0.0;
 }
 
 /* One DP layer by divide and conquer: cur[j] for j in [jlo, jhi], the optimal split of
  * each lying in [ilo, ihi] (and in [k-1, j-1]). */
-static void km_layer_dc(const double *s1, const double *s2, const double *prev, double *cur, double *arg,
-                        size_t k, size_t jlo, size_t jhi, size_t ilo, size_t ihi)
+static void km_layer_dc(const double *s1, const double *s2, const double *rc, const double *prev, double *cur,
+                        double *arg, size_t k, size_t jlo, size_t jhi, size_t ilo, size_t ihi)
 {
     while (jlo <= jhi) {
         size_t j = jlo + (jhi - jlo) / 2;
@@ -45,7 +46,7 @@ static void km_layer_dc(const double *s1, const double *s2, const double *prev, 
         double best = INFINITY;
         size_t bi = lo;
         for (size_t i = lo; i <= hi; i++) {
-            double v = prev[i] + km_cost(s1, s2, i, j);
+            double v = prev[i] + km_cost(s1, s2, rc, i, j);
             if (v < best) {
                 best = v;
                 bi = i;
@@ -55,7 +56,7 @@ static void km_layer_dc(const double *s1, const double *s2, const double *prev, 
         arg[j] = (double)bi;
         /* Left half recursively (depth <= log2 n), right half by iteration. */
         if (j > jlo)
-            km_layer_dc(s1, s2, prev, cur, arg, k, jlo, j - 1, ilo, bi);
+            km_layer_dc(s1, s2, rc, prev, cur, arg, k, jlo, j - 1, ilo, bi);
         jlo = j + 1;
         ilo = bi;
     }
@@ -70,19 +71,20 @@ void amscr__kmeans1d_dp(const double *sorted, size_t n, size_t kmax, double *scr
                         size_t *split_out)
 {
     const size_t m = n + 1;
-    double *s1 = scratch, *s2 = s1 + m, *prev = s2 + m, *cur = prev + m, *arg = cur + m;
+    double *s1 = scratch, *s2 = s1 + m, *rc = s2 + m, *prev = rc + m, *cur = prev + m, *arg = cur + m;
 
     /* Shift by the middle value so the prefix sums do not cancel catastrophically. */
     const double shift = sorted[n / 2];
-    s1[0] = s2[0] = 0.0;
+    s1[0] = s2[0] = rc[0] = 0.0;
     for (size_t i = 0; i < n; i++) {
         double v = sorted[i] - shift;
         s1[i + 1] = s1[i] + v;
         s2[i + 1] = s2[i] + v * v;
+        rc[i + 1] = 1.0 / (double)(i + 1);
     }
     /* k = 1 */
     for (size_t j = 1; j <= n; j++) {
-        prev[j] = km_cost(s1, s2, 0, j);
+        prev[j] = km_cost(s1, s2, rc, 0, j);
         arg[j] = 0.0;
     }
     sse_out[0] = prev[n];
@@ -94,7 +96,7 @@ void amscr__kmeans1d_dp(const double *sorted, size_t n, size_t kmax, double *scr
                 double best = INFINITY;
                 size_t bi = k - 1;
                 for (size_t i = k - 1; i < j; i++) {
-                    double v = prev[i] + km_cost(s1, s2, i, j);
+                    double v = prev[i] + km_cost(s1, s2, rc, i, j);
                     if (v < best) {
                         best = v;
                         bi = i;
@@ -104,7 +106,7 @@ void amscr__kmeans1d_dp(const double *sorted, size_t n, size_t kmax, double *scr
                 ak[j] = (double)bi;
             }
         } else {
-            km_layer_dc(s1, s2, prev, cur, ak, k, k, n, k - 1, n - 1);
+            km_layer_dc(s1, s2, rc, prev, cur, ak, k, k, n, k - 1, n - 1);
         }
         sse_out[k - 1] = cur[n];
         double *t = prev;
@@ -395,7 +397,7 @@ static double km_lloyd(const double *data, size_t n, size_t dim, size_t k, unsig
 static amscr_status km_fit_1d(const double *data, size_t n, size_t k, double *centers, double *out_sse)
 {
     size_t ns = amscr__kmeans1d_scratch(n, k);
-    if (ns / (k + 4) != n + 1)
+    if (ns / (k + 5) != n + 1)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_kmeans_fit: size overflow");
     double *sorted = amscr__malloc_array(n, sizeof *sorted);
     double *scratch = amscr__malloc_array(ns, sizeof *scratch);

@@ -18,7 +18,7 @@ void amscr__params_defaults(amscr_params *p)
     p->closed = 1;
     p->reflections = 0;
     p->parametrization = AMSCR_PARAM_WHITENED;
-    p->presmooth = 0.005;
+    p->presmooth = 0.01;
     p->arclength_passes = 3;
     p->oversampling = 8;
     p->kmax = 5;

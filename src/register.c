@@ -19,6 +19,28 @@
 #include <string.h>
 
 #define AMSCR__CANDIDATES 3
+
+/* Per-stage timing, compiled only into the benchmark's copy of the library
+ * (-DAMSCR_STAGE_TIMING): the product's hot path has no clock calls. */
+#ifdef AMSCR_STAGE_TIMING
+#include <time.h>
+static double stage_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+#define STAGE_T0 double stage_t = stage_now()
+#define STAGE_MARK(ws, i)                                                                                      \
+    do {                                                                                                       \
+        double stage_t1 = stage_now();                                                                         \
+        (ws)->stage[i] += stage_t1 - stage_t;                                                                  \
+        stage_t = stage_t1;                                                                                    \
+    } while (0)
+#else
+#define STAGE_T0 ((void)0)
+#define STAGE_MARK(ws, i) ((void)0)
+#endif
 #define AMSCR__KMAX 16
 
 struct amscr_workspace {
@@ -37,13 +59,29 @@ struct amscr_workspace {
     double *qa, *qb, *qw;
     int *qi;
     size_t qcap;
+    /* refinement in the aligned frame: closest-point pairs and residuals */
+    double *rbuf;
+    size_t rcap;
+#ifdef AMSCR_STAGE_TIMING
+    double stage[4]; /* shift search, per-scale solves, selection, final solve */
+#endif
 };
+
+#ifdef AMSCR_STAGE_TIMING
+void amscr__workspace_stage_times(const amscr_workspace *ws, double out[4]);
+void amscr__workspace_stage_times(const amscr_workspace *ws, double out[4])
+{
+    memcpy(out, ws->stage, sizeof ws->stage);
+}
+#endif
 
 typedef struct {
     double X[6]; /* h ≈ A f + B in the normalized frames: {a11, a12, b1, a21, a22, b2} */
     double dist;
     size_t shift;
     double fshift; /* continuous shift (closed curves) */
+    double rcut;   /* refined: the trimming cut-off of the closest-point pairs in ws->rbuf */
+    int refined;   /* the refinement replaced the method's solution */
     int reflected;
     size_t p;
     double resid[AMSCR__MAX_SCALES];
@@ -84,6 +122,9 @@ static void ws_release(amscr_workspace *ws)
     free(ws->scratch);
     free(ws->qa);
     free(ws->qi);
+    free(ws->rbuf);
+    ws->rbuf = NULL;
+    ws->rcap = 0;
     ws->z = ws->scratch = ws->qa = NULL;
     ws->qi = NULL;
     ws->n = ws->p = ws->qcap = ws->scratch_cap = 0;
@@ -274,6 +315,18 @@ static void select_scales(const amscr_params *prm, amscr_method method, size_t f
     }
     m->k = K;
     if (K <= 1) {
+        /* one class: the mixture is a single Gaussian and every scale is kept */
+        double mean = 0.0, var = 0.0;
+        for (size_t k = 0; k < p; k++)
+            mean += m->resid[k];
+        mean /= (double)p;
+        for (size_t k = 0; k < p; k++)
+            var += (m->resid[k] - mean) * (m->resid[k] - mean);
+        var /= (double)p;
+        m->ncomp = 1;
+        m->w[0] = 1.0;
+        m->mu[0] = mean;
+        m->var[0] = var > 1e-300 ? var : 1e-300;
         for (size_t k = 0; k < p; k++)
             m->kept[k] = 1;
         m->nkept = p;
@@ -282,7 +335,14 @@ static void select_scales(const amscr_params *prm, amscr_method method, size_t f
     unsigned it;
     int conv;
     double ll;
-    amscr__gmm1d_fit_small(m->resid, p, K, 100, 1e-8, 1e-6, m->w, m->mu, m->var, scratch, &it, &conv, &ll);
+    if (amscr__gmm1d_fit_small(m->resid, p, K, 100, 1e-8, 1e-6, m->w, m->mu, m->var, scratch, &it, &conv, &ll) !=
+        AMSCR_OK) {
+        /* cannot happen for finite residuals; keep every scale rather than guess */
+        for (size_t k = 0; k < p; k++)
+            m->kept[k] = 1;
+        m->nkept = p;
+        return;
+    }
     m->ncomp = K;
     double s0;
     amscr_status st = amscr_bayes_threshold(m->w[0], m->mu[0], m->var[0], m->w[1], m->mu[1], m->var[1], &s0);
@@ -490,17 +550,25 @@ static void crit_newton(const amscr_descriptor *f, int use_finest, const double 
 static double refine_shift(const amscr_descriptor *f, int use_finest, const double Si[3], amscr_workspace *ws,
                            size_t s, double *out_crit)
 {
+    size_t n = f->n;
     double x = (double)s, best_x = x, best_v = ws->crit[s];
+    /* start: the vertex of the parabola through the integer neighbours (free: from the FFT) */
+    double cm = ws->crit[(s + n - 1) % n], cp = ws->crit[(s + 1) % n], curv = cp - 2.0 * best_v + cm;
+    if (curv > 0.0) {
+        double step = -0.5 * (cp - cm) / curv;
+        x += step > 0.5 ? 0.5 : (step < -0.5 ? -0.5 : step);
+    }
     for (int it = 0; it < 3; it++) {
         double v, d1, d2;
         crit_newton(f, use_finest, Si, ws, x, &v, &d1, &d2);
-        if (v < best_v || it == 0) {
-            if (it > 0 || v <= best_v) {
-                best_v = v;
-                best_x = x;
-            }
-        } else {
+        if (v <= best_v) {
+            best_v = v;
+            best_x = x;
+        } else if (it > 0) {
             break; /* the last step went uphill: keep the best point */
+        } else {
+            x = best_x; /* the parabola overshot: restart Newton from the integer shift */
+            crit_newton(f, use_finest, Si, ws, x, &v, &d1, &d2);
         }
         if (!(d2 > 0.0))
             break;
@@ -536,6 +604,7 @@ static void run_method(const amscr_params *prm, const amscr_descriptor *f, const
     size_t n = f->n, p = f->p;
     int closed = f->params.closed;
     double R[AMSCR__MAX_SCALES + 1][6];
+    STAGE_T0;
     if (closed) {
         double dc[2] = {h->spec[0], h->spec[2 * n]};
         spectral_q(ws, n, s);
@@ -555,14 +624,25 @@ static void run_method(const amscr_params *prm, const amscr_descriptor *f, const
         m->fshift = 0.0;
         m->shift = 0;
     }
+    /* energy of the target as shifted: the band-limited interpolation keeps every frequency's
+     * energy except the Nyquist term's (even N), which is scaled by cos^2(pi s) */
+    double hn2 = h->norm2;
+    if (closed && h->nyq2 > 0.0) {
+        double sn = sin(3.14159265358979323846 * s);
+        hn2 -= h->nyq2 * sn * sn;
+    }
     m->p = p;
     m->reflected = o;
+    m->refined = 0;
+    m->rcut = 0.0;
     for (size_t k = 0; k < p; k++) {
         double X[6];
         solve_x(R[k + 1], f->minv + 9 * (k + 1), X);
-        m->resid[k] = resid_sum(X, f->mom, R[0], h->norm2) / (double)n;
+        m->resid[k] = resid_sum(X, f->mom, R[0], hn2) / (double)n;
     }
+    STAGE_MARK(ws, 1);
     select_scales(prm, prm->method, f->finest, m, ws->scratch);
+    STAGE_MARK(ws, 2);
     double Ms[6] = {0, 0, 0, 0, 0, 0}, Rs[6] = {0, 0, 0, 0, 0, 0}, Minv[9];
     for (size_t k = 0; k < p; k++) {
         if (!m->kept[k])
@@ -579,7 +659,8 @@ static void run_method(const amscr_params *prm, const amscr_descriptor *f, const
         memcpy(Rs, R[f->finest + 1], sizeof Rs);
     }
     solve_x(Rs, Minv, m->X);
-    m->dist = resid_sum(m->X, f->mom, R[0], h->norm2) / (double)n;
+    m->dist = resid_sum(m->X, f->mom, R[0], hn2) / (double)n;
+    STAGE_MARK(ws, 3);
 }
 
 /* Criterion of every integer cyclic shift for one orientation (closed curves): one FFT
@@ -650,6 +731,7 @@ static amscr_status match_one(const amscr_params *prm, const amscr_descriptor *f
      * refined criterion gets the whole method. */
     double best_s = 0.0, best_c = INFINITY, Si[3];
     int best_o = 0;
+    STAGE_T0;
     crit_matrix(f, use_finest, Si);
     for (int o = 0; o < norient; o++) {
         shift_criterion(f, h, o, use_finest, Si, ws);
@@ -695,9 +777,160 @@ static amscr_status match_one(const amscr_params *prm, const amscr_descriptor *f
     }
     if (best_o != norient - 1)
         spectral_prepare(f, h, best_o, ws); /* ws->P holds the last orientation's products */
+    STAGE_MARK(ws, 0);
     run_method(prm, f, h, best_s, best_o, ws, best);
     if (!isfinite(best->dist))
         return amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
+    return AMSCR_OK;
+}
+
+/* ------------------------------------------------- refinement (DESIGN.md §3.8)
+ * Once (A, B) is known, A f + B and h nearly coincide in the target's frame, so a correspondence
+ * that is not affine-invariant becomes usable: every source sample is paired with the closest
+ * point of the target polygon (searched in a window around its current partner), the worst 10 %
+ * of the pairs are trimmed (missing or extra parts of a contour), and the least squares is
+ * re-solved — a trimmed ICP started from AMSCR's global, closed-form estimate, so it does not
+ * fall into the local minima that sink ICP from arbitrary starts. Repeated while the trimmed
+ * cost drops, at most `refine` times. The distance is then the mean squared closest-point
+ * residual of all samples. */
+
+#define AMSCR__TRIM 0.9
+
+static amscr_status ws_reserve_refine(amscr_workspace *ws, size_t n)
+{
+    if (ws->rcap >= n && ws->rbuf)
+        return AMSCR_OK;
+    free(ws->rbuf);
+    ws->rbuf = amscr__malloc_array(6 * n + 8, sizeof(double)); /* q 2n, r2 n, sorted n, tmp 2n */
+    if (!ws->rbuf) {
+        ws->rcap = 0;
+        return amscr__fail(AMSCR_E_NOMEM, "workspace: out of memory");
+    }
+    ws->rcap = n;
+    return AMSCR_OK;
+}
+
+/* Closest point to (px, py) on the closed polygon H (n vertices), edges [b0-w, b0+w]. */
+static double closest_on_polygon(const double *H, size_t n, size_t b0, size_t w, double px, double py, double *qx,
+                                 double *qy)
+{
+    double best = INFINITY;
+    size_t cnt = 2 * w + 1 < n ? 2 * w + 1 : n;
+    size_t b = (b0 + n - (cnt == n ? 0 : w)) % n;
+    for (size_t i = 0; i < cnt; i++) {
+        size_t c = b + 1 == n ? 0 : b + 1;
+        double ax = H[2 * b], ay = H[2 * b + 1], ex = H[2 * c] - ax, ey = H[2 * c + 1] - ay;
+        double l2 = ex * ex + ey * ey, t = l2 > 0.0 ? ((px - ax) * ex + (py - ay) * ey) / l2 : 0.0;
+        t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+        double cx = ax + t * ex, cy = ay + t * ey, d2 = (px - cx) * (px - cx) + (py - cy) * (py - cy);
+        if (d2 < best) {
+            best = d2;
+            *qx = cx;
+            *qy = cy;
+        }
+        b = c;
+    }
+    return best;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Trimmed least squares X from pairs (f_a -> q_a) with r2_a <= cut. Returns 0 if singular. */
+static int trimmed_solve(const double *f, const double *q, const double *r2, size_t n, double cut, double X[6])
+{
+    double m[6] = {0, 0, 0, 0, 0, 0}, R[6] = {0, 0, 0, 0, 0, 0}, Minv[9];
+    for (size_t a = 0; a < n; a++) {
+        if (r2[a] > cut)
+            continue;
+        double x = f[2 * a], y = f[2 * a + 1], u = q[2 * a], v = q[2 * a + 1];
+        m[0] += x * x;
+        m[1] += x * y;
+        m[2] += y * y;
+        m[3] += x;
+        m[4] += y;
+        m[5] += 1.0;
+        R[0] += u * x;
+        R[1] += u * y;
+        R[2] += u;
+        R[3] += v * x;
+        R[4] += v * y;
+        R[5] += v;
+    }
+    const double M9[9] = {m[0], m[1], m[3], m[1], m[2], m[4], m[3], m[4], m[5]};
+    if (!inv3_general(M9, Minv))
+        return 0;
+    solve_x(R, Minv, X);
+    return 1;
+}
+
+/* One correspondence step: q_a = closest target point to X f_a; r2_a its squared distance;
+ * returns the trimmed cost and the cut-off. */
+static double icp_pairs(const amscr_descriptor *f, const amscr_descriptor *h, const match_t *m, const double X[6],
+                        double *q, double *r2, double *sorted, double *out_cut)
+{
+    size_t n = f->n, w = n / 4 > 2 ? n / 4 : 2;
+    for (size_t a = 0; a < n; a++) {
+        double fx = f->base[2 * a], fy = f->base[2 * a + 1];
+        double px = X[0] * fx + X[1] * fy + X[2], py = X[3] * fx + X[4] * fy + X[5];
+        size_t b0 = f->params.closed ? tgt_index(a, m->shift, m->reflected, 1, n) : tgt_index(a, 0, m->reflected, 0, n);
+        r2[a] = closest_on_polygon(h->base, n, b0, w, px, py, &q[2 * a], &q[2 * a + 1]);
+        sorted[a] = r2[a];
+    }
+    qsort(sorted, n, sizeof *sorted, cmp_double);
+    size_t keep = (size_t)(AMSCR__TRIM * (double)n);
+    if (keep < 8)
+        keep = n < 8 ? n : 8;
+    double cost = 0.0;
+    for (size_t a = 0; a < keep; a++)
+        cost += sorted[a];
+    *out_cut = sorted[keep - 1];
+    return cost / (double)keep;
+}
+
+/* Refines m in place (closed and open curves). */
+static amscr_status refine_match(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                 amscr_workspace *ws, match_t *m, int *out_refined)
+{
+    *out_refined = 0;
+    if (prm->refine == 0)
+        return AMSCR_OK;
+    size_t n = f->n;
+    amscr_status st = ws_reserve_refine(ws, n);
+    if (st != AMSCR_OK)
+        return st;
+    double *q = ws->rbuf, *r2 = q + 2 * n, *sorted = r2 + n;
+    double X[6], cut;
+    memcpy(X, m->X, sizeof X);
+    double cost = icp_pairs(f, h, m, X, q, r2, sorted, &cut);
+    for (unsigned it = 0; it < prm->refine; it++) {
+        double Xn[6], cutn;
+        if (!trimmed_solve(f->base, q, r2, n, cut, Xn))
+            break;
+        double *q2 = sorted + n; /* tmp 2n */
+        double costn = icp_pairs(f, h, m, Xn, q2, r2, sorted, &cutn);
+        if (!(costn < cost * (1.0 - 1e-9)))
+            break;
+        memcpy(X, Xn, sizeof X);
+        memcpy(q, q2, 2 * n * sizeof *q);
+        cost = costn;
+        cut = cutn;
+        *out_refined = 1;
+    }
+    if (*out_refined) {
+        /* r2 belongs to the accepted pairs only if the last trial was accepted: recompute */
+        cost = icp_pairs(f, h, m, X, q, r2, sorted, &cut);
+        double all = 0.0;
+        for (size_t a = 0; a < n; a++)
+            all += r2[a];
+        memcpy(m->X, X, sizeof X);
+        m->dist = all / (double)n;
+        m->refined = 1;
+        m->rcut = cut;
+    }
     return AMSCR_OK;
 }
 
@@ -712,14 +945,25 @@ static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor 
     return AMSCR_OK;
 }
 
+/* One direction: the method, then the optional refinement. */
+static amscr_status match_dir(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                              amscr_workspace *ws, match_t *m)
+{
+    amscr_status st = match_one(prm, f, h, ws, m);
+    int refined;
+    if (st == AMSCR_OK)
+        st = refine_match(prm, f, h, ws, m, &refined);
+    return st;
+}
+
 /* Distance (and match) honouring `symmetric`. */
 static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                amscr_workspace *ws, match_t *m)
 {
-    amscr_status st = match_one(prm, src, tgt, ws, m);
+    amscr_status st = match_dir(prm, src, tgt, ws, m);
     if (st == AMSCR_OK && prm->symmetric) {
         match_t back;
-        st = match_one(prm, tgt, src, ws, &back);
+        st = match_dir(prm, tgt, src, ws, &back);
         if (st == AMSCR_OK)
             m->dist = 0.5 * (m->dist + back.dist);
     }
@@ -844,6 +1088,37 @@ static amscr_status final_qr(const amscr_descriptor *f, const amscr_descriptor *
     return AMSCR_OK;
 }
 
+/* The reported solve after refinement: QR on the kept closest-point pairs. */
+static amscr_status final_qr_refined(const amscr_descriptor *f, amscr_workspace *ws, match_t *m)
+{
+    size_t n = f->n;
+    amscr_status st = ws_reserve_qr(ws, n);
+    if (st != AMSCR_OK)
+        return st;
+    const double *q = ws->rbuf, *r2 = q + 2 * n;
+    double *A = ws->qa, *B = ws->qb;
+    size_t rows = 0;
+    for (size_t a = 0; a < n; a++)
+        if (r2[a] <= m->rcut)
+            rows++;
+    size_t r = 0;
+    for (size_t a = 0; a < n; a++) {
+        if (r2[a] > m->rcut)
+            continue;
+        A[r] = f->base[2 * a];
+        A[rows + r] = f->base[2 * a + 1];
+        A[2 * rows + r] = 1.0;
+        B[r] = q[2 * a];
+        B[rows + r] = q[2 * a + 1];
+        r++;
+    }
+    double x[6];
+    st = amscr__lstsq_colmajor(A, rows, 3, B, 2, ws->qw, ws->qi, x, NULL);
+    if (st == AMSCR_OK)
+        memcpy(m->X, x, sizeof m->X); /* equals the closed-form trimmed solve up to rounding */
+    return st;
+}
+
 amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
                             amscr_workspace *ws, amscr_result **out_result)
 {
@@ -860,12 +1135,12 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
     if (!r)
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_register: out of memory");
     if (st == AMSCR_OK)
-        st = match_one(p, src, tgt, w, &r->m);
+        st = match_dir(p, src, tgt, w, &r->m);
     if (st == AMSCR_OK)
-        st = final_qr(src, tgt, w, &r->m);
+        st = r->m.refined ? final_qr_refined(src, w, &r->m) : final_qr(src, tgt, w, &r->m);
     if (st == AMSCR_OK && p->symmetric) {
         match_t back;
-        st = match_one(p, tgt, src, w, &back);
+        st = match_dir(p, tgt, src, w, &back);
         if (st == AMSCR_OK)
             r->m.dist = 0.5 * (r->m.dist + back.dist);
     }
@@ -893,13 +1168,17 @@ amscr_status amscr_register_contours(const amscr_params *p, const amscr_contour 
     AMSCR_CHECK_NULL(tgt);
     AMSCR_CHECK_NULL(out_result);
     amscr_descriptor *a = NULL, *b = NULL;
+    char detail[400];
     amscr_status st = amscr_descriptor_new(p, src, &a);
     if (st == AMSCR_OK) {
         st = amscr_descriptor_new(p, tgt, &b);
-        if (st != AMSCR_OK)
-            amscr__fail(st, "target: %s", amscr_last_error_detail());
+        if (st != AMSCR_OK) {
+            snprintf(detail, sizeof detail, "%s", amscr_last_error_detail());
+            amscr__fail(st, "target: %s", detail);
+        }
     } else {
-        amscr__fail(st, "source: %s", amscr_last_error_detail());
+        snprintf(detail, sizeof detail, "%s", amscr_last_error_detail());
+        amscr__fail(st, "source: %s", detail);
     }
     if (st == AMSCR_OK)
         st = amscr_register(p, a, b, NULL, out_result);

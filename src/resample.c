@@ -240,84 +240,99 @@ static void invert_cum(const double *cum, size_t n, int closed, double total, co
     }
 }
 
-/* The core of the parametrizations: P0 is a dense uniform (Euclidean) resampling of the
- * curve with M points; the output is m points of P0 equally spaced in the requested
- * parameter. */
-amscr_status amscr__parametrize(const double *P0, size_t M, int closed, amscr_parametrization kind, double sigma0_frac,
-                                unsigned passes, size_t m, double *out)
+/* Whitening matrix of a polygon: region moments when closed (exactly affine-covariant and
+ * noise-robust), point moments otherwise. Returns 0 when singular. */
+static int polygon_whitener(const double *P, size_t n, int closed, double W[4])
+{
+    double cx, cy, cov[3];
+    if (closed && region_moments(P, n, &cx, &cy, cov) && amscr__sym2_invsqrt(cov, W, NULL))
+        return 1;
+    double mx = 0, my = 0;
+    for (size_t i = 0; i < n; i++) {
+        mx += P[2 * i];
+        my += P[2 * i + 1];
+    }
+    mx /= (double)n;
+    my /= (double)n;
+    cov[0] = cov[1] = cov[2] = 0;
+    for (size_t i = 0; i < n; i++) {
+        double dx = P[2 * i] - mx, dy = P[2 * i + 1] - my;
+        cov[0] += dx * dx;
+        cov[1] += dx * dy;
+        cov[2] += dy * dy;
+    }
+    return amscr__sym2_invsqrt(cov, W, NULL);
+}
+
+/* Cumulative W-length over the vertices of a polygon (closed: total includes the closing edge). */
+static double wlength_cum(const double *Q, size_t n, int closed, const double W[4], double *cum)
+{
+    cum[0] = 0.0;
+    double total = 0.0;
+    for (size_t i = 1; i <= n; i++) {
+        if (i == n && !closed)
+            break;
+        size_t a = i - 1, b = (i == n) ? 0 : i;
+        double dx = Q[2 * b] - Q[2 * a], dy = Q[2 * b + 1] - Q[2 * a + 1];
+        double len = hypot(W[0] * dx + W[1] * dy, W[2] * dx + W[3] * dy);
+        if (i < n)
+            cum[i] = cum[i - 1] + len;
+        else
+            total = cum[n - 1] + len;
+    }
+    return closed ? total : cum[n - 1];
+}
+
+/* The parametrizations. P: the input polygon (np vertices). It is first densified to M
+ * points equally spaced in arc length of the polygon after the whitening W (W = I for the
+ * Euclidean and affine kinds; region moments for the whitened kind, which makes the
+ * densification exactly affine-covariant). Each pass then measures the parameter on a copy
+ * of the current samples smoothed over their index (sigma0_frac of the length; a linear filter,
+ * so affine-covariant) — affine speed |det(f', f'')|^(1/3) for the affine kind, W-length
+ * otherwise — and re-places the samples; positions always refer to the ORIGINAL polygon, so
+ * nothing is lost to repeated interpolation. Output: m points of P. */
+amscr_status amscr__parametrize(const double *P, size_t np, int closed, amscr_parametrization kind, double sigma0_frac,
+                                unsigned passes, size_t M, size_t m, double *out)
 {
     amscr_status st = AMSCR_OK;
-    double *buf = amscr__malloc_array(7 * M + m + 4, sizeof *buf);
+    double W[4] = {1, 0, 0, 1};
+    if (kind == AMSCR_PARAM_WHITENED && !polygon_whitener(P, np, closed, W))
+        return amscr__fail(AMSCR_E_DEGENERATE, "parametrization: singular moments (collinear curve)");
+    size_t big = M > np ? M : np;
+    double *buf = amscr__malloc_array(8 * big + m + 8, sizeof *buf);
     if (!buf)
         return amscr__fail(AMSCR_E_NOMEM, "parametrization: out of memory");
-    double *pos = buf;           /* M index positions on P0 */
-    double *P = buf + M;         /* 2M current samples */
-    double *cum = buf + 3 * M;   /* M */
-    double *tgt = buf + 4 * M;   /* M */
-    double *newpos = buf + 5 * M; /* M */
-    double *finalpos = buf + 6 * M; /* m */
-    double total = 0.0;
-
-    if (kind == AMSCR_PARAM_EUCLIDEAN || kind == AMSCR_PARAM_WHITENED) {
-        double W[4] = {1, 0, 0, 1};
-        if (kind == AMSCR_PARAM_WHITENED) {
-            double cx, cy, cov[3];
-            int ok = closed ? region_moments(P0, M, &cx, &cy, cov) : 0;
-            if (!ok || !amscr__sym2_invsqrt(cov, W, NULL)) {
-                /* open curves (or a failed region): point moments */
-                double mx = 0, my = 0;
-                for (size_t i = 0; i < M; i++) {
-                    mx += P0[2 * i];
-                    my += P0[2 * i + 1];
-                }
-                mx /= (double)M;
-                my /= (double)M;
-                cov[0] = cov[1] = cov[2] = 0;
-                for (size_t i = 0; i < M; i++) {
-                    double dx = P0[2 * i] - mx, dy = P0[2 * i + 1] - my;
-                    cov[0] += dx * dx;
-                    cov[1] += dx * dy;
-                    cov[2] += dy * dy;
-                }
-                if (!amscr__sym2_invsqrt(cov, W, NULL)) {
-                    free(buf);
-                    return amscr__fail(AMSCR_E_DEGENERATE, "parametrization: singular moments (collinear curve)");
-                }
+    double *pos = buf;               /* M positions on P (vertex index + fraction) */
+    double *C = buf + big;           /* 2M current samples */
+    double *S = buf + 3 * big;       /* 2M smoothed copy */
+    double *cum = buf + 5 * big;     /* max(M, np) */
+    double *tgt = buf + 6 * big;     /* M targets */
+    double *newpos = buf + 7 * big;  /* M */
+    double *finalpos = buf + 8 * big; /* m */
+    double total = wlength_cum(P, np, closed, W, cum);
+    if (!(total > 0.0) || !isfinite(total)) {
+        free(buf);
+        return amscr__fail(AMSCR_E_DEGENERATE, "parametrization: zero length");
+    }
+    equal_params(total, M, closed, tgt);
+    invert_cum(cum, np, closed, total, tgt, M, pos);
+    double sigma0 = sigma0_frac * (double)M;
+    for (unsigned pass = 0; pass < passes && st == AMSCR_OK; pass++) {
+        sample_by_index(P, np, closed, pos, M, C);
+        if (kind == AMSCR_PARAM_AFFINE) {
+            st = amscr__affine_cum(C, M, closed, sigma0, cum, &total);
+        } else {
+            const double *Q = C;
+            if (sigma0 > 0.0) {
+                st = amscr__smooth(C, M, closed, sigma0, S);
+                Q = S;
+            }
+            if (st == AMSCR_OK) {
+                total = wlength_cum(Q, M, closed, W, cum);
+                if (!(total > 0.0))
+                    st = amscr__fail(AMSCR_E_DEGENERATE, "parametrization: zero length");
             }
         }
-        cum[0] = 0.0;
-        for (size_t i = 1; i <= M; i++) {
-            if (i == M && !closed)
-                break;
-            size_t a = i - 1, b = (i == M) ? 0 : i;
-            double dx = P0[2 * b] - P0[2 * a], dy = P0[2 * b + 1] - P0[2 * a + 1];
-            double len = hypot(W[0] * dx + W[1] * dy, W[2] * dx + W[3] * dy);
-            if (i < M)
-                cum[i] = cum[i - 1] + len;
-            else
-                total = cum[M - 1] + len;
-        }
-        if (!closed)
-            total = cum[M - 1];
-        if (!(total > 0.0)) {
-            free(buf);
-            return amscr__fail(AMSCR_E_DEGENERATE, "parametrization: zero length");
-        }
-        equal_params(total, m, closed, tgt);
-        invert_cum(cum, M, closed, total, tgt, m, finalpos);
-        sample_by_index(P0, M, closed, finalpos, m, out);
-        free(buf);
-        return AMSCR_OK;
-    }
-
-    /* Affine arc length, iterated: each pass measures the affine length over the previous
-     * pass's parameter and re-samples the ORIGINAL dense polygon (no cumulative corner cutting). */
-    for (size_t i = 0; i < M; i++)
-        pos[i] = (double)i;
-    double sigma0 = sigma0_frac * (double)M;
-    for (unsigned pass = 0; pass < passes; pass++) {
-        sample_by_index(P0, M, closed, pos, M, P);
-        st = amscr__affine_cum(P, M, closed, sigma0, cum, &total);
         if (st != AMSCR_OK)
             break;
         int last = (pass + 1 == passes);
@@ -325,26 +340,29 @@ amscr_status amscr__parametrize(const double *P0, size_t M, int closed, amscr_pa
         equal_params(total, cnt, closed, tgt);
         double *dst = last ? finalpos : newpos;
         invert_cum(cum, M, closed, total, tgt, cnt, dst);
-        /* dst holds positions in the index space of P (= pos); map back to P0 positions */
+        /* dst: positions in the index space of C; map them to positions on P */
         for (size_t k = 0; k < cnt; k++) {
             double q = dst[k], fl = floor(q);
             size_t a = (size_t)fl;
             double u = q - fl;
-            double pa = pos[a % M];
-            double pb;
+            if (a >= M)
+                a = M - 1;
+            double pa = pos[a], pb;
             if (a + 1 < M)
                 pb = pos[a + 1];
             else
-                pb = closed ? pos[0] + (double)M : pos[M - 1];
+                pb = closed ? pos[0] + (double)np : pos[M - 1];
+            if (pb < pa) /* wrapped past the end of a closed polygon */
+                pb += (double)np;
             dst[k] = pa + u * (pb - pa);
-            if (closed && dst[k] >= (double)M)
-                dst[k] -= (double)M;
+            if (closed && dst[k] >= (double)np)
+                dst[k] -= (double)np;
         }
         if (!last)
             memcpy(pos, newpos, M * sizeof *pos);
     }
     if (st == AMSCR_OK)
-        sample_by_index(P0, M, closed, finalpos, m, out);
+        sample_by_index(P, np, closed, finalpos, m, out);
     free(buf);
     return st;
 }
@@ -364,16 +382,8 @@ amscr_status amscr_resample_affine(const double *xy, size_t n, int closed, doubl
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_resample_affine: passes = %u must be in 1..10", passes);
     if (!amscr__all_finite(xy, 2 * n))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_resample_affine: non-finite coordinates");
-    closed = closed ? 1 : 0;
     size_t M = 8 * m > n ? 8 * m : n;
-    double *P0 = amscr__malloc_array(2 * M, sizeof *P0);
-    if (!P0)
-        return amscr__fail(AMSCR_E_NOMEM, "amscr_resample_affine: out of memory");
-    amscr_status st = amscr__resample_euclid(xy, n, closed, M, P0);
-    if (st == AMSCR_OK)
-        st = amscr__parametrize(P0, M, closed, AMSCR_PARAM_AFFINE, sigma0, passes, m, out_xy);
-    free(P0);
-    return st;
+    return amscr__parametrize(xy, n, closed ? 1 : 0, AMSCR_PARAM_AFFINE, sigma0, passes, M, m, out_xy);
 }
 
 amscr_status amscr__whiten(const double *xy, size_t n, double *out_xy, double fwd[6], double inv[6])

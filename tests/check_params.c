@@ -34,7 +34,7 @@ START_TEST(test_defaults)
     ck_assert_int_eq(amscr_params_get_method(p), AMSCR_METHOD_MULTICLASS_EM);
     ck_assert_int_eq(amscr_params_get_closed(p), 1);
     ck_assert_int_eq(amscr_params_get_reflections(p), 0);
-    ck_assert_int_eq(amscr_params_get_parametrization(p), AMSCR_PARAM_AFFINE);
+    ck_assert_int_eq(amscr_params_get_parametrization(p), AMSCR_PARAM_WHITENED);
     ck_assert_uint_eq(amscr_params_get_oversampling(p), 8);
     ck_assert_uint_eq(amscr_params_get_kmax(p), 5);
     ck_assert_int_eq(amscr_params_get_symmetric(p), 0);

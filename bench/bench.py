@@ -1,0 +1,44 @@
+#!/usr/bin/env python3
+"""Runs the speed benchmark, then (when ../shared/datasets exists and the tool is built)
+`amscr eval` on Kimia-99 and Kimia-216, printing the top-k tables beside the paper's rows."""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+PAPER = {
+    'kimia99': [99, 99, 99, 99, 99, 99, 98, 97, 98, 97],
+    'kimia216': [216, 216, 216, 216, 215, 216, 215, 214, 212, 207, 207],
+}
+
+ap = argparse.ArgumentParser()
+ap.add_argument('--bench', required=True)
+ap.add_argument('--tool')
+ap.add_argument('--datasets')
+ap.add_argument('--shapes', default='1400')
+args, rest = ap.parse_known_args()
+
+sys.stdout.flush()
+rc = subprocess.call([args.bench, '--shapes', args.shapes] + rest)
+if rc != 0:
+    sys.exit(rc)
+if not args.tool or not args.datasets or not os.path.isdir(args.datasets):
+    print('(Kimia tables skipped: no tool or no ../shared/datasets)')
+    sys.exit(0)
+for name, paper in PAPER.items():
+    folder = os.path.join(args.datasets, name)
+    if not os.path.isdir(folder):
+        continue
+    ranks = len(paper)
+    out = subprocess.run([args.tool, 'eval', folder, '--protocol', 'topk', '--ranks', str(ranks), '--json'],
+                         capture_output=True, text=True)
+    if out.returncode != 0:
+        print('%s: amscr eval failed: %s' % (name, out.stderr.strip()))
+        continue
+    res = json.loads(out.stdout)
+    ours = res['topk']
+    print('%s (n = %d, %.2f s)' % (name, res['n'], res['seconds']))
+    print('  %-28s %s  sum' % ('', ' '.join('%4s' % ('T%d' % (r + 1)) for r in range(ranks))))
+    print('  %-28s %s  %d' % ('amscr (defaults)', ' '.join('%4d' % v for v in ours), sum(ours)))
+    print('  %-28s %s  %d' % ('paper, AMSCR multiclass-EM', ' '.join('%4d' % v for v in paper), sum(paper)))

@@ -1,0 +1,320 @@
+/* check_contour_io.c — text point lists: parsing, reading, atomic writing. */
+#include <check.h>
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "amscr.h"
+#include "suites.h"
+#include "testutil.h"
+
+/* Parses a C string; returns the status and (on success) the contour. */
+static amscr_status parse(const char *s, amscr_contour **c)
+{
+    *c = NULL;
+    return amscr_contour_parse_text(s, strlen(s), c);
+}
+
+/* Asserts that contour c holds exactly the n points of xy. */
+static void assert_points(const amscr_contour *c, const double *xy, size_t n)
+{
+    ck_assert_uint_eq(amscr_contour_size(c), n);
+    const double *p = amscr_contour_xy(c);
+    for (size_t i = 0; i < 2 * n; i++)
+        ck_assert_msg(p[i] == xy[i], "coordinate %zu: %.17g != %.17g", i, p[i], xy[i]);
+}
+
+/* A fresh temporary folder (removed by rm_tree). */
+static char *make_tmpdir(void)
+{
+    const char *base = getenv("TMPDIR");
+    char *buf = malloc(4096);
+    snprintf(buf, 4096, "%s/amscr_io_XXXXXX", base && *base ? base : "/tmp");
+    ck_assert_ptr_nonnull(mkdtemp(buf));
+    return buf;
+}
+
+/* Number of entries (other than . and ..) in a folder. */
+static int count_entries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    ck_assert_ptr_nonnull(d);
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL)
+        if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0)
+            n++;
+    closedir(d);
+    return n;
+}
+
+/* Removes the files of a flat folder, then the folder. */
+static void rm_tree(char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d) {
+        struct dirent *e;
+        char path[4200];
+        while ((e = readdir(d)) != NULL) {
+            if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+                continue;
+            snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+            unlink(path);
+        }
+        closedir(d);
+    }
+    rmdir(dir);
+    free(dir);
+}
+
+/* Writes a string to a file. */
+static void write_file(const char *path, const char *s)
+{
+    FILE *f = fopen(path, "wb");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_uint_eq(fwrite(s, 1, strlen(s), f), strlen(s));
+    ck_assert_int_eq(fclose(f), 0);
+}
+
+START_TEST(parse_separators)
+{
+    amscr_contour *c;
+    const char *text = "1 2\n3,4\n5, 6\n7\t8\n  9 \t 10  \n-1.5,+2.25\n11 ,12\n";
+    const double xy[] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, -1.5, 2.25, 11, 12};
+    ck_assert_int_eq(parse(text, &c), AMSCR_OK);
+    assert_points(c, xy, 7);
+    ck_assert_str_eq(amscr_last_error_detail(), "");
+    amscr_contour_free(c);
+}
+END_TEST
+
+START_TEST(parse_comments_blank_crlf)
+{
+    amscr_contour *c;
+    const char *text = "# header\r\n\r\n1 2 # trailing comment\r\n   \r\n\t\n3 4\r\n#5 6\n7 8#x y z\n# end";
+    const double xy[] = {1, 2, 3, 4, 7, 8};
+    ck_assert_int_eq(parse(text, &c), AMSCR_OK);
+    assert_points(c, xy, 3);
+    amscr_contour_free(c);
+}
+END_TEST
+
+START_TEST(parse_scientific_and_no_final_newline)
+{
+    amscr_contour *c;
+    const char *text = "1e3 -2.5E-2\n.5 6.\n0x1p-2 1e-310\n-0 0.1";
+    const double xy[] = {1000.0, -0.025, 0.5, 6.0, 0.25, 1e-310, -0.0, 0.1};
+    ck_assert_int_eq(parse(text, &c), AMSCR_OK);
+    assert_points(c, xy, 4);
+    ck_assert(signbit(amscr_contour_xy(c)[6]));
+    amscr_contour_free(c);
+}
+END_TEST
+
+START_TEST(parse_not_nul_terminated)
+{
+    /* Only the first len bytes count: "1 2\n3 4" out of a longer buffer. */
+    const char buf[] = "1 2\n3 4999 garbage";
+    amscr_contour *c = NULL;
+    ck_assert_int_eq(amscr_contour_parse_text(buf, 7, &c), AMSCR_OK);
+    const double xy[] = {1, 2, 3, 4};
+    assert_points(c, xy, 2);
+    amscr_contour_free(c);
+}
+END_TEST
+
+/* Bad inputs: each must fail with FORMAT naming the right line. */
+static const struct {
+    const char *text;
+    int line;
+} bad_cases[] = {
+    {"1 2\n3 4 5\n", 2},          /* three numbers */
+    {"1 2\n\n7\n", 3},            /* one number */
+    {"# c\nabc def\n", 2},        /* garbage */
+    {"1 2\n3 nan\n", 2},          /* NaN */
+    {"inf 1\n", 1},               /* infinity */
+    {"1 2\n1e999 3\n", 2},        /* overflow to infinity */
+    {"1,,2\n", 1},                /* two commas */
+    {"1, ,2\n", 1},               /* comma, blank, comma-less gap */
+    {"1-2\n", 1},                 /* no separator */
+    {"1 2,\n", 1},                /* trailing comma */
+    {",1 2\n", 1},                /* leading comma */
+    {"1 2\n3 4\n5 6x\n", 3},      /* trailing garbage */
+    {"1 2\r\n3\r\n", 2},          /* CRLF and one number */
+    {"1;2\n", 1},                 /* wrong separator */
+};
+
+START_TEST(parse_bad_line)
+{
+    amscr_contour *c = (amscr_contour *)&c; /* must stay untouched */
+    amscr_contour *const sentinel = c;
+    const char *text = bad_cases[_i].text;
+    ck_assert_int_eq(amscr_contour_parse_text(text, strlen(text), &c), AMSCR_E_FORMAT);
+    ck_assert_ptr_eq(c, sentinel);
+    char want[64];
+    snprintf(want, sizeof want, "line %d: expected 2 numbers", bad_cases[_i].line);
+    ck_assert_str_eq(amscr_last_error_detail(), want);
+}
+END_TEST
+
+START_TEST(parse_empty)
+{
+    amscr_contour *c = NULL;
+    ck_assert_int_eq(amscr_contour_parse_text("", 0, &c), AMSCR_E_FORMAT);
+    ck_assert_ptr_null(c);
+    ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), "no points"));
+    ck_assert_int_eq(parse("# only a comment\n\n   \r\n", &c), AMSCR_E_FORMAT);
+    ck_assert_ptr_null(c);
+    ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), "no points"));
+}
+END_TEST
+
+START_TEST(null_args)
+{
+    amscr_contour *c = NULL;
+    ck_assert_int_eq(amscr_contour_parse_text(NULL, 3, &c), AMSCR_E_INVALID_ARG);
+    ck_assert_str_ne(amscr_last_error_detail(), "");
+    ck_assert_int_eq(amscr_contour_parse_text("1 2", 3, NULL), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_contour_read_text(NULL, &c), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_contour_read_text("x.txt", NULL), AMSCR_E_INVALID_ARG);
+    ck_assert_str_ne(amscr_last_error_detail(), "");
+    const double xy[] = {0, 0, 1, 0, 0, 1};
+    ck_assert_int_eq(amscr_contour_new(xy, 3, &c), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_write_text(NULL, "x.txt"), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_contour_write_text(c, NULL), AMSCR_E_INVALID_ARG);
+    ck_assert_str_ne(amscr_last_error_detail(), "");
+    amscr_contour_free(c);
+}
+END_TEST
+
+START_TEST(read_file_and_errors)
+{
+    char *dir = make_tmpdir();
+    char path[4200];
+    snprintf(path, sizeof path, "%s/shape.txt", dir);
+    write_file(path, "# a square\n0 0\n1,0\n1\t1\r\n0, 1\n");
+    amscr_contour *c = NULL;
+    ck_assert_int_eq(amscr_contour_read_text(path, &c), AMSCR_OK);
+    const double xy[] = {0, 0, 1, 0, 1, 1, 0, 1};
+    assert_points(c, xy, 4);
+    amscr_contour_free(c);
+
+    /* A bad line: "path:line: expected 2 numbers". */
+    write_file(path, "0 0\n1 0\n\n1 1 1\n");
+    c = NULL;
+    ck_assert_int_eq(amscr_contour_read_text(path, &c), AMSCR_E_FORMAT);
+    ck_assert_ptr_null(c);
+    char want[4300];
+    snprintf(want, sizeof want, "%s:4: expected 2 numbers", path);
+    ck_assert_str_eq(amscr_last_error_detail(), want);
+
+    /* Empty file. */
+    write_file(path, "");
+    ck_assert_int_eq(amscr_contour_read_text(path, &c), AMSCR_E_FORMAT);
+    ck_assert_ptr_null(c);
+
+    /* A folder: opens, but reading fails: IO. */
+    ck_assert_int_eq(amscr_contour_read_text(dir, &c), AMSCR_E_IO);
+    ck_assert_ptr_null(c);
+
+    /* Missing file: IO, with the path and strerror in the detail. */
+    snprintf(path, sizeof path, "%s/missing.txt", dir);
+    ck_assert_int_eq(amscr_contour_read_text(path, &c), AMSCR_E_IO);
+    ck_assert_ptr_null(c);
+    ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), path));
+    ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), "No such file"));
+    rm_tree(dir);
+}
+END_TEST
+
+START_TEST(write_read_round_trip)
+{
+    char *dir = make_tmpdir();
+    char path[4200];
+    snprintf(path, sizeof path, "%s/out.txt", dir);
+    amscr_test_rng r;
+    amscr_test_rng_seed(&r, 42);
+    enum { N = 500 };
+    double xy[2 * N];
+    for (int i = 0; i < 2 * N; i++)
+        xy[i] = (amscr_test_uniform(&r) - 0.5) * pow(10.0, (double)(i % 41) - 20.0);
+    xy[0] = 0.1;
+    xy[1] = -0.0;
+    xy[2] = 1e-310; /* subnormal */
+    xy[3] = 1.7976931348623157e308;
+    amscr_contour *c = NULL, *back = NULL;
+    ck_assert_int_eq(amscr_contour_new(xy, N, &c), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_write_text(c, path), AMSCR_OK);
+    ck_assert_int_eq(count_entries(dir), 1); /* no temporary left */
+    ck_assert_int_eq(amscr_contour_read_text(path, &back), AMSCR_OK);
+    assert_points(back, xy, N);
+    amscr_contour_free(back);
+
+    /* Overwriting an existing file works and is exact too. */
+    double xy2[] = {1.0 / 3.0, 2.0 / 3.0, -5, 7};
+    amscr_contour *c2 = NULL;
+    ck_assert_int_eq(amscr_contour_new(xy2, 2, &c2), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_write_text(c2, path), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_read_text(path, &back), AMSCR_OK);
+    assert_points(back, xy2, 2);
+    ck_assert_int_eq(count_entries(dir), 1);
+
+    /* The file format is "%.17g %.17g\n". */
+    FILE *f = fopen(path, "rb");
+    char text[256] = {0};
+    ck_assert_ptr_nonnull(f);
+    size_t got = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    ck_assert_uint_gt(got, 0);
+    ck_assert_str_eq(text, "0.33333333333333331 0.66666666666666663\n-5 7\n");
+
+    amscr_contour_free(back);
+    amscr_contour_free(c);
+    amscr_contour_free(c2);
+    rm_tree(dir);
+}
+END_TEST
+
+START_TEST(write_missing_dir)
+{
+    char *dir = make_tmpdir();
+    char path[4200];
+    snprintf(path, sizeof path, "%s/no/such/dir/out.txt", dir);
+    const double xy[] = {0, 0, 1, 0, 0, 1};
+    amscr_contour *c = NULL;
+    ck_assert_int_eq(amscr_contour_new(xy, 3, &c), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_write_text(c, path), AMSCR_E_IO);
+    ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), path));
+    ck_assert_int_eq(access(path, F_OK), -1);
+    ck_assert_int_eq(count_entries(dir), 0);
+
+    /* The path is a folder: rename fails, the temporary is removed. */
+    ck_assert_int_eq(amscr_contour_write_text(c, dir), AMSCR_E_IO);
+    ck_assert_int_eq(count_entries(dir), 0);
+    amscr_contour_free(c);
+    rm_tree(dir);
+}
+END_TEST
+
+Suite *amscr_suite_contour_io(void)
+{
+    Suite *s = suite_create("contour_io");
+    TCase *tc = tcase_create("parse");
+    tcase_add_test(tc, parse_separators);
+    tcase_add_test(tc, parse_comments_blank_crlf);
+    tcase_add_test(tc, parse_scientific_and_no_final_newline);
+    tcase_add_test(tc, parse_not_nul_terminated);
+    tcase_add_loop_test(tc, parse_bad_line, 0, (int)(sizeof bad_cases / sizeof bad_cases[0]));
+    tcase_add_test(tc, parse_empty);
+    tcase_add_test(tc, null_args);
+    suite_add_tcase(s, tc);
+    TCase *tf = tcase_create("files");
+    tcase_add_test(tf, read_file_and_errors);
+    tcase_add_test(tf, write_read_round_trip);
+    tcase_add_test(tf, write_missing_dir);
+    suite_add_tcase(s, tf);
+    return s;
+}

@@ -1,0 +1,213 @@
+"""Collections: `amscr matrix` (.tsv and .npy agree), `amscr eval` on a manifest and a
+folder, `amscr search`, class names from file names."""
+import json
+import math
+import os
+import struct
+
+import pytest
+
+from imgutil import affine, image_bytes, img_ext, rasterize, run, smooth_shape, write_points
+
+MAPS = [((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
+        ((0.9, 0.4, 10.0), (-0.3, 1.1, -5.0)),
+        ((0.6, -0.5, -3.0), (0.7, 0.8, 2.0))]
+
+
+def base_shapes():
+    star = []
+    for i in range(200):
+        t = 2 * math.pi * i / 200
+        r = 1 + 0.35 * math.cos(5 * t) + 0.05 * math.sin(2 * t)
+        star.append((50 * r * math.cos(t), 50 * r * math.sin(t)))
+    return {"blob": smooth_shape(200, 0), "wave": smooth_shape(200, 2.5), "star": star}
+
+
+@pytest.fixture
+def manifest(tmp_path):
+    d = tmp_path / "shapes"
+    d.mkdir()
+    rows = ["file\tclass"]
+    for name, pts in base_shapes().items():
+        for k, m in enumerate(MAPS, 1):
+            rel = "shapes/%s_%d.txt" % (name, k)
+            write_points(tmp_path / rel, affine(m, pts))
+            rows.append("%s\t%s" % (rel, name.upper()))
+    mf = tmp_path / "manifest.tsv"
+    mf.write_text("\n".join(rows) + "\n")
+    return mf
+
+
+def read_npy(path):
+    data = open(path, "rb").read()
+    assert data[:6] == b"\x93NUMPY" and data[6:8] == b"\x01\x00"
+    hlen = struct.unpack("<H", data[8:10])[0]
+    assert (10 + hlen) % 64 == 0
+    header = data[10:10 + hlen].decode("latin1")
+    assert header.endswith("\n")
+    d = eval(header)  # a Python literal, as numpy writes it
+    assert d["descr"] == "<f8" and d["fortran_order"] is False
+    n, m = d["shape"]
+    vals = struct.unpack("<%dd" % (n * m), data[10 + hlen:])
+    return [list(vals[i * m:(i + 1) * m]) for i in range(n)]
+
+
+def read_tsv(path):
+    rows = []
+    for line in open(path):
+        if line.startswith("#"):
+            continue
+        rows.append([float(v) for v in line.split("\t")])
+    return rows
+
+
+def test_matrix_tsv_equals_npy(manifest, tmp_path):
+    tsv, npy, names = tmp_path / "d.tsv", tmp_path / "d.npy", tmp_path / "names.tsv"
+    r = run("matrix", manifest, "-o", tsv, "--names", names, "--threads", "2")
+    assert r.returncode == 0, r.stderr
+    r = run("matrix", manifest, "-o", npy, "--threads", "1")
+    assert r.returncode == 0, r.stderr
+    a, b = read_tsv(tsv), read_npy(npy)
+    assert len(a) == 9 and all(len(row) == 9 for row in a)
+    assert a == b  # %.17g text round-trips exactly; thread counts give identical results
+    assert all(a[i][i] == 0 for i in range(9))
+    lines = names.read_text().splitlines()
+    assert lines[0] == "file\tclass" and lines[1] == "shapes/blob_1.txt\tBLOB" and len(lines) == 10
+    try:
+        import numpy
+    except ImportError:
+        return
+    assert numpy.array_equal(numpy.load(npy), numpy.loadtxt(tsv))
+
+
+def test_matrix_stdout(manifest):
+    r = run("matrix", manifest, "-o", "-")
+    assert r.returncode == 0, r.stderr
+    rows = [ln for ln in r.stdout.splitlines() if not ln.startswith("#")]
+    assert len(rows) == 9
+
+
+def test_eval_manifest_json(manifest):
+    r = run("eval", manifest, "--json", "--ranks", "2")
+    assert r.returncode == 0, r.stderr
+    j = json.loads(r.stdout)
+    assert j["n"] == 9 and j["classes"] == 3
+    assert j["bullseye"] == 1.0
+    assert j["topk"] == [9, 9]
+    assert j["nn_accuracy"] == 1.0
+    assert j["seconds"] >= 0
+
+
+def test_eval_default_ranks_clamped(manifest):
+    j = json.loads(run("eval", manifest, "--json").stdout)
+    assert len(j["topk"]) == 8  # 10 by default, at most n - 1
+
+
+@pytest.mark.parametrize("protocol,keys", [("bullseye", {"bullseye"}), ("topk", {"topk"}),
+                                           ("nn", {"nn_accuracy"})])
+def test_eval_protocols(manifest, protocol, keys):
+    r = run("eval", manifest, "--json", "--protocol", protocol)
+    assert r.returncode == 0, r.stderr
+    j = json.loads(r.stdout)
+    assert {"bullseye", "topk", "nn_accuracy"} & set(j) == keys
+    assert {"n", "classes", "seconds"} <= set(j)
+
+
+def test_eval_human(manifest):
+    r = run("eval", manifest)
+    assert r.returncode == 0, r.stderr
+    assert "bull's eye" in r.stdout and "top-k" in r.stdout and "1-NN" in r.stdout
+
+
+def test_eval_folder_classes_from_names(tmp_path):
+    d = tmp_path / "imgs"
+    d.mkdir()
+    for name, pts in base_shapes().items():
+        for k, m in enumerate(MAPS, 1):
+            q = [(1.2 * x + 100, 1.2 * y + 100) for x, y in affine(m, pts)]
+            fn = "%s-%d%s" % (name, k, img_ext())
+            (d / fn).write_bytes(image_bytes(rasterize(q, 200, 200), fn))
+    (d / "manifest.tsv").write_text("ignored\n")  # not a shape: skipped in a folder
+    (d / "notes.md").write_text("# not a shape\n")
+    r = run("eval", d, "--json")
+    assert r.returncode == 0, r.stderr
+    j = json.loads(r.stdout)
+    assert j["n"] == 9 and j["classes"] == 3
+    assert j["nn_accuracy"] == 1.0
+
+
+def test_search(manifest, tmp_path):
+    q = tmp_path / "query.txt"
+    write_points(q, affine(((0.7, 0.2, 1.0), (0.1, 1.3, 2.0)), base_shapes()["wave"]))
+    r = run("search", q, manifest, "--top", "3", "--json")
+    assert r.returncode == 0, r.stderr
+    j = json.loads(r.stdout)
+    assert [x["class"] for x in j["results"]] == ["WAVE"] * 3
+    assert [x["rank"] for x in j["results"]] == [1, 2, 3]
+    d = [x["distance"] for x in j["results"]]
+    assert d == sorted(d)
+    r = run("search", q, manifest)
+    assert r.returncode == 0 and "WAVE" in r.stdout
+
+
+def test_bad_collection_member(manifest, tmp_path):
+    (tmp_path / "shapes" / "star_2.txt").write_text("1 2\nbroken\n")
+    r = run("eval", manifest)
+    assert r.returncode == 1
+    assert len(r.stderr.splitlines()) == 1 and "star_2.txt" in r.stderr
+    out = tmp_path / "m.npy"
+    r = run("matrix", manifest, "-o", out)
+    assert r.returncode == 1 and not out.exists()
+
+
+@pytest.mark.parametrize("text,needle", [("name\tlabel\na.txt\tx\n", "'file'"), ("file\tclass\n", "no shapes"),
+                                         ("file\tclass\na.txt\n", "line 2"), ("", "empty")])
+def test_bad_manifest(tmp_path, text, needle):
+    mf = tmp_path / "m.tsv"
+    mf.write_text(text)
+    r = run("eval", mf)
+    assert r.returncode == 1
+    assert len(r.stderr.splitlines()) == 1 and "m.tsv" in r.stderr and needle in r.stderr, r.stderr
+
+
+def test_empty_folder(tmp_path):
+    r = run("eval", tmp_path)
+    assert r.returncode == 1 and "no shapes" in r.stderr
+
+
+@pytest.mark.png
+def test_bundled_collection():
+    from imgutil import REPO
+    d = os.path.join(REPO, "examples", "collection")
+    if not os.path.isdir(d):
+        pytest.skip("examples/ not generated")
+    j = json.loads(run("eval", d, "--json").stdout)
+    assert j["n"] == 12 and j["classes"] == 4
+
+
+def test_quiet_without_terminal(manifest, tmp_path):
+    for args in (["eval", manifest], ["matrix", manifest, "-o", tmp_path / "m.tsv"]):
+        r = run(*args)
+        assert r.returncode == 0 and r.stderr == ""  # no progress bar when stderr is not a terminal
+
+
+def test_progress_on_terminal(manifest):
+    pty = pytest.importorskip("pty")
+    import subprocess
+    from imgutil import tool_path
+    master, slave = pty.openpty()
+    p = subprocess.run([tool_path(), "eval", str(manifest), "--json"], stdout=subprocess.PIPE, stderr=slave)
+    os.close(slave)
+    err = b""
+    try:
+        while True:
+            chunk = os.read(master, 65536)
+            if not chunk:
+                break
+            err += chunk
+    except OSError:
+        pass
+    os.close(master)
+    assert p.returncode == 0
+    json.loads(p.stdout)  # stdout stays clean
+    assert b"matching" in err and b"100%" in err

@@ -1,0 +1,225 @@
+"""Bad input and bad usage: exit 1 (input/failure) or 2 (usage), exactly one line on stderr
+naming the file, nothing on stdout, never a crash, no output file left behind."""
+import os
+import struct
+import zlib
+
+import pytest
+
+from imgutil import (blank, have_png, pgm_bytes, png_bytes, png_header_only, rect_mask, run, smooth_shape,
+                     write_points)
+
+GOOD_PNG = png_bytes(rect_mask(fg=255), 0, 8)
+
+
+def check_fail(r, code, *needles):
+    assert r.returncode == code, (r.returncode, r.stderr)
+    assert r.returncode >= 0  # not killed by a signal
+    lines = r.stderr.splitlines()
+    assert len(lines) == 1, r.stderr
+    assert lines[0].startswith("amscr: "), lines[0]
+    for n in needles:
+        assert str(n) in lines[0], (n, lines[0])
+    assert r.stdout == ""
+
+
+def corrupt_idat(data):
+    """Replaces the IDAT payload with garbage that has a valid CRC."""
+    i = data.index(b"IDAT") - 4
+    n = struct.unpack(">I", data[i:i + 4])[0]
+    payload = bytes((j * 37 + 11) & 0xFF for j in range(n))
+    chunk = struct.pack(">I", n) + b"IDAT" + payload + struct.pack(">I", zlib.crc32(b"IDAT" + payload) & 0xFFFFFFFF)
+    return data[:i] + chunk + data[i + 12 + n:]
+
+
+BAD_FILES = {
+    "empty.png": (b"", "empty"),
+    "sig-only.png": (b"\x89PNG\r\n\x1a\n", "truncated"),
+    "trunc.png": (GOOD_PNG[:len(GOOD_PNG) - 30], "PNG"),
+    "trunc-ihdr.png": (GOOD_PNG[:20], "truncated"),
+    "bad-crc.png": (GOOD_PNG[:29] + b"\x00\x00\x00\x00" + GOOD_PNG[33:], "corrupt PNG"),
+    "bad-idat.png": (corrupt_idat(GOOD_PNG), "corrupt PNG"),
+    "bad-depth.png": (png_header_only(10, 10, depth=3, color_type=0), "corrupt PNG"),
+    "huge.png": (png_header_only(40000, 40000), "too large"),
+    "huge-pixels.png": (png_header_only(20000, 20000), "too large"),
+    "wide.png": (png_header_only(32769, 1), "too large"),
+    "zero.png": (png_header_only(0, 10), "PNG"),
+    "trunc.pgm": (pgm_bytes(rect_mask(fg=255))[:200], "truncated"),
+    "trunc16.pgm": (pgm_bytes(rect_mask(fg=999), maxval=1000)[:-1], "truncated"),
+    "trunc-header.pgm": (b"P5\n40 30\n", "truncated"),
+    "bad-header.pgm": (b"P5\nabc 30\n255\n" + bytes(1200), "corrupt PGM"),
+    "bad-maxval.pgm": (b"P5\n4 3\n70000\n" + bytes(24), "maxval"),
+    "zero-maxval.pgm": (b"P5\n4 3\n0\n" + bytes(12), "maxval"),
+    "zero-size.pgm": (b"P5\n0 3\n255\n", "PGM"),
+    "over-maxval.pgm": (b"P2\n3 3\n10\n0 0 0\n0 11 0\n0 0 0\n", "exceeds maxval"),
+    "trunc.p2.pgm": (b"P2\n3 3\n255\n0 0 0\n0 255\n", "truncated"),
+    "garbage.p2.pgm": (b"P2\n3 3\n255\n0 0 0\n0 x 0\n0 0 0\n", "corrupt PGM"),
+    "huge.pgm": (b"P5\n100000 10\n255\n", "too large"),
+    "huge-pixels.pgm": (b"P5 30000 30000 255\n", "too large"),
+    "black.png": (png_bytes(blank(20, 20, 0), 0, 8), "no foreground"),
+    "white.pgm": (pgm_bytes(blank(20, 20, 255)), "no foreground"),
+    "transparent.png": (png_bytes([[(0, 0, 0, 0)] * 8] * 8, 6, 8), "no foreground"),
+    "photo.jpg": (b"\xff\xd8\xff\xe0\x00\x10JFIF\x00" + bytes(100), "unsupported image format"),
+    "pic.gif": (b"GIF89a" + bytes(100), "unsupported image format"),
+    "color.ppm": (b"P6\n2 2\n255\n" + bytes(12), "unsupported image format"),
+    "bad-line.txt": (b"1 2\n3 4\n5 six\n", "bad-line.txt:3"),
+    "three-numbers.txt": (b"1 2 3\n", "three-numbers.txt:1"),
+    "comments-only.txt": (b"# nothing here\n\n", "comments-only.txt"),
+    "binary.dat": (bytes(range(1, 256)) * 4, "binary.dat"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(BAD_FILES))
+def test_bad_file_contour(tmp_path, name):
+    data, needle = BAD_FILES[name]
+    if data.startswith(b"\x89PNG") and not have_png():
+        needle = "without libpng"
+    p = tmp_path / name
+    p.write_bytes(data)
+    out = tmp_path / "out.txt"
+    r = run("contour", p, "-o", out)
+    check_fail(r, 1, name, needle)
+    assert sorted(os.listdir(tmp_path)) == [name]  # no output, no temporary left
+
+
+@pytest.mark.parametrize("name", ["trunc.png", "huge.pgm", "black.png", "bad-line.txt", "empty.png"])
+@pytest.mark.png
+def test_bad_file_register_no_pictures(tmp_path, name):
+    data, needle = BAD_FILES[name]
+    bad = tmp_path / name
+    bad.write_bytes(data)
+    good = tmp_path / "good.png"
+    good.write_bytes(GOOD_PNG)
+    for args in ([bad, good], [good, bad]):
+        r = run("register", *args, "--overlay", tmp_path / "o.png", "--plot", tmp_path / "p.svg", "--json")
+        check_fail(r, 1, name, needle)
+    assert sorted(os.listdir(tmp_path)) == sorted([name, "good.png"])
+
+
+def test_missing_file(tmp_path):
+    p = tmp_path / "nope.png"
+    check_fail(run("contour", p), 1, "nope.png", "cannot open")
+    check_fail(run("register", p, p), 1, "nope.png")
+
+
+def test_directory_as_shape(tmp_path):
+    check_fail(run("contour", tmp_path), 1, str(tmp_path), "directory")
+
+
+def test_degenerate_point_list(tmp_path):
+    src = tmp_path / "line.txt"
+    src.write_text("0 0\n1 1\n2 2\n3 3\n4 4\n5 5\n6 6\n7 7\n8 8\n9 9\n")
+    tgt = tmp_path / "shape.txt"
+    write_points(tgt, smooth_shape(100))
+    check_fail(run("register", src, tgt), 1, "line.txt")
+
+
+def test_overlay_into_missing_folder(tmp_path):
+    a = tmp_path / "a.txt"
+    write_points(a, smooth_shape(100))
+    r = run("register", a, a, "--overlay", tmp_path / "no" / "such" / "dir" / "o.svg")
+    check_fail(r, 1, "o.svg")
+
+
+USAGE = [
+    [],
+    ["frobnicate"],
+    ["contour"],
+    ["contour", "a.png", "b.png"],
+    ["contour", "a.png", "--bogus"],
+    ["contour", "a.png", "--threshold", "300"],
+    ["contour", "a.png", "--threshold", "x"],
+    ["contour", "a.png", "-o"],
+    ["register", "a.png"],
+    ["register", "a.png", "b.png", "--points", "abc"],
+    ["register", "a.png", "b.png", "--points", "5"],
+    ["register", "a.png", "b.png", "--points", "-3"],
+    ["register", "a.png", "b.png", "--method", "foo"],
+    ["register", "a.png", "b.png", "--scales", "1,a"],
+    ["register", "a.png", "b.png", "--scales", ""],
+    ["register", "a.png", "b.png", "--refine", "51"],
+    ["register", "a.png", "b.png", "--threads", "x"],
+    ["register", "a.png", "b.png", "--overlay", "o.gif"],
+    ["register", "a.png", "b.png", "--plot", "p.png"],
+    ["register", "a.png", "b.png", "--json=1"],
+    ["register", "a.png", "b.png", "--top", "3"],
+    ["search", "q.png"],
+    ["search", "q.png", "dir", "--top", "0"],
+    ["matrix", "dir"],
+    ["matrix", "dir", "-o", "m.csv"],
+    ["eval", "dir", "--protocol", "median"],
+    ["eval", "dir", "--ranks", "0"],
+]
+
+
+@pytest.mark.parametrize("args", USAGE, ids=[" ".join(a) or "<none>" for a in USAGE])
+def test_usage_errors(tmp_path, args):
+    r = run(*args, cwd=tmp_path)
+    assert r.returncode == 2, (r.returncode, r.stderr)
+    if args:
+        lines = r.stderr.splitlines()
+        assert len(lines) == 1 and lines[0].startswith("amscr: "), r.stderr
+    assert r.stdout == ""
+    assert os.listdir(tmp_path) == []
+
+
+def test_bad_scales_value_rejected_by_library(tmp_path):
+    a = tmp_path / "a.txt"
+    write_points(a, smooth_shape(100))
+    r = run("register", a, a, "--scales", "1,2,1e9")  # sigma > N
+    assert r.returncode == 2, r.stderr
+    assert len(r.stderr.splitlines()) == 1 and "--scales" in r.stderr
+
+
+def test_help_and_version():
+    r = run("--help")
+    assert r.returncode == 0 and "register" in r.stdout and r.stderr == ""
+    for cmd in ["contour", "register", "search", "matrix", "eval"]:
+        r = run(cmd, "--help")
+        assert r.returncode == 0 and ("amscr " + cmd) in r.stdout, cmd
+    r = run("--version")
+    assert r.returncode == 0
+    assert r.stdout.strip().count(".") == 2 and r.stdout.strip().replace(".", "").isdigit()
+
+
+def _mutants(seed, data, count):
+    import random
+    rng = random.Random(seed)
+    for _ in range(count):
+        b = bytearray(data)
+        kind = rng.randrange(3)
+        if kind == 0:  # flip bytes
+            for _ in range(rng.randint(1, 8)):
+                b[rng.randrange(len(b))] = rng.randrange(256)
+        elif kind == 1:  # truncate
+            del b[rng.randrange(1, len(b)):]
+        else:  # duplicate a slice
+            i = rng.randrange(len(b))
+            b[i:i] = b[i:i + rng.randint(1, 64)]
+        yield bytes(b)
+
+
+def _fuzz_sources():
+    img = rect_mask(fg=255)
+    pal = [(0, 0, 0), (255, 255, 255)]
+    return {
+        "gray.png": png_bytes(img, 0, 8),
+        "adam7-rgba16.png": png_bytes([[(v * 257, 0, 0, 65535) for v in row] for row in img], 6, 16, interlace=True),
+        "pal2.png": png_bytes(rect_mask(fg=1), 3, 2, palette=pal, trns=b"\x00"),
+        "p5-16.pgm": pgm_bytes(rect_mask(fg=999), maxval=1000, comments=True),
+        "p2.pgm": pgm_bytes(rect_mask(fg=7), maxval=7, ascii=True, comments=True),
+    }
+
+
+@pytest.mark.parametrize("name", sorted(_fuzz_sources()))
+def test_mutated_files_never_crash(tmp_path, name):
+    data = _fuzz_sources()[name]
+    for k, mutant in enumerate(_mutants(zlib.crc32(name.encode()), data, 40)):
+        p = tmp_path / ("m%d-%s" % (k, name))
+        p.write_bytes(mutant)
+        r = run("contour", p)
+        assert r.returncode in (0, 1), (p, r.returncode, r.stderr)
+        if r.returncode == 1:
+            lines = r.stderr.splitlines()
+            assert len(lines) == 1 and lines[0].startswith("amscr: ") and p.name in lines[0], r.stderr
+        p.unlink()

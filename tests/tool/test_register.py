@@ -1,0 +1,210 @@
+"""End-to-end `amscr register`: the JSON recovers a known affine map; methods, options and
+pictures; the bundled example pair."""
+import json
+import math
+import os
+import xml.etree.ElementTree as ET
+
+import pytest
+
+from imgutil import REPO, affine, have_png, image_bytes, img_ext, rasterize, run, smooth_shape, write_points
+
+TRUE = ((1.3, 0.4, 15.0), (-0.2, 0.8, -7.0))  # shear + anisotropic scale, det > 0
+
+
+def check_png(data):
+    """A valid 8-bit RGB PNG: signature, chunk CRCs, IDAT inflates to the right size."""
+    import struct
+    import zlib
+    assert data.startswith(b"\x89PNG\r\n\x1a\n")
+    i, idat, kinds = 8, b"", []
+    while i < len(data):
+        n = struct.unpack(">I", data[i:i + 4])[0]
+        kind, body = data[i + 4:i + 8], data[i + 8:i + 8 + n]
+        assert struct.unpack(">I", data[i + 8 + n:i + 12 + n])[0] == zlib.crc32(kind + body) & 0xFFFFFFFF
+        if kind == b"IHDR":
+            w, h, depth, ctype = struct.unpack(">IIBB", body[:10])
+        if kind == b"IDAT":
+            idat += body
+        kinds.append(kind)
+        i += 12 + n
+    assert kinds[0] == b"IHDR" and kinds[-1] == b"IEND"
+    assert (depth, ctype) == (8, 2) and w > 100 and h > 100
+    assert len(zlib.decompress(idat)) == h * (1 + 3 * w)
+
+
+def rel_err_A(got, true):
+    (a, b), (c, d) = got
+    (ta, tb, _), (tc, td, _) = true
+    num = math.sqrt((a - ta) ** 2 + (b - tb) ** 2 + (c - tc) ** 2 + (d - td) ** 2)
+    return num / math.sqrt(ta * ta + tb * tb + tc * tc + td * td)
+
+
+def size_of(pts):
+    xs = [p[0] for p in pts]
+    ys = [p[1] for p in pts]
+    return max(max(xs) - min(xs), max(ys) - min(ys))
+
+
+@pytest.fixture
+def pair(tmp_path):
+    src = smooth_shape(300)
+    tgt = affine(TRUE, src)
+    # start the target at another point (the start-point search must find it)
+    tgt = tgt[77:] + tgt[:77]
+    s, t = tmp_path / "src.txt", tmp_path / "tgt.txt"
+    write_points(s, src)
+    write_points(t, tgt)
+    return s, t, size_of(tgt)
+
+
+def register_json(*args):
+    r = run("register", *args, "--json")
+    assert r.returncode == 0, r.stderr
+    assert r.stderr == ""
+    lines = r.stdout.strip().splitlines()
+    assert len(lines) == 1  # exactly one JSON object
+    return json.loads(lines[0])
+
+
+def test_recovers_known_affine_map(pair):
+    s, t, size = pair
+    j = register_json(s, t)
+    assert rel_err_A(j["A"], TRUE) < 1e-3, j["A"]
+    assert abs(j["B"][0] - TRUE[0][2]) < 1e-2 * size and abs(j["B"][1] - TRUE[1][2]) < 1e-2 * size, j["B"]
+    assert j["distance"] < 1e-6
+    assert j["reflected"] is False
+    assert j["method"] == "multiclass-em"
+    assert len(j["residuals"]) == len(j["scales"])
+    assert set(j["kept"]) <= set(j["scales"]) and len(j["kept"]) >= 1
+    assert isinstance(j["shift"], int) and 0 <= j["shift"] < j["samples"]
+    for key in ["k", "threshold", "sse", "mixture", "samples", "source_points", "target_points"]:
+        assert key in j
+
+
+@pytest.mark.parametrize("method", ["acma", "amscr", "binary-em", "multiclass-em"])
+def test_methods(pair, method):
+    s, t, size = pair
+    j = register_json(s, t, "--method", method, "--points", "64")
+    assert j["method"] == method
+    assert j["samples"] == 64
+    assert rel_err_A(j["A"], TRUE) < 1e-3
+
+
+def test_options(pair):
+    s, t, _ = pair
+    j = register_json(s, t, "--scales", "0,1,2,4,8", "--refine", "2", "--threads", "1", "--kmax", "3")
+    assert j["scales"] == [0, 1, 2, 4, 8]
+    assert len(j["residuals"]) == 5
+    assert rel_err_A(j["A"], TRUE) < 1e-3
+
+
+def test_inverse_direction(pair):
+    s, t, _ = pair
+    j = register_json(t, s)
+    (a, b), (c, d) = j["A"]
+    (ta, tb, _), (tc, td, _) = TRUE
+    # A * TRUE_A = I
+    prod = [[a * ta + b * tc, a * tb + b * td], [c * ta + d * tc, c * tb + d * td]]
+    assert all(abs(prod[i][k] - (i == k)) < 1e-3 for i in range(2) for k in range(2)), prod
+
+
+def test_reflected_pair(tmp_path):
+    src = smooth_shape(300, seed=1)
+    mirror = ((-1.1, 0.2, 300.0), (0.1, 0.9, 20.0))  # det < 0
+    s, t = tmp_path / "s.txt", tmp_path / "t.txt"
+    write_points(s, src)
+    write_points(t, affine(mirror, src))
+    j = register_json(s, t, "--reflections")
+    assert j["reflected"] is True
+    assert rel_err_A(j["A"], mirror) < 1e-3, j["A"]
+    assert j["distance"] < 1e-6
+    j0 = register_json(s, t)  # reflections off (the default for register)
+    assert j0["reflected"] is False
+    assert j0["distance"] > j["distance"]
+
+
+def test_open_curves(tmp_path):
+    src = smooth_shape(300)[:180]  # an open arc
+    tgt = affine(TRUE, src)
+    s, t = tmp_path / "s.txt", tmp_path / "t.txt"
+    write_points(s, src)
+    write_points(t, tgt)
+    j = register_json(s, t, "--open")
+    assert j["closed"] is False
+    assert rel_err_A(j["A"], TRUE) < 1e-2, j["A"]
+
+
+def test_human_output(pair):
+    s, t, _ = pair
+    r = run("register", s, t)
+    assert r.returncode == 0, r.stderr
+    for word in ["distance", "A ", "B ", "method", "kept", "shift", "reflected", "threshold"]:
+        assert word in r.stdout
+
+
+@pytest.mark.parametrize("ext", [".png", ".svg", ".PNG"])
+def test_overlay_and_plot(pair, tmp_path, ext):
+    s, t, _ = pair
+    ov, pl = tmp_path / ("overlay" + ext), tmp_path / "plot.svg"
+    r = run("register", s, t, "--overlay", ov, "--plot", pl)
+    assert r.returncode == 0, r.stderr
+    data = ov.read_bytes()
+    if ext.lower() == ".png":
+        check_png(data)
+    else:
+        assert b"<svg" in data and b"source registered" in data
+        ET.fromstring(data)  # well-formed XML
+    svg = pl.read_text()
+    ET.fromstring(svg)
+    assert svg.count("<svg") == 1 and "Residual per scale" in svg and "Elbow" in svg
+    # no temporary files left next to the outputs
+    assert not [n for n in os.listdir(tmp_path) if n.startswith(".")]
+
+
+def test_overlay_open_png(tmp_path):
+    src = smooth_shape(200)[:120]
+    s, t = tmp_path / "s.txt", tmp_path / "t.txt"
+    write_points(s, src)
+    write_points(t, affine(TRUE, src))
+    r = run("register", s, t, "--open", "--overlay", tmp_path / "o.png", "--method", "acma", "--plot",
+            tmp_path / "p.svg")
+    assert r.returncode == 0, r.stderr
+    assert "no elbow" in (tmp_path / "p.svg").read_text()
+
+
+def test_image_pair(tmp_path):
+    # the smooth shape, rasterized, and its affine image: the map is recovered approximately
+    src = [(x + 100, y + 100) for x, y in smooth_shape(400)]
+    m = ((0.8, 0.3, 20.0), (-0.15, 0.7, 40.0))
+    a, b = tmp_path / ("a" + img_ext()), tmp_path / ("b" + img_ext())
+    a.write_bytes(image_bytes(rasterize(src, 200, 200), a.name))
+    b.write_bytes(image_bytes(rasterize(affine(m, src), 200, 200), b.name))
+    j = register_json(a, b)
+    assert rel_err_A(j["A"], m) < 0.03, j["A"]
+    assert abs(j["B"][0] - 20) < 3 and abs(j["B"][1] - 40) < 3, j["B"]
+
+
+def test_bundled_example_pair():
+    ex = os.path.join(REPO, "examples")
+    if not os.path.exists(os.path.join(ex, "pair-source.txt")):
+        pytest.skip("examples/ not generated")
+    j = register_json(os.path.join(ex, "pair-source.txt"), os.path.join(ex, "pair-target.txt"))
+    true = ((0.75, 0.35, -15.7), (-0.2, 0.65, 46.6))  # examples/README.md
+    assert rel_err_A(j["A"], true) < 1e-3
+    assert abs(j["B"][0] + 15.7) < 0.1 and abs(j["B"][1] - 46.6) < 0.1
+    if have_png():
+        j = register_json(os.path.join(ex, "pair-source.png"), os.path.join(ex, "pair-target.png"))
+        assert rel_err_A(j["A"], true) < 0.05
+
+
+def test_odd_file_names(tmp_path):
+    src = smooth_shape(120)
+    s, t = tmp_path / 'a&b <"q">\t.txt', tmp_path / "é ü\\x.txt"
+    write_points(s, src)
+    write_points(t, affine(TRUE, src))
+    ov, pl = tmp_path / "o.svg", tmp_path / "p.svg"
+    j = register_json(s, t, "--overlay", ov, "--plot", pl)
+    assert j["source"] == str(s) and j["target"] == str(t)
+    ET.fromstring(ov.read_bytes())
+    ET.fromstring(pl.read_bytes())

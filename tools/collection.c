@@ -1,0 +1,331 @@
+/* collection.c — folders and manifests of shapes (see collection.h). */
+#include "collection.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "image.h"
+#include "util.h"
+
+void class_from_name(const char *filename, char *out, size_t cap)
+{
+    const char *base = path_base(filename);
+    size_t len = strlen(base);
+    const char *dot = strrchr(base, '.');
+    if (dot != NULL && dot != base)
+        len = (size_t)(dot - base);
+    size_t end = len;
+    while (end > 0 && base[end - 1] >= '0' && base[end - 1] <= '9')
+        end--;
+    size_t cls = len;
+    if (end < len && end > 0) {
+        if ((base[end - 1] == '-' || base[end - 1] == '_') && end > 1)
+            cls = end - 1; /* "bird-3" -> "bird" */
+        else if (base[end - 1] != '-' && base[end - 1] != '_')
+            cls = end; /* "Bone01" -> "Bone" */
+    }
+    if (cls >= cap)
+        cls = cap - 1;
+    memcpy(out, base, cls);
+    out[cls] = '\0';
+}
+
+void collection_free(collection *c)
+{
+    if (c == NULL)
+        return;
+    for (size_t i = 0; i < c->n; i++) {
+        free(c->items[i].path);
+        free(c->items[i].name);
+    }
+    for (size_t i = 0; i < c->nclasses; i++)
+        free(c->classes[i]);
+    free(c->items);
+    free(c->classes);
+    c->items = NULL;
+    c->classes = NULL;
+    c->n = c->nclasses = 0;
+}
+
+static int32_t class_index(collection *c, const char *cls, size_t *cap)
+{
+    for (size_t i = 0; i < c->nclasses; i++)
+        if (strcmp(c->classes[i], cls) == 0)
+            return (int32_t)i;
+    if (c->nclasses == *cap) {
+        size_t ncap = *cap ? *cap * 2 : 16;
+        char **p = realloc(c->classes, ncap * sizeof *p);
+        if (p == NULL) {
+            tool_error(NULL, "out of memory");
+            return -1;
+        }
+        c->classes = p;
+        *cap = ncap;
+    }
+    char *s = xstrdup(cls);
+    if (s == NULL)
+        return -1;
+    c->classes[c->nclasses] = s;
+    return (int32_t)c->nclasses++;
+}
+
+static int add_item(collection *c, size_t *icap, size_t *ccap, char *path, char *name, const char *cls)
+{
+    int32_t label = class_index(c, cls, ccap);
+    if (label < 0) {
+        free(path);
+        free(name);
+        return -1;
+    }
+    if (c->n == *icap) {
+        size_t ncap = *icap ? *icap * 2 : 64;
+        coll_item *p = realloc(c->items, ncap * sizeof *p);
+        if (p == NULL) {
+            free(path);
+            free(name);
+            tool_error(NULL, "out of memory");
+            return -1;
+        }
+        c->items = p;
+        *icap = ncap;
+    }
+    c->items[c->n].path = path;
+    c->items[c->n].name = name;
+    c->items[c->n].label = label;
+    c->n++;
+    return 0;
+}
+
+static int cmp_str(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+static int open_folder(const char *dir, collection *c)
+{
+    DIR *d = opendir(dir);
+    if (d == NULL) {
+        tool_error(dir, "cannot open folder: %s", strerror(errno));
+        return -1;
+    }
+    char **names = NULL;
+    size_t n = 0, cap = 0;
+    struct dirent *e;
+    int ok = 1;
+    while ((e = readdir(d)) != NULL) {
+        if (e->d_name[0] == '.')
+            continue;
+        char *path = path_join(dir, e->d_name);
+        if (path == NULL) {
+            ok = 0;
+            break;
+        }
+        struct stat st;
+        char ext[16];
+        path_ext(e->d_name, ext);
+        int take = stat(path, &st) == 0 && S_ISREG(st.st_mode) &&
+                   (strcmp(ext, ".txt") == 0 || strcmp(ext, ".csv") == 0 || file_is_image(path));
+        free(path);
+        if (!take)
+            continue;
+        if (n == cap) {
+            cap = cap ? cap * 2 : 64;
+            char **p = realloc(names, cap * sizeof *p);
+            if (p == NULL) {
+                tool_error(NULL, "out of memory");
+                ok = 0;
+                break;
+            }
+            names = p;
+        }
+        names[n] = xstrdup(e->d_name);
+        if (names[n] == NULL) {
+            ok = 0;
+            break;
+        }
+        n++;
+    }
+    closedir(d);
+    if (ok && n == 0) {
+        tool_error(dir, "no shapes in this folder (PNG or PGM images, .txt or .csv point lists)");
+        ok = 0;
+    }
+    if (ok)
+        qsort(names, n, sizeof *names, cmp_str);
+    size_t icap = 0, ccap = 0;
+    for (size_t i = 0; ok && i < n; i++) {
+        char cls[256];
+        class_from_name(names[i], cls, sizeof cls);
+        char *path = path_join(dir, names[i]);
+        char *name = xstrdup(names[i]);
+        if (path == NULL || name == NULL) {
+            free(path);
+            free(name);
+            ok = 0;
+            break;
+        }
+        if (add_item(c, &icap, &ccap, path, name, cls) != 0)
+            ok = 0;
+    }
+    for (size_t i = 0; i < n; i++)
+        free(names[i]);
+    free(names);
+    return ok ? 0 : -1;
+}
+
+/* Splits a line on tabs in place; returns the number of fields (at most max). */
+static size_t split_tabs(char *line, char **fields, size_t max)
+{
+    size_t n = 0;
+    char *p = line;
+    while (n < max) {
+        fields[n++] = p;
+        char *t = strchr(p, '\t');
+        if (t == NULL)
+            break;
+        *t = '\0';
+        p = t + 1;
+    }
+    return n;
+}
+
+static void trim(char *s)
+{
+    size_t n = strlen(s);
+    while (n > 0 && (s[n - 1] == ' ' || s[n - 1] == '\r' || s[n - 1] == '\n'))
+        s[--n] = '\0';
+    size_t i = 0;
+    while (s[i] == ' ')
+        i++;
+    if (i)
+        memmove(s, s + i, n - i + 1);
+}
+
+static int open_manifest(const char *mpath, collection *c)
+{
+    FILE *fp = fopen(mpath, "rb");
+    if (fp == NULL) {
+        tool_error(mpath, "cannot open: %s", strerror(errno));
+        return -1;
+    }
+    char *dir = path_dir(mpath);
+    if (dir == NULL) {
+        fclose(fp);
+        return -1;
+    }
+    size_t lcap = 4096;
+    char *line = malloc(lcap);
+    int ok = line != NULL, header = 1;
+    long fcol = -1, ccol = -1;
+    size_t lineno = 0, icap = 0, ccap = 0;
+    if (!ok)
+        tool_error(NULL, "out of memory");
+    while (ok) {
+        /* read one line of any length */
+        size_t len = 0;
+        int ch;
+        while ((ch = getc(fp)) != EOF && ch != '\n') {
+            if (len + 2 > lcap) {
+                char *p = realloc(line, lcap * 2);
+                if (p == NULL) {
+                    tool_error(NULL, "out of memory");
+                    ok = 0;
+                    break;
+                }
+                line = p;
+                lcap *= 2;
+            }
+            line[len++] = (char)ch;
+        }
+        if (!ok)
+            break;
+        if (ch == EOF && len == 0)
+            break;
+        line[len] = '\0';
+        lineno++;
+        if (memchr(line, '\0', len) != NULL) {
+            tool_error(mpath, "line %zu: not a text manifest", lineno);
+            ok = 0;
+            break;
+        }
+        trim(line);
+        if (line[0] == '\0' || line[0] == '#')
+            continue;
+        char *f[64];
+        size_t nf = split_tabs(line, f, 64);
+        if (header) {
+            for (size_t i = 0; i < nf; i++) {
+                trim(f[i]);
+                if (strcmp(f[i], "file") == 0)
+                    fcol = (long)i;
+                else if (strcmp(f[i], "class") == 0)
+                    ccol = (long)i;
+            }
+            if (fcol < 0 || ccol < 0) {
+                tool_error(mpath, "line %zu: the header must name the columns 'file' and 'class' (tab-separated)",
+                           lineno);
+                ok = 0;
+                break;
+            }
+            header = 0;
+            continue;
+        }
+        if ((size_t)fcol >= nf || (size_t)ccol >= nf) {
+            tool_error(mpath, "line %zu: expected %ld tab-separated columns, found %zu", lineno,
+                       (fcol > ccol ? fcol : ccol) + 1, nf);
+            ok = 0;
+            break;
+        }
+        trim(f[fcol]);
+        trim(f[ccol]);
+        if (f[fcol][0] == '\0' || f[ccol][0] == '\0') {
+            tool_error(mpath, "line %zu: empty file or class", lineno);
+            ok = 0;
+            break;
+        }
+        char *path = path_join(dir, f[fcol]);
+        char *name = xstrdup(f[fcol]);
+        if (path == NULL || name == NULL) {
+            free(path);
+            free(name);
+            ok = 0;
+            break;
+        }
+        if (add_item(c, &icap, &ccap, path, name, f[ccol]) != 0)
+            ok = 0;
+    }
+    if (ok && ferror(fp)) {
+        tool_error(mpath, "read error");
+        ok = 0;
+    }
+    if (ok && header) {
+        tool_error(mpath, lineno == 0 ? "empty file" : "no header line with 'file' and 'class' columns");
+        ok = 0;
+    }
+    if (ok && c->n == 0) {
+        tool_error(mpath, "the manifest lists no shapes");
+        ok = 0;
+    }
+    free(line);
+    free(dir);
+    fclose(fp);
+    return ok ? 0 : -1;
+}
+
+int collection_open(const char *path, collection *out)
+{
+    memset(out, 0, sizeof *out);
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        tool_error(path, "cannot open: %s", strerror(errno));
+        return -1;
+    }
+    int r = S_ISDIR(st.st_mode) ? open_folder(path, out) : open_manifest(path, out);
+    if (r != 0)
+        collection_free(out);
+    return r;
+}

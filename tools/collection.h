@@ -1,0 +1,40 @@
+/* collection.h — shape collections for `amscr search|matrix|eval`: a folder of images and
+ * point lists, or a manifest.tsv (columns `file` and `class`).
+ *
+ * Folder: the regular, non-hidden files whose magic bytes say PNG or PGM, or whose name
+ * ends in .txt or .csv (other files, e.g. manifest.tsv or stats.json, are skipped), sorted
+ * by name (byte order, strcmp). The class of a file is its name without the extension,
+ * cut before a final '-' or '_' followed by digits ("bird-3.png" -> "bird",
+ * "leaf_12.txt" -> "leaf"); failing that, trailing digits are dropped ("Bone01" -> "Bone");
+ * failing that, the whole name is the class.
+ *
+ * Manifest: a tab-separated file with a header line naming (at least) the columns `file`
+ * and `class`, in any order; paths are relative to the manifest's folder (absolute paths
+ * are kept); blank lines and lines starting with '#' are skipped. Rows keep their order. */
+#ifndef AMSCR_TOOL_COLLECTION_H
+#define AMSCR_TOOL_COLLECTION_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct coll_item {
+    char *path;    /* path to open */
+    char *name;    /* as listed (file name or manifest entry) */
+    int32_t label; /* index into classes */
+} coll_item;
+
+typedef struct collection {
+    coll_item *items;
+    size_t n;
+    char **classes; /* class names, in order of first appearance */
+    size_t nclasses;
+} collection;
+
+/* Reads a folder or a manifest. Returns 0, or -1 after printing one error line. */
+int collection_open(const char *path, collection *out);
+void collection_free(collection *c);
+
+/* Class of a file name (see above) into out (capacity cap). */
+void class_from_name(const char *filename, char *out, size_t cap);
+
+#endif

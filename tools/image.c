@@ -1,0 +1,601 @@
+/* image.c — PGM/PNG decoding and shape loading for the amscr tool (see image.h).
+ *
+ * Luminance conversion:
+ *   - gray: as is; 1/2/4-bit gray expanded to 0..255; 16-bit scaled (rounded) to 8 bits;
+ *   - RGB: Y = (299 R + 587 G + 114 B) / 1000 (Rec. 601 weights, on the stored values);
+ *   - palette: through the palette's RGB, tRNS entries give alpha;
+ *   - PGM: v * 255 / maxval, rounded (maxval 1..65535).
+ * Alpha (gray+alpha, RGBA, tRNS): when every pixel has alpha >= 128 the alpha channel is
+ * ignored. Otherwise transparent pixels (alpha < 128) are made background:
+ *   - if the opaque pixels have (nearly) one colour (luminance range <= 16), the alpha
+ *     channel is the silhouette: opaque -> 255, transparent -> 0;
+ *   - otherwise the image is composited over a background that contrasts with the mean
+ *     opaque colour (white under dark content, black under light content).
+ * The polarity of the result does not matter: amscr_contour_from_mask makes the image
+ * border background. */
+#include "image.h"
+
+#include <errno.h>
+#include <setjmp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "util.h"
+
+#if defined(AMSCR_TOOL_HAVE_PNG)
+#include <png.h>
+#endif
+
+int image_have_png(void)
+{
+#if defined(AMSCR_TOOL_HAVE_PNG)
+    return 1;
+#else
+    return 0;
+#endif
+}
+
+void image_free(tool_image *img)
+{
+    if (img) {
+        free(img->pix);
+        img->pix = NULL;
+        img->width = img->height = 0;
+    }
+}
+
+static int check_limits(const char *path, const char *fmt, size_t w, size_t h)
+{
+    if (w == 0 || h == 0) {
+        tool_error(path, "corrupt %s: image size is %zu x %zu", fmt, w, h);
+        return -1;
+    }
+    if (w > AMSCR_MAX_IMAGE_SIDE || h > AMSCR_MAX_IMAGE_SIDE ||
+        (double)w * (double)h > (double)AMSCR_MAX_IMAGE_PIXELS) {
+        tool_error(path, "image too large: %zu x %zu pixels (limits: %d per side, %u pixels)", w, h,
+                   AMSCR_MAX_IMAGE_SIDE, (unsigned)AMSCR_MAX_IMAGE_PIXELS);
+        return -1;
+    }
+    return 0;
+}
+
+/* ================================================================== PGM */
+/* Reads the next header integer, skipping whitespace and '#' comments. Returns -1 at EOF
+ * or on a non-digit. */
+static int pgm_int(FILE *fp, unsigned long *out)
+{
+    int c;
+    for (;;) {
+        c = getc(fp);
+        if (c == '#') {
+            while (c != EOF && c != '\n' && c != '\r')
+                c = getc(fp);
+            continue;
+        }
+        if (c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f')
+            continue;
+        break;
+    }
+    if (c == EOF)
+        return -2;
+    if (c < '0' || c > '9')
+        return -1;
+    unsigned long v = 0;
+    int digits = 0;
+    while (c >= '0' && c <= '9') {
+        if (v > 100000000ul) /* far beyond any limit; keeps the value exact */
+            v = 100000000ul;
+        else
+            v = v * 10 + (unsigned long)(c - '0');
+        digits++;
+        c = getc(fp);
+    }
+    (void)digits;
+    if (c != EOF)
+        ungetc(c, fp);
+    *out = v;
+    return 0;
+}
+
+static int read_pgm(FILE *fp, const char *path, int ascii, tool_image *out)
+{
+    unsigned long w, h, maxval;
+    const char *what[3] = {"width", "height", "maxval"};
+    unsigned long *vals[3] = {&w, &h, &maxval};
+    (void)getc(fp);
+    (void)getc(fp); /* "P5" / "P2" */
+    for (int i = 0; i < 3; i++) {
+        int r = pgm_int(fp, vals[i]);
+        if (r == -2) {
+            tool_error(path, "truncated PGM: header ends before the %s", what[i]);
+            return -1;
+        }
+        if (r != 0) {
+            tool_error(path, "corrupt PGM: bad %s in the header", what[i]);
+            return -1;
+        }
+    }
+    if (maxval < 1 || maxval > 65535) {
+        tool_error(path, "corrupt PGM: maxval %lu out of range 1..65535", maxval);
+        return -1;
+    }
+    if (check_limits(path, "PGM", w, h) != 0)
+        return -1;
+    /* Exactly one whitespace character ends the header (a comment may sit before it). */
+    int c = getc(fp);
+    if (c == '#') {
+        while (c != EOF && c != '\n' && c != '\r')
+            c = getc(fp);
+    }
+    if (c == EOF) {
+        tool_error(path, "truncated PGM: no pixel data");
+        return -1;
+    }
+    if (!(c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f')) {
+        tool_error(path, "corrupt PGM: no whitespace after maxval");
+        return -1;
+    }
+    size_t npix = (size_t)w * (size_t)h;
+    uint8_t *pix = xmalloc_array(npix, 1);
+    if (pix == NULL)
+        return -1;
+    unsigned long half = maxval / 2;
+    if (!ascii) {
+        size_t bps = maxval < 256 ? 1 : 2;
+        uint8_t *row = xmalloc_array((size_t)w, bps);
+        if (row == NULL) {
+            free(pix);
+            return -1;
+        }
+        for (size_t y = 0; y < h; y++) {
+            size_t got = fread(row, bps, (size_t)w, fp);
+            if (got != (size_t)w) {
+                tool_error(path, "truncated PGM: pixel data ends in row %zu of %lu", y + 1, h);
+                free(row);
+                free(pix);
+                return -1;
+            }
+            for (size_t x = 0; x < w; x++) {
+                unsigned long v = bps == 1 ? row[x] : ((unsigned long)row[2 * x] << 8) | row[2 * x + 1];
+                if (v > maxval) {
+                    tool_error(path, "corrupt PGM: sample %lu at (%zu, %zu) exceeds maxval %lu", v, x, y,
+                               maxval);
+                    free(row);
+                    free(pix);
+                    return -1;
+                }
+                pix[y * w + x] = (uint8_t)((v * 255 + half) / maxval);
+            }
+        }
+        free(row);
+    } else {
+        for (size_t i = 0; i < npix; i++) {
+            unsigned long v;
+            int r = pgm_int(fp, &v);
+            if (r == -2) {
+                tool_error(path, "truncated PGM: %zu of %zu samples", i, npix);
+                free(pix);
+                return -1;
+            }
+            if (r != 0) {
+                tool_error(path, "corrupt PGM: sample %zu is not a number", i + 1);
+                free(pix);
+                return -1;
+            }
+            if (v > maxval) {
+                tool_error(path, "corrupt PGM: sample %lu at (%zu, %zu) exceeds maxval %lu", v,
+                           i % (size_t)w, i / (size_t)w, maxval);
+                free(pix);
+                return -1;
+            }
+            pix[i] = (uint8_t)((v * 255 + half) / maxval);
+        }
+    }
+    out->pix = pix;
+    out->width = w;
+    out->height = h;
+    return 0;
+}
+
+/* ================================================================== PNG */
+#if defined(AMSCR_TOOL_HAVE_PNG)
+/* ============================================================= alpha policy */
+static void apply_alpha(uint8_t *lum, const uint8_t *alpha, size_t n)
+{
+    size_t transparent = 0, opaque = 0;
+    int lo = 255, hi = 0;
+    double sum = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        if (alpha[i] < 128) {
+            transparent++;
+        } else {
+            opaque++;
+            if (lum[i] < lo)
+                lo = lum[i];
+            if (lum[i] > hi)
+                hi = lum[i];
+            sum += lum[i];
+        }
+    }
+    if (transparent == 0)
+        return; /* fully opaque: alpha carries nothing */
+    if (opaque == 0 || hi - lo <= 16) {
+        for (size_t i = 0; i < n; i++)
+            lum[i] = alpha[i] >= 128 ? 255 : 0;
+        return;
+    }
+    unsigned bg = sum / (double)opaque < 128.0 ? 255u : 0u;
+    for (size_t i = 0; i < n; i++) {
+        unsigned a = alpha[i];
+        lum[i] = (uint8_t)((lum[i] * a + bg * (255u - a) + 127u) / 255u);
+    }
+}
+
+typedef struct png_ctx {
+    FILE *fp;
+    int truncated;
+    char msg[256];
+} png_ctx;
+
+static void png_err_fn(png_structp png, png_const_charp msg)
+{
+    png_ctx *ctx = (png_ctx *)png_get_error_ptr(png);
+    if (ctx != NULL && ctx->msg[0] == '\0')
+        snprintf(ctx->msg, sizeof ctx->msg, "%s", msg ? msg : "unknown libpng error");
+    png_longjmp(png, 1);
+}
+
+static void png_warn_fn(png_structp png, png_const_charp msg)
+{
+    (void)png;
+    (void)msg; /* warnings (ancillary-chunk CRC, extra data, ...) are not errors */
+}
+
+static void png_read_fn(png_structp png, png_bytep data, png_size_t len)
+{
+    png_ctx *ctx = (png_ctx *)png_get_io_ptr(png);
+    if (fread(data, 1, len, ctx->fp) != len) {
+        ctx->truncated = 1;
+        png_error(png, "unexpected end of file");
+    }
+}
+
+static void to_luminance_row(const uint8_t *src, int channels, size_t w, uint8_t *lum, uint8_t *alpha)
+{
+    for (size_t x = 0; x < w; x++) {
+        const uint8_t *p = src + (size_t)channels * x;
+        switch (channels) {
+        case 1:
+            lum[x] = p[0];
+            break;
+        case 2:
+            lum[x] = p[0];
+            alpha[x] = p[1];
+            break;
+        case 3:
+            lum[x] = (uint8_t)((299u * p[0] + 587u * p[1] + 114u * p[2] + 500u) / 1000u);
+            break;
+        default:
+            lum[x] = (uint8_t)((299u * p[0] + 587u * p[1] + 114u * p[2] + 500u) / 1000u);
+            alpha[x] = p[3];
+            break;
+        }
+    }
+}
+
+static int read_png(FILE *fp, const char *path, tool_image *out)
+{
+    /* The size limits are checked from IHDR before libpng reads on (a file truncated
+     * right after a huge IHDR is "too large", not "truncated"). */
+    unsigned char head[24];
+    if (fread(head, 1, sizeof head, fp) == sizeof head && memcmp(head + 12, "IHDR", 4) == 0) {
+        size_t w = ((size_t)head[16] << 24) | ((size_t)head[17] << 16) | ((size_t)head[18] << 8) | head[19];
+        size_t h = ((size_t)head[20] << 24) | ((size_t)head[21] << 16) | ((size_t)head[22] << 8) | head[23];
+        if (w > 0 && h > 0 && check_limits(path, "PNG", w, h) != 0)
+            return -1;
+    }
+    rewind(fp);
+    png_ctx ctx;
+    ctx.fp = fp;
+    ctx.truncated = 0;
+    ctx.msg[0] = '\0';
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &ctx, png_err_fn, png_warn_fn);
+    if (png == NULL) {
+        tool_error(path, "out of memory (libpng)");
+        return -1;
+    }
+    png_infop info = png_create_info_struct(png);
+    if (info == NULL) {
+        png_destroy_read_struct(&png, NULL, NULL);
+        tool_error(path, "out of memory (libpng)");
+        return -1;
+    }
+    /* Everything that must survive a longjmp is volatile. */
+    uint8_t *volatile lum = NULL;
+    uint8_t *volatile alpha = NULL;
+    uint8_t *volatile buf = NULL;
+    png_bytep *volatile rows = NULL;
+    volatile int limit_failed = 0;
+
+    if (setjmp(png_jmpbuf(png))) {
+        free(lum);
+        free(alpha);
+        free(buf);
+        free(rows);
+        png_destroy_read_struct(&png, &info, NULL);
+        if (!limit_failed) {
+            if (ctx.truncated)
+                tool_error(path, "truncated PNG: unexpected end of file");
+            else
+                tool_error(path, "corrupt PNG: %s", ctx.msg[0] ? ctx.msg : "unknown error");
+        }
+        return -1;
+    }
+    png_set_read_fn(png, &ctx, png_read_fn);
+    png_set_user_limits(png, 0x7fffffffu, 0x7fffffffu); /* our own limits are checked below */
+    png_read_info(png, info);
+
+    png_uint_32 w = png_get_image_width(png, info);
+    png_uint_32 h = png_get_image_height(png, info);
+    if (check_limits(path, "PNG", w, h) != 0) {
+        limit_failed = 1;
+        png_longjmp(png, 1);
+    }
+    int color = png_get_color_type(png, info);
+    int depth = png_get_bit_depth(png, info);
+    if (color == PNG_COLOR_TYPE_PALETTE)
+        png_set_palette_to_rgb(png);
+    if (color == PNG_COLOR_TYPE_GRAY && depth < 8)
+        png_set_expand_gray_1_2_4_to_8(png);
+    if (png_get_valid(png, info, PNG_INFO_tRNS))
+        png_set_tRNS_to_alpha(png);
+    if (depth == 16) {
+#if defined(PNG_READ_SCALE_16_TO_8_SUPPORTED)
+        png_set_scale_16(png);
+#else
+        png_set_strip_16(png);
+#endif
+    }
+    int passes = png_set_interlace_handling(png);
+    png_read_update_info(png, info);
+
+    int channels = png_get_channels(png, info);
+    size_t rowbytes = png_get_rowbytes(png, info);
+    if (png_get_bit_depth(png, info) != 8 || channels < 1 || channels > 4 || rowbytes != (size_t)w * (size_t)channels) {
+        snprintf(ctx.msg, sizeof ctx.msg, "unexpected pixel layout after conversion");
+        png_longjmp(png, 1);
+    }
+    int has_alpha = channels == 2 || channels == 4;
+    size_t npix = (size_t)w * (size_t)h;
+    lum = malloc(npix);
+    if (has_alpha)
+        alpha = malloc(npix);
+    if (lum == NULL || (has_alpha && alpha == NULL)) {
+        snprintf(ctx.msg, sizeof ctx.msg, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
+        png_longjmp(png, 1);
+    }
+    if (passes > 1) {
+        /* Adam7: libpng fills a whole image over 7 passes. */
+        if (rowbytes > SIZE_MAX / h) {
+            snprintf(ctx.msg, sizeof ctx.msg, "image too large");
+            png_longjmp(png, 1);
+        }
+        buf = malloc(rowbytes * h);
+        rows = malloc(sizeof(png_bytep) * h);
+        if (buf == NULL || rows == NULL) {
+            snprintf(ctx.msg, sizeof ctx.msg, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
+            png_longjmp(png, 1);
+        }
+        for (size_t y = 0; y < h; y++)
+            rows[y] = buf + y * rowbytes;
+        png_read_image(png, rows);
+        for (size_t y = 0; y < h; y++)
+            to_luminance_row(rows[y], channels, w, lum + y * w, has_alpha ? alpha + y * w : NULL);
+    } else {
+        buf = malloc(rowbytes);
+        if (buf == NULL) {
+            snprintf(ctx.msg, sizeof ctx.msg, "out of memory");
+            png_longjmp(png, 1);
+        }
+        for (size_t y = 0; y < h; y++) {
+            png_read_row(png, buf, NULL);
+            to_luminance_row(buf, channels, w, lum + y * w, has_alpha ? alpha + y * w : NULL);
+        }
+    }
+    /* The image data is complete; the chunks after it are not needed. */
+    if (has_alpha)
+        apply_alpha(lum, alpha, npix);
+    free(alpha);
+    free(buf);
+    free(rows);
+    png_destroy_read_struct(&png, &info, NULL);
+    out->pix = lum;
+    out->width = w;
+    out->height = h;
+    return 0;
+}
+#endif /* AMSCR_TOOL_HAVE_PNG */
+
+/* ============================================================ detection */
+static const unsigned char PNG_SIG[8] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
+
+static int is_ws(int c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f' || c == '#'; }
+
+static tool_format sniff(const unsigned char *m, size_t n, const char **other)
+{
+    *other = NULL;
+    if (n >= 8 && memcmp(m, PNG_SIG, 8) == 0)
+        return TOOL_FMT_PNG;
+    if (n >= 3 && m[0] == 'P' && (m[1] == '2' || m[1] == '5') && is_ws(m[2]))
+        return TOOL_FMT_PGM;
+    if (n >= 3 && m[0] == 'P' && (m[1] == '1' || m[1] == '3' || m[1] == '4' || m[1] == '6' || m[1] == '7') &&
+        is_ws(m[2]))
+        *other = "Netpbm other than PGM (P2/P5)";
+    else if (n >= 3 && m[0] == 0xFF && m[1] == 0xD8 && m[2] == 0xFF)
+        *other = "JPEG";
+    else if (n >= 4 && memcmp(m, "GIF8", 4) == 0)
+        *other = "GIF";
+    else if (n >= 4 && (memcmp(m, "II*\0", 4) == 0 || memcmp(m, "MM\0*", 4) == 0))
+        *other = "TIFF";
+    else if (n >= 4 && memcmp(m, "RIFF", 4) == 0)
+        *other = "RIFF/WebP";
+    else if (n >= 2 && m[0] == 'B' && m[1] == 'M' && n >= 6)
+        *other = "BMP";
+    else if (n >= 5 && memcmp(m, "\x89PNG", 4) == 0)
+        *other = "damaged PNG signature";
+    return TOOL_FMT_TEXT;
+}
+
+/* Opens `path` for reading after checking it is a non-empty regular file. */
+static FILE *open_input(const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        tool_error(path, "cannot open: %s", strerror(errno));
+        return NULL;
+    }
+    if (S_ISDIR(st.st_mode)) {
+        tool_error(path, "is a directory, not an image or point list");
+        return NULL;
+    }
+    FILE *fp = fopen(path, "rb");
+    if (fp == NULL) {
+        tool_error(path, "cannot open: %s", strerror(errno));
+        return NULL;
+    }
+    if (S_ISREG(st.st_mode) && st.st_size == 0) {
+        fclose(fp);
+        tool_error(path, "empty file");
+        return NULL;
+    }
+    return fp;
+}
+
+int file_is_image(const char *path)
+{
+    FILE *fp = fopen(path, "rb");
+    if (fp == NULL)
+        return 0;
+    unsigned char m[8];
+    size_t n = fread(m, 1, sizeof m, fp);
+    fclose(fp);
+    const char *other;
+    return sniff(m, n, &other) != TOOL_FMT_TEXT;
+}
+
+int image_read(const char *path, int text_ok, tool_image *out, tool_format *out_format)
+{
+    out->pix = NULL;
+    out->width = out->height = 0;
+    *out_format = TOOL_FMT_TEXT;
+    FILE *fp = open_input(path);
+    if (fp == NULL)
+        return -1;
+    unsigned char m[512];
+    size_t n = fread(m, 1, sizeof m, fp);
+    if (n == 0) {
+        fclose(fp);
+        tool_error(path, "empty file");
+        return -1;
+    }
+    const char *other;
+    tool_format f = sniff(m, n, &other);
+    *out_format = f;
+    if (f == TOOL_FMT_TEXT) {
+        fclose(fp);
+        if (other != NULL) {
+            tool_error(path, "unsupported image format (%s): use PNG, PGM or a text point list", other);
+            return -1;
+        }
+        if (!text_ok) {
+            tool_error(path, "not a PNG or PGM image");
+            return -1;
+        }
+        size_t ctrl = 0;
+        for (size_t i = 0; i < n; i++)
+            if (m[i] < 32 && m[i] != '\n' && m[i] != '\r' && m[i] != '\t' && m[i] != '\f' && m[i] != '\v')
+                ctrl++;
+        if (memchr(m, '\0', n) != NULL || ctrl * 20 > n) {
+            tool_error(path, "unrecognized binary file: not a PNG or PGM image, nor a text point list");
+            return -1;
+        }
+        return 1;
+    }
+    rewind(fp);
+    int r;
+    if (f == TOOL_FMT_PGM) {
+        r = read_pgm(fp, path, m[1] == '2', out);
+    } else {
+#if defined(AMSCR_TOOL_HAVE_PNG)
+        r = read_png(fp, path, out);
+#else
+        tool_error(path, "PNG input is not available: amscr was built without libpng");
+        r = -1;
+#endif
+    }
+    fclose(fp);
+    return r;
+}
+
+/* ============================================================ shapes */
+int shape_load(const char *path, int threshold, amscr_contour **out)
+{
+    tool_image img;
+    tool_format f;
+    *out = NULL;
+    int r = image_read(path, 1, &img, &f);
+    if (r < 0)
+        return -1;
+    if (r > 0) {
+        /* Not an image: a text point list. */
+        amscr_status st = amscr_contour_read_text(path, out);
+        if (st != AMSCR_OK) {
+            const char *d = lib_detail();
+            if (st == AMSCR_E_FORMAT && d[0] != '\0') {
+                /* "path:line: problem" from the library names the file already. */
+                size_t pl = strlen(path);
+                if (strncmp(d, path, pl) == 0 && d[pl] == ':')
+                    tool_error(NULL, "%s", d);
+                else
+                    tool_error(path, "not an image, and not a valid point list: %s", d);
+            } else {
+                tool_lib_error(path, st);
+            }
+            *out = NULL;
+            return -1;
+        }
+        return 0;
+    }
+    amscr_status st = amscr_contour_from_mask(img.pix, img.width, img.height, img.width, threshold, out);
+    if (st != AMSCR_OK) {
+        const char *d = lib_detail();
+        char thr[32];
+        if (threshold == AMSCR_THRESHOLD_AUTO)
+            snprintf(thr, sizeof thr, "auto");
+        else
+            snprintf(thr, sizeof thr, "%d", threshold);
+        switch (st) {
+        case AMSCR_E_NOT_FOUND:
+            if (d[0])
+                tool_error(path, "no foreground shape: %s", d);
+            else
+                tool_error(path, "no foreground shape at threshold %s", thr);
+            break;
+        case AMSCR_E_DEGENERATE:
+            tool_error(path, "the shape is too small to trace%s%s", d[0] ? ": " : "", d);
+            break;
+        case AMSCR_E_LIMIT:
+            tool_error(path, "image too large%s%s", d[0] ? ": " : "", d);
+            break;
+        default:
+            tool_lib_error(path, st);
+        }
+        image_free(&img);
+        *out = NULL;
+        return -1;
+    }
+    image_free(&img);
+    return 0;
+}

@@ -1,0 +1,43 @@
+/* image.h — input shapes for the amscr tool: PGM (P2/P5) and PNG (libpng) decoding to
+ * 8-bit luminance, format detection by magic bytes, and the text point-list fallback.
+ * Decoding lives in the tool, not in libamscr (STYLE.md: codecs stay out of the core). */
+#ifndef AMSCR_TOOL_IMAGE_H
+#define AMSCR_TOOL_IMAGE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "amscr.h"
+
+/* An 8-bit luminance image, rows packed (stride == width). */
+typedef struct tool_image {
+    uint8_t *pix;
+    size_t width, height;
+} tool_image;
+
+typedef enum tool_format {
+    TOOL_FMT_TEXT = 0, /* anything that is not an image magic: a text point list */
+    TOOL_FMT_PGM = 1,
+    TOOL_FMT_PNG = 2
+} tool_format;
+
+/* Decodes a PGM or PNG file into 8-bit luminance. On failure prints one error line
+ * naming `path` and returns -1. Size limits (AMSCR_MAX_IMAGE_SIDE, AMSCR_MAX_IMAGE_PIXELS)
+ * are checked before the pixel buffer is allocated. *out_format tells which format the
+ * magic bytes said. A file that is not an image returns 1 without a message when `text_ok`
+ * is non-zero (the caller reads it as a point list), else -1 with a message. */
+int image_read(const char *path, int text_ok, tool_image *out, tool_format *out_format);
+void image_free(tool_image *img);
+
+/* Loads a shape: an image (traced with amscr_contour_from_mask at `threshold`, 0..254 or
+ * AMSCR_THRESHOLD_AUTO) or a text point list. On failure prints one error line naming
+ * `path` and returns -1. The caller frees *out with amscr_contour_free. */
+int shape_load(const char *path, int threshold, amscr_contour **out);
+
+/* Non-zero when the file starts with PNG or PGM (P2/P5) magic bytes. */
+int file_is_image(const char *path);
+
+/* Non-zero when the tool was built with libpng. */
+int image_have_png(void);
+
+#endif

@@ -1,0 +1,425 @@
+/* util.c — helpers of the amscr tool (see util.h). */
+#include "util.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <time.h>
+#include <unistd.h>
+
+static int g_error_printed;
+
+int tool_error_printed(void) { return g_error_printed; }
+
+static void print_line(const char *what, const char *msg)
+{
+    /* One line, whatever the message contains. */
+    char line[1024];
+    if (what != NULL && what[0] != '\0')
+        snprintf(line, sizeof line, "amscr: %s: %s", what, msg);
+    else
+        snprintf(line, sizeof line, "amscr: %s", msg);
+    for (char *p = line; *p; p++)
+        if (*p == '\n' || *p == '\r')
+            *p = ' ';
+    fprintf(stderr, "%s\n", line);
+    fflush(stderr);
+}
+
+void tool_error(const char *what, const char *fmt, ...)
+{
+    if (g_error_printed)
+        return;
+    g_error_printed = 1;
+    char msg[900];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    print_line(what, msg);
+}
+
+const char *lib_detail(void)
+{
+    const char *d = amscr_last_error_detail();
+    /* drop a leading "amscr_function_name: " */
+    if (strncmp(d, "amscr_", 6) == 0) {
+        const char *p = d;
+        while ((*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') || *p == '_')
+            p++;
+        if (p[0] == ':' && p[1] == ' ')
+            return p + 2;
+    }
+    return d;
+}
+
+void tool_lib_error(const char *what, amscr_status st)
+{
+    const char *detail = lib_detail();
+    if (g_error_printed)
+        return;
+    if (detail != NULL && detail[0] != '\0') {
+        size_t wl = what ? strlen(what) : 0;
+        if (wl > 0 && strncmp(detail, what, wl) == 0 && detail[wl] == ':') {
+            g_error_printed = 1;
+            print_line(NULL, detail);
+            return;
+        }
+        tool_error(what, "%s (%s)", detail, amscr_strerror(st));
+    } else {
+        tool_error(what, "%s", amscr_strerror(st));
+    }
+}
+
+void *xmalloc_array(size_t n, size_t size)
+{
+    if (size != 0 && n > SIZE_MAX / size) {
+        tool_error(NULL, "out of memory (%zu x %zu bytes)", n, size);
+        return NULL;
+    }
+    void *p = malloc(n * size != 0 ? n * size : 1);
+    if (p == NULL)
+        tool_error(NULL, "out of memory (%zu bytes)", n * size);
+    return p;
+}
+
+void *xcalloc_array(size_t n, size_t size)
+{
+    if (size != 0 && n > SIZE_MAX / size) {
+        tool_error(NULL, "out of memory (%zu x %zu bytes)", n, size);
+        return NULL;
+    }
+    void *p = calloc(n ? n : 1, size ? size : 1);
+    if (p == NULL)
+        tool_error(NULL, "out of memory (%zu bytes)", n * size);
+    return p;
+}
+
+char *xstrdup(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *p = xmalloc_array(n, 1);
+    if (p)
+        memcpy(p, s, n);
+    return p;
+}
+
+/* ----------------------------------------------------------- output files */
+int tool_out_open(tool_out *o, const char *path)
+{
+    o->fp = NULL;
+    o->tmp = NULL;
+    o->path = NULL;
+    if (strcmp(path, "-") == 0) {
+        o->fp = stdout;
+        return 0;
+    }
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        tool_error(path, "is a directory");
+        return -1;
+    }
+    char *dir = path_dir(path);
+    if (dir == NULL)
+        return -1;
+    const char *base = path_base(path);
+    size_t n = strlen(dir) + strlen(base) + 16;
+    o->tmp = xmalloc_array(n, 1);
+    o->path = xstrdup(path);
+    if (o->tmp == NULL || o->path == NULL) {
+        free(dir);
+        free(o->tmp);
+        free(o->path);
+        o->tmp = o->path = NULL;
+        return -1;
+    }
+    snprintf(o->tmp, n, "%s/.%s.XXXXXX", dir, base);
+    free(dir);
+    int fd = mkstemp(o->tmp);
+    if (fd < 0) {
+        tool_error(path, "cannot create output file: %s", strerror(errno));
+        free(o->tmp);
+        free(o->path);
+        o->tmp = o->path = NULL;
+        return -1;
+    }
+    /* mkstemp makes 0600; give the usual 0666 & ~umask. */
+    mode_t mask = umask(0);
+    umask(mask);
+    (void)fchmod(fd, 0666 & ~mask);
+    o->fp = fdopen(fd, "wb");
+    if (o->fp == NULL) {
+        tool_error(path, "cannot create output file: %s", strerror(errno));
+        close(fd);
+        unlink(o->tmp);
+        free(o->tmp);
+        free(o->path);
+        o->tmp = o->path = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+int tool_out_commit(tool_out *o)
+{
+    if (o->fp == NULL)
+        return -1;
+    if (o->tmp == NULL) { /* stdout */
+        int bad = fflush(o->fp) != 0 || ferror(o->fp);
+        o->fp = NULL;
+        if (bad) {
+            tool_error("<stdout>", "write error: %s", strerror(errno));
+            return -1;
+        }
+        return 0;
+    }
+    int bad = fflush(o->fp) != 0 || ferror(o->fp);
+    int err = errno;
+    if (fclose(o->fp) != 0 && !bad) {
+        bad = 1;
+        err = errno;
+    }
+    o->fp = NULL;
+    if (!bad && rename(o->tmp, o->path) != 0) {
+        bad = 1;
+        err = errno;
+    }
+    if (bad) {
+        tool_error(o->path, "cannot write output file: %s", strerror(err));
+        unlink(o->tmp);
+    }
+    free(o->tmp);
+    free(o->path);
+    o->tmp = o->path = NULL;
+    return bad ? -1 : 0;
+}
+
+void tool_out_abort(tool_out *o)
+{
+    if (o->fp != NULL && o->tmp != NULL)
+        fclose(o->fp);
+    if (o->tmp != NULL)
+        unlink(o->tmp);
+    free(o->tmp);
+    free(o->path);
+    o->fp = NULL;
+    o->tmp = o->path = NULL;
+}
+
+/* ------------------------------------------------------------ strings */
+void sb_init(sbuf *b)
+{
+    b->s = NULL;
+    b->len = b->cap = 0;
+    b->oom = 0;
+}
+
+void sb_free(sbuf *b)
+{
+    free(b->s);
+    sb_init(b);
+}
+
+static int sb_reserve(sbuf *b, size_t extra)
+{
+    if (b->oom)
+        return -1;
+    if (b->len + extra + 1 <= b->cap)
+        return 0;
+    size_t cap = b->cap ? b->cap : 256;
+    while (cap < b->len + extra + 1)
+        cap *= 2;
+    char *s = realloc(b->s, cap);
+    if (s == NULL) {
+        b->oom = 1;
+        return -1;
+    }
+    b->s = s;
+    b->cap = cap;
+    return 0;
+}
+
+void sb_printf(sbuf *b, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (n < 0 || sb_reserve(b, (size_t)n) != 0)
+        return;
+    va_start(ap, fmt);
+    vsnprintf(b->s + b->len, (size_t)n + 1, fmt, ap);
+    va_end(ap);
+    b->len += (size_t)n;
+}
+
+void sb_puts(sbuf *b, const char *s)
+{
+    size_t n = strlen(s);
+    if (sb_reserve(b, n) != 0)
+        return;
+    memcpy(b->s + b->len, s, n + 1);
+    b->len += n;
+}
+
+void sb_json_num(sbuf *b, double v)
+{
+    if (!isfinite(v)) {
+        sb_puts(b, "null");
+        return;
+    }
+    if (v == 0.0) { /* also -0 */
+        sb_puts(b, "0");
+        return;
+    }
+    /* Shortest of %.15g..%.17g that reads back exactly. */
+    char buf[40];
+    for (int prec = 15; prec <= 17; prec++) {
+        snprintf(buf, sizeof buf, "%.*g", prec, v);
+        if (strtod(buf, NULL) == v)
+            break;
+    }
+    sb_puts(b, buf);
+}
+
+void sb_json_str(sbuf *b, const char *s)
+{
+    sb_puts(b, "\"");
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        switch (*p) {
+        case '"': sb_puts(b, "\\\""); break;
+        case '\\': sb_puts(b, "\\\\"); break;
+        case '\n': sb_puts(b, "\\n"); break;
+        case '\r': sb_puts(b, "\\r"); break;
+        case '\t': sb_puts(b, "\\t"); break;
+        default:
+            if (*p < 0x20)
+                sb_printf(b, "\\u%04x", *p);
+            else {
+                char c[2] = {(char)*p, 0};
+                sb_puts(b, c);
+            }
+        }
+    }
+    sb_puts(b, "\"");
+}
+
+const char *fmt_num(char buf[32], double v)
+{
+    if (isnan(v))
+        snprintf(buf, 32, "nan");
+    else if (isinf(v))
+        snprintf(buf, 32, v > 0 ? "inf" : "-inf");
+    else if (v == 0.0)
+        snprintf(buf, 32, "0");
+    else
+        snprintf(buf, 32, "%.6g", v);
+    return buf;
+}
+
+/* ------------------------------------------------------------ paths */
+void path_ext(const char *path, char out[16])
+{
+    const char *base = path_base(path);
+    const char *dot = strrchr(base, '.');
+    out[0] = '\0';
+    if (dot == NULL || dot == base || strlen(dot) >= 16)
+        return;
+    size_t i = 0;
+    for (; dot[i]; i++) {
+        char c = dot[i];
+        out[i] = (c >= 'A' && c <= 'Z') ? (char)(c - 'A' + 'a') : c;
+    }
+    out[i] = '\0';
+}
+
+const char *path_base(const char *path)
+{
+    const char *s = strrchr(path, '/');
+    return s ? s + 1 : path;
+}
+
+char *path_dir(const char *path)
+{
+    const char *s = strrchr(path, '/');
+    if (s == NULL)
+        return xstrdup(".");
+    if (s == path)
+        return xstrdup("/");
+    size_t n = (size_t)(s - path);
+    char *d = xmalloc_array(n + 1, 1);
+    if (d) {
+        memcpy(d, path, n);
+        d[n] = '\0';
+    }
+    return d;
+}
+
+char *path_join(const char *dir, const char *rel)
+{
+    if (rel[0] == '/' || strcmp(dir, ".") == 0 || dir[0] == '\0')
+        return xstrdup(rel);
+    size_t n = strlen(dir) + strlen(rel) + 2;
+    char *p = xmalloc_array(n, 1);
+    if (p) {
+        size_t dl = strlen(dir);
+        snprintf(p, n, "%s%s%s", dir, (dl > 0 && dir[dl - 1] == '/') ? "" : "/", rel);
+    }
+    return p;
+}
+
+double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ------------------------------------------------------------ progress */
+void progress_init(tool_progress *p, const char *label)
+{
+    p->enabled = isatty(2);
+    p->label = label;
+    p->last = 0.0;
+    p->shown = 0;
+}
+
+void progress_update(tool_progress *p, size_t done, size_t total)
+{
+    if (!p->enabled || total == 0)
+        return;
+    double t = now_seconds();
+    if (p->shown && t - p->last < 0.1 && done < total)
+        return;
+    p->last = t;
+    p->shown = 1;
+    double frac = (double)done / (double)total;
+    int width = 30, fill = (int)(frac * width + 0.5);
+    char bar[32];
+    for (int i = 0; i < width; i++)
+        bar[i] = i < fill ? '#' : '.';
+    bar[width] = '\0';
+    fprintf(stderr, "\ramscr: %s [%s] %3d%% (%zu/%zu)", p->label, bar, (int)(100.0 * frac + 0.5), done,
+            total);
+    fflush(stderr);
+}
+
+void progress_end(tool_progress *p)
+{
+    if (p->enabled && p->shown) {
+        fprintf(stderr, "\r\033[K");
+        fflush(stderr);
+    }
+    p->shown = 0;
+}
+
+int progress_cb(void *user, size_t done, size_t total)
+{
+    progress_update((tool_progress *)user, done, total);
+    return 0;
+}
