@@ -490,6 +490,14 @@ typedef enum amscr_invariance {
 /** @brief A params object with documented defaults (see each setter).
  *  Ownership: caller frees. @since 0.1 */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_new(amscr_params **out);
+/** @brief A params object tuned for registering single pairs rather than building collections:
+ *         the defaults with N = 256 samples and 20 refinement iterations (trimmed closest-point
+ *         refinement in the aligned frame). Measured in the README: on Kimia pixel contours under
+ *         random affine maps it keeps 100 % / 98.6 % / 97.6 % of pairs within 2 % of the shape
+ *         size (clean / 1 % noise / 5 % occlusion) at about 1 ms per registration, against
+ *         99.2 % / 81 % / 66 % for the collection defaults.
+ *  Ownership: caller frees. @since 0.1 */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_new_registration(amscr_params **out);
 /** @brief Deep copy. Ownership: caller frees. @since 0.1 */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_copy(const amscr_params *p, amscr_params **out);
 /** @brief Releases; accepts NULL. @since 0.1 */
@@ -607,7 +615,8 @@ AMSCR_API void amscr_workspace_free(amscr_workspace *ws);
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src,
                                                       const amscr_descriptor *tgt, amscr_workspace *ws,
                                                       amscr_result **out_result);
-/** @brief Convenience: builds both descriptors with p (NULL = defaults) and registers.
+/** @brief Convenience: builds both descriptors with p and registers. NULL p means the
+ *         registration preset (amscr_params_new_registration), not the collection defaults.
  *  Ownership: caller frees *out_result. @since 0.1 */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_register_contours(const amscr_params *p, const amscr_contour *src,
                                                                const amscr_contour *tgt, amscr_result **out_result);
@@ -681,6 +690,9 @@ AMSCR_API const amscr_params *amscr_db_params(const amscr_db *db);
 /**
  * @brief 1-vs-many: out_dist[i] = distance(q -> shape i), amscr_db_size values.
  *        Uses the db's threads; results are bit-identical for any thread count.
+ *        Batch outputs (this and the two calls below) are the one exception to "outputs are
+ *        written only on AMSCR_OK": they are computed in place, so on failure or cancellation
+ *        every element is set to NaN (never a silently partial result).
  * @return AMSCR_OK, AMSCR_E_INVALID_ARG, AMSCR_E_CANCELLED, AMSCR_E_NOMEM. @since 0.1
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_query(const amscr_db *db, const amscr_descriptor *q,

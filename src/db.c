@@ -287,11 +287,15 @@ static amscr_status batch_run(batch_t *b, unsigned threads, amscr_progress_fn pr
     free(tid);
     amscr_workspace_free(ws);
     pthread_mutex_destroy(&b->lock);
-    if (b->status != AMSCR_OK)
-        return amscr__fail(b->status, "%s", b->detail);
-    if (b->cancel)
+    if (b->status != AMSCR_OK || b->cancel) {
+        /* never a silently partial matrix: every cell becomes NaN */
+        for (size_t i = 0; i < total_cells; i++)
+            b->out[i] = NAN;
+        if (b->status != AMSCR_OK)
+            return amscr__fail(b->status, "%s", b->detail);
         return amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback after %zu of %zu items", b->done,
                            b->nitems);
+    }
     if (progress && last_reported != b->nitems)
         if (progress(user, total_cells, total_cells) != 0)
             return amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback at the end");
@@ -333,6 +337,10 @@ amscr_status amscr_db_distance_matrix(const amscr_db *db, amscr_progress_fn prog
     b.skip_diag = 1;
     b.out = out_dist;
     if (db->n == 1) {
+        if (progress && progress(user, 1, 1) != 0) {
+            out_dist[0] = NAN;
+            return amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback");
+        }
         out_dist[0] = 0.0;
         return AMSCR_OK;
     }
@@ -607,6 +615,9 @@ amscr_status amscr_db_load_memory(const void *buf, size_t len, amscr_db **out)
     prm.num_scales = (size_t)p;
     if (!r_f64s(&r, prm.scales, (size_t)p))
         return amscr__fail(AMSCR_E_FORMAT, "collection header: bad scales");
+    for (size_t k = 0; k < (size_t)p; k++)
+        if (!(prm.scales[k] >= 0.0 && prm.scales[k] <= (double)N))
+            return amscr__fail(AMSCR_E_FORMAT, "collection header: scale %g is outside 0..N", prm.scales[k]);
     prm.method = (amscr_method)r_u32(&r);
     prm.closed = (int)r_u32(&r);
     prm.reflections = (int)r_u32(&r);

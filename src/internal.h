@@ -75,6 +75,7 @@ void amscr__kernel_fill(double sigma, size_t r, double *taps);
 void amscr__smooth_with_kernel(const double *xy, size_t n, int closed, const double *g, size_t r, double *wrapped,
                                double *out);
 amscr_status amscr__smooth(const double *xy, size_t n, int closed, double sigma, double *out);
+amscr_status amscr__smooth_box3(const double *xy, size_t n, int closed, double sigma, double *out, double *scratch);
 amscr_status amscr__resample_euclid(const double *xy, size_t n, int closed, size_t m, double *out);
 amscr_status amscr__affine_cum(const double *xy, size_t n, int closed, double sigma0, double *cum, double *out_total);
 int amscr__sym2_invsqrt(const double cov[3], double W[4], double Winv[4]);
@@ -83,6 +84,7 @@ amscr_status amscr__parametrize(const double *P, size_t np, int closed, amscr_pa
 amscr_status amscr__whiten(const double *xy, size_t n, double *out_xy, double fwd[6], double inv[6]);
 void amscr__affine_compose(const double a[6], const double b[6], double out[6]);
 void amscr__params_defaults(amscr_params *p);
+void amscr__params_registration(amscr_params *p);
 
 /* ---- least squares (lstsq.c) ---- */
 size_t amscr__lstsq_work_size(size_t m, size_t n, size_t nrhs);

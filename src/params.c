@@ -41,6 +41,25 @@ amscr_status amscr_params_new(amscr_params **out)
     return AMSCR_OK;
 }
 
+void amscr__params_registration(amscr_params *p)
+{
+    amscr__params_defaults(p);
+    p->num_samples = 256;
+    p->refine = 20;
+}
+
+amscr_status amscr_params_new_registration(amscr_params **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(out);
+    amscr_params *p = malloc(sizeof *p);
+    if (!p)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_params_new_registration: out of memory");
+    amscr__params_registration(p);
+    *out = p;
+    return AMSCR_OK;
+}
+
 amscr_status amscr_params_copy(const amscr_params *p, amscr_params **out)
 {
     amscr__clear_error();

@@ -81,6 +81,7 @@ typedef struct {
     size_t shift;
     double fshift; /* continuous shift (closed curves) */
     double rcut;   /* refined: the trimming cut-off of the closest-point pairs in ws->rbuf */
+    double rcost;  /* refinement on: the trimmed closest-point cost of the final map */
     int refined;   /* the refinement replaced the method's solution */
     int reflected;
     size_t p;
@@ -703,6 +704,34 @@ static int better(const match_t *a, const match_t *b)
 }
 
 /* One direction f -> h: the best match over orientations and candidate shifts. */
+/* The lowest (at most AMSCR__CANDIDATES) circular local minima of ws->crit, ascending. */
+static size_t integer_candidates(const amscr_workspace *ws, size_t n, size_t *cand)
+{
+    size_t nc = 0;
+    for (size_t s = 0; s < n; s++) {
+        double v = ws->crit[s];
+        double l = ws->crit[(s + n - 1) % n], r = ws->crit[(s + 1) % n];
+        if (!(v <= l && v <= r))
+            continue;
+        size_t pos = nc;
+        while (pos > 0 && ws->crit[cand[pos - 1]] > v)
+            pos--;
+        if (pos >= AMSCR__CANDIDATES)
+            continue;
+        size_t last = nc < AMSCR__CANDIDATES ? nc : AMSCR__CANDIDATES - 1;
+        for (size_t j = last; j > pos; j--)
+            cand[j] = cand[j - 1];
+        cand[pos] = s;
+        if (nc < AMSCR__CANDIDATES)
+            nc++;
+    }
+    if (nc == 0) { /* flat criterion: take shift 0 */
+        cand[0] = 0;
+        nc = 1;
+    }
+    return nc;
+}
+
 static amscr_status match_one(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                               amscr_workspace *ws, match_t *best)
 {
@@ -736,28 +765,7 @@ static amscr_status match_one(const amscr_params *prm, const amscr_descriptor *f
     for (int o = 0; o < norient; o++) {
         shift_criterion(f, h, o, use_finest, Si, ws);
         size_t cand[AMSCR__CANDIDATES];
-        size_t nc = 0;
-        for (size_t s = 0; s < n; s++) {
-            double v = ws->crit[s];
-            double l = ws->crit[(s + n - 1) % n], r = ws->crit[(s + 1) % n];
-            if (!(v <= l && v <= r))
-                continue;
-            size_t pos = nc;
-            while (pos > 0 && ws->crit[cand[pos - 1]] > v)
-                pos--;
-            if (pos >= AMSCR__CANDIDATES)
-                continue;
-            size_t last = nc < AMSCR__CANDIDATES ? nc : AMSCR__CANDIDATES - 1;
-            for (size_t j = last; j > pos; j--)
-                cand[j] = cand[j - 1];
-            cand[pos] = s;
-            if (nc < AMSCR__CANDIDATES)
-                nc++;
-        }
-        if (nc == 0) { /* flat criterion: take shift 0 */
-            cand[0] = 0;
-            nc = 1;
-        }
+        size_t nc = integer_candidates(ws, n, cand);
         /* a candidate is worth refining only when its residual is close to the best one's:
          * refinement moves the residual by far less than a factor 1.25. The residual is
          * Σ_k |h_k|^2 + criterion; Σ_k |h_k|^2 is bounded by p |h|^2. */
@@ -795,13 +803,23 @@ static amscr_status match_one(const amscr_params *prm, const amscr_descriptor *f
  * residual of all samples. */
 
 #define AMSCR__TRIM 0.9
+/* Costs are mean squared distances in the target's normalized frame (RMS radius sqrt 2): a
+ * match whose trimmed cost is below this floor (an RMS misfit of 0.01 % of the size) is
+ * already exact, and closest-point steps smaller than half of it are noise: both would only
+ * let the map slide along the curve, which closest-point costs do not see. */
+#define AMSCR__REFINE_FLOOR 1e-8
+/* The target polygon the closest points are taken on: the N samples densified 4x by
+ * Catmull-Rom interpolation (through the samples, following the curvature), so that chords of a
+ * coarse polygon do not bias the fit. */
+#define AMSCR__DENSE 4
 
 static amscr_status ws_reserve_refine(amscr_workspace *ws, size_t n)
 {
     if (ws->rcap >= n && ws->rbuf)
         return AMSCR_OK;
     free(ws->rbuf);
-    ws->rbuf = amscr__malloc_array(6 * n + 8, sizeof(double)); /* q 2n, r2 n, sorted n, tmp 2n */
+    /* q 2n, r2 n, sorted n, tmp 2n, hints 2n, dense target 2 * AMSCR__DENSE n */
+    ws->rbuf = amscr__malloc_array((8 + 2 * AMSCR__DENSE) * n + 8, sizeof(double));
     if (!ws->rbuf) {
         ws->rcap = 0;
         return amscr__fail(AMSCR_E_NOMEM, "workspace: out of memory");
@@ -810,13 +828,19 @@ static amscr_status ws_reserve_refine(amscr_workspace *ws, size_t n)
     return AMSCR_OK;
 }
 
-/* Closest point to (px, py) on the closed polygon H (n vertices), edges [b0-w, b0+w]. */
-static double closest_on_polygon(const double *H, size_t n, size_t b0, size_t w, double px, double py, double *qx,
-                                 double *qy)
+/* Closest point to (px, py) on the polygon H (n vertices; closed: with the closing edge),
+ * edges b0-w .. b0+w; *seg receives the edge index. */
+static double closest_on_polygon(const double *H, size_t n, int closed, size_t b0, size_t w, double px, double py,
+                                 double *qx, double *qy, size_t *seg)
 {
     double best = INFINITY;
-    size_t cnt = 2 * w + 1 < n ? 2 * w + 1 : n;
-    size_t b = (b0 + n - (cnt == n ? 0 : w)) % n;
+    size_t nedges = closed ? n : n - 1;
+    size_t cnt = 2 * w + 1 < nedges ? 2 * w + 1 : nedges;
+    size_t b;
+    if (closed)
+        b = (b0 + n - (cnt == nedges ? 0 : w % n)) % n;
+    else
+        b = b0 > w ? (b0 - w + cnt <= nedges ? b0 - w : nedges - cnt) : 0;
     for (size_t i = 0; i < cnt; i++) {
         size_t c = b + 1 == n ? 0 : b + 1;
         double ax = H[2 * b], ay = H[2 * b + 1], ex = H[2 * c] - ax, ey = H[2 * c + 1] - ay;
@@ -827,16 +851,45 @@ static double closest_on_polygon(const double *H, size_t n, size_t b0, size_t w,
             best = d2;
             *qx = cx;
             *qy = cy;
+            *seg = b;
         }
         b = c;
     }
     return best;
 }
 
-static int cmp_double(const void *a, const void *b)
+/* Partially orders v so that v[k] is the k-th smallest and v[0..k) are the smaller ones
+ * (quickselect, median-of-three pivots): O(n), no allocation. */
+static void select_kth(double *v, size_t n, size_t k)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
+    size_t lo = 0, hi = n - 1;
+    while (hi > lo) {
+        size_t mid = lo + (hi - lo) / 2;
+        double a = v[lo], b = v[mid], c = v[hi];
+        double pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
+        size_t i = lo, j = hi;
+        while (i <= j) {
+            while (v[i] < pivot)
+                i++;
+            while (v[j] > pivot)
+                j--;
+            if (i <= j) {
+                double t = v[i];
+                v[i] = v[j];
+                v[j] = t;
+                i++;
+                if (j == 0)
+                    break;
+                j--;
+            }
+        }
+        if (k <= j)
+            hi = j;
+        else if (k >= i)
+            lo = i;
+        else
+            return;
+    }
 }
 
 /* Trimmed least squares X from pairs (f_a -> q_a) with r2_a <= cut. Returns 0 if singular. */
@@ -867,23 +920,61 @@ static int trimmed_solve(const double *f, const double *q, const double *r2, siz
     return 1;
 }
 
-/* One correspondence step: q_a = closest target point to X f_a; r2_a its squared distance;
- * returns the trimmed cost and the cut-off. */
-static double icp_pairs(const amscr_descriptor *f, const amscr_descriptor *h, const match_t *m, const double X[6],
-                        double *q, double *r2, double *sorted, double *out_cut)
+/* Catmull-Rom densification of the N target samples by AMSCR__DENSE (closed: periodic; open:
+ * end points repeated). out: 2 * AMSCR__DENSE * n (closed) or AMSCR__DENSE * (n - 1) + 1 points. */
+static size_t densify(const double *H, size_t n, int closed, double *out)
 {
-    size_t n = f->n, w = n / 4 > 2 ? n / 4 : 2;
+    size_t m = 0, nseg = closed ? n : n - 1;
+    for (size_t i = 0; i < nseg; i++) {
+        size_t i0 = closed ? (i + n - 1) % n : (i == 0 ? 0 : i - 1), i1 = i, i2 = closed ? (i + 1) % n : i + 1;
+        size_t i3 = closed ? (i + 2) % n : (i + 2 < n ? i + 2 : n - 1);
+        for (int k = 0; k < AMSCR__DENSE; k++) {
+            double t = (double)k / AMSCR__DENSE, t2 = t * t, t3 = t2 * t;
+            double c0 = -0.5 * t3 + t2 - 0.5 * t, c1 = 1.5 * t3 - 2.5 * t2 + 1.0, c2 = -1.5 * t3 + 2.0 * t2 + 0.5 * t,
+                   c3 = 0.5 * t3 - 0.5 * t2;
+            for (int d = 0; d < 2; d++)
+                out[2 * m + d] = c0 * H[2 * i0 + d] + c1 * H[2 * i1 + d] + c2 * H[2 * i2 + d] + c3 * H[2 * i3 + d];
+            m++;
+        }
+    }
+    if (!closed) {
+        out[2 * m] = H[2 * (n - 1)];
+        out[2 * m + 1] = H[2 * (n - 1) + 1];
+        m++;
+    }
+    return m;
+}
+
+/* One correspondence step: q_a = closest target point to X f_a; r2_a its squared distance;
+ * returns the trimmed cost and the cut-off. hints (n values): the edge found last time per
+ * sample, searched within ±8 edges; otherwise a window of N/8 around the method's partner. */
+static double icp_pairs(const amscr_descriptor *f, const double *Hd, size_t nd, const match_t *m, const double X[6],
+                        double *q, double *r2, double *sorted, double *hints, int use_hints, double *out_cut)
+{
+    size_t n = f->n, wide = AMSCR__DENSE * (n / 8 > 2 ? n / 8 : 2);
+    int closed = f->params.closed;
     for (size_t a = 0; a < n; a++) {
         double fx = f->base[2 * a], fy = f->base[2 * a + 1];
         double px = X[0] * fx + X[1] * fy + X[2], py = X[3] * fx + X[4] * fy + X[5];
-        size_t b0 = f->params.closed ? tgt_index(a, m->shift, m->reflected, 1, n) : tgt_index(a, 0, m->reflected, 0, n);
-        r2[a] = closest_on_polygon(h->base, n, b0, w, px, py, &q[2 * a], &q[2 * a + 1]);
+        size_t b0, w, seg = 0;
+        if (use_hints) {
+            b0 = (size_t)hints[a];
+            w = 3 * AMSCR__DENSE;
+        } else {
+            b0 = AMSCR__DENSE *
+                 (closed ? tgt_index(a, m->shift, m->reflected, 1, n) : tgt_index(a, 0, m->reflected, 0, n));
+            w = wide;
+        }
+        if (b0 >= nd)
+            b0 = nd - 1;
+        r2[a] = closest_on_polygon(Hd, nd, closed, b0, w, px, py, &q[2 * a], &q[2 * a + 1], &seg);
+        hints[a] = (double)seg;
         sorted[a] = r2[a];
     }
-    qsort(sorted, n, sizeof *sorted, cmp_double);
     size_t keep = (size_t)(AMSCR__TRIM * (double)n);
     if (keep < 8)
         keep = n < 8 ? n : 8;
+    select_kth(sorted, n, keep - 1);
     double cost = 0.0;
     for (size_t a = 0; a < keep; a++)
         cost += sorted[a];
@@ -891,38 +982,49 @@ static double icp_pairs(const amscr_descriptor *f, const amscr_descriptor *h, co
     return cost / (double)keep;
 }
 
-/* Refines m in place (closed and open curves). */
+/* Refines m in place (closed and open curves) with at most `iters` iterations. */
 static amscr_status refine_match(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                 amscr_workspace *ws, match_t *m, int *out_refined)
+                                 amscr_workspace *ws, match_t *m, unsigned iters, int *out_refined)
 {
     *out_refined = 0;
-    if (prm->refine == 0)
+    if (iters == 0)
         return AMSCR_OK;
+    (void)prm;
     size_t n = f->n;
     amscr_status st = ws_reserve_refine(ws, n);
     if (st != AMSCR_OK)
         return st;
-    double *q = ws->rbuf, *r2 = q + 2 * n, *sorted = r2 + n;
+    double *q = ws->rbuf, *r2 = q + 2 * n, *sorted = r2 + n, *q2 = sorted + n, *hints = q2 + 2 * n;
+    double *hints2 = hints + n, *Hd = hints2 + n;
+    size_t nd = densify(h->base, n, f->params.closed, Hd);
     double X[6], cut;
     memcpy(X, m->X, sizeof X);
-    double cost = icp_pairs(f, h, m, X, q, r2, sorted, &cut);
-    for (unsigned it = 0; it < prm->refine; it++) {
+    double cost = icp_pairs(f, Hd, nd, m, X, q, r2, sorted, hints, 0, &cut);
+    if (cost < AMSCR__REFINE_FLOOR)
+        iters = 0;
+    for (unsigned it = 0; it < iters; it++) {
         double Xn[6], cutn;
         if (!trimmed_solve(f->base, q, r2, n, cut, Xn))
             break;
-        double *q2 = sorted + n; /* tmp 2n */
-        double costn = icp_pairs(f, h, m, Xn, q2, r2, sorted, &cutn);
-        if (!(costn < cost * (1.0 - 1e-9)))
+        memcpy(hints2, hints, n * sizeof *hints);
+        double costn = icp_pairs(f, Hd, nd, m, Xn, q2, r2, sorted, hints2, 1, &cutn);
+        if (!(costn < cost - 0.5 * AMSCR__REFINE_FLOOR)) {
+            /* r2 now holds the rejected trial: restore the accepted pairs' residuals */
+            cost = icp_pairs(f, Hd, nd, m, X, q, r2, sorted, hints, 1, &cut);
             break;
+        }
+        int converged = costn > cost * (1.0 - 1e-6);
         memcpy(X, Xn, sizeof X);
         memcpy(q, q2, 2 * n * sizeof *q);
+        memcpy(hints, hints2, n * sizeof *hints);
         cost = costn;
         cut = cutn;
         *out_refined = 1;
+        if (converged)
+            break;
     }
+    m->rcost = cost;
     if (*out_refined) {
-        /* r2 belongs to the accepted pairs only if the last trial was accepted: recompute */
-        cost = icp_pairs(f, h, m, X, q, r2, sorted, &cut);
         double all = 0.0;
         for (size_t a = 0; a < n; a++)
             all += r2[a];
@@ -931,6 +1033,60 @@ static amscr_status refine_match(const amscr_params *prm, const amscr_descriptor
         m->refined = 1;
         m->rcut = cut;
     }
+    return AMSCR_OK;
+}
+
+/* With refinement on (registration of single pairs, where time matters less than
+ * robustness): every candidate (orientation, continuous shift) — the lowest local minima of
+ * the criterion for each orientation — gets the method and the refinement, and the one with
+ * the lowest trimmed closest-point cost wins. A wrong start point caused by a missing part of
+ * a contour is then caught by the geometry rather than by the criterion alone. */
+static amscr_status match_explore(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                  amscr_workspace *ws, match_t *best)
+{
+    size_t n = f->n;
+    amscr_status st = ws_reserve(ws, n, f->p);
+    if (st != AMSCR_OK)
+        return st;
+    int norient = prm->reflections ? 2 : 1, use_finest = prm->method == AMSCR_METHOD_ACMA, have = 0;
+    int best_o = 0;
+    double Si[3], best_s = 0.0;
+    crit_matrix(f, use_finest, Si);
+    for (int o = 0; o < norient; o++) {
+        size_t cand[AMSCR__CANDIDATES];
+        double shifts[AMSCR__CANDIDATES];
+        shift_criterion(f, h, o, use_finest, Si, ws);
+        size_t nc = integer_candidates(ws, n, cand);
+        for (size_t c = 0; c < nc; c++) {
+            double cv;
+            shifts[c] = refine_shift(f, use_finest, Si, ws, cand[c], &cv);
+        }
+        for (size_t c = 0; c < nc; c++) {
+            match_t cur;
+            int refined;
+            spectral_prepare(f, h, o, ws);
+            run_method(prm, f, h, shifts[c], o, ws, &cur);
+            st = refine_match(prm, f, h, ws, &cur, prm->refine < 2 ? prm->refine : 2, &refined);
+            if (st != AMSCR_OK)
+                return st;
+            if (!have || cur.rcost < best->rcost || (cur.rcost == best->rcost && better(&cur, best))) {
+                *best = cur;
+                best_o = o;
+                best_s = shifts[c];
+                have = 1;
+            }
+        }
+    }
+    /* the winner gets the whole refinement (and leaves its pairs in the workspace for the
+     * reported solve) */
+    int refined;
+    spectral_prepare(f, h, best_o, ws);
+    run_method(prm, f, h, best_s, best_o, ws, best);
+    st = refine_match(prm, f, h, ws, best, prm->refine, &refined);
+    if (st != AMSCR_OK)
+        return st;
+    if (!isfinite(best->dist))
+        return amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
     return AMSCR_OK;
 }
 
@@ -949,10 +1105,12 @@ static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor 
 static amscr_status match_dir(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                               amscr_workspace *ws, match_t *m)
 {
+    if (prm->refine > 0 && f->params.closed)
+        return match_explore(prm, f, h, ws, m);
     amscr_status st = match_one(prm, f, h, ws, m);
     int refined;
     if (st == AMSCR_OK)
-        st = refine_match(prm, f, h, ws, m, &refined);
+        st = refine_match(prm, f, h, ws, m, prm->refine, &refined);
     return st;
 }
 
@@ -1169,6 +1327,11 @@ amscr_status amscr_register_contours(const amscr_params *p, const amscr_contour 
     AMSCR_CHECK_NULL(out_result);
     amscr_descriptor *a = NULL, *b = NULL;
     char detail[400];
+    amscr_params preset;
+    if (!p) {
+        amscr__params_registration(&preset);
+        p = &preset;
+    }
     amscr_status st = amscr_descriptor_new(p, src, &a);
     if (st == AMSCR_OK) {
         st = amscr_descriptor_new(p, tgt, &b);

@@ -299,7 +299,7 @@ amscr_status amscr__parametrize(const double *P, size_t np, int closed, amscr_pa
     if (kind == AMSCR_PARAM_WHITENED && !polygon_whitener(P, np, closed, W))
         return amscr__fail(AMSCR_E_DEGENERATE, "parametrization: singular moments (collinear curve)");
     size_t big = M > np ? M : np;
-    double *buf = amscr__malloc_array(8 * big + m + 8, sizeof *buf);
+    double *buf = amscr__malloc_array(10 * big + m + 8, sizeof *buf);
     if (!buf)
         return amscr__fail(AMSCR_E_NOMEM, "parametrization: out of memory");
     double *pos = buf;               /* M positions on P (vertex index + fraction) */
@@ -308,7 +308,8 @@ amscr_status amscr__parametrize(const double *P, size_t np, int closed, amscr_pa
     double *cum = buf + 5 * big;     /* max(M, np) */
     double *tgt = buf + 6 * big;     /* M targets */
     double *newpos = buf + 7 * big;  /* M */
-    double *finalpos = buf + 8 * big; /* m */
+    double *tmp2 = buf + 8 * big;     /* 2M box-filter scratch */
+    double *finalpos = buf + 10 * big; /* m */
     double total = wlength_cum(P, np, closed, W, cum);
     if (!(total > 0.0) || !isfinite(total)) {
         free(buf);
@@ -324,7 +325,7 @@ amscr_status amscr__parametrize(const double *P, size_t np, int closed, amscr_pa
         } else {
             const double *Q = C;
             if (sigma0 > 0.0) {
-                st = amscr__smooth(C, M, closed, sigma0, S);
+                st = amscr__smooth_box3(C, M, closed, sigma0, S, tmp2);
                 Q = S;
             }
             if (st == AMSCR_OK) {

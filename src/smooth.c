@@ -132,3 +132,45 @@ amscr_status amscr_smooth_gaussian(const double *xy, size_t n, int closed, doubl
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_smooth_gaussian: non-finite coordinates");
     return amscr__smooth(xy, n, closed ? 1 : 0, sigma, out_xy);
 }
+
+/* Box smoothing of one pass: out[i] = mean of in[i-r .. i+r] (circular, or mirrored at open
+ * ends). Running sums: O(n) whatever r. */
+static void box_pass(const double *in, size_t n, int closed, size_t r, double *out)
+{
+    double sx = 0.0, sy = 0.0, inv = 1.0 / (double)(2 * r + 1);
+    for (long long j = -(long long)r; j <= (long long)r; j++) {
+        size_t k = closed ? (size_t)(((j % (long long)n) + (long long)n) % (long long)n) : mirror_index(j, n);
+        sx += in[2 * k];
+        sy += in[2 * k + 1];
+    }
+    for (size_t i = 0; i < n; i++) {
+        out[2 * i] = sx * inv;
+        out[2 * i + 1] = sy * inv;
+        long long add = (long long)i + (long long)r + 1, del = (long long)i - (long long)r;
+        size_t ka = closed ? (size_t)(((add % (long long)n) + (long long)n) % (long long)n) : mirror_index(add, n);
+        size_t kd = closed ? (size_t)(((del % (long long)n) + (long long)n) % (long long)n) : mirror_index(del, n);
+        sx += in[2 * ka] - in[2 * kd];
+        sy += in[2 * ka + 1] - in[2 * kd + 1];
+    }
+}
+
+/* Approximately Gaussian smoothing by three box passes of equal variance (3 (w^2 - 1) / 12 =
+ * sigma^2, w = 2r + 1), O(n) whatever sigma: used where only a smooth curve is needed to
+ * MEASURE a parameter (the parametrizations), not for the scale space. Linear, hence
+ * affine-covariant. Falls back to the FIR Gaussian when the box would exceed the curve.
+ * scratch: 2n doubles. */
+amscr_status amscr__smooth_box3(const double *xy, size_t n, int closed, double sigma, double *out, double *scratch)
+{
+    double w = sqrt(4.0 * sigma * sigma + 1.0);
+    size_t r = (size_t)floor(0.5 * (w - 1.0) + 0.5);
+    if (sigma <= 0.0 || r == 0) {
+        memcpy(out, xy, 2 * n * sizeof *out);
+        return AMSCR_OK;
+    }
+    if (2 * r + 1 > n)
+        return amscr__smooth(xy, n, closed, sigma, out);
+    box_pass(xy, n, closed, r, out);
+    box_pass(out, n, closed, r, scratch);
+    box_pass(scratch, n, closed, r, out);
+    return AMSCR_OK;
+}

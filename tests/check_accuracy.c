@@ -28,17 +28,26 @@
 #include "suites.h"
 #include "testutil.h"
 
+/* Registration accuracy is measured with the library's registration preset
+ * (amscr_params_new_registration: N 256, 20 refinement iterations), which the tool's
+ * `register` and Python's `register()` use by default; the plain defaults serve collections. */
+
+
 #define SYN_CASES 240 /* >= 200 seeded shapes per condition */
 #define KIMIA_REPEATS 2 /* random affine maps per image and condition */
 
 /* ------------------------------------------------------------------ helpers */
 
-static double now_seconds(void)
+static double clock_seconds(clockid_t id)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(id, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
+
+static double now_seconds(void) { return clock_seconds(CLOCK_MONOTONIC); }
+/* CPU time of this thread: meaningful on a loaded machine, where wall time is not */
+static double cpu_seconds(void) { return clock_seconds(CLOCK_THREAD_CPUTIME_ID); }
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -58,10 +67,19 @@ static const char *const cond_name[] = {"clean", "mirror (det<0)", "1% noise", "
 /* Timing accumulators of one run (prepare both shapes + register, and register only) and the
  * run's workspace (reused, as a batch caller would). */
 typedef struct {
-    double t_total, t_register;
+    double t_total, t_register, c_total, c_register;
     size_t count;
     amscr_workspace *ws;
 } timing;
+
+/* "a ms/pair (b ms/registration), CPU c / d ms" */
+static void print_timing(const timing *tm)
+{
+    double n = (double)(tm->count ? tm->count : 1);
+    printf("wall %.3f ms/pair (prepare both + register), %.3f ms/registration; CPU %.3f ms/pair, %.3f "
+           "ms/registration\n",
+           1e3 * tm->t_total / n, 1e3 * tm->t_register / n, 1e3 * tm->c_total / n, 1e3 * tm->c_register / n);
+}
 
 /* Registers src onto tgt with params prm; returns the error measure (or +inf when a call
  * fails, with the status in *out_status) and the distance. */
@@ -76,20 +94,25 @@ static double score_pair(const amscr_params *prm, const double *src, size_t ns, 
     amscr_status st = amscr_contour_new(src, ns, &cs);
     if (st == AMSCR_OK)
         st = amscr_contour_new(tgt, nt, &ct);
-    double t0 = now_seconds(), t1 = t0, t2 = t0;
+    double t0 = now_seconds(), t1 = t0, t2 = t0, c0 = cpu_seconds(), c1 = c0, c2 = c0;
     if (st == AMSCR_OK) {
         t0 = now_seconds();
+        c0 = cpu_seconds();
         st = amscr_descriptor_new(prm, cs, &ds);
         if (st == AMSCR_OK)
             st = amscr_descriptor_new(prm, ct, &dt);
         t1 = now_seconds();
+        c1 = cpu_seconds();
         if (st == AMSCR_OK)
             st = amscr_register(prm, ds, dt, tm->ws, &r);
         t2 = now_seconds();
+        c2 = cpu_seconds();
     }
     if (st == AMSCR_OK) {
         tm->t_total += t2 - t0;
         tm->t_register += t2 - t1;
+        tm->c_total += c2 - c0;
+        tm->c_register += c2 - c1;
         tm->count++;
         double M[6];
         st = amscr_result_affine(r, M);
@@ -192,7 +215,7 @@ static double synthetic_case(const amscr_params *prm, condition cond, uint64_t s
 static void run_synthetic(condition cond, syn_stats *s)
 {
     amscr_params *prm = NULL;
-    ck_assert_int_eq(amscr_params_new(&prm), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new_registration(&prm), AMSCR_OK);
     if (cond == COND_MIRROR)
         ck_assert_int_eq(amscr_params_set_reflections(prm, 1), AMSCR_OK);
     memset(s, 0, sizeof *s);
@@ -238,11 +261,11 @@ static void print_syn(condition cond, syn_stats *s)
     double med = median_of(copy, s->cases);
     free(copy);
     printf("accuracy: synthetic %-14s %zu cases: < 0.5 %%: %.2f %%, < 2 %%: %.2f %%, median %.5f %%, worst %.4f %% "
-           "(seed %llu), max distance %.3g; %.3f ms/pair (prepare both + register), %.3f ms/registration\n",
+           "(seed %llu), max distance %.3g; ",
            cond_name[cond], s->cases, 100.0 * (double)s->within_half / (double)s->cases,
            100.0 * (double)s->within_2pct / (double)s->cases, 100.0 * med, 100.0 * s->worst,
-           (unsigned long long)s->worst_seed, s->max_dist, 1e3 * s->tm.t_total / (double)(s->tm.count ? s->tm.count : 1),
-           1e3 * s->tm.t_register / (double)(s->tm.count ? s->tm.count : 1));
+           (unsigned long long)s->worst_seed, s->max_dist);
+    print_timing(&s->tm);
     fflush(stdout);
 }
 
@@ -282,7 +305,7 @@ static void assert_exact_protocol(condition cond)
     run_synthetic(cond, &s);
     print_syn(cond, &s);
     amscr_params *prm = NULL;
-    ck_assert_int_eq(amscr_params_new(&prm), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new_registration(&prm), AMSCR_OK);
     ck_assert_int_eq(amscr_params_set_reflections(prm, cond == COND_MIRROR), AMSCR_OK);
     double between = between_shape_median(prm);
     amscr_params_free(prm);
@@ -461,7 +484,7 @@ START_TEST(kimia_pixel_contours)
     }
 
     amscr_params *prm = NULL;
-    ck_assert_int_eq(amscr_params_new(&prm), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new_registration(&prm), AMSCR_OK);
     const condition conds[3] = {COND_CLEAN, COND_NOISE, COND_OCCLUSION};
     const double targets[3] = {0.99, 0.97, 0.95};
     kimia_stats ks[3];
@@ -492,11 +515,10 @@ START_TEST(kimia_pixel_contours)
         }
         amscr_workspace_free(s->tm.ws);
         s->tm.ws = NULL;
-        printf("accuracy: kimia99+216 %-12s %zu pairs: %.2f %% within 2 %% (target >= %.0f %%), worst %.3g %%; "
-               "%.3f ms/pair (prepare both + register), %.3f ms/registration\n",
+        printf("accuracy: kimia99+216 %-12s %zu pairs: %.2f %% within 2 %% (target >= %.0f %%), worst %.3g %%; ",
                cond_name[cond], s->cases, 100.0 * (double)s->within / (double)s->cases, 100.0 * targets[ci],
-               100.0 * s->worst, 1e3 * s->tm.t_total / (double)(s->tm.count ? s->tm.count : 1),
-               1e3 * s->tm.t_register / (double)(s->tm.count ? s->tm.count : 1));
+               100.0 * s->worst);
+        print_timing(&s->tm);
         fflush(stdout);
     }
     amscr_params_free(prm);
@@ -505,11 +527,15 @@ START_TEST(kimia_pixel_contours)
     free(pts);
     free(npts);
     list_free(&files);
+    double rate[3];
+    int ok = 1;
     for (int ci = 0; ci < 3; ci++) {
-        double rate = (double)ks[ci].within / (double)ks[ci].cases;
-        ck_assert_msg(rate >= targets[ci], "kimia %s: %.2f %% of %zu pairs within 2 %% (target %.0f %%)",
-                      cond_name[conds[ci]], 100.0 * rate, ks[ci].cases, 100.0 * targets[ci]);
+        rate[ci] = (double)ks[ci].within / (double)ks[ci].cases;
+        ok = ok && rate[ci] >= targets[ci];
     }
+    ck_assert_msg(ok, "kimia pairs within 2 %%: clean %.2f %% (target 99), 1 %% noise %.2f %% (target 97), "
+                      "5 %% occlusion %.2f %% (target 95)",
+                  100.0 * rate[0], 100.0 * rate[1], 100.0 * rate[2]);
 }
 END_TEST
 

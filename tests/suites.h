@@ -18,5 +18,6 @@ Suite *amscr_suite_register(void);
 Suite *amscr_suite_accuracy(void);
 Suite *amscr_suite_db(void);
 Suite *amscr_suite_retrieval(void);
+Suite *amscr_suite_threads(void);
 
 #endif

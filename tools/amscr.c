@@ -131,12 +131,13 @@ static const char *HELP_SHAPE_OPTS =
     "                          Polarity is automatic: the image border is background.\n"
     "shape options:\n"
     "  --method NAME           acma | amscr | binary-em | multiclass-em (default)\n"
-    "  --points N              samples per curve (default 128)\n"
+    "  --points N              samples per curve (default 256 for register, 128 otherwise)\n"
     "  --scales S1,S2,...      smoothing scales in samples (default: the library's)\n"
     "  --reflections           also try mirror matches (default: off for register,\n"
     "  --no-reflections          on for search, matrix and eval)\n"
     "  --open                  open curves (default closed)\n"
-    "  --refine N              refinement iterations in the aligned frame (0..50)\n"
+    "  --refine N              refinement iterations in the aligned frame (0..50; default:\n"
+    "                          20 for register, 0 for search/matrix/eval)\n"
     "  --kmax K                largest K of the elbow (1..16)\n"
     "  --symmetric             average the distance over both directions\n"
     "  --parametrization NAME  affine (default) | euclidean | whitened\n"
@@ -450,11 +451,15 @@ static int parse_args(opts *o, int argc, char **argv, int minpos, int maxpos, co
     return 0;
 }
 
-/* Builds the params from the options. `default_reflections` is the command's default. */
-static int make_params(const opts *o, int default_reflections, amscr_params **out)
+/* Builds the params from the options. `registration` selects the command's defaults: register
+ * starts from the library's registration preset (N 256, 20 refinement iterations: measured in
+ * the README) and does not try mirror images; retrieval starts from the collection defaults
+ * (N 128, no refinement: speed) and tries mirror images; flags override both. */
+static int make_params(const opts *o, int registration, amscr_params **out)
 {
     amscr_params *p = NULL;
-    amscr_status st = amscr_params_new(&p);
+    amscr_status st = registration ? amscr_params_new_registration(&p) : amscr_params_new(&p);
+    int default_reflections = !registration;
     if (st != AMSCR_OK) {
         tool_lib_error(NULL, st);
         return TOOL_EXIT_FAIL;
@@ -568,7 +573,7 @@ static int cmd_register(opts *o)
     sbuf b;
     sb_init(&b);
 
-    int r = make_params(o, 0, &p);
+    int r = make_params(o, 1, &p);
     if (r != 0)
         return r;
     if (shape_load(spath, o->threshold, &src) != 0 || shape_load(tpath, o->threshold, &tgt) != 0)
@@ -845,7 +850,7 @@ static int cmd_search(opts *o)
     memset(&c, 0, sizeof c);
     double t0 = now_seconds();
 
-    int r = make_params(o, 1, &p);
+    int r = make_params(o, 0, &p);
     if (r != 0)
         return r;
     if (shape_load(qpath, o->threshold, &q) != 0)
@@ -995,7 +1000,7 @@ static int cmd_matrix(opts *o)
     double *d = NULL;
     int ret = TOOL_EXIT_FAIL;
     memset(&c, 0, sizeof c);
-    int r = make_params(o, 1, &p);
+    int r = make_params(o, 0, &p);
     if (r != 0)
         return r;
     if (collection_open(cpath, &c) != 0 || load_db(p, &c, o->threshold, &db) != 0 ||
@@ -1055,7 +1060,7 @@ static int cmd_eval(opts *o)
     sb_init(&b);
     memset(&c, 0, sizeof c);
     double t0 = now_seconds();
-    int r = make_params(o, 1, &p);
+    int r = make_params(o, 0, &p);
     if (r != 0)
         return r;
     if (collection_open(cpath, &c) != 0)

@@ -1,0 +1,268 @@
+"""Private helpers: input validation, buffers, progress callbacks, locks."""
+from __future__ import annotations
+
+import contextlib
+import sys
+import threading
+import time
+from typing import Any, Callable, Iterator, Optional, Tuple, Union
+
+import numpy as np
+
+from ._lib import ffi, lib
+from .errors import InvalidArgumentError, _check
+
+INT32_MIN, INT32_MAX = -(2 ** 31), 2 ** 31 - 1
+
+
+def bad(msg: str) -> InvalidArgumentError:
+    """A Python-side validation error (also a ValueError)."""
+    return InvalidArgumentError(msg, lib.AMSCR_E_INVALID_ARG, msg)
+
+
+def as_points(x: Any, name: str = 'points') -> np.ndarray:
+    """array-like -> C-contiguous float64 array of shape (n, 2), n >= 1, all finite."""
+    if hasattr(x, 'input_points') and hasattr(x, 'scale_points'):
+        raise TypeError('%s: expected an array of points, got a prepared Shape' % name)
+    try:
+        a = np.asarray(x)
+    except ValueError as e:  # ragged nested lists
+        raise bad('%s: expected an array of shape (n, 2): %s' % (name, e)) from None
+    if a.dtype.kind not in 'iuf':
+        raise bad('%s: expected real numbers, got an array of dtype %s' % (name, a.dtype))
+    if a.ndim != 2 or a.shape[1] != 2:
+        raise bad('%s: expected an array of shape (n, 2) (one x, y row per point), got shape %s'
+                  % (name, a.shape))
+    if a.shape[0] == 0:
+        raise bad('%s: no points' % name)
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    finite = np.isfinite(a).all(axis=1)
+    if not finite.all():
+        i = int(np.argmin(finite))
+        raise bad('%s: point %d is not finite: (%r, %r)' % (name, i, float(a[i, 0]), float(a[i, 1])))
+    return a
+
+
+def as_float_array(x: Any, name: str, ndim: Optional[Tuple[int, ...]] = None, finite: bool = True) -> np.ndarray:
+    try:
+        a = np.asarray(x)
+    except ValueError as e:
+        raise bad('%s: not a regular array: %s' % (name, e)) from None
+    if a.dtype.kind not in 'iuf':
+        raise bad('%s: expected real numbers, got an array of dtype %s' % (name, a.dtype))
+    if ndim is not None and a.ndim not in ndim:
+        raise bad('%s: expected %s dimension(s), got shape %s' % (name, ' or '.join(map(str, ndim)), a.shape))
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    if finite and not np.isfinite(a).all():
+        idx = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
+        raise bad('%s: value at index %s is not finite' % (name, idx if len(idx) > 1 else idx[0]))
+    return a
+
+
+def as_scalar(x: Any, name: str) -> float:
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise bad('%s: expected a number, got %r' % (name, x)) from None
+    return v
+
+
+def as_count(x: Any, name: str, minimum: int = 0) -> int:
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer)):
+        raise bad('%s: expected an integer, got %r' % (name, x))
+    v = int(x)
+    if v < minimum:
+        raise bad('%s: must be >= %d, got %d' % (name, minimum, v))
+    return v
+
+
+def as_bool(x: Any, name: str) -> int:
+    if isinstance(x, (bool, np.bool_)) or (isinstance(x, (int, np.integer)) and x in (0, 1)):
+        return int(bool(x))
+    raise bad('%s: expected True or False, got %r' % (name, x))
+
+
+def dbuf(a: np.ndarray):
+    """`double *` view of a C-contiguous float64 array (no copy)."""
+    return ffi.from_buffer('double[]', a)
+
+
+def copy_doubles(p, count: int) -> np.ndarray:
+    """Copies `count` doubles from a borrowed C pointer into a new numpy array."""
+    if p == ffi.NULL:
+        raise bad('no data (NULL pointer from the library)')
+    return np.frombuffer(ffi.buffer(p, count * 8), dtype=np.float64).copy()
+
+
+def factorize(labels: Any, n: Optional[int] = None, name: str = 'labels') -> np.ndarray:
+    """Any labels (ints, strings...) -> int32 codes; equal labels get equal codes."""
+    a = np.asarray(labels)
+    if a.ndim != 1:
+        raise bad('%s: expected a 1-D sequence, got shape %s' % (name, a.shape))
+    if n is not None and a.shape[0] != n:
+        raise bad('%s: expected %d labels, got %d' % (name, n, a.shape[0]))
+    if a.dtype.kind in 'iu' and (a.size == 0 or (a.min() >= INT32_MIN and a.max() <= INT32_MAX)):
+        return np.ascontiguousarray(a, dtype=np.int32)
+    try:
+        _, codes = np.unique(a, return_inverse=True)
+    except TypeError as e:
+        raise bad('%s: labels cannot be compared: %s' % (name, e)) from None
+    return np.ascontiguousarray(codes.reshape(-1), dtype=np.int32)
+
+
+def to_m6(m: Any, name: str = 'matrix') -> np.ndarray:
+    """3x3 (last row 0 0 1), 2x3 or flat 6 -> the library's {a11, a12, tx, a21, a22, ty}."""
+    a = as_float_array(m, name)
+    if a.shape == (3, 3):
+        if not np.allclose(a[2], [0.0, 0.0, 1.0]):
+            raise bad('%s: the last row of a 3x3 affine matrix must be (0, 0, 1), got %s' % (name, a[2]))
+        a = a[:2]
+    if a.shape not in ((2, 3), (6,)):
+        raise bad('%s: expected a 3x3 or 2x3 affine matrix, got shape %s' % (name, a.shape))
+    return np.ascontiguousarray(a.reshape(6))
+
+
+def m6_to_matrix(m6) -> np.ndarray:
+    out = np.eye(3)
+    out[:2, :] = np.asarray([m6[i] for i in range(6)], dtype=np.float64).reshape(2, 3)
+    return out
+
+
+def matrix_out(fn, *args) -> np.ndarray:
+    """Calls fn(*args, double[6]) and returns the 3x3 matrix."""
+    m = ffi.new('double[6]')
+    _check(fn(*args, m))
+    return m6_to_matrix(m)
+
+
+# ------------------------------------------------------------------ progress / cancellation
+ProgressArg = Union[bool, Callable[[int, int], Any], None]
+
+
+class _ProgressState:
+    """Per-call state of the C progress callback (see `progress_call`)."""
+
+    __slots__ = ('progress', 'error', 'last', 'started', 'shown', 'stream')
+
+    def __init__(self, progress: ProgressArg):
+        self.progress = progress
+        self.error: Optional[BaseException] = None
+        self.last = 0.0
+        self.started = time.monotonic()
+        self.shown = False
+        self.stream = sys.stderr
+
+    def update(self, done: int, total: int) -> int:
+        p = self.progress
+        if p is True:
+            now = time.monotonic()
+            if done >= total or now - self.last >= 0.1:
+                self.last = now
+                self.bar(done, total, now)
+            return 0
+        if p:
+            return 1 if p(done, total) is True else 0
+        return 0
+
+    def bar(self, done: int, total: int, now: float) -> None:
+        width = 30
+        frac = done / total if total else 1.0
+        fill = int(round(width * frac))
+        elapsed = now - self.started
+        eta = (elapsed / frac - elapsed) if frac > 0 else float('nan')
+        self.stream.write('\ramscr [%s%s] %d/%d %3d%% %.1fs%s' % (
+            '#' * fill, '-' * (width - fill), done, total, int(100 * frac), elapsed,
+            (' eta %.1fs' % eta) if 0 < frac < 1 else '   '))
+        self.stream.flush()
+        self.shown = True
+
+    def finish(self) -> None:
+        if self.shown:
+            self.stream.write('\n')
+            self.stream.flush()
+
+
+_callback_errors = threading.local()
+
+
+def _progress_onerror(exc_type, exc_value, tb):
+    """An exception that escaped the trampoline itself: a signal (Ctrl-C) is raised as soon as the
+    callback starts running Python code, before its try block. Keep it for progress_call (the
+    callback runs on the thread that made the batch call) and cancel the call."""
+    if getattr(_callback_errors, 'error', None) is None:
+        _callback_errors.error = exc_value if exc_value is not None else exc_type()
+    return 1
+
+
+@ffi.callback('amscr_progress_fn', onerror=_progress_onerror)
+def _progress_trampoline(user, done, total):
+    state = ffi.from_handle(user)
+    try:
+        return state.update(done, total)
+    except BaseException as e:  # includes KeyboardInterrupt: cancel the call, re-raise after it
+        state.error = e
+        return 1
+
+
+def progress_call(fn, args_before: tuple, args_after: tuple, progress: ProgressArg) -> None:
+    """Calls fn(*args_before, callback, user, *args_after) with a progress callback.
+
+    The callback is always installed, so Ctrl-C (KeyboardInterrupt) cancels a long call made
+    from the main thread. An exception raised by a user's progress callable cancels the call
+    and is re-raised here; a callable returning True cancels it (CancelledError).
+    """
+    state = _ProgressState(progress)
+    handle = ffi.new_handle(state)
+    _callback_errors.error = None
+    try:
+        status = fn(*args_before, _progress_trampoline, handle, *args_after)
+        error = state.error or _callback_errors.error
+        if error is not None:  # the callback raised (or Ctrl-C): that is the error to report
+            _callback_errors.error = None
+            raise error
+        _check(status)
+    finally:
+        state.finish()
+
+
+# ------------------------------------------------------------------ locks
+class RWLock:
+    """Many readers or one writer, writers first (a collection may be queried by many threads and
+    added to by one; a waiting add() is not starved by a stream of queries). Not reentrant for a
+    thread that holds a read lock while a writer waits."""
+
+    def __init__(self) -> None:
+        self._cond = threading.Condition()
+        self._readers = 0
+        self._writer = False
+        self._writers_waiting = 0
+
+    @contextlib.contextmanager
+    def read(self) -> Iterator[None]:
+        with self._cond:
+            while self._writer or self._writers_waiting:
+                self._cond.wait()
+            self._readers += 1
+        try:
+            yield
+        finally:
+            with self._cond:
+                self._readers -= 1
+                self._cond.notify_all()
+
+    @contextlib.contextmanager
+    def write(self) -> Iterator[None]:
+        with self._cond:
+            self._writers_waiting += 1
+            try:
+                while self._writer or self._readers:
+                    self._cond.wait()
+            finally:
+                self._writers_waiting -= 1
+            self._writer = True
+        try:
+            yield
+        finally:
+            with self._cond:
+                self._writer = False
+                self._cond.notify_all()

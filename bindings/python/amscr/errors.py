@@ -1,0 +1,144 @@
+"""Exceptions raised by amscr: one class per C status code (``amscr_status``), all ``AmscrError``.
+
+Each class also derives from the built-in exception a Python user would catch for that kind of
+failure (``ValueError`` for bad input, ``OSError`` for files, ``MemoryError``...), so both
+``except amscr.AmscrError`` and ``except ValueError`` work.
+"""
+from typing import Dict, Optional, Type
+
+from ._lib import ffi, lib
+
+__all__ = [
+    'AmscrError', 'Error', 'InvalidArgumentError', 'NoMemoryError', 'FileError', 'IOError_', 'FormatError',
+    'UnsupportedError', 'DegenerateError', 'NumericError', 'NumericalError', 'NotConvergedError',
+    'NotFoundError', 'StateError', 'InternalError', 'CancelledError', 'LimitError', 'STATUS_EXCEPTIONS',
+]
+
+
+class AmscrError(Exception):
+    """Base of every error reported by libamscr.
+
+    Attributes:
+        status: the C status code (an ``int``, ``amscr.errors.lib.AMSCR_E_*``), or None when raised
+            by the Python layer itself.
+        detail: the C library's detail message for the failing call (may be empty).
+        message: the full message (``strerror(status): detail``).
+    """
+
+    status: Optional[int] = None
+
+    def __init__(self, message: str, status: Optional[int] = None, detail: str = ''):
+        super().__init__(message)
+        self.message = message
+        if status is not None:
+            self.status = status
+        self.detail = detail
+
+    def __str__(self) -> str:
+        return self.message
+
+
+#: Alias: the issue's name for the base class.
+Error = AmscrError
+
+
+class InvalidArgumentError(AmscrError, ValueError):
+    """AMSCR_E_INVALID_ARG: NULL pointer, out-of-range value, bad option."""
+    status = lib.AMSCR_E_INVALID_ARG
+
+
+class NoMemoryError(AmscrError, MemoryError):
+    """AMSCR_E_NOMEM: an allocation failed."""
+    status = lib.AMSCR_E_NOMEM
+
+
+class FileError(AmscrError, OSError):
+    """AMSCR_E_IO: a file could not be opened, read or written."""
+    status = lib.AMSCR_E_IO
+
+
+IOError_ = FileError
+
+
+class FormatError(AmscrError, ValueError):
+    """AMSCR_E_FORMAT: malformed or unsupported file content."""
+    status = lib.AMSCR_E_FORMAT
+
+
+class UnsupportedError(AmscrError, NotImplementedError):
+    """AMSCR_E_UNSUPPORTED: the feature is not compiled into this build of libamscr."""
+    status = lib.AMSCR_E_UNSUPPORTED
+
+
+class DegenerateError(AmscrError, ValueError):
+    """AMSCR_E_DEGENERATE: too few points, zero area, collinear, singular."""
+    status = lib.AMSCR_E_DEGENERATE
+
+
+class NumericError(AmscrError, ArithmeticError):
+    """AMSCR_E_NUMERIC: rank-deficient system, LAPACK failure, non-finite result."""
+    status = lib.AMSCR_E_NUMERIC
+
+
+NumericalError = NumericError
+
+
+class NotConvergedError(AmscrError, RuntimeError):
+    """AMSCR_E_NOT_CONVERGED: an iteration cap was reached without convergence."""
+    status = lib.AMSCR_E_NOT_CONVERGED
+
+
+class NotFoundError(AmscrError, LookupError):
+    """AMSCR_E_NOT_FOUND: nothing found (empty mask, no Bayes crossing)."""
+    status = lib.AMSCR_E_NOT_FOUND
+
+
+class StateError(AmscrError, RuntimeError):
+    """AMSCR_E_STATE: object used in the wrong state (e.g. not fitted)."""
+    status = lib.AMSCR_E_STATE
+
+
+class InternalError(AmscrError, RuntimeError):
+    """AMSCR_E_INTERNAL: a bug in libamscr; please report it."""
+    status = lib.AMSCR_E_INTERNAL
+
+
+class CancelledError(AmscrError):
+    """AMSCR_E_CANCELLED: a progress callback asked to stop."""
+    status = lib.AMSCR_E_CANCELLED
+
+
+class LimitError(AmscrError, ValueError):
+    """AMSCR_E_LIMIT: the input exceeds a documented size limit."""
+    status = lib.AMSCR_E_LIMIT
+
+
+#: status code -> exception class, one to one.
+STATUS_EXCEPTIONS: Dict[int, Type[AmscrError]] = {
+    cls.status: cls for cls in (
+        InvalidArgumentError, NoMemoryError, FileError, FormatError, UnsupportedError, DegenerateError,
+        NumericError, NotConvergedError, NotFoundError, StateError, InternalError, CancelledError, LimitError)
+}
+
+
+def _decode(p) -> str:
+    return ffi.string(p).decode('utf-8', 'replace') if p != ffi.NULL else ''
+
+
+def error_from_status(status: int, detail: str = '') -> AmscrError:
+    """The exception for a non-zero status code, with the library's message and ``detail``."""
+    status = int(status)
+    message = _decode(lib.amscr_strerror(status))
+    cls = STATUS_EXCEPTIONS.get(status, AmscrError)
+    return cls('%s: %s' % (message, detail) if detail else message, status, detail)
+
+
+def _check(status: int) -> None:
+    """Raises the exception for ``status`` unless it is AMSCR_OK.
+
+    Call it right after the C call, on the same thread: the detail is the calling thread's
+    (thread-local in the library) and is valid until the next amscr call on that thread.
+    """
+    if status:
+        detail = _decode(lib.amscr_last_error_detail())
+        raise error_from_status(status, detail)

@@ -1,0 +1,132 @@
+"""Bad inputs raise the right exception types, with the C library's message."""
+import numpy as np
+import pytest
+
+import amscr
+from helpers import blob
+
+GOOD = blob(100)
+
+
+@pytest.mark.parametrize('bad', [
+    np.zeros((10, 3)),  # wrong shape
+    np.zeros(10),  # 1-D
+    np.zeros((0, 2)),  # empty
+    [[0, 0], [1, 2, 3]],  # ragged
+    [['a', 'b'], ['c', 'd']],  # not numbers
+    np.array([[0, 0], [1, np.nan]] * 8),  # NaN
+    np.array([[0, 0], [np.inf, 1]] * 8),  # inf
+    np.ones((10, 2), dtype=bool),  # bool
+    np.ones((10, 2), dtype=complex),  # complex
+])
+def test_bad_points_raise_value_error(bad):
+    for fn in (lambda p: amscr.register(p, GOOD), lambda p: amscr.register(GOOD, p), amscr.Shape,
+               lambda p: amscr.smooth(p, 1.0), lambda p: amscr.Collection().add(p)):
+        with pytest.raises(ValueError) as ei:
+            fn(bad)
+        assert isinstance(ei.value, amscr.InvalidArgumentError)
+        assert ei.value.status == amscr.errors.lib.AMSCR_E_INVALID_ARG
+
+
+def test_messages_are_clear():
+    with pytest.raises(ValueError, match=r'shape \(n, 2\).*got shape \(10, 3\)'):
+        amscr.Shape(np.zeros((10, 3)))
+    with pytest.raises(ValueError, match=r'point 1 is not finite'):
+        amscr.smooth([[0, 0], [np.nan, 0]], 1.0)
+    with pytest.raises(ValueError, match=r"method: expected one of 'acma'"):
+        amscr.register(GOOD, GOOD, method='nope')
+
+
+def test_degenerate_contours():
+    with pytest.raises(amscr.DegenerateError) as ei:
+        amscr.register([[0, 0], [1, 0], [1, 1]], GOOD)
+    assert isinstance(ei.value, ValueError) and ei.value.detail
+    line = np.column_stack([np.arange(30.0), 2 * np.arange(30.0)])
+    with pytest.raises(amscr.DegenerateError):
+        amscr.Shape(line)
+    with pytest.raises(amscr.DegenerateError):
+        amscr.validate_contour(line)
+
+
+def test_c_side_option_errors_carry_the_detail():
+    with pytest.raises(amscr.InvalidArgumentError) as ei:
+        amscr.Params(points=3)
+    e = ei.value
+    assert e.status == amscr.errors.lib.AMSCR_E_INVALID_ARG
+    assert e.detail and e.detail in str(e) and str(e).startswith('invalid argument')
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.Params(scales=[1.0, -2.0])
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.Params(kmax=0)
+    with pytest.raises(ValueError):
+        amscr.Params(closed='yes')
+    with pytest.raises(TypeError, match='unknown amscr option'):
+        amscr.Params(pionts=10)
+    with pytest.raises(TypeError):
+        amscr.register(GOOD, GOOD, colour='red')
+
+
+def test_mask_errors():
+    with pytest.raises(ValueError):
+        amscr.contour_from_mask(np.zeros((3, 3, 3), np.uint8))
+    with pytest.raises(ValueError):
+        amscr.contour_from_mask(np.zeros((8, 8), np.float64))
+    with pytest.raises(ValueError):
+        amscr.contour_from_mask(np.full((8, 8), 300, np.int32))
+    with pytest.raises(amscr.NotFoundError):
+        amscr.contour_from_mask(np.zeros((8, 8), bool))
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.contour_from_mask(np.zeros((8, 8), np.uint8), threshold=255)
+
+
+def test_file_errors(tmp_path):
+    with pytest.raises(amscr.FileError) as ei:
+        amscr.read_points(tmp_path / 'missing.txt')
+    assert isinstance(ei.value, OSError)
+    p = tmp_path / 'bad.txt'
+    p.write_text('1 2\n3 4\nfive 6\n')
+    with pytest.raises(amscr.FormatError, match='bad.txt:3'):
+        amscr.read_points(p)
+    with pytest.raises(amscr.FormatError):
+        amscr.parse_points('')
+    with pytest.raises(amscr.FileError):
+        amscr.write_points(tmp_path / 'no' / 'such' / 'dir.txt', GOOD)
+
+
+def test_numeric_and_state_errors():
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.kmeans([1.0, 2.0], 3)  # n < k
+    with pytest.raises(amscr.StateError):
+        amscr.GMM1D(2).means
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.gaussian_kernel(-1.0)
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.bayes_threshold(0.5, 0, -1, 0.5, 1, 1)
+    with pytest.raises(ValueError):
+        amscr.lstsq(np.ones((3, 2)), np.ones(4))
+    with pytest.raises(ValueError):
+        amscr.bullseye(np.zeros((3, 4)), [0, 0, 1])
+    with pytest.raises(ValueError):
+        amscr.bullseye(np.zeros((3, 3)), [0, 0])
+
+
+def test_error_detail_is_per_thread():
+    """A failure in one thread does not change the message another thread reports."""
+    import threading
+    errs = {}
+
+    def fail(name, fn):
+        try:
+            for _ in range(200):
+                try:
+                    fn()
+                except amscr.AmscrError as e:
+                    errs.setdefault(name, set()).add(e.detail)
+        except Exception as e:  # pragma: no cover
+            errs[name] = e
+
+    t1 = threading.Thread(target=fail, args=('a', lambda: amscr.Params(points=3)))
+    t2 = threading.Thread(target=fail, args=('b', lambda: amscr.gaussian_kernel(-1.0)))
+    t1.start(), t2.start()
+    t1.join(), t2.join()
+    assert len(errs['a']) == 1 and len(errs['b']) == 1 and errs['a'] != errs['b']

@@ -1,0 +1,145 @@
+"""Packaging checks: the committed cdef is fresh and cffi-clean, the soversion and the versions agree."""
+import importlib.util
+import os
+import re
+import subprocess
+import sys
+
+import pytest
+
+import amscr
+from amscr import _lib, errors
+
+from conftest import PKG_ROOT, REPO_ROOT
+
+HEADER = os.path.join(REPO_ROOT, 'include', 'amscr.h')
+CDEF = os.path.join(PKG_ROOT, 'amscr', '_cdef.h')
+GEN = os.path.join(REPO_ROOT, 'scripts', 'gen_cdef.py')
+
+in_tree = pytest.mark.skipif(not (os.path.exists(HEADER) and os.path.exists(GEN)),
+                             reason='not run from the source tree (no include/amscr.h or scripts/gen_cdef.py)')
+
+
+def _gen_module():
+    spec = importlib.util.spec_from_file_location('gen_cdef', GEN)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@in_tree
+def test_cdef_is_fresh():
+    with open(HEADER, encoding='utf-8') as f:
+        expected = _gen_module().generate(f.read())
+    with open(CDEF, encoding='utf-8') as f:
+        committed = f.read()
+    assert committed == expected, ('bindings/python/amscr/_cdef.h is stale: run '
+                                   'python3 scripts/gen_cdef.py -o bindings/python/amscr/_cdef.h')
+
+
+@in_tree
+def test_gen_cdef_check_mode():
+    r = subprocess.run([sys.executable, GEN, '--check'], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+
+
+def test_cdef_is_cffi_clean_abi():
+    from cffi import FFI
+    ffi = FFI()
+    with open(CDEF, encoding='utf-8') as f:
+        text = f.read()
+    ffi.cdef(text)
+    assert '...' not in re.sub(r'/\*.*?\*/', '', text, flags=re.S)
+    # every enumerator has an explicit value
+    for body in re.findall(r'enum\s+\w*\s*\{(.*?)\}', text, flags=re.S):
+        for item in body.split(','):
+            if item.strip():
+                assert '=' in item, item
+
+
+def test_every_header_function_is_declared():
+    if not os.path.exists(HEADER):
+        pytest.skip('no header')
+    with open(HEADER, encoding='utf-8') as f:
+        header_names = set(re.findall(r'AMSCR_API[^;(]*?\b(amscr_\w+)\s*\(', f.read()))
+    with open(CDEF, encoding='utf-8') as f:
+        cdef_names = set(re.findall(r'\b(amscr_\w+)\s*\(', f.read()))
+    assert header_names and header_names <= cdef_names
+
+
+def test_generator_handles_implicit_enums_and_macros():
+    gen = _gen_module() if os.path.exists(GEN) else pytest.skip('no generator')
+    out = gen.generate('#define X_H\n#define A 2u /* c */\n#define B (A * 3 + 1)\n#define F(x) x\n'
+                       '#ifdef __cplusplus\nextern "C" {\n#endif\n'
+                       'typedef enum e { E0, E1 = B, E2 } e; // x\n'
+                       'AMSCR_API AMSCR_NODISCARD int f(const double m[6],\n  e v);\n'
+                       '#ifdef __cplusplus\n}\n#endif\n')
+    assert '#define A 2\n#define B 7\n' in out
+    assert 'E0 = 0,' in out and 'E1 = 7,' in out and 'E2 = 8' in out
+    assert 'int f(const double m[6], e v);' in out
+    assert 'extern' not in out and 'AMSCR_API' not in out and 'F(' not in out
+    from cffi import FFI
+    FFI().cdef(out)
+
+
+def test_soversion_matches_meson():
+    meson = os.path.join(REPO_ROOT, 'meson.build')
+    if not os.path.exists(meson):
+        pytest.skip('no meson.build (not the source tree)')
+    with open(meson, encoding='utf-8') as f:
+        m = re.search(r"^amscr_soversion\s*=\s*'(\d+)'", f.read(), re.M)
+    assert m, 'amscr_soversion not found in meson.build'
+    assert amscr.SOVERSION == int(m.group(1))
+    assert _lib.SOVERSION == int(m.group(1))
+    spec = importlib.util.spec_from_file_location('_b', os.path.join(PKG_ROOT, 'amscr', '_build.py'))
+    with open(spec.origin, encoding='utf-8') as f:
+        assert "SOVERSION = '%s'" % m.group(1) in f.read()
+
+
+def test_versions_agree():
+    major, minor, patch = (int(x) for x in amscr.__version__.split('.')[:3])
+    assert (_lib.lib.AMSCR_VERSION_MAJOR, _lib.lib.AMSCR_VERSION_MINOR, _lib.lib.AMSCR_VERSION_PATCH) == \
+        (major, minor, patch)
+    n = _lib.lib.amscr_version_number()
+    assert n // 10000 == major and n // 100 % 100 >= minor
+    assert amscr.library_version() == '%d.%d.%d' % (n // 10000, n // 100 % 100, n % 100)
+
+
+def test_errors_one_to_one():
+    names = [n for n in dir(_lib.lib) if n.startswith('AMSCR_E_')]
+    codes = {getattr(_lib.lib, n) for n in names}
+    assert codes == set(errors.STATUS_EXCEPTIONS), 'every status code maps to exactly one class'
+    assert len(set(errors.STATUS_EXCEPTIONS.values())) == len(codes)
+    for code, cls in errors.STATUS_EXCEPTIONS.items():
+        e = errors.error_from_status(code, 'some detail')
+        assert type(e) is cls and e.status == code and e.detail == 'some detail'
+        assert str(e).endswith(': some detail') and isinstance(e, amscr.AmscrError)
+    assert issubclass(amscr.InvalidArgumentError, ValueError)
+    assert issubclass(amscr.NoMemoryError, MemoryError)
+    assert issubclass(amscr.FileError, OSError)
+    assert amscr.Error is amscr.AmscrError
+
+
+def test_version_mismatch_is_a_clear_import_error(tmp_path):
+    """A library whose major differs makes `import amscr` fail with a clear ImportError."""
+    # A fake libamscr reporting version 9.0.0 (built with the system compiler).
+    import shutil
+    cc = shutil.which('cc') or shutil.which('gcc')
+    if not cc:
+        pytest.skip('no C compiler')
+    src = tmp_path / 'fake.c'
+    src.write_text('int amscr_version_number(void) { return 90000; }\n')
+    so = tmp_path / 'libamscr.so.0'
+    subprocess.run([cc, '-shared', '-fPIC', '-o', str(so), str(src)], check=True)
+    env = dict(os.environ, AMSCR_FORCE_ABI='1', AMSCR_LIBRARY=str(so),
+               PYTHONPATH=os.pathsep.join([os.path.dirname(os.path.dirname(amscr.__file__))]))
+    r = subprocess.run([sys.executable, '-c', 'import amscr'], env=env, capture_output=True, text=True)
+    assert r.returncode != 0
+    assert 'ImportError' in r.stderr and 'incompatible C library' in r.stderr and '9.0.0' in r.stderr
+
+
+def test_missing_library_is_a_clear_import_error(tmp_path):
+    env = dict(os.environ, AMSCR_FORCE_ABI='1', AMSCR_LIBRARY=str(tmp_path / 'nope.so'),
+               PYTHONPATH=os.path.dirname(os.path.dirname(amscr.__file__)))
+    r = subprocess.run([sys.executable, '-c', 'import amscr'], env=env, capture_output=True, text=True)
+    assert r.returncode != 0 and 'cannot load the C library' in r.stderr and 'AMSCR_LIBRARY' in r.stderr

@@ -1,0 +1,301 @@
+"""Registration, prepared shapes and collections through the Pythonic layer."""
+import pickle
+
+import numpy as np
+import pytest
+
+import amscr
+from helpers import A_TRUE, B_TRUE, affine, blob
+
+
+@pytest.fixture(scope='module')
+def pair():
+    src = blob(600, seed=1)
+    return src, affine(src, A_TRUE, B_TRUE)
+
+
+def _rms(a, b):
+    return float(np.sqrt(((np.asarray(a) - np.asarray(b)) ** 2).sum(axis=1).mean()))
+
+
+@pytest.mark.parametrize('method', ['multiclass-em', 'binary-em', 'amscr', 'acma'])
+def test_exact_affine_round_trip(pair, method):
+    src, tgt = pair
+    r = amscr.register(src, tgt, method=method)
+    assert r.method == method
+    np.testing.assert_allclose(r.A, A_TRUE, atol=5e-3)
+    np.testing.assert_allclose(r.B, B_TRUE, atol=5e-3)
+    assert _rms(r.apply(src), tgt) < 5e-3 * _rms(tgt, tgt.mean(axis=0))
+    assert 0 <= r.distance < 1e-3
+    assert not r.reflected
+
+
+def test_registration_result_fields(pair):
+    src, tgt = pair
+    r = amscr.register(src, tgt, points=128, reflections=True)
+    p = len(r.scales)
+    assert r.A.shape == (2, 2) and r.B.shape == (2,) and r.matrix.shape == (3, 3)
+    np.testing.assert_array_equal(r.matrix[2], [0, 0, 1])
+    np.testing.assert_array_equal(r.matrix[:2, :2], r.A)
+    assert r.residuals.shape == (p,) and r.kept.shape == (p,) and r.kept.dtype == bool
+    assert r.kept.any()
+    np.testing.assert_array_equal(r.kept_scales, r.scales[r.kept])
+    assert 0 <= r.shift < 128
+    assert len(r.mixture.weights) == len(r.mixture.means) == len(r.mixture.variances)
+    assert r.k >= 1 and len(r.sse) >= 1
+    if r.k >= 1 and len(r.mixture.weights):
+        assert r.mixture.weights.sum() == pytest.approx(1.0)
+    # kept scales are those at or below the threshold (when there is one)
+    if np.isfinite(r.threshold):
+        assert np.all(r.residuals[r.kept] <= r.threshold)
+    assert 'Registration(' in repr(r)
+    # the normalized map takes the source's normalized points near the target's
+    assert r.matrix_normalized.shape == (3, 3)
+
+
+def test_distance_is_affine_invariant_and_matches_register(pair):
+    src, tgt = pair
+    other = blob(500, seed=7)
+    d1 = amscr.distance(src, other)
+    d2 = amscr.distance(affine(src, [[0.5, -1.2], [0.9, 0.3]], [3, 4]), other)
+    assert d1 > 1e-3
+    assert d2 == pytest.approx(d1, rel=0.05)
+    assert amscr.register(src, other).distance == pytest.approx(d1, rel=1e-9, abs=1e-12)
+
+
+def test_reflections(pair):
+    src, _ = pair
+    mirror = src * [-1, 1]
+    r = amscr.register(src, mirror, reflections=True)
+    assert r.reflected
+    assert np.linalg.det(r.A) < 0
+    np.testing.assert_allclose(r.A, [[-1, 0], [0, 1]], atol=5e-3)
+    r0 = amscr.register(src, mirror, reflections=False)
+    assert not r0.reflected and r0.distance > r.distance
+
+
+def test_start_point_shift(pair):
+    src, tgt = pair
+    rolled = np.roll(tgt, 150, axis=0)
+    r = amscr.register(src, rolled)
+    np.testing.assert_allclose(r.A, A_TRUE, atol=5e-3)
+
+
+def test_shape_prepared_once(pair):
+    src, tgt = pair
+    s = amscr.Shape(src, points=64)
+    assert s.num_samples == 64 and len(s) == 64 and s.num_scales == len(s.params.scales)
+    pts = s.points
+    assert pts.shape == (64, 2)
+    np.testing.assert_allclose(pts.mean(axis=0), 0, atol=1e-10)
+    np.testing.assert_allclose(np.cov(pts.T, bias=True), np.eye(2), atol=1e-10)
+    np.testing.assert_allclose(amscr.affine_apply(s.normalization, s.input_points), pts, atol=1e-10)
+    for k in range(s.num_scales):
+        assert s.scale_points(k).shape == (64, 2)
+    with pytest.raises(IndexError):
+        s.scale_points(s.num_scales)
+    t = amscr.Shape(tgt, points=64)
+    r1 = amscr.register(s, t)
+    r2 = amscr.register(src, tgt, points=64)
+    np.testing.assert_array_equal(r1.matrix, r2.matrix)
+    assert r1.distance == r2.distance
+    # mixed: the array is prepared with the Shape's options
+    assert amscr.register(s, tgt).distance == r1.distance
+    # mismatched preparation is a C-side InvalidArgumentError
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.register(s, amscr.Shape(tgt, points=128))
+    s2 = pickle.loads(pickle.dumps(s))
+    np.testing.assert_array_equal(s2.points, s.points)
+
+
+def test_params_roundtrip():
+    p = amscr.Params(points=96, scales=[0, 1, 2, 4], method='binary_em', reflections=True, closed=True,
+                     refine=2, symmetric=True, threads=2, parametrization='whitened', invariance='similarity')
+    assert p.points == 96 and list(p.scales) == [0, 1, 2, 4] and p.method == 'binary-em'
+    assert p.reflections and p.symmetric and p.refine == 2 and p.threads == 2
+    assert p.parametrization == 'whitened' and p.invariance == 'similarity'
+    q = pickle.loads(pickle.dumps(p))
+    assert q == p and q is not p
+    assert p.copy(points=32).points == 32 and p.points == 96
+    d = amscr.Params().to_dict()
+    assert set(d) == set(amscr.Params.OPTIONS)
+
+
+# ---------------------------------------------------------------- collections
+@pytest.fixture(scope='module')
+def shapes():
+    rng = np.random.default_rng(11)
+    out, labels = [], []
+    for c in range(3):
+        base = blob(300, seed=100 + c)
+        for _ in range(4):
+            M = np.eye(2) + 0.3 * rng.normal(size=(2, 2))
+            out.append(affine(base, M, rng.normal(size=2)) + 0.002 * rng.normal(size=base.shape))
+            labels.append(c)
+    return out, np.array(labels)
+
+
+@pytest.fixture(scope='module')
+def collection(shapes):
+    pts, labels = shapes
+    db = amscr.Collection(points=64, reflections=True)
+    for p, lab in zip(pts, labels):
+        db.add(p, label=int(lab))
+    return db
+
+
+def test_collection_basics(collection, shapes):
+    pts, labels = shapes
+    assert len(collection) == len(pts)
+    np.testing.assert_array_equal(collection.labels, labels)
+    assert collection.labels.dtype == np.int32
+    D = collection.distance_matrix()
+    assert D.shape == (12, 12)
+    np.testing.assert_array_equal(np.diag(D), 0)
+    assert (D >= 0).all()
+    # affine copies of one shape are near, other shapes far: perfect retrieval
+    assert amscr.nn_accuracy(D, labels) == 1.0
+    assert amscr.bullseye(D, labels) == 1.0
+    q = collection.query(pts[5])
+    off = np.arange(12) != 5
+    np.testing.assert_allclose(q[off], D[5, off], rtol=1e-9, atol=1e-12)
+    assert q[5] < 1e-6
+
+
+def test_collection_threads_are_bit_identical(collection):
+    D1 = collection.distance_matrix(threads=1)
+    D2 = collection.distance_matrix(threads=2)
+    D0 = collection.distance_matrix()
+    np.testing.assert_array_equal(D1, D2)
+    np.testing.assert_array_equal(D1, D0)
+    q = collection.shape(3)
+    np.testing.assert_array_equal(collection.query(q, threads=1), collection.query(q, threads=2))
+
+
+def test_collection_cross_matrix(collection, shapes):
+    pts, labels = shapes
+    small = amscr.Collection(collection.params)
+    for p in pts[:3]:
+        small.add(p)
+    C = small.cross_matrix(collection)
+    assert C.shape == (3, 12)
+    D = collection.distance_matrix()
+    off = np.ones_like(C, dtype=bool)
+    off[[0, 1, 2], [0, 1, 2]] = False
+    np.testing.assert_allclose(C[off], D[:3][off], rtol=1e-9, atol=1e-12)
+
+
+def test_collection_persistence(collection, tmp_path):
+    D = collection.distance_matrix()
+    path = tmp_path / 'db.amscr'
+    collection.save(path)
+    loaded = amscr.Collection.load(path)
+    assert len(loaded) == len(collection)
+    np.testing.assert_array_equal(loaded.labels, collection.labels)
+    np.testing.assert_array_equal(loaded.distance_matrix(), D)
+    b = collection.to_bytes()
+    assert isinstance(b, bytes) and len(b) > 0
+    np.testing.assert_array_equal(amscr.Collection.from_bytes(b).distance_matrix(), D)
+    np.testing.assert_array_equal(pickle.loads(pickle.dumps(collection)).distance_matrix(), D)
+    with pytest.raises(amscr.FormatError):
+        amscr.Collection.from_bytes(b[:len(b) // 2])
+    bad = bytearray(b)
+    bad[len(bad) // 2] ^= 0xFF
+    with pytest.raises(amscr.FormatError):
+        amscr.Collection.from_bytes(bytes(bad))
+    with pytest.raises(amscr.FileError):
+        amscr.Collection.load(tmp_path / 'missing.amscr')
+
+
+def test_collection_string_labels(shapes):
+    pts, labels = shapes
+    names = np.array(['bird', 'fish', 'leaf'])[labels]
+    db = amscr.Collection(points=64)
+    idx = db.extend(pts, names)
+    assert idx == list(range(12))
+    assert list(db.labels) == list(names)
+    np.testing.assert_array_equal(db.label_codes, labels)
+    with pytest.raises(ValueError):
+        db.add(pts[0], label=3)
+    db2 = pickle.loads(pickle.dumps(db))
+    assert list(db2.labels) == list(names)
+    D = db.distance_matrix()
+    assert amscr.bullseye(D, db.labels) == 1.0
+
+
+def test_collection_add_shape_and_mismatch(shapes):
+    pts, _ = shapes
+    db = amscr.Collection(points=64)
+    db.add(amscr.Shape(pts[0], points=64), label=1)
+    with pytest.raises(amscr.InvalidArgumentError):
+        db.add(amscr.Shape(pts[0], points=32))
+    assert len(db) == 1 and db.shape(0).num_samples == 64 and db.shape(-1).num_samples == 64
+    with pytest.raises(IndexError):
+        db.shape(1)
+
+
+def test_module_distance_matrix(shapes):
+    pts, labels = shapes
+    D = amscr.distance_matrix(pts[:4], points=64, threads=1)
+    db = amscr.Collection(points=64)
+    db.extend(pts[:4])
+    np.testing.assert_array_equal(D, db.distance_matrix())
+
+
+def test_progress_bar_and_callbacks(collection, capfd):
+    D = collection.distance_matrix(progress=True)
+    err = capfd.readouterr().err
+    assert 'amscr [' in err and '100%' in err and err.endswith('\n')
+    seen = []
+    np.testing.assert_array_equal(collection.distance_matrix(progress=lambda d, t: seen.append((d, t))), D)
+    assert seen and seen[-1][0] == seen[-1][1] and all(d <= t for d, t in seen)
+
+    class Boom(Exception):
+        pass
+
+    def raiser(done, total):
+        raise Boom('stop here')
+
+    with pytest.raises(Boom, match='stop here'):
+        collection.distance_matrix(progress=raiser)
+    with pytest.raises(amscr.CancelledError):
+        collection.query(blob(200), progress=lambda d, t: True)
+    # still usable after a cancellation
+    np.testing.assert_array_equal(collection.distance_matrix(), D)
+
+
+def _noisy_pairs():
+    for s in range(6):
+        rng = np.random.default_rng(100 + s)
+        yield s, blob(400, seed=s), blob(400, seed=s + 10) + 0.01 * rng.normal(size=(400, 2))
+
+
+@pytest.mark.parametrize('method', ['acma', 'multiclass-em'])
+def test_batch_distance_agrees_with_register_on_noisy_shapes(method):
+    """amscr.h: amscr_distance "agrees with amscr_result_distance to rounding"."""
+    worst = 0.0
+    for s, a, b in _noisy_pairs():
+        d = amscr.distance(a, b, method=method)
+        r = amscr.register(a, b, method=method).distance
+        worst = max(worst, abs(d - r) / r)
+    assert worst < 1e-9, 'largest relative difference %.3g' % worst
+
+
+def test_shape_from_collection_survives_later_adds(shapes):
+    pts, _ = shapes
+    db = amscr.Collection(points=64)
+    db.add(pts[0])
+    s = db.shape(0)
+    before = s.points
+    for p in pts * 4:  # grows (and may reallocate) the C collection
+        db.add(p)
+    np.testing.assert_array_equal(s.points, before)
+    assert amscr.register(s, db.shape(0)).distance < 1e-9
+
+
+def test_loaded_collection_keeps_int_labels(collection, tmp_path):
+    db = amscr.Collection.from_bytes(collection.to_bytes())
+    with pytest.raises(ValueError):
+        db.add(blob(200), label='name')
+    db.add(blob(200), label=7)
+    assert db.labels[-1] == 7

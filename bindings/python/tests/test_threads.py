@@ -1,0 +1,170 @@
+"""Python threads: the GIL is released in C calls, and concurrent matching gives the same answers."""
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import amscr
+from helpers import affine, blob
+
+
+def _run_threads(targets):
+    errors = []
+
+    def wrap(fn):
+        def run():
+            try:
+                fn()
+            except BaseException as e:  # pragma: no cover - reported below
+                errors.append(e)
+        return run
+
+    threads = [threading.Thread(target=wrap(t)) for t in targets]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    if errors:
+        raise errors[0]
+
+
+def test_gil_is_released_during_c_calls():
+    """While one thread is inside a long C call (no callback), the main thread keeps running Python."""
+    rng = np.random.default_rng(0)
+    a = rng.normal(size=(150000, 40))
+    b = rng.normal(size=(150000, 2))
+    window = {}
+
+    def worker():
+        window['start'] = time.perf_counter()
+        amscr.lstsq(a, b)
+        window['end'] = time.perf_counter()
+
+    ticks = []
+    t = threading.Thread(target=worker)
+    t.start()
+    while t.is_alive():
+        ticks.append(time.perf_counter())
+    t.join()
+    start, end = window['start'], window['end']
+    if end - start < 0.05:
+        pytest.skip('the C call was too fast to observe (%.3f s)' % (end - start))
+    inside = [x for x in ticks if start + 0.01 < x < end - 0.01]
+    # with the GIL held for the whole call the main thread could not tick at all inside it
+    assert len(inside) > 100, 'main thread ticked %d times during a %.3f s C call' % (len(inside), end - start)
+
+
+def _pairs():
+    shapes = [blob(300, seed=s) for s in range(6)]
+    shapes += [affine(s, [[1.1, 0.3], [-0.2, 0.9]], [1, 2]) for s in shapes[:3]]
+    return [(i, j) for i in range(len(shapes)) for j in range(len(shapes)) if i != j], shapes
+
+
+def test_two_threads_registering_match_one_thread():
+    pairs, shapes = _pairs()
+    prepared = [amscr.Shape(s, reflections=True) for s in shapes]  # shared by both threads
+    ref = {(i, j): amscr.register(prepared[i], prepared[j]) for i, j in pairs}
+    # raw points get the registration preset (not the prepared shapes' settings): own reference
+    ref_pts = {(i, j): amscr.register(shapes[i], shapes[j], reflections=True).distance for i, j in pairs}
+    results = [{}, {}]
+
+    def job(k):
+        def run():
+            order = pairs if k == 0 else pairs[::-1]
+            for _ in range(3):
+                for i, j in order:
+                    r = amscr.register(prepared[i], prepared[j])
+                    results[k][(i, j)] = (r.matrix, r.distance, r.residuals, r.shift, r.reflected)
+                    results[k][('pts', i, j)] = amscr.register(shapes[i], shapes[j], reflections=True).distance
+        return run
+
+    _run_threads([job(0), job(1)])
+    for res in results:
+        for i, j in pairs:
+            m, d, resid, shift, refl = res[(i, j)]
+            r = ref[(i, j)]
+            np.testing.assert_array_equal(m, r.matrix)
+            assert d == r.distance and shift == r.shift and refl == r.reflected
+            np.testing.assert_array_equal(resid, r.residuals)
+            assert res[('pts', i, j)] == ref_pts[(i, j)]
+
+
+def test_two_threads_distance_matrices_match_one():
+    _, shapes = _pairs()
+    db = amscr.Collection(points=64, threads=1)
+    db.extend(shapes, labels=range(len(shapes)))
+    ref = db.distance_matrix()
+    out = [None, None, None]
+
+    def job(k):
+        def run():
+            if k == 2:
+                out[k] = np.vstack([db.query(db.shape(i)) for i in range(len(db))])
+            else:
+                out[k] = db.distance_matrix(threads=1 + k)
+        return run
+
+    _run_threads([job(0), job(1), job(2)])
+    np.testing.assert_array_equal(out[0], ref)
+    np.testing.assert_array_equal(out[1], ref)
+    off = ~np.eye(len(db), dtype=bool)
+    np.testing.assert_allclose(out[2][off], ref[off], rtol=1e-9, atol=1e-12)
+
+
+def test_adding_while_querying_is_serialized():
+    """add() waits for running queries (the C contract forbids add during a query): no crash."""
+    _, shapes = _pairs()
+    db = amscr.Collection(points=64, threads=1)
+    db.extend(shapes[:4])
+    stop = threading.Event()
+    sizes = []
+
+    def reader():
+        while not stop.is_set():
+            sizes.append(len(db.distance_matrix()))
+
+    def writer():
+        for s in shapes[4:]:
+            db.add(s)
+            time.sleep(0.001)
+        stop.set()
+
+    _run_threads([reader, writer])
+    assert len(db) == len(shapes) and sizes and min(sizes) >= 4
+
+
+CTRL_C_SCRIPT = r'''
+import os, signal, sys, threading, time
+import amscr
+from helpers import blob
+db = amscr.Collection(points=128, threads=1)
+db.extend([blob(200, seed=s) for s in range(300)])
+threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+t = time.time()
+try:
+    db.distance_matrix()
+    print('finished %.2f' % (time.time() - t))
+except KeyboardInterrupt:
+    print('interrupted %.2f' % (time.time() - t))
+print(db.distance_matrix(threads=2).shape)
+'''
+
+
+@pytest.mark.skipif(not hasattr(__import__('signal'), 'SIGINT') or __import__('os').name != 'posix',
+                    reason='POSIX signals')
+def test_ctrl_c_cancels_a_long_batch_call():
+    import os
+    import subprocess
+    import sys
+    here = os.path.dirname(os.path.abspath(__file__))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [os.path.dirname(os.path.dirname(os.path.abspath(amscr.__file__))), here]))
+    r = subprocess.run([sys.executable, '-c', CTRL_C_SCRIPT], env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    first, second = r.stdout.split('\n')[:2]
+    if first.startswith('finished'):
+        pytest.skip('the matrix finished before the signal (%s)' % first)
+    assert first.startswith('interrupted'), r.stdout + r.stderr
+    assert second == '(300, 300)'  # usable afterwards
+    assert 'Exception ignored' not in r.stderr
