@@ -225,11 +225,118 @@ static void cross_sums(const double *f, const double *h, size_t n, size_t s, int
 }
 
 /* X = R M^-1 with Minv 3x3 (row-major, symmetric). */
+static int inv3_general(const double m[9], double out[9]);
+
 static void solve_x(const double R[6], const double Minv[9], double X[6])
 {
     for (int i = 0; i < 2; i++)
         for (int j = 0; j < 3; j++)
             X[3 * i + j] = R[3 * i] * Minv[j] + R[3 * i + 1] * Minv[3 + j] + R[3 * i + 2] * Minv[6 + j];
+}
+
+/* Solves a small dense system a x = b (n <= 6) by Gaussian elimination with partial pivoting.
+ * Returns 0 when singular. a is destroyed. */
+static int gauss_solve(double *a, double *b, int n)
+{
+    for (int c = 0; c < n; c++) {
+        int piv = c;
+        for (int r = c + 1; r < n; r++)
+            if (fabs(a[r * n + c]) > fabs(a[piv * n + c]))
+                piv = r;
+        if (!(fabs(a[piv * n + c]) > 1e-300))
+            return 0;
+        if (piv != c) {
+            for (int k = 0; k < n; k++) {
+                double t = a[c * n + k];
+                a[c * n + k] = a[piv * n + k];
+                a[piv * n + k] = t;
+            }
+            double t = b[c];
+            b[c] = b[piv];
+            b[piv] = t;
+        }
+        for (int r = c + 1; r < n; r++) {
+            double f = a[r * n + c] / a[c * n + c];
+            for (int k = c; k < n; k++)
+                a[r * n + k] -= f * a[c * n + k];
+            b[r] -= f * b[c];
+        }
+    }
+    for (int c = n - 1; c >= 0; c--) {
+        double v = b[c];
+        for (int k = c + 1; k < n; k++)
+            v -= a[c * n + k] * b[k];
+        b[c] = v / a[c * n + c];
+    }
+    return 1;
+}
+
+/* The least-squares map of one system (moments mom of the source, cross sums R) restricted to
+ * the invariance group of the params:
+ *   affine      X = R M^-1 (Minv given, or computed);
+ *   similarity  A = [[a, -b], [b, a]] from the centred sums (closed form);
+ *   penalized   affine plus lambda * n * |A - sim(A)|_F^2 (6x6 normal equations).
+ * Returns 0 when singular. */
+static int fit_x(const amscr_params *prm, const double mom[6], const double *Minv, const double R[6], double X[6])
+{
+    if (prm->invariance == AMSCR_INVARIANCE_SIMILARITY) {
+        double n = mom[5], fx = mom[3] / n, fy = mom[4] / n, hx = R[2] / n, hy = R[5] / n;
+        double cxx = R[0] - n * hx * fx, cxy = R[1] - n * hx * fy, cyx = R[3] - n * hy * fx, cyy = R[4] - n * hy * fy;
+        double sc = mom[0] + mom[2] - n * (fx * fx + fy * fy);
+        if (!(sc > 0.0))
+            return 0;
+        double a = (cxx + cyy) / sc, b = (cyx - cxy) / sc;
+        X[0] = a;
+        X[1] = -b;
+        X[3] = b;
+        X[4] = a;
+        X[2] = hx - (a * fx - b * fy);
+        X[5] = hy - (b * fx + a * fy);
+        return 1;
+    }
+    if (prm->invariance == AMSCR_INVARIANCE_PENALIZED) {
+        /* unknowns u = (a11, a12, b1, a21, a22, b2); blockdiag(M, M) + Q, Q from
+         * (lambda n / 2) ((a11 - a22)^2 + (a12 + a21)^2) = lambda n |A - sim(A)|_F^2 */
+        double G[36] = {0}, r[6] = {R[0], R[1], R[2], R[3], R[4], R[5]};
+        const double M9[9] = {mom[0], mom[1], mom[3], mom[1], mom[2], mom[4], mom[3], mom[4], mom[5]};
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                G[i * 6 + j] = M9[i * 3 + j];
+                G[(i + 3) * 6 + (j + 3)] = M9[i * 3 + j];
+            }
+        /* normal equations of data + P: G u + grad(P) / 2 = r, grad P / 2 = (lambda n / 2) (...) */
+        double w = 0.5 * prm->penalty * mom[5];
+        G[0 * 6 + 0] += w;
+        G[4 * 6 + 4] += w;
+        G[0 * 6 + 4] -= w;
+        G[4 * 6 + 0] -= w;
+        G[1 * 6 + 1] += w;
+        G[3 * 6 + 3] += w;
+        G[1 * 6 + 3] += w;
+        G[3 * 6 + 1] += w;
+        if (!gauss_solve(G, r, 6))
+            return 0;
+        memcpy(X, r, 6 * sizeof(double));
+        return 1;
+    }
+    double Mi[9];
+    if (!Minv) {
+        const double M9[9] = {mom[0], mom[1], mom[3], mom[1], mom[2], mom[4], mom[3], mom[4], mom[5]};
+        if (!inv3_general(M9, Mi))
+            return 0;
+        Minv = Mi;
+    }
+    solve_x(R, Minv, X);
+    return 1;
+}
+
+/* The penalty of the penalized mode for n points (0 otherwise). */
+static double penalty_of(const amscr_params *prm, const double X[6], double n)
+{
+    if (prm->invariance != AMSCR_INVARIANCE_PENALIZED)
+        return 0.0;
+    double c = 0.5 * (X[0] - X[4]), d = 0.5 * (X[1] + X[3]);
+    return prm->penalty * n * 2.0 * (c * c + d * d);
 }
 
 /* Σ_a |X [f;1] - h|^2 = tr(X M X^T) - 2 tr(X R^T) + |h|^2 with M the 3x3 moments of f. */
@@ -437,7 +544,7 @@ static void spectral_level(const amscr_workspace *ws, size_t n, const double *ga
 /* The search criterion: minus the explained part of the stacked smoothed least-squares
  * problem, -tr(C S^-1 C^T) with C = Σ_k R_k(s) (2x2) and S = Σ_k S_k over all scales (or the
  * finest scale for acma). Minimizing it over s minimizes that least-squares residual. */
-static void crit_matrix(const amscr_descriptor *f, int use_finest, double Sinv[3])
+static void crit_matrix(const amscr_descriptor *f, int use_finest, int sim, double Sinv[4])
 {
     double Sxx = 0, Sxy = 0, Syy = 0;
     if (use_finest) {
@@ -457,10 +564,19 @@ static void crit_matrix(const amscr_descriptor *f, int use_finest, double Sinv[3
     Sinv[0] = Syy / det;
     Sinv[1] = -Sxy / det;
     Sinv[2] = Sxx / det;
+    Sinv[3] = 0.0;
+    if (sim) { /* similarity: the explained part is ((Cxx + Cyy)^2 + (Cyx - Cxy)^2) / tr S */
+        Sinv[0] = 1.0 / (Sxx + Syy);
+        Sinv[3] = 1.0;
+    }
 }
 
-static inline double crit_value(const double C[4], const double Si[3])
+static inline double crit_value(const double C[4], const double Si[4])
 {
+    if (Si[3] != 0.0) {
+        double u = C[0] + C[3], v = C[2] - C[1];
+        return -(u * u + v * v) * Si[0];
+    }
     /* tr(C Si C^T) = Σ_i c_i^T Si c_i over the rows c_i of C */
     double t = 0.0;
     for (int i = 0; i < 2; i++) {
@@ -471,7 +587,7 @@ static inline double crit_value(const double C[4], const double Si[3])
 }
 
 /* The criterion at a continuous shift s from the spectral products in ws->P (one fused pass). */
-static double crit_at(const amscr_descriptor *f, int use_finest, const double Si[3], amscr_workspace *ws, double s)
+static double crit_at(const amscr_descriptor *f, int use_finest, const double Si[4], amscr_workspace *ws, double s)
 {
     size_t n = f->n, half = n / 2 + 1;
     const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
@@ -500,7 +616,7 @@ static double crit_at(const amscr_descriptor *f, int use_finest, const double Si
 
 /* The criterion and its first two derivatives in s in one spectral pass:
  * d/ds Re(P e^{iks}) = -k Im(P e^{iks}), d2/ds2 = -k^2 Re(P e^{iks}), k = 2πw/N. */
-static void crit_newton(const amscr_descriptor *f, int use_finest, const double Si[3], amscr_workspace *ws, double s,
+static void crit_newton(const amscr_descriptor *f, int use_finest, const double Si[4], amscr_workspace *ws, double s,
                         double *val, double *d1, double *d2)
 {
     size_t n = f->n, half = n / 2 + 1;
@@ -532,6 +648,14 @@ static void crit_newton(const amscr_descriptor *f, int use_finest, const double 
         D[j] *= inv_n;
         E[j] *= inv_n;
     }
+    if (Si[3] != 0.0) { /* similarity: crit = -(u^2 + v^2) / tr S */
+        double u = C[0] + C[3], v = C[2] - C[1], du = D[0] + D[3], dv = D[2] - D[1], eu = E[0] + E[3],
+               ev = E[2] - E[1];
+        *val = -(u * u + v * v) * Si[0];
+        *d1 = -2.0 * (u * du + v * dv) * Si[0];
+        *d2 = -2.0 * (du * du + u * eu + dv * dv + v * ev) * Si[0];
+        return;
+    }
     /* crit = -tr(C Si C^T); crit' = -2 tr(D Si C^T); crit'' = -2 [tr(E Si C^T) + tr(D Si D^T)] */
     double t1 = 0, t2 = 0, t3 = 0;
     for (int i = 0; i < 2; i++) {
@@ -548,7 +672,7 @@ static void crit_newton(const amscr_descriptor *f, int use_finest, const double 
 
 /* Refinement of an integer shift s (a local minimum of the criterion) to a continuous one
  * by Newton's method with exact derivatives (at most three passes, steps within ±0.5). */
-static double refine_shift(const amscr_descriptor *f, int use_finest, const double Si[3], amscr_workspace *ws,
+static double refine_shift(const amscr_descriptor *f, int use_finest, const double Si[4], amscr_workspace *ws,
                            size_t s, double *out_crit)
 {
     size_t n = f->n;
@@ -638,7 +762,8 @@ static void run_method(const amscr_params *prm, const amscr_descriptor *f, const
     m->rcut = 0.0;
     for (size_t k = 0; k < p; k++) {
         double X[6];
-        solve_x(R[k + 1], f->minv + 9 * (k + 1), X);
+        if (!fit_x(prm, f->mom + 6 * (k + 1), f->minv + 9 * (k + 1), R[k + 1], X))
+            memset(X, 0, sizeof X);
         m->resid[k] = resid_sum(X, f->mom, R[0], hn2) / (double)n;
     }
     STAGE_MARK(ws, 1);
@@ -653,14 +778,13 @@ static void run_method(const amscr_params *prm, const amscr_descriptor *f, const
             Rs[j] += R[k + 1][j];
         }
     }
-    const double M9[9] = {Ms[0], Ms[1], Ms[3], Ms[1], Ms[2], Ms[4], Ms[3], Ms[4], Ms[5]};
-    if (!inv3_general(M9, Minv)) {
+    (void)Minv;
+    if (!fit_x(prm, Ms, NULL, Rs, m->X)) {
         /* cannot happen for validated descriptors (each level is invertible); be safe */
-        memcpy(Minv, f->minv + 9 * (f->finest + 1), sizeof Minv);
-        memcpy(Rs, R[f->finest + 1], sizeof Rs);
+        if (!fit_x(prm, f->mom + 6 * (f->finest + 1), f->minv + 9 * (f->finest + 1), R[f->finest + 1], m->X))
+            memset(m->X, 0, sizeof m->X);
     }
-    solve_x(Rs, Minv, m->X);
-    m->dist = resid_sum(m->X, f->mom, R[0], hn2) / (double)n;
+    m->dist = (resid_sum(m->X, f->mom, R[0], hn2) + penalty_of(prm, m->X, (double)n)) / (double)n;
     STAGE_MARK(ws, 3);
 }
 
@@ -668,7 +792,7 @@ static void run_method(const amscr_params *prm, const amscr_descriptor *f, const
  * product and two complex inverse FFTs (x and y rows packed as real + imaginary parts); also
  * leaves the spectral products of this orientation in ws->P. */
 static void shift_criterion(const amscr_descriptor *f, const amscr_descriptor *h, int o, int use_finest,
-                            const double Si[3], amscr_workspace *ws)
+                            const double Si[4], amscr_workspace *ws)
 {
     size_t n = f->n;
     spectral_prepare(f, h, o, ws);
@@ -758,10 +882,10 @@ static amscr_status match_one(const amscr_params *prm, const amscr_descriptor *f
     /* closed: for each orientation, the criterion of every integer shift by FFT; its lowest
      * local minima are refined to a continuous shift; the best (orientation, shift) by the
      * refined criterion gets the whole method. */
-    double best_s = 0.0, best_c = INFINITY, Si[3];
+    double best_s = 0.0, best_c = INFINITY, Si[4];
     int best_o = 0;
     STAGE_T0;
-    crit_matrix(f, use_finest, Si);
+    crit_matrix(f, use_finest, prm->invariance != AMSCR_INVARIANCE_AFFINE, Si);
     for (int o = 0; o < norient; o++) {
         shift_criterion(f, h, o, use_finest, Si, ws);
         size_t cand[AMSCR__CANDIDATES];
@@ -893,7 +1017,8 @@ static void select_kth(double *v, size_t n, size_t k)
 }
 
 /* Trimmed least squares X from pairs (f_a -> q_a) with r2_a <= cut. Returns 0 if singular. */
-static int trimmed_solve(const double *f, const double *q, const double *r2, size_t n, double cut, double X[6])
+static int trimmed_solve(const amscr_params *prm, const double *f, const double *q, const double *r2, size_t n,
+                         double cut, double X[6])
 {
     double m[6] = {0, 0, 0, 0, 0, 0}, R[6] = {0, 0, 0, 0, 0, 0}, Minv[9];
     for (size_t a = 0; a < n; a++) {
@@ -913,11 +1038,8 @@ static int trimmed_solve(const double *f, const double *q, const double *r2, siz
         R[4] += v * y;
         R[5] += v;
     }
-    const double M9[9] = {m[0], m[1], m[3], m[1], m[2], m[4], m[3], m[4], m[5]};
-    if (!inv3_general(M9, Minv))
-        return 0;
-    solve_x(R, Minv, X);
-    return 1;
+    (void)Minv;
+    return fit_x(prm, m, NULL, R, X);
 }
 
 /* Catmull-Rom densification of the N target samples by AMSCR__DENSE (closed: periodic; open:
@@ -989,7 +1111,6 @@ static amscr_status refine_match(const amscr_params *prm, const amscr_descriptor
     *out_refined = 0;
     if (iters == 0)
         return AMSCR_OK;
-    (void)prm;
     size_t n = f->n;
     amscr_status st = ws_reserve_refine(ws, n);
     if (st != AMSCR_OK)
@@ -1004,7 +1125,7 @@ static amscr_status refine_match(const amscr_params *prm, const amscr_descriptor
         iters = 0;
     for (unsigned it = 0; it < iters; it++) {
         double Xn[6], cutn;
-        if (!trimmed_solve(f->base, q, r2, n, cut, Xn))
+        if (!trimmed_solve(prm, f->base, q, r2, n, cut, Xn))
             break;
         memcpy(hints2, hints, n * sizeof *hints);
         double costn = icp_pairs(f, Hd, nd, m, Xn, q2, r2, sorted, hints2, 1, &cutn);
@@ -1029,7 +1150,7 @@ static amscr_status refine_match(const amscr_params *prm, const amscr_descriptor
         for (size_t a = 0; a < n; a++)
             all += r2[a];
         memcpy(m->X, X, sizeof X);
-        m->dist = all / (double)n;
+        m->dist = (all + penalty_of(prm, X, (double)n)) / (double)n;
         m->refined = 1;
         m->rcut = cut;
     }
@@ -1050,8 +1171,8 @@ static amscr_status match_explore(const amscr_params *prm, const amscr_descripto
         return st;
     int norient = prm->reflections ? 2 : 1, use_finest = prm->method == AMSCR_METHOD_ACMA, have = 0;
     int best_o = 0;
-    double Si[3], best_s = 0.0;
-    crit_matrix(f, use_finest, Si);
+    double Si[4], best_s = 0.0;
+    crit_matrix(f, use_finest, prm->invariance != AMSCR_INVARIANCE_AFFINE, Si);
     for (int o = 0; o < norient; o++) {
         size_t cand[AMSCR__CANDIDATES];
         double shifts[AMSCR__CANDIDATES];
@@ -1294,7 +1415,8 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_register: out of memory");
     if (st == AMSCR_OK)
         st = match_dir(p, src, tgt, w, &r->m);
-    if (st == AMSCR_OK)
+    /* the reported solve by LAPACKE QR (affine); the constrained groups keep their closed form */
+    if (st == AMSCR_OK && p->invariance == AMSCR_INVARIANCE_AFFINE)
         st = r->m.refined ? final_qr_refined(src, w, &r->m) : final_qr(src, tgt, w, &r->m);
     if (st == AMSCR_OK && p->symmetric) {
         match_t back;

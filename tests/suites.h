@@ -19,5 +19,7 @@ Suite *amscr_suite_accuracy(void);
 Suite *amscr_suite_db(void);
 Suite *amscr_suite_retrieval(void);
 Suite *amscr_suite_threads(void);
+Suite *amscr_suite_rerank(void);
+Suite *amscr_suite_invariance(void);
 
 #endif

@@ -14,6 +14,23 @@ MAPS = [((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
         ((0.6, -0.5, -3.0), (0.7, 0.8, 2.0))]
 
 
+# Retrieval commands default to the similarity group with re-ranking (README: retrieval table);
+# these collections are affine-distorted copies, the case for the affine group.
+AFFINE = ("--invariance", "affine", "--no-rerank")
+
+
+def test_retrieval_defaults_and_rerank(manifest):
+    """The defaults (similarity + re-ranking) run, and --rerank changes the matrix."""
+    import json as _json
+    j = _json.loads(run("eval", manifest, "--json").stdout)
+    assert j["n"] == 9 and len(j["topk"]) == 8
+    a = run("matrix", manifest, "-o", "-", "--no-rerank").stdout
+    b = run("matrix", manifest, "-o", "-", "--rerank", "3,10").stdout
+    assert a != b
+    assert run("eval", manifest, "--rerank", "0").returncode == 2
+    assert run("eval", manifest, "--rerank", "3,0").returncode == 2
+
+
 def base_shapes():
     star = []
     for i in range(200):
@@ -88,7 +105,8 @@ def test_matrix_stdout(manifest):
 
 
 def test_eval_manifest_json(manifest):
-    r = run("eval", manifest, "--json", "--ranks", "2")
+    # the collection holds affine-distorted copies: the affine group, plain pairwise distances
+    r = run("eval", manifest, "--json", "--ranks", "2", *AFFINE)
     assert r.returncode == 0, r.stderr
     j = json.loads(r.stdout)
     assert j["n"] == 9 and j["classes"] == 3
@@ -129,7 +147,7 @@ def test_eval_folder_classes_from_names(tmp_path):
             (d / fn).write_bytes(image_bytes(rasterize(q, 200, 200), fn))
     (d / "manifest.tsv").write_text("ignored\n")  # not a shape: skipped in a folder
     (d / "notes.md").write_text("# not a shape\n")
-    r = run("eval", d, "--json")
+    r = run("eval", d, "--json", *AFFINE)
     assert r.returncode == 0, r.stderr
     j = json.loads(r.stdout)
     assert j["n"] == 9 and j["classes"] == 3
@@ -139,7 +157,7 @@ def test_eval_folder_classes_from_names(tmp_path):
 def test_search(manifest, tmp_path):
     q = tmp_path / "query.txt"
     write_points(q, affine(((0.7, 0.2, 1.0), (0.1, 1.3, 2.0)), base_shapes()["wave"]))
-    r = run("search", q, manifest, "--top", "3", "--json")
+    r = run("search", q, manifest, "--top", "3", "--json", *AFFINE)
     assert r.returncode == 0, r.stderr
     j = json.loads(r.stdout)
     assert [x["class"] for x in j["results"]] == ["WAVE"] * 3

@@ -202,3 +202,4 @@ amscr_status amscr_score_bullseye(const double *dist, size_t n, const int32_t *l
 amscr_status amscr_score_topk_table(const double *dist, size_t n, const int32_t *labels, size_t kmax, size_t *out_counts);
 amscr_status amscr_score_nn_accuracy(const double *dist, size_t n, const int32_t *labels, double *out_accuracy);
 amscr_status amscr_score_nn_split(const double *dist, size_t ntest, size_t ntrain, const int32_t *test_labels, const int32_t *train_labels, double *out_accuracy);
+amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);

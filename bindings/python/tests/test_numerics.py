@@ -360,3 +360,22 @@ def test_signed_area_and_orient():
     assert amscr.signed_area(sq[::-1]) == pytest.approx(-1.0)
     np.testing.assert_array_equal(amscr.orient_ccw(sq), sq)
     assert amscr.signed_area(amscr.orient_ccw(sq[::-1])) == pytest.approx(1.0)
+
+
+def test_rerank_diffusion_blocks():
+    """Three separated classes: after re-ranking every same-class pair ranks before every other,
+    and the result equals the C function's (deterministic)."""
+    import amscr
+    idx = np.arange(12)
+    same = (idx[:, None] // 4) == (idx[None, :] // 4)
+    D = np.where(same, 0.1 + 0.01 * np.abs(idx[:, None] - idx[None, :]),
+                 5.0 + 0.1 * np.abs(idx[:, None] - idx[None, :]))
+    np.fill_diagonal(D, 0.0)
+    R = amscr.rerank_diffusion(D, k=2, iterations=10)
+    assert R.shape == D.shape
+    assert np.all(R[same] < 1.0) and np.all(R[~same] >= 1.0)
+    np.testing.assert_array_equal(R, amscr.rerank_diffusion(D, k=2, iterations=10))
+    with pytest.raises(ValueError):
+        amscr.rerank_diffusion(D, k=0)
+    with pytest.raises(ValueError):
+        amscr.rerank_diffusion(D[:, :5])

@@ -1,0 +1,477 @@
+"""amscr.distributed — distance matrices and collection search on a Dask cluster.
+
+Beyond one machine: a collection's distance matrix, a cross matrix and the top-k search of many
+queries against a large collection, computed as a graph of tiles on ``dask.distributed``
+(``pip install "amscr[distributed]"``)::
+
+    from dask.distributed import Client
+    import amscr.distributed as ad
+    D = ad.distance_matrix(db, client=Client("tcp://scheduler:8786"))   # lazy Dask array
+    idx, dist = ad.topk(queries, db, k=10, client=client)               # (nq, k) each, NumPy
+
+How it runs:
+
+* The prepared shapes travel once per worker: the collection is serialized once on the client
+  (:meth:`amscr.Collection.to_bytes`), scattered to every worker (``broadcast=True``) and
+  rebuilt there once (:meth:`amscr.Collection.from_bytes`, on first use, kept for as long as the
+  computation holds it). Queries of :func:`cross_matrix` and :func:`topk` travel as row blocks,
+  each only to the workers that need it.
+* Each tile (rows x columns) is one multi-threaded C call (``amscr_db_cross_distances``) on
+  sub-collections of the tile's rows and columns. The C results are per cell independent and
+  bit-identical for any thread count, so every result equals the single-machine
+  :meth:`amscr.Collection.distance_matrix`, :meth:`amscr.Collection.cross_matrix` and
+  :meth:`amscr.Collection.query` element for element.
+* :func:`topk` keeps the k best of each tile row and merges these partial lists in a tree,
+  without ever materializing the full matrix. Ranking is by (distance, index): the order of
+  ``np.argsort(row, kind='stable')`` (NaN last), so ties go to the lower index.
+* ``client=None`` starts a local cluster (one single-threaded worker process per core), computes
+  and closes it. With a client, :func:`distance_matrix` and :func:`cross_matrix` return a lazy
+  Dask array (``out=`` a path instead writes the tiles, as they arrive, into a ``.npy`` file
+  memory-mapped on the client).
+* A worker that dies mid-run has its tiles rescheduled by Dask (``distributed.scheduler.
+  allowed-failures``, 3 by default); tasks raising an exception are retried ``retries`` times.
+"""
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import threading
+import uuid
+from collections import defaultdict
+from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+try:
+    import dask
+    import distributed
+    from distributed import as_completed
+    from distributed.comm import get_address_host
+except ImportError as e:  # pragma: no cover - exercised only without Dask
+    raise ImportError('amscr.distributed needs Dask: pip install "dask[distributed]>=2023" '
+                      '(or pip install "amscr[distributed]")') from e
+
+from . import Collection, FormatError, Shape, _check, ffi, lib
+
+__all__ = ['distance_matrix', 'cross_matrix', 'topk', 'tile_size']
+
+TILE_MIN, TILE_MAX = 64, 2048
+TILES_PER_THREAD = 4
+MERGE_FAN_IN = 8
+
+PathLike = Union[str, 'os.PathLike[str]']
+TileArg = Union[None, int, Tuple[int, int]]
+
+
+# ========================================================================== worker side
+class _Payload:
+    """A serialized collection sent to the workers. The first task using it on a worker parses
+    it (once per worker process, under a lock) and drops the bytes; the parsed collection lives
+    as long as Dask keeps the scattered payload."""
+
+    def __init__(self, data: bytes, what: str = 'collection'):
+        self._data: Optional[bytes] = data
+        self._coll: Optional[Collection] = None
+        self._lock = threading.Lock()
+        self.what = what
+
+    def collection(self) -> Collection:
+        with self._lock:
+            if self._coll is None:
+                try:
+                    self._coll = Collection.from_bytes(self._data)
+                except FormatError as e:
+                    where = _worker_address() or 'this process'
+                    raise FormatError('amscr.distributed: the serialized %s received by %s is corrupt (%d bytes): %s'
+                                      % (self.what, where, len(self._data or b''), e.message),
+                                      e.status, e.detail) from None
+                _PARSED[0] += 1
+                self._data = None
+            return self._coll
+
+    def __reduce__(self):
+        # moved between workers (a replacement worker) or spilled: serialize what we hold
+        with self._lock:
+            data = self._data if self._coll is None else self._coll.to_bytes()
+        return (_Payload, (data, self.what))
+
+
+_PARSED = [0]  # collections parsed in this process (tests read it through client.run)
+
+
+def _parsed_count() -> int:
+    return _PARSED[0]
+
+
+def _worker_address() -> Optional[str]:
+    try:
+        return distributed.get_worker().address
+    except ValueError:
+        return None
+
+
+def _cores() -> int:
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):  # pragma: no cover - non-Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def _tile_threads(threads: Union[int, Dict[str, int], None]) -> int:
+    """C threads of this tile: an explicit count, or this worker host's share of its cores."""
+    if isinstance(threads, int):
+        return threads
+    addr = _worker_address()
+    if threads and addr is not None and get_address_host(addr) in threads:
+        return threads[get_address_host(addr)]
+    try:
+        nthreads = distributed.get_worker().state.nthreads
+    except (ValueError, AttributeError):
+        nthreads = 1
+    return max(1, _cores() // max(1, nthreads))
+
+
+def _block(coll: Collection, lo: int, hi: int, threads: int) -> Collection:
+    """Shapes lo..hi-1 of `coll` as a collection computing with `threads` C threads (one copy of
+    each prepared shape; `coll` itself when nothing changes)."""
+    p = coll.params
+    if lo == 0 and hi == len(coll) and p.threads == threads:
+        return coll
+    sub = Collection(p, threads=threads)
+    with coll._lock.read():
+        for i in range(lo, hi):
+            _check(lib.amscr_db_add_descriptor(sub._db, lib.amscr_db_descriptor(coll._db, i), 0, ffi.NULL))
+    return sub
+
+
+def _matrix_tile(payload: _Payload, r0: int, r1: int, c0: int, c1: int, threads) -> np.ndarray:
+    """D[r0:r1, c0:c1] of the payload collection's distance matrix (zero diagonal)."""
+    coll = payload.collection()
+    t = _tile_threads(threads)
+    rows = _block(coll, r0, r1, t)
+    cols = rows if (r0, r1) == (c0, c1) else _block(coll, c0, c1, t)
+    D = rows.cross_matrix(cols)
+    lo, hi = max(r0, c0), min(r1, c1)
+    if lo < hi:  # the distance matrix's diagonal is 0 by definition (never computed in C)
+        i = np.arange(lo, hi)
+        D[i - r0, i - c0] = 0.0
+    return D
+
+
+def _cross_tile(qpayload: _Payload, tpayload: _Payload, c0: int, c1: int, threads) -> np.ndarray:
+    """Distances from a block of queries to targets c0..c1-1 (the queries' options)."""
+    t = _tile_threads(threads)
+    q = qpayload.collection()
+    return _block(q, 0, len(q), t).cross_matrix(_block(tpayload.collection(), c0, c1, t))
+
+
+def _select(idx: np.ndarray, dist: np.ndarray, k: int) -> Tuple[np.ndarray, np.ndarray]:
+    """The k best candidates of each row, ordered by (valid, distance with NaN last, index);
+    index -1 marks no candidate."""
+    order = np.lexsort((idx, dist, idx < 0), axis=-1)[:, :k]
+    return np.take_along_axis(idx, order, 1), np.take_along_axis(dist, order, 1)
+
+
+def _topk_tile(qpayload: _Payload, tpayload: _Payload, c0: int, c1: int, k: int,
+               exclude: Optional[np.ndarray], threads) -> Tuple[np.ndarray, np.ndarray]:
+    D = _cross_tile(qpayload, tpayload, c0, c1, threads)
+    idx = np.broadcast_to(np.arange(c0, c1, dtype=np.intp), D.shape)
+    if exclude is not None:
+        idx = np.where(idx == exclude[:, None], -1, idx)
+    return _select(idx, D, k)
+
+
+def _merge(k: int, *parts: Tuple[np.ndarray, np.ndarray]) -> Tuple[np.ndarray, np.ndarray]:
+    idx = np.concatenate([p[0] for p in parts], axis=1)
+    dist = np.concatenate([p[1] for p in parts], axis=1)
+    return _select(idx, dist, k)
+
+
+# ========================================================================== client side
+def tile_size(nrows: int, ncols: int, nthreads: int, tile: TileArg = None) -> Tuple[int, int]:
+    """(rows, cols) of a tile: `tile` if given (an int or a pair), else about
+    ``TILES_PER_THREAD * nthreads`` tiles in all, clipped to [64, 2048] (and to the matrix)."""
+    if tile is None:
+        t = math.ceil(math.sqrt(nrows * ncols / (TILES_PER_THREAD * max(1, nthreads))))
+        tr = tc = min(max(t, TILE_MIN), TILE_MAX)
+    else:
+        tr, tc = (tile, tile) if np.ndim(tile) == 0 else tuple(tile)
+        tr, tc = int(tr), int(tc)
+        if tr < 1 or tc < 1:
+            raise ValueError('tile: expected positive sizes, got %r' % (tile,))
+    return max(1, min(tr, nrows)), max(1, min(tc, ncols))
+
+
+def _bounds(n: int, t: int) -> List[Tuple[int, int]]:
+    return [(lo, min(lo + t, n)) for lo in range(0, n, t)]
+
+
+def _threads_by_host(client) -> Dict[str, int]:
+    """C threads per tile on each host: its cores over the Dask threads of its workers."""
+    nthreads = client.nthreads()
+    if not nthreads:
+        return {}
+    cores = client.run(_cores)
+    dask_threads: Dict[str, int] = defaultdict(int)
+    host_cores: Dict[str, int] = {}
+    for addr, nt in nthreads.items():
+        h = get_address_host(addr)
+        dask_threads[h] += nt
+        host_cores[h] = cores.get(addr, 1)
+    return {h: max(1, host_cores[h] // dask_threads[h]) for h in dask_threads}
+
+
+@contextlib.contextmanager
+def _client_or_local(client):
+    if client is not None:
+        yield client
+        return
+    n = _cores()
+    with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                  dashboard_address=':0') as cluster, distributed.Client(cluster) as c:
+        yield c
+
+
+def _as_collection(x: Any, name: str) -> Collection:
+    if isinstance(x, Collection):
+        return x
+    if isinstance(x, (bytes, bytearray, memoryview)):
+        return Collection.from_bytes(x)  # FormatError here when corrupt
+    raise TypeError('%s: expected an amscr.Collection (or its to_bytes()), got %s' % (name, type(x).__name__))
+
+
+def _queries_like(queries: Any, targets: Collection) -> Collection:
+    """The queries prepared as :meth:`Collection.query` would: with the targets' options."""
+    if isinstance(queries, (bytes, bytearray, memoryview)):
+        queries = Collection.from_bytes(queries)
+    q = Collection(targets.params)
+    if isinstance(queries, Collection):
+        with queries._lock.read():
+            for i in range(len(queries)):
+                _check(lib.amscr_db_add_descriptor(q._db, lib.amscr_db_descriptor(queries._db, i), 0, ffi.NULL))
+        return q
+    if isinstance(queries, Shape) or (isinstance(queries, np.ndarray) and queries.ndim == 2):
+        queries = [queries]
+    for s in queries:
+        q.add(s)
+    return q
+
+
+def _scatter_blocks(client, coll: Collection, bounds: Sequence[Tuple[int, int]], what: str) -> list:
+    """Row blocks of `coll` as scattered payloads (each goes where it is needed)."""
+    payloads = [_Payload(_block(coll, lo, hi, coll.params.threads).to_bytes(), what) for lo, hi in bounds]
+    return client.scatter(payloads, hash=False)
+
+
+def _out_array(out: Any, shape: Tuple[int, int]) -> np.ndarray:
+    if out is None:
+        return np.empty(shape, dtype=np.float64)
+    if isinstance(out, np.ndarray):
+        if out.shape != shape or out.dtype != np.float64 or not out.flags.writeable:
+            raise ValueError('out: expected a writeable float64 array of shape %s, got %s %s'
+                             % (shape, out.dtype, out.shape))
+        return out
+    return np.lib.format.open_memmap(os.fspath(out), mode='w+', dtype=np.float64, shape=shape)
+
+
+def _show_progress(client, futures: list) -> Optional[threading.Thread]:
+    """Dask's progress bar over `futures` (and everything they depend on), without blocking."""
+    from distributed.utils import is_kernel
+    if is_kernel():  # pragma: no cover - notebooks
+        from IPython.display import display
+        display(distributed.progress(futures, notebook=True, scheduler=client.scheduler.address))
+        return None
+    t = threading.Thread(target=distributed.progress, args=(futures,),
+                         kwargs={'notebook': False, 'scheduler': client.scheduler.address},
+                         name='amscr-progress', daemon=True)
+    t.start()
+    return t
+
+
+def _drain(client, placed: Dict[Any, Any], progress: bool, put) -> None:
+    """Waits for the futures of `placed` (future -> where), calling put(where, result) as each
+    arrives and dropping it at once; on an error, cancels the rest and raises it."""
+    bar = _show_progress(client, list(placed)) if progress else None
+    try:
+        for fut, result in as_completed(list(placed), with_results=True):
+            put(placed.pop(fut), result)
+            del fut, result
+    except BaseException:
+        client.cancel(list(placed))
+        raise
+    finally:
+        placed.clear()
+        if bar is not None:
+            bar.join(timeout=5)
+
+
+def _eager_matrix(client, task, row_b, col_b, args_of, out, progress, retries, token, shape):
+    arr = _out_array(out, shape)
+    placed = {}
+    for i, (r0, r1) in enumerate(row_b):
+        for j, (c0, c1) in enumerate(col_b):
+            f = client.submit(task, *args_of(i, j), key='%s-%d-%d' % (token, i, j), retries=retries, pure=False)
+            placed[f] = (slice(r0, r1), slice(c0, c1))
+
+    def put(where, tile):
+        arr[where] = tile
+
+    _drain(client, placed, progress, put)
+    if isinstance(arr, np.memmap):
+        arr.flush()
+    return arr
+
+
+def _lazy_matrix(client, task, row_b, col_b, args_of, progress, retries, token):
+    import dask.array as da
+    with dask.annotate(retries=retries):
+        blocks = [[da.from_delayed(dask.delayed(task, pure=True)(*args_of(i, j),
+                                                                  dask_key_name='%s-%d-%d' % (token, i, j)),
+                                   shape=(r1 - r0, c1 - c0), dtype=np.float64)
+                   for j, (c0, c1) in enumerate(col_b)] for i, (r0, r1) in enumerate(row_b)]
+    arr = da.block(blocks)
+    if progress:
+        arr = client.persist(arr)
+        bar = _show_progress(client, distributed.futures_of(arr))
+        distributed.wait(arr)
+        if bar is not None:
+            bar.join(timeout=5)
+    return arr
+
+
+def distance_matrix(collection: Union[Collection, bytes], client=None, tile: TileArg = None, progress: bool = False,
+                    out: Union[None, PathLike, np.ndarray] = None, *, threads: Optional[int] = None,
+                    retries: int = 2):
+    """The (n, n) distance matrix of a collection, tiled over a Dask cluster; equal element for
+    element to ``collection.distance_matrix()``.
+
+    Args:
+        collection: an :class:`amscr.Collection` (or its ``to_bytes()``).
+        client: a ``distributed.Client``; None starts a local cluster (one single-threaded worker
+            process per core) for this call and closes it.
+        tile: tile size (an int, or (rows, cols)); None picks it from n and the cluster's threads
+            (see :func:`tile_size`).
+        progress: show Dask's progress bar.
+        out: None, or a path: the tiles are written as they arrive into a new ``.npy`` file,
+            memory-mapped on the client (``np.lib.format.open_memmap``), which is returned;
+            a writeable float64 NumPy array of the right shape is accepted too.
+        threads: C threads per tile; None: each host's cores over the Dask threads of its workers.
+        retries: retries of a tile whose task raised (a dead worker's tiles are rescheduled anyway).
+
+    Returns:
+        with a client and no `out`: a lazy Dask array (computed on `client`; with
+        ``progress=True`` it is persisted first and the bar shown); with ``client=None``: a NumPy
+        array; with `out`: the memmap (or array).
+    """
+    coll = _as_collection(collection, 'collection')
+    n = len(coll)
+    lazy = client is not None and out is None
+    with _client_or_local(client) as c:
+        tr, tc = tile_size(n, n, sum(c.nthreads().values()), tile)
+        row_b, col_b = _bounds(n, tr), _bounds(n, tc)
+        th = threads if threads is not None else _threads_by_host(c)
+        [payload] = c.scatter([_Payload(coll.to_bytes())], broadcast=True, hash=False)
+        token = 'amscr-matrix-' + uuid.uuid4().hex
+
+        def args_of(i, j):
+            return (payload,) + row_b[i] + col_b[j] + (th,)
+
+        if lazy:
+            return _lazy_matrix(c, _matrix_tile, row_b, col_b, args_of, progress, retries, token)
+        return _eager_matrix(c, _matrix_tile, row_b, col_b, args_of, out, progress, retries, token, (n, n))
+
+
+def cross_matrix(queries: Union[Collection, bytes], targets: Union[Collection, bytes], client=None,
+                 tile: TileArg = None, progress: bool = False, out: Union[None, PathLike, np.ndarray] = None, *,
+                 threads: Optional[int] = None, retries: int = 2):
+    """The (len(queries), len(targets)) cross matrix, equal element for element to
+    ``queries.cross_matrix(targets)`` (the queries' options). Arguments and result as
+    :func:`distance_matrix`; the queries travel as row blocks, the targets once per worker."""
+    q = _as_collection(queries, 'queries')
+    t = _as_collection(targets, 'targets')
+    nq, nt = len(q), len(t)
+    lazy = client is not None and out is None
+    with _client_or_local(client) as c:
+        tr, tc = tile_size(nq, nt, sum(c.nthreads().values()), tile)
+        row_b, col_b = _bounds(nq, tr), _bounds(nt, tc)
+        th = threads if threads is not None else _threads_by_host(c)
+        [tpay] = c.scatter([_Payload(t.to_bytes(), 'target collection')], broadcast=True, hash=False)
+        qpays = _scatter_blocks(c, q, row_b, 'query block')
+        token = 'amscr-cross-' + uuid.uuid4().hex
+
+        def args_of(i, j):
+            return (qpays[i], tpay) + col_b[j] + (th,)
+
+        if lazy:
+            return _lazy_matrix(c, _cross_tile, row_b, col_b, args_of, progress, retries, token)
+        return _eager_matrix(c, _cross_tile, row_b, col_b, args_of, out, progress, retries, token, (nq, nt))
+
+
+def topk(queries: Union[Collection, Iterable[Any], bytes], collection: Union[Collection, bytes], k: int = 10,
+         client=None, tile: TileArg = None, progress: bool = False, *, exclude: Optional[Sequence[int]] = None,
+         threads: Optional[int] = None, retries: int = 2) -> Tuple[np.ndarray, np.ndarray]:
+    """The k nearest shapes of `collection` for each query, without materializing the matrix.
+
+    Args:
+        queries: a :class:`amscr.Collection`, or point arrays / :class:`amscr.Shape` s; they are
+            matched with the collection's options, as :meth:`Collection.query` does.
+        collection: the targets.
+        k: neighbours per query (at most len(collection), minus one with `exclude`).
+        exclude: per query, a target index to leave out (negative: none), e.g.
+            ``range(len(db))`` for a leave-one-out search of a collection against itself.
+        client, tile, progress, threads, retries: as :func:`distance_matrix`.
+
+    Returns:
+        (indices, distances), each (len(queries), k): for query i the targets ordered as
+        ``np.argsort(collection.query(q_i), kind='stable')`` (ascending distance, NaN last, ties
+        by lower index), excluded target removed.
+    """
+    t = _as_collection(collection, 'collection')
+    nt = len(t)
+    q = _queries_like(queries, t)
+    nq = len(q)
+    ex = None
+    if exclude is not None:
+        ex = np.asarray(exclude)
+        if ex.shape != (nq,) or ex.dtype.kind not in 'iu':
+            raise ValueError('exclude: expected %d integer indices (one per query), got %s %s'
+                             % (nq, ex.dtype, ex.shape))
+        ex = np.where(ex < 0, -1, ex).astype(np.intp)
+    if isinstance(k, (bool, np.bool_)) or int(k) != k or k < 0:
+        raise ValueError('k: expected a non-negative integer, got %r' % (k,))
+    k = min(int(k), nt - (1 if ex is not None and (ex >= 0).any() else 0))
+    k = max(k, 0)
+    indices = np.zeros((nq, k), dtype=np.intp)
+    distances = np.zeros((nq, k), dtype=np.float64)
+    if nq == 0 or k == 0:
+        return indices, distances
+    with _client_or_local(client) as c:
+        tr, tc = tile_size(nq, nt, sum(c.nthreads().values()), tile)
+        row_b, col_b = _bounds(nq, tr), _bounds(nt, tc)
+        th = threads if threads is not None else _threads_by_host(c)
+        [tpay] = c.scatter([_Payload(t.to_bytes(), 'target collection')], broadcast=True, hash=False)
+        qpays = _scatter_blocks(c, q, row_b, 'query block')
+        token = uuid.uuid4().hex
+        placed = {}
+        for i, (r0, r1) in enumerate(row_b):
+            exi = None if ex is None else ex[r0:r1]
+            level = [c.submit(_topk_tile, qpays[i], tpay, c0, c1, k, exi, th, retries=retries, pure=False,
+                              key='amscr-topk-%s-%d-%d' % (token, i, j)) for j, (c0, c1) in enumerate(col_b)]
+            depth = 0
+            while len(level) > 1:
+                level = [c.submit(_merge, k, *level[m:m + MERGE_FAN_IN], retries=retries, pure=False,
+                                  key='amscr-merge-%s-%d-%d-%d' % (token, i, depth, m))
+                         for m in range(0, len(level), MERGE_FAN_IN)]
+                depth += 1
+            placed[level[0]] = slice(r0, r1)
+        del level
+
+        def put(rows, result):
+            idx, dist = result
+            if (idx < 0).any():  # pragma: no cover - k is clipped to the valid candidates
+                raise RuntimeError('amscr.distributed.topk: fewer than k candidates in a row')
+            indices[rows], distances[rows] = idx, dist
+
+        _drain(c, placed, progress, put)
+    return indices, distances

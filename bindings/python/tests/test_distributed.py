@@ -1,0 +1,225 @@
+"""amscr.distributed on a real LocalCluster (2 worker processes on loopback): distance matrix,
+cross matrix and top-k equal the single-machine results exactly, a worker killed mid-run does not
+change the matrix, a corrupt serialized collection is a clear error. Skipped without Dask."""
+import concurrent.futures
+import os
+
+import numpy as np
+import pytest
+
+distributed = pytest.importorskip(
+    'distributed', reason='Dask is not installed: pip install "dask[distributed]>=2023" to run these tests')
+
+import amscr  # noqa: E402
+import amscr.distributed as ad  # noqa: E402
+from helpers import blob  # noqa: E402
+
+N_SHAPES = 240
+POINTS = 32  # small N keeps the file fast; the tiling does not depend on N
+TIMEOUT = 60  # seconds: a failure must be an error, never a hang
+
+
+def _shapes(n, seed0):
+    return [blob(120, seed=seed0 + i, phase=0.1 * i) for i in range(n)]
+
+
+@pytest.fixture(scope='module')
+def db():
+    c = amscr.Collection(points=POINTS, reflections=True, threads=0)
+    c.extend(_shapes(N_SHAPES, 0), [i % 12 for i in range(N_SHAPES)])
+    return c
+
+
+@pytest.fixture(scope='module')
+def queries():
+    c = amscr.Collection(points=POINTS, reflections=True, threads=0)
+    c.extend(_shapes(45, 10_000))
+    return c
+
+
+@pytest.fixture(scope='module')
+def D(db):
+    return db.distance_matrix()
+
+
+@pytest.fixture(scope='module')
+def client():
+    # workers are spawned processes: they inherit os.environ (AMSCR_LIBRARY set by conftest) and
+    # sys.path, so they load the same amscr and library as this process
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=':0',
+                                  host='127.0.0.1') as cluster, distributed.Client(cluster) as c:
+        c.wait_for_workers(2, timeout=TIMEOUT)
+        yield c
+
+
+def _within(fn, timeout=TIMEOUT):
+    """fn() on a thread; fails (instead of hanging the suite) when it takes longer than timeout."""
+    ex = concurrent.futures.ThreadPoolExecutor(1)
+    try:
+        return ex.submit(fn).result(timeout=timeout)
+    finally:
+        ex.shutdown(wait=False)
+
+
+def _ranking(row, k, exclude=-1):
+    order = np.argsort(row, kind='stable')
+    return order[order != exclude][:k]
+
+
+# ------------------------------------------------------------------------------ no cluster
+def test_merge_is_the_stable_argsort():
+    """Per-tile top-k merged in any grouping = np.argsort(kind='stable') of the full row, with
+    heavy ties, NaN, -0.0/+0.0 and exclusions."""
+    rng = np.random.default_rng(1)
+    for trial in range(200):
+        m, n = int(rng.integers(1, 6)), int(rng.integers(2, 60))
+        row = rng.integers(0, 4, size=(m, n)).astype(float)
+        row[rng.random((m, n)) < 0.1] = np.nan
+        row[rng.random((m, n)) < 0.1] = -0.0
+        ex = np.where(rng.random(m) < 0.5, rng.integers(0, n, size=m), -1)
+        k = int(rng.integers(1, n))  # <= n - 1
+        cuts = np.unique(np.concatenate([[0, n], rng.integers(0, n, size=3)]))
+        parts = []
+        for c0, c1 in zip(cuts[:-1], cuts[1:]):
+            idx = np.broadcast_to(np.arange(c0, c1), (m, c1 - c0))
+            idx = np.where(idx == ex[:, None], -1, idx)
+            parts.append(ad._select(idx, row[:, c0:c1], k))
+        while len(parts) > 1:
+            parts = [ad._merge(k, *parts[i:i + 2]) for i in range(0, len(parts), 2)]
+        idx, dist = parts[0]
+        for r in range(m):
+            want = _ranking(row[r], k, ex[r])
+            assert np.array_equal(idx[r], want), (trial, r)
+            assert np.array_equal(dist[r], row[r, want], equal_nan=True)
+
+
+def test_tile_size():
+    assert ad.tile_size(300, 300, 2) == (107, 107)  # ~8 tiles
+    assert ad.tile_size(10 ** 6, 10 ** 6, 3200) == (2048, 2048)
+    assert ad.tile_size(100, 100, 64) == (64, 64)
+    assert ad.tile_size(30, 1000, 2, tile=(16, 100)) == (16, 100)
+    assert ad.tile_size(30, 40, 2, tile=500) == (30, 40)
+    with pytest.raises(ValueError):
+        ad.tile_size(10, 10, 1, tile=0)
+
+
+# ------------------------------------------------------------------------------ on the cluster
+def test_workers_use_the_same_library(client):
+    paths = client.run(lambda: (amscr.LIBRARY_PATH, amscr.API_MODE, amscr.library_version()))
+    assert len(paths) == 2
+    assert set(paths.values()) == {(amscr.LIBRARY_PATH, amscr.API_MODE, amscr.library_version())}
+
+
+def test_distance_matrix_equals_single_machine(client, db, D):
+    before = client.run(ad._parsed_count)
+    A = ad.distance_matrix(db, client=client, tile=50)  # lazy: 5 x 5 tiles, ragged last
+    assert A.shape == D.shape and A.chunks[0] == (50, 50, 50, 50, 40)
+    assert np.array_equal(_within(A.compute), D)
+    # the collection was parsed once per worker, not once per tile
+    after = client.run(ad._parsed_count)
+    assert all(after[w] - before[w] <= 1 for w in after)
+    # default tiles, progress bar, eager into a NumPy array
+    out = np.full(D.shape, np.nan)
+    got = _within(lambda: ad.distance_matrix(db, client=client, progress=True, out=out))
+    assert got is out and np.array_equal(out, D)
+
+
+def test_distance_matrix_into_memmap(client, db, D, tmp_path):
+    path = tmp_path / 'D.npy'
+    M = _within(lambda: ad.distance_matrix(db, client=client, tile=(64, 96), out=path))
+    assert isinstance(M, np.memmap) and np.array_equal(M, D)
+    assert np.array_equal(np.load(path), D)
+
+
+def test_cross_matrix_equals_single_machine(client, db, queries):
+    want = queries.cross_matrix(db)
+    got = _within(ad.cross_matrix(queries, db, client=client, tile=(20, 64)).compute)
+    assert np.array_equal(got, want)
+
+
+def test_topk_equals_single_machine_query(client, db, queries):
+    k = 10
+    idx, dist = _within(lambda: ad.topk(queries, db, k=k, client=client, tile=(16, 32), progress=True))
+    assert idx.shape == dist.shape == (len(queries), k)
+    for i in range(len(queries)):
+        row = db.query(queries.shape(i))  # the single-machine search
+        assert np.array_equal(idx[i], _ranking(row, k))
+        assert np.array_equal(dist[i], row[idx[i]])
+    # raw points are prepared with the collection's options, as Collection.query does
+    pts = _shapes(3, 10_000)
+    idx2, dist2 = _within(lambda: ad.topk(pts, db, k=k, client=client, tile=(2, 64)))
+    assert np.array_equal(idx2, idx[:3]) and np.array_equal(dist2, dist[:3])
+
+
+def test_topk_leave_one_out_equals_matrix_rows(client, db, D):
+    """A collection against itself, each shape excluded: the ranking of the query rows."""
+    n, k = len(db), 12
+    idx, dist = _within(lambda: ad.topk(db, db, k=k, client=client, tile=(40, 64), exclude=range(n)))
+    for i in range(n):
+        row = db.query(db.shape(i))
+        assert np.array_equal(idx[i], _ranking(row, k, exclude=i))
+        assert np.array_equal(dist[i], row[idx[i]])
+    # off the diagonal the rows are those of the distance matrix
+    assert np.array_equal(dist, np.take_along_axis(D, idx, 1))
+    # k larger than the candidates is clipped
+    idx, _ = _within(lambda: ad.topk(db.shape(0).input_points, db, k=10 ** 6, client=client))
+    assert idx.shape == (1, n)
+
+
+def test_corrupt_serialized_collection_is_a_clear_error(client, db, monkeypatch):
+    data = bytearray(db.to_bytes())
+    data[len(data) // 2] ^= 0xFF
+    # handed over corrupt: refused on the client at once
+    with pytest.raises(amscr.FormatError):
+        ad.distance_matrix(bytes(data), client=client)
+    # corrupted on its way to the workers: each worker refuses it, the client gets the error
+    monkeypatch.setattr(amscr.Collection, 'to_bytes', lambda self: bytes(data))
+    with pytest.raises(amscr.FormatError, match='corrupt'):
+        _within(lambda: ad.distance_matrix(db, client=client, tile=60, out=np.empty((len(db),) * 2)))
+    with pytest.raises(ValueError, match='corrupt'):  # FormatError is a ValueError
+        _within(ad.distance_matrix(db, client=client, tile=60).compute)
+
+
+class _KillOnce(distributed.WorkerPlugin):
+    """Kills its worker process (os._exit) when the third matrix tile starts on it; only once
+    in the whole cluster (an O_EXCL marker file claims the kill)."""
+
+    def __init__(self, marker):
+        self.marker = marker
+        self.started = 0
+
+    def transition(self, key, start, finish, **kwargs):
+        if finish != 'executing' or not str(key).startswith('amscr-matrix-'):
+            return
+        self.started += 1
+        if self.started < 3:
+            return
+        try:
+            fd = os.open(self.marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+        except FileExistsError:
+            return
+        os.close(fd)
+        os._exit(1)
+
+
+def test_worker_killed_mid_run_gives_the_same_matrix(client, db, D, tmp_path):
+    marker = str(tmp_path / 'killed')
+    name = 'amscr-kill-once'
+    register = getattr(client, 'register_plugin', None) or client.register_worker_plugin
+    register(_KillOnce(marker), name=name)
+    try:
+        out = np.full(D.shape, np.nan)
+        _within(lambda: ad.distance_matrix(db, client=client, tile=30, out=out))  # 64 tiles
+        assert os.path.exists(marker), 'no worker was killed'
+        assert np.array_equal(out, D)
+    finally:
+        client.unregister_worker_plugin(name)
+        client.wait_for_workers(2, timeout=TIMEOUT)  # the nanny restarts the killed worker
+
+
+def test_no_client_starts_and_closes_a_local_cluster(db, D):
+    small = amscr.Collection(db.params)
+    for i in range(40):
+        small.add(db.shape(i))
+    got = _within(lambda: ad.distance_matrix(small, tile=16))
+    assert isinstance(got, np.ndarray) and np.array_equal(got, D[:40, :40])

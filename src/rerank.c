@@ -1,0 +1,131 @@
+/* rerank.c — contextual re-ranking of a distance matrix by affinity diffusion on a kNN
+ * tensor-product graph (Yang, Prasad, Latecki, CVPR 2012). See amscr_rerank_diffusion in
+ * amscr.h for the definition. */
+#include "internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    double d;
+    size_t j;
+} nb_t;
+
+static int cmp_nb(const void *a, const void *b)
+{
+    const nb_t *x = a, *y = b;
+    if (x->d != y->d)
+        return x->d < y->d ? -1 : 1;
+    return x->j < y->j ? -1 : (x->j > y->j);
+}
+
+amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(dist);
+    AMSCR_CHECK_NULL(out_dist);
+    if (n == 0 || k < 1 || k > n || iterations < 1 || iterations > 1000)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_rerank_diffusion: need n >= 1, 1 <= k <= n, 1 <= iterations "
+                                                "<= 1000 (n=%zu k=%zu iterations=%u)",
+                           n, k, iterations);
+    if (n > 65536)
+        return amscr__fail(AMSCR_E_LIMIT, "amscr_rerank_diffusion: n = %zu exceeds 65536", n);
+    for (size_t i = 0; i < n * n; i++)
+        if (!isfinite(dist[i]) || dist[i] < 0.0)
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_rerank_diffusion: distance %zu is negative or not finite",
+                               i);
+    double *D = amscr__malloc_array(n * n, sizeof *D), *Q = amscr__malloc_array(n * n, sizeof *Q);
+    double *T = amscr__malloc_array(n * n, sizeof *T), *sc = amscr__malloc_array(n, sizeof *sc);
+    double *pw = amscr__malloc_array(n * k, sizeof *pw);
+    size_t *pj = amscr__malloc_array(n * k, sizeof *pj);
+    nb_t *row = amscr__malloc_array(n, sizeof *row);
+    if (!D || !Q || !T || !sc || !pw || !pj || !row) {
+        free(D);
+        free(Q);
+        free(T);
+        free(sc);
+        free(pw);
+        free(pj);
+        free(row);
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_rerank_diffusion: out of memory");
+    }
+    double dmax = 0.0;
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < n; j++) {
+            D[i * n + j] = i == j ? 0.0 : 0.5 * (dist[i * n + j] + dist[j * n + i]);
+            if (D[i * n + j] > dmax)
+                dmax = D[i * n + j];
+        }
+    /* neighbours (itself first: distance 0, ties by index) and self-tuning scales */
+    for (size_t i = 0; i < n; i++) {
+        for (size_t j = 0; j < n; j++) {
+            row[j].d = D[i * n + j];
+            row[j].j = j;
+        }
+        row[i].d = -1.0; /* itself is always its own first neighbour */
+        qsort(row, n, sizeof *row, cmp_nb);
+        for (size_t t = 0; t < k; t++)
+            pj[i * k + t] = row[t].j;
+        sc[i] = D[i * n + row[k - 1].j];
+    }
+    double tiny = dmax > 0.0 ? 1e-12 * dmax : 1e-300;
+    for (size_t i = 0; i < n; i++) {
+        double sum = 0.0;
+        for (size_t t = 0; t < k; t++) {
+            size_t j = pj[i * k + t];
+            double s = sqrt((sc[i] + tiny) * (sc[j] + tiny));
+            pw[i * k + t] = exp(-D[i * n + j] / s);
+            sum += pw[i * k + t];
+        }
+        for (size_t t = 0; t < k; t++)
+            pw[i * k + t] /= sum;
+    }
+    /* Q = P, then Q <- P Q P^T + I (P sparse: k entries a row) */
+    memset(Q, 0, n * n * sizeof *Q);
+    for (size_t i = 0; i < n; i++)
+        for (size_t t = 0; t < k; t++)
+            Q[i * n + pj[i * k + t]] += pw[i * k + t];
+    for (unsigned it = 0; it < iterations; it++) {
+        /* T = P Q */
+        for (size_t i = 0; i < n; i++) {
+            double *ti = T + i * n;
+            memset(ti, 0, n * sizeof *ti);
+            for (size_t t = 0; t < k; t++) {
+                double w = pw[i * k + t];
+                const double *qr = Q + pj[i * k + t] * n;
+                for (size_t j = 0; j < n; j++)
+                    ti[j] += w * qr[j];
+            }
+        }
+        /* Q = T P^T + I: Q_ij = Σ_t P_jt T_i,pj(t) */
+        for (size_t i = 0; i < n; i++) {
+            const double *ti = T + i * n;
+            for (size_t j = 0; j < n; j++) {
+                double v = 0.0;
+                for (size_t t = 0; t < k; t++)
+                    v += pw[j * k + t] * ti[pj[j * k + t]];
+                Q[i * n + j] = v + (i == j ? 1.0 : 0.0);
+            }
+        }
+    }
+    for (size_t i = 0; i < n; i++) {
+        double qmax = 0.0;
+        for (size_t j = 0; j < n; j++)
+            if (Q[i * n + j] > qmax)
+                qmax = Q[i * n + j];
+        for (size_t j = 0; j < n; j++) {
+            double q = Q[i * n + j];
+            out_dist[i * n + j] = (q > 0.0 && qmax > 0.0) ? 1.0 - q / qmax
+                                                           : 1.0 + (dmax > 0.0 ? D[i * n + j] / dmax : 0.0);
+        }
+    }
+    free(D);
+    free(Q);
+    free(T);
+    free(sc);
+    free(pw);
+    free(pj);
+    free(row);
+    return AMSCR_OK;
+}

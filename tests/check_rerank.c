@@ -1,0 +1,115 @@
+/* check_rerank.c — contextual re-ranking (amscr_rerank_diffusion) on hand-made matrices whose
+ * correct answer is known, and its argument checks. */
+#include <amscr.h>
+#include <check.h>
+#include <math.h>
+#include <stdlib.h>
+
+#include "suites.h"
+
+/* Two classes: A = {0, 1, 2, 3}, B = {4, 5, 6, 7}. Item 3 is a loose member of A (0.30 from
+ * 0, 1, 2, which are 0.20 apart), and its single nearest item is 4 (0.25), a member of the tight
+ * class B (0.10 apart). Everything else is 1.0 apart. The pairwise distance puts 4 first for 3;
+ * the context says A: 4 lives in a much tighter neighbourhood (self-tuning scale 0.10 against
+ * 0.20 for A), so the affinity 3-4 is weaker than 3-0 (worked out by hand:
+ * exp(-0.25 / sqrt(0.30 * 0.10)) = 0.236 < exp(-0.30 / sqrt(0.30 * 0.20)) = 0.294), and the
+ * diffusion ranks class A first for item 3. */
+static void two_classes(double *D)
+{
+    for (int i = 0; i < 8; i++)
+        for (int j = 0; j < 8; j++) {
+            double d = 1.0;
+            if (i == j)
+                d = 0.0;
+            else if (i < 3 && j < 3)
+                d = 0.20;
+            else if ((i == 3 && j < 3) || (j == 3 && i < 3))
+                d = 0.30;
+            else if (i >= 4 && j >= 4)
+                d = 0.10;
+            else if ((i == 3 && j == 4) || (i == 4 && j == 3))
+                d = 0.25;
+            D[i * 8 + j] = d;
+        }
+}
+
+static int nearest(const double *D, int n, int i)
+{
+    int best = -1;
+    for (int j = 0; j < n; j++)
+        if (j != i && (best < 0 || D[i * n + j] < D[i * n + best]))
+            best = j;
+    return best;
+}
+
+START_TEST(test_known_answer)
+{
+    double D[64], R[64];
+    two_classes(D);
+    ck_assert_int_eq(nearest(D, 8, 3), 4); /* the pairwise distance is wrong for item 3 */
+    ck_assert_int_eq(amscr_rerank_diffusion(D, 8, 3, 20, R), AMSCR_OK);
+    for (int i = 0; i < 8; i++) {
+        int j = nearest(R, 8, i);
+        ck_assert_msg((i < 4) == (j < 4), "item %d: nearest after re-ranking is %d", i, j);
+        ck_assert_double_le(R[i * 8 + i], 1e-12); /* itself first */
+        for (int t = 0; t < 8; t++)
+            ck_assert(isfinite(R[i * 8 + t]) && R[i * 8 + t] >= 0.0);
+    }
+}
+END_TEST
+
+START_TEST(test_blocks_and_unreached)
+{
+    /* three well-separated classes of 4: with k = 2 the diffusion stays inside a class, so every
+     * same-class item ranks before every other (reached < 1 <= unreached) */
+    enum { N = 12 };
+    double D[N * N], R[N * N];
+    for (int i = 0; i < N; i++)
+        for (int j = 0; j < N; j++)
+            D[i * N + j] = i == j ? 0.0 : (i / 4 == j / 4 ? 0.1 + 0.01 * abs(i - j) : 5.0 + 0.1 * abs(i - j));
+    ck_assert_int_eq(amscr_rerank_diffusion(D, N, 2, 10, R), AMSCR_OK);
+    for (int i = 0; i < N; i++)
+        for (int j = 0; j < N; j++) {
+            if (i / 4 == j / 4)
+                ck_assert_double_lt(R[i * N + j], 1.0);
+            else
+                ck_assert_double_ge(R[i * N + j], 1.0);
+        }
+    /* in place gives the same answer, and it is deterministic */
+    double R2[N * N];
+    for (int i = 0; i < N * N; i++)
+        R2[i] = D[i];
+    ck_assert_int_eq(amscr_rerank_diffusion(R2, N, 2, 10, R2), AMSCR_OK);
+    for (int i = 0; i < N * N; i++)
+        ck_assert(R2[i] == R[i]);
+}
+END_TEST
+
+START_TEST(test_invalid)
+{
+    double D[4] = {0, 1, 1, 0}, R[4];
+    ck_assert_int_eq(amscr_rerank_diffusion(NULL, 2, 1, 1, R), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_rerank_diffusion(D, 2, 1, 1, NULL), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_rerank_diffusion(D, 0, 1, 1, R), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_rerank_diffusion(D, 2, 0, 1, R), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_rerank_diffusion(D, 2, 3, 1, R), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_rerank_diffusion(D, 2, 1, 0, R), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_rerank_diffusion(D, 2, 1, 1001, R), AMSCR_E_INVALID_ARG);
+    D[1] = NAN;
+    ck_assert_int_eq(amscr_rerank_diffusion(D, 2, 1, 1, R), AMSCR_E_INVALID_ARG);
+    D[1] = -1.0;
+    ck_assert_int_eq(amscr_rerank_diffusion(D, 2, 1, 1, R), AMSCR_E_INVALID_ARG);
+    ck_assert_str_ne(amscr_last_error_detail(), "");
+}
+END_TEST
+
+Suite *amscr_suite_rerank(void)
+{
+    Suite *s = suite_create("rerank");
+    TCase *tc = tcase_create("diffusion");
+    tcase_add_test(tc, test_known_answer);
+    tcase_add_test(tc, test_blocks_and_unreached);
+    tcase_add_test(tc, test_invalid);
+    suite_add_tcase(s, tc);
+    return s;
+}
