@@ -30,8 +30,18 @@ if [ -z "${AMSCR_NO_INSTALL:-}" ] && ! "$PY" -c 'import numpy, cffi, pytest, sci
     || "$PY" -m pip install -q --break-system-packages numpy cffi pytest scipy
 fi
 
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
 if [ ! -f build/build.ninja ]; then
-  meson setup build --buildtype=release >/dev/null
+  if ! meson setup build --buildtype=release >"$log" 2>&1; then
+    cat "$log" >&2
+    echo "setup: meson setup failed (full log: build/meson-logs/meson-log.txt)" >&2
+    exit 1
+  fi
 fi
-meson compile -C build >/dev/null
+if ! meson compile -C build >"$log" 2>&1; then
+  cat "$log" >&2
+  echo "setup: build failed" >&2
+  exit 1
+fi
 echo "setup: built into ./build" >&2
