@@ -86,7 +86,27 @@ void amscr__fft(const amscr__fft_plan *p, double *z, int inverse)
             z[2 * r + 1] = ti;
         }
     }
-    for (size_t len = 2; len <= n; len <<= 1) {
+    /* the first two stages have trivial twiddles (1, and -i or +i): no multiplications */
+    size_t start = 2;
+    if (n >= 4) {
+        for (size_t i = 0; i < n; i += 4) {
+            double *a = z + 2 * i;
+            double r0 = a[0] + a[2], i0 = a[1] + a[3], r1 = a[0] - a[2], i1 = a[1] - a[3];
+            double r2 = a[4] + a[6], i2 = a[5] + a[7], r3 = a[4] - a[6], i3 = a[5] - a[7];
+            /* forward: w = -i; inverse: w = +i (sgn) */
+            double t3r = sgn * i3, t3i = -sgn * r3;
+            a[0] = r0 + r2;
+            a[1] = i0 + i2;
+            a[4] = r0 - r2;
+            a[5] = i0 - i2;
+            a[2] = r1 + t3r;
+            a[3] = i1 + t3i;
+            a[6] = r1 - t3r;
+            a[7] = i1 - t3i;
+        }
+        start = 8;
+    }
+    for (size_t len = start; len <= n; len <<= 1) {
         size_t half = len >> 1, step = n / len;
         for (size_t i = 0; i < n; i += len) {
             for (size_t j = 0; j < half; j++) {

@@ -443,7 +443,7 @@ static void select_scales(const amscr_params *prm, amscr_method method, size_t f
     unsigned it;
     int conv;
     double ll;
-    if (amscr__gmm1d_fit_small(m->resid, p, K, 100, 1e-8, 1e-6, m->w, m->mu, m->var, scratch, &it, &conv, &ll) !=
+    if (amscr__gmm1d_fit_small(m->resid, p, K, 100, 1e-6, 1e-6, m->w, m->mu, m->var, scratch, &it, &conv, &ll) !=
         AMSCR_OK) {
         /* cannot happen for finite residuals; keep every scale rather than guess */
         for (size_t k = 0; k < p; k++)
