@@ -47,8 +47,6 @@ struct amscr_workspace {
     size_t n, p;
     amscr__fft_plan plan;
     double *z;       /* 4N: two complex arrays */
-    double *c0;      /* 4N: R_0(s) entries xx, xy, yx, yy for every s */
-    double *cs;      /* 4N: the criterion's filtered R(s) */
     double *crit;    /* N */
     double *P;       /* 8 (N/2+1): products H_i conj(F_j) for ij = xx, xy, yx, yy (complex) */
     double *q;       /* 4 (N/2+1): their real parts at the current fractional shift */
@@ -145,7 +143,7 @@ static amscr_status ws_reserve(amscr_workspace *ws, size_t n, size_t p)
         return AMSCR_OK;
     ws_release(ws);
     size_t half = n / 2 + 1;
-    ws->z = amscr__malloc_array(17 * n + 12 * half + 2 * n * (p + 1) + 2 * n, sizeof(double));
+    ws->z = amscr__malloc_array(5 * n + 12 * half + 2 * n * (p + 1) + 2 * n, sizeof(double));
     size_t kmax = p < AMSCR__KMAX ? p : AMSCR__KMAX;
     size_t s1 = amscr__kmeans1d_scratch(p, kmax), s2 = amscr__gmm1d_small_scratch(p, kmax);
     ws->scratch_cap = (s1 > s2 ? s1 : s2) + 4 * p + 64;
@@ -154,10 +152,8 @@ static amscr_status ws_reserve(amscr_workspace *ws, size_t n, size_t p)
         ws_release(ws);
         return amscr__fail(AMSCR_E_NOMEM, "workspace: out of memory");
     }
-    ws->c0 = ws->z + 4 * n;
-    ws->cs = ws->z + 8 * n;
-    ws->crit = ws->z + 12 * n;
-    ws->P = ws->z + 17 * n;
+    ws->crit = ws->z + 4 * n;
+    ws->P = ws->z + 5 * n;
     ws->q = ws->P + 8 * half;
     ws->curve = ws->q + 4 * half;
     ws->n = n;
