@@ -240,9 +240,17 @@ static amscr_status batch_run(batch_t *b, unsigned threads, amscr_progress_fn pr
         threads = (unsigned)b->nitems;
     if (threads < 1)
         threads = 1;
+    /* The first report (0 done) comes before any worker starts, so every callback sees the
+     * start and (below) the end, whatever the scheduling. */
+    size_t last_reported = (size_t)-1;
+    if (progress) {
+        last_reported = 0;
+        if (progress(user, 0, total_cells) != 0)
+            b->cancel = 1;
+    }
     pthread_t *tid = NULL;
     unsigned started = 0;
-    if (threads > 1) {
+    if (threads > 1 && !b->cancel) {
         tid = malloc((threads - 1) * sizeof *tid);
         if (tid)
             for (unsigned t = 0; t + 1 < threads; t++) {
@@ -254,7 +262,7 @@ static amscr_status batch_run(batch_t *b, unsigned threads, amscr_progress_fn pr
     /* the calling thread works too, and reports progress between its items */
     amscr_workspace *ws = NULL;
     amscr_status own = amscr_workspace_new(&ws);
-    size_t item, last_reported = (size_t)-1;
+    size_t item;
     if (own != AMSCR_OK) {
         batch_finish_item(b, own);
     } else {

@@ -773,6 +773,33 @@ START_TEST(cancellation)
 }
 END_TEST
 
+/* Regression (found by the hardening pass): with 2+ threads a worker could finish every item
+ * before the calling thread's first progress check, so a callback saw only (total, total) and
+ * could not cancel at its second call. The first report is now always (0, total), before any
+ * worker starts. */
+START_TEST(progress_first_report_is_zero)
+{
+    amscr_params *p = small_params(2);
+    amscr_descriptor **d = make_descs(p, 40, 1401);
+    amscr_db *db = db_from(p, d, 40);
+    double *q = alloc_doubles(40), *m = alloc_doubles(40 * 40);
+    for (int rep = 0; rep < 20; rep++) {
+        prog_rec r;
+        prog_init(&r, 0);
+        ck_assert_int_eq(amscr_db_query(db, d[0], prog_cb, &r, q), AMSCR_OK);
+        ck_assert_uint_eq(r.first_done, 0);
+        ck_assert_uint_ge(r.calls, 2);
+        prog_init(&r, 2); /* stop at the second call: always possible now */
+        ck_assert_int_eq(amscr_db_distance_matrix(db, prog_cb, &r, m), AMSCR_E_CANCELLED);
+    }
+    free(q);
+    free(m);
+    free_descs(d, 40);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+END_TEST
+
 /* amscr.h (amscr_db_query): batch outputs are computed in place, so on failure or
  * cancellation every element is NaN — never a silently partial result. */
 START_TEST(cancel_writes_no_output)
@@ -1492,6 +1519,7 @@ Suite *amscr_suite_db(void)
     tcase_add_test(tc, progress_contract);
     tcase_add_test(tc, cancellation);
     tcase_add_test(tc, cancel_writes_no_output);
+    tcase_add_test(tc, progress_first_report_is_zero);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("io");

@@ -22,12 +22,14 @@ if [ ${#missing[@]} -gt 0 ] && [ -z "${AMSCR_NO_INSTALL:-}" ]; then
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# Python side (tests and bindings): numpy, cffi, pytest, scipy (test cross-checks only).
+# Python side (tests and bindings): numpy, cffi, pytest, scipy (test cross-checks only) and
+# dask[distributed] (the optional amscr.distributed, issue 9).
 PY=${PYTHON:-python3}
-if [ -z "${AMSCR_NO_INSTALL:-}" ] && ! "$PY" -c 'import numpy, cffi, pytest, scipy' >/dev/null 2>&1; then
-  echo "setup: installing Python packages: numpy cffi pytest scipy" >&2
-  "$PY" -m pip install -q numpy cffi pytest scipy 2>/dev/null \
-    || "$PY" -m pip install -q --break-system-packages numpy cffi pytest scipy
+pypkgs=(numpy cffi pytest scipy "dask[distributed]>=2023")
+if [ -z "${AMSCR_NO_INSTALL:-}" ] && ! "$PY" -c 'import numpy, cffi, pytest, scipy, distributed' >/dev/null 2>&1; then
+  echo "setup: installing Python packages: ${pypkgs[*]}" >&2
+  "$PY" -m pip install -q "${pypkgs[@]}" 2>/dev/null \
+    || "$PY" -m pip install -q --break-system-packages "${pypkgs[@]}"
 fi
 
 log=$(mktemp)

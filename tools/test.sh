@@ -1,10 +1,14 @@
 #!/usr/bin/env bash
 # Sets up (installs what is missing, builds) and runs every test: the per-area Check suites,
-# the ABI checks, the tool and Python tests (all through `meson test`), then the master Check
-# runner, whose closing line ("100%: Checks: N, Failures: 0, Errors: 0") ends the output.
+# the ABI checks, the tool and Python tests (all through `meson test`), the hardening pass
+# (tools/hardening.sh), then the master Check runner, whose closing line
+# ("100%: Checks: N, Failures: 0, Errors: 0") ends the output.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/setup.sh
 meson test -C build --no-suite all --print-errorlogs --num-processes 2
+# sanitizers (ASan+UBSan, TSan), valgrind, ABI diff against the committed baseline, a short
+# fuzz pass (AMSCR_FUZZ_SECONDS, default 30 s a target); AMSCR_NO_HARDENING=1 skips it
+[ -n "${AMSCR_NO_HARDENING:-}" ] || tools/hardening.sh
 echo "== check_all =="
 build/tests/check_all
