@@ -582,34 +582,6 @@ static inline double crit_value(const double C[4], const double Si[4])
     return -t;
 }
 
-/* The criterion at a continuous shift s from the spectral products in ws->P (one fused pass). */
-static double crit_at(const amscr_descriptor *f, int use_finest, const double Si[4], amscr_workspace *ws, double s)
-{
-    size_t n = f->n, half = n / 2 + 1;
-    const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
-    double th = 2.0 * 3.14159265358979323846 * s / (double)n;
-    double cs = cos(th), sn = sin(th), er = 1.0, ei = 0.0;
-    double c0 = 0, c1 = 0, c2 = 0, c3 = 0;
-    for (size_t w = 0; w < half; w++) {
-        if ((w & 255) == 0 && w > 0) { /* re-anchor the rotation recurrence (large N only) */
-            er = cos(th * (double)w);
-            ei = sin(th * (double)w);
-        }
-        double g = (w == 0 || 2 * w == n) ? gain[w] : 2.0 * gain[w];
-        const double *P = ws->P + 8 * w;
-        c0 += g * (P[0] * er - P[1] * ei);
-        c1 += g * (P[2] * er - P[3] * ei);
-        c2 += g * (P[4] * er - P[5] * ei);
-        c3 += g * (P[6] * er - P[7] * ei);
-        double t = er * cs - ei * sn;
-        ei = er * sn + ei * cs;
-        er = t;
-    }
-    double inv_n = 1.0 / (double)n;
-    double C[4] = {c0 * inv_n, c1 * inv_n, c2 * inv_n, c3 * inv_n};
-    return crit_value(C, Si);
-}
-
 /* The criterion and its first two derivatives in s in one spectral pass:
  * d/ds Re(P e^{iks}) = -k Im(P e^{iks}), d2/ds2 = -k^2 Re(P e^{iks}), k = 2πw/N. */
 static void crit_newton(const amscr_descriptor *f, int use_finest, const double Si[4], amscr_workspace *ws, double s,
@@ -667,7 +639,9 @@ static void crit_newton(const amscr_descriptor *f, int use_finest, const double 
 }
 
 /* Refinement of an integer shift s (a local minimum of the criterion) to a continuous one
- * by Newton's method with exact derivatives (at most three passes, steps within ±0.5). */
+ * by Newton's method with exact derivatives (at most two passes, steps within ±0.5; the last
+ * step is taken with its quadratic prediction of the criterion, which only ranks candidates —
+ * the distance is computed exactly afterwards). */
 static double refine_shift(const amscr_descriptor *f, int use_finest, const double Si[4], amscr_workspace *ws,
                            size_t s, double *out_crit)
 {
@@ -679,7 +653,7 @@ static double refine_shift(const amscr_descriptor *f, int use_finest, const doub
         double step = -0.5 * (cp - cm) / curv;
         x += step > 0.5 ? 0.5 : (step < -0.5 ? -0.5 : step);
     }
-    for (int it = 0; it < 3; it++) {
+    for (int it = 0; it < 2; it++) {
         double v, d1, d2;
         crit_newton(f, use_finest, Si, ws, x, &v, &d1, &d2);
         if (v <= best_v) {
@@ -704,10 +678,10 @@ static double refine_shift(const amscr_descriptor *f, int use_finest, const doub
             best_x = x;
             break;
         }
-        if (it == 2) { /* no pass left: accept the Newton prediction only if it is lower */
+        if (it == 1) { /* no pass left: accept the Newton prediction only if it is lower */
             double pred = v + d1 * step + 0.5 * d2 * step * step;
             if (pred < best_v) {
-                best_v = crit_at(f, use_finest, Si, ws, x);
+                best_v = pred;
                 best_x = x;
             }
         }
