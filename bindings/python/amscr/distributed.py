@@ -57,7 +57,7 @@ from . import Collection, FormatError, Shape, _check, ffi, lib
 __all__ = ['distance_matrix', 'cross_matrix', 'topk', 'tile_size']
 
 TILE_MIN, TILE_MAX = 64, 2048
-TILES_PER_THREAD = 4
+TILES_PER_THREAD = 8  # enough tiles that the last round leaves few threads idle
 MERGE_FAN_IN = 8
 
 PathLike = Union[str, 'os.PathLike[str]']
@@ -76,7 +76,9 @@ class _Payload:
         self._lock = threading.Lock()
         self.what = what
 
-    def collection(self) -> Collection:
+    def collection(self, threads: Optional[int] = None) -> Collection:
+        """The collection, computing with `threads` C threads (converted once: a worker always
+        asks with the same count)."""
         with self._lock:
             if self._coll is None:
                 try:
@@ -88,6 +90,8 @@ class _Payload:
                                       e.status, e.detail) from None
                 _PARSED[0] += 1
                 self._data = None
+            if threads is not None and self._coll.params.threads != threads:
+                self._coll = _block(self._coll, 0, len(self._coll), threads)
             return self._coll
 
     def __reduce__(self):
@@ -126,8 +130,8 @@ def _tile_threads(threads: Union[int, Dict[str, int], None]) -> int:
     if threads and addr is not None and get_address_host(addr) in threads:
         return threads[get_address_host(addr)]
     try:
-        nthreads = distributed.get_worker().state.nthreads
-    except (ValueError, AttributeError):
+        nthreads = distributed.get_worker().nthreads
+    except ValueError:  # not on a worker
         nthreads = 1
     return max(1, _cores() // max(1, nthreads))
 
@@ -147,8 +151,8 @@ def _block(coll: Collection, lo: int, hi: int, threads: int) -> Collection:
 
 def _matrix_tile(payload: _Payload, r0: int, r1: int, c0: int, c1: int, threads) -> np.ndarray:
     """D[r0:r1, c0:c1] of the payload collection's distance matrix (zero diagonal)."""
-    coll = payload.collection()
     t = _tile_threads(threads)
+    coll = payload.collection(t)
     rows = _block(coll, r0, r1, t)
     cols = rows if (r0, r1) == (c0, c1) else _block(coll, c0, c1, t)
     D = rows.cross_matrix(cols)
@@ -162,8 +166,8 @@ def _matrix_tile(payload: _Payload, r0: int, r1: int, c0: int, c1: int, threads)
 def _cross_tile(qpayload: _Payload, tpayload: _Payload, c0: int, c1: int, threads) -> np.ndarray:
     """Distances from a block of queries to targets c0..c1-1 (the queries' options)."""
     t = _tile_threads(threads)
-    q = qpayload.collection()
-    return _block(q, 0, len(q), t).cross_matrix(_block(tpayload.collection(), c0, c1, t))
+    q = qpayload.collection(t)  # a query block: all of it
+    return q.cross_matrix(_block(tpayload.collection(t), c0, c1, t))
 
 
 def _select(idx: np.ndarray, dist: np.ndarray, k: int) -> Tuple[np.ndarray, np.ndarray]:
@@ -173,13 +177,35 @@ def _select(idx: np.ndarray, dist: np.ndarray, k: int) -> Tuple[np.ndarray, np.n
     return np.take_along_axis(idx, order, 1), np.take_along_axis(dist, order, 1)
 
 
+def _tile_candidates(D: np.ndarray, c0: int, k: int, exclude: Optional[np.ndarray]) -> Tuple[np.ndarray, np.ndarray]:
+    """The k best of each row of a tile whose columns are targets c0.. (`exclude[row]`: a target
+    to leave out, or -1). A partition finds each row's k-th value first, so only the entries up to
+    it (all its ties included) are sorted."""
+    m, c = D.shape
+    cols = np.arange(c0, c0 + c, dtype=np.intp)
+    hit = None if exclude is None else cols[None, :] == exclude[:, None]
+    key = D if hit is None or not hit.any() else np.where(hit, np.nan, D)  # excluded: ranked last
+    if k < c:
+        kth = np.partition(key, k - 1, axis=1)[:, k - 1:k]
+        cand = (key <= kth) | np.isnan(kth)  # a NaN k-th value: every entry may rank
+    else:
+        cand = np.ones(D.shape, dtype=bool)
+    if hit is not None:
+        cand &= ~hit
+    counts = cand.sum(axis=1)
+    width = max(int(counts.max(initial=0)), 1)
+    r, j = np.nonzero(cand)  # row-major: ascending columns within a row
+    pos = np.arange(r.size) - np.repeat(np.cumsum(counts) - counts, counts)
+    idx = np.full((m, width), -1, dtype=np.intp)
+    dist = np.full((m, width), np.nan)
+    idx[r, pos] = cols[j]
+    dist[r, pos] = D[r, j]
+    return _select(idx, dist, k)
+
+
 def _topk_tile(qpayload: _Payload, tpayload: _Payload, c0: int, c1: int, k: int,
                exclude: Optional[np.ndarray], threads) -> Tuple[np.ndarray, np.ndarray]:
-    D = _cross_tile(qpayload, tpayload, c0, c1, threads)
-    idx = np.broadcast_to(np.arange(c0, c1, dtype=np.intp), D.shape)
-    if exclude is not None:
-        idx = np.where(idx == exclude[:, None], -1, idx)
-    return _select(idx, D, k)
+    return _tile_candidates(_cross_tile(qpayload, tpayload, c0, c1, threads), c0, k, exclude)
 
 
 def _merge(k: int, *parts: Tuple[np.ndarray, np.ndarray]) -> Tuple[np.ndarray, np.ndarray]:
@@ -222,6 +248,18 @@ def _threads_by_host(client) -> Dict[str, int]:
     return {h: max(1, host_cores[h] // dask_threads[h]) for h in dask_threads}
 
 
+def _check_threads(threads: Any) -> Optional[int]:
+    if threads is None:
+        return None
+    if isinstance(threads, (bool, np.bool_)) or int(threads) != threads or not 0 <= threads <= 0xFFFFFFFF:
+        raise ValueError('threads: expected None or a count >= 0 (0 = all cores), got %r' % (threads,))
+    return int(threads)
+
+
+def _threads_arg(threads: Optional[int], client) -> Union[int, Dict[str, int]]:
+    return _threads_by_host(client) if threads is None else threads
+
+
 @contextlib.contextmanager
 def _client_or_local(client):
     if client is not None:
@@ -261,7 +299,7 @@ def _queries_like(queries: Any, targets: Collection) -> Collection:
 def _scatter_blocks(client, coll: Collection, bounds: Sequence[Tuple[int, int]], what: str) -> list:
     """Row blocks of `coll` as scattered payloads (each goes where it is needed)."""
     payloads = [_Payload(_block(coll, lo, hi, coll.params.threads).to_bytes(), what) for lo, hi in bounds]
-    return client.scatter(payloads, hash=False)
+    return client.scatter(payloads, hash=False) if payloads else []
 
 
 def _out_array(out: Any, shape: Tuple[int, int]) -> np.ndarray:
@@ -325,6 +363,8 @@ def _eager_matrix(client, task, row_b, col_b, args_of, out, progress, retries, t
 
 def _lazy_matrix(client, task, row_b, col_b, args_of, progress, retries, token):
     import dask.array as da
+    if not row_b or not col_b:
+        return da.zeros((row_b[-1][1] if row_b else 0, col_b[-1][1] if col_b else 0), dtype=np.float64)
     with dask.annotate(retries=retries):
         blocks = [[da.from_delayed(dask.delayed(task, pure=True)(*args_of(i, j),
                                                                   dask_key_name='%s-%d-%d' % (token, i, j)),
@@ -365,12 +405,13 @@ def distance_matrix(collection: Union[Collection, bytes], client=None, tile: Til
         array; with `out`: the memmap (or array).
     """
     coll = _as_collection(collection, 'collection')
+    threads = _check_threads(threads)
     n = len(coll)
     lazy = client is not None and out is None
     with _client_or_local(client) as c:
         tr, tc = tile_size(n, n, sum(c.nthreads().values()), tile)
         row_b, col_b = _bounds(n, tr), _bounds(n, tc)
-        th = threads if threads is not None else _threads_by_host(c)
+        th = _threads_arg(threads, c)
         [payload] = c.scatter([_Payload(coll.to_bytes())], broadcast=True, hash=False)
         token = 'amscr-matrix-' + uuid.uuid4().hex
 
@@ -390,12 +431,13 @@ def cross_matrix(queries: Union[Collection, bytes], targets: Union[Collection, b
     :func:`distance_matrix`; the queries travel as row blocks, the targets once per worker."""
     q = _as_collection(queries, 'queries')
     t = _as_collection(targets, 'targets')
+    threads = _check_threads(threads)
     nq, nt = len(q), len(t)
     lazy = client is not None and out is None
     with _client_or_local(client) as c:
         tr, tc = tile_size(nq, nt, sum(c.nthreads().values()), tile)
         row_b, col_b = _bounds(nq, tr), _bounds(nt, tc)
-        th = threads if threads is not None else _threads_by_host(c)
+        th = _threads_arg(threads, c)
         [tpay] = c.scatter([_Payload(t.to_bytes(), 'target collection')], broadcast=True, hash=False)
         qpays = _scatter_blocks(c, q, row_b, 'query block')
         token = 'amscr-cross-' + uuid.uuid4().hex
@@ -428,6 +470,7 @@ def topk(queries: Union[Collection, Iterable[Any], bytes], collection: Union[Col
         by lower index), excluded target removed.
     """
     t = _as_collection(collection, 'collection')
+    threads = _check_threads(threads)
     nt = len(t)
     q = _queries_like(queries, t)
     nq = len(q)
@@ -449,7 +492,7 @@ def topk(queries: Union[Collection, Iterable[Any], bytes], collection: Union[Col
     with _client_or_local(client) as c:
         tr, tc = tile_size(nq, nt, sum(c.nthreads().values()), tile)
         row_b, col_b = _bounds(nq, tr), _bounds(nt, tc)
-        th = threads if threads is not None else _threads_by_host(c)
+        th = _threads_arg(threads, c)
         [tpay] = c.scatter([_Payload(t.to_bytes(), 'target collection')], broadcast=True, hash=False)
         qpays = _scatter_blocks(c, q, row_b, 'query block')
         token = uuid.uuid4().hex
