@@ -572,6 +572,9 @@ AMSCR_API double amscr_params_get_penalty(const amscr_params *p);
  * @brief Prepares a shape once (DESIGN.md §2: validate, orient, resample, parametrize,
  *        sample N points, whiten, smooth at every scale). Immutable afterwards, shareable
  *        by any number of threads. It keeps a copy of the params it was built with.
+ *        Memory: about 784 + 8 * (9N + 3Np + 15p + 15) bytes (N samples, p scales): 35.8 KB at
+ *        the defaults (N = 128, p = 8); a collection (amscr_db) holds one per shape plus ~16
+ *        bytes; a saved collection takes 4 + 8 * (12 + 4N + 2Np) bytes per shape (20.6 KB).
  * @param[in] p  params (NULL = defaults).
  * @return AMSCR_OK, AMSCR_E_INVALID_ARG, AMSCR_E_DEGENERATE, AMSCR_E_NOMEM.
  * Ownership: caller frees *out. Thread-safety: reentrant. @since 0.1
