@@ -684,7 +684,7 @@ static void svg_axes(sbuf *b, const panel *P, const char *title, const char *xla
     sb_printf(b,
               "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" font-size=\"12\" "
               "transform=\"rotate(-90 %.1f %.1f)\">",
-              P->x - 52, P->y + P->h / 2, P->x - 52, P->y + P->h / 2);
+              P->x - 74, P->y + P->h / 2, P->x - 74, P->y + P->h / 2);
     svg_escape(b, ylabel);
     sb_puts(b, "</text>\n");
 }
@@ -708,7 +708,7 @@ int draw_plot_svg(const char *path, const plot_input *in)
     }
 
     /* ---- panel 1: residual per scale */
-    panel P = {80, 70, 380, 250, -0.5, (double)in->p - 0.5, 0, 1};
+    panel P = {104, 70, 356, 250, -0.5, (double)in->p - 0.5, 0, 1};
     /* y range: the residuals and the threshold, padded; zero-based only when they spread widely */
     double ymin = INFINITY, ymax = -INFINITY;
     for (size_t k = 0; k < in->p; k++)
@@ -773,7 +773,7 @@ int draw_plot_svg(const char *path, const plot_input *in)
                       x, y);
     }
     /* legend of panel 1 */
-    double lx = P.x + 8, ly = P.y + P.h + 52;
+    double lx = P.x - 16, ly = P.y + P.h + 52;
     sb_printf(&b, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"5\" fill=\"#2ca02c\" stroke=\"#1b6e1b\"/>"
                   "<text x=\"%.1f\" y=\"%.1f\">kept scale</text>\n",
               lx, ly, lx + 10, ly + 4);
@@ -829,7 +829,7 @@ int draw_plot_svg(const char *path, const plot_input *in)
                 sb_printf(&b, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"#1f77b4\"/>\n", x, y);
         }
         sb_printf(&b, "<text x=\"%.1f\" y=\"%.1f\">dashed: chord from K = 1 to K = %zu; K* farthest below it</text>\n",
-                  Q.x + 8, Q.y + Q.h + 56, in->kmax);
+                  Q.x + 8, Q.y + Q.h + 70, in->kmax);
     }
     sb_puts(&b, "</svg>\n");
     int r = write_text_file(path, &b);
