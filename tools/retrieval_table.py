@@ -33,12 +33,15 @@ METHODS = [('acma', 'ACMA'), ('amscr', 'AMSCR'), ('binary-em', 'AMSCR with Binar
            ('multiclass-em', 'AMSCR based on Multiclass-EM')]
 # label, flags (added to `amscr eval`)
 MODES = [
-    ('affine (paper), no re-ranking', ['--invariance', 'affine', '--no-rerank']),
-    ('affine + re-ranking', ['--invariance', 'affine', '--rerank', '5,20']),
-    ('similarity, no re-ranking', ['--invariance', 'similarity', '--no-rerank']),
-    ('similarity + re-ranking (retrieval default)', ['--invariance', 'similarity', '--rerank', '5,20']),
-    ('penalized (lambda 0.5), no re-ranking', ['--invariance', 'penalized', '--no-rerank']),
-    ('penalized (lambda 0.5) + re-ranking', ['--invariance', 'penalized', '--rerank', '5,20']),
+    ('affine (paper), no re-ranking', ['--invariance', 'affine', '--no-rerank', '--refine', '0']),
+    ('affine + re-ranking', ['--invariance', 'affine', '--rerank', '5,20', '--refine', '0']),
+    ('similarity, no re-ranking', ['--invariance', 'similarity', '--no-rerank', '--refine', '0']),
+    ('similarity + re-ranking', ['--invariance', 'similarity', '--rerank', '5,20', '--refine', '0']),
+    ('penalized (lambda 0.5), no re-ranking', ['--invariance', 'penalized', '--no-rerank', '--refine', '0']),
+    ('penalized (lambda 0.5) + re-ranking', ['--invariance', 'penalized', '--rerank', '5,20', '--refine', '0']),
+    ('similarity + refine 1 + re-ranking', ['--invariance', 'similarity', '--refine', '1', '--rerank', '5,20']),
+    ('similarity + refine 2 + re-ranking (retrieval default)',
+     ['--invariance', 'similarity', '--refine', '2', '--rerank', '5,20']),
     ('similarity + refine 5 + re-ranking', ['--invariance', 'similarity', '--refine', '5', '--rerank', '5,20']),
 ]
 
@@ -87,7 +90,7 @@ def main():
         print('| method | top-1 .. top-%d | sum | bull\'s eye, 1-NN, seconds |' % ranks)
         print('|---|---|---|---|')
         for m, paper_name in METHODS:
-            j = run(a.tool, folder, ranks, ['--method', m, '--invariance', 'affine', '--no-rerank'])
+            j = run(a.tool, folder, ranks, ['--method', m, '--invariance', 'affine', '--no-rerank', '--refine', '0'])
             print(row('amscr `%s`' % m, j['topk'], '%.2f %%, %.2f %%, %.1f s' % (100 * j['bullseye'],
                       100 * j['nn_accuracy'], j['seconds'])))
             print(row('paper: %s' % paper_name, PAPER[name][paper_name]))
@@ -102,12 +105,12 @@ def main():
         if not a.sweep:
             continue
         print('\nTable 3: one factor at a time from the defaults: sum of the top-k counts, affine group '
-              'without re-ranking | similarity + re-ranking\n')
+              'without re-ranking | similarity + re-ranking (both without refinement)\n')
         print('| setting | affine, no re-ranking | similarity + re-ranking |')
         print('|---|---|---|')
         for label, flags in SWEEP:
-            ja = run(a.tool, folder, ranks, flags + ['--invariance', 'affine', '--no-rerank'])
-            js = run(a.tool, folder, ranks, flags + ['--invariance', 'similarity', '--rerank', '5,20'])
+            ja = run(a.tool, folder, ranks, flags + ['--invariance', 'affine', '--no-rerank', '--refine', '0'])
+            js = run(a.tool, folder, ranks, flags + ['--invariance', 'similarity', '--rerank', '5,20', '--refine', '0'])
             print('| %s | %d | %d |' % (label, sum(ja['topk']), sum(js['topk'])))
     sys.stdout.flush()
 

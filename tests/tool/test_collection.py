@@ -14,9 +14,10 @@ MAPS = [((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
         ((0.6, -0.5, -3.0), (0.7, 0.8, 2.0))]
 
 
-# Retrieval commands default to the similarity group with re-ranking (README: retrieval table);
+# Retrieval commands default to the similarity group, 2 refinement iterations and re-ranking
+# (README: retrieval table);
 # these collections are affine-distorted copies, the case for the affine group.
-AFFINE = ("--invariance", "affine", "--no-rerank")
+AFFINE = ("--invariance", "affine", "--no-rerank", "--refine", "0")
 
 
 def test_retrieval_defaults_and_rerank(manifest):

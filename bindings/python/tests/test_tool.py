@@ -36,7 +36,7 @@ def test_matrix_of_point_files_equals_tool(tmp_path):
     out = tmp_path / 'D.npy'
     # the tool's retrieval defaults are similarity + re-ranking; the plain affine matrix first
     _tool('matrix', str(folder), '-o', str(out), '--points', '64', '--threads', '2', '--invariance', 'affine',
-          '--no-rerank')
+          '--no-rerank', '--refine', '0')
     D_tool = np.load(out)
     names = sorted(os.listdir(folder), key=os.fsencode)  # the tool sorts by byte order
     db = amscr.Collection(points=64, reflections=True)  # reflections: on by default in `amscr matrix`
@@ -46,13 +46,15 @@ def test_matrix_of_point_files_equals_tool(tmp_path):
     assert D_tool.shape == D.shape == (9, 9)
     np.testing.assert_array_equal(D, D_tool)
     # the tool's text output agrees too (to its printed precision)
-    tsv = _tool('matrix', str(folder), '-o', '-', '--points', '64', '--invariance', 'affine', '--no-rerank').stdout
+    tsv = _tool('matrix', str(folder), '-o', '-', '--points', '64', '--invariance', 'affine', '--no-rerank', '--refine',
+                '0').stdout
     rows = [list(map(float, line.split('\t'))) for line in tsv.splitlines() if line and not line.startswith('#')]
     np.testing.assert_allclose(np.array(rows), D, rtol=1e-9, atol=1e-12)
-    # and the tool's defaults are the similarity group followed by re-ranking (k 5, 20 iterations)
+    # and the tool's defaults are the similarity group, 2 refinement iterations, then re-ranking
+    # (k 5, 20 iterations)
     out2 = tmp_path / 'D2.npy'
     _tool('matrix', str(folder), '-o', str(out2), '--points', '64')
-    dbs = amscr.Collection(points=64, reflections=True, invariance='similarity')
+    dbs = amscr.Collection(points=64, reflections=True, invariance='similarity', refine=2)
     for n in names:
         dbs.add(amscr.read_points(folder / n), label=n.split('-')[0])
     np.testing.assert_array_equal(amscr.rerank_diffusion(dbs.distance_matrix(), 5, 20), np.load(out2))
@@ -118,7 +120,8 @@ def test_matrix_of_images_equals_tool(tmp_path):
     manifest.write_text('file\tclass\n' + ''.join('%s\t%s\n' % (os.path.join(os.path.abspath(folder), f),
                                                                  f.split('-')[0]) for f in pick))
     out = tmp_path / 'D.npy'
-    _tool('matrix', str(manifest), '-o', str(out), '--points', '64', '--invariance', 'affine', '--no-rerank')
+    _tool('matrix', str(manifest), '-o', str(out), '--points', '64', '--invariance', 'affine', '--no-rerank',
+          '--refine', '0')
     D_tool = np.load(out)
     db = amscr.Collection(points=64, reflections=True)
     for f, img in zip(pick, imgs):
