@@ -12,6 +12,11 @@ import numpy as np
 from ._lib import ffi, lib
 from .errors import InvalidArgumentError, _check
 
+try:
+    from numpy.typing import ArrayLike
+except ImportError:  # numpy < 1.20
+    ArrayLike = Any  # type: ignore
+
 INT32_MIN, INT32_MAX = -(2 ** 31), 2 ** 31 - 1
 
 
@@ -76,10 +81,26 @@ def as_count(x: Any, name: str, minimum: int = 0) -> int:
     return v
 
 
+def as_uint(x: Any, name: str) -> int:
+    """A count that fits the library's `unsigned` (32-bit) arguments."""
+    v = as_count(x, name, 0)
+    if v > 0xFFFFFFFF:
+        raise bad('%s: too large (%d)' % (name, v))
+    return v
+
+
 def as_bool(x: Any, name: str) -> int:
     if isinstance(x, (bool, np.bool_)) or (isinstance(x, (int, np.integer)) and x in (0, 1)):
         return int(bool(x))
     raise bad('%s: expected True or False, got %r' % (name, x))
+
+
+def new_object(ctype: str, make: Callable[..., int], free: Callable[[Any], None], *args: Any):
+    """Calls ``make(*args, ctype **out)`` (a C constructor) and returns ``*out``, which the
+    garbage collector frees with `free`."""
+    out = ffi.new(ctype + ' **')
+    _check(make(*args, out))
+    return ffi.gc(out[0], free)
 
 
 def dbuf(a: np.ndarray):
@@ -92,6 +113,23 @@ def copy_doubles(p, count: int) -> np.ndarray:
     if p == ffi.NULL:
         raise bad('no data (NULL pointer from the library)')
     return np.frombuffer(ffi.buffer(p, count * 8), dtype=np.float64).copy()
+
+
+def copy_points(p, n: int) -> np.ndarray:
+    """Copies n (x, y) points from a borrowed C pointer into a new (n, 2) array."""
+    return copy_doubles(p, 2 * n).reshape(n, 2)
+
+
+def sized_arrays(fn, *args: Any, arrays: int = 1, dtype: Any = np.float64, ctype: str = 'double[]'
+                 ) -> Tuple[np.ndarray, ...]:
+    """The library's two-call size pattern: ``fn(*args, NULL..., &n)`` asks for the length n,
+    ``fn(*args, buf..., &n)`` fills `arrays` buffers of n values; returns them as numpy arrays."""
+    n = ffi.new('size_t *', 0)
+    _check(fn(*args, *([ffi.NULL] * arrays), n))
+    bufs = [np.zeros(int(n[0]), dtype=dtype) for _ in range(arrays)]
+    if n[0]:
+        _check(fn(*args, *(ffi.from_buffer(ctype, b) for b in bufs), n))
+    return tuple(b[:int(n[0])] for b in bufs)
 
 
 def factorize(labels: Any, n: Optional[int] = None, name: str = 'labels') -> np.ndarray:

@@ -1,0 +1,69 @@
+"""Curve building blocks: Gaussian smoothing, resampling in Euclidean or affine arc length, whitening."""
+from __future__ import annotations
+
+from typing import Optional, Tuple
+
+import numpy as np
+
+from ._lib import ffi, lib
+from ._util import ArrayLike, as_bool, as_count, as_points, as_scalar, as_uint, dbuf, m6_to_matrix, sized_arrays
+from .errors import _check
+from .params import Params
+
+
+def gaussian_kernel(sigma: float) -> np.ndarray:
+    """FIR Gaussian taps: radius ceil(4 sigma), 2r+1 taps, sum 1."""
+    taps, = sized_arrays(lib.amscr_gaussian_kernel, as_scalar(sigma, 'sigma'))
+    return taps
+
+
+def smooth(points: ArrayLike, sigma: float, closed: bool = True) -> np.ndarray:
+    """Gaussian smoothing of x and y (sigma in samples): circular when closed, mirrored at the ends
+    ("reflect") when open; sigma 0 copies."""
+    pts = as_points(points)
+    out = np.empty_like(pts)
+    _check(lib.amscr_smooth_gaussian(dbuf(pts), pts.shape[0], as_bool(closed, 'closed'),
+                                     as_scalar(sigma, 'sigma'), dbuf(out)))
+    return out
+
+
+def resample_euclidean(points: ArrayLike, m: int, closed: bool = True) -> np.ndarray:
+    """m points equally spaced in Euclidean arc length along the polygon."""
+    pts = as_points(points)
+    m = as_count(m, 'm', 1)
+    out = np.empty((m, 2), dtype=np.float64)
+    _check(lib.amscr_resample_euclidean(dbuf(pts), pts.shape[0], as_bool(closed, 'closed'), m, dbuf(out)))
+    return out
+
+
+def resample_affine(points: ArrayLike, m: int, closed: bool = True, sigma0: Optional[float] = None,
+                    passes: Optional[int] = None) -> np.ndarray:
+    """m points equally spaced in affine arc length (sigma0: pre-smoothing as a fraction of the curve
+    length; passes: affine arc-length passes; None takes the defaults of :class:`Params`)."""
+    pts = as_points(points)
+    m = as_count(m, 'm', 1)
+    defaults = Params()
+    s0 = defaults.presmooth if sigma0 is None else as_scalar(sigma0, 'sigma0')
+    ps = defaults.arclength_passes if passes is None else as_uint(passes, 'passes')
+    out = np.empty((m, 2), dtype=np.float64)
+    _check(lib.amscr_resample_affine(dbuf(pts), pts.shape[0], as_bool(closed, 'closed'), s0, ps, m, dbuf(out)))
+    return out
+
+
+def affine_arclength(points: ArrayLike, closed: bool = True, sigma0: float = 0.0) -> Tuple[np.ndarray, float]:
+    """Cumulative affine arc length at each vertex (not normalized) and the total length."""
+    pts = as_points(points)
+    cum = np.empty(pts.shape[0], dtype=np.float64)
+    total = ffi.new('double *')
+    _check(lib.amscr_affine_arclength(dbuf(pts), pts.shape[0], as_bool(closed, 'closed'),
+                                      as_scalar(sigma0, 'sigma0'), dbuf(cum), total))
+    return cum, float(total[0])
+
+
+def normalize_whiten(points: ArrayLike) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(whitened points, 3x3 forward map, 3x3 inverse map): centroid to 0, identity covariance."""
+    pts = as_points(points)
+    out = np.empty_like(pts)
+    fwd, inv = ffi.new('double[6]'), ffi.new('double[6]')
+    _check(lib.amscr_normalize_whiten(dbuf(pts), pts.shape[0], dbuf(out), fwd, inv))
+    return out, m6_to_matrix(fwd), m6_to_matrix(inv)
