@@ -51,8 +51,10 @@ class _Option(Generic[T]):
     """A Params attribute backed by ``amscr_params_get_<c_name>`` / ``amscr_params_set_<c_name>``."""
 
     def __init__(self, c_name: str, conv: _Conv[T], doc: str):
-        self.c_name, self.conv, self.__doc__ = c_name, conv, doc
+        self.conv, self.__doc__ = conv, doc
         self.name = c_name
+        self.c_get = getattr(lib, 'amscr_params_get_' + c_name)
+        self.c_set = getattr(lib, 'amscr_params_set_' + c_name)
 
     def __set_name__(self, owner: type, name: str) -> None:
         self.name = name
@@ -65,10 +67,10 @@ class _Option(Generic[T]):
     def __get__(self, obj, owner=None):
         if obj is None:
             return self
-        return self.conv.read(getattr(lib, 'amscr_params_get_' + self.c_name), obj._p)
+        return self.conv.read(self.c_get, obj._p)
 
     def __set__(self, obj: 'Params', value: Any) -> None:
-        _check(getattr(lib, 'amscr_params_set_' + self.c_name)(obj._p, *self.conv.write(value, self.name)))
+        _check(self.c_set(obj._p, *self.conv.write(value, self.name)))
 
 
 def _new_params(make: Callable[..., int], *args: Any):

@@ -14,13 +14,6 @@ from .errors import _check
 from .params import Params, make_params
 from .shape import PointsLike, Shape, as_shape
 
-class Mixture(NamedTuple):
-    """The 1-D Gaussian mixture of the per-scale residuals (components sorted by mean)."""
-    weights: np.ndarray
-    means: np.ndarray
-    variances: np.ndarray
-
-
 _tls = threading.local()
 
 
@@ -30,6 +23,13 @@ def _workspace():
     if ws is None:
         ws = _tls.ws = new_object('amscr_workspace', lib.amscr_workspace_new, lib.amscr_workspace_free)
     return ws
+
+
+class Mixture(NamedTuple):
+    """The 1-D Gaussian mixture of the per-scale residuals (components sorted by mean)."""
+    weights: np.ndarray
+    means: np.ndarray
+    variances: np.ndarray
 
 
 class Registration:
@@ -87,6 +87,7 @@ class Registration:
 
 def _pair(src: PointsLike, tgt: PointsLike, params: Optional[Params], options: Dict[str, Any]
           ) -> Tuple[Params, Shape, Shape]:
+    """The options of one registration and the two prepared shapes (see :func:`register`)."""
     base = params
     if base is None:
         first = src if isinstance(src, Shape) else tgt if isinstance(tgt, Shape) else None
@@ -132,7 +133,8 @@ def register(src: PointsLike, tgt: PointsLike, *, method: Optional[str] = None, 
 
 
 def distance(src: PointsLike, tgt: PointsLike, *, params: Optional[Params] = None, **options: Any) -> float:
-    """The distance only (the fast batch path; equal to ``register(...).distance`` to rounding)."""
+    """The distance only (the fast batch path; equal to ``register(...).distance`` to rounding).
+    Options left as None take the registration preset, as in :func:`register`."""
     p, s, t = _pair(src, tgt, params, options)
     out = ffi.new('double *')
     _check(lib.amscr_distance(p._p, s._d, t._d, _workspace(), out))

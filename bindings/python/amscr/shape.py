@@ -10,6 +10,7 @@ from ._util import ArrayLike, as_count, as_points, copy_points, matrix_out, new_
 from .contour import contour_new
 from .params import Params, make_params
 
+
 class Shape:
     """A prepared shape (C ``amscr_descriptor``): resampled, parametrized, whitened and smoothed at
     every scale once, then matched any number of times. Immutable; shareable between threads.
