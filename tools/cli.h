@@ -35,6 +35,11 @@ enum {
      * with K = 5 neighbours and 20 iterations; --no-rerank for the plain pairwise distance */
     TOOL_RERANK_K = 5,
     TOOL_RERANK_ITERS = 20,
+    TOOL_TOP_MAX = 1000000000,    /* --top: a bound that keeps k * sizeof(size_t) small */
+    TOOL_RANKS_MAX = 1000000,     /* --ranks: likewise for the top-k table */
+    TOOL_RERANK_K_MAX = 100000,   /* --rerank K: neighbours; clamped to the collection at use */
+    TOOL_RERANK_ITERS_MAX = 1000, /* --rerank ITER: diffusion converges long before */
+    TOOL_POINTS_MIN = 16,         /* the library's range of samples: 16..AMSCR_MAX_SAMPLES */
     TOOL_REFINE_MAX = 50,         /* the library's range of refinement iterations */
     TOOL_KMAX_MAX = 16,           /* the library's range of the elbow's Kmax */
     TOOL_THREADS_MAX = 1024       /* the library's range of threads */

@@ -167,8 +167,10 @@ static int parse_rerank(const char *opt, const char *v, opts *o)
         it = strtoul(end + 1, &e2, 10);
         end = e2;
     }
-    if (!end || *end != '\0' || k < 1 || k > 100000 || it < 1 || it > 1000 || v[0] == '-')
-        return usage_error(opt, "expected K[,ITER] with K >= 1 and 1 <= ITER <= 1000, got '%s'", v);
+    if (!end || *end != '\0' || k < 1 || k > TOOL_RERANK_K_MAX || it < 1 || it > TOOL_RERANK_ITERS_MAX ||
+        v[0] == '-')
+        return usage_error(opt, "expected K[,ITER] with K >= 1 and 1 <= ITER <= %d, got '%s'",
+                           TOOL_RERANK_ITERS_MAX, v);
     o->rerank_k = (size_t)k;
     o->rerank_iters = (unsigned)it;
     return 0;
@@ -213,18 +215,18 @@ static int set_option(opts *o, const optdef *d, const char *v)
     case O_OVERLAY:
     case O_PLOT: return set_picture(o, d->id, v);
     case O_NAMES: o->names = v; return 0;
-    case O_TOP: return parse_size(n, v, 1, 1000000000, &o->top) != 0 ? TOOL_EXIT_USAGE : 0;
+    case O_TOP: return parse_size(n, v, 1, TOOL_TOP_MAX, &o->top) != 0 ? TOOL_EXIT_USAGE : 0;
     case O_PROTOCOL:
         o->protocol = v;
         return parse_name(n, v, &PROTOCOL_NAMES, NULL, &o->protocol_id);
-    case O_RANKS: return parse_size(n, v, 1, 1000000, &o->ranks) != 0 ? TOOL_EXIT_USAGE : 0;
+    case O_RANKS: return parse_size(n, v, 1, TOOL_RANKS_MAX, &o->ranks) != 0 ? TOOL_EXIT_USAGE : 0;
     case O_METHOD:
         r = parse_name(n, v, &METHOD_NAMES, &o->method_set, &e);
         o->method = (amscr_method)e;
         return r;
     case O_POINTS:
         o->points_set = 1;
-        return parse_size(n, v, 16, AMSCR_MAX_SAMPLES, &o->points) != 0 ? TOOL_EXIT_USAGE : 0;
+        return parse_size(n, v, TOOL_POINTS_MIN, AMSCR_MAX_SAMPLES, &o->points) != 0 ? TOOL_EXIT_USAGE : 0;
     case O_SCALES:
         o->scales_set = 1;
         return parse_scales(v, o->scales, &o->nscales) != 0 ? TOOL_EXIT_USAGE : 0;
