@@ -15,12 +15,22 @@ class Shape:
     """A prepared shape (C ``amscr_descriptor``): resampled, parametrized, whitened and smoothed at
     every scale once, then matched any number of times. Immutable; shareable between threads.
 
-    ``Shape(contour, params=None, **options)`` — `contour` is an (n, 2) point array; the options
-    are those of :class:`Params` (e.g. ``Shape(pts, points=256)``).
+    Args:
+        contour: the shape's points: an (n, 2) array of (x, y) rows (any real dtype), or an
+            OpenCV contour ((n, 1, 2), as ``cv2.findContours`` gives it).
+        params: a :class:`Params` to start from (None: the library defaults).
+        order: 'xy' (default) or 'rc' for (row, col) points such as scikit-image's
+            ``measure.find_contours`` gives; they are taken as x = column, y = row, so every
+            output (points, matrices) is in the (x, y) image frame.
+        **options: options of :class:`Params` (e.g. ``Shape(pts, points=256)``).
+    Raises:
+        InvalidArgumentError: bad points or options; DegenerateError: too few distinct points
+        or zero area.
     """
 
-    def __init__(self, contour: ArrayLike, /, params: Optional[Params] = None, **options: Any):
-        pts = as_points(contour, 'contour')
+    def __init__(self, contour: ArrayLike, /, params: Optional[Params] = None, *, order: str = 'xy',
+                 **options: Any):
+        pts = as_points(contour, 'contour', order)
         p = make_params(params, options)
         self._d = new_object('amscr_descriptor', lib.amscr_descriptor_new, lib.amscr_descriptor_free,
                              p._p, contour_new(pts))
@@ -99,8 +109,8 @@ def _shape_from_state(points: np.ndarray, params: Params) -> Shape:
     return Shape(points, params)
 
 
-def as_shape(x: PointsLike, params: Params, name: str) -> Shape:
-    """`x` itself when it is a Shape, else the points `x` prepared with `params`."""
+def as_shape(x: PointsLike, params: Params, name: str, order: str = 'xy') -> Shape:
+    """`x` itself when it is a Shape, else the points `x` (in `order`) prepared with `params`."""
     if isinstance(x, Shape):
         return x
-    return Shape(as_points(x, name), params)
+    return Shape(as_points(x, name, order), params)
