@@ -102,27 +102,55 @@ def contour_from_mask(mask: ArrayLike, threshold: Union[int, str, None] = None) 
 
 
 def read_points(path: Union[str, os.PathLike]) -> np.ndarray:
-    """Reads a text point list ("x y" or "x,y" per line, '#' comments) as an (n, 2) array.
+    """Reads a text point list ("x y" or "x,y" per line, '#' comments).
 
-    Raises FileError (cannot read) or FormatError (a bad line; the message names path:line).
+    Args:
+        path: the file (``amscr contour IMG -o FILE`` writes one from a PNG or PGM).
+    Returns:
+        (n, 2) float array of (x, y) rows.
+    Raises:
+        FileError: cannot read; FormatError: a bad line (the message names path:line).
     """
     return _take(_new_contour(lib.amscr_contour_read_text, os.fsencode(path)))
 
 
 def parse_points(text: Union[str, bytes]) -> np.ndarray:
-    """Parses a text point list from a string (the format of :func:`read_points`)."""
+    """Parses a text point list from a string.
+
+    Args:
+        text: str or bytes in the format of :func:`read_points`.
+    Returns:
+        (n, 2) float array of (x, y) rows.
+    Raises:
+        FormatError: a bad line (the message names the line).
+    """
     b = text.encode('utf-8') if isinstance(text, str) else bytes(text)
     return _take(_new_contour(lib.amscr_contour_parse_text, ffi.from_buffer('char[]', b), len(b)))
 
 
 def write_points(path: Union[str, os.PathLike], points: ArrayLike) -> None:
-    """Writes points as a text point list, atomically (temporary file + rename)."""
+    """Writes points as a text point list, atomically (temporary file + rename).
+
+    Args:
+        path: the file to write.
+        points: (n, 2) points (or an OpenCV contour).
+    Raises:
+        InvalidArgumentError: bad points; FileError: the file cannot be written.
+    """
     c = contour_new(_as_points(points))
     _check(lib.amscr_contour_write_text(c, os.fsencode(path)))
 
 
 def signed_area(points: ArrayLike) -> float:
-    """Signed area of the closed polygon (positive = counter-clockwise in a y-up frame)."""
+    """Signed area of the closed polygon.
+
+    Args:
+        points: (n, 2) points (or an OpenCV contour).
+    Returns:
+        the area, positive when counter-clockwise in a y-up frame (clockwise on screen, y down).
+    Raises:
+        InvalidArgumentError: bad points.
+    """
     c = contour_new(_as_points(points))
     out = ffi.new('double *')
     _check(lib.amscr_contour_signed_area(c, out))
@@ -130,14 +158,29 @@ def signed_area(points: ArrayLike) -> float:
 
 
 def orient_ccw(points: ArrayLike) -> np.ndarray:
-    """A copy of the points, reversed when their signed area is negative."""
+    """A copy of the points, reversed when their signed area is negative.
+
+    Args:
+        points: (n, 2) points (or an OpenCV contour).
+    Returns:
+        (n, 2) float array with a signed area >= 0.
+    Raises:
+        InvalidArgumentError: bad points.
+    """
     c = contour_new(_as_points(points))
     _check(lib.amscr_contour_orient_ccw(c))
     return contour_points(c)
 
 
 def validate_contour(points: ArrayLike, closed: bool = True) -> None:
-    """Raises DegenerateError when the contour cannot be registered (too few distinct points,
-    zero area when closed, all collinear when open)."""
+    """Checks that a contour can be registered.
+
+    Args:
+        points: (n, 2) points (or an OpenCV contour).
+        closed: True for a closed curve, False for an open one.
+    Raises:
+        DegenerateError: too few distinct points, zero area when closed, all collinear when
+        open; InvalidArgumentError: bad points.
+    """
     c = contour_new(_as_points(points))
     _check(lib.amscr_contour_validate(c, as_bool(closed, 'closed')))

@@ -63,7 +63,8 @@ class Registration:
 
     def __init__(self, handle, scales: np.ndarray):
         """Copies everything out of `handle`, a C ``amscr_result`` (made by :func:`register`,
-        which users call instead), and `scales`, the sigma_k of the registration."""
+        which users call instead), and `scales`, the sigma_k of the registration. Raises
+        nothing of its own: the handle comes from a successful registration."""
         r = handle
         self.distance = float(lib.amscr_result_distance(r))
         self.matrix = matrix_out(lib.amscr_result_affine, r)

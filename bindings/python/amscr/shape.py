@@ -60,6 +60,7 @@ class Shape:
         return int(lib.amscr_descriptor_num_scales(self._d))
 
     def __len__(self) -> int:
+        """N, samples per scale."""
         return self.num_samples
 
     @property
@@ -68,7 +69,15 @@ class Shape:
         return copy_points(lib.amscr_descriptor_base_points(self._d), self.num_samples)
 
     def scale_points(self, k: int) -> np.ndarray:
-        """(N, 2) normalized points smoothed at scale k (0 <= k < num_scales)."""
+        """The normalized points smoothed at one scale.
+
+        Args:
+            k: the scale index, 0 <= k < num_scales.
+        Returns:
+            (N, 2) float array.
+        Raises:
+            IndexError: `k` out of range; InvalidArgumentError: `k` not an integer >= 0.
+        """
         k = as_count(k, 'k', 0)
         if k >= self.num_scales:
             raise IndexError('scale %d out of range (the shape has %d scales)' % (k, self.num_scales))
@@ -91,6 +100,7 @@ class Shape:
 
     @property
     def closed(self) -> bool:
+        """True when the shape is a closed curve."""
         return bool(lib.amscr_params_get_closed(lib.amscr_descriptor_params(self._d)))
 
     def __repr__(self) -> str:
