@@ -61,6 +61,26 @@ def test_opencv_shaped_contours_are_accepted_everywhere():
     assert np.array_equal(amscr.distance_matrix([cs, ct], points=64), db.distance_matrix())
 
 
+BUILDING_BLOCKS = {
+    'orient_ccw': amscr.orient_ccw, 'validate_contour': amscr.validate_contour,
+    'resample_euclidean': lambda p: amscr.resample_euclidean(p, 40),
+    'resample_affine': lambda p: amscr.resample_affine(p, 40),
+    'affine_arclength': lambda p: amscr.affine_arclength(p)[0],
+    'normalize_whiten': lambda p: amscr.normalize_whiten(p)[0],
+    'affine_apply': lambda p: amscr.affine_apply(np.eye(3), p), 'affine_fit': lambda p: amscr.affine_fit(p, p)[0],
+}
+
+
+@pytest.mark.parametrize('name', sorted(BUILDING_BLOCKS))
+def test_building_blocks_take_opencv_contours(name, tmp_path):
+    c = _opencv_like(blob(120, seed=5))
+    fn = BUILDING_BLOCKS[name]
+    a, b = fn(c), fn(c[:, 0, :].astype(float))
+    assert (a is None and b is None) or np.array_equal(a, b)
+    amscr.write_points(tmp_path / 'c.txt', c)
+    assert np.array_equal(amscr.read_points(tmp_path / 'c.txt'), c[:, 0, :])
+
+
 def test_a_list_of_opencv_contours_is_refused_with_a_hint():
     c = _opencv_like(blob(50))
     with pytest.raises(amscr.InvalidArgumentError, match='OpenCV contours'):
