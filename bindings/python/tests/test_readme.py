@@ -8,6 +8,7 @@ import builtins
 import importlib.util
 import os
 import re
+import shutil
 
 import pytest
 
@@ -16,6 +17,8 @@ from conftest import BUILD_DIR, PKG_ROOT, REPO_ROOT
 README = os.path.join(PKG_ROOT, 'README.md')
 EXAMPLES = os.path.join(REPO_ROOT, 'examples')
 TOOL = os.environ.get('AMSCR_TOOL') or os.path.join(BUILD_DIR, 'tools', 'amscr')
+if not os.access(TOOL, os.X_OK):  # the command pip installed, when testing the installed package
+    TOOL = shutil.which('amscr') or TOOL
 BLOCK = re.compile(r'(?:<!-- requires: ([\w .]+) -->\n)?```python\n(.*?)```', re.S)
 
 pytestmark = pytest.mark.skipif(not (os.path.exists(README) and os.path.isdir(EXAMPLES)),
