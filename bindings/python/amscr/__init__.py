@@ -12,9 +12,12 @@ Quick start::
     D = db.distance_matrix(progress=True)      # GIL released, POSIX threads in C
     amscr.bullseye(D, db.labels)
 
-Points are NumPy arrays of shape (n, 2) (x, y rows); any array-like of real numbers is accepted
-and validated (finite, at least one point) before it reaches C. Affine maps are returned as 3x3
-matrices. C failures raise subclasses of :class:`AmscrError` (``amscr.Error``) that carry the
+Points are NumPy arrays of shape (n, 2) (x, y rows; for images x = column, y = row); any
+array-like of real numbers is accepted and validated (finite, at least one point) before it
+reaches C. OpenCV contours ((n, 1, 2) from ``cv2.findContours``) are taken as they are;
+(row, col) points from scikit-image's ``measure.find_contours`` with ``order='rc'``
+(:func:`register`, :class:`Shape`, :class:`Collection`, :func:`as_points`). Affine maps are
+returned as 3x3 matrices. C failures raise subclasses of :class:`AmscrError` (``amscr.Error``) that carry the
 library's message. Library handles are freed automatically. The GIL is released during every C
 call (cffi does that in both API and ABI mode), so Python threads run registrations in parallel.
 """
@@ -29,8 +32,8 @@ from .errors import (AmscrError, CancelledError, DegenerateError, Error, FileErr
 from ._util import ArrayLike, ProgressArg
 from .library import has_threads, library_version
 from .params import Params
-from .contour import (contour_from_mask, orient_ccw, parse_points, read_points, signed_area, validate_contour,
-                      write_points)
+from .contour import (as_points, contour_from_mask, orient_ccw, parse_points, read_points, signed_area,
+                      validate_contour, write_points)
 from .shape import PointsLike, Shape
 from .result import Mixture, Registration, distance, register
 from .collection import Collection, distance_matrix
@@ -55,7 +58,7 @@ __all__ = [
     'Params', 'Shape', 'Registration', 'Mixture', 'register', 'distance', 'Collection', 'distance_matrix',
     'bullseye', 'topk_table', 'nn_accuracy', 'nn_split', 'topk', 'rerank_diffusion',
     # contours
-    'contour_from_mask', 'read_points', 'parse_points', 'write_points', 'signed_area', 'orient_ccw',
+    'as_points', 'contour_from_mask', 'read_points', 'parse_points', 'write_points', 'signed_area', 'orient_ccw',
     'validate_contour',
     # building blocks
     'smooth', 'gaussian_kernel', 'resample_euclidean', 'resample_affine', 'affine_arclength',

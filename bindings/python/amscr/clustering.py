@@ -30,6 +30,15 @@ def kmeans(data: ArrayLike, k: int, seed: int = 0, *, max_iterations: Optional[i
 
     Args:
         data: (n,) or (n, dim) values, n >= k.
+        k: the number of clusters (>= 1).
+        seed: the seed of k-means++ (the result depends only on it and the data).
+        max_iterations: Lloyd iterations cap (None: the library default).
+        tolerance: convergence tolerance (None: the library default).
+        restarts: k-means++ restarts, the best kept (None: the library default).
+    Returns:
+        a :class:`KMeansResult` (centers, inertia, labels).
+    Raises:
+        InvalidArgumentError: n < k, non-finite values or bad options.
     """
     x, one_d = _data_2d(data)
     km = new_object('amscr_kmeans', lib.amscr_kmeans_new, lib.amscr_kmeans_free, as_count(k, 'k', 1))
@@ -51,8 +60,18 @@ def kmeans(data: ArrayLike, k: int, seed: int = 0, *, max_iterations: Optional[i
 
 
 def elbow(data: ArrayLike, k_max: Optional[int] = None, k_min: int = 1, seed: int = 0) -> Tuple[int, np.ndarray]:
-    """SSE(k) for k in [k_min, k_max] and the elbow k; returns (k_best, sse array).
-    k_max defaults to the registration's Kmax (clamped to n)."""
+    """The elbow of SSE(k), as the registration chooses K.
+
+    Args:
+        data: (n,) or (n, dim) values.
+        k_max: the largest k (None: the registration's Kmax, clamped to n).
+        k_min: the smallest k (>= 1).
+        seed: the seed of k-means++.
+    Returns:
+        (k_best, sse): the elbow k and the (k_max - k_min + 1,) array of SSE(k).
+    Raises:
+        InvalidArgumentError: k_max < k_min or k_max > n.
+    """
     x, _ = _data_2d(data)
     n, dim = x.shape
     if k_max is None:

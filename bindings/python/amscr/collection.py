@@ -29,6 +29,13 @@ class Collection:
     Labels are int32 values, or any other hashable values (e.g. strings), which are mapped to
     codes 0, 1, ... in order of first use (:attr:`labels` gives them back; saved files hold codes).
     Thread-safety: any number of threads may query at once; :meth:`add` waits for them.
+
+    Args:
+        params: a :class:`Params` to start from (None: the library defaults, tuned for
+            collections: N = 128, no refinement).
+        **options: options of :class:`Params`, e.g. ``reflections=True, threads=0``.
+    Raises:
+        InvalidArgumentError: a bad option.
     """
 
     def __init__(self, params: Optional[Params] = None, **options: Any):
@@ -83,28 +90,50 @@ class Collection:
             self._label_names.append(label)
         return code
 
-    def add(self, shape: PointsLike, label: Any = 0) -> int:
-        """Prepares (points) or copies (a :class:`Shape`) a shape into the collection; returns its index."""
+    def add(self, shape: PointsLike, label: Any = 0, *, order: str = 'xy') -> int:
+        """Prepares (points) or copies (a :class:`Shape`) a shape into the collection.
+
+        Args:
+            shape: (n, 2) points, an OpenCV (n, 1, 2) contour, or a prepared :class:`Shape`.
+            label: an int32 class label, or any hashable name (not both kinds in one collection).
+            order: 'xy' (default) or 'rc' for (row, col) points (scikit-image).
+        Returns:
+            the index of the new shape.
+        Raises:
+            InvalidArgumentError: bad points or label; DegenerateError: a degenerate shape.
+        """
         with self._lock.write():
             code = self._label_code(label)
             idx = ffi.new('size_t *')
             if isinstance(shape, Shape):
                 _check(lib.amscr_db_add_descriptor(self._db, shape._d, code, idx))
             else:
-                c = contour_new(as_points(shape, 'shape'))
+                c = contour_new(as_points(shape, 'shape', order))
                 _check(lib.amscr_db_add_contour(self._db, c, code, idx))
             return int(idx[0])
 
-    def extend(self, shapes: Iterable[PointsLike], labels: Optional[Iterable[Any]] = None) -> List[int]:
-        """Adds many shapes (labels default to 0); returns their indices."""
+    def extend(self, shapes: Iterable[PointsLike], labels: Optional[Iterable[Any]] = None, *,
+               order: str = 'xy') -> List[int]:
+        """Adds many shapes, as :meth:`add`.
+
+        Args:
+            shapes: point arrays or :class:`Shape` s.
+            labels: one label per shape (None: all 0).
+            order: 'xy' (default) or 'rc', the order of every shape's points.
+        Returns:
+            the indices of the new shapes.
+        Raises:
+            InvalidArgumentError: as many labels as shapes are needed; as :meth:`add`.
+        """
         shapes = list(shapes)
         labels = [0] * len(shapes) if labels is None else list(labels)
         if len(labels) != len(shapes):
             raise bad('extend: %d shapes but %d labels' % (len(shapes), len(labels)))
-        return [self.add(s, lab) for s, lab in zip(shapes, labels)]
+        return [self.add(s, lab, order=order) for s, lab in zip(shapes, labels)]
 
     # -- reading ----------------------------------------------------------------------
     def __len__(self) -> int:
+        """The number of shapes."""
         return int(lib.amscr_db_size(self._db))
 
     @property
@@ -131,9 +160,16 @@ class Collection:
         return Params._copy_of(lib.amscr_db_params(self._db))
 
     def shape(self, i: int) -> Shape:
-        """A copy of the prepared shape i (negative indices count from the end).
+        """A copy of the prepared shape i (a copy, because the C collection's own descriptors
+        are only valid until it is modified).
 
-        A copy, because the C collection's own descriptors are only valid until it is modified."""
+        Args:
+            i: the index; negative indices count from the end.
+        Returns:
+            a :class:`Shape`.
+        Raises:
+            IndexError: `i` out of range.
+        """
         with self._lock.read():
             n = len(self)
             i = int(i)
@@ -157,17 +193,25 @@ class Collection:
         tmp._add_copies(self, range(len(self)))
         return tmp, True
 
-    def query(self, shape: PointsLike, threads: Optional[int] = None, progress: ProgressArg = False) -> np.ndarray:
-        """Distances from `shape` (points or a :class:`Shape`) to every shape of the collection.
+    def query(self, shape: PointsLike, threads: Optional[int] = None, progress: ProgressArg = False, *,
+              order: str = 'xy') -> np.ndarray:
+        """Distances from `shape` to every shape of the collection.
 
         Args:
+            shape: the query: (n, 2) points, an OpenCV (n, 1, 2) contour or a :class:`Shape`.
             threads: threads for this call (None: the collection's).
             progress: True for a progress bar on stderr, or a callable(done, total) (returning
                 True cancels with CancelledError; an exception it raises cancels and propagates).
+            order: 'xy' (default) or 'rc' for (row, col) points (scikit-image).
+        Returns:
+            (len(self),) float array; rank it with :func:`topk` or ``numpy.argsort``.
+        Raises:
+            InvalidArgumentError: bad points; DegenerateError: a degenerate query;
+            CancelledError: cancelled by `progress`; KeyboardInterrupt: Ctrl-C.
         """
         with self._lock.read():
             p = self.params
-            q = as_shape(shape, p, 'shape')
+            q = as_shape(shape, p, 'shape', order)
             out = np.zeros(len(self), dtype=np.float64)
             if threads is None or int(threads) == p.threads:
                 progress_call(lib.amscr_db_query, (self._db, q._d), (dbuf(out),), progress)
@@ -178,7 +222,17 @@ class Collection:
             return out
 
     def distance_matrix(self, threads: Optional[int] = None, progress: ProgressArg = False) -> np.ndarray:
-        """(n, n) matrix, ``D[i, j]`` = distance(shape i -> shape j); zero diagonal."""
+        """All pairwise distances of the collection.
+
+        Args:
+            threads: threads for this call (None: the collection's).
+            progress: True for a progress bar on stderr, or a callable(done, total), as in
+                :meth:`query`.
+        Returns:
+            (n, n) float array, ``D[i, j]`` = distance(shape i -> shape j); zero diagonal.
+        Raises:
+            CancelledError: cancelled by `progress`; KeyboardInterrupt: Ctrl-C.
+        """
         with self._lock.read():
             src, _ = self._with_threads(threads)
             n = len(self)
@@ -188,8 +242,18 @@ class Collection:
 
     def cross_matrix(self, other: 'Collection', threads: Optional[int] = None,
                      progress: ProgressArg = False) -> np.ndarray:
-        """(len(self), len(other)) matrix of distances from this collection's shapes (queries)
-        to `other`'s (targets), with this collection's options."""
+        """Distances from this collection's shapes (queries) to `other`'s (targets), with this
+        collection's options.
+
+        Args:
+            other: the target :class:`Collection`.
+            threads: threads for this call (None: the collection's).
+            progress: as in :meth:`query`.
+        Returns:
+            (len(self), len(other)) float array.
+        Raises:
+            TypeError: `other` is not a Collection; CancelledError: cancelled by `progress`.
+        """
         if not isinstance(other, Collection):
             raise TypeError('other: expected an amscr.Collection, got %s' % type(other).__name__)
         with self._lock.read(), (other._lock.read() if other is not self else contextlib.nullcontext()):
@@ -201,18 +265,36 @@ class Collection:
     # -- persistence ------------------------------------------------------------------
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the prepared collection (binary, versioned, checksummed; atomic rename).
-        Named labels are stored as their codes."""
+
+        Args:
+            path: the file to write. Named labels are stored as their codes (give the names
+                back to :meth:`load`).
+        Raises:
+            FileError: the file cannot be written.
+        """
         with self._lock.read():
             _check(lib.amscr_db_save(self._db, os.fsencode(path)))
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike], label_names: Optional[Sequence[Any]] = None) -> 'Collection':
-        """Reads a collection written by :meth:`save` (or the tool). `label_names[code]` names
-        the codes again if given."""
+        """Reads a collection written by :meth:`save` (or the ``amscr`` tool).
+
+        Args:
+            path: the file.
+            label_names: if given, ``label_names[code]`` names the stored label codes again.
+        Returns:
+            a new :class:`Collection`.
+        Raises:
+            FileError: cannot read; FormatError: not a collection file, or a corrupt one.
+        """
         return cls._wrap(_new_db(lib.amscr_db_load, os.fsencode(path)), label_names)
 
     def to_bytes(self) -> bytes:
-        """The collection serialized as :meth:`save` writes it."""
+        """The collection serialized as :meth:`save` writes it.
+
+        Returns:
+            bytes (give them to :meth:`from_bytes`).
+        """
         with self._lock.read():
             buf = ffi.new('void **')
             n = ffi.new('size_t *')
@@ -225,7 +307,16 @@ class Collection:
     @classmethod
     def from_bytes(cls, data: Union[bytes, bytearray, memoryview],
                    label_names: Optional[Sequence[Any]] = None) -> 'Collection':
-        """The inverse of :meth:`to_bytes`."""
+        """The inverse of :meth:`to_bytes`.
+
+        Args:
+            data: bytes written by :meth:`to_bytes` (or a saved file's content).
+            label_names: as in :meth:`load`.
+        Returns:
+            a new :class:`Collection`.
+        Raises:
+            FormatError: not a serialized collection, or a corrupt one.
+        """
         b = bytes(data)
         return cls._wrap(_new_db(lib.amscr_db_load_memory, ffi.from_buffer(b), len(b)), label_names)
 
@@ -238,8 +329,23 @@ def _collection_from_state(data: bytes, label_names: Optional[List[Any]]) -> Col
 
 
 def distance_matrix(shapes: Sequence[PointsLike], *, threads: Optional[int] = None, progress: ProgressArg = False,
-                    params: Optional[Params] = None, **options: Any) -> np.ndarray:
-    """(n, n) distance matrix of a list of shapes (points or Shapes); see :class:`Collection`."""
+                    params: Optional[Params] = None, order: str = 'xy', **options: Any) -> np.ndarray:
+    """All pairwise distances of a list of shapes (through a temporary :class:`Collection`).
+
+    Args:
+        shapes: point arrays (or OpenCV contours) or :class:`Shape` s.
+        threads: threads (None: the library default, 0 = all cores).
+        progress: True for a progress bar on stderr, or a callable(done, total), as in
+            :meth:`Collection.query`.
+        params: a :class:`Params` to start from (None: the library defaults).
+        order: 'xy' (default) or 'rc' for (row, col) points.
+        **options: options of :class:`Params`.
+    Returns:
+        (n, n) float array, ``D[i, j]`` = distance(shape i -> shape j).
+    Raises:
+        InvalidArgumentError: bad points or options; DegenerateError: a degenerate shape;
+        CancelledError: cancelled by `progress`.
+    """
     db = Collection(params, threads=threads, **options)
-    db.extend(shapes)
+    db.extend(shapes, order=order)
     return db.distance_matrix(progress=progress)

@@ -16,6 +16,14 @@ class GMM1D:
     ``GMM1D(k, max_iterations=None, tolerance=None, variance_floor=None).fit(x)``; the fitted
     parameters are attributes (components sorted by mean). A fitted model may be used by many
     threads; fitting is serialized by a lock.
+
+    Args:
+        k: the number of components (>= 1).
+        max_iterations: EM iterations cap (None: the library default).
+        tolerance: convergence tolerance on the log-likelihood (None: the library default).
+        variance_floor: the smallest variance allowed (None: the library default).
+    Raises:
+        InvalidArgumentError: a bad option.
     """
 
     def __init__(self, k: int, *, max_iterations: Optional[int] = None, tolerance: Optional[float] = None,
@@ -32,10 +40,20 @@ class GMM1D:
 
     @property
     def k(self) -> int:
+        """The number of components."""
         return int(lib.amscr_gmm1d_num_components(self._g))
 
     def fit(self, x: ArrayLike) -> 'GMM1D':
-        """Fits by EM to the values x (n >= k); returns self."""
+        """Fits the mixture by EM.
+
+        Args:
+            x: (n,) values, n >= k.
+        Returns:
+            self.
+        Raises:
+            InvalidArgumentError: n < k or non-finite values (reaching the iteration cap is
+            not an error: see :attr:`converged`).
+        """
         a = as_float_array(x, 'x', ndim=(1,))
         with self._lock.write():
             _check(lib.amscr_gmm1d_fit(self._g, dbuf(a), a.shape[0]))
@@ -50,37 +68,59 @@ class GMM1D:
 
     @property
     def weights(self) -> np.ndarray:
+        """(k,) mixing weights (StateError before :meth:`fit`)."""
         return self._arr(lib.amscr_gmm1d_weights)
 
     @property
     def means(self) -> np.ndarray:
+        """(k,) means, ascending (StateError before :meth:`fit`)."""
         return self._arr(lib.amscr_gmm1d_means)
 
     @property
     def variances(self) -> np.ndarray:
+        """(k,) variances (StateError before :meth:`fit`)."""
         return self._arr(lib.amscr_gmm1d_variances)
 
     @property
     def loglik(self) -> float:
+        """The log-likelihood of the fitted data."""
         return float(lib.amscr_gmm1d_loglik(self._g))
 
     @property
     def iterations(self) -> int:
+        """EM iterations of the last fit."""
         return int(lib.amscr_gmm1d_iterations(self._g))
 
     @property
     def converged(self) -> bool:
+        """True when the last fit converged."""
         return bool(lib.amscr_gmm1d_converged(self._g))
 
     def posterior(self, x: float) -> np.ndarray:
-        """Responsibilities of the components at x."""
+        """Responsibilities of the components at a value.
+
+        Args:
+            x: the value.
+        Returns:
+            (k,) float array summing to 1.
+        Raises:
+            StateError: not fitted.
+        """
         out = np.zeros(self.k, dtype=np.float64)
         with self._lock.read():
             _check(lib.amscr_gmm1d_posterior(self._g, as_scalar(x, 'x'), dbuf(out)))
         return out
 
     def bayes_threshold(self, i: int = 0, j: int = 1) -> float:
-        """Bayes threshold between components i and j (see :func:`bayes_threshold`)."""
+        """Bayes threshold between two fitted components (see :func:`bayes_threshold`).
+
+        Args:
+            i, j: component indices (by ascending mean).
+        Returns:
+            the threshold (the midpoint of the means when no crossing lies between them).
+        Raises:
+            StateError: not fitted; InvalidArgumentError: an index out of range.
+        """
         out = ffi.new('double *', float('nan'))
         with self._lock.read():
             st = lib.amscr_gmm1d_bayes_threshold(self._g, as_count(i, 'i'), as_count(j, 'j'), out)
@@ -97,7 +137,17 @@ class GMM1D:
 
 
 def gmm1d(x: ArrayLike, k: int, **options: Any) -> GMM1D:
-    """Fits a k-component 1-D Gaussian mixture to x; see :class:`GMM1D`."""
+    """Fits a 1-D Gaussian mixture.
+
+    Args:
+        x: (n,) values, n >= k.
+        k: the number of components.
+        **options: ``max_iterations``, ``tolerance``, ``variance_floor`` (see :class:`GMM1D`).
+    Returns:
+        the fitted :class:`GMM1D`.
+    Raises:
+        InvalidArgumentError: bad values or options.
+    """
     return GMM1D(k, **options).fit(x)
 
 
@@ -105,8 +155,14 @@ def bayes_threshold(w1: float, mu1: float, var1: float, w2: float, mu2: float, v
                     strict: bool = False) -> float:
     """The point s between mu1 and mu2 where w1 N(s; mu1, var1) = w2 N(s; mu2, var2).
 
-    When no crossing lies strictly between the means, returns their midpoint (DESIGN.md §3.4d),
-    or raises NotFoundError if `strict`.
+    Args:
+        w1, mu1, var1: weight, mean and variance of the first Gaussian.
+        w2, mu2, var2: those of the second.
+        strict: raise instead of returning the midpoint when there is no crossing.
+    Returns:
+        the threshold s; when no crossing lies strictly between the means, their midpoint.
+    Raises:
+        NotFoundError: no crossing and `strict`; InvalidArgumentError: bad values.
     """
     args = [as_scalar(v, n) for v, n in ((w1, 'w1'), (mu1, 'mu1'), (var1, 'var1'), (w2, 'w2'), (mu2, 'mu2'),
                                           (var2, 'var2'))]

@@ -7,10 +7,18 @@ __all__ = ['API_MODE', 'LIBRARY_PATH', 'SOVERSION', 'library_version', 'has_thre
 
 
 def library_version() -> str:
-    """Version string of the loaded C library ("M.m.p")."""
+    """The version of the loaded C library.
+
+    Returns:
+        the version string "M.m.p" (the package's is ``amscr.__version__``).
+    """
     return ffi.string(lib.amscr_version_string()).decode()
 
 
 def has_threads() -> bool:
-    """True when the loaded library runs batch calls on POSIX threads."""
+    """Whether the loaded library was built with threads.
+
+    Returns:
+        True when batch calls (:class:`Collection`) run on POSIX threads.
+    """
     return bool(lib.amscr_has_feature(lib.AMSCR_FEATURE_THREADS))

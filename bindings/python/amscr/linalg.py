@@ -11,10 +11,17 @@ from .errors import _check
 
 
 def lstsq(a: ArrayLike, b: ArrayLike, return_residuals: bool = False):
-    """Least squares min ||a x - b|| by Householder QR (a: (m, n), m >= n; b: (m,) or (m, k)).
+    """Least squares min ||a x - b|| by Householder QR.
 
-    Returns x ((n,) or (n, k)), and the residual 2-norms when `return_residuals`.
-    Raises NumericError when `a` is rank-deficient or ill-conditioned.
+    Args:
+        a: (m, n) matrix, m >= n.
+        b: (m,) or (m, k) right-hand side(s).
+        return_residuals: also return the residual 2-norms.
+    Returns:
+        x ((n,) or (n, k)), or (x, residual norms) when `return_residuals`.
+    Raises:
+        InvalidArgumentError: shapes that do not match; NumericError: `a` rank-deficient or
+        ill-conditioned.
     """
     A = as_float_array(a, 'a', ndim=(2,))
     B = as_float_array(b, 'b', ndim=(1, 2))
@@ -33,7 +40,16 @@ def lstsq(a: ArrayLike, b: ArrayLike, return_residuals: bool = False):
 
 
 def affine_fit(src: ArrayLike, dst: ArrayLike) -> Tuple[np.ndarray, float]:
-    """Least-squares affine map taking src[i] to dst[i]: (3x3 matrix, RMS residual distance)."""
+    """Least-squares affine map taking src[i] to dst[i].
+
+    Args:
+        src: (n, 2) points, n >= 3.
+        dst: (n, 2) points, the images of `src`.
+    Returns:
+        (3x3 matrix, RMS residual distance).
+    Raises:
+        InvalidArgumentError: different point counts; NumericError: collinear `src`.
+    """
     s, d = as_points(src, 'src'), as_points(dst, 'dst')
     if s.shape != d.shape:
         raise bad('src and dst: expected the same number of points, got %d and %d' % (s.shape[0], d.shape[0]))
@@ -44,7 +60,16 @@ def affine_fit(src: ArrayLike, dst: ArrayLike) -> Tuple[np.ndarray, float]:
 
 
 def affine_apply(matrix: ArrayLike, points: ArrayLike) -> np.ndarray:
-    """Applies a 3x3 (or 2x3) affine matrix to (n, 2) points."""
+    """Applies an affine map to points.
+
+    Args:
+        matrix: 3x3 (last row 0, 0, 1), 2x3 or flat 6 affine matrix.
+        points: (n, 2) points (or an OpenCV contour).
+    Returns:
+        (n, 2) float array.
+    Raises:
+        InvalidArgumentError: a bad matrix or points.
+    """
     m = to_m6(matrix)
     pts = as_points(points)
     out = np.empty_like(pts)
@@ -53,6 +78,14 @@ def affine_apply(matrix: ArrayLike, points: ArrayLike) -> np.ndarray:
 
 
 def affine_invert(matrix: ArrayLike) -> np.ndarray:
-    """Inverse of a 3x3 (or 2x3) affine matrix; DegenerateError when singular."""
+    """Inverse of an affine map.
+
+    Args:
+        matrix: 3x3 (last row 0, 0, 1), 2x3 or flat 6 affine matrix.
+    Returns:
+        3x3 matrix.
+    Raises:
+        InvalidArgumentError: a bad matrix; DegenerateError: singular.
+    """
     m = to_m6(matrix)
     return matrix_out(lib.amscr_affine_invert, dbuf(m))

@@ -80,8 +80,9 @@ def _new_params(make: Callable[..., int], *args: Any):
 class Params:
     """Options of shape preparation and matching (a copy of the C ``amscr_params``).
 
-    Every option is a keyword of the constructor and an attribute; ``None`` leaves the library's
-    default. Options:
+    ``Params(**options)``: every option is a keyword of the constructor and an attribute;
+    ``None`` leaves the library's default. An unknown option raises TypeError, a bad value
+    InvalidArgumentError (also a ValueError). Options:
 
     """
 
@@ -116,7 +117,15 @@ class Params:
     def registration(cls, **options: Any) -> 'Params':
         """The registration preset (C ``amscr_params_new_registration``): the defaults with
         N = 256 and 20 refinement iterations, for registering single pairs robustly; the
-        plain defaults (N = 128, no refinement) are tuned for collections."""
+        plain defaults (N = 128, no refinement) are tuned for collections.
+
+        Args:
+            **options: options to change from the preset.
+        Returns:
+            a new :class:`Params`.
+        Raises:
+            TypeError: an unknown option; InvalidArgumentError: a bad value.
+        """
         self = cls.__new__(cls)
         self._p = _new_params(lib.amscr_params_new_registration)
         self.update(**options)
@@ -132,13 +141,30 @@ class Params:
         return self
 
     def copy(self, **options: Any) -> 'Params':
-        """A copy, with `options` changed."""
+        """A copy, with `options` changed.
+
+        Args:
+            **options: options to change in the copy.
+        Returns:
+            a new :class:`Params`.
+        Raises:
+            TypeError: an unknown option; InvalidArgumentError: a bad value.
+        """
         p = Params._copy_of(self._p)
         p.update(**options)
         return p
 
     def update(self, **options: Any) -> 'Params':
-        """Sets the given options (None values are skipped); returns self."""
+        """Sets the given options in place.
+
+        Args:
+            **options: options to set (None values are skipped; the C names ``num_samples``
+                and ``num_threads`` are accepted too).
+        Returns:
+            self.
+        Raises:
+            TypeError: an unknown option; InvalidArgumentError: a bad value.
+        """
         for k, v in options.items():
             k = self.ALIASES.get(k, k)
             if k not in self.OPTIONS:
@@ -148,7 +174,11 @@ class Params:
         return self
 
     def to_dict(self) -> Dict[str, Any]:
-        """Every option and its value."""
+        """Every option and its value.
+
+        Returns:
+            a dict {option: value} (``Params(**d)`` makes an equal Params).
+        """
         return {k: getattr(self, k) for k in self.OPTIONS}
 
     def __eq__(self, other: object) -> bool:

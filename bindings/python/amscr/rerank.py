@@ -13,7 +13,17 @@ def rerank_diffusion(D: ArrayLike, k: int = 5, iterations: int = 20) -> np.ndarr
     k-nearest-neighbour tensor-product graph (Yang, Prasad, Latecki, CVPR 2012), as
     ``amscr_rerank_diffusion``. Returns a new (n, n) dissimilarity for ranking: values in [0, 1)
     for pairs the diffusion reaches, 1 + D/max(D) for the others. The defaults (k = 5,
-    20 iterations) are the ones the README's Kimia measurements chose."""
+    20 iterations) are the ones the README's Kimia measurements chose.
+
+    Args:
+        D: (n, n) distance matrix, finite.
+        k: neighbours of the graph (clamped to n).
+        iterations: diffusion iterations.
+    Returns:
+        (n, n) float array (smaller = more similar).
+    Raises:
+        InvalidArgumentError: D not square or not finite, bad k or iterations.
+    """
     d = np.array(as_float_array(D, 'D', ndim=(2,), finite=True), dtype=np.float64, order='C', copy=True)
     n = d.shape[0]
     if d.shape != (n, n):

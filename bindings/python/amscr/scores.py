@@ -19,7 +19,17 @@ def _square(D: ArrayLike, name: str = 'D') -> np.ndarray:
 
 
 def topk(dist: ArrayLike, k: int, exclude: Optional[int] = None) -> np.ndarray:
-    """Indices of the k smallest distances, ascending (ties by lower index), skipping `exclude`."""
+    """Indices of the k smallest distances, ascending (ties by lower index).
+
+    Args:
+        dist: (n,) distances, e.g. a row of :meth:`Collection.query`.
+        k: how many (at most n, or n - 1 with `exclude`).
+        exclude: an index to skip (the query itself), or None.
+    Returns:
+        (k,) int array of indices into `dist`.
+    Raises:
+        InvalidArgumentError: `dist` not 1-D, `k` too large, `exclude` out of range.
+    """
     d = as_float_array(dist, 'dist', ndim=(1,), finite=False)
     k = as_count(k, 'k', 0)
     ex = ffi.cast('size_t', -1) if exclude is None else as_count(exclude, 'exclude', 0)
@@ -30,7 +40,17 @@ def topk(dist: ArrayLike, k: int, exclude: Optional[int] = None) -> np.ndarray:
 
 def bullseye(D: ArrayLike, labels: ArrayLike, window: int = 0) -> float:
     """Bull's eye score (MPEG-7): same-class shapes among each query's `window` nearest (itself
-    included; 0 = twice its class size), over the sum of class sizes. In [0, 1]."""
+    included), over the sum of class sizes.
+
+    Args:
+        D: (n, n) distance matrix (rows = queries).
+        labels: n class labels (ints or names).
+        window: how many nearest to look at (0 = twice the query's class size, the MPEG-7 rule).
+    Returns:
+        the score, in [0, 1].
+    Raises:
+        InvalidArgumentError: D not square, or not one label per row.
+    """
     d = _square(D)
     lab = factorize(labels, d.shape[0])
     out = ffi.new('double *')
@@ -40,8 +60,18 @@ def bullseye(D: ArrayLike, labels: ArrayLike, window: int = 0) -> float:
 
 
 def topk_table(D: ArrayLike, labels: ArrayLike, ranks: int = 10) -> np.ndarray:
-    """Top-k table (Kimia): ``out[r]`` = queries whose (r+1)-th nearest neighbour (query excluded)
-    has their label, r = 0..ranks-1."""
+    """Top-k table (Kimia): how many queries have a same-class shape at each rank.
+
+    Args:
+        D: (n, n) distance matrix (rows = queries).
+        labels: n class labels (ints or names).
+        ranks: the number of ranks (columns of the Kimia tables: 10 for Kimia-99).
+    Returns:
+        (ranks,) int array: ``out[r]`` = queries whose (r+1)-th nearest neighbour (the query
+        excluded) has their label.
+    Raises:
+        InvalidArgumentError: D not square, not one label per row, ranks >= n.
+    """
     d = _square(D)
     lab = factorize(labels, d.shape[0])
     ranks = as_count(ranks, 'ranks', 1)
@@ -52,7 +82,16 @@ def topk_table(D: ArrayLike, labels: ArrayLike, ranks: int = 10) -> np.ndarray:
 
 
 def nn_accuracy(D: ArrayLike, labels: ArrayLike) -> float:
-    """Leave-one-out nearest-neighbour accuracy, in [0, 1]."""
+    """Leave-one-out nearest-neighbour accuracy.
+
+    Args:
+        D: (n, n) distance matrix (rows = queries).
+        labels: n class labels (ints or names).
+    Returns:
+        the fraction of queries whose nearest other shape has their label, in [0, 1].
+    Raises:
+        InvalidArgumentError: D not square, or not one label per row.
+    """
     d = _square(D)
     lab = factorize(labels, d.shape[0])
     out = ffi.new('double *')
@@ -61,7 +100,18 @@ def nn_accuracy(D: ArrayLike, labels: ArrayLike) -> float:
 
 
 def nn_split(D: ArrayLike, test_labels: ArrayLike, train_labels: ArrayLike) -> float:
-    """Train/test nearest-neighbour accuracy; D is (ntest, ntrain)."""
+    """Train/test nearest-neighbour accuracy.
+
+    Args:
+        D: (ntest, ntrain) distances from the test shapes to the training shapes (e.g.
+            :meth:`Collection.cross_matrix`).
+        test_labels: ntest labels (ints or names).
+        train_labels: ntrain labels, of the same kind.
+    Returns:
+        the fraction of test shapes whose nearest training shape has their label, in [0, 1].
+    Raises:
+        InvalidArgumentError: label counts that do not match D.
+    """
     d = as_float_array(D, 'D', ndim=(2,), finite=False)
     nt, nr = d.shape
     te, tr = np.asarray(test_labels), np.asarray(train_labels)

@@ -15,12 +15,22 @@ class Shape:
     """A prepared shape (C ``amscr_descriptor``): resampled, parametrized, whitened and smoothed at
     every scale once, then matched any number of times. Immutable; shareable between threads.
 
-    ``Shape(contour, params=None, **options)`` — `contour` is an (n, 2) point array; the options
-    are those of :class:`Params` (e.g. ``Shape(pts, points=256)``).
+    Args:
+        contour: the shape's points: an (n, 2) array of (x, y) rows (any real dtype), or an
+            OpenCV contour ((n, 1, 2), as ``cv2.findContours`` gives it).
+        params: a :class:`Params` to start from (None: the library defaults).
+        order: 'xy' (default) or 'rc' for (row, col) points such as scikit-image's
+            ``measure.find_contours`` gives; they are taken as x = column, y = row, so every
+            output (points, matrices) is in the (x, y) image frame.
+        **options: options of :class:`Params` (e.g. ``Shape(pts, points=256)``).
+    Raises:
+        InvalidArgumentError: bad points or options; DegenerateError: too few distinct points
+        or zero area.
     """
 
-    def __init__(self, contour: ArrayLike, /, params: Optional[Params] = None, **options: Any):
-        pts = as_points(contour, 'contour')
+    def __init__(self, contour: ArrayLike, /, params: Optional[Params] = None, *, order: str = 'xy',
+                 **options: Any):
+        pts = as_points(contour, 'contour', order)
         p = make_params(params, options)
         self._d = new_object('amscr_descriptor', lib.amscr_descriptor_new, lib.amscr_descriptor_free,
                              p._p, contour_new(pts))
@@ -50,6 +60,7 @@ class Shape:
         return int(lib.amscr_descriptor_num_scales(self._d))
 
     def __len__(self) -> int:
+        """N, samples per scale."""
         return self.num_samples
 
     @property
@@ -58,7 +69,15 @@ class Shape:
         return copy_points(lib.amscr_descriptor_base_points(self._d), self.num_samples)
 
     def scale_points(self, k: int) -> np.ndarray:
-        """(N, 2) normalized points smoothed at scale k (0 <= k < num_scales)."""
+        """The normalized points smoothed at one scale.
+
+        Args:
+            k: the scale index, 0 <= k < num_scales.
+        Returns:
+            (N, 2) float array.
+        Raises:
+            IndexError: `k` out of range; InvalidArgumentError: `k` not an integer >= 0.
+        """
         k = as_count(k, 'k', 0)
         if k >= self.num_scales:
             raise IndexError('scale %d out of range (the shape has %d scales)' % (k, self.num_scales))
@@ -81,6 +100,7 @@ class Shape:
 
     @property
     def closed(self) -> bool:
+        """True when the shape is a closed curve."""
         return bool(lib.amscr_params_get_closed(lib.amscr_descriptor_params(self._d)))
 
     def __repr__(self) -> str:
@@ -99,8 +119,8 @@ def _shape_from_state(points: np.ndarray, params: Params) -> Shape:
     return Shape(points, params)
 
 
-def as_shape(x: PointsLike, params: Params, name: str) -> Shape:
-    """`x` itself when it is a Shape, else the points `x` prepared with `params`."""
+def as_shape(x: PointsLike, params: Params, name: str, order: str = 'xy') -> Shape:
+    """`x` itself when it is a Shape, else the points `x` (in `order`) prepared with `params`."""
     if isinstance(x, Shape):
         return x
-    return Shape(as_points(x, name), params)
+    return Shape(as_points(x, name, order), params)
