@@ -34,9 +34,12 @@ extern "C" {
  * Errors.      Every fallible function returns `amscr_status`. On failure
  *              amscr_last_error_detail() says what went wrong, for the
  *              calling thread. The library never prints and never aborts.
- * Ownership.   Only functions whose names contain _new, _copy, _read, _parse
- *              or _load hand the caller something to free, with that object's
- *              own amscr_<obj>_free() (each accepts NULL). Every other pointer
+ * Ownership.   Functions whose names contain _new, _copy, _read, _parse or
+ *              _load, and amscr_register, amscr_register_contours,
+ *              amscr_contour_from_mask and amscr_db_save_memory, hand the
+ *              caller something to free: an object with its own
+ *              amscr_<obj>_free() (each accepts NULL), or for
+ *              amscr_db_save_memory a buffer for amscr_free(). Every other pointer
  *              returned is borrowed: valid until its owner is freed or
  *              modified.
  *
@@ -642,7 +645,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_affine_normalized(const amsc
 AMSCR_API size_t amscr_result_shift(const amscr_result *r);
 /** @brief Non-zero when the match used the reversed target (a mirror match). @since 0.1 */
 AMSCR_API int amscr_result_reflected(const amscr_result *r);
-/** @brief The method used. @since 0.1 */
+/** @brief The method used; (amscr_method)-1, which is no method, for a NULL result. @since 0.1 */
 AMSCR_API amscr_method amscr_result_method(const amscr_result *r);
 /** @brief Number of scales p. @since 0.1 */
 AMSCR_API size_t amscr_result_num_scales(const amscr_result *r);

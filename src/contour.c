@@ -1,4 +1,5 @@
 /* contour.c — the contour object, validation and orientation. */
+#include "dense.h"
 #include "internal.h"
 
 #include <math.h>
@@ -135,23 +136,10 @@ amscr_status amscr__validate_points(const double *xy, size_t n, int closed, cons
     if (!(ext > 0.0))
         return amscr__fail(AMSCR_E_DEGENERATE, "%s: all points coincide", what);
     /* second moments: collinear points have a singular covariance */
-    double cx = 0, cy = 0;
-    for (size_t i = 0; i < n; i++) {
-        cx += xy[2 * i];
-        cy += xy[2 * i + 1];
-    }
-    cx /= (double)n;
-    cy /= (double)n;
-    double sxx = 0, sxy = 0, syy = 0;
-    for (size_t i = 0; i < n; i++) {
-        double dx = (xy[2 * i] - cx) / ext, dy = (xy[2 * i + 1] - cy) / ext;
-        sxx += dx * dx;
-        sxy += dx * dy;
-        syy += dy * dy;
-    }
-    sxx /= (double)n;
-    sxy /= (double)n;
-    syy /= (double)n;
+    double cx, cy, cov[3];
+    amscr__centroid(xy, n, &cx, &cy);
+    amscr__scatter(xy, n, cx, cy, ext, cov);
+    double sxx = cov[0] / (double)n, sxy = cov[1] / (double)n, syy = cov[2] / (double)n;
     double det = sxx * syy - sxy * sxy, tr = sxx + syy;
     if (!(det > 1e-10 * tr * tr))
         return amscr__fail(AMSCR_E_DEGENERATE, "%s: points are (nearly) collinear", what);

@@ -1,5 +1,6 @@
 /* descriptor.c — a prepared shape (DESIGN.md §2): validated, oriented, resampled, parametrized,
  * sampled at N points, normalized, smoothed at every scale. Immutable once built. */
+#include "dense.h"
 #include "fft.h"
 #include "internal.h"
 
@@ -60,58 +61,15 @@ int amscr__params_compatible(const amscr_params *a, const amscr_params *b, const
     return 1;
 }
 
-/* Inverse of the symmetric 3x3 normal matrix [[sxx sxy sx] [sxy syy sy] [sx sy n]].
- * Returns 0 when it is (numerically) singular. */
-static int inv3_sym(const double m[6], double out[9])
-{
-    double a = m[0], b = m[1], c = m[3], e = m[2], f = m[4], i = m[5];
-    /* [[a b c] [b e f] [c f i]] */
-    double A = e * i - f * f, B = -(b * i - c * f), C = b * f - c * e;
-    double det = a * A + b * B + c * C;
-    double scale = fabs(a) + fabs(e) + fabs(i);
-    if (!(fabs(det) > 1e-13 * scale * scale * scale))
-        return 0;
-    double D = -(b * i - f * c), E = a * i - c * c, F = -(a * f - b * c);
-    double G = b * f - e * c, H = -(a * f - c * b), I = a * e - b * b;
-    (void)D;
-    out[0] = A / det;
-    out[1] = B / det;
-    out[2] = C / det;
-    out[3] = B / det;
-    out[4] = E / det;
-    out[5] = F / det;
-    out[6] = G / det;
-    out[7] = H / det;
-    out[8] = I / det;
-    return 1;
-}
-
-static void moments(const double *xy, size_t n, double m[6])
-{
-    double sxx = 0, sxy = 0, syy = 0, sx = 0, sy = 0;
-    for (size_t a = 0; a < n; a++) {
-        double x = xy[2 * a], y = xy[2 * a + 1];
-        sxx += x * x;
-        sxy += x * y;
-        syy += y * y;
-        sx += x;
-        sy += y;
-    }
-    m[0] = sxx;
-    m[1] = sxy;
-    m[2] = syy;
-    m[3] = sx;
-    m[4] = sy;
-    m[5] = (double)n;
-}
-
 amscr_status amscr__descriptor_finish(amscr_descriptor *d)
 {
     size_t n = d->n, p = d->p;
     for (size_t k = 0; k <= p; k++) {
         const double *xy = k == 0 ? d->base : d->scaled + 2 * n * (k - 1);
-        moments(xy, n, d->mom + 6 * k);
-        if (!inv3_sym(d->mom + 6 * k, d->minv + 9 * k)) {
+        double M9[9];
+        amscr__moments(xy, n, d->mom + 6 * k);
+        amscr__moment_matrix(d->mom + 6 * k, M9);
+        if (!amscr__inv3(M9, d->minv + 9 * k)) {
             if (k == 0)
                 return amscr__fail(AMSCR_E_DEGENERATE, "descriptor: the sampled curve is degenerate");
             return amscr__fail(AMSCR_E_DEGENERATE,
@@ -191,13 +149,8 @@ amscr_status amscr__descriptor_finish(amscr_descriptor *d)
 /* Similarity normalization: centroid to the origin, RMS radius to 1 (no whitening). */
 static amscr_status normalize_similarity(const double *xy, size_t n, double *out, double fwd[6], double inv[6])
 {
-    double cx = 0, cy = 0, s = 0;
-    for (size_t i = 0; i < n; i++) {
-        cx += xy[2 * i];
-        cy += xy[2 * i + 1];
-    }
-    cx /= (double)n;
-    cy /= (double)n;
+    double cx, cy, s = 0;
+    amscr__centroid(xy, n, &cx, &cy);
     for (size_t i = 0; i < n; i++) {
         double dx = xy[2 * i] - cx, dy = xy[2 * i + 1] - cy;
         s += dx * dx + dy * dy;

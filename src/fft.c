@@ -2,13 +2,10 @@
  * two, a direct DFT otherwise. A plan (twiddles, bit reversal) is made once per size and
  * kept in the per-thread workspace or the descriptor: no global state. */
 #include "fft.h"
+#include "dense.h"
 
 #include <math.h>
 #include <stdlib.h>
-
-#ifndef M_PI
-#define M_PI 3.14159265358979323846
-#endif
 
 int amscr__fft_plan_init(amscr__fft_plan *p, size_t n)
 {
@@ -22,7 +19,7 @@ int amscr__fft_plan_init(amscr__fft_plan *p, size_t n)
         return -1;
     }
     for (size_t k = 0; k < n; k++) {
-        double a = -2.0 * M_PI * (double)k / (double)n;
+        double a = -2.0 * AMSCR__PI * (double)k / (double)n;
         p->tw[2 * k] = cos(a);
         p->tw[2 * k + 1] = sin(a);
     }

@@ -10,6 +10,7 @@
  *      (floored at 1e-12, renormalized).
  *   Stop when |loglik - previous| <= tol * (1 + |loglik|) (converged) or at the cap.
  * Variance floor: max(floor_rel * var(data), 1e-300 * max(1, |mean|)^2). */
+#include "dense.h"
 #include "internal.h"
 
 #include <float.h>
@@ -17,8 +18,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define GMM_SMALL_KMAX 16
-#define GMM_SMALL_SORT_N 64
 #define GMM_WEIGHT_FLOOR 1e-12
 #define GMM_LOG_2PI 1.8378770664093454835606594728112
 
@@ -27,12 +26,6 @@
 size_t amscr__gmm1d_small_scratch(size_t n, size_t k)
 {
     return n + amscr__kmeans1d_scratch(n, k) + 7 * k;
-}
-
-static int gmm_cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
 }
 
 /* One E pass at the current parameters: returns the log-likelihood (NaN/-inf when a point
@@ -93,9 +86,10 @@ static void gmm_sort_components(size_t k, double *w, double *mu, double *var)
     }
 }
 
-/* The fit shared by amscr_gmm1d_fit and amscr__gmm1d_fit_small. x: n finite values,
- * 1 <= k <= n; scratch: amscr__gmm1d_small_scratch(n, k) doubles; split: k*k. */
-static amscr_status gmm_fit_core(const double *x, size_t n, size_t k, unsigned max_iter, double tol,
+/* The fit shared by amscr_gmm1d_fit and amscr__gmm1d_fit_small/_sorted. x: n finite values
+ * (ascending when presorted; may then be scratch itself), 1 <= k <= n; scratch:
+ * amscr__gmm1d_small_scratch(n, k) doubles; split: k*k. */
+static amscr_status gmm_fit_core(const double *x, int presorted, size_t n, size_t k, unsigned max_iter, double tol,
                                  double floor_rel, double *w, double *mu, double *var, double *scratch,
                                  size_t *split, unsigned *out_iter, int *out_converged, double *out_loglik)
 {
@@ -104,20 +98,10 @@ static amscr_status gmm_fit_core(const double *x, size_t n, size_t k, unsigned m
     double *sse = dp + amscr__kmeans1d_scratch(n, k);
     double *lc = sse + k, *iv = lc + k, *lp = iv + k, *sr = lp + k, *srd = sr + k, *srd2 = srd + k;
 
-    memcpy(sorted, x, n * sizeof *sorted);
-    if (n <= GMM_SMALL_SORT_N) {
-        for (size_t i = 1; i < n; i++) {
-            double t = sorted[i];
-            size_t j = i;
-            while (j > 0 && sorted[j - 1] > t) {
-                sorted[j] = sorted[j - 1];
-                j--;
-            }
-            sorted[j] = t;
-        }
-    } else {
-        qsort(sorted, n, sizeof *sorted, gmm_cmp_double);
-    }
+    if (x != sorted)
+        memcpy(sorted, x, n * sizeof *sorted);
+    if (!presorted)
+        amscr__sort_doubles(sorted, n);
 
     /* Data mean and variance (two passes), and the variance floor. */
     double m = 0.0;
@@ -196,6 +180,22 @@ static amscr_status gmm_fit_core(const double *x, size_t n, size_t k, unsigned m
     return AMSCR_OK;
 }
 
+static amscr_status fit_small(const double *x, int presorted, size_t n, size_t k, unsigned max_iter, double tol,
+                              double var_floor_rel, double *w, double *mu, double *var, double *scratch,
+                              unsigned *out_iter, int *out_converged, double *out_loglik)
+{
+    if (!x || !w || !mu || !var || !scratch)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr__gmm1d_fit_small: NULL argument");
+    if (k < 1 || k > AMSCR__KMAX || k > n)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr__gmm1d_fit_small: k = %zu (n = %zu, k <= %d)", k, n,
+                           AMSCR__KMAX);
+    if (max_iter < 1 || !(tol >= 0.0) || !(var_floor_rel >= 0.0 && var_floor_rel <= 1.0))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr__gmm1d_fit_small: bad settings");
+    size_t split[AMSCR__KMAX * AMSCR__KMAX];
+    return gmm_fit_core(x, presorted, n, k, max_iter, tol, var_floor_rel, w, mu, var, scratch, split, out_iter,
+                        out_converged, out_loglik);
+}
+
 /* Hot-path fit without allocation: K-component mixture of n finite values (1 <= k <= 16,
  * k <= n; meant for n <= 64 but any n works), max_iter >= 1, tol >= 0, var_floor_rel in
  * [0, 1]. Writes k weights/means/variances sorted by mean; out_* may be NULL.
@@ -205,16 +205,16 @@ amscr_status amscr__gmm1d_fit_small(const double *x, size_t n, size_t k, unsigne
                                     double var_floor_rel, double *w, double *mu, double *var, double *scratch,
                                     unsigned *out_iter, int *out_converged, double *out_loglik)
 {
-    if (!x || !w || !mu || !var || !scratch)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr__gmm1d_fit_small: NULL argument");
-    if (k < 1 || k > GMM_SMALL_KMAX || k > n)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr__gmm1d_fit_small: k = %zu (n = %zu, k <= %d)", k, n,
-                           GMM_SMALL_KMAX);
-    if (max_iter < 1 || !(tol >= 0.0) || !(var_floor_rel >= 0.0 && var_floor_rel <= 1.0))
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr__gmm1d_fit_small: bad settings");
-    size_t split[GMM_SMALL_KMAX * GMM_SMALL_KMAX];
-    return gmm_fit_core(x, n, k, max_iter, tol, var_floor_rel, w, mu, var, scratch, split, out_iter, out_converged,
-                        out_loglik);
+    return fit_small(x, 0, n, k, max_iter, tol, var_floor_rel, w, mu, var, scratch, out_iter, out_converged,
+                     out_loglik);
+}
+
+amscr_status amscr__gmm1d_fit_sorted(const double *sorted, size_t n, size_t k, unsigned max_iter, double tol,
+                                     double var_floor_rel, double *w, double *mu, double *var, double *scratch,
+                                     unsigned *out_iter, int *out_converged, double *out_loglik)
+{
+    return fit_small(sorted, 1, n, k, max_iter, tol, var_floor_rel, w, mu, var, scratch, out_iter, out_converged,
+                     out_loglik);
 }
 
 /* ======================================================================
@@ -329,7 +329,7 @@ amscr_status amscr_gmm1d_fit(amscr_gmm1d *g, const double *x, size_t n)
     unsigned it = 0;
     int conv = 0;
     double ll = NAN;
-    amscr_status st = gmm_fit_core(x, n, k, g->max_iterations, g->tol, g->var_floor, params, params + k,
+    amscr_status st = gmm_fit_core(x, 0, n, k, g->max_iterations, g->tol, g->var_floor, params, params + k,
                                    params + 2 * k, scratch, split, &it, &conv, &ll);
     free(scratch);
     free(split);

@@ -42,6 +42,9 @@ struct amscr_contour {
 amscr_status amscr__contour_wrap(double *xy, size_t n, amscr_contour **out);
 
 #define AMSCR__MAX_SCALES 64
+/* Largest mixture class count of the scale selection (amscr_params_set_kmax's bound): the
+ * per-scale residuals of at most 64 scales never support more classes than this. */
+#define AMSCR__KMAX 16
 
 struct amscr_params {
     size_t num_samples;
@@ -97,6 +100,10 @@ size_t amscr__gmm1d_small_scratch(size_t n, size_t k);
 amscr_status amscr__gmm1d_fit_small(const double *x, size_t n, size_t k, unsigned max_iter, double tol, double var_floor_rel,
                            double *w, double *mu, double *var, double *scratch, unsigned *out_iter,
                            int *out_converged, double *out_loglik);
+/* The same fit of data already ascending (sorted may be scratch itself: no copy, no sort). */
+amscr_status amscr__gmm1d_fit_sorted(const double *sorted, size_t n, size_t k, unsigned max_iter, double tol,
+                                     double var_floor_rel, double *w, double *mu, double *var, double *scratch,
+                                     unsigned *out_iter, int *out_converged, double *out_loglik);
 
 /* ---- prepared shapes (descriptor.c) ---- */
 struct amscr_descriptor {
@@ -126,7 +133,7 @@ amscr_status amscr__descriptor_alloc(size_t n, size_t p, amscr_descriptor **out)
  * parametrization, invariance); fills a detail otherwise. */
 int amscr__params_compatible(const amscr_params *a, const amscr_params *b, const char *what);
 
-/* ---- matching (register.c) ---- */
+/* ---- matching (register.c; the engine's own internals are in match.h) ---- */
 /* The distance with a caller workspace (batch path; symmetric honoured). p must be
  * compatible with both descriptors (not checked here). */
 amscr_status amscr__distance_ws(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,

@@ -105,7 +105,7 @@ SETTER(arclength_passes, unsigned, arclength_passes, v >= 1 && v <= 10, "%u is o
 GETTER(arclength_passes, unsigned, arclength_passes)
 SETTER(oversampling, unsigned, oversampling, v >= 1 && v <= 64, "%u is outside 1..64")
 GETTER(oversampling, unsigned, oversampling)
-SETTER(kmax, unsigned, kmax, v >= 1 && v <= 16, "%u is outside 1..16")
+SETTER(kmax, unsigned, kmax, v >= 1 && v <= AMSCR__KMAX, "%u is outside 1..16")
 GETTER(kmax, unsigned, kmax)
 SETTER(symmetric, int, symmetric, v == 0 || v == 1, "%d is not 0 or 1")
 GETTER(symmetric, int, symmetric)

@@ -1,4 +1,5 @@
 /* resample.c — Euclidean and affine arc-length resampling, whitening normalization. */
+#include "dense.h"
 #include "internal.h"
 
 #include <math.h>
@@ -247,20 +248,9 @@ static int polygon_whitener(const double *P, size_t n, int closed, double W[4])
     double cx, cy, cov[3];
     if (closed && region_moments(P, n, &cx, &cy, cov) && amscr__sym2_invsqrt(cov, W, NULL))
         return 1;
-    double mx = 0, my = 0;
-    for (size_t i = 0; i < n; i++) {
-        mx += P[2 * i];
-        my += P[2 * i + 1];
-    }
-    mx /= (double)n;
-    my /= (double)n;
-    cov[0] = cov[1] = cov[2] = 0;
-    for (size_t i = 0; i < n; i++) {
-        double dx = P[2 * i] - mx, dy = P[2 * i + 1] - my;
-        cov[0] += dx * dx;
-        cov[1] += dx * dy;
-        cov[2] += dy * dy;
-    }
+    double mx, my;
+    amscr__centroid(P, n, &mx, &my);
+    amscr__scatter(P, n, mx, my, 1.0, cov);
     return amscr__sym2_invsqrt(cov, W, NULL);
 }
 
@@ -389,20 +379,9 @@ amscr_status amscr_resample_affine(const double *xy, size_t n, int closed, doubl
 
 amscr_status amscr__whiten(const double *xy, size_t n, double *out_xy, double fwd[6], double inv[6])
 {
-    double cx = 0, cy = 0;
-    for (size_t i = 0; i < n; i++) {
-        cx += xy[2 * i];
-        cy += xy[2 * i + 1];
-    }
-    cx /= (double)n;
-    cy /= (double)n;
-    double cov[3] = {0, 0, 0};
-    for (size_t i = 0; i < n; i++) {
-        double dx = xy[2 * i] - cx, dy = xy[2 * i + 1] - cy;
-        cov[0] += dx * dx;
-        cov[1] += dx * dy;
-        cov[2] += dy * dy;
-    }
+    double cx, cy, cov[3];
+    amscr__centroid(xy, n, &cx, &cy);
+    amscr__scatter(xy, n, cx, cy, 1.0, cov);
     cov[0] /= (double)n;
     cov[1] /= (double)n;
     cov[2] /= (double)n;

@@ -62,12 +62,9 @@ static int tr_otsu(const uint64_t hist[256])
     return (t_first + t_last) / 2;
 }
 
-amscr_status amscr_contour_from_mask(const uint8_t *pixels, size_t width, size_t height, size_t stride,
-                                     int threshold, amscr_contour **out)
+/* Step 0: the arguments. */
+static amscr_status tr_check_args(size_t width, size_t height, size_t stride, int threshold)
 {
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(pixels);
-    AMSCR_CHECK_NULL(out);
     if (width == 0 || height == 0)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_contour_from_mask: empty image (%zu x %zu)", width, height);
     if (width > AMSCR_MAX_IMAGE_SIDE || height > AMSCR_MAX_IMAGE_SIDE)
@@ -83,22 +80,28 @@ amscr_status amscr_contour_from_mask(const uint8_t *pixels, size_t width, size_t
     if (threshold != AMSCR_THRESHOLD_AUTO && (threshold < 0 || threshold > 254))
         return amscr__fail(AMSCR_E_INVALID_ARG,
                            "amscr_contour_from_mask: threshold %d not in 0..254 or AMSCR_THRESHOLD_AUTO", threshold);
+    return AMSCR_OK;
+}
 
-    const size_t w = width, h = height;
-    int t = threshold;
-    if (t == AMSCR_THRESHOLD_AUTO) {
-        uint64_t hist[256];
-        memset(hist, 0, sizeof hist);
-        for (size_t y = 0; y < h; y++) {
-            const uint8_t *row = pixels + y * stride;
-            for (size_t x = 0; x < w; x++)
-                hist[row[x]]++;
-        }
-        t = tr_otsu(hist);
+/* Step 1: the threshold (the given one, or Otsu's on the image's histogram). */
+static int tr_threshold(const uint8_t *pixels, size_t w, size_t h, size_t stride, int threshold)
+{
+    if (threshold != AMSCR_THRESHOLD_AUTO)
+        return threshold;
+    uint64_t hist[256];
+    memset(hist, 0, sizeof hist);
+    for (size_t y = 0; y < h; y++) {
+        const uint8_t *row = pixels + y * stride;
+        for (size_t x = 0; x < w; x++)
+            hist[row[x]]++;
     }
-    const uint8_t thr = (uint8_t)t;
+    return tr_otsu(hist);
+}
 
-    /* Polarity: count "on" pixels on the border (each border pixel once). */
+/* Step 2: polarity — 1 when most border pixels are "on" (the border is background, so the
+ * image is inverted). Each border pixel is counted once. */
+static uint8_t tr_invert(const uint8_t *pixels, size_t w, size_t h, size_t stride, uint8_t thr)
+{
     size_t border = 0, border_on = 0;
     for (size_t y = 0; y < h; y++) {
         const uint8_t *row = pixels + y * stride;
@@ -115,42 +118,43 @@ amscr_status amscr_contour_from_mask(const uint8_t *pixels, size_t width, size_t
             }
         }
     }
-    const uint8_t invert = 2 * border_on > border;
+    return 2 * border_on > border;
+}
 
-    /* Padded mask: TR_ON = foreground, 0 = background (the one-pixel frame included). */
+/* Step 3: the padded mask ((w+2) x (h+2)): TR_ON = foreground, 0 = background (the one-pixel
+ * frame included); *fg: the foreground count. */
+static amscr_status tr_padded_mask(const uint8_t *pixels, size_t w, size_t h, size_t stride, uint8_t thr,
+                                   uint8_t invert, uint8_t **out_map, size_t *fg)
+{
     const size_t W = w + 2, H = h + 2;
     uint8_t *map = amscr__calloc_array(W * H, 1);
     if (!map)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_from_mask: out of memory (%zu x %zu mask)", W, H);
-    size_t fg = 0;
+    size_t count = 0;
     for (size_t y = 0; y < h; y++) {
         const uint8_t *row = pixels + y * stride;
         uint8_t *m = map + (y + 1) * W + 1;
         for (size_t x = 0; x < w; x++) {
             uint8_t on = (uint8_t)((row[x] > thr) ^ invert);
             m[x] = on;
-            fg += on;
+            count += on;
         }
     }
-    if (fg == 0) {
-        free(map);
-        if (invert)
-            return amscr__fail(AMSCR_E_NOT_FOUND, "amscr_contour_from_mask: foreground everywhere (threshold %d)", t);
-        return amscr__fail(AMSCR_E_NOT_FOUND, "amscr_contour_from_mask: no foreground pixels (threshold %d)", t);
-    }
+    *out_map = map;
+    *fg = count;
+    return AMSCR_OK;
+}
 
-    /* Neighbour offsets in the padded mask. */
-    ptrdiff_t off[8];
-    for (int d = 0; d < 8; d++)
-        off[d] = (ptrdiff_t)tr_dy[d] * (ptrdiff_t)W + tr_dx[d];
-
-    /* Components by BFS (explicit queue; bit TR_SEEN is set when a pixel is enqueued).
-     * The padded index fits in 32 bits: W*H <= (2^15+2)^2 < 2^32. */
+/* Step 4: the largest 8-connected component by BFS (explicit queue; bit TR_SEEN is set when a
+ * pixel is enqueued): its size and first pixel in raster order. The padded index fits in 32
+ * bits: W*H <= (2^15+2)^2 < 2^32. */
+static amscr_status tr_largest_component(uint8_t *map, size_t w, size_t h, const ptrdiff_t off[8], size_t fg,
+                                         size_t *out_size, size_t *out_seed)
+{
+    const size_t W = w + 2;
     uint32_t *queue = amscr__malloc_array(fg, sizeof *queue);
-    if (!queue) {
-        free(map);
+    if (!queue)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_from_mask: out of memory (%zu pixels)", fg);
-    }
     size_t best_size = 0, best_seed = 0;
     for (size_t y = 1; y <= h; y++) {
         for (size_t x = 1; x <= w; x++) {
@@ -177,22 +181,52 @@ amscr_status amscr_contour_from_mask(const uint8_t *pixels, size_t width, size_t
         }
     }
     free(queue);
+    *out_size = best_size;
+    *out_seed = best_seed;
+    return AMSCR_OK;
+}
 
-    /* Moore-neighbour tracing from the component's first pixel in raster order: its west
-     * neighbour is background, so we "entered" it from the west (backtrack W). Every
-     * neighbour reached is 8-adjacent, hence in the same component. A state is (pixel,
-     * backtrack); backtracks are always W, N, E or S, so the states seen are 4 flag bits
-     * per pixel. Jacob's stopping criterion, in its exact form: stop when a pixel is
-     * entered a second time in the same manner (a state repeats); the boundary is the
-     * cycle from that state's first occurrence (in practice the whole sequence). */
-    const size_t start = best_seed;
-    size_t cap = 1024, np = 0, first = 0;
+/* Room for one more boundary point (pts and backs grow together, up to AMSCR_MAX_POINTS). */
+static amscr_status tr_grow(uint32_t **pts, uint8_t **backs, size_t np, size_t *cap)
+{
+    if (np == AMSCR_MAX_POINTS)
+        return amscr__fail(AMSCR_E_LIMIT, "amscr_contour_from_mask: boundary exceeds %u points",
+                           (unsigned)AMSCR_MAX_POINTS);
+    if (np < *cap)
+        return AMSCR_OK;
+    size_t ncap = 2 * *cap > AMSCR_MAX_POINTS ? AMSCR_MAX_POINTS : 2 * *cap;
+    uint32_t *npts = realloc(*pts, ncap * sizeof *npts);
+    if (npts)
+        *pts = npts;
+    uint8_t *nbacks = npts ? realloc(*backs, ncap) : NULL;
+    if (nbacks)
+        *backs = nbacks;
+    if (!npts || !nbacks)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_from_mask: out of memory (%zu boundary points)", ncap);
+    *cap = ncap;
+    return AMSCR_OK;
+}
+
+/* First boundary allocation (points); doubled as needed. */
+#define TR_INITIAL_CAP 1024
+
+/* Step 5: Moore-neighbour tracing from the component's first pixel in raster order: its west
+ * neighbour is background, so we "entered" it from the west (backtrack W). Every
+ * neighbour reached is 8-adjacent, hence in the same component. A state is (pixel,
+ * backtrack); backtracks are always W, N, E or S, so the states seen are 4 flag bits
+ * per pixel. Jacob's stopping criterion, in its exact form: stop when a pixel is
+ * entered a second time in the same manner (a state repeats); the boundary is the
+ * cycle pts[*first..*np-1] from that state's first occurrence (in practice the whole
+ * sequence). */
+static amscr_status tr_trace(uint8_t *map, const ptrdiff_t off[8], size_t start, uint32_t **out_pts, size_t *out_np,
+                             size_t *out_first)
+{
+    size_t cap = TR_INITIAL_CAP, np = 0, first = 0;
     uint32_t *pts = malloc(cap * sizeof *pts);
     uint8_t *backs = malloc(cap);
     if (!pts || !backs) {
         free(pts);
         free(backs);
-        free(map);
         return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_from_mask: out of memory");
     }
     size_t p = start;
@@ -222,89 +256,112 @@ amscr_status amscr_contour_from_mask(const uint8_t *pixels, size_t width, size_t
             break;
         }
         map[q] |= bit;
-        if (np == AMSCR_MAX_POINTS) {
-            st = amscr__fail(AMSCR_E_LIMIT, "amscr_contour_from_mask: boundary exceeds %u points",
-                             (unsigned)AMSCR_MAX_POINTS);
+        st = tr_grow(&pts, &backs, np, &cap);
+        if (st != AMSCR_OK)
             break;
-        }
-        if (np == cap) {
-            size_t ncap = 2 * cap > AMSCR_MAX_POINTS ? AMSCR_MAX_POINTS : 2 * cap;
-            uint32_t *npts = realloc(pts, ncap * sizeof *npts);
-            if (npts)
-                pts = npts;
-            uint8_t *nbacks = npts ? realloc(backs, ncap) : NULL;
-            if (nbacks)
-                backs = nbacks;
-            if (!npts || !nbacks) {
-                st = amscr__fail(AMSCR_E_NOMEM, "amscr_contour_from_mask: out of memory (%zu boundary points)",
-                                 ncap);
-                break;
-            }
-            cap = ncap;
-        }
         pts[np] = (uint32_t)q;
         backs[np++] = (uint8_t)nback;
         p = q;
         back = nback;
     }
-    free(map);
     free(backs);
+    if (st == AMSCR_OK && first >= np) /* cannot happen: the repeated state was recorded */
+        st = amscr__fail(AMSCR_E_INTERNAL, "amscr_contour_from_mask: boundary tracing lost its cycle");
     if (st != AMSCR_OK) {
         free(pts);
         return st;
     }
-    if (first >= np) { /* cannot happen: the repeated state was recorded */
-        free(pts);
-        return amscr__fail(AMSCR_E_INTERNAL, "amscr_contour_from_mask: boundary tracing lost its cycle");
-    }
-    /* Keep the cycle pts[first..np-1]; start it at the start pixel when it is on it. */
+    *out_pts = pts;
+    *out_np = np;
+    *out_first = first;
+    return AMSCR_OK;
+}
+
+/* Step 6: the cycle pts[first..np-1] as coordinates, started at the start pixel when it is on
+ * it, oriented to positive signed area. Frees pts. */
+static amscr_status tr_cycle_points(uint32_t *pts, size_t first, size_t np, size_t start, size_t W, size_t comp_size,
+                                    double **out_xy, size_t *out_n)
+{
     size_t ncyc = np - first, rot = 0;
     for (size_t i = 0; i < ncyc; i++)
         if (pts[first + i] == start) {
             rot = i;
             break;
         }
-    np = ncyc;
-    if (np < 3) {
+    if (ncyc < 3) {
         free(pts);
         return amscr__fail(AMSCR_E_DEGENERATE,
                            "amscr_contour_from_mask: largest component (%zu pixels) has %zu boundary points (< 3)",
-                           best_size, np);
+                           comp_size, ncyc);
     }
-
-    double *xy = amscr__malloc_array(np, 2 * sizeof *xy);
+    double *xy = amscr__malloc_array(ncyc, 2 * sizeof *xy);
     if (!xy) {
         free(pts);
-        return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_from_mask: out of memory (%zu points)", np);
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_from_mask: out of memory (%zu points)", ncyc);
     }
-    for (size_t i = 0; i < np; i++) {
+    for (size_t i = 0; i < ncyc; i++) {
         size_t idx = pts[first + (rot + i) % ncyc];
         xy[2 * i] = (double)(idx % W - 1);
         xy[2 * i + 1] = (double)(idx / W - 1);
     }
     free(pts);
-
     /* Signed area (shoelace, twice the area). */
     double a2 = 0.0;
-    for (size_t i = 0; i < np; i++) {
-        size_t j = i + 1 == np ? 0 : i + 1;
+    for (size_t i = 0; i < ncyc; i++) {
+        size_t j = i + 1 == ncyc ? 0 : i + 1;
         a2 += xy[2 * i] * xy[2 * j + 1] - xy[2 * j] * xy[2 * i + 1];
     }
     if (a2 == 0.0) {
         free(xy);
         return amscr__fail(AMSCR_E_DEGENERATE,
-                           "amscr_contour_from_mask: largest component (%zu pixels) is a line: zero area",
-                           best_size);
+                           "amscr_contour_from_mask: largest component (%zu pixels) is a line: zero area", comp_size);
     }
-    if (a2 < 0.0) {
-        for (size_t i = 0, j = np - 1; i < j; i++, j--) {
-            double tx = xy[2 * i], ty = xy[2 * i + 1];
-            xy[2 * i] = xy[2 * j];
-            xy[2 * i + 1] = xy[2 * j + 1];
-            xy[2 * j] = tx;
-            xy[2 * j + 1] = ty;
-        }
+    if (a2 < 0.0)
+        amscr__reverse_points(xy, ncyc);
+    *out_xy = xy;
+    *out_n = ncyc;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_contour_from_mask(const uint8_t *pixels, size_t width, size_t height, size_t stride,
+                                     int threshold, amscr_contour **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(pixels);
+    AMSCR_CHECK_NULL(out);
+    amscr_status st = tr_check_args(width, height, stride, threshold);
+    if (st != AMSCR_OK)
+        return st;
+    const size_t w = width, h = height, W = w + 2;
+    int t = tr_threshold(pixels, w, h, stride, threshold);
+    const uint8_t thr = (uint8_t)t;
+    const uint8_t invert = tr_invert(pixels, w, h, stride, thr);
+    uint8_t *map = NULL;
+    size_t fg = 0;
+    st = tr_padded_mask(pixels, w, h, stride, thr, invert, &map, &fg);
+    if (st != AMSCR_OK)
+        return st;
+    if (fg == 0) {
+        free(map);
+        if (invert)
+            return amscr__fail(AMSCR_E_NOT_FOUND, "amscr_contour_from_mask: foreground everywhere (threshold %d)", t);
+        return amscr__fail(AMSCR_E_NOT_FOUND, "amscr_contour_from_mask: no foreground pixels (threshold %d)", t);
     }
+    /* Neighbour offsets in the padded mask. */
+    ptrdiff_t off[8];
+    for (int d = 0; d < 8; d++)
+        off[d] = (ptrdiff_t)tr_dy[d] * (ptrdiff_t)W + tr_dx[d];
+    size_t comp_size = 0, start = 0, np = 0, first = 0, n = 0;
+    uint32_t *pts = NULL;
+    double *xy = NULL;
+    st = tr_largest_component(map, w, h, off, fg, &comp_size, &start);
+    if (st == AMSCR_OK)
+        st = tr_trace(map, off, start, &pts, &np, &first);
+    free(map);
+    if (st == AMSCR_OK)
+        st = tr_cycle_points(pts, first, np, start, W, comp_size, &xy, &n);
+    if (st != AMSCR_OK)
+        return st;
     /* amscr__contour_wrap takes ownership of xy (also on failure). */
-    return amscr__contour_wrap(xy, np, out);
+    return amscr__contour_wrap(xy, n, out);
 }

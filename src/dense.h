@@ -1,0 +1,47 @@
+/* dense.h — small dense numerics shared by the geometry and the registration (never installed):
+ * centroid and scatter of a point set, the moment sums of a least-squares fit, 3x3 inverse,
+ * a small Gaussian elimination and the sort of a short array. */
+#ifndef AMSCR_DENSE_H
+#define AMSCR_DENSE_H
+
+#include <stddef.h>
+
+/* π, written once (C99 has no M_PI). */
+#define AMSCR__PI 3.14159265358979323846
+
+/* Mean point of n points xy (2n). */
+void amscr__centroid(const double *xy, size_t n, double *cx, double *cy);
+
+/* Scatter about (cx, cy) in units of `unit`: cov = Σ (d/unit)(d/unit)^T, d = p - c, as
+ * {xx, xy, yy} (not divided by n; unit 1 for plain coordinates). */
+void amscr__scatter(const double *xy, size_t n, double cx, double cy, double unit, double cov[3]);
+
+/* Moment sums of a least-squares fit x ≈ X [f; 1]: m = {Σ fx², Σ fx fy, Σ fy², Σ fx, Σ fy, count}. */
+static inline void amscr__moment_add(double m[6], double x, double y)
+{
+    m[0] += x * x;
+    m[1] += x * y;
+    m[2] += y * y;
+    m[3] += x;
+    m[4] += y;
+    m[5] += 1.0;
+}
+
+/* The moment sums of n points (see amscr__moment_add). */
+void amscr__moments(const double *xy, size_t n, double m[6]);
+
+/* The 3x3 normal matrix [[sxx sxy sx] [sxy syy sy] [sx sy n]] of moment sums (row-major). */
+void amscr__moment_matrix(const double mom[6], double M[9]);
+
+/* Inverse of a 3x3 matrix (row-major) by cofactors; returns 0 when it is numerically singular
+ * (|det| <= AMSCR__INV3_TOL (|m00| + |m11| + |m22|)^3). */
+int amscr__inv3(const double m[9], double out[9]);
+
+/* Solves a x = b (n x n, n <= 6) by Gaussian elimination with partial pivoting; the solution
+ * replaces b, a is destroyed. Returns 0 when singular. */
+int amscr__gauss_solve(double *a, double *b, int n);
+
+/* Sorts n values ascending in place (insertion sort when short, qsort otherwise). */
+void amscr__sort_doubles(double *v, size_t n);
+
+#endif

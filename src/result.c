@@ -1,0 +1,98 @@
+/* result.c — the result object of amscr_register and its getters. */
+#include "match.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void amscr_result_free(amscr_result *r) { free(r); }
+
+double amscr_result_distance(const amscr_result *r) { return r ? r->m.dist : NAN; }
+
+amscr_status amscr_result_affine(const amscr_result *r, double out_m6[6])
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(out_m6);
+    memcpy(out_m6, r->affine_in, 6 * sizeof(double));
+    return AMSCR_OK;
+}
+
+amscr_status amscr_result_affine_normalized(const amscr_result *r, double out_m6[6])
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(out_m6);
+    memcpy(out_m6, r->affine_norm, 6 * sizeof(double));
+    return AMSCR_OK;
+}
+
+size_t amscr_result_shift(const amscr_result *r) { return r ? r->m.shift : 0; }
+int amscr_result_reflected(const amscr_result *r) { return r ? r->m.reflected : 0; }
+amscr_method amscr_result_method(const amscr_result *r) { return r ? r->method : (amscr_method)-1; }
+size_t amscr_result_num_scales(const amscr_result *r) { return r ? r->m.p : 0; }
+size_t amscr_result_num_kept(const amscr_result *r) { return r ? r->m.nkept : 0; }
+size_t amscr_result_k(const amscr_result *r) { return r ? r->m.k : 0; }
+double amscr_result_threshold(const amscr_result *r) { return r ? r->m.threshold : NAN; }
+
+static amscr_status copy_out(const double *src, size_t count, double *out, size_t *inout_n, const char *what)
+{
+    if (out) {
+        if (*inout_n < count)
+            return amscr__fail(AMSCR_E_INVALID_ARG, "%s: room for %zu values, %zu needed", what, *inout_n, count);
+        if (src)
+            memcpy(out, src, count * sizeof *out);
+    }
+    *inout_n = count;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_result_residuals(const amscr_result *r, double *out, size_t *inout_n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(inout_n);
+    return copy_out(r->m.resid, r->m.p, out, inout_n, "amscr_result_residuals");
+}
+
+amscr_status amscr_result_sse(const amscr_result *r, double *out, size_t *inout_n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(inout_n);
+    return copy_out(r->m.sse, r->m.nsse, out, inout_n, "amscr_result_sse");
+}
+
+amscr_status amscr_result_kept(const amscr_result *r, int *out, size_t *inout_n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(inout_n);
+    if (out) {
+        if (*inout_n < r->m.p)
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_result_kept: room for %zu values, %zu needed", *inout_n,
+                               r->m.p);
+        memcpy(out, r->m.kept, r->m.p * sizeof *out);
+    }
+    *inout_n = r->m.p;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_result_mixture(const amscr_result *r, double *out_weights, double *out_means,
+                                  double *out_variances, size_t *inout_n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(inout_n);
+    size_t k = r->m.ncomp;
+    if ((out_weights || out_means || out_variances) && *inout_n < k)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_result_mixture: room for %zu, %zu needed", *inout_n, k);
+    if (out_weights)
+        memcpy(out_weights, r->m.w, k * sizeof(double));
+    if (out_means)
+        memcpy(out_means, r->m.mu, k * sizeof(double));
+    if (out_variances)
+        memcpy(out_variances, r->m.var, k * sizeof(double));
+    *inout_n = k;
+    return AMSCR_OK;
+}
