@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Sets up (installs what is missing, builds) and runs every test: the per-area Check suites,
-# the ABI checks, the tool and Python tests (all through `meson test`), the hardening pass
+# Sets up (installs what is missing, builds, installs the amscr package into the project's
+# virtual environment .venv/) and runs every test: the per-area Check suites, the ABI checks,
+# the tool and Python tests (all through `meson test`; the Python suite runs in .venv against
+# the INSTALLED package, not this source tree), the hardening pass
 # (tools/hardening.sh), then the master Check runner, whose closing line
 # ("100%: Checks: N, Failures: 0, Errors: 0") ends the output.
 set -euo pipefail
