@@ -12,5 +12,8 @@ meson test -C build --no-suite all --print-errorlogs --num-processes 2
 # sanitizers (ASan+UBSan, TSan), valgrind, ABI diff against the committed baseline, a short
 # fuzz pass (AMSCR_FUZZ_SECONDS, default 30 s a target); AMSCR_NO_HARDENING=1 skips it
 [ -n "${AMSCR_NO_HARDENING:-}" ] || tools/hardening.sh
+# the Python package for distribution: sdist + wheel, manylinux repair, a clean install of it
+# (tools/wheel.sh, about a minute); AMSCR_NO_WHEEL=1 skips it
+[ -n "${AMSCR_NO_WHEEL:-}" ] || { echo "== wheel =="; tools/wheel.sh; }
 echo "== check_all =="
 build/tests/check_all
