@@ -12,6 +12,11 @@ import numpy as np
 from ._lib import ffi, lib
 from .errors import InvalidArgumentError, _check
 
+try:
+    from numpy.typing import ArrayLike
+except ImportError:  # numpy < 1.20
+    ArrayLike = Any  # type: ignore
+
 INT32_MIN, INT32_MAX = -(2 ** 31), 2 ** 31 - 1
 
 
@@ -20,27 +25,57 @@ def bad(msg: str) -> InvalidArgumentError:
     return InvalidArgumentError(msg, lib.AMSCR_E_INVALID_ARG, msg)
 
 
-def as_points(x: Any, name: str = 'points') -> np.ndarray:
-    """array-like -> C-contiguous float64 array of shape (n, 2), n >= 1, all finite."""
+#: The point orders accepted by ``order=``: (x, y) columns, or (row, col) as scikit-image gives them.
+ORDERS = ('xy', 'rc')
+
+
+def as_order(order: Any) -> str:
+    """Validates an ``order=`` argument: 'xy' or 'rc'."""
+    if order not in ORDERS:
+        raise bad("order: expected 'xy' (x = column, y = row) or 'rc' (row, column), got %r" % (order,))
+    return order
+
+
+def as_points(x: Any, name: str = 'points', order: str = 'xy') -> np.ndarray:
+    """The one conversion of user points: array-like -> C-contiguous float64 (n, 2) array of
+    (x, y) rows, n >= 1, all finite.
+
+    Accepts (n, 2) arrays of any real dtype, and OpenCV contours ((n, 1, 2) int32 from
+    ``cv2.findContours``, already (x, y)). ``order='rc'`` takes (row, col) points (scikit-image's
+    ``measure.find_contours``) and swaps them: x = column, y = row.
+    """
+    order = as_order(order)
     if hasattr(x, 'input_points') and hasattr(x, 'scale_points'):
         raise TypeError('%s: expected an array of points, got a prepared Shape' % name)
     try:
         a = np.asarray(x)
-    except ValueError as e:  # ragged nested lists
-        raise bad('%s: expected an array of shape (n, 2): %s' % (name, e)) from None
+    except ValueError as e:  # ragged nested lists, e.g. the whole tuple cv2.findContours returns
+        raise bad('%s: expected an array of shape (n, 2) (or one OpenCV contour, (n, 1, 2)): %s'
+                  % (name, e)) from None
     if a.dtype.kind not in 'iuf':
         raise bad('%s: expected real numbers, got an array of dtype %s' % (name, a.dtype))
+    if a.ndim == 3 and a.shape[1:] == (1, 2):  # an OpenCV contour
+        a = a[:, 0, :]
     if a.ndim != 2 or a.shape[1] != 2:
-        raise bad('%s: expected an array of shape (n, 2) (one x, y row per point), got shape %s'
-                  % (name, a.shape))
+        hint = (' (a list of OpenCV contours? pass one of them, e.g. max(contours, key=cv2.contourArea))'
+                if a.ndim == 4 and a.shape[2:] == (1, 2) else '')
+        raise bad('%s: expected an array of shape (n, 2) (one x, y row per point) or (n, 1, 2) (OpenCV), '
+                  'got shape %s%s' % (name, a.shape, hint))
     if a.shape[0] == 0:
         raise bad('%s: no points' % name)
+    if order == 'rc':
+        a = a[:, ::-1]
     a = np.ascontiguousarray(a, dtype=np.float64)
     finite = np.isfinite(a).all(axis=1)
     if not finite.all():
         i = int(np.argmin(finite))
         raise bad('%s: point %d is not finite: (%r, %r)' % (name, i, float(a[i, 0]), float(a[i, 1])))
     return a
+
+
+def points_in_order(xy: np.ndarray, order: str) -> np.ndarray:
+    """(x, y) points returned in the caller's `order` (the inverse of :func:`as_points`'s swap)."""
+    return np.ascontiguousarray(xy[:, ::-1]) if as_order(order) == 'rc' else xy
 
 
 def as_float_array(x: Any, name: str, ndim: Optional[Tuple[int, ...]] = None, finite: bool = True) -> np.ndarray:
@@ -76,10 +111,26 @@ def as_count(x: Any, name: str, minimum: int = 0) -> int:
     return v
 
 
+def as_uint(x: Any, name: str) -> int:
+    """A count that fits the library's `unsigned` (32-bit) arguments."""
+    v = as_count(x, name, 0)
+    if v > 0xFFFFFFFF:
+        raise bad('%s: too large (%d)' % (name, v))
+    return v
+
+
 def as_bool(x: Any, name: str) -> int:
     if isinstance(x, (bool, np.bool_)) or (isinstance(x, (int, np.integer)) and x in (0, 1)):
         return int(bool(x))
     raise bad('%s: expected True or False, got %r' % (name, x))
+
+
+def new_object(ctype: str, make: Callable[..., int], free: Callable[[Any], None], *args: Any):
+    """Calls ``make(*args, ctype **out)`` (a C constructor) and returns ``*out``, which the
+    garbage collector frees with `free`."""
+    out = ffi.new(ctype + ' **')
+    _check(make(*args, out))
+    return ffi.gc(out[0], free)
 
 
 def dbuf(a: np.ndarray):
@@ -92,6 +143,23 @@ def copy_doubles(p, count: int) -> np.ndarray:
     if p == ffi.NULL:
         raise bad('no data (NULL pointer from the library)')
     return np.frombuffer(ffi.buffer(p, count * 8), dtype=np.float64).copy()
+
+
+def copy_points(p, n: int) -> np.ndarray:
+    """Copies n (x, y) points from a borrowed C pointer into a new (n, 2) array."""
+    return copy_doubles(p, 2 * n).reshape(n, 2)
+
+
+def sized_arrays(fn, *args: Any, arrays: int = 1, dtype: Any = np.float64, ctype: str = 'double[]'
+                 ) -> Tuple[np.ndarray, ...]:
+    """The library's two-call size pattern: ``fn(*args, NULL..., &n)`` asks for the length n,
+    ``fn(*args, buf..., &n)`` fills `arrays` buffers of n values; returns them as numpy arrays."""
+    n = ffi.new('size_t *', 0)
+    _check(fn(*args, *([ffi.NULL] * arrays), n))
+    bufs = [np.zeros(int(n[0]), dtype=dtype) for _ in range(arrays)]
+    if n[0]:
+        _check(fn(*args, *(ffi.from_buffer(ctype, b) for b in bufs), n))
+    return tuple(b[:int(n[0])] for b in bufs)
 
 
 def factorize(labels: Any, n: Optional[int] = None, name: str = 'labels') -> np.ndarray:

@@ -52,7 +52,9 @@ except ImportError as e:  # pragma: no cover - exercised only without Dask
     raise ImportError('amscr.distributed needs Dask: pip install "dask[distributed]>=2023" '
                       '(or pip install "amscr[distributed]")') from e
 
-from . import Collection, FormatError, Shape, _check, ffi, lib
+from .collection import Collection
+from .errors import FormatError
+from .shape import Shape
 
 __all__ = ['distance_matrix', 'cross_matrix', 'topk', 'tile_size']
 
@@ -144,8 +146,7 @@ def _block(coll: Collection, lo: int, hi: int, threads: int) -> Collection:
         return coll
     sub = Collection(p, threads=threads)
     with coll._lock.read():
-        for i in range(lo, hi):
-            _check(lib.amscr_db_add_descriptor(sub._db, lib.amscr_db_descriptor(coll._db, i), 0, ffi.NULL))
+        sub._add_copies(coll, range(lo, hi))
     return sub
 
 
@@ -286,8 +287,7 @@ def _queries_like(queries: Any, targets: Collection) -> Collection:
     q = Collection(targets.params)
     if isinstance(queries, Collection):
         with queries._lock.read():
-            for i in range(len(queries)):
-                _check(lib.amscr_db_add_descriptor(q._db, lib.amscr_db_descriptor(queries._db, i), 0, ffi.NULL))
+            q._add_copies(queries, range(len(queries)))
         return q
     if isinstance(queries, Shape) or (isinstance(queries, np.ndarray) and queries.ndim == 2):
         queries = [queries]
@@ -300,6 +300,17 @@ def _scatter_blocks(client, coll: Collection, bounds: Sequence[Tuple[int, int]],
     """Row blocks of `coll` as scattered payloads (each goes where it is needed)."""
     payloads = [_Payload(_block(coll, lo, hi, coll.params.threads).to_bytes(), what) for lo, hi in bounds]
     return client.scatter(payloads, hash=False) if payloads else []
+
+
+def _scatter_cross(client, q: Collection, t: Collection, tile: TileArg, threads: Optional[int]):
+    """Tiles of a queries x targets computation: (row bounds, column bounds, threads argument,
+    the targets' payload (on every worker), the query row blocks' payloads)."""
+    nq, nt = len(q), len(t)
+    tr, tc = tile_size(nq, nt, sum(client.nthreads().values()), tile)
+    row_b, col_b = _bounds(nq, tr), _bounds(nt, tc)
+    th = _threads_arg(threads, client)
+    [tpay] = client.scatter([_Payload(t.to_bytes(), 'target collection')], broadcast=True, hash=False)
+    return row_b, col_b, th, tpay, _scatter_blocks(client, q, row_b, 'query block')
 
 
 def _out_array(out: Any, shape: Tuple[int, int]) -> np.ndarray:
@@ -435,11 +446,7 @@ def cross_matrix(queries: Union[Collection, bytes], targets: Union[Collection, b
     nq, nt = len(q), len(t)
     lazy = client is not None and out is None
     with _client_or_local(client) as c:
-        tr, tc = tile_size(nq, nt, sum(c.nthreads().values()), tile)
-        row_b, col_b = _bounds(nq, tr), _bounds(nt, tc)
-        th = _threads_arg(threads, c)
-        [tpay] = c.scatter([_Payload(t.to_bytes(), 'target collection')], broadcast=True, hash=False)
-        qpays = _scatter_blocks(c, q, row_b, 'query block')
+        row_b, col_b, th, tpay, qpays = _scatter_cross(c, q, t, tile, threads)
         token = 'amscr-cross-' + uuid.uuid4().hex
 
         def args_of(i, j):
@@ -490,11 +497,7 @@ def topk(queries: Union[Collection, Iterable[Any], bytes], collection: Union[Col
     if nq == 0 or k == 0:
         return indices, distances
     with _client_or_local(client) as c:
-        tr, tc = tile_size(nq, nt, sum(c.nthreads().values()), tile)
-        row_b, col_b = _bounds(nq, tr), _bounds(nt, tc)
-        th = _threads_arg(threads, c)
-        [tpay] = c.scatter([_Payload(t.to_bytes(), 'target collection')], broadcast=True, hash=False)
-        qpays = _scatter_blocks(c, q, row_b, 'query block')
+        row_b, col_b, th, tpay, qpays = _scatter_cross(c, q, t, tile, threads)
         token = uuid.uuid4().hex
         placed = {}
         for i, (r0, r1) in enumerate(row_b):

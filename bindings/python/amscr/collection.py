@@ -1,0 +1,351 @@
+"""Collection: many prepared shapes with labels (C ``amscr_db``), and :func:`distance_matrix`."""
+from __future__ import annotations
+
+import contextlib
+import os
+from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from ._lib import ffi, lib
+from ._util import ProgressArg, RWLock, as_points, bad, dbuf, new_object, progress_call
+from .contour import contour_new
+from .errors import _check
+from .params import Params, make_params
+from .shape import PointsLike, Shape, as_shape
+
+
+def _new_db(make: Any, *args: Any):
+    return new_object('amscr_db', make, lib.amscr_db_free, *args)
+
+
+class Collection:
+    """Many prepared shapes with labels (C ``amscr_db``), for 1-vs-many queries and distance matrices.
+
+    ``Collection(params=None, **options)`` — the options are those of :class:`Params`; every shape
+    is prepared with them. Batch calls run on ``threads`` POSIX threads (0 = all cores) with the
+    GIL released, and give bit-identical results for any thread count.
+
+    Labels are int32 values, or any other hashable values (e.g. strings), which are mapped to
+    codes 0, 1, ... in order of first use (:attr:`labels` gives them back; saved files hold codes).
+    Thread-safety: any number of threads may query at once; :meth:`add` waits for them.
+
+    Args:
+        params: a :class:`Params` to start from (None: the library defaults, tuned for
+            collections: N = 128, no refinement).
+        **options: options of :class:`Params`, e.g. ``reflections=True, threads=0``.
+    Raises:
+        InvalidArgumentError: a bad option.
+    """
+
+    def __init__(self, params: Optional[Params] = None, **options: Any):
+        p = make_params(params, options)
+        self._init(_new_db(lib.amscr_db_new, p._p))
+
+    def _init(self, db, label_names: Optional[Sequence[Any]] = None) -> None:
+        """Adopts `db`, an owned C collection (from _new_db)."""
+        self._db = db
+        self._lock = RWLock()
+        self._label_names: Optional[List[Any]] = list(label_names) if label_names is not None else None
+        self._label_codes: Dict[Any, int] = ({n: i for i, n in enumerate(self._label_names)}
+                                             if self._label_names is not None else {})
+        # a loaded collection without names holds int labels already
+        self._int_labels = self._label_names is None and int(lib.amscr_db_size(db)) > 0
+
+    @classmethod
+    def _wrap(cls, db, label_names: Optional[Sequence[Any]] = None) -> 'Collection':
+        self = cls.__new__(cls)
+        self._init(db, label_names)
+        return self
+
+    def _add_copies(self, src: 'Collection', indices: Iterable[int]) -> None:
+        """Adds copies of the prepared shapes `indices` of `src` (label 0). The caller holds
+        src's read lock; self is a private collection nobody else sees yet."""
+        for i in indices:
+            _check(lib.amscr_db_add_descriptor(self._db, lib.amscr_db_descriptor(src._db, i), 0, ffi.NULL))
+
+    # -- building ---------------------------------------------------------------------
+    def _label_code(self, label: Any) -> int:
+        if isinstance(label, (bool, np.bool_)):
+            raise bad('label: expected an int or a name, got a bool')
+        if isinstance(label, (int, np.integer)):
+            if self._label_names is not None:
+                raise bad('label: this collection uses named labels; got the int %r' % (label,))
+            v = int(label)
+            if not -(2 ** 31) <= v < 2 ** 31:
+                raise bad('label: %d does not fit in int32' % v)
+            self._int_labels = True
+            return v
+        if self._int_labels:
+            raise bad('label: this collection uses int labels; got %r' % (label,))
+        try:
+            hash(label)
+        except TypeError:
+            raise bad('label: expected an int or a hashable name, got %r' % (label,)) from None
+        if self._label_names is None:
+            self._label_names = []
+        code = self._label_codes.get(label)
+        if code is None:
+            code = self._label_codes[label] = len(self._label_names)
+            self._label_names.append(label)
+        return code
+
+    def add(self, shape: PointsLike, label: Any = 0, *, order: str = 'xy') -> int:
+        """Prepares (points) or copies (a :class:`Shape`) a shape into the collection.
+
+        Args:
+            shape: (n, 2) points, an OpenCV (n, 1, 2) contour, or a prepared :class:`Shape`.
+            label: an int32 class label, or any hashable name (not both kinds in one collection).
+            order: 'xy' (default) or 'rc' for (row, col) points (scikit-image).
+        Returns:
+            the index of the new shape.
+        Raises:
+            InvalidArgumentError: bad points or label; DegenerateError: a degenerate shape.
+        """
+        with self._lock.write():
+            code = self._label_code(label)
+            idx = ffi.new('size_t *')
+            if isinstance(shape, Shape):
+                _check(lib.amscr_db_add_descriptor(self._db, shape._d, code, idx))
+            else:
+                c = contour_new(as_points(shape, 'shape', order))
+                _check(lib.amscr_db_add_contour(self._db, c, code, idx))
+            return int(idx[0])
+
+    def extend(self, shapes: Iterable[PointsLike], labels: Optional[Iterable[Any]] = None, *,
+               order: str = 'xy') -> List[int]:
+        """Adds many shapes, as :meth:`add`.
+
+        Args:
+            shapes: point arrays or :class:`Shape` s.
+            labels: one label per shape (None: all 0).
+            order: 'xy' (default) or 'rc', the order of every shape's points.
+        Returns:
+            the indices of the new shapes.
+        Raises:
+            InvalidArgumentError: as many labels as shapes are needed; as :meth:`add`.
+        """
+        shapes = list(shapes)
+        labels = [0] * len(shapes) if labels is None else list(labels)
+        if len(labels) != len(shapes):
+            raise bad('extend: %d shapes but %d labels' % (len(shapes), len(labels)))
+        return [self.add(s, lab, order=order) for s, lab in zip(shapes, labels)]
+
+    # -- reading ----------------------------------------------------------------------
+    def __len__(self) -> int:
+        """The number of shapes."""
+        return int(lib.amscr_db_size(self._db))
+
+    @property
+    def label_codes(self) -> np.ndarray:
+        """The int32 labels stored in C."""
+        with self._lock.read():
+            n = len(self)
+            return np.fromiter((lib.amscr_db_label(self._db, i) for i in range(n)), dtype=np.int32, count=n)
+
+    @property
+    def labels(self) -> np.ndarray:
+        """The labels as given to :meth:`add` (int32 array, or an object array of names)."""
+        codes = self.label_codes
+        if self._label_names is None:
+            return codes
+        out = np.empty(codes.shape[0], dtype=object)
+        for i, c in enumerate(codes):
+            out[i] = self._label_names[c] if 0 <= c < len(self._label_names) else c
+        return out
+
+    @property
+    def params(self) -> Params:
+        """A copy of the collection's options."""
+        return Params._copy_of(lib.amscr_db_params(self._db))
+
+    def shape(self, i: int) -> Shape:
+        """A copy of the prepared shape i (a copy, because the C collection's own descriptors
+        are only valid until it is modified).
+
+        Args:
+            i: the index; negative indices count from the end.
+        Returns:
+            a :class:`Shape`.
+        Raises:
+            IndexError: `i` out of range.
+        """
+        with self._lock.read():
+            n = len(self)
+            i = int(i)
+            if i < 0:
+                i += n
+            if not 0 <= i < n:
+                raise IndexError('shape index %d out of range (%d shapes)' % (i, n))
+            holder = Collection(self.params)  # a private, never modified, one-shape collection
+            holder._add_copies(self, (i,))
+        return Shape._borrowed(lib.amscr_db_descriptor(holder._db, 0), holder)
+
+    def __repr__(self) -> str:
+        return 'Collection(%d shapes)' % len(self)
+
+    # -- matching ---------------------------------------------------------------------
+    def _with_threads(self, threads: Optional[int]) -> Tuple['Collection', bool]:
+        """(a collection computing with `threads`, whether it is a temporary copy)."""
+        if threads is None or int(threads) == self.params.threads:
+            return self, False
+        tmp = Collection(self.params, threads=threads)
+        tmp._add_copies(self, range(len(self)))
+        return tmp, True
+
+    def query(self, shape: PointsLike, threads: Optional[int] = None, progress: ProgressArg = False, *,
+              order: str = 'xy') -> np.ndarray:
+        """Distances from `shape` to every shape of the collection.
+
+        Args:
+            shape: the query: (n, 2) points, an OpenCV (n, 1, 2) contour or a :class:`Shape`.
+            threads: threads for this call (None: the collection's).
+            progress: True for a progress bar on stderr, or a callable(done, total) (returning
+                True cancels with CancelledError; an exception it raises cancels and propagates).
+            order: 'xy' (default) or 'rc' for (row, col) points (scikit-image).
+        Returns:
+            (len(self),) float array; rank it with :func:`topk` or ``numpy.argsort``.
+        Raises:
+            InvalidArgumentError: bad points; DegenerateError: a degenerate query;
+            CancelledError: cancelled by `progress`; KeyboardInterrupt: Ctrl-C.
+        """
+        with self._lock.read():
+            p = self.params
+            q = as_shape(shape, p, 'shape', order)
+            out = np.zeros(len(self), dtype=np.float64)
+            if threads is None or int(threads) == p.threads:
+                progress_call(lib.amscr_db_query, (self._db, q._d), (dbuf(out),), progress)
+            else:
+                qdb = Collection(p, threads=threads)
+                _check(lib.amscr_db_add_descriptor(qdb._db, q._d, 0, ffi.NULL))
+                progress_call(lib.amscr_db_cross_distances, (qdb._db, self._db), (dbuf(out),), progress)
+            return out
+
+    def distance_matrix(self, threads: Optional[int] = None, progress: ProgressArg = False) -> np.ndarray:
+        """All pairwise distances of the collection.
+
+        Args:
+            threads: threads for this call (None: the collection's).
+            progress: True for a progress bar on stderr, or a callable(done, total), as in
+                :meth:`query`.
+        Returns:
+            (n, n) float array, ``D[i, j]`` = distance(shape i -> shape j); zero diagonal.
+        Raises:
+            CancelledError: cancelled by `progress`; KeyboardInterrupt: Ctrl-C.
+        """
+        with self._lock.read():
+            src, _ = self._with_threads(threads)
+            n = len(self)
+            out = np.zeros((n, n), dtype=np.float64)
+            progress_call(lib.amscr_db_distance_matrix, (src._db,), (dbuf(out),), progress)
+            return out
+
+    def cross_matrix(self, other: 'Collection', threads: Optional[int] = None,
+                     progress: ProgressArg = False) -> np.ndarray:
+        """Distances from this collection's shapes (queries) to `other`'s (targets), with this
+        collection's options.
+
+        Args:
+            other: the target :class:`Collection`.
+            threads: threads for this call (None: the collection's).
+            progress: as in :meth:`query`.
+        Returns:
+            (len(self), len(other)) float array.
+        Raises:
+            TypeError: `other` is not a Collection; CancelledError: cancelled by `progress`.
+        """
+        if not isinstance(other, Collection):
+            raise TypeError('other: expected an amscr.Collection, got %s' % type(other).__name__)
+        with self._lock.read(), (other._lock.read() if other is not self else contextlib.nullcontext()):
+            src, _ = self._with_threads(threads)
+            out = np.zeros((len(self), len(other)), dtype=np.float64)
+            progress_call(lib.amscr_db_cross_distances, (src._db, other._db), (dbuf(out),), progress)
+            return out
+
+    # -- persistence ------------------------------------------------------------------
+    def save(self, path: Union[str, os.PathLike]) -> None:
+        """Writes the prepared collection (binary, versioned, checksummed; atomic rename).
+
+        Args:
+            path: the file to write. Named labels are stored as their codes (give the names
+                back to :meth:`load`).
+        Raises:
+            FileError: the file cannot be written.
+        """
+        with self._lock.read():
+            _check(lib.amscr_db_save(self._db, os.fsencode(path)))
+
+    @classmethod
+    def load(cls, path: Union[str, os.PathLike], label_names: Optional[Sequence[Any]] = None) -> 'Collection':
+        """Reads a collection written by :meth:`save` (or the ``amscr`` tool).
+
+        Args:
+            path: the file.
+            label_names: if given, ``label_names[code]`` names the stored label codes again.
+        Returns:
+            a new :class:`Collection`.
+        Raises:
+            FileError: cannot read; FormatError: not a collection file, or a corrupt one.
+        """
+        return cls._wrap(_new_db(lib.amscr_db_load, os.fsencode(path)), label_names)
+
+    def to_bytes(self) -> bytes:
+        """The collection serialized as :meth:`save` writes it.
+
+        Returns:
+            bytes (give them to :meth:`from_bytes`).
+        """
+        with self._lock.read():
+            buf = ffi.new('void **')
+            n = ffi.new('size_t *')
+            _check(lib.amscr_db_save_memory(self._db, buf, n))
+            try:
+                return bytes(ffi.buffer(buf[0], n[0]))
+            finally:
+                lib.amscr_free(buf[0])
+
+    @classmethod
+    def from_bytes(cls, data: Union[bytes, bytearray, memoryview],
+                   label_names: Optional[Sequence[Any]] = None) -> 'Collection':
+        """The inverse of :meth:`to_bytes`.
+
+        Args:
+            data: bytes written by :meth:`to_bytes` (or a saved file's content).
+            label_names: as in :meth:`load`.
+        Returns:
+            a new :class:`Collection`.
+        Raises:
+            FormatError: not a serialized collection, or a corrupt one.
+        """
+        b = bytes(data)
+        return cls._wrap(_new_db(lib.amscr_db_load_memory, ffi.from_buffer(b), len(b)), label_names)
+
+    def __reduce__(self):
+        return (_collection_from_state, (self.to_bytes(), self._label_names))
+
+
+def _collection_from_state(data: bytes, label_names: Optional[List[Any]]) -> Collection:
+    return Collection.from_bytes(data, label_names)
+
+
+def distance_matrix(shapes: Sequence[PointsLike], *, threads: Optional[int] = None, progress: ProgressArg = False,
+                    params: Optional[Params] = None, order: str = 'xy', **options: Any) -> np.ndarray:
+    """All pairwise distances of a list of shapes (through a temporary :class:`Collection`).
+
+    Args:
+        shapes: point arrays (or OpenCV contours) or :class:`Shape` s.
+        threads: threads (None: the library default, 0 = all cores).
+        progress: True for a progress bar on stderr, or a callable(done, total), as in
+            :meth:`Collection.query`.
+        params: a :class:`Params` to start from (None: the library defaults).
+        order: 'xy' (default) or 'rc' for (row, col) points.
+        **options: options of :class:`Params`.
+    Returns:
+        (n, n) float array, ``D[i, j]`` = distance(shape i -> shape j).
+    Raises:
+        InvalidArgumentError: bad points or options; DegenerateError: a degenerate shape;
+        CancelledError: cancelled by `progress`.
+    """
+    db = Collection(params, threads=threads, **options)
+    db.extend(shapes, order=order)
+    return db.distance_matrix(progress=progress)

@@ -1,0 +1,186 @@
+"""Contours (C ``amscr_contour``): tracing a mask, text point lists, orientation and validation.
+
+The C contour is a private carrier here: functions take and return (n, 2) NumPy arrays of
+(x, y) rows. Every function taking points accepts an OpenCV contour ((n, 1, 2) from
+``cv2.findContours``) as it is; (row, col) points (scikit-image) are converted by
+:func:`as_points` with ``order='rc'`` (or the ``order=`` keyword of :func:`register`,
+:class:`Shape` and :class:`Collection`).
+"""
+from __future__ import annotations
+
+import os
+from typing import Any, Union
+
+import numpy as np
+
+from ._lib import ffi, lib
+from ._util import ArrayLike, as_bool, as_count, bad, copy_points, dbuf, new_object
+from ._util import as_points as _as_points
+from .errors import _check
+
+
+def _new_contour(make: Any, *args: Any):
+    return new_object('amscr_contour', make, lib.amscr_contour_free, *args)
+
+
+def as_points(points: ArrayLike, order: str = 'xy') -> np.ndarray:
+    """Points as amscr takes them: a new C-contiguous float64 (n, 2) array of (x, y) rows.
+
+    Args:
+        points: (n, 2) array-like of real numbers, or an OpenCV contour ((n, 1, 2) int32 from
+            ``cv2.findContours``, already (x, y)).
+        order: 'xy' (default) or 'rc' for (row, col) points, as scikit-image's
+            ``measure.find_contours`` gives them: x = column (col), y = row. Image contours
+            are then in the frame of :func:`contour_from_mask`, OpenCV and
+            ``skimage.transform``.
+    Returns:
+        (n, 2) float64 array of (x, y) rows.
+    Raises:
+        InvalidArgumentError: not (n, 2) / (n, 1, 2), not real numbers, no points, a
+        non-finite value, or a bad `order`; TypeError: a prepared :class:`Shape`.
+    """
+    return _as_points(points, 'points', order)
+
+
+def contour_new(pts: np.ndarray):
+    """A C contour holding a copy of the (n, 2) float64 array `pts` (validated by the caller)."""
+    return _new_contour(lib.amscr_contour_new, dbuf(pts), pts.shape[0])
+
+
+def contour_points(c) -> np.ndarray:
+    """The points of a C contour, copied into an (n, 2) array."""
+    return copy_points(lib.amscr_contour_xy(c), int(lib.amscr_contour_size(c)))
+
+
+def _take(c) -> np.ndarray:
+    """The points of an owned C contour, which is freed right away."""
+    pts = contour_points(c)
+    ffi.release(c)
+    return pts
+
+
+def contour_from_mask(mask: ArrayLike, threshold: Union[int, str, None] = None) -> np.ndarray:
+    """Outer boundary of the largest 8-connected foreground component of a 2-D image.
+
+    Args:
+        mask: 2-D NumPy array, ``bool`` (True = foreground; stored as 0/255) or ``uint8`` (other
+            integer arrays with values in 0..255 are accepted too); any strides or order.
+        threshold: a pixel is "on" when its value is > threshold (0..254); ``'auto'`` for Otsu's
+            threshold; None for 127 (the ``amscr`` tool's default). The polarity is automatic:
+            if most of the image border is "on", on and off are swapped.
+    Returns:
+        (n, 2) float array of boundary pixel centres (x = column, y = row), with positive signed
+        area (counter-clockwise in a y-up frame), no repeated end point.
+    Raises:
+        NotFoundError: no foreground (or foreground everywhere); DegenerateError: too small;
+        LimitError: image too large.
+    """
+    a = np.asarray(mask)
+    if a.ndim != 2:
+        raise bad('mask: expected a 2-D array, got shape %s' % (a.shape,))
+    if a.dtype == np.bool_:
+        a = np.where(a, np.uint8(255), np.uint8(0))
+    elif a.dtype != np.uint8:
+        if a.dtype.kind not in 'iu':
+            raise bad('mask: expected a bool or uint8 array, got dtype %s' % a.dtype)
+        if a.size and (a.min() < 0 or a.max() > 255):
+            raise bad('mask: values must be in 0..255 for dtype %s (got %d..%d)' % (a.dtype, a.min(), a.max()))
+        a = a.astype(np.uint8)
+    a = np.ascontiguousarray(a)
+    if threshold is None:
+        thr = 127
+    elif isinstance(threshold, str):
+        if threshold.strip().lower() not in ('auto', 'otsu'):
+            raise bad("threshold: expected 0..254, 'auto' or None, got %r" % threshold)
+        thr = lib.AMSCR_THRESHOLD_AUTO
+    else:
+        thr = as_count(threshold, 'threshold', 0)
+        if thr > 0x7FFFFFFF:
+            raise bad('threshold: expected 0..254, got %d' % thr)
+    h, w = a.shape
+    return _take(_new_contour(lib.amscr_contour_from_mask, ffi.from_buffer('uint8_t[]', a), w, h, w, thr))
+
+
+def read_points(path: Union[str, os.PathLike]) -> np.ndarray:
+    """Reads a text point list ("x y" or "x,y" per line, '#' comments).
+
+    Args:
+        path: the file (``amscr contour IMG -o FILE`` writes one from a PNG or PGM).
+    Returns:
+        (n, 2) float array of (x, y) rows.
+    Raises:
+        FileError: cannot read; FormatError: a bad line (the message names path:line).
+    """
+    return _take(_new_contour(lib.amscr_contour_read_text, os.fsencode(path)))
+
+
+def parse_points(text: Union[str, bytes]) -> np.ndarray:
+    """Parses a text point list from a string.
+
+    Args:
+        text: str or bytes in the format of :func:`read_points`.
+    Returns:
+        (n, 2) float array of (x, y) rows.
+    Raises:
+        FormatError: a bad line (the message names the line).
+    """
+    b = text.encode('utf-8') if isinstance(text, str) else bytes(text)
+    return _take(_new_contour(lib.amscr_contour_parse_text, ffi.from_buffer('char[]', b), len(b)))
+
+
+def write_points(path: Union[str, os.PathLike], points: ArrayLike) -> None:
+    """Writes points as a text point list, atomically (temporary file + rename).
+
+    Args:
+        path: the file to write.
+        points: (n, 2) points (or an OpenCV contour).
+    Raises:
+        InvalidArgumentError: bad points; FileError: the file cannot be written.
+    """
+    c = contour_new(_as_points(points))
+    _check(lib.amscr_contour_write_text(c, os.fsencode(path)))
+
+
+def signed_area(points: ArrayLike) -> float:
+    """Signed area of the closed polygon.
+
+    Args:
+        points: (n, 2) points (or an OpenCV contour).
+    Returns:
+        the area, positive when counter-clockwise in a y-up frame (clockwise on screen, y down).
+    Raises:
+        InvalidArgumentError: bad points.
+    """
+    c = contour_new(_as_points(points))
+    out = ffi.new('double *')
+    _check(lib.amscr_contour_signed_area(c, out))
+    return float(out[0])
+
+
+def orient_ccw(points: ArrayLike) -> np.ndarray:
+    """A copy of the points, reversed when their signed area is negative.
+
+    Args:
+        points: (n, 2) points (or an OpenCV contour).
+    Returns:
+        (n, 2) float array with a signed area >= 0.
+    Raises:
+        InvalidArgumentError: bad points.
+    """
+    c = contour_new(_as_points(points))
+    _check(lib.amscr_contour_orient_ccw(c))
+    return contour_points(c)
+
+
+def validate_contour(points: ArrayLike, closed: bool = True) -> None:
+    """Checks that a contour can be registered.
+
+    Args:
+        points: (n, 2) points (or an OpenCV contour).
+        closed: True for a closed curve, False for an open one.
+    Raises:
+        DegenerateError: too few distinct points, zero area when closed, all collinear when
+        open; InvalidArgumentError: bad points.
+    """
+    c = contour_new(_as_points(points))
+    _check(lib.amscr_contour_validate(c, as_bool(closed, 'closed')))

@@ -1,0 +1,185 @@
+"""Registration of one pair: :func:`register` and its result (C ``amscr_result``),
+:func:`distance`, and the per-thread workspace they reuse."""
+from __future__ import annotations
+
+import threading
+from typing import Any, Dict, NamedTuple, Optional, Tuple
+
+import numpy as np
+
+from ._lib import ffi, lib
+from ._util import ArrayLike, as_points, matrix_out, new_object, points_in_order, sized_arrays
+from .enums import METHODS, enum_out
+from .errors import _check
+from .params import Params, make_params
+from .shape import PointsLike, Shape, as_shape
+
+_tls = threading.local()
+
+
+def _workspace():
+    """The calling thread's workspace (scratch memory reused across registrations)."""
+    ws = getattr(_tls, 'ws', None)
+    if ws is None:
+        ws = _tls.ws = new_object('amscr_workspace', lib.amscr_workspace_new, lib.amscr_workspace_free)
+    return ws
+
+
+class Mixture(NamedTuple):
+    """The 1-D Gaussian mixture of the per-scale residuals (components sorted by mean)."""
+    weights: np.ndarray
+    means: np.ndarray
+    variances: np.ndarray
+
+
+class Registration:
+    """The result of :func:`register`: the affine map taking the source onto the target and the
+    diagnostics of scale selection. Every array is a NumPy copy (nothing refers to C memory).
+
+    All maps are in the (x, y) frame of the input points (x = column, y = row for image
+    contours, also when they were given with ``order='rc'``), the frame of OpenCV and of
+    scikit-image's transforms: ``cv2.warpAffine(src_img, r.matrix[:2], (width, height))`` and
+    ``skimage.transform.warp(src_img, AffineTransform(matrix=r.matrix).inverse)`` move the
+    source image onto the target.
+
+    Attributes:
+        A: (2, 2) linear part, in input coordinates: ``tgt ~= src @ A.T + B``.
+        B: (2,) translation.
+        matrix: (3, 3) homogeneous form of (A, B): ``[[A, B], [0, 0, 1]]``.
+        matrix_normalized: (3, 3) the same map between the normalized frames.
+        distance: affine-invariant distance (target's normalized frame).
+        residuals: (p,) per-scale residuals L2_k (eq. 13).
+        scales: (p,) the scales sigma_k.
+        kept: (p,) bool, the scales kept by the selection.
+        kept_scales: the sigma_k kept.
+        k: K chosen by the elbow (2 for binary-em, 0 for acma/amscr).
+        sse: SSE(K) for K = 1..Kmax of the elbow.
+        mixture: :class:`Mixture` found by EM.
+        threshold: the Bayes threshold s0 (inf when every scale is kept without one).
+        shift: start shift (source sample a <-> target sample (a + shift) mod N).
+        reflected: True when the match used the mirrored target.
+        method: the method used.
+    """
+
+    def __init__(self, handle, scales: np.ndarray):
+        """Copies everything out of `handle`, a C ``amscr_result`` (made by :func:`register`,
+        which users call instead), and `scales`, the sigma_k of the registration. Raises
+        nothing of its own: the handle comes from a successful registration."""
+        r = handle
+        self.distance = float(lib.amscr_result_distance(r))
+        self.matrix = matrix_out(lib.amscr_result_affine, r)
+        self.matrix_normalized = matrix_out(lib.amscr_result_affine_normalized, r)
+        self.A = self.matrix[:2, :2].copy()
+        self.B = self.matrix[:2, 2].copy()
+        self.shift = int(lib.amscr_result_shift(r))
+        self.reflected = bool(lib.amscr_result_reflected(r))
+        self.method = enum_out(METHODS, lib.amscr_result_method(r))
+        self.residuals, = sized_arrays(lib.amscr_result_residuals, r)
+        kept, = sized_arrays(lib.amscr_result_kept, r, dtype=np.intc, ctype='int[]')
+        self.kept = kept.astype(bool)
+        self.scales = np.asarray(scales, dtype=np.float64).copy()
+        self.kept_scales = self.scales[self.kept] if self.scales.shape == self.kept.shape else self.scales[:0]
+        self.k = int(lib.amscr_result_k(r))
+        self.sse, = sized_arrays(lib.amscr_result_sse, r)
+        self.mixture = Mixture(*sized_arrays(lib.amscr_result_mixture, r, arrays=3))
+        self.threshold = float(lib.amscr_result_threshold(r))
+
+    def apply(self, points: ArrayLike, order: str = 'xy') -> np.ndarray:
+        """Maps points of the source onto the target: ``points @ A.T + B``.
+
+        Args:
+            points: (n, 2) points (or an OpenCV (n, 1, 2) contour) in source coordinates.
+            order: 'xy' (default) or 'rc': the order of the given points' columns, kept in
+                the returned array.
+        Returns:
+            (n, 2) float array, in the same order as `points`.
+        Raises:
+            InvalidArgumentError: bad points or order.
+        """
+        return points_in_order(as_points(points, 'points', order) @ self.A.T + self.B, order)
+
+    def __repr__(self) -> str:
+        return ('Registration(distance=%.6g, method=%r, kept %d/%d scales, k=%d, shift=%d, reflected=%s)'
+                % (self.distance, self.method, int(self.kept.sum()), self.kept.size, self.k, self.shift,
+                   self.reflected))
+
+
+def _pair(src: PointsLike, tgt: PointsLike, params: Optional[Params], options: Dict[str, Any], order: str
+          ) -> Tuple[Params, Shape, Shape]:
+    """The options of one registration and the two prepared shapes (see :func:`register`)."""
+    base = params
+    if base is None:
+        first = src if isinstance(src, Shape) else tgt if isinstance(tgt, Shape) else None
+        # prepared shapes bring their own settings; raw points get the registration preset
+        base = first.params if first is not None else Params.registration()
+    p = make_params(base, options)
+    return p, as_shape(src, p, 'src', order), as_shape(tgt, p, 'tgt', order)
+
+
+def register(src: PointsLike, tgt: PointsLike, *, method: Optional[str] = None, points: Optional[int] = None,
+             scales: Optional[ArrayLike] = None, reflections: Optional[bool] = None,
+             closed: Optional[bool] = None, refine: Optional[int] = None, symmetric: Optional[bool] = None,
+             parametrization: Optional[str] = None, invariance: Optional[str] = None,
+             params: Optional[Params] = None, order: str = 'xy', **options: Any) -> Registration:
+    """Registers `src` onto `tgt`: finds (A, B) with ``tgt ~= A @ src + B`` and the distance.
+
+    Args:
+        src, tgt: the two shapes: (n, 2) point arrays (contours, closed by default; OpenCV
+            (n, 1, 2) contours are accepted as they are) or prepared :class:`Shape` s.
+        method: 'multiclass-em' (default), 'binary-em', 'amscr' or 'acma'.
+        points: N, samples per scale (None: 256, the registration preset; see below).
+        scales: the smoothing scales sigma_k (samples of the N-point curve).
+        reflections: also try the mirrored target.
+        closed: closed (default) or open curves.
+        refine: refinement iterations in the aligned frame (trimmed closest-point pairs, started
+            from AMSCR's global estimate); 0 gives the paper's method (None: 20, the preset).
+        symmetric: symmetric distance.
+        parametrization: 'affine', 'euclidean' or 'whitened'.
+        invariance: 'affine', 'similarity' or 'penalized'.
+        params: a :class:`Params` to start from; other keywords of :class:`Params` are accepted.
+        order: 'xy' (default: x = column, y = row for image contours) or 'rc' for (row, col)
+            points such as scikit-image's ``measure.find_contours`` gives. Either way the
+            result is in the (x, y) frame: 'rc' points are swapped on the way in.
+        **options: other options of :class:`Params`.
+
+    Returns:
+        a :class:`Registration`: the affine map (``A``, ``B``, ``matrix``), the distance and the
+        diagnostics of scale selection.
+
+    Raises:
+        InvalidArgumentError: bad points or options; DegenerateError: a shape with too few
+        distinct points or zero area; NumericError: the registration failed numerically.
+
+    Options left as None take the registration preset (:meth:`Params.registration`: N = 256,
+    20 refinement iterations, as the ``amscr register`` tool), or the settings of a given Shape
+    (the options of preparation, N, scales, closed and parametrization, must then agree with the
+    shapes').
+    """
+    options.update(method=method, points=points, scales=scales, reflections=reflections, closed=closed,
+                   refine=refine, symmetric=symmetric, parametrization=parametrization, invariance=invariance)
+    p, s, t = _pair(src, tgt, params, options, order)
+    r = new_object('amscr_result', lib.amscr_register, lib.amscr_result_free, p._p, s._d, t._d, _workspace())
+    res = Registration(r, p.scales)
+    ffi.release(r)
+    return res
+
+
+def distance(src: PointsLike, tgt: PointsLike, *, params: Optional[Params] = None, order: str = 'xy',
+             **options: Any) -> float:
+    """The distance only (the fast batch path; equal to ``register(...).distance`` to rounding).
+
+    Args:
+        src, tgt: (n, 2) point arrays, OpenCV (n, 1, 2) contours or prepared :class:`Shape` s.
+        params: a :class:`Params` to start from (None: the registration preset, as in
+            :func:`register`).
+        order: 'xy' (default) or 'rc' for (row, col) points, as in :func:`register`.
+        **options: options of :class:`Params`.
+    Returns:
+        the affine-invariant distance, a float >= 0.
+    Raises:
+        InvalidArgumentError: bad points or options; DegenerateError: a degenerate shape.
+    """
+    p, s, t = _pair(src, tgt, params, options, order)
+    out = ffi.new('double *')
+    _check(lib.amscr_distance(p._p, s._d, t._d, _workspace(), out))
+    return float(out[0])

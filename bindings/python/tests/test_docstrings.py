@@ -1,0 +1,78 @@
+"""Every public name of amscr (amscr.__all__) is documented: functions, classes, their public
+methods, properties and options have a docstring; a function's names every parameter and says
+what it returns (unless None) and what it raises (when it takes arguments)."""
+import inspect
+import re
+
+import pytest
+
+import amscr
+
+
+def _public_callables():
+    """(qualified name, object, docstring holder) for every public function, class, method and property."""
+    out = []
+    for name in amscr.__all__:
+        obj = getattr(amscr, name)
+        if inspect.isclass(obj):
+            out.append((name, obj, obj))
+            for attr, member in vars(obj).items():
+                if attr.startswith('_') and attr != '__init__':
+                    continue
+                if isinstance(member, (staticmethod, classmethod)):
+                    member = member.__func__
+                if isinstance(member, property):
+                    out.append(('%s.%s' % (name, attr), None, member.fget))
+                elif inspect.isdatadescriptor(member):  # e.g. the options of Params
+                    out.append(('%s.%s' % (name, attr), None, member))
+                elif inspect.isfunction(member):
+                    # __init__ may be documented in the class docstring (the numpy/Google style)
+                    out.append(('%s.%s' % (name, attr), member, obj if attr == '__init__' else member))
+        elif inspect.isfunction(obj):
+            out.append((name, obj, obj))
+    return out
+
+
+CALLABLES = _public_callables()
+
+
+def _parameters(fn):
+    try:
+        sig = inspect.signature(fn)
+    except (TypeError, ValueError):
+        return []
+    return [p.name for p in sig.parameters.values() if p.name not in ('self', 'cls')]
+
+
+def test_the_walk_finds_the_api():
+    names = {n for n, _, _ in CALLABLES}
+    assert {'register', 'Registration.apply', 'Collection.query', 'Shape.points', 'Params.copy',
+            'as_points', 'GMM1D.fit', 'Params.points', 'AmscrError.__init__'} <= names
+
+
+def _doc(name, obj, holder):
+    doc = inspect.getdoc(holder) or ''
+    if name.endswith('.__init__'):  # the class docstring and __init__'s own
+        doc += '\n' + (inspect.getdoc(obj) or '')
+    return doc
+
+
+def _returns_something(fn):
+    ann = inspect.signature(fn).return_annotation
+    return ann not in (None, 'None', inspect.Signature.empty)
+
+
+@pytest.mark.parametrize('name,obj,holder', CALLABLES, ids=[n for n, _, _ in CALLABLES])
+def test_public_name_is_documented(name, obj, holder):
+    doc = _doc(name, obj, holder)
+    assert doc.strip(), '%s has no docstring' % name
+    if obj is None or inspect.isclass(obj):
+        return  # a property (documented), or a class (its __init__ is checked as Class.__init__)
+    params = _parameters(obj)
+    missing = [p for p in params if not re.search(r'\b%s\b' % re.escape(p), doc)]
+    assert not missing, '%s: the docstring does not mention %s' % (name, ', '.join(missing))
+    is_init = name.endswith('.__init__')
+    if _returns_something(obj) and not is_init:
+        assert re.search(r'\breturns?\b', doc, re.I), '%s: the docstring does not say what it returns' % name
+    if params and not (is_init and issubclass(getattr(amscr, name.split('.')[0]), Exception)):
+        assert re.search(r'\braises?\b', doc, re.I), '%s: the docstring does not say what it raises' % name

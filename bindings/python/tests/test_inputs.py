@@ -1,0 +1,154 @@
+"""Points as Python users have them: OpenCV contours ((n, 1, 2) int32, x-y) and scikit-image
+contours ((row, col) floats, order='rc'); r.matrix goes straight into cv2.warpAffine and
+skimage.transform.AffineTransform. The tests with OpenCV / scikit-image skip when those are absent."""
+import os
+
+import numpy as np
+import pytest
+
+import amscr
+from conftest import REPO_ROOT
+from helpers import A_TRUE, B_TRUE, affine, blob
+
+EXAMPLES = os.path.join(REPO_ROOT, 'examples')
+PAIR = [os.path.join(EXAMPLES, 'pair-%s.png' % w) for w in ('source', 'target')]
+needs_pair = pytest.mark.skipif(not all(os.path.exists(p) for p in PAIR),
+                                reason='the repository examples/pair-*.png are not here')
+
+
+def _pair_xy():
+    src = blob(300, seed=11)
+    return src, affine(src, A_TRUE, B_TRUE)
+
+
+def _opencv_like(xy):
+    """What cv2.findContours gives: (n, 1, 2) int32 of (x, y) pixel coordinates."""
+    return np.round(xy * 40 + 200).astype(np.int32).reshape(-1, 1, 2)
+
+
+def _iou(a, b):
+    a, b = np.asarray(a, dtype=bool), np.asarray(b, dtype=bool)
+    return (a & b).sum() / (a | b).sum()
+
+
+# -- without OpenCV / scikit-image ------------------------------------------------------------
+def test_matrix_is_homogeneous_3x3():
+    src, tgt = _pair_xy()
+    r = amscr.register(src, tgt)
+    assert r.matrix.shape == (3, 3)
+    assert np.array_equal(r.matrix[2], [0.0, 0.0, 1.0])
+    assert np.array_equal(r.matrix[:2, :2], r.A) and np.array_equal(r.matrix[:2, 2], r.B)
+    homog = np.column_stack([src, np.ones(len(src))]) @ r.matrix.T
+    assert np.allclose(homog[:, :2], r.apply(src)) and np.allclose(homog[:, 2], 1.0)
+    assert np.allclose(r.matrix[:2], np.column_stack([A_TRUE, B_TRUE]), atol=1e-3)
+
+
+def test_opencv_shaped_contours_are_accepted_everywhere():
+    src, tgt = _pair_xy()
+    cs, ct = _opencv_like(src), _opencv_like(tgt)
+    flat_s, flat_t = cs[:, 0, :].astype(float), ct[:, 0, :].astype(float)
+    assert np.array_equal(amscr.as_points(cs), flat_s)
+    r, r_flat = amscr.register(cs, ct), amscr.register(flat_s, flat_t)
+    assert np.array_equal(r.matrix, r_flat.matrix) and r.distance == r_flat.distance
+    assert amscr.distance(cs, ct) == amscr.distance(flat_s, flat_t)
+    assert np.array_equal(r.apply(cs), r.apply(flat_s))
+    assert np.array_equal(amscr.Shape(cs).points, amscr.Shape(flat_s).points)
+    db = amscr.Collection(points=64)
+    db.extend([cs, ct])
+    assert np.array_equal(db.query(cs), db.query(flat_s))
+    assert amscr.signed_area(cs) == amscr.signed_area(flat_s)
+    assert np.array_equal(amscr.smooth(cs, 2.0), amscr.smooth(flat_s, 2.0))
+    assert np.array_equal(amscr.distance_matrix([cs, ct], points=64), db.distance_matrix())
+
+
+BUILDING_BLOCKS = {
+    'orient_ccw': amscr.orient_ccw, 'validate_contour': amscr.validate_contour,
+    'resample_euclidean': lambda p: amscr.resample_euclidean(p, 40),
+    'resample_affine': lambda p: amscr.resample_affine(p, 40),
+    'affine_arclength': lambda p: amscr.affine_arclength(p)[0],
+    'normalize_whiten': lambda p: amscr.normalize_whiten(p)[0],
+    'affine_apply': lambda p: amscr.affine_apply(np.eye(3), p), 'affine_fit': lambda p: amscr.affine_fit(p, p)[0],
+}
+
+
+@pytest.mark.parametrize('name', sorted(BUILDING_BLOCKS))
+def test_building_blocks_take_opencv_contours(name, tmp_path):
+    c = _opencv_like(blob(120, seed=5))
+    fn = BUILDING_BLOCKS[name]
+    a, b = fn(c), fn(c[:, 0, :].astype(float))
+    assert (a is None and b is None) or np.array_equal(a, b)
+    amscr.write_points(tmp_path / 'c.txt', c)
+    assert np.array_equal(amscr.read_points(tmp_path / 'c.txt'), c[:, 0, :])
+
+
+def test_a_list_of_opencv_contours_is_refused_with_a_hint():
+    c = _opencv_like(blob(50))
+    with pytest.raises(amscr.InvalidArgumentError, match='OpenCV contours'):
+        amscr.register((c,), c)
+    with pytest.raises(amscr.InvalidArgumentError, match=r'\(n, 2\)'):
+        amscr.register(np.zeros((5, 2, 2)), c)
+
+
+def test_rc_order_is_the_swapped_xy():
+    src, tgt = _pair_xy()
+    src_rc, tgt_rc = src[:, ::-1].copy(), tgt[:, ::-1].copy()
+    r, r_rc = amscr.register(src, tgt), amscr.register(src_rc, tgt_rc, order='rc')
+    assert np.array_equal(r.matrix, r_rc.matrix) and r.distance == r_rc.distance
+    assert np.array_equal(r_rc.apply(src_rc, order='rc'), r.apply(src)[:, ::-1])
+    assert amscr.distance(src_rc, tgt_rc, order='rc') == amscr.distance(src, tgt)
+    assert np.array_equal(amscr.as_points(src_rc, order='rc'), src)
+    assert np.array_equal(amscr.Shape(src_rc, order='rc').points, amscr.Shape(src).points)
+    db, db_rc = amscr.Collection(points=64), amscr.Collection(points=64)
+    db.extend([src, tgt])
+    db_rc.extend([src_rc, tgt_rc], order='rc')
+    assert np.array_equal(db.distance_matrix(), db_rc.distance_matrix())
+    assert np.array_equal(db.query(tgt), db_rc.query(tgt_rc, order='rc'))
+    assert np.array_equal(amscr.distance_matrix([src_rc, tgt_rc], points=64, order='rc'), db.distance_matrix())
+
+
+@pytest.mark.parametrize('order', ['yx', 'RC', None, 1])
+def test_a_bad_order_is_refused(order):
+    src, tgt = _pair_xy()
+    with pytest.raises(amscr.InvalidArgumentError, match='order'):
+        amscr.register(src, tgt, order=order)
+    with pytest.raises(amscr.InvalidArgumentError, match='order'):
+        amscr.as_points(src, order=order)
+
+
+# -- with OpenCV ------------------------------------------------------------------------------
+@needs_pair
+@pytest.mark.parametrize('approx', ['CHAIN_APPROX_NONE', 'CHAIN_APPROX_SIMPLE'])
+def test_opencv_contours_register_and_warp_the_mask(approx):
+    cv2 = pytest.importorskip('cv2')
+    src_img, tgt_img = (cv2.imread(p, cv2.IMREAD_GRAYSCALE) for p in PAIR)
+    contours = []
+    for img in (src_img, tgt_img):
+        found = cv2.findContours((img > 127).astype(np.uint8), cv2.RETR_EXTERNAL, getattr(cv2, approx))[-2]
+        contours.append(max(found, key=cv2.contourArea))
+    assert contours[0].ndim == 3 and contours[0].shape[1:] == (1, 2)
+    r = amscr.register(*contours)  # as cv2 gives them
+    h, w = tgt_img.shape
+    warped = cv2.warpAffine(src_img, r.matrix[:2], (w, h), flags=cv2.INTER_NEAREST)
+    assert _iou(warped > 127, tgt_img > 127) > 0.95
+    # the map of examples/README.md
+    assert np.allclose(r.A, [[0.75, 0.35], [-0.2, 0.65]], atol=0.03)
+
+
+# -- with scikit-image ------------------------------------------------------------------------
+@needs_pair
+def test_skimage_contours_register_and_warp_the_mask():
+    pytest.importorskip('skimage')
+    from skimage import io, measure, transform
+    src_mask, tgt_mask = (io.imread(p) > 127 for p in PAIR)
+    src_rc, tgt_rc = (max(measure.find_contours(m.astype(float), 0.5), key=len) for m in (src_mask, tgt_mask))
+    r = amscr.register(src_rc, tgt_rc, order='rc')  # (row, col) -> x = col, y = row
+    tform = transform.AffineTransform(matrix=r.matrix)
+    warped = transform.warp(src_mask.astype(float), tform.inverse, output_shape=tgt_mask.shape, order=0)
+    assert _iou(warped > 0.5, tgt_mask) > 0.95
+    src_xy = src_rc[:, ::-1]  # skimage's transforms take (x, y) = (col, row), as amscr's maps
+    assert np.allclose(tform(src_xy), r.apply(src_xy))
+    assert np.allclose(r.apply(src_rc, order='rc'), r.apply(src_xy)[:, ::-1])
+    # (row, col) taken as (x, y) gives a map in the transposed frame: wrong for skimage's (x, y)
+    wrong = transform.AffineTransform(matrix=amscr.register(src_rc, tgt_rc).matrix)
+    warped_wrong = transform.warp(src_mask.astype(float), wrong.inverse, output_shape=tgt_mask.shape, order=0)
+    assert _iou(warped_wrong > 0.5, tgt_mask) < 0.8
