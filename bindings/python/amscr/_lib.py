@@ -1,13 +1,16 @@
 """Loads libamscr: API mode first (the compiled ``amscr._amscr``), ABI mode as the fallback.
 
+An installed package carries its own library: ``libamscr.so.<SOVERSION>`` sits beside this file,
+and the extension finds it through its ``$ORIGIN`` run path (a repaired manylinux wheel also
+carries OpenBLAS, LAPACKE and libpng in ``amscr.libs/``). Nothing points into a source tree.
+
 API mode is skipped when ``AMSCR_FORCE_ABI=1``. ABI mode ``dlopen``s, first match wins:
 
 1. ``AMSCR_LIBRARY`` when set (a path or a soname; nothing else is tried then);
-2. the versioned soname ``libamscr.so.<SOVERSION>`` (``libamscr.<SOVERSION>.dylib`` on macOS,
-   ``amscr-<SOVERSION>.dll`` on Windows) through the system's search path;
-3. unless ``AMSCR_USE_SYSTEM=1``: the library folders recorded when the package was built, and
-   the repository's Meson build folder (``build/``, or ``AMSCR_BUILD_DIR``) when the package is
-   used from the source tree.
+2. unless ``AMSCR_USE_SYSTEM=1``: the library bundled in the package, then the folder
+   ``AMSCR_BUILD_DIR`` (a Meson build folder, for running the package from a source tree);
+3. the versioned soname ``libamscr.so.<SOVERSION>`` (``libamscr.<SOVERSION>.dylib`` on macOS,
+   ``amscr-<SOVERSION>.dll`` on Windows) through the system's search path.
 
 Then the runtime version is checked against the header the bindings were generated from: the
 major must be equal and the minor at least as new (symbols are only ever added within a
@@ -41,19 +44,10 @@ def _soname():
 
 
 def _candidate_dirs():
-    dirs = []
-    try:
-        from . import _buildinfo  # written by setup.py
-        dirs += list(_buildinfo.LIBRARY_DIRS)
-    except ImportError:
-        pass
-    build = os.environ.get('AMSCR_BUILD_DIR') or os.path.join(_HERE, '..', '..', '..', 'build')
-    dirs.append(os.path.normpath(build))
-    out = []
-    for d in dirs:
-        if d not in out:
-            out.append(d)
-    return out
+    dirs = [_HERE]
+    if os.environ.get('AMSCR_BUILD_DIR'):
+        dirs.append(os.path.normpath(os.environ['AMSCR_BUILD_DIR']))
+    return dirs
 
 
 def _load_abi():
@@ -66,18 +60,19 @@ def _load_abi():
     if explicit:
         candidates = [explicit]
     else:
-        candidates = [_soname()]
+        candidates = []
         if not _flag('AMSCR_USE_SYSTEM'):
             candidates += [os.path.join(d, _soname()) for d in _candidate_dirs()
                            if os.path.exists(os.path.join(d, _soname()))]
+        candidates.append(_soname())
     errors = []
     for c in candidates:
         try:
             return ffi, ffi.dlopen(c), c
         except OSError as e:
             errors.append('%s: %s' % (c, e))
-    hint = ('set AMSCR_LIBRARY to the path of libamscr.so.%d, install libamscr, or build it with '
-            '`meson setup build && meson compile -C build` in the repository' % SOVERSION)
+    hint = ('reinstall the package (`pip install ./bindings/python` builds the library into it), '
+            'or set AMSCR_LIBRARY to the path of libamscr.so.%d' % SOVERSION)
     if not explicit and not _flag('AMSCR_USE_SYSTEM'):
         errors.append('%s in: %s (not there)' % (_soname(), ', '.join(_candidate_dirs())))
     raise ImportError('amscr: cannot load the C library (%s). Tried:\n  %s' % (hint, '\n  '.join(errors)))

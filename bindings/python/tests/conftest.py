@@ -1,10 +1,11 @@
-"""pytest setup: use the installed amscr if there is one, else the source tree with the in-tree library.
+"""pytest setup: use the installed amscr if there is one, else the source tree.
 
-* installed (``pip install ./bindings/python``): nothing to do;
-* not installed, or AMSCR_TEST_SOURCE=1 (meson test: always test the source tree against the
-  fresh build): bindings/python goes first on sys.path and, unless already set, AMSCR_LIBRARY
-  points at the repository's build/libamscr.so.0 (or AMSCR_BUILD_DIR's), so ABI mode finds it
-  (an in-place API-mode build, ``python amscr/_build.py``, is used when present).
+* installed (``pip install ./bindings/python``; ``meson test`` and ``tools/test.sh`` run the suite
+  in .venv with AMSCR_TEST_INSTALLED=1, which makes an amscr imported from this source tree an
+  error): nothing to do;
+* not installed, or AMSCR_TEST_SOURCE=1: bindings/python goes first on sys.path and, unless
+  already set, AMSCR_LIBRARY points at the repository's build/libamscr.so.0 (or AMSCR_BUILD_DIR's),
+  so ABI mode finds it.
 """
 import importlib.util
 import os
@@ -23,7 +24,11 @@ def _installed():
     return os.path.dirname(os.path.dirname(os.path.abspath(spec.origin))) != PKG_ROOT
 
 
-if os.environ.get('AMSCR_TEST_SOURCE', '') not in ('', '0') or not _installed():
+if os.environ.get('AMSCR_TEST_INSTALLED', '') not in ('', '0'):
+    if not _installed():
+        raise RuntimeError('AMSCR_TEST_INSTALLED is set but amscr is not installed in %s (tools/setup.sh '
+                           'installs it into .venv: pip install ./bindings/python)' % sys.executable)
+elif os.environ.get('AMSCR_TEST_SOURCE', '') not in ('', '0') or not _installed():
     if PKG_ROOT not in sys.path:
         sys.path.insert(0, PKG_ROOT)
     lib = os.path.join(BUILD_DIR, 'libamscr.so.0')

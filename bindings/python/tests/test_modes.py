@@ -61,7 +61,8 @@ def test_api_mode(here, tmp_path):
                 import _build
             finally:
                 sys.path.pop(0)
-            ffibuilder = _build.make_ffibuilder()
+            from conftest import BUILD_DIR, REPO_ROOT
+            ffibuilder = _build.make_ffibuilder([os.path.join(REPO_ROOT, 'include')], [BUILD_DIR])
         except Exception as e:
             pytest.skip('cannot set up the API-mode build: %s' % e)
         if not (shutil.which('cc') or shutil.which('gcc')):
