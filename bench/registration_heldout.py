@@ -118,7 +118,7 @@ def amscr_register(src, tgt, partial, mode):
 
 
 # ------------------------------------------------------------------------ ECC
-CANVAS = 160
+CANVAS = 400
 
 
 def render(xy, cv2):
@@ -129,7 +129,7 @@ def render(xy, cv2):
     P = np.array([[s, 0, off[0]], [0, s, off[1]]])
     img = np.zeros((CANVAS, CANVAS), np.uint8)
     cv2.fillPoly(img, [np.round(apply(P, xy) * 16).astype(np.int32)], 255, lineType=cv2.LINE_AA, shift=4)
-    return cv2.GaussianBlur(img, (0, 0), 2.0).astype(np.float32) / 255.0, P
+    return cv2.GaussianBlur(img, (0, 0), 4.0).astype(np.float32) / 255.0, P
 
 
 def inv_affine(P):

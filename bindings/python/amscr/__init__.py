@@ -119,11 +119,12 @@ class Params:
     ``threads``         threads of batch calls (0 = all cores)
     ``invariance``      'affine' (default), 'similarity' or 'penalized'
     ``penalty``         weight of the 'penalized' invariance
+    ``partial``         the source is an open fragment of the target's closed boundary (register)
     """
 
     OPTIONS = ('points', 'scales', 'method', 'closed', 'reflections', 'parametrization', 'presmooth',
                'arclength_passes', 'oversampling', 'kmax', 'symmetric', 'refine', 'threads', 'invariance',
-               'penalty')
+               'penalty', 'partial')
 
     def __init__(self, **options: Any):
         out = ffi.new('amscr_params **')
@@ -324,6 +325,14 @@ class Params:
     @penalty.setter
     def penalty(self, v: float) -> None:
         _check(lib.amscr_params_set_penalty(self._p, as_scalar(v, 'penalty')))
+
+    @property
+    def partial(self) -> bool:
+        return bool(lib.amscr_params_get_partial(self._p))
+
+    @partial.setter
+    def partial(self, v: bool) -> None:
+        _check(lib.amscr_params_set_partial(self._p, 1 if v else 0))
 
 
 def _uint(v: Any, name: str) -> int:
@@ -601,6 +610,16 @@ class Registration:
         shift: start shift (source sample a <-> target sample (a + shift) mod N).
         reflected: True when the match used the mirrored target.
         method: the method used.
+        confidence: how sure the map is, in [0, 1] ((1 - ambiguity) x inlier_fraction; reject
+            maps below about 0.25 — see the README's accuracy section).
+        ambiguity: cost of the chosen map over that of the best clearly different candidate
+            (1: a symmetric shape or a fragment that fits several places).
+        inlier_fraction: share of source samples within 5 % of the target's size of its boundary.
+        part: (start, end) fractions of the target's boundary the source's first and last samples
+            fall on (where a fragment lies, with partial=True).
+        correspondences: (N,) target boundary parameter (fraction) matched to each source sample.
+        source_samples: (N, 2) the source samples (input coordinates).
+        target_points: (N, 2) the matched target boundary points (input coordinates).
     """
 
     def __init__(self, handle, scales: np.ndarray):
@@ -632,6 +651,19 @@ class Registration:
             _check(lib.amscr_result_mixture(r, dbuf(w), dbuf(m), dbuf(v), n))
         self.mixture = Mixture(w, m, v)
         self.threshold = float(lib.amscr_result_threshold(r))
+        self.confidence = float(lib.amscr_result_confidence(r))
+        self.ambiguity = float(lib.amscr_result_ambiguity(r))
+        self.inlier_fraction = float(lib.amscr_result_inlier_fraction(r))
+        part = ffi.new('double[2]')
+        _check(lib.amscr_result_part(r, part, part + 1))
+        self.part = (float(part[0]), float(part[1]))
+        n = ffi.new('size_t *', 0)
+        _check(lib.amscr_result_correspondences(r, ffi.NULL, ffi.NULL, ffi.NULL, n))
+        m = int(n[0])
+        src, par, tgt = np.zeros((m, 2)), np.zeros(m), np.zeros((m, 2))
+        if m:
+            _check(lib.amscr_result_correspondences(r, dbuf(src), dbuf(par), dbuf(tgt), n))
+        self.source_samples, self.correspondences, self.target_points = src, par, tgt
 
     def apply(self, points: ArrayLike) -> np.ndarray:
         """The registered source: ``points @ A.T + B`` for (n, 2) points in source coordinates."""
@@ -651,6 +683,8 @@ def _pair(src: PointsLike, tgt: PointsLike, params: Optional[Params], options: D
         # prepared shapes bring their own settings; raw points get the registration preset
         base = first.params if first is not None else Params.registration()
     p = _make_params(base, options)
+    if p.partial:  # the source prepared open, the target closed
+        return p, _as_shape(src, p.copy(closed=False), 'src'), _as_shape(tgt, p.copy(closed=True), 'tgt')
     return p, _as_shape(src, p, 'src'), _as_shape(tgt, p, 'tgt')
 
 
