@@ -212,6 +212,13 @@ static void crit_newton(const amscr_descriptor *f, int use_finest, const double 
     *d2 = -2.0 * (t2 + t3);
 }
 
+/* Newton on the shift: an integer local minimum's basin is one sample wide, so a step stays
+ * within half a sample; two passes reach well below a sample from the parabola's vertex; a
+ * step under a thousandth of a sample has converged. */
+#define AMSCR__SHIFT_MAX_STEP 0.5
+#define AMSCR__SHIFT_PASSES 2
+#define AMSCR__SHIFT_TOL 1e-3
+
 /* Refinement of an integer shift s (a local minimum of the criterion) to a continuous one
  * by Newton's method with exact derivatives (at most two passes, steps within ±0.5; the last
  * step is taken with its quadratic prediction of the criterion, which only ranks candidates —
@@ -225,9 +232,10 @@ static double refine_shift(const amscr_descriptor *f, int use_finest, const doub
     double cm = ws->crit[(s + n - 1) % n], cp = ws->crit[(s + 1) % n], curv = cp - 2.0 * best_v + cm;
     if (curv > 0.0) {
         double step = -0.5 * (cp - cm) / curv;
-        x += step > 0.5 ? 0.5 : (step < -0.5 ? -0.5 : step);
+        x += step > AMSCR__SHIFT_MAX_STEP ? AMSCR__SHIFT_MAX_STEP
+                                          : (step < -AMSCR__SHIFT_MAX_STEP ? -AMSCR__SHIFT_MAX_STEP : step);
     }
-    for (int it = 0; it < 2; it++) {
+    for (int it = 0; it < AMSCR__SHIFT_PASSES; it++) {
         double v, d1, d2;
         crit_newton(f, use_finest, Si, ws, x, &v, &d1, &d2);
         if (v <= best_v) {
@@ -242,17 +250,17 @@ static double refine_shift(const amscr_descriptor *f, int use_finest, const doub
         if (!(d2 > 0.0))
             break;
         double step = -d1 / d2;
-        if (step > 0.5)
-            step = 0.5;
-        if (step < -0.5)
-            step = -0.5;
+        if (step > AMSCR__SHIFT_MAX_STEP)
+            step = AMSCR__SHIFT_MAX_STEP;
+        if (step < -AMSCR__SHIFT_MAX_STEP)
+            step = -AMSCR__SHIFT_MAX_STEP;
         x += step;
-        if (fabs(step) < 1e-3) { /* converged to well below a sample: take the step as is */
+        if (fabs(step) < AMSCR__SHIFT_TOL) { /* converged to well below a sample: take the step as is */
             best_v = v + 0.5 * d1 * step;
             best_x = x;
             break;
         }
-        if (it == 1) { /* no pass left: accept the Newton prediction only if it is lower */
+        if (it == AMSCR__SHIFT_PASSES - 1) { /* no pass left: accept the Newton prediction only if lower */
             double pred = v + d1 * step + 0.5 * d2 * step * step;
             if (pred < best_v) {
                 best_v = pred;
