@@ -73,8 +73,16 @@ static int32_t class_index(collection *c, const char *cls, size_t *cap)
     return (int32_t)c->nclasses++;
 }
 
-static int add_item(collection *c, size_t *icap, size_t *ccap, char *path, char *name, const char *cls)
+/* Appends the entry `entry` (a name in dir's listing or a manifest's file column) of class cls. */
+static int add_item(collection *c, size_t *icap, size_t *ccap, const char *dir, const char *entry, const char *cls)
 {
+    char *path = path_join(dir, entry);
+    char *name = xstrdup(entry);
+    if (path == NULL || name == NULL) {
+        free(path);
+        free(name);
+        return -1;
+    }
     int32_t label = class_index(c, cls, ccap);
     if (label < 0) {
         free(path);
@@ -160,15 +168,7 @@ static int open_folder(const char *dir, collection *c)
     for (size_t i = 0; ok && i < n; i++) {
         char cls[256];
         class_from_name(names[i], cls, sizeof cls);
-        char *path = path_join(dir, names[i]);
-        char *name = xstrdup(names[i]);
-        if (path == NULL || name == NULL) {
-            free(path);
-            free(name);
-            ok = 0;
-            break;
-        }
-        if (add_item(c, &icap, &ccap, path, name, cls) != 0)
+        if (add_item(c, &icap, &ccap, dir, names[i], cls) != 0)
             ok = 0;
     }
     for (size_t i = 0; i < n; i++)
@@ -287,15 +287,7 @@ static int open_manifest(const char *mpath, collection *c)
             ok = 0;
             break;
         }
-        char *path = path_join(dir, f[fcol]);
-        char *name = xstrdup(f[fcol]);
-        if (path == NULL || name == NULL) {
-            free(path);
-            free(name);
-            ok = 0;
-            break;
-        }
-        if (add_item(c, &icap, &ccap, path, name, f[ccol]) != 0)
+        if (add_item(c, &icap, &ccap, dir, f[fcol], f[ccol]) != 0)
             ok = 0;
     }
     if (ok && ferror(fp)) {

@@ -285,10 +285,10 @@ static void to_luminance_row(const uint8_t *src, int channels, size_t w, uint8_t
     }
 }
 
-static int read_png(FILE *fp, const char *path, tool_image *out)
+/* The size limits are checked from IHDR before libpng reads on (a file truncated right after
+ * a huge IHDR is "too large", not "truncated"). Leaves fp rewound. */
+static int png_check_ihdr(FILE *fp, const char *path)
 {
-    /* The size limits are checked from IHDR before libpng reads on (a file truncated
-     * right after a huge IHDR is "too large", not "truncated"). */
     unsigned char head[24];
     if (fread(head, 1, sizeof head, fp) == sizeof head && memcmp(head + 12, "IHDR", 4) == 0) {
         size_t w = ((size_t)head[16] << 24) | ((size_t)head[17] << 16) | ((size_t)head[18] << 8) | head[19];
@@ -297,6 +297,56 @@ static int read_png(FILE *fp, const char *path, tool_image *out)
             return -1;
     }
     rewind(fp);
+    return 0;
+}
+
+/* Asks libpng for 8-bit gray or RGB, with alpha when the file has any; returns the number of
+ * interlace passes. */
+static int png_set_transforms(png_structp png, png_infop info)
+{
+    int color = png_get_color_type(png, info);
+    int depth = png_get_bit_depth(png, info);
+    if (color == PNG_COLOR_TYPE_PALETTE)
+        png_set_palette_to_rgb(png);
+    if (color == PNG_COLOR_TYPE_GRAY && depth < 8)
+        png_set_expand_gray_1_2_4_to_8(png);
+    if (png_get_valid(png, info, PNG_INFO_tRNS))
+        png_set_tRNS_to_alpha(png);
+    if (depth == 16) {
+#if defined(PNG_READ_SCALE_16_TO_8_SUPPORTED)
+        png_set_scale_16(png);
+#else
+        png_set_strip_16(png);
+#endif
+    }
+    int passes = png_set_interlace_handling(png);
+    png_read_update_info(png, info);
+    return passes;
+}
+
+/* Reads the pixels into lum (and alpha): an interlaced image whole into buf (rows[] pointing
+ * into it: libpng fills it over 7 passes), else row by row through buf. */
+static void png_read_pixels(png_structp png, int passes, uint8_t *buf, png_bytep *rows, size_t rowbytes,
+                            int channels, size_t w, size_t h, uint8_t *lum, uint8_t *alpha)
+{
+    if (passes > 1) {
+        for (size_t y = 0; y < h; y++)
+            rows[y] = buf + y * rowbytes;
+        png_read_image(png, rows);
+        for (size_t y = 0; y < h; y++)
+            to_luminance_row(rows[y], channels, w, lum + y * w, alpha ? alpha + y * w : NULL);
+        return;
+    }
+    for (size_t y = 0; y < h; y++) {
+        png_read_row(png, buf, NULL);
+        to_luminance_row(buf, channels, w, lum + y * w, alpha ? alpha + y * w : NULL);
+    }
+}
+
+static int read_png(FILE *fp, const char *path, tool_image *out)
+{
+    if (png_check_ihdr(fp, path) != 0)
+        return -1;
     png_ctx ctx;
     ctx.fp = fp;
     ctx.truncated = 0;
@@ -343,24 +393,7 @@ static int read_png(FILE *fp, const char *path, tool_image *out)
         limit_failed = 1;
         png_longjmp(png, 1);
     }
-    int color = png_get_color_type(png, info);
-    int depth = png_get_bit_depth(png, info);
-    if (color == PNG_COLOR_TYPE_PALETTE)
-        png_set_palette_to_rgb(png);
-    if (color == PNG_COLOR_TYPE_GRAY && depth < 8)
-        png_set_expand_gray_1_2_4_to_8(png);
-    if (png_get_valid(png, info, PNG_INFO_tRNS))
-        png_set_tRNS_to_alpha(png);
-    if (depth == 16) {
-#if defined(PNG_READ_SCALE_16_TO_8_SUPPORTED)
-        png_set_scale_16(png);
-#else
-        png_set_strip_16(png);
-#endif
-    }
-    int passes = png_set_interlace_handling(png);
-    png_read_update_info(png, info);
-
+    int passes = png_set_transforms(png, info);
     int channels = png_get_channels(png, info);
     size_t rowbytes = png_get_rowbytes(png, info);
     if (png_get_bit_depth(png, info) != 8 || channels < 1 || channels > 4 || rowbytes != (size_t)w * (size_t)channels) {
@@ -376,34 +409,21 @@ static int read_png(FILE *fp, const char *path, tool_image *out)
         snprintf(ctx.msg, sizeof ctx.msg, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
         png_longjmp(png, 1);
     }
-    if (passes > 1) {
-        /* Adam7: libpng fills a whole image over 7 passes. */
-        if (rowbytes > SIZE_MAX / h) {
-            snprintf(ctx.msg, sizeof ctx.msg, "image too large");
-            png_longjmp(png, 1);
-        }
-        buf = malloc(rowbytes * h);
-        rows = malloc(sizeof(png_bytep) * h);
-        if (buf == NULL || rows == NULL) {
-            snprintf(ctx.msg, sizeof ctx.msg, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
-            png_longjmp(png, 1);
-        }
-        for (size_t y = 0; y < h; y++)
-            rows[y] = buf + y * rowbytes;
-        png_read_image(png, rows);
-        for (size_t y = 0; y < h; y++)
-            to_luminance_row(rows[y], channels, w, lum + y * w, has_alpha ? alpha + y * w : NULL);
-    } else {
-        buf = malloc(rowbytes);
-        if (buf == NULL) {
-            snprintf(ctx.msg, sizeof ctx.msg, "out of memory");
-            png_longjmp(png, 1);
-        }
-        for (size_t y = 0; y < h; y++) {
-            png_read_row(png, buf, NULL);
-            to_luminance_row(buf, channels, w, lum + y * w, has_alpha ? alpha + y * w : NULL);
-        }
+    if (passes > 1 && rowbytes > SIZE_MAX / h) {
+        snprintf(ctx.msg, sizeof ctx.msg, "image too large");
+        png_longjmp(png, 1);
     }
+    buf = malloc(passes > 1 ? rowbytes * h : rowbytes);
+    if (passes > 1)
+        rows = malloc(sizeof(png_bytep) * h);
+    if (buf == NULL || (passes > 1 && rows == NULL)) {
+        if (passes > 1)
+            snprintf(ctx.msg, sizeof ctx.msg, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
+        else
+            snprintf(ctx.msg, sizeof ctx.msg, "out of memory");
+        png_longjmp(png, 1);
+    }
+    png_read_pixels(png, passes, buf, rows, rowbytes, channels, w, h, lum, alpha);
     /* The image data is complete; the chunks after it are not needed. */
     if (has_alpha)
         apply_alpha(lum, alpha, npix);

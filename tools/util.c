@@ -267,46 +267,18 @@ void sb_puts(sbuf *b, const char *s)
     b->len += n;
 }
 
-void sb_json_num(sbuf *b, double v)
+int sb_write_stdout(const sbuf *b)
 {
-    if (!isfinite(v)) {
-        sb_puts(b, "null");
-        return;
+    if (b->oom) {
+        tool_error(NULL, "out of memory");
+        return -1;
     }
-    if (v == 0.0) { /* also -0 */
-        sb_puts(b, "0");
-        return;
+    fputs(b->s, stdout);
+    if (fflush(stdout) != 0) {
+        tool_error("<stdout>", "write error: %s", strerror(errno));
+        return -1;
     }
-    /* Shortest of %.15g..%.17g that reads back exactly. */
-    char buf[40];
-    for (int prec = 15; prec <= 17; prec++) {
-        snprintf(buf, sizeof buf, "%.*g", prec, v);
-        if (strtod(buf, NULL) == v)
-            break;
-    }
-    sb_puts(b, buf);
-}
-
-void sb_json_str(sbuf *b, const char *s)
-{
-    sb_puts(b, "\"");
-    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-        switch (*p) {
-        case '"': sb_puts(b, "\\\""); break;
-        case '\\': sb_puts(b, "\\\\"); break;
-        case '\n': sb_puts(b, "\\n"); break;
-        case '\r': sb_puts(b, "\\r"); break;
-        case '\t': sb_puts(b, "\\t"); break;
-        default:
-            if (*p < 0x20)
-                sb_printf(b, "\\u%04x", *p);
-            else {
-                char c[2] = {(char)*p, 0};
-                sb_puts(b, c);
-            }
-        }
-    }
-    sb_puts(b, "\"");
+    return 0;
 }
 
 const char *fmt_num(char buf[32], double v)

@@ -1,5 +1,5 @@
 /* util.h — small helpers of the amscr command-line tool: one-line error reporting,
- * atomic output files, growable strings, JSON number/string printing, progress lines.
+ * atomic output files, growable strings, progress lines (JSON printing: json.h).
  * Tool-internal: uses the public amscr.h only. */
 #ifndef AMSCR_TOOL_UTIL_H
 #define AMSCR_TOOL_UTIL_H
@@ -63,10 +63,9 @@ void sb_init(sbuf *b);
 void sb_free(sbuf *b);
 void sb_printf(sbuf *b, const char *fmt, ...) TOOL_PRINTF(2, 3);
 void sb_puts(sbuf *b, const char *s);
-/* JSON helpers: finite numbers as %.17g (shortest round-trip is not in C99), non-finite
- * as null; strings escaped. */
-void sb_json_num(sbuf *b, double v);
-void sb_json_str(sbuf *b, const char *s);
+/* Prints b on stdout and flushes: 0, or -1 after printing "out of memory" (b ran out) or
+ * "<stdout>: write error: ..." (a command's whole output is built first, then written once). */
+int sb_write_stdout(const sbuf *b);
 
 /* Formats a number compactly for humans ("%.6g"). */
 const char *fmt_num(char buf[32], double v);

@@ -1,0 +1,126 @@
+/* cmd_search.c — `amscr search QUERY COLLECTION`: the closest shapes of a collection. */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amscr.h"
+#include "cli.h"
+#include "collection.h"
+#include "image.h"
+#include "json.h"
+#include "params.h"
+#include "retrieval.h"
+
+/* The distances from the query dq to every shape of db (n of them) into dist: plain, or read
+ * from the re-ranked matrix of the collection plus the query (dq is added to db). */
+static int query_distances(amscr_db *db, const amscr_descriptor *dq, const char *qpath, const char *cpath,
+                           const opts *o, double *dist)
+{
+    size_t n = amscr_db_size(db);
+    if (o->rerank_k > 0) {
+        /* contextual re-ranking needs the whole matrix of the collection and the query */
+        double *full = NULL;
+        if (amscr_db_add_descriptor(db, dq, -1, NULL) != AMSCR_OK) {
+            tool_lib_error(qpath, AMSCR_E_NOMEM);
+            return -1;
+        }
+        if (compute_matrix(db, cpath, o, &full) != 0)
+            return -1;
+        for (size_t j = 0; j < n; j++)
+            dist[j] = full[n * (n + 1) + j]; /* the query's row (last), collection columns */
+        free(full);
+        return 0;
+    }
+    tool_progress pr;
+    progress_init(&pr, "matching");
+    amscr_status st = amscr_db_query(db, dq, progress_cb, &pr, dist);
+    progress_end(&pr);
+    if (st != AMSCR_OK) {
+        tool_lib_error(qpath, st);
+        return -1;
+    }
+    return 0;
+}
+
+/* The k results idx[] of n (distances dist) as text or JSON. */
+static void format_results(sbuf *b, const opts *o, const collection *c, const double *dist, const size_t *idx,
+                           size_t k, size_t n, double secs)
+{
+    const char *qpath = o->pos[0], *cpath = o->pos[1];
+    if (o->json) {
+        sb_puts(b, "{\"query\": ");
+        sb_json_str(b, qpath);
+        sb_puts(b, ", \"collection\": ");
+        sb_json_str(b, cpath);
+        sb_printf(b, ", \"n\": %zu, \"results\": [", n);
+        for (size_t i = 0; i < k; i++) {
+            const coll_item *it = &c->items[idx[i]];
+            sb_printf(b, "%s{\"rank\": %zu, \"index\": %zu, \"file\": ", i ? ", " : "", i + 1, idx[i]);
+            sb_json_str(b, it->name);
+            sb_puts(b, ", \"class\": ");
+            sb_json_str(b, c->classes[it->label]);
+            sb_puts(b, ", \"distance\": ");
+            sb_json_num(b, dist[idx[i]]);
+            sb_puts(b, "}");
+        }
+        sb_puts(b, "], \"seconds\": ");
+        sb_json_num(b, secs);
+        sb_puts(b, "}\n");
+        return;
+    }
+    sb_printf(b, "query %s against %s (%zu shapes, %.2f s)\n", qpath, cpath, n, secs);
+    sb_printf(b, "%4s  %-12s  %-16s  %s\n", "rank", "distance", "class", "file");
+    char d1[32];
+    for (size_t i = 0; i < k; i++) {
+        const coll_item *it = &c->items[idx[i]];
+        sb_printf(b, "%4zu  %-12s  %-16s  %s\n", i + 1, fmt_num(d1, dist[idx[i]]), c->classes[it->label], it->name);
+    }
+}
+
+int cmd_search(opts *o)
+{
+    const char *qpath = o->pos[0], *cpath = o->pos[1];
+    amscr_params *p = NULL;
+    collection c;
+    amscr_db *db = NULL;
+    amscr_contour *q = NULL;
+    amscr_descriptor *dq = NULL;
+    double *dist = NULL;
+    size_t *idx = NULL;
+    int ret = TOOL_EXIT_FAIL;
+    sbuf b;
+    sb_init(&b);
+    memset(&c, 0, sizeof c);
+    double t0 = now_seconds();
+
+    int r = make_params(o, 0, &p);
+    if (r != 0)
+        return r;
+    if (shape_load(qpath, o->threshold, &q) != 0 || collection_open(cpath, &c) != 0 ||
+        load_db(p, &c, o->threshold, &db) != 0 || prepare(amscr_db_params(db), qpath, q, &dq) != 0)
+        goto done;
+    size_t n = amscr_db_size(db);
+    dist = xmalloc_array(n, sizeof(double));
+    size_t k = o->top < n ? o->top : n;
+    idx = xmalloc_array(k ? k : 1, sizeof(size_t));
+    if (dist == NULL || idx == NULL || query_distances(db, dq, qpath, cpath, o, dist) != 0)
+        goto done;
+    amscr_status st = amscr_topk(dist, n, k, SIZE_MAX, idx);
+    if (st != AMSCR_OK) {
+        tool_lib_error(qpath, st);
+        goto done;
+    }
+    format_results(&b, o, &c, dist, idx, k, n, now_seconds() - t0);
+    if (sb_write_stdout(&b) == 0)
+        ret = TOOL_EXIT_OK;
+done:
+    sb_free(&b);
+    free(dist);
+    free(idx);
+    amscr_descriptor_free(dq);
+    amscr_contour_free(q);
+    amscr_db_free(db);
+    collection_free(&c);
+    amscr_params_free(p);
+    return ret;
+}
