@@ -799,7 +799,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_rerank_diffusion(const double *dist
  *        partial=True) prepare the source open and the target closed whatever `closed` says;
  *        with amscr_register the descriptors must have been prepared that way. Fragments of at
  *        least half the boundary register reliably; shorter ones are often ambiguous, which
- *        amscr_result_confidence reports. @since 0.2
+ *        amscr_result_confidence reports. A partial match has no per-scale systems: its
+ *        residuals are 0, no scale is kept, the threshold is +inf. @since 0.2
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_partial(amscr_params *p, int on);
 /** @brief The partial flag (0 for NULL). @since 0.2 */

@@ -170,7 +170,7 @@ size_t amscr__densify(const double *H, size_t n, int closed, double *out);
 /* The trimmed point-to-line solve (affine invariance; the other groups: point-to-point) of the
  * pairs f_a -> q_a with r2_a <= cut, seg_a the dense target edge of q_a. Returns 0 if singular. */
 int amscr__plane_solve(const amscr_params *prm, const double *f, const double *q, const double *r2,
-                       const size_t *seg, const double *Hd, size_t nd, size_t n, double cut, double X[6]);
+                       const double *seg, const double *Hd, size_t nd, size_t n, double cut, double X[6]);
 /* Mean squared displacement between the maps X1 and X2 over the samples of f's base level. */
 double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6]);
 /* A candidate map differing from the chosen one by more than this RMS displacement (10 % of

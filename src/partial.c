@@ -141,15 +141,15 @@ static void keep_placement(placement *best, size_t *nb, const placement *c)
 /* One closest-point pass: partners of X f_a on the dense target Hd (nd edges, closed) within
  * b[a] ± w; q, r2, b updated; returns the trimmed cost, *cut its cut-off. */
 static double pairs(const amscr_descriptor *f, const double *Hd, size_t nd, const double X[6], size_t w, double *q,
-                    double *r2, double *sorted, size_t *b, double *cut)
+                    double *r2, double *sorted, double *b, double *cut)
 {
     size_t n = f->n;
     for (size_t a = 0; a < n; a++) {
         double fx = f->base[2 * a], fy = f->base[2 * a + 1];
         double px = X[0] * fx + X[1] * fy + X[2], py = X[3] * fx + X[4] * fy + X[5];
-        size_t seg = b[a];
-        r2[a] = amscr__closest_on_polygon(Hd, nd, 1, b[a], w, px, py, &q[2 * a], &q[2 * a + 1], &seg);
-        b[a] = seg;
+        size_t seg = (size_t)b[a];
+        r2[a] = amscr__closest_on_polygon(Hd, nd, 1, seg, w, px, py, &q[2 * a], &q[2 * a + 1], &seg);
+        b[a] = (double)seg;
         sorted[a] = r2[a];
     }
     size_t keep = (size_t)(PART_TRIM * (double)n);
@@ -164,7 +164,7 @@ static double pairs(const amscr_descriptor *f, const double *Hd, size_t nd, cons
 /* Trimmed closest-point refinement of placement pl (X in/out); returns the trimmed cost.
  * b: the initial partners (dense edge per sample), updated. */
 static double refine_placement(const amscr_params *prm, const amscr_descriptor *f, const double *Hd, size_t nd,
-                               double X[6], size_t *b, double *q, double *r2, double *sorted, double *out_cut)
+                               double X[6], double *b, double *q, double *r2, double *sorted, double *out_cut)
 {
     size_t n = f->n, wide = AMSCR__DENSE * (n / PART_WINDOW_DIV), near = AMSCR__DENSE * PART_HINT;
     double cut, cost = pairs(f, Hd, nd, X, wide, q, r2, sorted, b, &cut);
@@ -187,7 +187,7 @@ static double refine_placement(const amscr_params *prm, const amscr_descriptor *
 /* Partners (dense target edges) of the samples under placement pl: sample a at fragment
  * position u_a -> uniform target index s ± phi U u_a -> its dense edge. */
 static void initial_partners(const placement *pl, const double *cumF, double LF, const double *Hp, size_t n,
-                             size_t nd, size_t *b)
+                             size_t nd, double *b)
 {
     for (size_t a = 0; a < n; a++) {
         double off = pl->phi * (double)PART_U * cumF[a] / LF;
@@ -196,7 +196,7 @@ static void initial_partners(const placement *pl, const double *cumF, double LF,
         if (i < 0.0)
             i += (double)PART_U;
         size_t ii = (size_t)(i + 0.5) % PART_U;
-        b[a] = (size_t)(Hp[ii] * (double)nd) % nd;
+        b[a] = (double)((size_t)(Hp[ii] * (double)nd) % nd);
     }
 }
 
@@ -226,11 +226,15 @@ amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descripto
                                   amscr_workspace *ws, match_t *m)
 {
     size_t n = f->n;
+    /* no per-scale systems here: the scale diagnostics are zero, nothing kept, no threshold */
+    memset(m, 0, sizeof *m);
+    m->p = f->p;
+    m->threshold = INFINITY;
     amscr_status st = amscr__ws_reserve_refine(ws, n);
     if (st != AMSCR_OK)
         return st;
     double *buf = amscr__malloc_array(6 * n + 2 * PART_K + 3 * PART_U, sizeof *buf);
-    size_t *b = amscr__malloc_array(n, sizeof *b);
+    double *b = amscr__malloc_array(n, sizeof *b);
     if (!buf || !b) {
         free(buf);
         free(b);

@@ -200,7 +200,7 @@ amscr_status amscr__refine_match(const amscr_params *prm, const amscr_descriptor
         iters = 0;
     for (unsigned it = 0; it < iters; it++) {
         double Xn[6], cutn;
-        if (!trimmed_solve(prm, f->base, q, r2, n, cut, Xn))
+        if (!amscr__plane_solve(prm, f->base, q, r2, hints, Hd, nd, n, cut, Xn))
             break;
         memcpy(hints2, hints, n * sizeof *hints);
         double costn = icp_pairs(f, Hd, nd, m, Xn, q2, r2, sorted, hints2, 1, &cutn);
@@ -259,7 +259,7 @@ size_t amscr__densify(const double *H, size_t n, int closed, double *out) { retu
 #define AMSCR__PLANE_MU 0.1
 
 int amscr__plane_solve(const amscr_params *prm, const double *f, const double *q, const double *r2,
-                       const size_t *seg, const double *Hd, size_t nd, size_t n, double cut, double X[6])
+                       const double *seg, const double *Hd, size_t nd, size_t n, double cut, double X[6])
 {
     if (prm->invariance != AMSCR_INVARIANCE_AFFINE)
         return trimmed_solve(prm, f, q, r2, n, cut, X);
@@ -267,7 +267,7 @@ int amscr__plane_solve(const amscr_params *prm, const double *f, const double *q
     for (size_t a = 0; a < n; a++) {
         if (r2[a] > cut)
             continue;
-        size_t s = seg[a], c = s + 1 == nd ? 0 : s + 1;
+        size_t s = (size_t)seg[a], c = s + 1 == nd ? 0 : s + 1;
         double tx = Hd[2 * c] - Hd[2 * s], ty = Hd[2 * c + 1] - Hd[2 * s + 1], tl = sqrt(tx * tx + ty * ty);
         double nx = tl > 0.0 ? -ty / tl : 0.0, ny = tl > 0.0 ? tx / tl : 0.0;
         double x = f[2 * a], y = f[2 * a + 1], qx = q[2 * a], qy = q[2 * a + 1], nq = nx * qx + ny * qy;
