@@ -176,6 +176,9 @@ double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const doub
 /* A candidate map differing from the chosen one by more than this RMS displacement (10 % of
  * the normalized frame's RMS radius sqrt 2) is a different answer for the ambiguity. */
 #define AMSCR__DISTINCT_GAP2 0.02
+/* Cost differences below an RMS misfit of 0.5 % of the RMS radius are no evidence for one map
+ * over another: the ambiguity compares (cost + floor) of the two. */
+#define AMSCR__AMBIGUITY_FLOOR (0.005 * 0.005 * 2.0)
 
 /* partial.c: source f an open fragment of the closed target h: the whole search and refinement
  * into m (refined; ws->rbuf holds the final closest-point pairs as after amscr__refine_match). */

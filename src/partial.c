@@ -280,7 +280,7 @@ amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descripto
     m->ambiguity = 0.0;
     for (size_t c = 0; c < nb; c++)
         if (c != win && amscr__map_gap2(f, best[c].X, best[win].X) > AMSCR__DISTINCT_GAP2) {
-            double ratio = best[c].tcost > 0.0 ? best[win].tcost / best[c].tcost : 1.0;
+            double ratio = (best[win].tcost + AMSCR__AMBIGUITY_FLOOR) / (best[c].tcost + AMSCR__AMBIGUITY_FLOOR);
             if (ratio > m->ambiguity)
                 m->ambiguity = ratio > 1.0 ? 1.0 : ratio;
         }

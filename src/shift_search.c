@@ -404,7 +404,7 @@ static double ambiguity_of(const amscr_descriptor *f, double X[][6], const doubl
     for (size_t i = 0; i < count; i++) {
         if (i == best || !(amscr__map_gap2(f, X[i], X[best]) > AMSCR__DISTINCT_GAP2))
             continue;
-        double r = score[i] > 0.0 ? score[best] / score[i] : 1.0;
+        double r = (score[best] + AMSCR__AMBIGUITY_FLOOR) / (score[i] + AMSCR__AMBIGUITY_FLOOR);
         if (r > amb)
             amb = r > 1.0 ? 1.0 : r;
     }
