@@ -786,6 +786,72 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_nn_split(const double *dist, 
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k,
                                                               unsigned iterations, double *out_dist);
 
+/* ======================================================================
+ * Robust and partial registration, confidence, dense correspondences (0.2)
+ * ====================================================================== */
+
+/**
+ * @brief Partial matching (default 0): the source is an open fragment of the target's closed
+ *        boundary. amscr_register then searches where on the target the fragment lies (its start
+ *        and its length, in affine arc length, which an affine map preserves up to one factor),
+ *        refines the map by trimmed closest points, and reports the place
+ *        (amscr_result_part). amscr_register_contours (and the tool's --partial, Python's
+ *        partial=True) prepare the source open and the target closed whatever `closed` says;
+ *        with amscr_register the descriptors must have been prepared that way. Fragments of at
+ *        least half the boundary register reliably; shorter ones are often ambiguous, which
+ *        amscr_result_confidence reports. A partial match has no per-scale systems: its
+ *        residuals are 0, no scale is kept, the threshold is +inf. @since 0.2
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_partial(amscr_params *p, int on);
+/** @brief The partial flag (0 for NULL). @since 0.2 */
+AMSCR_API int amscr_params_get_partial(const amscr_params *p);
+
+/**
+ * @brief How sure the registration is, in [0, 1]: (1 - ambiguity) x inlier fraction.
+ *        Near 0: reject the map — either another, clearly different map explains the target
+ *        almost as well (a symmetric shape: circle, square, regular star, or a fragment too short
+ *        to place), or most source samples found no target boundary near them. Measured on the
+ *        held-out benchmark (README): maps with confidence >= 0.25 were right in >99 % of the
+ *        cases. NaN for NULL. @since 0.2
+ */
+AMSCR_API double amscr_result_confidence(const amscr_result *r);
+/**
+ * @brief Ambiguity in [0, 1]: the trimmed closest-point cost of the chosen map divided by that
+ *        of the best clearly different candidate map (a map moving the source samples by more
+ *        than 10 % of the shape's RMS radius on average). 1 = two different maps fit equally
+ *        well (symmetry); near 0 = the runner-up is far worse. 0 when no different candidate
+ *        was evaluated (the batch path without refinement). NaN for NULL. @since 0.2
+ */
+AMSCR_API double amscr_result_ambiguity(const amscr_result *r);
+/**
+ * @brief Fraction of the source samples whose closest target boundary point lies within
+ *        3 times the median closest-point distance (at least 1 % of the target's RMS radius) of
+ *        their image under the map: 1 for a complete, clean match; about 1 - missing share
+ *        when part of the target's boundary is missing. NaN for NULL. @since 0.2
+ */
+AMSCR_API double amscr_result_inlier_fraction(const amscr_result *r);
+/**
+ * @brief Where the source lies on the target: the boundary parameters, as fractions in [0, 1)
+ *        of the target's boundary, of the targets points matched to the source's first and last
+ *        samples. The parameter runs along the target's samples (its parametrization,
+ *        whitened arc length by default) from the target's first input point in its input
+ *        direction. For a partial match: where the fragment starts and ends (end < start when
+ *        it wraps over the target's first point). @since 0.2
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_part(const amscr_result *r, double *out_start,
+                                                         double *out_end);
+/**
+ * @brief Dense correspondences: for each of the N source samples (in input coordinates,
+ *        out_src_xy, 2N values), the matched target boundary parameter (out_param, N values,
+ *        fractions as in amscr_result_part) and the matched target point (out_tgt_xy, 2N values,
+ *        input coordinates): the closest point of the target's boundary to the sample's image
+ *        under the map. Any out may be NULL; *inout_n: capacity in samples in, N out (size
+ *        query with all outs NULL). @since 0.2
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_correspondences(const amscr_result *r, double *out_src_xy,
+                                                                    double *out_param, double *out_tgt_xy,
+                                                                    size_t *inout_n);
+
 #ifdef __cplusplus
 }
 #endif

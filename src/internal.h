@@ -63,6 +63,8 @@ struct amscr_params {
     unsigned num_threads;
     amscr_invariance invariance;
     double penalty;
+    /* issue 14 (registration): the source is an open fragment of the target's closed boundary */
+    int partial;
 };
 
 

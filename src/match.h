@@ -77,6 +77,8 @@ typedef struct {
     double w[AMSCR__KMAX], mu[AMSCR__KMAX], var[AMSCR__KMAX];
     size_t ncomp;
     double threshold;
+    /* issue 14: confidence of the match (see amscr_result_ambiguity / _inlier_fraction) */
+    double ambiguity;
 } match_t;
 
 struct amscr_result {
@@ -84,6 +86,11 @@ struct amscr_result {
     match_t m;
     double affine_in[6];
     double affine_norm[6];
+    /* issue 14: dense correspondences (see correspond.c), malloc'ed, n samples */
+    size_t ncorr;
+    double *corr;  /* 5n: source xy (input), target parameter, target xy (input) */
+    double inlier; /* inlier fraction */
+    double part[2];
 };
 
 /* ---- workspace.c ---- */
@@ -150,5 +157,36 @@ amscr_status amscr__refine_match(const amscr_params *prm, const amscr_descriptor
  * scales, or after refinement the kept closest-point pairs. */
 amscr_status amscr__final_solve(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                 amscr_workspace *ws, match_t *m);
+
+/* ---- issue 14 (registration): robust, partial, confidence, correspondences ---- */
+/* Exported pieces of refine.c: the closest point on a polygon within edges b0 ± w; quickselect;
+ * the trimmed solve of the pairs with r2 <= cut; Catmull-Rom densification by AMSCR__DENSE. */
+double amscr__closest_on_polygon(const double *H, size_t n, int closed, size_t b0, size_t w, double px, double py,
+                                 double *qx, double *qy, size_t *seg);
+void amscr__select_kth(double *v, size_t n, size_t k);
+int amscr__trimmed_solve(const amscr_params *prm, const double *f, const double *q, const double *r2, size_t n,
+                         double cut, double X[6]);
+size_t amscr__densify(const double *H, size_t n, int closed, double *out);
+/* The trimmed point-to-line solve (affine invariance; the other groups: point-to-point) of the
+ * pairs f_a -> q_a with r2_a <= cut, seg_a the dense target edge of q_a. Returns 0 if singular. */
+int amscr__plane_solve(const amscr_params *prm, const double *f, const double *q, const double *r2,
+                       const double *seg, const double *Hd, size_t nd, size_t n, double cut, double X[6]);
+/* Mean squared displacement between the maps X1 and X2 over the samples of f's base level. */
+double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6]);
+/* A candidate map differing from the chosen one by more than this RMS displacement (10 % of
+ * the normalized frame's RMS radius sqrt 2) is a different answer for the ambiguity. */
+#define AMSCR__DISTINCT_GAP2 0.02
+/* Cost differences below an RMS misfit of 0.5 % of the RMS radius are no evidence for one map
+ * over another: the ambiguity compares (cost + floor) of the two. */
+#define AMSCR__AMBIGUITY_FLOOR (0.005 * 0.005 * 2.0)
+
+/* partial.c: source f an open fragment of the closed target h: the whole search and refinement
+ * into m (refined; ws->rbuf holds the final closest-point pairs as after amscr__refine_match). */
+amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                  amscr_workspace *ws, match_t *m);
+
+/* correspond.c: the dense correspondences, inlier fraction and part of a finished result r of
+ * f -> h (fills r->corr, r->ncorr, r->inlier, r->part). */
+amscr_status amscr__correspond(const amscr_descriptor *f, const amscr_descriptor *h, amscr_result *r);
 
 #endif

@@ -118,6 +118,10 @@ GETTER(invariance, amscr_invariance, invariance)
 SETTER(penalty, double, penalty, v >= 0.0 && v <= 1e6, "%g is not in 0..1e6")
 GETTER(penalty, double, penalty)
 
+/* ---- issue 14 (registration): partial matching ---- */
+SETTER(partial, int, partial, v == 0 || v == 1, "%d is not 0 or 1")
+GETTER(partial, int, partial)
+
 amscr_status amscr_params_set_scales(amscr_params *p, const double *sigmas, size_t n)
 {
     amscr__clear_error();

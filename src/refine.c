@@ -200,7 +200,7 @@ amscr_status amscr__refine_match(const amscr_params *prm, const amscr_descriptor
         iters = 0;
     for (unsigned it = 0; it < iters; it++) {
         double Xn[6], cutn;
-        if (!trimmed_solve(prm, f->base, q, r2, n, cut, Xn))
+        if (!amscr__plane_solve(prm, f->base, q, r2, hints, Hd, nd, n, cut, Xn))
             break;
         memcpy(hints2, hints, n * sizeof *hints);
         double costn = icp_pairs(f, Hd, nd, m, Xn, q2, r2, sorted, hints2, 1, &cutn);
@@ -232,3 +232,65 @@ amscr_status amscr__refine_match(const amscr_params *prm, const amscr_descriptor
     return AMSCR_OK;
 }
 
+
+/* ---- issue 14 (registration): the closest-point pieces shared with partial.c and
+ * correspond.c (thin exported names of the statics above) ---- */
+double amscr__closest_on_polygon(const double *H, size_t n, int closed, size_t b0, size_t w, double px, double py,
+                                 double *qx, double *qy, size_t *seg)
+{
+    return closest_on_polygon(H, n, closed, b0, w, px, py, qx, qy, seg);
+}
+
+void amscr__select_kth(double *v, size_t n, size_t k) { select_kth(v, n, k); }
+
+int amscr__trimmed_solve(const amscr_params *prm, const double *f, const double *q, const double *r2, size_t n,
+                         double cut, double X[6])
+{
+    return trimmed_solve(prm, f, q, r2, n, cut, X);
+}
+
+size_t amscr__densify(const double *H, size_t n, int closed, double *out) { return densify(H, n, closed, out); }
+
+/* Point-to-line weight of the pairs' tangential part: the solve minimizes
+ * Σ (n·e)^2 + AMSCR__PLANE_MU |e|^2 over the kept pairs, e = X f - q and n the target's normal
+ * at q. Closest-point pairs slide along the curve only slowly under point-to-point costs; the
+ * normal part converges in a few steps, the small tangential part keeps the 6 unknowns
+ * determined on straight stretches. */
+#define AMSCR__PLANE_MU 0.1
+
+int amscr__plane_solve(const amscr_params *prm, const double *f, const double *q, const double *r2,
+                       const double *seg, const double *Hd, size_t nd, size_t n, double cut, double X[6])
+{
+    if (prm->invariance != AMSCR_INVARIANCE_AFFINE)
+        return trimmed_solve(prm, f, q, r2, n, cut, X);
+    double N[36] = {0}, rhs[6] = {0};
+    for (size_t a = 0; a < n; a++) {
+        if (r2[a] > cut)
+            continue;
+        size_t s = (size_t)seg[a], c = s + 1 == nd ? 0 : s + 1;
+        double tx = Hd[2 * c] - Hd[2 * s], ty = Hd[2 * c + 1] - Hd[2 * s + 1], tl = sqrt(tx * tx + ty * ty);
+        double nx = tl > 0.0 ? -ty / tl : 0.0, ny = tl > 0.0 ? tx / tl : 0.0;
+        double x = f[2 * a], y = f[2 * a + 1], qx = q[2 * a], qy = q[2 * a + 1], nq = nx * qx + ny * qy;
+        double g[6] = {nx * x, nx * y, nx, ny * x, ny * y, ny}, jx[3] = {x, y, 1.0};
+        for (int i = 0; i < 6; i++) {
+            for (int j = 0; j < 6; j++)
+                N[6 * i + j] += g[i] * g[j];
+            rhs[i] += g[i] * nq;
+        }
+        for (int i = 0; i < 3; i++) {
+            for (int j = 0; j < 3; j++) {
+                N[6 * i + j] += AMSCR__PLANE_MU * jx[i] * jx[j];
+                N[6 * (i + 3) + j + 3] += AMSCR__PLANE_MU * jx[i] * jx[j];
+            }
+            rhs[i] += AMSCR__PLANE_MU * jx[i] * qx;
+            rhs[i + 3] += AMSCR__PLANE_MU * jx[i] * qy;
+        }
+    }
+    if (!amscr__gauss_solve(N, rhs, 6))
+        return 0;
+    for (int i = 0; i < 6; i++)
+        if (!isfinite(rhs[i]))
+            return 0;
+    memcpy(X, rhs, 6 * sizeof *X);
+    return 1;
+}

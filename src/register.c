@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+static amscr_status check_partial(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt);
 static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor *src, const amscr_descriptor *tgt);
 static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                int report, amscr_workspace *ws, match_t *m);
@@ -36,6 +37,11 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
         st = match_pair(p, src, tgt, 1, w, &r->m);
     if (!ws)
         amscr__ws_release(&local);
+    if (st != AMSCR_OK) {
+        free(r);
+        return st;
+    }
+    st = amscr__correspond(src, tgt, r);
     if (st != AMSCR_OK) {
         free(r);
         return st;
@@ -78,11 +84,28 @@ amscr_status amscr__distance_ws(const amscr_params *prm, const amscr_descriptor 
     return st;
 }
 
+/* Partial matching: an open source and a closed target, otherwise compatible. */
+static amscr_status check_partial(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt)
+{
+    if (src->params.closed || !tgt->params.closed)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "partial registration: the source must be prepared open and the "
+                                                "target closed (source %s, target %s)",
+                           src->params.closed ? "closed" : "open", tgt->params.closed ? "closed" : "open");
+    amscr_params a = src->params, b = tgt->params, c = *prm;
+    a.closed = b.closed = c.closed = 1;
+    if (!amscr__params_compatible(&a, &b, "partial registration (source vs target)") ||
+        !amscr__params_compatible(&c, &a, "partial registration (params vs descriptors)"))
+        return AMSCR_E_INVALID_ARG;
+    return AMSCR_OK;
+}
+
 /* Null params: the source's. Both descriptors and the params must describe compatible shapes. */
 static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor *src, const amscr_descriptor *tgt)
 {
     if (!*prm)
         *prm = &src->params;
+    if ((*prm)->partial)
+        return check_partial(*prm, src, tgt);
     if (!amscr__params_compatible(&src->params, &tgt->params, "registration (source vs target)"))
         return AMSCR_E_INVALID_ARG;
     if (!amscr__params_compatible(*prm, &src->params, "registration (params vs descriptors)"))
@@ -96,6 +119,10 @@ static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor 
 static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                int report, amscr_workspace *ws, match_t *m)
 {
+    if (prm->partial) { /* issue 14: the fragment's place, then the reported QR of its pairs */
+        amscr_status st = amscr__match_partial(prm, src, tgt, ws, m);
+        return st == AMSCR_OK && report ? amscr__final_solve(prm, src, tgt, ws, m) : st;
+    }
     amscr_status st = amscr__match_dir(prm, src, tgt, ws, m);
     if (st == AMSCR_OK && report && prm->invariance == AMSCR_INVARIANCE_AFFINE)
         st = amscr__final_solve(prm, src, tgt, ws, m);
@@ -122,9 +149,14 @@ amscr_status amscr_register_contours(const amscr_params *p, const amscr_contour 
         amscr__params_registration(&preset);
         p = &preset;
     }
-    amscr_status st = amscr_descriptor_new(p, src, &a);
+    amscr_params ps = *p, pt = *p; /* partial: the source open, the target closed */
+    if (p->partial) {
+        ps.closed = 0;
+        pt.closed = 1;
+    }
+    amscr_status st = amscr_descriptor_new(&ps, src, &a);
     if (st == AMSCR_OK) {
-        st = amscr_descriptor_new(p, tgt, &b);
+        st = amscr_descriptor_new(&pt, tgt, &b);
         if (st != AMSCR_OK) {
             snprintf(detail, sizeof detail, "%s", amscr_last_error_detail());
             amscr__fail(st, "target: %s", detail);

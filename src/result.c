@@ -5,7 +5,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-void amscr_result_free(amscr_result *r) { free(r); }
+void amscr_result_free(amscr_result *r)
+{
+    if (r)
+        free(r->corr);
+    free(r);
+}
 
 double amscr_result_distance(const amscr_result *r) { return r ? r->m.dist : NAN; }
 
@@ -94,5 +99,51 @@ amscr_status amscr_result_mixture(const amscr_result *r, double *out_weights, do
     if (out_variances)
         memcpy(out_variances, r->m.var, k * sizeof(double));
     *inout_n = k;
+    return AMSCR_OK;
+}
+
+/* ---- issue 14 (registration): confidence, part, dense correspondences ---- */
+double amscr_result_ambiguity(const amscr_result *r) { return r ? r->m.ambiguity : NAN; }
+double amscr_result_inlier_fraction(const amscr_result *r) { return r ? r->inlier : NAN; }
+double amscr_result_confidence(const amscr_result *r)
+{
+    return r ? (1.0 - r->m.ambiguity) * r->inlier : NAN;
+}
+
+amscr_status amscr_result_part(const amscr_result *r, double *out_start, double *out_end)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(out_start);
+    AMSCR_CHECK_NULL(out_end);
+    *out_start = r->part[0];
+    *out_end = r->part[1];
+    return AMSCR_OK;
+}
+
+amscr_status amscr_result_correspondences(const amscr_result *r, double *out_src_xy, double *out_param,
+                                          double *out_tgt_xy, size_t *inout_n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    AMSCR_CHECK_NULL(inout_n);
+    size_t n = r->ncorr;
+    if ((out_src_xy || out_param || out_tgt_xy) && *inout_n < n)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_result_correspondences: room for %zu samples, %zu needed",
+                           *inout_n, n);
+    for (size_t a = 0; a < n; a++) {
+        const double *c = r->corr + 5 * a;
+        if (out_src_xy) {
+            out_src_xy[2 * a] = c[0];
+            out_src_xy[2 * a + 1] = c[1];
+        }
+        if (out_param)
+            out_param[a] = c[2];
+        if (out_tgt_xy) {
+            out_tgt_xy[2 * a] = c[3];
+            out_tgt_xy[2 * a + 1] = c[4];
+        }
+    }
+    *inout_n = n;
     return AMSCR_OK;
 }

@@ -396,6 +396,21 @@ static amscr_status run_start(const amscr_params *prm, const amscr_descriptor *f
     return amscr__refine_match(prm, f, h, ws, m, iters);
 }
 
+/* issue 14: the chosen candidate's score over the best score of a clearly different candidate
+ * map (1: as good; 0: none, or far worse). */
+static double ambiguity_of(const amscr_descriptor *f, double X[][6], const double *score, size_t count, size_t best)
+{
+    double amb = 0.0;
+    for (size_t i = 0; i < count; i++) {
+        if (i == best || !(amscr__map_gap2(f, X[i], X[best]) > AMSCR__DISTINCT_GAP2))
+            continue;
+        double r = (score[best] + AMSCR__AMBIGUITY_FLOOR) / (score[i] + AMSCR__AMBIGUITY_FLOOR);
+        if (r > amb)
+            amb = r > 1.0 ? 1.0 : r;
+    }
+    return amb;
+}
+
 amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                               amscr_workspace *ws, match_t *m)
 {
@@ -410,6 +425,7 @@ amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f
     int prepared_o = (prm->reflections ? 2 : 1) - 1;
     size_t best = 0;
     double best_score = INFINITY, best_dist = INFINITY;
+    double cand_X[2 * AMSCR__CANDIDATES][6], cand_score[2 * AMSCR__CANDIDATES]; /* issue 14: ambiguity */
     for (size_t i = 0; i < count; i++) {
         double score = crit[i], dist = crit[i];
         if (kind != SCORE_CRITERION) {
@@ -420,7 +436,9 @@ amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f
                 return st;
             score = kind == SCORE_GEOMETRY ? cur.rcost : cur.dist;
             dist = cur.dist;
+            memcpy(cand_X[i], cur.X, sizeof cand_X[i]);
         }
+        cand_score[i] = score;
         /* the one ranking rule: lower score, then lower distance, then the earlier candidate */
         if (i == 0 || score < best_score || (score == best_score && dist < best_dist)) {
             best = i;
@@ -430,6 +448,8 @@ amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f
     }
     STAGE_MARK(ws, 0);
     st = run_start(prm, f, h, &starts[best], &prepared_o, prm->refine, ws, m);
+    if (st == AMSCR_OK)
+        m->ambiguity = kind == SCORE_CRITERION ? 0.0 : ambiguity_of(f, cand_X, cand_score, count, best);
     if (st == AMSCR_OK && !isfinite(m->dist))
         st = amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
     return st;

@@ -21,5 +21,7 @@ Suite *amscr_suite_retrieval(void);
 Suite *amscr_suite_threads(void);
 Suite *amscr_suite_rerank(void);
 Suite *amscr_suite_invariance(void);
+/* issue 14 (registration) */
+Suite *amscr_suite_robust(void);
 
 #endif

@@ -70,6 +70,7 @@ typedef struct opts {
     size_t nscales;
     int reflections; /* -1: the command's default */
     int open;
+    int partial; /* register --partial (issue 14) */
     int refine_set;
     unsigned refine;
     int threads_set;

@@ -26,6 +26,10 @@ typedef struct reg_report {
     size_t shift, K, nkept, N;
     int refl;
     const char *mname;
+    /* issue 14: confidence, the part of the target covered, dense correspondences */
+    double conf, amb, inl, part[2];
+    size_t ncorr;
+    double *corr_param, *corr_xy; /* ncorr and 2 ncorr */
 } reg_report;
 
 static void report_free(reg_report *r)
@@ -34,6 +38,28 @@ static void report_free(reg_report *r)
     free(r->resid);
     free(r->kept);
     free(r->sse);
+    free(r->corr_param);
+    free(r->corr_xy);
+}
+
+/* Prepares both shapes; --partial: the source open, the target closed. */
+static int prepare_pair(const amscr_params *p, const opts *o, const amscr_contour *src, const amscr_contour *tgt,
+                        amscr_descriptor **ds, amscr_descriptor **dt)
+{
+    amscr_params *ps = NULL, *pt = NULL;
+    int ret = -1;
+    if (amscr_params_copy(p, &ps) != AMSCR_OK || amscr_params_copy(p, &pt) != AMSCR_OK) {
+        tool_lib_error("register", AMSCR_E_NOMEM);
+        goto done;
+    }
+    if (amscr_params_get_partial(p) &&
+        (amscr_params_set_closed(ps, 0) != AMSCR_OK || amscr_params_set_closed(pt, 1) != AMSCR_OK))
+        goto done;
+    ret = prepare(ps, o->pos[0], src, ds) != 0 || prepare(pt, o->pos[1], tgt, dt) != 0 ? -1 : 0;
+done:
+    amscr_params_free(ps);
+    amscr_params_free(pt);
+    return ret;
 }
 
 /* Loads, prepares and registers the pair; *src, *tgt, *res owned by the caller. */
@@ -45,7 +71,7 @@ static int register_pair(const opts *o, const amscr_params *p, amscr_contour **s
     int ret = -1;
     if (shape_load(spath, o->threshold, src) != 0 || shape_load(tpath, o->threshold, tgt) != 0)
         goto done;
-    if (prepare(p, spath, *src, &ds) != 0 || prepare(p, tpath, *tgt, &dt) != 0)
+    if (prepare_pair(p, o, *src, *tgt, &ds, &dt) != 0)
         goto done;
     amscr_status st = amscr_register(p, ds, dt, NULL, res);
     if (st != AMSCR_OK) {
@@ -109,6 +135,24 @@ static int read_report(const amscr_result *res, const amscr_params *p, reg_repor
     r->refl = amscr_result_reflected(res);
     r->mname = name_of(&METHOD_NAMES, (int)amscr_result_method(res));
     r->N = amscr_params_get_num_samples(p);
+    r->conf = amscr_result_confidence(res);
+    r->amb = amscr_result_ambiguity(res);
+    r->inl = amscr_result_inlier_fraction(res);
+    if (amscr_result_part(res, &r->part[0], &r->part[1]) != AMSCR_OK ||
+        amscr_result_correspondences(res, NULL, NULL, NULL, &r->ncorr) != AMSCR_OK)
+    {
+        tool_lib_error("register", AMSCR_E_INTERNAL);
+        return -1;
+    }
+    r->corr_param = xmalloc_array(r->ncorr ? r->ncorr : 1, sizeof(double));
+    r->corr_xy = xmalloc_array(r->ncorr ? 2 * r->ncorr : 1, sizeof(double));
+    if (!r->corr_param || !r->corr_xy)
+        return -1;
+    amscr_status st = amscr_result_correspondences(res, NULL, r->corr_param, r->corr_xy, &r->ncorr);
+    if (st != AMSCR_OK) {
+        tool_lib_error("register", st);
+        return -1;
+    }
     return 0;
 }
 
@@ -149,6 +193,28 @@ static int draw_pictures(const opts *o, const amscr_contour *src, const amscr_co
     return 0;
 }
 
+/* issue 14: confidence, part and correspondences ({"param": [...], "points": [[x, y], ...]}). */
+static void json_confidence(sbuf *b, const opts *o, const reg_report *r)
+{
+    sb_puts(b, ", \"confidence\": ");
+    sb_json_num(b, r->conf);
+    sb_puts(b, ", \"ambiguity\": ");
+    sb_json_num(b, r->amb);
+    sb_puts(b, ", \"inlier_fraction\": ");
+    sb_json_num(b, r->inl);
+    sb_printf(b, ", \"partial\": %s, \"part\": ", o->partial ? "true" : "false");
+    sb_json_nums(b, r->part, NULL, 2);
+    sb_puts(b, ", \"correspondences\": {\"param\": ");
+    sb_json_nums(b, r->corr_param, NULL, r->ncorr);
+    sb_puts(b, ", \"points\": [");
+    for (size_t a = 0; a < r->ncorr; a++) {
+        if (a)
+            sb_puts(b, ", ");
+        sb_json_nums(b, r->corr_xy + 2 * a, NULL, 2);
+    }
+    sb_puts(b, "]}");
+}
+
 static void format_json(sbuf *b, const opts *o, const amscr_contour *src, const amscr_contour *tgt,
                         const reg_report *r)
 {
@@ -185,8 +251,10 @@ static void format_json(sbuf *b, const opts *o, const amscr_contour *src, const 
         sb_printf(b, "%s\"%s\": ", i ? ", " : ", \"mixture\": {", mix_keys[i]);
         sb_json_nums(b, mix[i], NULL, r->nmix);
     }
-    sb_printf(b, "}, \"samples\": %zu, \"closed\": %s, \"source_points\": %zu, \"target_points\": %zu}\n", r->N,
+    sb_printf(b, "}, \"samples\": %zu, \"closed\": %s, \"source_points\": %zu, \"target_points\": %zu", r->N,
               o->open ? "false" : "true", amscr_contour_size(src), amscr_contour_size(tgt));
+    json_confidence(b, o, r);
+    sb_puts(b, "}\n");
 }
 
 static void format_text(sbuf *b, const opts *o, const amscr_contour *src, const amscr_contour *tgt,
@@ -218,6 +286,10 @@ static void format_text(sbuf *b, const opts *o, const amscr_contour *src, const 
     sb_puts(b, "   (scale:residual, * = kept)\n");
     sb_printf(b, "shift       %zu (of %zu samples)\n", r->shift, r->N);
     sb_printf(b, "reflected   %s\n", r->refl ? "yes" : "no");
+    sb_printf(b, "confidence  %.3f (ambiguity %.3f, inliers %.1f %%)%s\n", r->conf, r->amb, 100.0 * r->inl,
+              r->conf < 0.25 ? "  LOW: the map may be wrong" : "");
+    if (o->partial)
+        sb_printf(b, "part        %.4f .. %.4f of the target's boundary\n", r->part[0], r->part[1]);
     if (o->overlay)
         sb_printf(b, "overlay     %s\n", o->overlay);
     if (o->plot)

@@ -36,7 +36,13 @@ static const char HELP_REGISTER[] =
     "                          threshold, sse, mixture, ...)\n"
     "  --overlay FILE          picture (.png or .svg): target, source before and after\n"
     "  --plot FILE             SVG: residual per scale with the Bayes threshold and the\n"
-    "                          kept scales, and the elbow curve SSE(K)\n";
+    "                          kept scales, and the elbow curve SSE(K)\n"
+    "  --partial               SRC is an open fragment of TGT's closed boundary: also\n"
+    "                          prints where on TGT it lies (start, end as fractions)\n"
+    "\n"
+    "Every result prints its confidence in [0, 1] ((1 - ambiguity) x inlier fraction;\n"
+    "reject maps below about 0.25) and, with --json, the matched target boundary\n"
+    "parameter and point of every source sample (\"correspondences\").\n";
 
 static const char HELP_SEARCH[] =
     "usage: amscr search QUERY COLLECTION [--top K] [--json] [options]\n"

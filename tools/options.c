@@ -33,6 +33,7 @@ typedef enum opt_id {
     O_SYMMETRIC,
     O_PARAMETRIZATION,
     O_INVARIANCE,
+    O_PARTIAL,
     O_RERANK,
     O_NO_RERANK
 } opt_id;
@@ -69,6 +70,7 @@ static const optdef OPTS[] = {
     {"--symmetric", O_SYMMETRIC, 0, C_SHAPES, NULL},
     {"--parametrization", O_PARAMETRIZATION, 1, C_SHAPES, "NAME"},
     {"--invariance", O_INVARIANCE, 1, C_SHAPES, "NAME"},
+    {"--partial", O_PARTIAL, 0, C_REGISTER, NULL},
     {"--rerank", O_RERANK, 1, C_RETRIEVAL, "K[,ITER]"},
     {"--no-rerank", O_NO_RERANK, 0, C_RETRIEVAL, NULL},
 };
@@ -233,6 +235,7 @@ static int set_option(opts *o, const optdef *d, const char *v)
     case O_REFLECTIONS: o->reflections = 1; return 0;
     case O_NO_REFLECTIONS: o->reflections = 0; return 0;
     case O_OPEN: o->open = 1; return 0;
+    case O_PARTIAL: o->partial = 1; return 0;
     case O_REFINE: return parse_unsigned(n, v, 0, TOOL_REFINE_MAX, &o->refine_set, &o->refine);
     case O_THREADS: return parse_unsigned(n, v, 0, TOOL_THREADS_MAX, &o->threads_set, &o->threads);
     case O_KMAX: return parse_unsigned(n, v, 1, TOOL_KMAX_MAX, &o->kmax_set, &o->kmax);

@@ -203,3 +203,10 @@ amscr_status amscr_score_topk_table(const double *dist, size_t n, const int32_t 
 amscr_status amscr_score_nn_accuracy(const double *dist, size_t n, const int32_t *labels, double *out_accuracy);
 amscr_status amscr_score_nn_split(const double *dist, size_t ntest, size_t ntrain, const int32_t *test_labels, const int32_t *train_labels, double *out_accuracy);
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);
+amscr_status amscr_params_set_partial(amscr_params *p, int on);
+int amscr_params_get_partial(const amscr_params *p);
+double amscr_result_confidence(const amscr_result *r);
+double amscr_result_ambiguity(const amscr_result *r);
+double amscr_result_inlier_fraction(const amscr_result *r);
+amscr_status amscr_result_part(const amscr_result *r, double *out_start, double *out_end);
+amscr_status amscr_result_correspondences(const amscr_result *r, double *out_src_xy, double *out_param, double *out_tgt_xy, size_t *inout_n);

@@ -103,6 +103,7 @@ class Params:
     threads = _Option('num_threads', _UINT, 'threads of batch calls (0 = all cores)')
     invariance = _Option('invariance', _enum(INVARIANCES), "'affine' (default), 'similarity' or 'penalized'")
     penalty = _Option('penalty', _FLOAT, "weight of the 'penalized' invariance")
+    partial = _Option('partial', _BOOL, "the source is an open fragment of the target's closed boundary (register)")
 
     #: The option names, in the order of the table above.
     OPTIONS: Tuple[str, ...] = ()

@@ -59,6 +59,16 @@ class Registration:
         shift: start shift (source sample a <-> target sample (a + shift) mod N).
         reflected: True when the match used the mirrored target.
         method: the method used.
+        confidence: how sure the map is, in [0, 1] ((1 - ambiguity) x inlier_fraction; see the
+            README's accuracy section for what a low value means).
+        ambiguity: cost of the chosen map over that of the best clearly different candidate
+            (1: a symmetric shape or a fragment that fits several places).
+        inlier_fraction: share of source samples within 5 % of the target's size of its boundary.
+        part: (start, end) fractions of the target's boundary the source's first and last samples
+            fall on (where a fragment lies, with partial=True).
+        correspondences: (N,) target boundary parameter (fraction) matched to each source sample.
+        source_samples: (N, 2) the source samples (input coordinates).
+        target_points: (N, 2) the matched target boundary points (input coordinates).
     """
 
     def __init__(self, handle, scales: np.ndarray):
@@ -83,6 +93,13 @@ class Registration:
         self.sse, = sized_arrays(lib.amscr_result_sse, r)
         self.mixture = Mixture(*sized_arrays(lib.amscr_result_mixture, r, arrays=3))
         self.threshold = float(lib.amscr_result_threshold(r))
+        self.confidence = float(lib.amscr_result_confidence(r))
+        self.ambiguity = float(lib.amscr_result_ambiguity(r))
+        self.inlier_fraction = float(lib.amscr_result_inlier_fraction(r))
+        part = ffi.new('double[2]')
+        _check(lib.amscr_result_part(r, part, part + 1))
+        self.part = (float(part[0]), float(part[1]))
+        self.source_samples, self.correspondences, self.target_points = _correspondences(r)
 
     def apply(self, points: ArrayLike, order: str = 'xy') -> np.ndarray:
         """Maps points of the source onto the target: ``points @ A.T + B``.
@@ -104,6 +121,18 @@ class Registration:
                    self.reflected))
 
 
+def _correspondences(r) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(source samples (N, 2), target parameters (N,), target points (N, 2)) of a result."""
+    n = ffi.new('size_t *', 0)
+    _check(lib.amscr_result_correspondences(r, ffi.NULL, ffi.NULL, ffi.NULL, n))
+    m = int(n[0])
+    src, par, tgt = np.zeros((m, 2)), np.zeros(m), np.zeros((m, 2))
+    if m:
+        _check(lib.amscr_result_correspondences(r, ffi.from_buffer('double[]', src), ffi.from_buffer('double[]', par),
+                                                ffi.from_buffer('double[]', tgt), n))
+    return src, par, tgt
+
+
 def _pair(src: PointsLike, tgt: PointsLike, params: Optional[Params], options: Dict[str, Any], order: str
           ) -> Tuple[Params, Shape, Shape]:
     """The options of one registration and the two prepared shapes (see :func:`register`)."""
@@ -113,6 +142,8 @@ def _pair(src: PointsLike, tgt: PointsLike, params: Optional[Params], options: D
         # prepared shapes bring their own settings; raw points get the registration preset
         base = first.params if first is not None else Params.registration()
     p = make_params(base, options)
+    if p.partial:  # the source prepared open, the target closed
+        return p, as_shape(src, p.copy(closed=False), 'src', order), as_shape(tgt, p.copy(closed=True), 'tgt', order)
     return p, as_shape(src, p, 'src', order), as_shape(tgt, p, 'tgt', order)
 
 

@@ -11,12 +11,14 @@ CHANGED = {
     'points': 96, 'scales': [0.5, 2.0, 5.0], 'method': 'binary-em', 'closed': False, 'reflections': True,
     'parametrization': 'affine', 'presmooth': 0.02, 'arclength_passes': 2, 'oversampling': 4, 'kmax': 7,
     'symmetric': True, 'refine': 3, 'threads': 2, 'invariance': 'penalized', 'penalty': 0.25,
+    'partial': True,
 }
 # one value per option that the setter refuses (by Python-side validation or the C range check)
 REFUSED = {
     'points': 8, 'scales': [[1.0]], 'method': 'nearest', 'closed': 2, 'reflections': 'yes',
     'parametrization': 'polar', 'presmooth': 0.5, 'arclength_passes': 0, 'oversampling': 65, 'kmax': 17,
     'symmetric': None, 'refine': 51, 'threads': -1, 'invariance': 'projective', 'penalty': -1.0,
+    'partial': 2,
 }
 
 

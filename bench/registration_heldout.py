@@ -1,0 +1,256 @@
+#!/usr/bin/env python3
+"""Held-out registration check (issue 14): amscr against OpenCV's ECC on MPEG-7-like contours.
+
+For each of the first 35 classes of a manifest (one shape per class, the class's first file) and
+2 seeded draws per condition: the traced pixel contour f, a random affine map T (any rotation,
+anisotropic scale x0.5-2, shear +-0.5, translation), the target T(f) with a new start point and a
+new point count (Euclidean resampling to 0.6-1.4 times the count), then the condition:
+
+  clean; 1 % / 2 % Gaussian noise (sigma relative to the shape size); 5 / 10 / 20 % of the
+  boundary missing (one contiguous run of the target's points dropped, the rest still closed);
+  an open fragment of 70 % / 50 % of the source's boundary against the whole target (--partial).
+
+Success: max_i |M(f_i) - T(f_i)| / size(T(f)) < 2 %, over the source's own points (the fragment's,
+for the partial conditions), size = RMS radius about the centroid (tests/testutil.c's definition).
+
+ECC (optional, --ecc; needs opencv-python-headless): cv2.findTransformECC with MOTION_AFFINE on
+rendered, blurred masks (the fragment closed by its chord), from 8 starting rotations with
+centroid and area matched, the best correlation kept.
+
+Usage: nice python3 bench/registration_heldout.py [--data DIR] [--ecc] [--draws 2] [--json OUT]
+Deterministic: every draw is seeded by (condition, class index, draw).
+"""
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, '..', 'bindings', 'python'))
+import amscr  # noqa: E402
+
+CONDITIONS = [
+    ('clean', 'clean', 0.0, 99.5),
+    ('noise1', '1 % noise', 0.01, 99.0),
+    ('noise2', '2 % noise', 0.02, 99.0),
+    ('miss5', '5 % missing', 0.05, 98.0),
+    ('miss10', '10 % missing', 0.10, 95.0),
+    ('miss20', '20 % missing', 0.20, 85.0),
+    ('frag70', 'fragment 70 %', 0.70, 95.0),
+    ('frag50', 'fragment 50 %', 0.50, 90.0),
+]
+
+
+def shape_size(xy):
+    c = xy - xy.mean(axis=0)
+    return math.sqrt((c * c).sum(axis=1).mean())
+
+
+def apply(T, xy):
+    return xy @ T[:, :2].T + T[:, 2]
+
+
+def random_affine(rng):
+    th, ph = rng.uniform(0, 2 * math.pi, 2)
+    s1 = rng.uniform(1.0, 2.0)
+    s2 = 1.0 / rng.uniform(1.0, 2.0)
+    h = rng.uniform(-0.5, 0.5)
+    scale = rng.uniform(0.5, 2.5)
+    rot = lambda a: np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+    A = scale * rot(th) @ np.array([[s1, s1 * h], [0.0, s2]]) @ rot(ph)
+    return np.hstack([A, rng.uniform(-50, 50, (2, 1))])
+
+
+def resample(xy, m):
+    """Closed polygon resampled to m points equally spaced in Euclidean arc length."""
+    p = np.vstack([xy, xy[:1]])
+    seg = np.hypot(*np.diff(p, axis=0).T)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    t = np.arange(m) * cum[-1] / m
+    return np.column_stack([np.interp(t, cum, p[:, 0]), np.interp(t, cum, p[:, 1])])
+
+
+def make_case(f, key, amount, rng):
+    """(source points, target points, T, partial) of one draw."""
+    T = random_affine(rng)
+    n = len(f)
+    shift = int(rng.integers(n))
+    nt = int(round(rng.uniform(0.6, 1.4) * n))
+    tgt = resample(apply(T, np.roll(f, -shift, axis=0)), max(nt, 16))
+    src = f
+    size = shape_size(apply(T, f))
+    if key.startswith('noise'):
+        tgt = tgt + rng.normal(0.0, amount * size, tgt.shape)
+    elif key.startswith('miss'):
+        m = len(tgt)
+        drop = int(math.ceil(amount * m))
+        start = int(rng.integers(m))
+        tgt = np.roll(tgt, -start, axis=0)[drop:]
+    elif key.startswith('frag'):
+        k = int(round(amount * n))
+        start = int(rng.integers(n))
+        src = np.roll(f, -start, axis=0)[:k]
+    return src, tgt, T, size, key.startswith('frag')
+
+
+def map_error(M, T, src, size):
+    d = apply(M, src) - apply(T, src)
+    return float(np.sqrt((d * d).sum(axis=1)).max() / size)
+
+
+def amscr_register(src, tgt, partial, mode):
+    """The recovered 2x3 map, or None when the call fails."""
+    try:
+        if partial:
+            if mode == 'partial':
+                r = amscr.register(src, tgt, partial=True)
+            else:  # today's main: both curves open
+                r = amscr.register(src, tgt, closed=False)
+        else:
+            r = amscr.register(src, tgt)
+    except amscr.AmscrError:
+        return None, None
+    return np.hstack([r.A, r.B[:, None]]), r
+
+
+# ------------------------------------------------------------------------ ECC
+CANVAS = 400
+
+
+def render(xy, cv2):
+    """Mask of the polygon in a CANVAS^2 image and the 2x3 map input -> pixels."""
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    s = 0.7 * CANVAS / max(hi - lo)
+    off = 0.5 * CANVAS - s * 0.5 * (lo + hi)
+    P = np.array([[s, 0, off[0]], [0, s, off[1]]])
+    img = np.zeros((CANVAS, CANVAS), np.uint8)
+    cv2.fillPoly(img, [np.round(apply(P, xy) * 16).astype(np.int32)], 255, lineType=cv2.LINE_AA, shift=4)
+    return cv2.GaussianBlur(img, (0, 0), 4.0).astype(np.float32) / 255.0, P
+
+
+def inv_affine(P):
+    A = np.linalg.inv(P[:, :2])
+    return np.hstack([A, -(A @ P[:, 2:])])
+
+
+def compose(P, Q):  # P after Q
+    return np.hstack([P[:, :2] @ Q[:, :2], P[:, :2] @ Q[:, 2:] + P[:, 2:]])
+
+
+def ecc_register(src, tgt, cv2):
+    a, Ps = render(src, cv2)
+    b, Pt = render(tgt, cv2)
+    ma, mb = cv2.moments(a), cv2.moments(b)
+    if ma['m00'] <= 0 or mb['m00'] <= 0:
+        return None
+    ca = np.array([ma['m10'], ma['m01']]) / ma['m00']
+    cb = np.array([mb['m10'], mb['m01']]) / mb['m00']
+    k = math.sqrt(mb['m00'] / ma['m00'])
+    crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 100, 1e-5)
+    best, best_rho = None, -np.inf
+    for i in range(8):
+        t = 2 * math.pi * i / 8
+        A = k * np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+        W = np.hstack([A, (cb - A @ ca)[:, None]]).astype(np.float32)
+        try:
+            rho, W = cv2.findTransformECC(a, b, W, cv2.MOTION_AFFINE, crit, None, 5)
+        except cv2.error:
+            continue
+        if rho > best_rho:
+            best, best_rho = W.astype(np.float64), rho
+    if best is None:
+        return None
+    # a(x) ~ b(W x): W maps source pixels to target pixels
+    return compose(inv_affine(Pt), compose(best, Ps))
+
+
+# ------------------------------------------------------------------------ main
+def load_shapes(data, nclass):
+    from PIL import Image
+    rows = [l.rstrip('\n').split('\t') for l in open(os.path.join(data, 'manifest.tsv'))][1:]
+    first = {}
+    for fname, cls in rows:
+        first.setdefault(cls, fname)
+    shapes = []
+    for cls, fname in list(first.items())[:nclass]:
+        img = np.asarray(Image.open(os.path.join(data, fname)).convert('L'))
+        shapes.append((cls, amscr.contour_from_mask(img)))
+    return shapes
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    ap.add_argument('--data', default=os.environ.get('AMSCR_HELDOUT_DATA', '/work/shared/datasets/mpeg7-dev'))
+    ap.add_argument('--classes', type=int, default=35)
+    ap.add_argument('--draws', type=int, default=2)
+    ap.add_argument('--ecc', action='store_true', help='also run OpenCV ECC (slow)')
+    ap.add_argument('--mode', choices=['partial', 'open'], default='partial',
+                    help='fragments: the partial option (default) or both curves open (0.1 behaviour)')
+    ap.add_argument('--only', help='comma-separated condition keys')
+    ap.add_argument('--json', help='write per-case results here')
+    ap.add_argument('-v', '--verbose', action='store_true')
+    args = ap.parse_args()
+    if not os.path.exists(os.path.join(args.data, 'manifest.tsv')):
+        print('no manifest in %s: skipped' % args.data)
+        return 0
+    cv2 = None
+    if args.ecc:
+        try:
+            import cv2
+        except ImportError:
+            print('opencv not installed: ECC column skipped')
+    shapes = load_shapes(args.data, args.classes)
+    conds = [c for c in CONDITIONS if not args.only or c[0] in args.only.split(',')]
+    rows, cases = [], []
+    for ci, (key, label, amount, goal) in enumerate(CONDITIONS):
+        if (key, label, amount, goal) not in conds:
+            continue
+        ok_a = ok_e = total = 0
+        t_reg = 0.0
+        conf_ok, conf_bad = [], []
+        for si, (cls, f) in enumerate(shapes):
+            for d in range(args.draws):
+                rng = np.random.default_rng([14, ci, si, d])
+                src, tgt, T, size, partial = make_case(f, key, amount, rng)
+                t0 = time.perf_counter()
+                M, res = amscr_register(src, tgt, partial, args.mode)
+                t_reg += time.perf_counter() - t0
+                ea = map_error(M, T, src, size) if M is not None else math.inf
+                ee = None
+                if cv2 is not None:
+                    W = ecc_register(src, tgt, cv2)
+                    ee = map_error(W, T, src, size) if W is not None else math.inf
+                    ok_e += ee < 0.02
+                ok_a += ea < 0.02
+                total += 1
+                conf = getattr(res, 'confidence', None) if res is not None else None
+                if conf is not None:
+                    (conf_ok if ea < 0.02 else conf_bad).append(conf)
+                cases.append(dict(cond=key, cls=cls, draw=d, amscr=ea, ecc=ee, confidence=conf))
+                if args.verbose and ea >= 0.02:
+                    print('  %s %s draw %d: amscr error %.2f %%%s' % (key, cls, d, 100 * ea,
+                          '' if conf is None else ', confidence %.3f' % conf))
+        rows.append((label, 100.0 * ok_a / total, 100.0 * ok_e / total if cv2 is not None else None, goal,
+                     1e3 * t_reg / total, conf_ok, conf_bad))
+        sys.stdout.flush()
+    print('| condition | amscr | ECC multi-start | goal | ms/registration (Python call) |')
+    print('|---|---|---|---|---|')
+    for label, a, e, goal, ms, _, _ in rows:
+        print('| %s | %.1f %% | %s | >= %.1f %% | %.2f |' % (label, a, '-' if e is None else '%.1f %%' % e, goal, ms))
+    if any(r[5] or r[6] for r in rows):
+        print('\nconfidence (median) of successes / failures per condition:')
+        for label, _, _, _, _, good, bad in rows:
+            print('  %-14s %s / %s' % (label, '%.3f' % np.median(good) if good else '-',
+                                      '%.3f' % np.median(bad) if bad else '-'))
+    if args.json:
+        with open(args.json, 'w') as fp:
+            json.dump(cases, fp, indent=0)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

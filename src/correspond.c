@@ -1,0 +1,73 @@
+/* correspond.c — what a finished registration says beyond the map (issue 14): for every source
+ * sample the closest point of the target's boundary to its image (dense correspondences, for
+ * landmark transfer), the share of samples that found the boundary near them (inliers), and
+ * where the source's first and last samples fall on the target (the part it covers). */
+#include "dense.h"
+#include "match.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A sample is an inlier when its image lies within 5 % of the target's RMS radius (sqrt 2 in
+ * the normalized frame) of the target's boundary: 2.5 standard deviations of 2 % noise. */
+#define AMSCR__INLIER_DIST (0.05 * 1.4142135623730951)
+/* Partners after the first are searched within ±N/8 samples of the previous sample's. */
+#define AMSCR__CORR_WINDOW_DIV 8
+
+double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6])
+{
+    const double *mo = f->mom; /* level 0: the base samples */
+    double M9[9], s = 0.0;
+    amscr__moment_matrix(mo, M9);
+    for (int i = 0; i < 2; i++) {
+        double d[3] = {X1[3 * i] - X2[3 * i], X1[3 * i + 1] - X2[3 * i + 1], X1[3 * i + 2] - X2[3 * i + 2]};
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                s += d[r] * M9[3 * r + c] * d[c];
+    }
+    return s / (double)f->n;
+}
+
+amscr_status amscr__correspond(const amscr_descriptor *f, const amscr_descriptor *h, amscr_result *r)
+{
+    size_t n = f->n;
+    int closed = h->params.closed;
+    double *Hd = amscr__malloc_array(2 * AMSCR__DENSE * h->n, sizeof *Hd);
+    double *corr = amscr__malloc_array(5 * n, sizeof *corr);
+    if (!Hd || !corr) {
+        free(Hd);
+        free(corr);
+        return amscr__fail(AMSCR_E_NOMEM, "correspondences: out of memory");
+    }
+    size_t nd = amscr__densify(h->base, h->n, closed, Hd), nedge = closed ? nd : nd - 1;
+    size_t w = AMSCR__DENSE * (h->n / AMSCR__CORR_WINDOW_DIV), prev = 0, inl = 0;
+    const double *X = r->m.X, *iv = h->inv;
+    for (size_t a = 0; a < n; a++) {
+        double fx = f->base[2 * a], fy = f->base[2 * a + 1];
+        double px = X[0] * fx + X[1] * fy + X[2], py = X[3] * fx + X[4] * fy + X[5], qx, qy;
+        size_t seg = 0;
+        double d2 = amscr__closest_on_polygon(Hd, nd, closed, a == 0 ? 0 : prev, a == 0 ? nd : w, px, py, &qx, &qy,
+                                              &seg);
+        prev = seg;
+        size_t nx = seg + 1 == nd ? 0 : seg + 1;
+        double ex = Hd[2 * nx] - Hd[2 * seg], ey = Hd[2 * nx + 1] - Hd[2 * seg + 1], l2 = ex * ex + ey * ey;
+        double t = l2 > 0.0 ? ((qx - Hd[2 * seg]) * ex + (qy - Hd[2 * seg + 1]) * ey) / l2 : 0.0;
+        double *c = corr + 5 * a;
+        c[0] = f->input[2 * a];
+        c[1] = f->input[2 * a + 1];
+        c[2] = fmod(((double)seg + t) / (double)nedge, 1.0);
+        c[3] = iv[0] * qx + iv[1] * qy + iv[2];
+        c[4] = iv[3] * qx + iv[4] * qy + iv[5];
+        if (sqrt(d2) <= AMSCR__INLIER_DIST)
+            inl++;
+    }
+    free(Hd);
+    free(r->corr);
+    r->corr = corr;
+    r->ncorr = n;
+    r->inlier = (double)inl / (double)n;
+    r->part[0] = corr[2];
+    r->part[1] = corr[5 * (n - 1) + 2];
+    return AMSCR_OK;
+}

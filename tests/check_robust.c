@@ -1,0 +1,287 @@
+/* check_robust.c — issue 14: partial matching, confidence (symmetric shapes ambiguous), inlier
+ * fraction under missing parts, dense correspondences, on generated shapes (seeded) and Kimia
+ * pixel contours (skipped cleanly when the datasets are absent). */
+#include <amscr.h>
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "suites.h"
+#include "testutil.h"
+
+/* Registers src (ns) onto tgt (nt) with the registration preset (+ partial); returns the map
+ * error of T over the source points relative to size(T(src_full)); r kept when out_r. */
+static double reg_error(const double *src, size_t ns, const double *tgt, size_t nt, const double T[6], double size,
+                        int partial, amscr_result **out_r)
+{
+    amscr_params *p = NULL;
+    amscr_contour *cs = NULL, *ct = NULL;
+    amscr_result *r = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_partial(p, partial), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_new(src, ns, &cs), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_new(tgt, nt, &ct), AMSCR_OK);
+    amscr_status st = amscr_register_contours(p, cs, ct, &r);
+    ck_assert_msg(st == AMSCR_OK, "register: %s", amscr_last_error_detail());
+    double M[6];
+    ck_assert_int_eq(amscr_result_affine(r, M), AMSCR_OK);
+    double err = amscr_test_max_map_error(M, T, src, ns) / size;
+    if (out_r)
+        *out_r = r;
+    else
+        amscr_result_free(r);
+    amscr_contour_free(cs);
+    amscr_contour_free(ct);
+    amscr_params_free(p);
+    return err;
+}
+
+/* A random shape of n points, its image under a random affine map with a new start point. */
+static void make_pair(uint64_t seed, size_t n, double *src, double *tgt, double T[6], double *size)
+{
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, seed);
+    amscr_test_random_shape(&rng, n, 3 + (int)(seed % 6), src);
+    amscr_test_random_affine(&rng, 2.0, 0.5, 10.0, 0, T);
+    double *a = malloc(2 * n * sizeof *a);
+    ck_assert_ptr_nonnull(a);
+    amscr_test_cyclic_shift(src, n, (size_t)(amscr_test_uniform(&rng) * (double)n) % n, a);
+    amscr_test_apply_affine(T, a, n, tgt);
+    *size = amscr_test_shape_size(tgt, n);
+    free(a);
+}
+
+/* Fragments of 70 % and 50 % of a random shape register (>= 95 % / >= 90 % of the cases within
+ * 2 % of the size); the reported part covers about the fragment's share of the boundary. */
+static void fragments(double share, double rate_min)
+{
+    enum { CASES = 40, N = 400 };
+    double src[2 * N], tgt[2 * N], T[6], size;
+    size_t ok = 0, k = (size_t)(share * N);
+    for (uint64_t c = 0; c < CASES; c++) {
+        make_pair(7000 + c, N, src, tgt, T, &size);
+        size_t start = (size_t)(c * 37) % N;
+        double frag[2 * N];
+        for (size_t i = 0; i < k; i++) {
+            frag[2 * i] = src[2 * ((start + i) % N)];
+            frag[2 * i + 1] = src[2 * ((start + i) % N) + 1];
+        }
+        amscr_result *r = NULL;
+        double err = reg_error(frag, k, tgt, N, T, size, 1, &r);
+        if (err < 0.02) {
+            ok++;
+            double s0, s1;
+            ck_assert_int_eq(amscr_result_part(r, &s0, &s1), AMSCR_OK);
+            double covered = fmod(s1 - s0 + 1.0, 1.0);
+            ck_assert_msg(covered > 0.5 * share && covered < 1.0, "part %.3f..%.3f for a %.0f %% fragment", s0, s1,
+                          100.0 * share);
+            ck_assert(amscr_result_confidence(r) > 0.25);
+        }
+        amscr_result_free(r);
+    }
+    printf("robust: %.0f %% fragments: %zu of %d within 2 %%\n", 100.0 * share, ok, CASES);
+    ck_assert_msg((double)ok >= rate_min * CASES, "%.0f %% fragments: %zu of %d", 100.0 * share, ok, CASES);
+}
+
+START_TEST(partial_fragment_70) { fragments(0.7, 0.95); }
+END_TEST
+
+START_TEST(partial_fragment_50) { fragments(0.5, 0.85); }
+END_TEST
+
+/* A closed polygon through v (nv vertices), each edge split into m points. */
+static size_t polygon(const double *v, size_t nv, size_t m, double *out)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < nv; i++)
+        for (size_t j = 0; j < m; j++, k++) {
+            double s = (double)j / (double)m;
+            size_t b = (i + 1) % nv;
+            out[2 * k] = (1 - s) * v[2 * i] + s * v[2 * b];
+            out[2 * k + 1] = (1 - s) * v[2 * i + 1] + s * v[2 * b + 1];
+        }
+    return k;
+}
+
+static double confidence_of(const double *s, size_t n, double *out_amb)
+{
+    static const double T[6] = {1.2, 0.4, 3.0, -0.2, 0.8, -1.0};
+    double *a = malloc(2 * n * sizeof *a), *t = malloc(2 * n * sizeof *t);
+    ck_assert(a && t);
+    amscr_test_cyclic_shift(s, n, n / 7, a);
+    amscr_test_apply_affine(T, a, n, t);
+    amscr_result *r = NULL;
+    (void)reg_error(s, n, t, n, T, 1.0, 0, &r);
+    double c = amscr_result_confidence(r);
+    *out_amb = amscr_result_ambiguity(r);
+    ck_assert(c >= 0.0 && c <= 1.0);
+    ck_assert_double_eq_tol(c, (1.0 - *out_amb) * amscr_result_inlier_fraction(r), 1e-12);
+    amscr_result_free(r);
+    free(a);
+    free(t);
+    return c;
+}
+
+/* Circle, square and regular 5-pointed star: reported ambiguous; an asymmetric shape: sure. */
+START_TEST(symmetric_shapes_ambiguous)
+{
+    double xy[2 * 400], amb;
+    amscr_test_ellipse(360, 1.0, 1.0, 0.0, xy);
+    double c = confidence_of(xy, 360, &amb);
+    ck_assert_msg(amb > 0.8 && c < 0.2, "circle: confidence %.3f ambiguity %.3f", c, amb);
+    const double sq[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    c = confidence_of(xy, polygon(sq, 4, 90, xy), &amb);
+    ck_assert_msg(amb > 0.8 && c < 0.2, "square: confidence %.3f ambiguity %.3f", c, amb);
+    double star[20];
+    for (int k = 0; k < 10; k++) {
+        double r = k % 2 ? 0.4 : 1.0, ang = 1.5707963267948966 + k * 0.6283185307179586;
+        star[2 * k] = r * cos(ang);
+        star[2 * k + 1] = r * sin(ang);
+    }
+    c = confidence_of(xy, polygon(star, 10, 36, xy), &amb);
+    ck_assert_msg(amb > 0.8 && c < 0.2, "star: confidence %.3f ambiguity %.3f", c, amb);
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, 4242);
+    amscr_test_random_shape(&rng, 300, 5, xy);
+    c = confidence_of(xy, 300, &amb);
+    ck_assert_msg(c > 0.8, "asymmetric shape: confidence %.3f ambiguity %.3f", c, amb);
+}
+END_TEST
+
+/* A tenth of the target's boundary missing: the inlier fraction drops to about 0.9; correspondences: N samples, target points on the target's boundary. */
+START_TEST(missing_run_inliers_and_correspondences)
+{
+    enum { N = 400, DROP = 40 };
+    double src[2 * N], tgt[2 * N], T[6], size;
+    make_pair(99, N, src, tgt, T, &size);
+    amscr_result *r = NULL;
+    double err = reg_error(src, N, tgt + 2 * DROP, N - DROP, T, size, 0, &r);
+    double inl = amscr_result_inlier_fraction(r);
+    printf("robust: 10 %% missing: error %.3f %%, inliers %.3f\n", 100.0 * err, inl);
+    fflush(stdout);
+    ck_assert_msg(err < 0.02, "10 %% missing: error %.3f %%", 100.0 * err);
+    ck_assert_msg(inl > 0.75 && inl < 0.97, "inlier fraction %.3f with 10 %% missing", inl);
+    size_t n = 0;
+    ck_assert_int_eq(amscr_result_correspondences(r, NULL, NULL, NULL, &n), AMSCR_OK);
+    ck_assert_uint_eq(n, 256);
+    double *sxy = malloc(2 * n * sizeof *sxy), *par = malloc(n * sizeof *par), *txy = malloc(2 * n * sizeof *txy);
+    ck_assert(sxy && par && txy);
+    size_t small = n - 1;
+    ck_assert_int_eq(amscr_result_correspondences(r, sxy, par, txy, &small), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_result_correspondences(r, sxy, par, txy, &n), AMSCR_OK);
+    size_t near = 0;
+    for (size_t a = 0; a < n; a++) {
+        ck_assert(par[a] >= 0.0 && par[a] < 1.0);
+        double p[2];
+        amscr_test_apply_affine(T, sxy + 2 * a, 1, p);
+        if (hypot(p[0] - txy[2 * a], p[1] - txy[2 * a + 1]) < 0.03 * size)
+            near++;
+    }
+    ck_assert_msg((double)near >= 0.7 * (double)n, "%zu of %zu correspondences within 3 %%", near, n);
+    amscr_result_free(r);
+    free(sxy);
+    free(par);
+    free(txy);
+}
+END_TEST
+
+/* Bad input: partial needs an open source and a closed target; the flag is 0 or 1. */
+START_TEST(partial_errors)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_partial(p, 2), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_get_partial(p), 0);
+    ck_assert_int_eq(amscr_params_set_partial(p, 1), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_get_partial(p), 1);
+    double xy[2 * 200];
+    amscr_test_ellipse(200, 2.0, 1.0, 0.0, xy);
+    amscr_contour *c = NULL;
+    amscr_descriptor *d = NULL;
+    amscr_result *r = NULL;
+    ck_assert_int_eq(amscr_contour_new(xy, 200, &c), AMSCR_OK);
+    ck_assert_int_eq(amscr_descriptor_new(p, c, &d), AMSCR_OK); /* closed */
+    ck_assert_int_eq(amscr_register(p, d, d, NULL, &r), AMSCR_E_INVALID_ARG);
+    ck_assert_ptr_null(r);
+    ck_assert(isnan(amscr_result_confidence(NULL)) && isnan(amscr_result_inlier_fraction(NULL)));
+    double s0, s1;
+    ck_assert_int_eq(amscr_result_part(NULL, &s0, &s1), AMSCR_E_INVALID_ARG);
+    amscr_descriptor_free(d);
+    amscr_contour_free(c);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* Kimia-99 pixel contours: 70 % fragments of every shape register (>= 90 % within 2 %). */
+START_TEST(kimia_fragments)
+{
+    const char *root = amscr_test_datasets_dir();
+    if (!root) {
+        printf("robust: datasets not found (AMSCR_DATASETS); Kimia fragments skipped\n");
+        return;
+    }
+    char path[4096], line[1024];
+    snprintf(path, sizeof path, "%s/kimia99/manifest.tsv", root);
+    FILE *fp = fopen(path, "r");
+    if (!fp) {
+        printf("robust: %s absent; Kimia fragments skipped\n", path);
+        return;
+    }
+    size_t cases = 0, ok = 0;
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, 1414);
+    while (fgets(line, sizeof line, fp)) {
+        char *tab = strchr(line, '\t');
+        if (!tab || strncmp(line, "file", 4) == 0 || cases >= 33)
+            continue;
+        *tab = '\0';
+        snprintf(path, sizeof path, "%s/kimia99/%s", root, line);
+        unsigned char *px = NULL;
+        size_t w = 0, h = 0;
+        ck_assert_msg(amscr_test_read_png_gray(path, &px, &w, &h) == 0, "cannot read %s", path);
+        amscr_contour *c = NULL;
+        ck_assert_int_eq(amscr_contour_from_mask(px, w, h, w, 127, &c), AMSCR_OK);
+        free(px);
+        size_t n = amscr_contour_size(c), k = (size_t)(0.7 * (double)n);
+        const double *f = amscr_contour_xy(c);
+        double T[6];
+        amscr_test_random_affine(&rng, 2.0, 0.5, 50.0, 0, T);
+        double *tgt = malloc(2 * n * sizeof *tgt), *frag = malloc(2 * k * sizeof *frag);
+        ck_assert(tgt && frag);
+        amscr_test_apply_affine(T, f, n, tgt);
+        size_t start = (size_t)(amscr_test_uniform(&rng) * (double)n) % n;
+        for (size_t i = 0; i < k; i++) {
+            frag[2 * i] = f[2 * ((start + i) % n)];
+            frag[2 * i + 1] = f[2 * ((start + i) % n) + 1];
+        }
+        double err = reg_error(frag, k, tgt, n, T, amscr_test_shape_size(tgt, n), 1, NULL);
+        cases++;
+        ok += err < 0.02;
+        if (!(err < 0.02))
+            printf("robust: kimia fragment %s: error %.2f %%\n", line, 100.0 * err);
+        free(tgt);
+        free(frag);
+        amscr_contour_free(c);
+    }
+    fclose(fp);
+    printf("robust: kimia99 70 %% fragments: %zu of %zu within 2 %%\n", ok, cases);
+    ck_assert_msg((double)ok >= 0.9 * (double)cases, "%zu of %zu", ok, cases);
+}
+END_TEST
+
+Suite *amscr_suite_robust(void)
+{
+    Suite *s = suite_create("robust");
+    TCase *tc = tcase_create("robust");
+    tcase_set_timeout(tc, 300);
+    tcase_add_test(tc, partial_fragment_70);
+    tcase_add_test(tc, partial_fragment_50);
+    tcase_add_test(tc, symmetric_shapes_ambiguous);
+    tcase_add_test(tc, missing_run_inliers_and_correspondences);
+    tcase_add_test(tc, partial_errors);
+    tcase_add_test(tc, kimia_fragments);
+    suite_add_tcase(s, tc);
+    return s;
+}
