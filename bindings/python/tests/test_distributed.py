@@ -259,7 +259,7 @@ def lose_first_query_block(two_workers, monkeypatch):
         futures = scatter(self, which)
         if not self.broadcast and not recovered:  # the first scatter of query blocks
             [holder] = two_workers.who_has(futures[:1])[futures[0].key]
-            two_workers.restart_workers([holder])
+            two_workers.restart_workers([holder], timeout=TIMEOUT, raise_for_error=False)  # its nanny: a new one
             deadline = time.monotonic() + TIMEOUT
             while futures[0].status == 'finished' and time.monotonic() < deadline:
                 time.sleep(0.05)
