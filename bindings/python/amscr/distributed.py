@@ -30,16 +30,24 @@ How it runs:
   memory-mapped on the client).
 * A worker that dies mid-run has its tiles rescheduled by Dask (``distributed.scheduler.
   allowed-failures``, 3 by default); tasks raising an exception are retried ``retries`` times.
+  The shapes a tile needs may have lived only on the dead worker: query blocks go to one worker,
+  and Dask's active memory manager drops the extra replicas of the broadcast collection that no
+  waiting task needs. Dask then cancels the tiles depending on them. The eager paths (``out=``,
+  ``client=None``, :func:`topk`) scatter the lost shapes again from the client's copy and
+  resubmit those tiles (up to ``LOST_ROUNDS`` times, then :class:`LostTilesError`); a lazy
+  array carries its shapes in its graph instead (one task per block, held by the scheduler), so
+  Dask rebuilds a lost block by itself.
 """
 from __future__ import annotations
 
+import concurrent.futures
 import contextlib
 import math
 import os
 import threading
 import uuid
 from collections import defaultdict
-from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -53,17 +61,24 @@ except ImportError as e:  # pragma: no cover - exercised only without Dask
                       '(or pip install "amscr[distributed]")') from e
 
 from .collection import Collection
-from .errors import FormatError
+from .errors import AmscrError, FormatError
 from .shape import Shape
 
-__all__ = ['distance_matrix', 'cross_matrix', 'topk', 'tile_size']
+__all__ = ['distance_matrix', 'cross_matrix', 'topk', 'tile_size', 'LostTilesError']
 
 TILE_MIN, TILE_MAX = 64, 2048
 TILES_PER_THREAD = 8  # enough tiles that the last round leaves few threads idle
 MERGE_FAN_IN = 8
+LOST_ROUNDS = 3  # resubmissions of tiles cancelled because the shapes they needed were lost
 
 PathLike = Union[str, 'os.PathLike[str]']
 TileArg = Union[None, int, Tuple[int, int]]
+
+
+class LostTilesError(AmscrError, RuntimeError):
+    """Tiles were cancelled by Dask (their shapes were lost with the workers holding them, or
+    the computation was cancelled) more than ``LOST_ROUNDS`` times in a row; no partial result
+    is returned."""
 
 
 # ========================================================================== worker side
@@ -296,21 +311,63 @@ def _queries_like(queries: Any, targets: Collection) -> Collection:
     return q
 
 
-def _scatter_blocks(client, coll: Collection, bounds: Sequence[Tuple[int, int]], what: str) -> list:
-    """Row blocks of `coll` as scattered payloads (each goes where it is needed)."""
-    payloads = [_Payload(_block(coll, lo, hi, coll.params.threads).to_bytes(), what) for lo, hi in bounds]
-    return client.scatter(payloads, hash=False) if payloads else []
+PayloadMaker = Callable[[], _Payload]
 
 
-def _scatter_cross(client, q: Collection, t: Collection, tile: TileArg, threads: Optional[int]):
+def _whole(coll: Collection, what: str) -> PayloadMaker:
+    return lambda: _Payload(coll.to_bytes(), what)
+
+
+def _blocks(coll: Collection, bounds: Sequence[Tuple[int, int]], what: str) -> List[PayloadMaker]:
+    return [lambda lo=lo, hi=hi: _Payload(_block(coll, lo, hi, coll.params.threads).to_bytes(), what)
+            for lo, hi in bounds]
+
+
+class _Scattered:
+    """Payloads scattered from the client's collections (`makers` serialize them on demand);
+    :meth:`refresh` scatters again those the cluster lost. `broadcast`: to every worker, else
+    each payload to one worker (it travels to the others when a tile there needs it)."""
+
+    def __init__(self, client, makers: Sequence[PayloadMaker], broadcast: bool):
+        self.client, self.makers, self.broadcast = client, list(makers), broadcast
+        self.futures = self._scatter(range(len(self.makers)))
+
+    def _scatter(self, which: Iterable[int]) -> list:
+        payloads = [self.makers[i]() for i in which]
+        return self.client.scatter(payloads, broadcast=self.broadcast, hash=False) if payloads else []
+
+    def __getitem__(self, i: int):
+        return self.futures[i]
+
+    def refresh(self) -> int:
+        """Scatters again the payloads no worker holds any more; returns how many."""
+        who: Dict[Any, Any] = {}
+        for _ in range(3):  # who_has raises when a future is cancelled meanwhile: ask again
+            held = [f for f in self.futures if f.status == 'finished']
+            try:
+                who = self.client.who_has(held) if held else {}
+                break
+            except concurrent.futures.CancelledError:
+                continue
+        lost = [i for i, f in enumerate(self.futures) if f.status != 'finished' or not who.get(f.key)]
+        for i, f in zip(lost, self._scatter(lost)):
+            self.futures[i] = f
+        return len(lost)
+
+
+def _graph_payloads(makers: Sequence[PayloadMaker], token: str) -> list:
+    """Payloads as tasks of a lazy graph (one key each): Dask recomputes a lost one."""
+    return [dask.delayed(m(), name='%s-payload-%d' % (token, i), traverse=False) for i, m in enumerate(makers)]
+
+
+def _cross_layout(client, q: Collection, t: Collection, tile: TileArg, threads: Optional[int]):
     """Tiles of a queries x targets computation: (row bounds, column bounds, threads argument,
-    the targets' payload (on every worker), the query row blocks' payloads)."""
+    the targets' payload maker, the query row blocks' payload makers)."""
     nq, nt = len(q), len(t)
     tr, tc = tile_size(nq, nt, sum(client.nthreads().values()), tile)
     row_b, col_b = _bounds(nq, tr), _bounds(nt, tc)
     th = _threads_arg(threads, client)
-    [tpay] = client.scatter([_Payload(t.to_bytes(), 'target collection')], broadcast=True, hash=False)
-    return row_b, col_b, th, tpay, _scatter_blocks(client, q, row_b, 'query block')
+    return row_b, col_b, th, _whole(t, 'target collection'), _blocks(q, row_b, 'query block')
 
 
 def _out_array(out: Any, shape: Tuple[int, int]) -> np.ndarray:
@@ -338,13 +395,20 @@ def _show_progress(client, futures: list) -> Optional[threading.Thread]:
     return t
 
 
-def _drain(client, placed: Dict[Any, Any], progress: bool, put) -> None:
-    """Waits for the futures of `placed` (future -> where), calling put(where, result) as each
-    arrives and dropping it at once; on an error, cancels the rest and raises it."""
+def _collect(client, placed: Dict[Any, Any], progress: bool, put) -> Tuple[list, Optional[BaseException]]:
+    """Waits for the futures of `placed` (future -> job), calling put(job, result) as each
+    arrives and dropping it at once. Returns the jobs whose futures Dask cancelled (with the last
+    reason); on an error, cancels the rest and raises it."""
     bar = _show_progress(client, list(placed)) if progress else None
+    cancelled, reason = [], None
     try:
         for fut, result in as_completed(list(placed), with_results=True):
-            put(placed.pop(fut), result)
+            job = placed.pop(fut)
+            if fut.status == 'cancelled' or isinstance(result, BaseException):
+                cancelled.append(job)  # as_completed yields the CancelledError as the result
+                reason = result if isinstance(result, BaseException) else reason
+            else:
+                put(job, result)
             del fut, result
     except BaseException:
         client.cancel(list(placed))
@@ -353,20 +417,42 @@ def _drain(client, placed: Dict[Any, Any], progress: bool, put) -> None:
         placed.clear()
         if bar is not None:
             bar.join(timeout=5)
+    return cancelled, reason
 
 
-def _eager_matrix(client, task, row_b, col_b, args_of, out, progress, retries, token, shape):
+def _drain(client, jobs: Dict[Any, Callable[[int], Any]], progress: bool, put,
+           payloads: Sequence[_Scattered]) -> None:
+    """Runs the jobs (job -> submit(attempt), returning the job's future), calling put(job,
+    result) for each. Jobs cancelled by Dask (a payload lost with its worker) are resubmitted
+    after the lost payloads are scattered again, up to LOST_ROUNDS times; then LostTilesError."""
+    placed = {submit(0): job for job, submit in jobs.items()}
+    for attempt in range(1, LOST_ROUNDS + 2):
+        cancelled, reason = _collect(client, placed, progress, put)
+        if not cancelled:
+            return
+        if attempt > LOST_ROUNDS:
+            raise LostTilesError('amscr.distributed: %d tiles were cancelled by Dask %d times in a row (their '
+                                 'shapes were lost with the workers holding them, or the computation was '
+                                 'cancelled); last reason: %s' % (len(cancelled), attempt, reason))
+        for p in payloads:
+            p.refresh()
+        placed = {jobs[job](attempt): job for job in cancelled}
+
+
+def _eager_matrix(client, task, row_b, col_b, args_of, out, progress, retries, token, shape, payloads):
     arr = _out_array(out, shape)
-    placed = {}
-    for i, (r0, r1) in enumerate(row_b):
-        for j, (c0, c1) in enumerate(col_b):
-            f = client.submit(task, *args_of(i, j), key='%s-%d-%d' % (token, i, j), retries=retries, pure=False)
-            placed[f] = (slice(r0, r1), slice(c0, c1))
 
-    def put(where, tile):
-        arr[where] = tile
+    def submit_of(i, j):
+        return lambda attempt: client.submit(task, *args_of(i, j), key='%s-%d-%d-%d' % (token, i, j, attempt),
+                                             retries=retries, pure=False)
 
-    _drain(client, placed, progress, put)
+    jobs = {(i, j): submit_of(i, j) for i in range(len(row_b)) for j in range(len(col_b))}
+
+    def put(ij, tile):
+        i, j = ij
+        arr[slice(*row_b[i]), slice(*col_b[j])] = tile
+
+    _drain(client, jobs, progress, put, payloads)
     if isinstance(arr, np.memmap):
         arr.flush()
     return arr
@@ -414,6 +500,10 @@ def distance_matrix(collection: Union[Collection, bytes], client=None, tile: Til
         with a client and no `out`: a lazy Dask array (computed on `client`; with
         ``progress=True`` it is persisted first and the bar shown); with ``client=None``: a NumPy
         array; with `out`: the memmap (or array).
+
+    Raises:
+        LostTilesError: (eager paths) tiles were still cancelled by Dask after ``LOST_ROUNDS``
+            resubmissions with their lost shapes scattered again.
     """
     coll = _as_collection(collection, 'collection')
     threads = _check_threads(threads)
@@ -423,15 +513,17 @@ def distance_matrix(collection: Union[Collection, bytes], client=None, tile: Til
         tr, tc = tile_size(n, n, sum(c.nthreads().values()), tile)
         row_b, col_b = _bounds(n, tr), _bounds(n, tc)
         th = _threads_arg(threads, c)
-        [payload] = c.scatter([_Payload(coll.to_bytes())], broadcast=True, hash=False)
         token = 'amscr-matrix-' + uuid.uuid4().hex
+        maker = _whole(coll, 'collection')
+        payload = _graph_payloads([maker], token) if lazy else _Scattered(c, [maker], broadcast=True)
 
         def args_of(i, j):
-            return (payload,) + row_b[i] + col_b[j] + (th,)
+            return (payload[0],) + row_b[i] + col_b[j] + (th,)
 
         if lazy:
             return _lazy_matrix(c, _matrix_tile, row_b, col_b, args_of, progress, retries, token)
-        return _eager_matrix(c, _matrix_tile, row_b, col_b, args_of, out, progress, retries, token, (n, n))
+        return _eager_matrix(c, _matrix_tile, row_b, col_b, args_of, out, progress, retries, token, (n, n),
+                             [payload])
 
 
 def cross_matrix(queries: Union[Collection, bytes], targets: Union[Collection, bytes], client=None,
@@ -446,15 +538,20 @@ def cross_matrix(queries: Union[Collection, bytes], targets: Union[Collection, b
     nq, nt = len(q), len(t)
     lazy = client is not None and out is None
     with _client_or_local(client) as c:
-        row_b, col_b, th, tpay, qpays = _scatter_cross(c, q, t, tile, threads)
+        row_b, col_b, th, tmaker, qmakers = _cross_layout(c, q, t, tile, threads)
         token = 'amscr-cross-' + uuid.uuid4().hex
+        if lazy:
+            tpay, qpays = _graph_payloads([tmaker], token + '-t'), _graph_payloads(qmakers, token + '-q')
+        else:
+            tpay, qpays = _Scattered(c, [tmaker], broadcast=True), _Scattered(c, qmakers, broadcast=False)
 
         def args_of(i, j):
-            return (qpays[i], tpay) + col_b[j] + (th,)
+            return (qpays[i], tpay[0]) + col_b[j] + (th,)
 
         if lazy:
             return _lazy_matrix(c, _cross_tile, row_b, col_b, args_of, progress, retries, token)
-        return _eager_matrix(c, _cross_tile, row_b, col_b, args_of, out, progress, retries, token, (nq, nt))
+        return _eager_matrix(c, _cross_tile, row_b, col_b, args_of, out, progress, retries, token, (nq, nt),
+                             [tpay, qpays])
 
 
 def topk(queries: Union[Collection, Iterable[Any], bytes], collection: Union[Collection, bytes], k: int = 10,
@@ -497,27 +594,32 @@ def topk(queries: Union[Collection, Iterable[Any], bytes], collection: Union[Col
     if nq == 0 or k == 0:
         return indices, distances
     with _client_or_local(client) as c:
-        row_b, col_b, th, tpay, qpays = _scatter_cross(c, q, t, tile, threads)
+        row_b, col_b, th, tmaker, qmakers = _cross_layout(c, q, t, tile, threads)
+        tpay, qpays = _Scattered(c, [tmaker], broadcast=True), _Scattered(c, qmakers, broadcast=False)
         token = uuid.uuid4().hex
-        placed = {}
-        for i, (r0, r1) in enumerate(row_b):
+
+        def submit_row(i, attempt):
+            """The tiles of query block i and their merge tree; returns the root's future."""
+            r0, r1 = row_b[i]
             exi = None if ex is None else ex[r0:r1]
-            level = [c.submit(_topk_tile, qpays[i], tpay, c0, c1, k, exi, th, retries=retries, pure=False,
-                              key='amscr-topk-%s-%d-%d' % (token, i, j)) for j, (c0, c1) in enumerate(col_b)]
+            name = '%s-%d-%d' % (token, i, attempt)
+            level = [c.submit(_topk_tile, qpays[i], tpay[0], c0, c1, k, exi, th, retries=retries, pure=False,
+                              key='amscr-topk-%s-%d' % (name, j)) for j, (c0, c1) in enumerate(col_b)]
             depth = 0
             while len(level) > 1:
                 level = [c.submit(_merge, k, *level[m:m + MERGE_FAN_IN], retries=retries, pure=False,
-                                  key='amscr-merge-%s-%d-%d-%d' % (token, i, depth, m))
+                                  key='amscr-merge-%s-%d-%d' % (name, depth, m))
                          for m in range(0, len(level), MERGE_FAN_IN)]
                 depth += 1
-            placed[level[0]] = slice(r0, r1)
-        del level
+            return level[0]
 
-        def put(rows, result):
+        def put(i, result):
             idx, dist = result
             if (idx < 0).any():  # pragma: no cover - k is clipped to the valid candidates
                 raise RuntimeError('amscr.distributed.topk: fewer than k candidates in a row')
+            rows = slice(*row_b[i])
             indices[rows], distances[rows] = idx, dist
 
-        _drain(c, placed, progress, put)
+        jobs = {i: (lambda attempt, i=i: submit_row(i, attempt)) for i in range(len(row_b))}
+        _drain(c, jobs, progress, put, [tpay, qpays])
     return indices, distances

@@ -1,8 +1,11 @@
 """amscr.distributed on a real LocalCluster (2 worker processes on loopback): distance matrix,
-cross matrix and top-k equal the single-machine results exactly, a worker killed mid-run does not
-change the matrix, a corrupt serialized collection is a clear error. Skipped without Dask."""
+cross matrix and top-k equal the single-machine results exactly, a worker killed mid-run (or one
+that dies holding the only copy of a query block) does not change the result, a corrupt serialized
+collection is a clear error. Skipped without Dask."""
 import concurrent.futures
+import contextlib
 import os
+import time
 
 import numpy as np
 import pytest
@@ -54,6 +57,15 @@ def client():
         yield c
 
 
+@pytest.fixture
+def two_workers(client):
+    """The module's client once both workers are up (a test before may have killed one: its nanny
+    restarts it)."""
+    client.wait_for_workers(2, timeout=TIMEOUT)
+    assert len(client.nthreads()) == 2
+    return client
+
+
 def _within(fn, timeout=TIMEOUT):
     """fn() on a thread; fails (instead of hanging the suite) when it takes longer than timeout."""
     ex = concurrent.futures.ThreadPoolExecutor(1)
@@ -103,8 +115,8 @@ def test_tile_size():
 
 
 # ------------------------------------------------------------------------------ on the cluster
-def test_workers_use_the_same_library(client):
-    paths = client.run(lambda: (amscr.LIBRARY_PATH, amscr.API_MODE, amscr.library_version()))
+def test_workers_use_the_same_library(two_workers):
+    paths = two_workers.run(lambda: (amscr.LIBRARY_PATH, amscr.API_MODE, amscr.library_version()))
     assert len(paths) == 2
     assert set(paths.values()) == {(amscr.LIBRARY_PATH, amscr.API_MODE, amscr.library_version())}
 
@@ -181,18 +193,18 @@ def test_corrupt_serialized_collection_is_a_clear_error(client, db, monkeypatch)
 
 
 class _KillOnce(distributed.WorkerPlugin):
-    """Kills its worker process (os._exit) when the third matrix tile starts on it; only once
-    in the whole cluster (an O_EXCL marker file claims the kill)."""
+    """Kills its worker process (os._exit) when the nth task whose key starts with `prefix`
+    starts on it; only once in the whole cluster (an O_EXCL marker file claims the kill)."""
 
-    def __init__(self, marker):
-        self.marker = marker
+    def __init__(self, marker, prefix='amscr-matrix-', nth=3):
+        self.marker, self.prefix, self.nth = marker, prefix, nth
         self.started = 0
 
     def transition(self, key, start, finish, **kwargs):
-        if finish != 'executing' or not str(key).startswith('amscr-matrix-'):
+        if finish != 'executing' or not str(key).startswith(self.prefix):
             return
         self.started += 1
-        if self.started < 3:
+        if self.started < self.nth:
             return
         try:
             fd = os.open(self.marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
@@ -202,19 +214,105 @@ class _KillOnce(distributed.WorkerPlugin):
         os._exit(1)
 
 
-def test_worker_killed_mid_run_gives_the_same_matrix(client, db, D, tmp_path):
+@contextlib.contextmanager
+def _kill_once(client, tmp_path, prefix, nth):
+    """A worker dies (once) at the nth task of `prefix` it starts; yields the marker path."""
     marker = str(tmp_path / 'killed')
     name = 'amscr-kill-once'
     register = getattr(client, 'register_plugin', None) or client.register_worker_plugin
-    register(_KillOnce(marker), name=name)
+    register(_KillOnce(marker, prefix, nth), name=name)
     try:
-        out = np.full(D.shape, np.nan)
-        _within(lambda: ad.distance_matrix(db, client=client, tile=30, out=out))  # 64 tiles
-        assert os.path.exists(marker), 'no worker was killed'
-        assert np.array_equal(out, D)
+        yield marker
     finally:
         client.unregister_worker_plugin(name)
         client.wait_for_workers(2, timeout=TIMEOUT)  # the nanny restarts the killed worker
+
+
+def test_worker_killed_mid_run_gives_the_same_matrix(two_workers, db, D, tmp_path):
+    with _kill_once(two_workers, tmp_path, 'amscr-matrix-', 3) as marker:
+        out = np.full(D.shape, np.nan)
+        _within(lambda: ad.distance_matrix(db, client=two_workers, tile=30, out=out))  # 64 tiles
+        assert os.path.exists(marker), 'no worker was killed'
+        assert np.array_equal(out, D)
+
+
+def test_worker_killed_holding_its_query_block_gives_the_same_topk(two_workers, db, queries, tmp_path):
+    """Each query block lives on one worker: the worker starting the first top-k tile holds that
+    tile's block (usually the only copy) and dies; the tiles are resubmitted, the result equal."""
+    k = 7
+    with _kill_once(two_workers, tmp_path, 'amscr-topk-', 1) as marker:
+        idx, dist = _within(lambda: ad.topk(queries, db, k=k, client=two_workers, tile=(8, 120)))
+        assert os.path.exists(marker), 'no worker was killed'
+    want = queries.cross_matrix(db)
+    assert np.array_equal(idx, np.argsort(want, axis=1, kind='stable')[:, :k])
+    assert np.array_equal(dist, np.take_along_axis(want, idx, 1))
+
+
+@pytest.fixture
+def lose_first_query_block(two_workers, monkeypatch):
+    """Right after the query blocks are scattered, the worker holding block 0 (its only copy)
+    is restarted, so the tiles of block 0 depend on lost data. Yields the payload counts that
+    _Scattered.refresh scattered again."""
+    scatter, refresh, recovered = ad._Scattered._scatter, ad._Scattered.refresh, []
+
+    def scatter_then_lose(self, which):
+        futures = scatter(self, which)
+        if not self.broadcast and not recovered:  # the first scatter of query blocks
+            [holder] = two_workers.who_has(futures[:1])[futures[0].key]
+            two_workers.restart_workers([holder], timeout=TIMEOUT, raise_for_error=False)  # its nanny: a new one
+            deadline = time.monotonic() + TIMEOUT
+            while futures[0].status == 'finished' and time.monotonic() < deadline:
+                time.sleep(0.05)
+            assert futures[0].status != 'finished', 'the restarted worker kept query block 0'
+            recovered.append(0)
+        return futures
+
+    def counted_refresh(self):
+        n = refresh(self)
+        recovered.append(n)
+        return n
+
+    monkeypatch.setattr(ad._Scattered, '_scatter', scatter_then_lose)
+    monkeypatch.setattr(ad._Scattered, 'refresh', counted_refresh)
+    yield recovered
+    two_workers.wait_for_workers(2, timeout=TIMEOUT)
+
+
+def test_lost_query_block_is_scattered_again_for_topk(two_workers, db, queries, lose_first_query_block):
+    k = 5
+    idx, dist = _within(lambda: ad.topk(queries, db, k=k, client=two_workers, tile=(10, 64)))
+    assert sum(lose_first_query_block) >= 1, 'no lost payload was scattered again'
+    want = queries.cross_matrix(db)
+    assert np.array_equal(idx, np.argsort(want, axis=1, kind='stable')[:, :k])
+    assert np.array_equal(dist, np.take_along_axis(want, idx, 1))
+
+
+def test_lost_query_block_is_scattered_again_for_cross_matrix(two_workers, db, queries, lose_first_query_block):
+    out = np.full((len(queries), len(db)), np.nan)
+    _within(lambda: ad.cross_matrix(queries, db, client=two_workers, tile=(10, 64), out=out))
+    assert sum(lose_first_query_block) >= 1, 'no lost payload was scattered again'
+    assert np.array_equal(out, queries.cross_matrix(db))
+
+
+def test_tiles_cancelled_every_time_are_a_clear_error(two_workers, db, queries, monkeypatch):
+    """A payload that cannot be brought back (here: refresh does nothing) ends in LostTilesError
+    after LOST_ROUNDS resubmissions, never in a partial result or an exception in the matrix."""
+    monkeypatch.setattr(ad._Scattered, 'refresh', lambda self: 0)
+    monkeypatch.setattr(ad, 'LOST_ROUNDS', 1)
+    scatter = ad._Scattered._scatter
+
+    def scatter_then_lose(self, which):
+        futures = scatter(self, which)
+        if not self.broadcast:
+            two_workers.cancel(futures)  # every query block gone: its tiles are cancelled
+        return futures
+
+    monkeypatch.setattr(ad._Scattered, '_scatter', scatter_then_lose)
+    out = np.full((len(queries), len(db)), np.nan)
+    with pytest.raises(ad.LostTilesError, match='cancelled by Dask 2 times'):
+        _within(lambda: ad.cross_matrix(queries, db, client=two_workers, tile=(10, 64), out=out))
+    with pytest.raises(amscr.AmscrError):
+        _within(lambda: ad.topk(queries, db, k=3, client=two_workers, tile=(10, 64)))
 
 
 def test_no_client_starts_and_closes_a_local_cluster(db, D):
