@@ -60,6 +60,14 @@ struct amscr_params {
     unsigned num_threads;
     amscr_invariance invariance;
     double penalty;
+    /* retrieval (0.2, channel.c / fuse.c) */
+    double channel_weight;             /* weight of the shape channel in the fused distance, 0 = off */
+    amscr_invariance channel_invariance; /* frame of the shape channel (affine or similarity) */
+    double channel_band;               /* DP band half-width, fraction of N */
+    double channel_skip;               /* DP cost of a sample matched twice */
+    double channel_locality;           /* height bins weighted 1 / (1 + locality * distance along the curve) */
+    unsigned rerank_k;                 /* re-ranking neighbours, 0 = no re-ranking */
+    unsigned rerank_iterations;
 };
 
 
@@ -85,6 +93,7 @@ amscr_status amscr__whiten(const double *xy, size_t n, double *out_xy, double fw
 void amscr__affine_compose(const double a[6], const double b[6], double out[6]);
 void amscr__params_defaults(amscr_params *p);
 void amscr__params_registration(amscr_params *p);
+void amscr__params_retrieval(amscr_params *p);
 
 /* ---- least squares (lstsq.c) ---- */
 size_t amscr__lstsq_work_size(size_t m, size_t n, size_t nrhs);
@@ -143,6 +152,9 @@ void amscr__kmeans1d_dp(const double *sorted, size_t n, size_t kmax, double *scr
 
 /* Elbow choice on sse[0..m-1] for K = k_min..k_min+m-1; returns chosen K. */
 size_t amscr__elbow_choose(const double *sse, size_t m, size_t k_min);
+
+/* Re-ranking as amscr_rerank_diffusion, output 1 - Q_ij / sqrt(Q_ii Q_jj) (rerank.c). */
+amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);
 
 /* Thread count helper: 0 -> online cores. */
 unsigned amscr__resolve_threads(unsigned requested);

@@ -20,21 +20,24 @@ static int cmp_nb(const void *a, const void *b)
     return x->j < y->j ? -1 : (x->j > y->j);
 }
 
-amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
+/* Output normalizations of the diffused affinity Q. */
+enum { NORM_ROW_MAX = 0, NORM_COSINE = 1 };
+
+static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iterations, int norm, double *out_dist,
+                           const char *what)
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(dist);
     AMSCR_CHECK_NULL(out_dist);
     if (n == 0 || k < 1 || k > n || iterations < 1 || iterations > 1000)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_rerank_diffusion: need n >= 1, 1 <= k <= n, 1 <= iterations "
+        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: need n >= 1, 1 <= k <= n, 1 <= iterations "
                                                 "<= 1000 (n=%zu k=%zu iterations=%u)",
-                           n, k, iterations);
+                           what, n, k, iterations);
     if (n > 65536)
-        return amscr__fail(AMSCR_E_LIMIT, "amscr_rerank_diffusion: n = %zu exceeds 65536", n);
+        return amscr__fail(AMSCR_E_LIMIT, "%s: n = %zu exceeds 65536", what, n);
     for (size_t i = 0; i < n * n; i++)
         if (!isfinite(dist[i]) || dist[i] < 0.0)
-            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_rerank_diffusion: distance %zu is negative or not finite",
-                               i);
+            return amscr__fail(AMSCR_E_INVALID_ARG, "%s: distance %zu is negative or not finite", what, i);
     double *D = amscr__malloc_array(n * n, sizeof *D), *Q = amscr__malloc_array(n * n, sizeof *Q);
     double *T = amscr__malloc_array(n * n, sizeof *T), *sc = amscr__malloc_array(n, sizeof *sc);
     double *pw = amscr__malloc_array(n * k, sizeof *pw);
@@ -109,7 +112,20 @@ amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsi
             }
         }
     }
-    for (size_t i = 0; i < n; i++) {
+    if (norm == NORM_COSINE) {
+        /* Q is close to sum_t P^t (P^t)^T, which is positive semi-definite and >= 0, so
+         * Q_ij <= sqrt(Q_ii Q_jj) up to the asymmetry of the start Q = P: the symmetrized
+         * 1 - Q_ij / sqrt(Q_ii Q_jj), clamped to [0, 1], is symmetric and 0 on the diagonal
+         * (pairs the diffusion does not reach get 1) */
+        for (size_t i = 0; i < n; i++)
+            sc[i] = Q[i * n + i] > 0.0 ? 1.0 / sqrt(Q[i * n + i]) : 0.0;
+        for (size_t i = 0; i < n; i++)
+            for (size_t j = 0; j < n; j++) {
+                double c = 0.5 * (Q[i * n + j] + Q[j * n + i]) * sc[i] * sc[j];
+                out_dist[i * n + j] = i == j ? 0.0 : c >= 1.0 ? 0.0 : c <= 0.0 ? 1.0 : 1.0 - c;
+            }
+    }
+    for (size_t i = 0; norm == NORM_ROW_MAX && i < n; i++) {
         double qmax = 0.0;
         for (size_t j = 0; j < n; j++)
             if (Q[i * n + j] > qmax)
@@ -128,4 +144,14 @@ amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsi
     free(pj);
     free(row);
     return AMSCR_OK;
+}
+
+amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
+{
+    return rerank(dist, n, k, iterations, NORM_ROW_MAX, out_dist, "amscr_rerank_diffusion");
+}
+
+amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
+{
+    return rerank(dist, n, k, iterations, NORM_COSINE, out_dist, "re-ranking");
 }
