@@ -828,9 +828,11 @@ AMSCR_API unsigned amscr_params_get_rerank_iterations(const amscr_params *p);
  *        signed distances of all samples to the tangent at each sample, binned and weighted
  *        by locality; Wang et al., Pattern Recognition Letters 2012) in the channel's frame,
  *        compared by an order-preserving dynamic-programming correspondence in a band around
- *        the best cyclic shift (and mirror image when reflections are on). Symmetric, >= 0,
- *        0 for a shape against itself, invariant to the channel's group, tolerant of
- *        articulation and local stretch. The channel settings come from `p` (NULL = a's).
+ *        the best cyclic shift (and mirror image when reflections are on). >= 0, 0 for a
+ *        shape against itself, invariant to the channel's group, tolerant of articulation
+ *        and local stretch. d(a, b) and d(b, a) differ only when the shift/mirror search
+ *        of the two orders picks different candidates (rare); amscr_db_channel_matrix uses
+ *        d(i, j) for i < j in both cells. The channel settings come from `p` (NULL = a's).
  * @return AMSCR_OK, AMSCR_E_INVALID_ARG (NULL, open curves, different N), AMSCR_E_NOMEM.
  * Thread-safety: reentrant. @since 0.2
  */

@@ -87,10 +87,7 @@ amscr_status amscr_channel_distance(const amscr_params *p, const amscr_descripto
     }
     st = amscr__hf_ws_init(&ws, a->n, cfg.band);
     if (st == AMSCR_OK) {
-        /* the matrix computes the cell (i, j), i < j, once; here both orders agree by
-         * taking the smaller of the two (the DP is symmetric up to the shift search) */
-        double d1 = amscr__hf_distance(&ha, &hb, &cfg, &ws), d2 = amscr__hf_distance(&hb, &ha, &cfg, &ws);
-        *out_dist = d1 < d2 ? d1 : d2;
+        *out_dist = amscr__hf_distance(&ha, &hb, &cfg, &ws);
         amscr__hf_ws_free(&ws);
     }
     amscr__hf_free(&ha);
