@@ -789,14 +789,16 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_rerank_diffusion(const double *dist
  * ====================================================================== */
 
 /**
- * @brief The retrieval preset: the defaults plus mirror images, the shape channel fused with
- *        weight 1 and context re-ranking with k = 5 (bench/RESULTS-retrieval.md: measured on
- *        mpeg7-dev, Kimia-99/216 and the MCD-style affine set). Use it with
- *        amscr_db_retrieval_matrix. Ownership: caller frees. @since 0.2
+ * @brief The retrieval preset: the defaults plus mirror images, the shape channel alone
+ *        (channel weight 1: on articulated collections the AMSCR distance lowered the fused
+ *        result at every weight measured) and context re-ranking with k = 7 (README /
+ *        bench/RESULTS-retrieval.md: measured on mpeg7-dev, Kimia-99/216 and the MCD-style
+ *        affine set). Use it with amscr_db_retrieval_matrix. Ownership: caller frees. @since 0.2
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_new_retrieval(amscr_params **out);
-/** Weight of the shape channel in amscr_db_retrieval_matrix, 0..1e6; 0 = the AMSCR distance
- *  alone (default 0; 1 in the retrieval preset). @since 0.2 */
+/** Share of the shape channel in amscr_db_retrieval_matrix, 0..1: fused = (1 - w) AMSCR + w
+ *  channel (each divided by its median); 0 = the AMSCR distance alone (default), 1 = the
+ *  channel alone, and the AMSCR matrix is then not computed (the retrieval preset). @since 0.2 */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_weight(amscr_params *p, double w);
 AMSCR_API double amscr_params_get_channel_weight(const amscr_params *p);
 /** Frame of the shape channel: AMSCR_INVARIANCE_SIMILARITY (default) or _AFFINE (whitened);
@@ -816,7 +818,7 @@ AMSCR_API double amscr_params_get_channel_skip(const amscr_params *p);
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_locality(amscr_params *p, double locality);
 AMSCR_API double amscr_params_get_channel_locality(const amscr_params *p);
 /** Neighbours of the context re-ranking in amscr_db_retrieval_matrix, 0..1000; 0 = none
- *  (default 0; 5 in the retrieval preset). @since 0.2 */
+ *  (default 0; 7 in the retrieval preset). @since 0.2 */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_rerank_k(amscr_params *p, unsigned k);
 AMSCR_API unsigned amscr_params_get_rerank_k(const amscr_params *p);
 /** Diffusion iterations of the re-ranking, 1..1000 (default 20). @since 0.2 */
@@ -848,10 +850,12 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_channel_matrix(const amscr_db *d
                                                                void *user, double *out_dist);
 /**
  * @brief The retrieval distance of a collection: the AMSCR matrix (symmetrized) and the shape
- *        channel, each divided by its median off-diagonal value and summed with the channel's
- *        weight, then (rerank_k > 0) diffusion re-ranking as in amscr_rerank_diffusion with the
- *        result normalized as 1 - Q_ij / sqrt(Q_ii Q_jj): a dissimilarity in [0, 1], symmetric,
- *        0 on the diagonal. Without re-ranking the fused distance itself (0 on the diagonal).
+ *        channel, each divided by its median off-diagonal value and mixed by the channel
+ *        weight, then (rerank_k > 0) diffusion re-ranking exactly as amscr_rerank_diffusion
+ *        with its output halved: a dissimilarity in [0, 1] where row i ranks i's neighbours,
+ *        0 for i itself, below 0.5 for the shapes the diffusion reaches from i and 0.5 + half
+ *        the normalized fused distance for the others. Without re-ranking the fused distance
+ *        itself (symmetric, 0 on the diagonal).
  * @return AMSCR_OK, AMSCR_E_INVALID_ARG (open curves with a channel weight), AMSCR_E_NOMEM,
  *         AMSCR_E_CANCELLED (matrix all NaN). @since 0.2
  */

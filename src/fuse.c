@@ -174,9 +174,13 @@ static amscr_status offdiag_median(const double *M, size_t n, double *out)
     return AMSCR_OK;
 }
 
-/* out = sym(A) / median(A) + w * H / median(H), zero diagonal. A may equal out. */
+/* A = (1 - w) sym(A) / median(A) + w H / median(H), zero diagonal (A unused when w = 1). */
 static amscr_status fuse(double *A, const double *H, size_t n, double w)
 {
+    if (H && w >= 1.0) {
+        memcpy(A, H, n * n * sizeof *A);
+        return AMSCR_OK;
+    }
     for (size_t i = 0; i < n; i++) {
         A[i * n + i] = 0.0;
         for (size_t j = i + 1; j < n; j++)
@@ -190,7 +194,7 @@ static amscr_status fuse(double *A, const double *H, size_t n, double w)
         st = offdiag_median(H, n, &mh);
     if (st != AMSCR_OK)
         return st;
-    double sa = ma > 0.0 ? 1.0 / ma : 1.0, sh = mh > 0.0 ? w / mh : w;
+    double sa = ma > 0.0 ? (1.0 - w) / ma : 1.0 - w, sh = mh > 0.0 ? w / mh : w;
     for (size_t i = 0; i < n * n; i++)
         A[i] = sa * A[i] + sh * H[i];
     return AMSCR_OK;
@@ -207,8 +211,13 @@ amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn pro
     if (with_channel && !p->closed)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_db_retrieval_matrix: the shape channel needs closed curves; "
                                                 "set the channel weight to 0 for open ones");
-    stage_progress sp = {progress, user, 0, with_channel ? 2 : 1};
-    amscr_status st = amscr_db_distance_matrix(db, progress ? stage_cb : NULL, &sp, out_dist);
+    int with_amscr = p->channel_weight < 1.0; /* the channel alone needs no AMSCR matrix */
+    stage_progress sp = {progress, user, 0, (size_t)with_channel + (size_t)with_amscr};
+    amscr_status st = AMSCR_OK;
+    if (with_amscr) {
+        st = amscr_db_distance_matrix(db, progress ? stage_cb : NULL, &sp, out_dist);
+        sp.stage = 1;
+    }
     if (st != AMSCR_OK || n == 0)
         return st;
     double *H = NULL;
@@ -216,7 +225,6 @@ amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn pro
         H = amscr__malloc_array(n * n, sizeof *H);
         if (!H)
             st = amscr__fail(AMSCR_E_NOMEM, "amscr_db_retrieval_matrix: out of memory");
-        sp.stage = 1;
         if (st == AMSCR_OK)
             st = channel_matrix(db, progress ? stage_cb : NULL, &sp, H);
     }

@@ -61,7 +61,7 @@ struct amscr_params {
     amscr_invariance invariance;
     double penalty;
     /* retrieval (0.2, channel.c / fuse.c) */
-    double channel_weight;             /* weight of the shape channel in the fused distance, 0 = off */
+    double channel_weight;             /* share of the shape channel in the fused distance, 0..1 */
     amscr_invariance channel_invariance; /* frame of the shape channel (affine or similarity) */
     double channel_band;               /* DP band half-width, fraction of N */
     double channel_skip;               /* DP cost of a sample matched twice */
@@ -153,7 +153,8 @@ void amscr__kmeans1d_dp(const double *sorted, size_t n, size_t kmax, double *scr
 /* Elbow choice on sse[0..m-1] for K = k_min..k_min+m-1; returns chosen K. */
 size_t amscr__elbow_choose(const double *sse, size_t m, size_t k_min);
 
-/* Re-ranking as amscr_rerank_diffusion, output 1 - Q_ij / sqrt(Q_ii Q_jj) (rerank.c). */
+/* Re-ranking as amscr_rerank_diffusion with the output halved into [0, 1] (< 0.5: reached by
+ * the diffusion) and a zero diagonal (rerank.c). */
 amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);
 
 /* Thread count helper: 0 -> online cores. */

@@ -80,7 +80,7 @@ void amscr__params_retrieval(amscr_params *p)
     amscr__params_defaults(p);
     p->reflections = 1;
     p->channel_weight = 1.0;
-    p->rerank_k = 5;
+    p->rerank_k = 7;
 }
 
 amscr_status amscr_params_new_retrieval(amscr_params **out)
@@ -152,7 +152,7 @@ SETTER(invariance, amscr_invariance, invariance, (int)v >= 0 && (int)v <= 2, "un
 GETTER(invariance, amscr_invariance, invariance)
 SETTER(penalty, double, penalty, v >= 0.0 && v <= 1e6, "%g is not in 0..1e6")
 GETTER(penalty, double, penalty)
-SETTER(channel_weight, double, channel_weight, v >= 0.0 && v <= 1e6, "%g is not in 0..1e6")
+SETTER(channel_weight, double, channel_weight, v >= 0.0 && v <= 1.0, "%g is not in 0..1")
 GETTER(channel_weight, double, channel_weight)
 SETTER(channel_invariance, amscr_invariance, channel_invariance,
        v == AMSCR_INVARIANCE_AFFINE || v == AMSCR_INVARIANCE_SIMILARITY, "%d is not affine (0) or similarity (1)")

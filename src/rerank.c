@@ -21,7 +21,7 @@ static int cmp_nb(const void *a, const void *b)
 }
 
 /* Output normalizations of the diffused affinity Q. */
-enum { NORM_ROW_MAX = 0, NORM_COSINE = 1 };
+enum { NORM_ROW_MAX = 0, NORM_UNIT = 1 };
 
 static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iterations, int norm, double *out_dist,
                            const char *what)
@@ -112,20 +112,7 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
             }
         }
     }
-    if (norm == NORM_COSINE) {
-        /* Q is close to sum_t P^t (P^t)^T, which is positive semi-definite and >= 0, so
-         * Q_ij <= sqrt(Q_ii Q_jj) up to the asymmetry of the start Q = P: the symmetrized
-         * 1 - Q_ij / sqrt(Q_ii Q_jj), clamped to [0, 1], is symmetric and 0 on the diagonal
-         * (pairs the diffusion does not reach get 1) */
-        for (size_t i = 0; i < n; i++)
-            sc[i] = Q[i * n + i] > 0.0 ? 1.0 / sqrt(Q[i * n + i]) : 0.0;
-        for (size_t i = 0; i < n; i++)
-            for (size_t j = 0; j < n; j++) {
-                double c = 0.5 * (Q[i * n + j] + Q[j * n + i]) * sc[i] * sc[j];
-                out_dist[i * n + j] = i == j ? 0.0 : c >= 1.0 ? 0.0 : c <= 0.0 ? 1.0 : 1.0 - c;
-            }
-    }
-    for (size_t i = 0; norm == NORM_ROW_MAX && i < n; i++) {
+    for (size_t i = 0; i < n; i++) {
         double qmax = 0.0;
         for (size_t j = 0; j < n; j++)
             if (Q[i * n + j] > qmax)
@@ -134,6 +121,12 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
             double q = Q[i * n + j];
             out_dist[i * n + j] = (q > 0.0 && qmax > 0.0) ? 1.0 - q / qmax
                                                            : 1.0 + (dmax > 0.0 ? D[i * n + j] / dmax : 0.0);
+            /* unit: the same order halved into [0, 1]: below 0.5 for shapes the diffusion
+             * reaches, 0.5 and above for the others (in the order of the input distance), 0
+             * for the shape itself (its own affinity is the row's largest; if not, it still
+             * ranks first) */
+            if (norm == NORM_UNIT)
+                out_dist[i * n + j] = i == j ? 0.0 : 0.5 * out_dist[i * n + j];
         }
     }
     free(D);
@@ -153,5 +146,5 @@ amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsi
 
 amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
 {
-    return rerank(dist, n, k, iterations, NORM_COSINE, out_dist, "re-ranking");
+    return rerank(dist, n, k, iterations, NORM_UNIT, out_dist, "re-ranking");
 }
