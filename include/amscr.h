@@ -791,7 +791,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_rerank_diffusion(const double *dist
 /**
  * @brief The retrieval preset: the defaults plus mirror images, the shape channel alone
  *        (channel weight 1: on articulated collections the AMSCR distance lowered the fused
- *        result at every weight measured) and context re-ranking with k = 7 (README /
+ *        result at every weight measured) and context re-ranking with k = 8, 10 iterations
+ *        (README /
  *        bench/RESULTS-retrieval.md: measured on mpeg7-dev, Kimia-99/216 and the MCD-style
  *        affine set). Use it with amscr_db_retrieval_matrix. Ownership: caller frees. @since 0.2
  */
@@ -805,8 +806,14 @@ AMSCR_API double amscr_params_get_channel_weight(const amscr_params *p);
  *  the channel distance is invariant to that group. @since 0.2 */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_invariance(amscr_params *p, amscr_invariance v);
 AMSCR_API amscr_invariance amscr_params_get_channel_invariance(const amscr_params *p);
+/** With the similarity frame: the share, 0..1, of the same channel computed in the whitened
+ *  (affine-normalized) frame, mixed in as (1 - s) d_similarity + s d_affine (default 0.2:
+ *  keeps affine-distorted views retrievable while articulation is judged in the similarity
+ *  frame). Ignored when the channel's frame is affine. @since 0.2 */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_affine_share(amscr_params *p, double share);
+AMSCR_API double amscr_params_get_channel_affine_share(const amscr_params *p);
 /** Half width of the channel's dynamic-programming band, a fraction of N in (0, 0.5]
- *  (default 1/16). @since 0.2 */
+ *  (default 0.08: 10 samples at N = 128). @since 0.2 */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_band(amscr_params *p, double fraction);
 AMSCR_API double amscr_params_get_channel_band(const amscr_params *p);
 /** Cost of a sample matched twice (a skipped stretch on the other curve), in height units of
@@ -818,10 +825,10 @@ AMSCR_API double amscr_params_get_channel_skip(const amscr_params *p);
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_locality(amscr_params *p, double locality);
 AMSCR_API double amscr_params_get_channel_locality(const amscr_params *p);
 /** Neighbours of the context re-ranking in amscr_db_retrieval_matrix, 0..1000; 0 = none
- *  (default 0; 7 in the retrieval preset). @since 0.2 */
+ *  (default 0; 8 in the retrieval preset). @since 0.2 */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_rerank_k(amscr_params *p, unsigned k);
 AMSCR_API unsigned amscr_params_get_rerank_k(const amscr_params *p);
-/** Diffusion iterations of the re-ranking, 1..1000 (default 20). @since 0.2 */
+/** Diffusion iterations of the re-ranking, 1..1000 (default 10). @since 0.2 */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_rerank_iterations(amscr_params *p, unsigned iterations);
 AMSCR_API unsigned amscr_params_get_rerank_iterations(const amscr_params *p);
 

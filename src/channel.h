@@ -46,8 +46,9 @@ double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__h
 /* Symmetric n x n matrix of channel distances (zero diagonal), on `threads` threads. */
 amscr_status amscr__hf_matrix(const amscr__hf *hf, size_t n, const amscr__hf_cfg *cfg, unsigned threads,
                               amscr_progress_fn progress, void *user, double *out);
-/* The channel's sequences of a prepared shape, in the frame and with the settings of p. */
-amscr_status amscr__hf_of_descriptor(const amscr_params *p, const amscr_descriptor *d, amscr__hf *out);
+/* The channel's sequences of a prepared shape in `frame`, with the settings of p. */
+amscr_status amscr__hf_of_descriptor(const amscr_params *p, amscr_invariance frame, const amscr_descriptor *d,
+                                     amscr__hf *out);
 /* The channel's pair settings from p for N samples. */
 void amscr__hf_cfg_from(const amscr_params *p, size_t n, amscr__hf_cfg *cfg);
 

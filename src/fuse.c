@@ -19,10 +19,10 @@ void amscr__hf_cfg_from(const amscr_params *p, size_t n, amscr__hf_cfg *cfg)
 /* The N prepared samples (input coordinates, group-invariant parametrization) moved into
  * the channel's frame: centroid at the origin and either whitened (affine) or scaled to an
  * RMS radius of sqrt(2) (similarity; the trace of the covariance is 2 in both frames). */
-static amscr_status channel_frame(const amscr_params *p, const amscr_descriptor *d, double *out)
+static amscr_status channel_frame(amscr_invariance frame, const amscr_descriptor *d, double *out)
 {
     size_t n = d->n;
-    if (p->channel_invariance == AMSCR_INVARIANCE_AFFINE) {
+    if (frame == AMSCR_INVARIANCE_AFFINE) {
         double fwd[6], inv[6];
         return amscr__whiten(d->input, n, out, fwd, inv);
     }
@@ -48,17 +48,60 @@ static amscr_status channel_frame(const amscr_params *p, const amscr_descriptor 
     return AMSCR_OK;
 }
 
-amscr_status amscr__hf_of_descriptor(const amscr_params *p, const amscr_descriptor *d, amscr__hf *out)
+amscr_status amscr__hf_of_descriptor(const amscr_params *p, amscr_invariance frame, const amscr_descriptor *d,
+                                     amscr__hf *out)
 {
     if (!d->params.closed)
         return amscr__fail(AMSCR_E_INVALID_ARG, "shape channel: needs closed curves");
     double *xy = amscr__malloc_array(2 * d->n, sizeof *xy);
     if (!xy)
         return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
-    amscr_status st = channel_frame(p, d, xy);
+    amscr_status st = channel_frame(frame, d, xy);
     if (st == AMSCR_OK)
         st = amscr__hf_build(xy, d->n, p->channel_locality, out);
     free(xy);
+    return st;
+}
+
+/* The frames of the channel and their shares: the primary frame, plus the whitened frame with
+ * channel_affine_share when the primary one is the similarity frame. Returns the count. */
+static int channel_frames(const amscr_params *p, amscr_invariance frames[2], double share[2])
+{
+    frames[0] = frames[1] = AMSCR_INVARIANCE_AFFINE;
+    share[0] = 1.0;
+    share[1] = 0.0;
+    if (p->channel_invariance == AMSCR_INVARIANCE_AFFINE || p->channel_affine_share >= 1.0)
+        return 1;
+    frames[0] = p->channel_invariance;
+    if (p->channel_affine_share <= 0.0)
+        return 1;
+    share[1] = p->channel_affine_share;
+    share[0] = 1.0 - share[1];
+    return 2;
+}
+
+static amscr_status pair_in_frame(const amscr_params *p, amscr_invariance frame, const amscr_descriptor *a,
+                                  const amscr_descriptor *b, double *out)
+{
+    amscr__hf ha, hb;
+    amscr__hf_ws ws;
+    amscr__hf_cfg cfg;
+    amscr__hf_cfg_from(p, a->n, &cfg);
+    amscr_status st = amscr__hf_of_descriptor(p, frame, a, &ha);
+    if (st != AMSCR_OK)
+        return st;
+    st = amscr__hf_of_descriptor(p, frame, b, &hb);
+    if (st != AMSCR_OK) {
+        amscr__hf_free(&ha);
+        return st;
+    }
+    st = amscr__hf_ws_init(&ws, a->n, cfg.band);
+    if (st == AMSCR_OK) {
+        *out = amscr__hf_distance(&ha, &hb, &cfg, &ws);
+        amscr__hf_ws_free(&ws);
+    }
+    amscr__hf_free(&ha);
+    amscr__hf_free(&hb);
     return st;
 }
 
@@ -73,26 +116,18 @@ amscr_status amscr_channel_distance(const amscr_params *p, const amscr_descripto
         p = &a->params;
     if (a->n != b->n)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_channel_distance: N differs (%zu vs %zu)", a->n, b->n);
-    amscr__hf ha, hb;
-    amscr__hf_ws ws;
-    amscr__hf_cfg cfg;
-    amscr__hf_cfg_from(p, a->n, &cfg);
-    amscr_status st = amscr__hf_of_descriptor(p, a, &ha);
-    if (st != AMSCR_OK)
-        return st;
-    st = amscr__hf_of_descriptor(p, b, &hb);
-    if (st != AMSCR_OK) {
-        amscr__hf_free(&ha);
-        return st;
+    amscr_invariance frames[2];
+    double share[2], sum = 0.0;
+    int nf = channel_frames(p, frames, share);
+    for (int f = 0; f < nf; f++) {
+        double d = 0.0;
+        amscr_status st = pair_in_frame(p, frames[f], a, b, &d);
+        if (st != AMSCR_OK)
+            return st;
+        sum += share[f] * d;
     }
-    st = amscr__hf_ws_init(&ws, a->n, cfg.band);
-    if (st == AMSCR_OK) {
-        *out_dist = amscr__hf_distance(&ha, &hb, &cfg, &ws);
-        amscr__hf_ws_free(&ws);
-    }
-    amscr__hf_free(&ha);
-    amscr__hf_free(&hb);
-    return st;
+    *out_dist = sum;
+    return AMSCR_OK;
 }
 
 static void free_hfs(amscr__hf *hf, size_t n)
@@ -104,40 +139,7 @@ static void free_hfs(amscr__hf *hf, size_t n)
     free(hf);
 }
 
-static amscr_status channel_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out)
-{
-    const amscr_params *p = amscr_db_params(db);
-    size_t n = amscr_db_size(db);
-    if (n == 0)
-        return AMSCR_OK;
-    if (!p->closed)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "shape channel: needs closed curves (the collection is open)");
-    amscr__hf *hf = calloc(n, sizeof *hf);
-    if (!hf)
-        return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
-    amscr_status st = AMSCR_OK;
-    for (size_t i = 0; i < n && st == AMSCR_OK; i++)
-        st = amscr__hf_of_descriptor(p, amscr_db_descriptor(db, i), &hf[i]);
-    if (st == AMSCR_OK) {
-        amscr__hf_cfg cfg;
-        amscr__hf_cfg_from(p, hf[0].n, &cfg);
-        st = amscr__hf_matrix(hf, n, &cfg, amscr__resolve_threads(p->num_threads), progress, user, out);
-    }
-    free_hfs(hf, n);
-    return st;
-}
-
-amscr_status amscr_db_channel_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out_dist)
-{
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(db);
-    AMSCR_CHECK_NULL(out_dist);
-    return channel_matrix(db, progress, user, out_dist);
-}
-
-/* ------------------------------------------------------------ fusion */
-
-/* Progress of one stage mapped into the whole retrieval (stage s of `stages`). */
+/* Progress of one stage mapped into a whole (stage s of `stages`). */
 typedef struct {
     amscr_progress_fn fn;
     void *user;
@@ -150,6 +152,67 @@ static int stage_cb(void *user, size_t done, size_t total)
     size_t whole = total * sp->stages;
     return sp->fn(sp->user, sp->stage * total + done, whole);
 }
+
+/* The channel matrix in one frame into out. */
+static amscr_status matrix_in_frame(const amscr_db *db, amscr_invariance frame, amscr_progress_fn progress,
+                                    void *user, double *out)
+{
+    const amscr_params *p = amscr_db_params(db);
+    size_t n = amscr_db_size(db);
+    amscr__hf *hf = calloc(n, sizeof *hf);
+    if (!hf)
+        return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
+    amscr_status st = AMSCR_OK;
+    for (size_t i = 0; i < n && st == AMSCR_OK; i++)
+        st = amscr__hf_of_descriptor(p, frame, amscr_db_descriptor(db, i), &hf[i]);
+    if (st == AMSCR_OK) {
+        amscr__hf_cfg cfg;
+        amscr__hf_cfg_from(p, hf[0].n, &cfg);
+        st = amscr__hf_matrix(hf, n, &cfg, amscr__resolve_threads(p->num_threads), progress, user, out);
+    }
+    free_hfs(hf, n);
+    return st;
+}
+
+static amscr_status channel_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out)
+{
+    const amscr_params *p = amscr_db_params(db);
+    size_t n = amscr_db_size(db);
+    if (n == 0)
+        return AMSCR_OK;
+    if (!p->closed)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "shape channel: needs closed curves (the collection is open)");
+    amscr_invariance frames[2];
+    double share[2];
+    int nf = channel_frames(p, frames, share);
+    stage_progress sp = {progress, user, 0, (size_t)nf};
+    amscr_status st = matrix_in_frame(db, frames[0], progress ? stage_cb : NULL, &sp, out);
+    if (st != AMSCR_OK || nf == 1)
+        return st;
+    double *second = amscr__malloc_array(n * n, sizeof *second);
+    if (!second)
+        st = amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
+    sp.stage = 1;
+    if (st == AMSCR_OK)
+        st = matrix_in_frame(db, frames[1], progress ? stage_cb : NULL, &sp, second);
+    for (size_t i = 0; st == AMSCR_OK && i < n * n; i++)
+        out[i] = share[0] * out[i] + share[1] * second[i];
+    if (st != AMSCR_OK)
+        for (size_t i = 0; i < n * n; i++)
+            out[i] = NAN;
+    free(second);
+    return st;
+}
+
+amscr_status amscr_db_channel_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out_dist)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(db);
+    AMSCR_CHECK_NULL(out_dist);
+    return channel_matrix(db, progress, user, out_dist);
+}
+
+/* ------------------------------------------------------------ fusion */
 
 static int cmp_double(const void *a, const void *b)
 {

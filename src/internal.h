@@ -63,6 +63,7 @@ struct amscr_params {
     /* retrieval (0.2, channel.c / fuse.c) */
     double channel_weight;             /* share of the shape channel in the fused distance, 0..1 */
     amscr_invariance channel_invariance; /* frame of the shape channel (affine or similarity) */
+    double channel_affine_share;       /* similarity frame: share of the whitened frame's channel */
     double channel_band;               /* DP band half-width, fraction of N */
     double channel_skip;               /* DP cost of a sample matched twice */
     double channel_locality;           /* height bins weighted 1 / (1 + locality * distance along the curve) */

@@ -15,11 +15,12 @@ static void retrieval_defaults(amscr_params *p)
 {
     p->channel_weight = 0.0;
     p->channel_invariance = AMSCR_INVARIANCE_SIMILARITY;
-    p->channel_band = 1.0 / 16.0;
+    p->channel_affine_share = 0.2;
+    p->channel_band = 0.08;
     p->channel_skip = 1.0;
     p->channel_locality = 4.0;
     p->rerank_k = 0;
-    p->rerank_iterations = 20;
+    p->rerank_iterations = 10;
 }
 
 void amscr__params_defaults(amscr_params *p)
@@ -80,7 +81,7 @@ void amscr__params_retrieval(amscr_params *p)
     amscr__params_defaults(p);
     p->reflections = 1;
     p->channel_weight = 1.0;
-    p->rerank_k = 7;
+    p->rerank_k = 8;
 }
 
 amscr_status amscr_params_new_retrieval(amscr_params **out)
@@ -157,6 +158,8 @@ GETTER(channel_weight, double, channel_weight)
 SETTER(channel_invariance, amscr_invariance, channel_invariance,
        v == AMSCR_INVARIANCE_AFFINE || v == AMSCR_INVARIANCE_SIMILARITY, "%d is not affine (0) or similarity (1)")
 GETTER(channel_invariance, amscr_invariance, channel_invariance)
+SETTER(channel_affine_share, double, channel_affine_share, v >= 0.0 && v <= 1.0, "%g is not in 0..1")
+GETTER(channel_affine_share, double, channel_affine_share)
 SETTER(channel_band, double, channel_band, v > 0.0 && v <= 0.5, "%g is not in (0, 0.5]")
 GETTER(channel_band, double, channel_band)
 SETTER(channel_skip, double, channel_skip, v >= 0.0 && v <= 1e3, "%g is not in 0..1000")

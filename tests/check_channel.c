@@ -213,7 +213,7 @@ START_TEST(test_bad_input)
     ck_assert(amscr_params_get_channel_weight(plain) == 0.0);
     ck_assert_uint_eq(amscr_params_get_rerank_k(plain), 0);
     ck_assert(amscr_params_get_channel_weight(p) > 0.0);
-    ck_assert_uint_eq(amscr_params_get_rerank_k(p), 7);
+    ck_assert_uint_eq(amscr_params_get_rerank_k(p), 8);
     amscr_params_free(plain);
     amscr_descriptor_free(f);
     amscr_descriptor_free(g);

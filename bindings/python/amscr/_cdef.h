@@ -208,6 +208,8 @@ amscr_status amscr_params_set_channel_weight(amscr_params *p, double w);
 double amscr_params_get_channel_weight(const amscr_params *p);
 amscr_status amscr_params_set_channel_invariance(amscr_params *p, amscr_invariance v);
 amscr_invariance amscr_params_get_channel_invariance(const amscr_params *p);
+amscr_status amscr_params_set_channel_affine_share(amscr_params *p, double share);
+double amscr_params_get_channel_affine_share(const amscr_params *p);
 amscr_status amscr_params_set_channel_band(amscr_params *p, double fraction);
 double amscr_params_get_channel_band(const amscr_params *p);
 amscr_status amscr_params_set_channel_skip(amscr_params *p, double cost);
