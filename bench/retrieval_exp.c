@@ -26,6 +26,7 @@ typedef struct {
     int both, fuse_knn, no_amscr;
     double wa, w2;
     int hf2; /* -1 none, else the invariance of a second channel frame */
+    size_t stride;
     int core;   /* > 0: the library's retrieval preset end to end, the set loaded `core` times */
     int rowmax; /* re-ranking output normalized by the row maximum (0.1) instead of the core's cosine */
 } cfg_t;
@@ -255,7 +256,7 @@ static void run_set(const char *spec, const cfg_t *c)
     t0 = now();
     char keyA[600], keyH[600];
     snprintf(keyA, sizeof keyA, "A %s %d %u", spec, (int)c->inv, c->refine);
-    snprintf(keyH, sizeof keyH, "H5 %s %d %zu %g %g %d", spec, (int)c->hf_inv, c->band, c->skip, c->loc, c->both);
+    snprintf(keyH, sizeof keyH, "H6 %s %d %zu %g %g %d %zu", spec, (int)c->hf_inv, c->band, c->skip, c->loc, c->both, c->stride);
     int cached = cache_io(keyA, A, n, 0) == 0;
     if (!cached && !c->no_amscr && amscr_db_distance_matrix(db, NULL, NULL, A) != AMSCR_OK) {
         fprintf(stderr, "matrix: %s\n", amscr_last_error_detail());
@@ -270,7 +271,7 @@ static void run_set(const char *spec, const cfg_t *c)
         if (amscr__hf_build(amscr_descriptor_base_points(amscr_db_descriptor(dbh, i)), 128, c->loc, &hf[i]) != AMSCR_OK)
             return;
     double thb = now() - t0;
-    amscr__hf_cfg hc = {c->band, c->skip, 1, c->both};
+    amscr__hf_cfg hc = {c->band, c->skip, 1, c->both, c->stride};
     t0 = now();
     double c0 = cpu();
     if (cache_io(keyH, H, n, 0) != 0) {
@@ -295,7 +296,7 @@ static void run_set(const char *spec, const cfg_t *c)
         amscr_db *db2 = prepare(&s, (amscr_invariance)c->hf2, c);
         double *H2 = malloc(n * n * sizeof *H2);
         char key2[600];
-        snprintf(key2, sizeof key2, "H5 %s %d %zu %g %g %d", spec, c->hf2, c->band, c->skip, c->loc, c->both);
+        snprintf(key2, sizeof key2, "H6 %s %d %zu %g %g %d %zu", spec, c->hf2, c->band, c->skip, c->loc, c->both, c->stride);
         if (cache_io(key2, H2, n, 0) != 0) {
             amscr__hf *h2 = calloc(n, sizeof *h2);
             for (size_t i = 0; i < n; i++)
@@ -416,7 +417,7 @@ static amscr_invariance parse_inv(const char *v)
 
 int main(int argc, char **argv)
 {
-    cfg_t c = {AMSCR_INVARIANCE_AFFINE, AMSCR_INVARIANCE_AFFINE, 0, 2, 20, 5, 8, 1.0, 4.0, 1.0, 0, 0, 0, 1.0, 1.0, -1, 0, 0};
+    cfg_t c = {AMSCR_INVARIANCE_AFFINE, AMSCR_INVARIANCE_AFFINE, 0, 2, 20, 5, 8, 1.0, 4.0, 1.0, 0, 0, 0, 1.0, 1.0, -1, 1, 0, 0};
     int i = 1;
     for (; i < argc && strncmp(argv[i], "--", 2) == 0; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : "0";
@@ -447,6 +448,8 @@ int main(int argc, char **argv)
             c.loc = atof(v);
         else if (strcmp(o, "--weight") == 0)
             c.weight = atof(v);
+        else if (strcmp(o, "--stride") == 0)
+            c.stride = (size_t)atoi(v);
         else if (strcmp(o, "--core") == 0)
             c.core = atoi(v);
         else if (strcmp(o, "--wa") == 0)

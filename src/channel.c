@@ -14,7 +14,8 @@
  * kept as well. The DFT of every bin column is kept for the shift search.
  *
  * Per pair: the cyclic shift (and orientation) that maximizes the correlation of the two
- * sequences (one inverse FFT per orientation), then a banded DTW with a cost `skip` for
+ * sequences, low-passed to the first N/8 frequencies (the band absorbs the coarser shift;
+ * one inverse FFT per orientation), then a banded DTW with a cost `skip` for
  * every sample matched twice (a skipped stretch on the other side) and free start/end
  * within the band (the difference of the end and start offsets pays `skip` per sample, so
  * a path that does not close costs what its missing samples would). Cost O(N * band * bins)
@@ -161,16 +162,16 @@ static size_t best_shift(const amscr__hf *a, const amscr__hf *b, int o, amscr__h
     const size_t D = AMSCR__HF_BINS, n = a->n;
     double *z = ws->z;
     memset(z, 0, 2 * n * sizeof *z);
-    size_t half = n / 2;
+    size_t half = n / 2, fmax = AMSCR__HF_FREQS(n);
     for (size_t bin = 0; bin < D; bin++) {
         const double *fa = a->spec[0] + bin * 2 * n, *fb = b->spec[o] + bin * 2 * n;
-        for (size_t f = 0; f <= half; f++) {
+        for (size_t f = 0; f <= fmax; f++) {
             double ar = fa[2 * f], ai = fa[2 * f + 1], br = fb[2 * f], bi = fb[2 * f + 1];
             z[2 * f] += ar * br + ai * bi; /* conj(A) B */
             z[2 * f + 1] += ar * bi - ai * br;
         }
     }
-    for (size_t f = half + 1; f < n; f++) { /* Hermitian: the inputs are real */
+    for (size_t f = n - fmax; f < n && f > half; f++) { /* Hermitian: the inputs are real */
         z[2 * f] = z[2 * (n - f)];
         z[2 * f + 1] = -z[2 * (n - f) + 1];
     }
@@ -200,18 +201,24 @@ static inline int32_t l1(const uint8_t *x, const uint8_t *y)
 }
 
 /* Banded DTW of a against b (orientation o) cyclically shifted by s; see the file comment. */
-static double band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, size_t band, int32_t skip,
-                      amscr__hf_ws *ws)
+static double band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, size_t band, size_t stride,
+                      int32_t skip, amscr__hf_ws *ws)
 {
-    const size_t D = AMSCR__HF_BINS;
-    const long w = (long)band, W = 2 * w + 1;
+    const size_t D = AMSCR__HF_BINS, m = n / stride;
+    const long w = (long)(band / stride > 0 ? band / stride : 1), W = 2 * w + 1;
     int32_t *prev = ws->row, *cur = ws->row + W;
     int *ps = ws->start, *cs = ws->start + W;
-    for (size_t i = 0; i < n; i++) {
-        const uint8_t *ai = A + i * D;
-        size_t jb = (s + i + n - (size_t)w) % n;
+    int32_t *cost = ws->row + 2 * W;
+    for (size_t i = 0; i < m; i++) {
+        const uint8_t *ai = A + i * stride * D;
+        size_t jb = (s + i * stride + n * stride - (size_t)w * stride) % n;
+        for (long kk = 0; kk < W; kk++) { /* the row's costs first: independent, pipelined */
+            cost[kk] = l1(ai, B + jb * D);
+            jb += stride;
+            if (jb >= n)
+                jb -= n;
+        }
         for (long kk = 0; kk < W; kk++) {
-            int32_t c = l1(ai, B + jb * D);
             int32_t best;
             int st;
             if (i == 0) {
@@ -220,19 +227,19 @@ static double band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, si
             } else {
                 best = prev[kk];
                 st = ps[kk];
-                if (kk + 1 < W && prev[kk + 1] + skip < best) {
-                    best = prev[kk + 1] + skip;
+                int32_t v = kk + 1 < W ? prev[kk + 1] + skip : INT32_MAX;
+                if (v < best) {
+                    best = v;
                     st = ps[kk + 1];
                 }
             }
-            if (kk > 0 && cur[kk - 1] + skip < best) {
-                best = cur[kk - 1] + skip;
+            int32_t h = kk > 0 ? cur[kk - 1] + skip : INT32_MAX;
+            if (h < best) {
+                best = h;
                 st = cs[kk - 1];
             }
-            cur[kk] = c + best;
+            cur[kk] = cost[kk] + best;
             cs[kk] = st;
-            if (++jb == n)
-                jb = 0;
         }
         int32_t *t = prev;
         prev = cur;
@@ -247,7 +254,7 @@ static double band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, si
         if (v < best)
             best = v;
     }
-    return best / ((double)n * AMSCR__HF_QUANT);
+    return best / ((double)m * AMSCR__HF_QUANT);
 }
 
 double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__hf_cfg *cfg, amscr__hf_ws *ws)
@@ -260,10 +267,10 @@ double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__h
         s1 = best_shift(a, b, 1, ws, &c1);
     int32_t skip = (int32_t)lround(cfg->skip * AMSCR__HF_QUANT);
     if (cfg->reflections && cfg->both_orientations) {
-        double d0 = band_dp(a->seq[0], b->seq[0], n, s0, band, skip, ws);
-        double d1 = band_dp(a->seq[0], b->seq[1], n, s1, band, skip, ws);
+        double d0 = band_dp(a->seq[0], b->seq[0], n, s0, band, cfg->stride, skip, ws);
+        double d1 = band_dp(a->seq[0], b->seq[1], n, s1, band, cfg->stride, skip, ws);
         return d0 < d1 ? d0 : d1;
     }
     int o = c1 > c0 ? 1 : 0;
-    return band_dp(a->seq[0], b->seq[o], n, o ? s1 : s0, band, skip, ws);
+    return band_dp(a->seq[0], b->seq[o], n, o ? s1 : s0, band, cfg->stride, skip, ws);
 }

@@ -11,6 +11,9 @@
 /* Quantization of the heights (units of the normalized frame, RMS radius ~1.4): steps of
  * 1/16, range +-8; the pair cost is then an exact integer sum of absolute differences. */
 #define AMSCR__HF_QUANT 16.0
+/* Frequencies used by the shift search (the correlation is low-passed; the DP band absorbs
+ * the coarser shift): the first N/8, at most N/2. */
+#define AMSCR__HF_FREQS(n) ((n) / 8 < (n) / 2 ? (n) / 8 : (n) / 2)
 
 /* A shape's height-function sequences: forward and mirrored, with the DFT of every bin. */
 typedef struct {
@@ -24,6 +27,7 @@ typedef struct {
     double skip;           /* cost of a sample matched twice (a skipped one on the other side) */
     int reflections;       /* also try the mirrored sequence */
     int both_orientations; /* run the DP on both orientations (else the better correlation) */
+    size_t stride;         /* the DP visits every stride-th sample of both curves (1 or 2) */
 } amscr__hf_cfg;
 
 /* Per-thread scratch of the pair distance. */

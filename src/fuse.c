@@ -14,6 +14,7 @@ void amscr__hf_cfg_from(const amscr_params *p, size_t n, amscr__hf_cfg *cfg)
     cfg->skip = p->channel_skip;
     cfg->reflections = p->reflections;
     cfg->both_orientations = 0;
+    cfg->stride = 1;
 }
 
 /* The N prepared samples (input coordinates, group-invariant parametrization) moved into
