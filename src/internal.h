@@ -158,6 +158,14 @@ size_t amscr__elbow_choose(const double *sse, size_t m, size_t k_min);
  * the diffusion) and a zero diagonal (rerank.c). */
 amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);
 
+/* The retrieval settings in the saved collection (format version 2, retrieval_io.c):
+ * little-endian f64 channel_weight, u32 channel_invariance, f64 channel_affine_share,
+ * f64 channel_band, f64 channel_skip, f64 channel_locality, u32 rerank_k,
+ * u32 rerank_iterations. read validates through the setters' rules (AMSCR_E_FORMAT). */
+#define AMSCR__RETRIEVAL_BLOCK 52
+void amscr__retrieval_block_write(const amscr_params *p, unsigned char out[AMSCR__RETRIEVAL_BLOCK]);
+amscr_status amscr__retrieval_block_read(const unsigned char in[AMSCR__RETRIEVAL_BLOCK], amscr_params *p);
+
 /* Thread count helper: 0 -> online cores. */
 unsigned amscr__resolve_threads(unsigned requested);
 
