@@ -139,6 +139,26 @@ START_TEST(test_matrices)
                             if (k / 3 != i / 3)
                                 ck_assert_msg(R[i * 6 + j] < R[i * 6 + k], "%d: %d vs %d", i, j, k);
                 }
+            /* AMSCR and the channel fused half and half, without re-ranking: symmetric, finite,
+             * zero diagonal */
+            amscr_params *q = NULL;
+            ck_assert_int_eq(amscr_params_copy(p, &q), AMSCR_OK);
+            ck_assert_int_eq(amscr_params_set_rerank_k(q, 0), AMSCR_OK);
+            ck_assert_int_eq(amscr_params_set_channel_weight(q, 0.5), AMSCR_OK);
+            amscr_db *fdb = NULL;
+            ck_assert_int_eq(amscr_db_new(q, &fdb), AMSCR_OK);
+            for (int i = 0; i < 6; i++)
+                ck_assert_int_eq(amscr_db_add_descriptor(fdb, amscr_db_descriptor(db, i), i / 3, NULL), AMSCR_OK);
+            ck_assert_int_eq(amscr_db_retrieval_matrix(fdb, NULL, NULL, R), AMSCR_OK);
+            for (int i = 0; i < 6; i++)
+                for (int j = 0; j < 6; j++) {
+                    ck_assert(isfinite(R[i * 6 + j]) && R[i * 6 + j] >= 0.0);
+                    ck_assert(R[i * 6 + j] == R[j * 6 + i]);
+                    if (i == j)
+                        ck_assert(R[i * 6 + j] == 0.0);
+                }
+            amscr_db_free(fdb);
+            amscr_params_free(q);
         }
         amscr_db_free(db);
     }
