@@ -188,9 +188,12 @@ static size_t best_shift(const amscr__hf *a, const amscr__hf *b, int o, amscr__h
 static inline int32_t l1(const uint8_t *x, const uint8_t *y)
 {
 #if defined(__SSE2__)
-    __m128i a = _mm_loadu_si128((const __m128i *)(const void *)x);
-    __m128i b = _mm_loadu_si128((const __m128i *)(const void *)y);
-    __m128i s = _mm_sad_epu8(a, b);
+    __m128i s = _mm_setzero_si128();
+    for (size_t d = 0; d < AMSCR__HF_BINS; d += 16) {
+        __m128i a = _mm_loadu_si128((const __m128i *)(const void *)(x + d));
+        __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(y + d));
+        s = _mm_add_epi64(s, _mm_sad_epu8(a, b));
+    }
     return _mm_cvtsi128_si32(s) + _mm_extract_epi16(s, 4);
 #else
     int32_t s = 0;
