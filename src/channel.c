@@ -18,8 +18,11 @@
  * one inverse FFT per orientation), then a banded DTW with a cost `skip` for
  * every sample matched twice (a skipped stretch on the other side) and free start/end
  * within the band (the difference of the end and start offsets pays `skip` per sample, so
- * a path that does not close costs what its missing samples would). Cost O(N * band * bins)
- * per pair; the distance is symmetric and 0 for a shape against itself. */
+ * a path that does not close costs what its missing samples would). Heights are quantized
+ * to bytes (AMSCR__HF_QUANT), so the cell cost is an exact integer sum of absolute
+ * differences (one SSE2 instruction per 16 bins) and the result is the same on every
+ * platform. Cost O(N * band * bins) per pair; 0 for a shape against itself; d(a, b) and
+ * d(b, a) agree unless the two shift searches pick different candidates. */
 #include "channel.h"
 
 #include <float.h>
