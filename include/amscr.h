@@ -852,6 +852,91 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_correspondences(const amscr_
                                                                     double *out_param, double *out_tgt_xy,
                                                                     size_t *inout_n);
 
+/* ======================================================================
+ * Retrieval beyond one aligned distance (0.2): the shape channel, fusion, re-ranking
+ * ====================================================================== */
+
+/**
+ * @brief The retrieval preset: the defaults plus mirror images, the shape channel alone
+ *        (channel weight 1: on articulated collections the AMSCR distance lowered the fused
+ *        result at every weight measured) and context re-ranking with k = 8, 10 iterations
+ *        (README /
+ *        bench/RESULTS-retrieval.md: measured on mpeg7-dev, Kimia-99/216 and the MCD-style
+ *        affine set). Use it with amscr_db_retrieval_matrix. Ownership: caller frees. @since 0.2
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_new_retrieval(amscr_params **out);
+/** Share of the shape channel in amscr_db_retrieval_matrix, 0..1: fused = (1 - w) AMSCR + w
+ *  channel (each divided by its median); 0 = the AMSCR distance alone (default), 1 = the
+ *  channel alone, and the AMSCR matrix is then not computed (the retrieval preset). @since 0.2 */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_weight(amscr_params *p, double w);
+AMSCR_API double amscr_params_get_channel_weight(const amscr_params *p);
+/** Frame of the shape channel: AMSCR_INVARIANCE_SIMILARITY (default) or _AFFINE (whitened);
+ *  the channel distance is invariant to that group. @since 0.2 */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_invariance(amscr_params *p, amscr_invariance v);
+AMSCR_API amscr_invariance amscr_params_get_channel_invariance(const amscr_params *p);
+/** With the similarity frame: the share, 0..1, of the same channel computed in the whitened
+ *  (affine-normalized) frame, mixed in as (1 - s) d_similarity + s d_affine (default 0.2:
+ *  keeps affine-distorted views retrievable while articulation is judged in the similarity
+ *  frame). Ignored when the channel's frame is affine. @since 0.2 */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_affine_share(amscr_params *p, double share);
+AMSCR_API double amscr_params_get_channel_affine_share(const amscr_params *p);
+/** Half width of the channel's dynamic-programming band, a fraction of N in (0, 0.5]
+ *  (default 0.08: 10 samples at N = 128). @since 0.2 */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_band(amscr_params *p, double fraction);
+AMSCR_API double amscr_params_get_channel_band(const amscr_params *p);
+/** Cost of a sample matched twice (a skipped stretch on the other curve), in height units of
+ *  the normalized frame, 0..1000 (default 1). @since 0.2 */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_skip(amscr_params *p, double cost);
+AMSCR_API double amscr_params_get_channel_skip(const amscr_params *p);
+/** Locality of the height functions: the bin at distance t (fraction of the curve, 0..0.5)
+ *  from the sample is weighted 1 / (1 + locality * t); 0..1000 (default 4). @since 0.2 */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_locality(amscr_params *p, double locality);
+AMSCR_API double amscr_params_get_channel_locality(const amscr_params *p);
+/** Neighbours of the context re-ranking in amscr_db_retrieval_matrix, 0..1000; 0 = none
+ *  (default 0; 8 in the retrieval preset). @since 0.2 */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_rerank_k(amscr_params *p, unsigned k);
+AMSCR_API unsigned amscr_params_get_rerank_k(const amscr_params *p);
+/** Diffusion iterations of the re-ranking, 1..1000 (default 10). @since 0.2 */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_rerank_iterations(amscr_params *p, unsigned iterations);
+AMSCR_API unsigned amscr_params_get_rerank_iterations(const amscr_params *p);
+
+/**
+ * @brief The shape channel's distance of two prepared closed shapes: height functions (the
+ *        signed distances of all samples to the tangent at each sample, binned and weighted
+ *        by locality; Wang et al., Pattern Recognition Letters 2012) in the channel's frame,
+ *        compared by an order-preserving dynamic-programming correspondence in a band around
+ *        the best cyclic shift (and mirror image when reflections are on). >= 0, 0 for a
+ *        shape against itself, invariant to the channel's group, tolerant of articulation
+ *        and local stretch. d(a, b) and d(b, a) differ only when the shift/mirror search
+ *        of the two orders picks different candidates (rare); amscr_db_channel_matrix uses
+ *        d(i, j) for i < j in both cells. The channel settings come from `p` (NULL = a's).
+ * @return AMSCR_OK, AMSCR_E_INVALID_ARG (NULL, open curves, different N), AMSCR_E_NOMEM.
+ * Thread-safety: reentrant. @since 0.2
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_channel_distance(const amscr_params *p, const amscr_descriptor *a,
+                                                              const amscr_descriptor *b, double *out_dist);
+/**
+ * @brief The n x n matrix of shape-channel distances of a collection (symmetric, zero
+ *        diagonal), on the collection's threads; result independent of the thread count.
+ * @return AMSCR_OK, AMSCR_E_INVALID_ARG, AMSCR_E_NOMEM, AMSCR_E_CANCELLED (matrix all NaN).
+ * @since 0.2
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_channel_matrix(const amscr_db *db, amscr_progress_fn progress,
+                                                               void *user, double *out_dist);
+/**
+ * @brief The retrieval distance of a collection: the AMSCR matrix (symmetrized) and the shape
+ *        channel, each divided by its median off-diagonal value and mixed by the channel
+ *        weight, then (rerank_k > 0) diffusion re-ranking exactly as amscr_rerank_diffusion
+ *        with its output halved: a dissimilarity in [0, 1] where row i ranks i's neighbours,
+ *        0 for i itself, below 0.5 for the shapes the diffusion reaches from i and 0.5 + half
+ *        the normalized fused distance for the others. Without re-ranking the fused distance
+ *        itself (symmetric, 0 on the diagonal).
+ * @return AMSCR_OK, AMSCR_E_INVALID_ARG (open curves with a channel weight), AMSCR_E_NOMEM,
+ *         AMSCR_E_CANCELLED (matrix all NaN). @since 0.2
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn progress,
+                                                                 void *user, double *out_dist);
+
 #ifdef __cplusplus
 }
 #endif

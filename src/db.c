@@ -378,10 +378,12 @@ amscr_status amscr_db_cross_distances(const amscr_db *queries, const amscr_db *t
 /* ------------------------------------------------------------ serialization
  * Little-endian. Header: "AMSCRDB\0", u32 version, u32 reserved, params, u64 count, u64 N,
  * u64 p; per shape: i32 label, f64 fwd[6], f64 inv[6], f64 input[2N], base[2N], scaled[2Np];
- * trailer: u64 FNV-1a of everything before it. */
+ * trailer: u64 FNV-1a of everything before it. Version 2 adds, right after the params, the
+ * retrieval settings (retrieval_io.c); the shape channel itself is derived from the prepared
+ * shapes on demand and is not stored. */
 
 #define DB_MAGIC "AMSCRDB"
-#define DB_VERSION 1u
+#define DB_VERSION 2u /* 2 (0.2): the retrieval settings follow the params; 1 still loads */
 
 typedef struct {
     unsigned char *buf;
@@ -479,6 +481,9 @@ amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *ou
     w_u32(&w, DB_VERSION);
     w_u32(&w, 0);
     w_params(&w, &db->params);
+    unsigned char rblock[AMSCR__RETRIEVAL_BLOCK];
+    amscr__retrieval_block_write(&db->params, rblock);
+    w_bytes(&w, rblock, sizeof rblock);
     size_t N = db->params.num_samples, p = db->params.num_scales;
     w_u64(&w, db->n);
     w_u64(&w, N);
@@ -653,6 +658,12 @@ amscr_status amscr_db_load_memory(const void *buf, size_t len, amscr_db **out)
         amscr_params_set_penalty(&chk, prm.penalty))
         return amscr__fail(AMSCR_E_FORMAT, "collection header: invalid parameters");
     amscr__clear_error();
+    if (version >= 2) {
+        if (r.bad || len - r.pos < AMSCR__RETRIEVAL_BLOCK ||
+            amscr__retrieval_block_read(r.p + r.pos, &prm) != AMSCR_OK)
+            return amscr__fail(AMSCR_E_FORMAT, "collection header: invalid retrieval settings");
+        r.pos += AMSCR__RETRIEVAL_BLOCK;
+    }
     uint64_t count = r_u64(&r), N2 = r_u64(&r), p2 = r_u64(&r);
     if (r.bad || N2 != N || p2 != p)
         return amscr__fail(AMSCR_E_FORMAT, "collection header: inconsistent sizes");

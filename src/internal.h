@@ -65,6 +65,15 @@ struct amscr_params {
     double penalty;
     /* issue 14 (registration): the source is an open fragment of the target's closed boundary */
     int partial;
+    /* retrieval (0.2, channel.c / fuse.c) */
+    double channel_weight;             /* share of the shape channel in the fused distance, 0..1 */
+    amscr_invariance channel_invariance; /* frame of the shape channel (affine or similarity) */
+    double channel_affine_share;       /* similarity frame: share of the whitened frame's channel */
+    double channel_band;               /* DP band half-width, fraction of N */
+    double channel_skip;               /* DP cost of a sample matched twice */
+    double channel_locality;           /* height bins weighted 1 / (1 + locality * distance along the curve) */
+    unsigned rerank_k;                 /* re-ranking neighbours, 0 = no re-ranking */
+    unsigned rerank_iterations;
 };
 
 
@@ -90,6 +99,7 @@ amscr_status amscr__whiten(const double *xy, size_t n, double *out_xy, double fw
 void amscr__affine_compose(const double a[6], const double b[6], double out[6]);
 void amscr__params_defaults(amscr_params *p);
 void amscr__params_registration(amscr_params *p);
+void amscr__params_retrieval(amscr_params *p);
 
 /* ---- least squares (lstsq.c) ---- */
 size_t amscr__lstsq_work_size(size_t m, size_t n, size_t nrhs);
@@ -152,6 +162,18 @@ void amscr__kmeans1d_dp(const double *sorted, size_t n, size_t kmax, double *scr
 
 /* Elbow choice on sse[0..m-1] for K = k_min..k_min+m-1; returns chosen K. */
 size_t amscr__elbow_choose(const double *sse, size_t m, size_t k_min);
+
+/* Re-ranking as amscr_rerank_diffusion with the output halved into [0, 1] (< 0.5: reached by
+ * the diffusion) and a zero diagonal (rerank.c). */
+amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);
+
+/* The retrieval settings in the saved collection (format version 2, retrieval_io.c):
+ * little-endian f64 channel_weight, u32 channel_invariance, f64 channel_affine_share,
+ * f64 channel_band, f64 channel_skip, f64 channel_locality, u32 rerank_k,
+ * u32 rerank_iterations. read validates through the setters' rules (AMSCR_E_FORMAT). */
+#define AMSCR__RETRIEVAL_BLOCK 52
+void amscr__retrieval_block_write(const amscr_params *p, unsigned char out[AMSCR__RETRIEVAL_BLOCK]);
+amscr_status amscr__retrieval_block_read(const unsigned char in[AMSCR__RETRIEVAL_BLOCK], amscr_params *p);
 
 /* Thread count helper: 0 -> online cores. */
 unsigned amscr__resolve_threads(unsigned requested);

@@ -8,6 +8,21 @@
 /* Defaults: chosen by measurement (README "Choosing the defaults"). */
 static const double default_scales[] = {1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 11.0, 16.0};
 
+/* The retrieval options (0.2): off in the plain defaults (amscr_db_distance_matrix is the
+ * AMSCR distance exactly as in 0.1); the channel's own settings are those measured in
+ * bench/RESULTS-retrieval.md, so turning the channel on needs only a weight. */
+static void retrieval_defaults(amscr_params *p)
+{
+    p->channel_weight = 0.0;
+    p->channel_invariance = AMSCR_INVARIANCE_SIMILARITY;
+    p->channel_affine_share = 0.2;
+    p->channel_band = 0.08;
+    p->channel_skip = 1.0;
+    p->channel_locality = 4.0;
+    p->rerank_k = 0;
+    p->rerank_iterations = 10;
+}
+
 void amscr__params_defaults(amscr_params *p)
 {
     memset(p, 0, sizeof *p);
@@ -27,6 +42,7 @@ void amscr__params_defaults(amscr_params *p)
     p->num_threads = 0;
     p->invariance = AMSCR_INVARIANCE_AFFINE;
     p->penalty = 0.5;
+    retrieval_defaults(p);
 }
 
 amscr_status amscr_params_new(amscr_params **out)
@@ -56,6 +72,26 @@ amscr_status amscr_params_new_registration(amscr_params **out)
     if (!p)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_params_new_registration: out of memory");
     amscr__params_registration(p);
+    *out = p;
+    return AMSCR_OK;
+}
+
+void amscr__params_retrieval(amscr_params *p)
+{
+    amscr__params_defaults(p);
+    p->reflections = 1;
+    p->channel_weight = 1.0;
+    p->rerank_k = 8;
+}
+
+amscr_status amscr_params_new_retrieval(amscr_params **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(out);
+    amscr_params *p = malloc(sizeof *p);
+    if (!p)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_params_new_retrieval: out of memory");
+    amscr__params_retrieval(p);
     *out = p;
     return AMSCR_OK;
 }
@@ -117,6 +153,23 @@ SETTER(invariance, amscr_invariance, invariance, (int)v >= 0 && (int)v <= 2, "un
 GETTER(invariance, amscr_invariance, invariance)
 SETTER(penalty, double, penalty, v >= 0.0 && v <= 1e6, "%g is not in 0..1e6")
 GETTER(penalty, double, penalty)
+SETTER(channel_weight, double, channel_weight, v >= 0.0 && v <= 1.0, "%g is not in 0..1")
+GETTER(channel_weight, double, channel_weight)
+SETTER(channel_invariance, amscr_invariance, channel_invariance,
+       v == AMSCR_INVARIANCE_AFFINE || v == AMSCR_INVARIANCE_SIMILARITY, "%d is not affine (0) or similarity (1)")
+GETTER(channel_invariance, amscr_invariance, channel_invariance)
+SETTER(channel_affine_share, double, channel_affine_share, v >= 0.0 && v <= 1.0, "%g is not in 0..1")
+GETTER(channel_affine_share, double, channel_affine_share)
+SETTER(channel_band, double, channel_band, v > 0.0 && v <= 0.5, "%g is not in (0, 0.5]")
+GETTER(channel_band, double, channel_band)
+SETTER(channel_skip, double, channel_skip, v >= 0.0 && v <= 1e3, "%g is not in 0..1000")
+GETTER(channel_skip, double, channel_skip)
+SETTER(channel_locality, double, channel_locality, v >= 0.0 && v <= 1e3, "%g is not in 0..1000")
+GETTER(channel_locality, double, channel_locality)
+SETTER(rerank_k, unsigned, rerank_k, v <= 1000, "%u is outside 0..1000")
+GETTER(rerank_k, unsigned, rerank_k)
+SETTER(rerank_iterations, unsigned, rerank_iterations, v >= 1 && v <= 1000, "%u is outside 1..1000")
+GETTER(rerank_iterations, unsigned, rerank_iterations)
 
 /* ---- issue 14 (registration): partial matching ---- */
 SETTER(partial, int, partial, v == 0 || v == 1, "%d is not 0 or 1")

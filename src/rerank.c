@@ -20,21 +20,24 @@ static int cmp_nb(const void *a, const void *b)
     return x->j < y->j ? -1 : (x->j > y->j);
 }
 
-amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
+/* Output normalizations of the diffused affinity Q. */
+enum { NORM_ROW_MAX = 0, NORM_UNIT = 1 };
+
+static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iterations, int norm, double *out_dist,
+                           const char *what)
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(dist);
     AMSCR_CHECK_NULL(out_dist);
     if (n == 0 || k < 1 || k > n || iterations < 1 || iterations > 1000)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_rerank_diffusion: need n >= 1, 1 <= k <= n, 1 <= iterations "
+        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: need n >= 1, 1 <= k <= n, 1 <= iterations "
                                                 "<= 1000 (n=%zu k=%zu iterations=%u)",
-                           n, k, iterations);
+                           what, n, k, iterations);
     if (n > 65536)
-        return amscr__fail(AMSCR_E_LIMIT, "amscr_rerank_diffusion: n = %zu exceeds 65536", n);
+        return amscr__fail(AMSCR_E_LIMIT, "%s: n = %zu exceeds 65536", what, n);
     for (size_t i = 0; i < n * n; i++)
         if (!isfinite(dist[i]) || dist[i] < 0.0)
-            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_rerank_diffusion: distance %zu is negative or not finite",
-                               i);
+            return amscr__fail(AMSCR_E_INVALID_ARG, "%s: distance %zu is negative or not finite", what, i);
     double *D = amscr__malloc_array(n * n, sizeof *D), *Q = amscr__malloc_array(n * n, sizeof *Q);
     double *T = amscr__malloc_array(n * n, sizeof *T), *sc = amscr__malloc_array(n, sizeof *sc);
     double *pw = amscr__malloc_array(n * k, sizeof *pw);
@@ -118,6 +121,12 @@ amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsi
             double q = Q[i * n + j];
             out_dist[i * n + j] = (q > 0.0 && qmax > 0.0) ? 1.0 - q / qmax
                                                            : 1.0 + (dmax > 0.0 ? D[i * n + j] / dmax : 0.0);
+            /* unit: the same order halved into [0, 1]: below 0.5 for shapes the diffusion
+             * reaches, 0.5 and above for the others (in the order of the input distance), 0
+             * for the shape itself (its own affinity is the row's largest; if not, it still
+             * ranks first) */
+            if (norm == NORM_UNIT)
+                out_dist[i * n + j] = i == j ? 0.0 : 0.5 * out_dist[i * n + j];
         }
     }
     free(D);
@@ -128,4 +137,14 @@ amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsi
     free(pj);
     free(row);
     return AMSCR_OK;
+}
+
+amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
+{
+    return rerank(dist, n, k, iterations, NORM_ROW_MAX, out_dist, "amscr_rerank_diffusion");
+}
+
+amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
+{
+    return rerank(dist, n, k, iterations, NORM_UNIT, out_dist, "re-ranking");
 }

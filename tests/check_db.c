@@ -1169,7 +1169,7 @@ START_TEST(blob_layout_sanity)
     unsigned char *b = small_blob(&len);
     ck_assert(len > 100);
     ck_assert(memcmp(b, "AMSCRDB", 8) == 0);
-    ck_assert(b[8] == 1 && b[9] == 0 && b[10] == 0 && b[11] == 0); /* version 1, little-endian */
+    ck_assert(b[8] == 2 && b[9] == 0 && b[10] == 0 && b[11] == 0); /* version 2, little-endian */
     uint64_t h = 0;
     for (int i = 0; i < 8; i++)
         h |= (uint64_t)b[len - 8 + i] << (8 * i);
@@ -1179,6 +1179,69 @@ START_TEST(blob_layout_sanity)
     ck_assert_uint_eq(amscr_db_size(db), 2);
     amscr_db_free(db);
     free(b);
+}
+END_TEST
+
+/* Format version 2 puts the retrieval settings (52 bytes) right after the params, which end
+ * 60 bytes after the scales; version 1 files (the same without that block) still load, with
+ * the retrieval settings at their defaults. */
+#define BLOB_RETRIEVAL_OFFSET (BLOB_SCALE_OFFSET + 8 + 60)
+START_TEST(format_v1_still_loads)
+{
+    size_t len = 0;
+    unsigned char *b = small_blob(&len);
+    memmove(b + BLOB_RETRIEVAL_OFFSET, b + BLOB_RETRIEVAL_OFFSET + 52, len - BLOB_RETRIEVAL_OFFSET - 52);
+    len -= 52;
+    b[8] = 1;
+    fix_checksum(b, len);
+    amscr_db *db = NULL;
+    ck_assert_int_eq(load_exact(b, len, &db), AMSCR_OK);
+    ck_assert_uint_eq(amscr_db_size(db), 2);
+    ck_assert(amscr_params_get_channel_weight(amscr_db_params(db)) == 0.0);
+    ck_assert_uint_eq(amscr_params_get_rerank_k(amscr_db_params(db)), 0);
+    amscr_db_free(db);
+    free(b);
+}
+END_TEST
+
+START_TEST(retrieval_settings_roundtrip)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_channel_band(p, 0.125), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_channel_affine_share(p, 0.3), AMSCR_OK);
+    amscr_db *db = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
+    void *buf = NULL;
+    size_t len = 0;
+    ck_assert_int_eq(amscr_db_save_memory(db, &buf, &len), AMSCR_OK);
+    amscr_db *back = NULL;
+    ck_assert_int_eq(amscr_db_load_memory(buf, len, &back), AMSCR_OK);
+    const amscr_params *q = amscr_db_params(back);
+    ck_assert(amscr_params_get_channel_weight(q) == amscr_params_get_channel_weight(p));
+    ck_assert(amscr_params_get_channel_band(q) == 0.125);
+    ck_assert(amscr_params_get_channel_affine_share(q) == 0.3);
+    ck_assert(amscr_params_get_channel_skip(q) == amscr_params_get_channel_skip(p));
+    ck_assert(amscr_params_get_channel_locality(q) == amscr_params_get_channel_locality(p));
+    ck_assert_int_eq(amscr_params_get_channel_invariance(q), amscr_params_get_channel_invariance(p));
+    ck_assert_uint_eq(amscr_params_get_rerank_k(q), amscr_params_get_rerank_k(p));
+    ck_assert_uint_eq(amscr_params_get_rerank_iterations(q), amscr_params_get_rerank_iterations(p));
+    /* an out-of-range weight in the block is a format error, not a silent value */
+    unsigned char *b = buf;
+    double bad = 2.0;
+    uint64_t v;
+    memcpy(&v, &bad, 8);
+    size_t nscales = 0;
+    ck_assert_int_eq(amscr_params_get_scales(p, NULL, &nscales), AMSCR_OK);
+    for (size_t i = 0; i < 8; i++) /* the weight opens the block, after the params */
+        b[BLOB_SCALE_OFFSET + 8 * nscales + 60 + i] = (unsigned char)(v >> (8 * i));
+    fix_checksum(b, len);
+    amscr_db *bad_db = NULL;
+    ck_assert_int_eq(amscr_db_load_memory(b, len, &bad_db), AMSCR_E_FORMAT);
+    amscr_free(buf);
+    amscr_db_free(back);
+    amscr_db_free(db);
+    amscr_params_free(p);
 }
 END_TEST
 
@@ -1528,6 +1591,8 @@ Suite *amscr_suite_db(void)
     tcase_add_test(tc, save_io_errors);
     tcase_add_test(tc, blob_layout_sanity);
     tcase_add_test(tc, corrupt_magic_and_version);
+    tcase_add_test(tc, format_v1_still_loads);
+    tcase_add_test(tc, retrieval_settings_roundtrip);
     tcase_add_test(tc, corrupt_truncated);
     tcase_add_test(tc, corrupt_flipped_bytes);
     tcase_add_test(tc, crafted_files_valid_checksum);

@@ -23,5 +23,6 @@ Suite *amscr_suite_rerank(void);
 Suite *amscr_suite_invariance(void);
 /* issue 14 (registration) */
 Suite *amscr_suite_robust(void);
+Suite *amscr_suite_channel(void);
 
 #endif

@@ -1,0 +1,59 @@
+/* channel.h — internals of the shape channel (channel.c) and of the fused retrieval
+ * matrix (fuse.c). Never installed. */
+#ifndef AMSCR_CHANNEL_H
+#define AMSCR_CHANNEL_H
+
+#include "fft.h"
+#include "internal.h"
+
+/* Bins of the height function of one sample (the descriptor's dimension). */
+#define AMSCR__HF_BINS 16
+/* Quantization of the heights (units of the normalized frame, RMS radius ~1.4): steps of
+ * 1/16, range +-8; the pair cost is then an exact integer sum of absolute differences. */
+#define AMSCR__HF_QUANT 16.0
+/* Frequencies used by the shift search (the correlation is low-passed; the DP band absorbs
+ * the coarser shift): the first N/8, at most N/2. */
+#define AMSCR__HF_FREQS(n) ((n) / 8 < (n) / 2 ? (n) / 8 : (n) / 2)
+
+/* A shape's height-function sequences: forward and mirrored, with the DFT of every bin. */
+typedef struct {
+    size_t n;
+    uint8_t *seq[2]; /* n * AMSCR__HF_BINS, weighted heights, quantized: 128 + QUANT * h */
+    double *spec[2]; /* AMSCR__HF_BINS * 2n, complex interleaved */
+} amscr__hf;
+
+typedef struct {
+    size_t band;           /* half width of the DP band, samples */
+    double skip;           /* cost of a sample matched twice (a skipped one on the other side) */
+    int reflections;       /* also try the mirrored sequence */
+    int both_orientations; /* run the DP on both orientations (else the better correlation) */
+    size_t stride;         /* the DP visits every stride-th sample of both curves (1 or 2) */
+} amscr__hf_cfg;
+
+/* Per-thread scratch of the pair distance. */
+typedef struct {
+    size_t n;
+    amscr__fft_plan plan;
+    int have_plan;
+    double *z;
+    int32_t *row;
+    int *start;
+} amscr__hf_ws;
+
+amscr_status amscr__hf_build(const double *base, size_t n, double locality, amscr__hf *out);
+void amscr__hf_free(amscr__hf *h);
+amscr_status amscr__hf_ws_init(amscr__hf_ws *ws, size_t n, size_t band);
+void amscr__hf_ws_free(amscr__hf_ws *ws);
+/* The channel distance of two shapes built with the same n (>= 0, 0 for identical ones). */
+double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__hf_cfg *cfg, amscr__hf_ws *ws);
+
+/* Symmetric n x n matrix of channel distances (zero diagonal), on `threads` threads. */
+amscr_status amscr__hf_matrix(const amscr__hf *hf, size_t n, const amscr__hf_cfg *cfg, unsigned threads,
+                              amscr_progress_fn progress, void *user, double *out);
+/* The channel's sequences of a prepared shape in `frame`, with the settings of p. */
+amscr_status amscr__hf_of_descriptor(const amscr_params *p, amscr_invariance frame, const amscr_descriptor *d,
+                                     amscr__hf *out);
+/* The channel's pair settings from p for N samples. */
+void amscr__hf_cfg_from(const amscr_params *p, size_t n, amscr__hf_cfg *cfg);
+
+#endif
