@@ -42,7 +42,10 @@ enum {
     TOOL_POINTS_MIN = 16,         /* the library's range of samples: 16..AMSCR_MAX_SAMPLES */
     TOOL_REFINE_MAX = 50,         /* the library's range of refinement iterations */
     TOOL_KMAX_MAX = 16,           /* the library's range of the elbow's Kmax */
-    TOOL_THREADS_MAX = 1024       /* the library's range of threads */
+    TOOL_THREADS_MAX = 1024,      /* the library's range of threads */
+    TOOL_SPLITS_DEFAULT = 10,     /* eval --protocol split: random splits averaged */
+    TOOL_SPLITS_MAX = 100000,     /* a bound on the work, far above any useful spread estimate */
+    TOOL_SEED_DEFAULT = 1         /* eval --protocol split: the splits are reproducible */
 };
 
 typedef struct opts {
@@ -60,6 +63,9 @@ typedef struct opts {
     const char *protocol; /* as given (printed back by eval --json); NULL: all */
     int protocol_id;      /* PROTO_* (names.h) */
     size_t ranks;
+    size_t train;       /* --train K: training shapes per class (protocol split); 0: not given */
+    size_t splits;      /* --splits R (default TOOL_SPLITS_DEFAULT) */
+    unsigned long long seed; /* --seed S (default TOOL_SEED_DEFAULT) */
     /* shape parameters (set only when given) */
     int method_set;
     amscr_method method;

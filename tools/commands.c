@@ -61,6 +61,8 @@ static const char HELP_MATRIX[] =
 
 static const char HELP_EVAL[] =
     "usage: amscr eval COLLECTION [--protocol P] [--ranks K] [--json] [options]\n"
+    "       amscr eval COLLECTION --protocol split --train K [--splits R] [--seed S]\n"
+    "       amscr eval MANIFEST --protocol groups\n"
     "\n"
     "Retrieval scores of a labelled collection from its full distance matrix:\n"
     "  bullseye  bull's eye (MPEG-7): same-class shapes among the 2*Nc nearest,\n"
@@ -69,14 +71,23 @@ static const char HELP_EVAL[] =
     "            neighbour (query excluded; Kimia tables)\n"
     "  nn        leave-one-out nearest-neighbour accuracy\n"
     "  all       all three (default)\n"
+    "  split     per-class random split: K shapes of every class train, the rest are\n"
+    "            classified by 1-NN; mean and spread over R splits (Swedish leaf: K 25)\n"
+    "  groups    leave one group out: each group's shapes are classified by 1-NN\n"
+    "            against the other groups (ETH-80: one object out); needs a manifest\n"
+    "            with a 'group' column\n"
     "Classes: a folder's file names (\"bird-3.png\" -> bird) or the manifest's column.\n"
     "Reflections are on by default.\n"
     "\n"
-    "  --protocol P            all | bullseye | topk | nn\n"
+    "  --protocol P            all | bullseye | topk | nn | split | groups\n"
+    "  --train K               split: training shapes per class (each class needs > K)\n"
+    "  --splits R              split: random splits averaged (default 10)\n"
+    "  --seed S                split: seed of the random splits (default 1)\n"
     "  --ranks K               ranks of the top-k table (default 10; Kimia-216 uses 11;\n"
     "                          alias --topk-ranks)\n"
     "  --json                  one JSON object: n, classes, seconds and bullseye,\n"
-    "                          topk, nn_accuracy (those the protocol computes)\n";
+    "                          topk, nn_accuracy, split, groups (those the protocol\n"
+    "                          computes) and per_class: each class's scores\n";
 
 static const tool_command COMMANDS[] = {
     {"contour", C_CONTOUR, 1, "IMG [-o FILE]", "trace the outer contour of a silhouette image", HELP_CONTOUR, 0,

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -21,6 +22,9 @@ typedef enum opt_id {
     O_TOP,
     O_PROTOCOL,
     O_RANKS,
+    O_TRAIN,
+    O_SPLITS,
+    O_SEED,
     O_METHOD,
     O_POINTS,
     O_SCALES,
@@ -57,6 +61,9 @@ static const optdef OPTS[] = {
     {"--protocol", O_PROTOCOL, 1, C_EVAL, "NAME"},
     {"--ranks", O_RANKS, 1, C_EVAL, "K"},
     {"--topk-ranks", O_RANKS, 1, C_EVAL, "K"},
+    {"--train", O_TRAIN, 1, C_EVAL, "K"},
+    {"--splits", O_SPLITS, 1, C_EVAL, "R"},
+    {"--seed", O_SEED, 1, C_EVAL, "S"},
     {"--method", O_METHOD, 1, C_SHAPES, "NAME"},
     {"--points", O_POINTS, 1, C_SHAPES, "N"},
     {"--scales", O_SCALES, 1, C_SHAPES, "S1,S2,..."},
@@ -95,6 +102,8 @@ void opts_init(opts *o, const tool_command *c)
     o->protocol_id = PROTO_ALL;
     o->rerank_k = TOOL_RERANK_K;
     o->rerank_iters = TOOL_RERANK_ITERS;
+    o->splits = TOOL_SPLITS_DEFAULT;
+    o->seed = TOOL_SEED_DEFAULT;
 }
 
 static int parse_size(const char *opt, const char *s, size_t lo, size_t hi, size_t *out)
@@ -220,6 +229,15 @@ static int set_option(opts *o, const optdef *d, const char *v)
         o->protocol = v;
         return parse_name(n, v, &PROTOCOL_NAMES, NULL, &o->protocol_id);
     case O_RANKS: return parse_size(n, v, 1, TOOL_RANKS_MAX, &o->ranks) != 0 ? TOOL_EXIT_USAGE : 0;
+    case O_TRAIN: return parse_size(n, v, 1, TOOL_TOP_MAX, &o->train) != 0 ? TOOL_EXIT_USAGE : 0;
+    case O_SPLITS: return parse_size(n, v, 1, TOOL_SPLITS_MAX, &o->splits) != 0 ? TOOL_EXIT_USAGE : 0;
+    case O_SEED: {
+        size_t sd;
+        if (parse_size(n, v, 0, SIZE_MAX, &sd) != 0)
+            return TOOL_EXIT_USAGE;
+        o->seed = sd;
+        return 0;
+    }
     case O_METHOD:
         r = parse_name(n, v, &METHOD_NAMES, &o->method_set, &e);
         o->method = (amscr_method)e;
