@@ -58,6 +58,7 @@ typedef struct opts {
     int json;
     const char *overlay;
     const char *plot;
+    const char *sheet; /* search --sheet FILE */
     const char *names;
     size_t top;
     const char *protocol; /* as given (printed back by eval --json); NULL: all */

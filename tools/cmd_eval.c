@@ -1,5 +1,6 @@
 /* cmd_eval.c — `amscr eval COLLECTION`: retrieval scores of a labelled collection. */
 #include <math.h>
+#include <stdio.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,6 +8,7 @@
 #include "amscr.h"
 #include "cli.h"
 #include "collection.h"
+#include "eval_plot.h"
 #include "json.h"
 #include "names.h"
 #include "params.h"
@@ -22,7 +24,7 @@ typedef struct eval_scores {
     double t0, t1, t2, secs; /* start, db prepared, matrix done; total seconds */
     double *cls_nn, *cls_be; /* per class (leave-one-out), when nn / bull's eye are computed */
     size_t *sizes;           /* class sizes */
-    int want_split, want_groups;
+    int want_split, want_groups, want_nn_classes;
     split_result split;
     groups_result groups;
 } eval_scores;
@@ -32,6 +34,10 @@ static int compute_protocols(const double *d, const collection *c, const opts *o
 {
     size_t nc = c->nclasses;
     if ((s->sizes = class_sizes(c)) == NULL)
+        return -1;
+    if (o->plot && !s->want_be && !s->want_nn && !s->want_split && !s->want_groups)
+        s->want_nn_classes = 1; /* the plot's bars */
+    if (s->want_nn_classes && (s->cls_nn = xmalloc_array(nc, sizeof(double))) == NULL)
         return -1;
     if (s->want_nn && (s->cls_nn = xmalloc_array(nc, sizeof(double))) == NULL)
         return -1;
@@ -182,6 +188,32 @@ static void format_text(sbuf *b, const opts *o, const collection *c, const amscr
               s->t2 > s->t1 ? (double)n * (double)(n - 1) / tm : 0.0);
 }
 
+enum { PR_LEVELS = 21 }; /* recall 0, 0.05, ..., 1 */
+
+/* --plot: the per-class scores the protocol computed and the precision-recall curve. */
+static int draw_plot(const opts *o, const double *d, const collection *c, const eval_scores *s)
+{
+    double rec[PR_LEVELS], prec[PR_LEVELS];
+    score_series ser[4];
+    size_t ns = 0;
+    if (pr_curve(d, c, PR_LEVELS, prec) != 0)
+        return -1;
+    for (size_t l = 0; l < PR_LEVELS; l++)
+        rec[l] = (double)l / (PR_LEVELS - 1);
+    if (s->cls_nn)
+        ser[ns++] = (score_series){"1-NN (leave one out)", s->cls_nn};
+    if (s->cls_be)
+        ser[ns++] = (score_series){"bull's eye", s->cls_be};
+    if (s->want_split)
+        ser[ns++] = (score_series){"1-NN (random split, mean)", s->split.cls};
+    if (s->want_groups)
+        ser[ns++] = (score_series){"1-NN (leave one group out)", s->groups.cls};
+    char title[600];
+    snprintf(title, sizeof title, "%s: %zu shapes, %zu classes", path_base(o->pos[0]), c->n, c->nclasses);
+    eval_plot_input in = {title, c->classes, c->nclasses, ser, ns, rec, prec, PR_LEVELS};
+    return draw_eval_plot(o->plot, &in);
+}
+
 /* What the protocol needs of the collection, checked before any shape is prepared. */
 static int check_collection(const opts *o, const collection *c)
 {
@@ -248,6 +280,8 @@ int cmd_eval(opts *o)
     if (s.ranks > c.n - 1)
         s.ranks = c.n - 1;
     if (compute_scores(d, &c, o, cpath, &s) != 0)
+        goto done;
+    if (o->plot && draw_plot(o, d, &c, &s) != 0)
         goto done;
     s.secs = now_seconds() - s.t0;
     if (o->json)

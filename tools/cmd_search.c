@@ -1,5 +1,6 @@
 /* cmd_search.c — `amscr search QUERY COLLECTION`: the closest shapes of a collection. */
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -10,6 +11,7 @@
 #include "json.h"
 #include "params.h"
 #include "retrieval.h"
+#include "sheet.h"
 
 /* The distances from the query dq to every shape of db (n of them) into dist: plain, or read
  * from the re-ranked matrix of the collection plus the query (dq is added to db). */
@@ -77,6 +79,60 @@ static void format_results(sbuf *b, const opts *o, const collection *c, const do
     }
 }
 
+/* One hit's tile: its sampled points registered onto the query (the retrieval params: the
+ * registration that the distance measured). */
+static int hit_tile(const amscr_db *db, const amscr_descriptor *dq, size_t j, double *after, sheet_tile *t)
+{
+    const amscr_descriptor *h = amscr_db_descriptor(db, j);
+    size_t n = amscr_descriptor_num_samples(h);
+    amscr_result *res = NULL;
+    double m[6];
+    amscr_status st = amscr_register(amscr_db_params(db), h, dq, NULL, &res);
+    if (st == AMSCR_OK)
+        st = amscr_result_affine(res, m);
+    if (st == AMSCR_OK)
+        st = amscr_affine_apply(m, amscr_descriptor_input_points(h), n, after);
+    amscr_result_free(res);
+    if (st != AMSCR_OK) {
+        tool_lib_error("--sheet", st);
+        return -1;
+    }
+    t->over = after;
+    t->no = n;
+    return 0;
+}
+
+/* --sheet: the query and its k hits. */
+static int draw_search_sheet(const opts *o, const amscr_db *db, const amscr_contour *q, const amscr_descriptor *dq,
+                             const collection *c, const double *dist, const size_t *idx, size_t k)
+{
+    size_t ns = amscr_descriptor_num_samples(dq);
+    sheet_tile *t = xcalloc_array(k + 1, sizeof *t);
+    double *pts = xmalloc_array(k ? k : 1, 2 * ns * sizeof(double));
+    int ret = -1;
+    if (t == NULL || pts == NULL)
+        goto done;
+    for (size_t i = 0; i <= k; i++) {
+        t[i].base = amscr_contour_xy(q);
+        t[i].nb = amscr_contour_size(q);
+    }
+    snprintf(t[0].title, sizeof t[0].title, "query");
+    snprintf(t[0].name, sizeof t[0].name, "%s", path_base(o->pos[0]));
+    for (size_t i = 0; i < k; i++) {
+        const coll_item *it = &c->items[idx[i]];
+        if (hit_tile(db, dq, idx[i], pts + i * 2 * ns, &t[i + 1]) != 0)
+            goto done;
+        snprintf(t[i + 1].title, sizeof t[i + 1].title, "%zu %.9s %.3g", i + 1, c->classes[it->label],
+                 dist[idx[i]]);
+        snprintf(t[i + 1].name, sizeof t[i + 1].name, "%s", path_base(it->name));
+    }
+    ret = draw_sheet(o->sheet, t, k + 1, amscr_params_get_closed(amscr_db_params(db)));
+done:
+    free(t);
+    free(pts);
+    return ret;
+}
+
 int cmd_search(opts *o)
 {
     const char *qpath = o->pos[0], *cpath = o->pos[1];
@@ -110,6 +166,8 @@ int cmd_search(opts *o)
         tool_lib_error(qpath, st);
         goto done;
     }
+    if (o->sheet && draw_search_sheet(o, db, q, dq, &c, dist, idx, k) != 0)
+        goto done;
     format_results(&b, o, &c, dist, idx, k, n, now_seconds() - t0);
     if (sb_write_stdout(&b) == 0)
         ret = TOOL_EXIT_OK;

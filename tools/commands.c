@@ -39,13 +39,16 @@ static const char HELP_REGISTER[] =
     "                          kept scales, and the elbow curve SSE(K)\n";
 
 static const char HELP_SEARCH[] =
-    "usage: amscr search QUERY COLLECTION [--top K] [--json] [options]\n"
+    "usage: amscr search QUERY COLLECTION [--top K] [--json] [--sheet FILE] [options]\n"
     "\n"
     "Ranks the shapes of COLLECTION (a folder or a manifest.tsv) by their distance\n"
     "from QUERY and prints the K closest (default 10). Reflections are on by default.\n"
     "\n"
     "  --top K                 how many results (default 10)\n"
-    "  --json                  print one JSON object\n";
+    "  --json                  print one JSON object\n"
+    "  --sheet FILE            contact sheet (.png or .svg): the query and its hits as\n"
+    "                          thumbnails with rank, class and distance, each hit drawn\n"
+    "                          (red) registered onto the query (grey)\n";
 
 static const char HELP_MATRIX[] =
     "usage: amscr matrix COLLECTION -o FILE [--names FILE] [options]\n"
@@ -85,6 +88,8 @@ static const char HELP_EVAL[] =
     "  --seed S                split: seed of the random splits (default 1)\n"
     "  --ranks K               ranks of the top-k table (default 10; Kimia-216 uses 11;\n"
     "                          alias --topk-ranks)\n"
+    "  --plot FILE             SVG: each class's scores as bars and the precision-recall\n"
+    "                          curve (each shape querying the others)\n"
     "  --json                  one JSON object: n, classes, seconds and bullseye,\n"
     "                          topk, nn_accuracy, split, groups (those the protocol\n"
     "                          computes) and per_class: each class's scores\n";

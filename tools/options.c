@@ -18,6 +18,7 @@ typedef enum opt_id {
     O_JSON,
     O_OVERLAY,
     O_PLOT,
+    O_SHEET,
     O_NAMES,
     O_TOP,
     O_PROTOCOL,
@@ -55,7 +56,8 @@ static const optdef OPTS[] = {
     {"--threshold", O_THRESHOLD, 1, C_ALL, "N|auto"},
     {"--json", O_JSON, 0, C_REGISTER | C_SEARCH | C_EVAL, NULL},
     {"--overlay", O_OVERLAY, 1, C_REGISTER, "FILE"},
-    {"--plot", O_PLOT, 1, C_REGISTER, "FILE"},
+    {"--plot", O_PLOT, 1, C_REGISTER | C_EVAL, "FILE"},
+    {"--sheet", O_SHEET, 1, C_SEARCH, "FILE"},
     {"--names", O_NAMES, 1, C_MATRIX, "FILE"},
     {"--top", O_TOP, 1, C_SEARCH, "K"},
     {"--protocol", O_PROTOCOL, 1, C_EVAL, "NAME"},
@@ -198,15 +200,16 @@ static int parse_name(const char *opt, const char *v, const name_table *t, int *
 
 static int set_picture(opts *o, opt_id id, const char *v)
 {
-    if (id == O_OVERLAY) {
+    if (id == O_OVERLAY || id == O_SHEET) {
+        const char *opt = id == O_OVERLAY ? "--overlay" : "--sheet";
         if (!draw_overlay_ext_ok(v))
-            return usage_error("--overlay", "'%s': the picture must be a .png or .svg file", v);
-        o->overlay = v;
+            return usage_error(opt, "'%s': the picture must be a .png or .svg file", v);
+        *(id == O_OVERLAY ? &o->overlay : &o->sheet) = v;
         return 0;
     }
     char ext[16];
     path_ext(v, ext);
-    if (strcmp(ext, ".svg") != 0)
+    if (strcmp(ext, ".svg") != 0) /* register's and eval's plots */
         return usage_error("--plot", "'%s': the plot is an .svg file", v);
     o->plot = v;
     return 0;
@@ -222,6 +225,7 @@ static int set_option(opts *o, const optdef *d, const char *v)
     case O_THRESHOLD: return parse_threshold(n, v, &o->threshold);
     case O_JSON: o->json = 1; return 0;
     case O_OVERLAY:
+    case O_SHEET:
     case O_PLOT: return set_picture(o, d->id, v);
     case O_NAMES: o->names = v; return 0;
     case O_TOP: return parse_size(n, v, 1, TOOL_TOP_MAX, &o->top) != 0 ? TOOL_EXIT_USAGE : 0;

@@ -247,3 +247,49 @@ void groups_result_free(groups_result *r)
     free(r->cls);
     r->grp = r->cls = NULL;
 }
+
+/* One query's precision at the recall levels into acc[] (interpolated: the best precision at
+ * any recall >= the level). */
+static void query_pr(const collection *c, size_t i, const size_t *order, size_t m, size_t relevant, double *acc,
+                     size_t nlevels)
+{
+    double *best = acc + nlevels; /* scratch: nlevels entries */
+    for (size_t l = 0; l < nlevels; l++)
+        best[l] = 0.0;
+    size_t hits = 0;
+    for (size_t r = 0; r < m && hits < relevant; r++) {
+        if (c->items[order[r]].label != c->items[i].label)
+            continue;
+        hits++;
+        double rec = (double)hits / (double)relevant, prec = (double)hits / (double)(r + 1);
+        for (size_t l = 0; l < nlevels; l++)
+            if ((double)l / (double)(nlevels - 1) <= rec + 1e-12 && prec > best[l])
+                best[l] = prec;
+    }
+    for (size_t l = 0; l < nlevels; l++)
+        acc[l] += best[l];
+}
+
+int pr_curve(const double *d, const collection *c, size_t nlevels, double *precision)
+{
+    size_t n = c->n, *sz = class_sizes(c), *order = xmalloc_array(n, sizeof(size_t)), queries = 0;
+    double *acc = xcalloc_array(2 * nlevels, sizeof(double));
+    int ret = -1;
+    if (sz == NULL || order == NULL || acc == NULL || n < 2)
+        goto done;
+    for (size_t i = 0; i < n; i++) {
+        size_t relevant = sz[c->items[i].label] - 1;
+        if (relevant == 0 || amscr_topk(d + i * n, n, n - 1, i, order) != AMSCR_OK)
+            continue;
+        query_pr(c, i, order, n - 1, relevant, acc, nlevels);
+        queries++;
+    }
+    for (size_t l = 0; l < nlevels; l++)
+        precision[l] = queries ? acc[l] / (double)queries : NAN;
+    ret = 0;
+done:
+    free(sz);
+    free(order);
+    free(acc);
+    return ret;
+}

@@ -46,4 +46,9 @@ typedef struct groups_result {
 int protocol_groups(const double *d, const collection *c, groups_result *out);
 void groups_result_free(groups_result *r);
 
+/* The precision-recall curve of the whole collection: each shape queries the others (its own
+ * class are the relevant ones), precision interpolated at the recall levels l / (nlevels - 1),
+ * l = 0..nlevels-1, averaged over the queries whose class has another shape. Returns 0 or -1. */
+int pr_curve(const double *d, const collection *c, size_t nlevels, double *precision);
+
 #endif
