@@ -21,5 +21,6 @@ Suite *amscr_suite_retrieval(void);
 Suite *amscr_suite_threads(void);
 Suite *amscr_suite_rerank(void);
 Suite *amscr_suite_invariance(void);
+Suite *amscr_suite_trace_all(void);
 
 #endif

@@ -45,7 +45,10 @@ enum {
     TOOL_THREADS_MAX = 1024,      /* the library's range of threads */
     TOOL_SPLITS_DEFAULT = 10,     /* eval --protocol split: random splits averaged */
     TOOL_SPLITS_MAX = 100000,     /* a bound on the work, far above any useful spread estimate */
-    TOOL_SEED_DEFAULT = 1         /* eval --protocol split: the splits are reproducible */
+    TOOL_SEED_DEFAULT = 1,        /* eval --protocol split: the splits are reproducible */
+    /* contour --all: contours enclosing fewer pixels^2 are specks of noise (a 4 x 4 square
+     * through pixel centres has area 9) */
+    TOOL_MIN_AREA_DEFAULT = 10
 };
 
 typedef struct opts {
@@ -59,6 +62,9 @@ typedef struct opts {
     const char *overlay;
     const char *plot;
     const char *sheet; /* search --sheet FILE */
+    int all;           /* contour --all */
+    double min_area;   /* --min-area A (pixels^2) */
+    long component;    /* --component N; -1: the largest outer contour */
     const char *names;
     size_t top;
     const char *protocol; /* as given (printed back by eval --json); NULL: all */

@@ -6,6 +6,7 @@
 
 #include "amscr.h"
 #include "cli.h"
+#include "components.h"
 #include "collection.h"
 #include "image.h"
 #include "json.h"
@@ -152,7 +153,7 @@ int cmd_search(opts *o)
     int r = make_params(o, 0, &p);
     if (r != 0)
         return r;
-    if (shape_load(qpath, o->threshold, &q) != 0 || collection_open(cpath, &c) != 0 ||
+    if (shape_load_opts(o, qpath, &q) != 0 || collection_open(cpath, &c) != 0 ||
         load_db(p, &c, o->threshold, &db) != 0 || prepare(amscr_db_params(db), qpath, q, &dq) != 0)
         goto done;
     size_t n = amscr_db_size(db);

@@ -10,6 +10,7 @@
 
 static const char HELP_CONTOUR[] =
     "usage: amscr contour IMG [-o FILE] [--threshold N|auto]\n"
+    "       amscr contour IMG --all [--json] [--min-area A] [-o FILE]\n"
     "\n"
     "Traces the outer boundary of the largest 8-connected foreground component of a\n"
     "PNG or PGM silhouette (holes and specks are ignored) and prints its points, one\n"
@@ -21,7 +22,17 @@ static const char HELP_CONTOUR[] =
     "coloured image on a transparent background is traced by its alpha channel.\n"
     "\n"
     "  -o, --output FILE       write the points to FILE instead of stdout\n"
-    "  --threshold N|auto      pixels > N are 'on' (0..254, default 127); auto = Otsu\n";
+    "  --threshold N|auto      pixels > N are 'on' (0..254, default 127); auto = Otsu\n"
+    "  --all                   every contour: each 8-connected component's outer boundary\n"
+    "                          (counter-clockwise) and each hole's (clockwise, through the\n"
+    "                          hole's own pixels), with its parent (findContours' tree):\n"
+    "                          a hole's parent is the component around it, a component's\n"
+    "                          the hole it lies in. Text: '# contour I: outer|hole, parent\n"
+    "                          P|-, area A, N points' then the points; blank lines between\n"
+    "  --json                  (with --all) {image, count, contours: [{index, parent,\n"
+    "                          hole, area, points}]}\n"
+    "  --min-area A            (with --all) drop contours enclosing less than A pixels^2\n"
+    "                          (and what lies inside them; default 10)\n";
 
 static const char HELP_REGISTER[] =
     "usage: amscr register SRC TGT [options]\n"
@@ -36,7 +47,9 @@ static const char HELP_REGISTER[] =
     "                          threshold, sse, mixture, ...)\n"
     "  --overlay FILE          picture (.png or .svg): target, source before and after\n"
     "  --plot FILE             SVG: residual per scale with the Bayes threshold and the\n"
-    "                          kept scales, and the elbow curve SSE(K)\n";
+    "                          kept scales, and the elbow curve SSE(K)\n"
+    "  --component N           use contour N of 'amscr contour --all' of each image\n"
+    "                          (default: the largest outer contour); --min-area A as there\n";
 
 static const char HELP_SEARCH[] =
     "usage: amscr search QUERY COLLECTION [--top K] [--json] [--sheet FILE] [options]\n"
@@ -48,7 +61,9 @@ static const char HELP_SEARCH[] =
     "  --json                  print one JSON object\n"
     "  --sheet FILE            contact sheet (.png or .svg): the query and its hits as\n"
     "                          thumbnails with rank, class and distance, each hit drawn\n"
-    "                          (red) registered onto the query (grey)\n";
+    "                          (red) registered onto the query (grey)\n"
+    "  --component N           the query is contour N of 'amscr contour --all' (default:\n"
+    "                          the largest outer contour); --min-area A as there\n";
 
 static const char HELP_MATRIX[] =
     "usage: amscr matrix COLLECTION -o FILE [--names FILE] [options]\n"
@@ -95,7 +110,7 @@ static const char HELP_EVAL[] =
     "                          computes) and per_class: each class's scores\n";
 
 static const tool_command COMMANDS[] = {
-    {"contour", C_CONTOUR, 1, "IMG [-o FILE]", "trace the outer contour of a silhouette image", HELP_CONTOUR, 0,
+    {"contour", C_CONTOUR, 1, "IMG [-o FILE]", "trace a silhouette's outer contour, or every contour (--all)", HELP_CONTOUR, 0,
      cmd_contour},
     {"register", C_REGISTER, 2, "SRC TGT", "register SRC onto TGT: affine map, distance, scales", HELP_REGISTER,
      1, cmd_register},

@@ -19,6 +19,9 @@ typedef enum opt_id {
     O_OVERLAY,
     O_PLOT,
     O_SHEET,
+    O_ALL,
+    O_MIN_AREA,
+    O_COMPONENT,
     O_NAMES,
     O_TOP,
     O_PROTOCOL,
@@ -54,10 +57,13 @@ static const optdef OPTS[] = {
     {"-o", O_OUTPUT, 1, C_CONTOUR | C_MATRIX, "FILE"},
     {"--output", O_OUTPUT, 1, C_CONTOUR | C_MATRIX, "FILE"},
     {"--threshold", O_THRESHOLD, 1, C_ALL, "N|auto"},
-    {"--json", O_JSON, 0, C_REGISTER | C_SEARCH | C_EVAL, NULL},
+    {"--json", O_JSON, 0, C_CONTOUR | C_REGISTER | C_SEARCH | C_EVAL, NULL},
     {"--overlay", O_OVERLAY, 1, C_REGISTER, "FILE"},
     {"--plot", O_PLOT, 1, C_REGISTER | C_EVAL, "FILE"},
     {"--sheet", O_SHEET, 1, C_SEARCH, "FILE"},
+    {"--all", O_ALL, 0, C_CONTOUR, NULL},
+    {"--min-area", O_MIN_AREA, 1, C_CONTOUR | C_REGISTER | C_SEARCH, "A"},
+    {"--component", O_COMPONENT, 1, C_REGISTER | C_SEARCH, "N"},
     {"--names", O_NAMES, 1, C_MATRIX, "FILE"},
     {"--top", O_TOP, 1, C_SEARCH, "K"},
     {"--protocol", O_PROTOCOL, 1, C_EVAL, "NAME"},
@@ -106,6 +112,8 @@ void opts_init(opts *o, const tool_command *c)
     o->rerank_iters = TOOL_RERANK_ITERS;
     o->splits = TOOL_SPLITS_DEFAULT;
     o->seed = TOOL_SEED_DEFAULT;
+    o->min_area = TOOL_MIN_AREA_DEFAULT;
+    o->component = -1;
 }
 
 static int parse_size(const char *opt, const char *s, size_t lo, size_t hi, size_t *out)
@@ -240,6 +248,23 @@ static int set_option(opts *o, const optdef *d, const char *v)
         if (parse_size(n, v, 0, SIZE_MAX, &sd) != 0)
             return TOOL_EXIT_USAGE;
         o->seed = sd;
+        return 0;
+    }
+    case O_ALL: o->all = 1; return 0;
+    case O_MIN_AREA: {
+        char *end;
+        errno = 0;
+        double a = strtod(v, &end);
+        if (end == v || *end != '\0' || errno != 0 || !(a >= 0.0) || !isfinite(a))
+            return usage_error(n, "expected an area >= 0 in pixels^2, got '%s'", v);
+        o->min_area = a;
+        return 0;
+    }
+    case O_COMPONENT: {
+        size_t k;
+        if (parse_size(n, v, 0, 100000000, &k) != 0)
+            return TOOL_EXIT_USAGE;
+        o->component = (long)k;
         return 0;
     }
     case O_METHOD:

@@ -203,3 +203,11 @@ amscr_status amscr_score_topk_table(const double *dist, size_t n, const int32_t 
 amscr_status amscr_score_nn_accuracy(const double *dist, size_t n, const int32_t *labels, double *out_accuracy);
 amscr_status amscr_score_nn_split(const double *dist, size_t ntest, size_t ntrain, const int32_t *test_labels, const int32_t *train_labels, double *out_accuracy);
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);
+typedef struct amscr_contour_set amscr_contour_set;
+amscr_status amscr_contours_from_mask(const uint8_t *pixels, size_t width, size_t height, size_t stride, int threshold, double min_area, amscr_contour_set **out);
+void amscr_contour_set_free(amscr_contour_set *s);
+size_t amscr_contour_set_size(const amscr_contour_set *s);
+const amscr_contour *amscr_contour_set_contour(const amscr_contour_set *s, size_t i);
+size_t amscr_contour_set_parent(const amscr_contour_set *s, size_t i);
+int amscr_contour_set_is_hole(const amscr_contour_set *s, size_t i);
+double amscr_contour_set_area(const amscr_contour_set *s, size_t i);
