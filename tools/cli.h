@@ -19,9 +19,10 @@ enum {
     C_SEARCH = 4,
     C_MATRIX = 8,
     C_EVAL = 16,
-    C_SHAPES = C_REGISTER | C_SEARCH | C_MATRIX | C_EVAL,
-    C_RETRIEVAL = C_SEARCH | C_MATRIX | C_EVAL,
-    C_ALL = 31
+    C_INDEX = 32,
+    C_SHAPES = C_REGISTER | C_SEARCH | C_MATRIX | C_EVAL | C_INDEX,
+    C_RETRIEVAL = C_SEARCH | C_MATRIX | C_EVAL | C_INDEX,
+    C_ALL = 63
 };
 
 /* Defaults and limits of the tool's own options (the shape parameters' defaults are the
@@ -48,7 +49,10 @@ enum {
     TOOL_SEED_DEFAULT = 1,        /* eval --protocol split: the splits are reproducible */
     /* contour --all: contours enclosing fewer pixels^2 are specks of noise (a 4 x 4 square
      * through pixel centres has area 9) */
-    TOOL_MIN_AREA_DEFAULT = 10
+    TOOL_MIN_AREA_DEFAULT = 10,
+    /* search against an index: the shapes whose signatures are nearest the query's are
+     * matched (README: index); every shape when the index is no larger */
+    TOOL_CANDIDATES_DEFAULT = 256
 };
 
 typedef struct opts {
@@ -65,6 +69,8 @@ typedef struct opts {
     int all;           /* contour --all */
     double min_area;   /* --min-area A (pixels^2) */
     long component;    /* --component N; -1: the largest outer contour */
+    int add;           /* index --add */
+    size_t candidates; /* search against an index: shapes matched (0: all) */
     const char *names;
     size_t top;
     const char *protocol; /* as given (printed back by eval --json); NULL: all */
@@ -132,5 +138,6 @@ int cmd_register(opts *o);
 int cmd_search(opts *o);
 int cmd_matrix(opts *o);
 int cmd_eval(opts *o);
+int cmd_index(opts *o);
 
 #endif

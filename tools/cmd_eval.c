@@ -217,6 +217,10 @@ static int draw_plot(const opts *o, const double *d, const collection *c, const 
 /* What the protocol needs of the collection, checked before any shape is prepared. */
 static int check_collection(const opts *o, const collection *c)
 {
+    if (c->n < 2) {
+        tool_error(o->pos[0], "eval needs at least 2 shapes, found %zu", c->n);
+        return TOOL_EXIT_FAIL;
+    }
     if (o->protocol_id == PROTO_SPLIT)
         return split_check(c, o->train);
     if (o->protocol_id != PROTO_GROUPS)
@@ -257,21 +261,11 @@ int cmd_eval(opts *o)
         return usage_error("--train", "only with --protocol split");
     if (pr == PROTO_SPLIT && o->train == 0)
         return usage_error("--protocol", "split needs --train K (training shapes per class)");
-    int r = make_params(o, 0, &p);
-    if (r != 0)
-        return r;
-    if (collection_open(cpath, &c) != 0)
-        goto done;
-    if (c.n < 2) {
-        tool_error(cpath, "eval needs at least 2 shapes, found %zu", c.n);
-        goto done;
-    }
-    if ((r = check_collection(o, &c)) != 0) {
+    int r = open_collection_db(o, cpath, check_collection, &p, &c, &db);
+    if (r != 0) {
         ret = r;
         goto done;
     }
-    if (load_db(p, &c, o->threshold, &db) != 0)
-        goto done;
     s.t1 = now_seconds();
     if (compute_matrix(db, cpath, o, &d) != 0)
         goto done;

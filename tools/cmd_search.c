@@ -9,6 +9,8 @@
 #include "components.h"
 #include "collection.h"
 #include "image.h"
+#include "index_build.h"
+#include "index_query.h"
 #include "json.h"
 #include "params.h"
 #include "retrieval.h"
@@ -134,11 +136,38 @@ done:
     return ret;
 }
 
+/* The collection to search: an index (x, is_index set; c and db point into it) or a folder /
+ * manifest prepared now (c and db owned by the caller). Returns 0 or an exit code. */
+static int open_target(const opts *o, tool_index *x, int *is_index, amscr_params **p, collection **c,
+                       amscr_db **db, collection *own)
+{
+    const char *cpath = o->pos[1];
+    int r = open_shapes(o, cpath, x, is_index);
+    if (r != 0)
+        return r;
+    if (!*is_index) {
+        *c = own;
+        if ((r = make_params(o, 0, p)) != 0)
+            return r;
+        return collection_open(cpath, own) == 0 && load_db(*p, own, o->threshold, db) == 0 ? 0 : TOOL_EXIT_FAIL;
+    }
+    *c = &x->coll;
+    *db = x->db;
+    size_t n = x->coll.n, need = o->rerank_k < n ? o->rerank_k : n;
+    if (x->k < need)
+        return usage_error("--rerank", "the index '%s' holds %zu neighbours a shape (built with %s); use --rerank K "
+                           "with K <= %zu, --no-rerank, or rebuild the index with --rerank %zu", cpath, x->k,
+                           x->k ? "a smaller --rerank" : "--no-rerank", x->k, o->rerank_k);
+    return index_params(o, cpath, x, p);
+}
+
 int cmd_search(opts *o)
 {
     const char *qpath = o->pos[0], *cpath = o->pos[1];
     amscr_params *p = NULL;
-    collection c;
+    collection own, *c = &own;
+    tool_index x;
+    int is_index = 0;
     amscr_db *db = NULL;
     amscr_contour *q = NULL;
     amscr_descriptor *dq = NULL;
@@ -147,29 +176,35 @@ int cmd_search(opts *o)
     int ret = TOOL_EXIT_FAIL;
     sbuf b;
     sb_init(&b);
-    memset(&c, 0, sizeof c);
+    memset(&own, 0, sizeof own);
+    memset(&x, 0, sizeof x);
     double t0 = now_seconds();
 
-    int r = make_params(o, 0, &p);
-    if (r != 0)
-        return r;
-    if (shape_load_opts(o, qpath, &q) != 0 || collection_open(cpath, &c) != 0 ||
-        load_db(p, &c, o->threshold, &db) != 0 || prepare(amscr_db_params(db), qpath, q, &dq) != 0)
+    int r = open_target(o, &x, &is_index, &p, &c, &db, &own);
+    if (r != 0) {
+        ret = r;
+        goto done;
+    }
+    if (shape_load_opts(o, qpath, &q) != 0 || prepare(is_index ? p : amscr_db_params(db), qpath, q, &dq) != 0)
         goto done;
     size_t n = amscr_db_size(db);
     dist = xmalloc_array(n, sizeof(double));
     size_t k = o->top < n ? o->top : n;
     idx = xmalloc_array(k ? k : 1, sizeof(size_t));
-    if (dist == NULL || idx == NULL || query_distances(db, dq, qpath, cpath, o, dist) != 0)
+    if (dist == NULL || idx == NULL)
+        goto done;
+    if (is_index ? index_search(&x, p, dq, o->candidates < k ? k : o->candidates, o->rerank_k, o->rerank_iters,
+                                dist) != 0
+                 : query_distances(db, dq, qpath, cpath, o, dist) != 0)
         goto done;
     amscr_status st = amscr_topk(dist, n, k, SIZE_MAX, idx);
     if (st != AMSCR_OK) {
         tool_lib_error(qpath, st);
         goto done;
     }
-    if (o->sheet && draw_search_sheet(o, db, q, dq, &c, dist, idx, k) != 0)
+    if (o->sheet && draw_search_sheet(o, db, q, dq, c, dist, idx, k) != 0)
         goto done;
-    format_results(&b, o, &c, dist, idx, k, n, now_seconds() - t0);
+    format_results(&b, o, c, dist, idx, k, n, now_seconds() - t0);
     if (sb_write_stdout(&b) == 0)
         ret = TOOL_EXIT_OK;
 done:
@@ -178,8 +213,10 @@ done:
     free(idx);
     amscr_descriptor_free(dq);
     amscr_contour_free(q);
-    amscr_db_free(db);
-    collection_free(&c);
+    if (!is_index)
+        amscr_db_free(db);
+    collection_free(&own);
+    index_free(&x);
     amscr_params_free(p);
     return ret;
 }

@@ -109,6 +109,25 @@ static const char HELP_EVAL[] =
     "                          topk, nn_accuracy, split, groups (those the protocol\n"
     "                          computes) and per_class: each class's scores\n";
 
+static const char HELP_INDEX[] =
+    "usage: amscr index COLLECTION -o FILE [--add] [options]\n"
+    "\n"
+    "Prepares every shape of COLLECTION (a folder or a manifest.tsv) once and writes an\n"
+    "index: the prepared shapes with their file names, classes and groups, the shape\n"
+    "options, a signature per shape and each shape's K nearest neighbours (--rerank K,\n"
+    "default 5), so that search, matrix and eval take FILE wherever they take a\n"
+    "collection, and one search never recomputes the collection's matrix. Building\n"
+    "matches every pair once. The file is versioned and checksummed, and written under a\n"
+    "temporary name then renamed.\n"
+    "\n"
+    "  -o, --output FILE       the index file\n"
+    "  --add                   append the shapes of COLLECTION to the index FILE: only the\n"
+    "                          new shapes are prepared, and only pairs with a new shape\n"
+    "                          matched; the shape options must be the index's\n"
+    "A command given an index uses the index's shape options; an option that differs from\n"
+    "them is an error (rebuild the index). search --candidates M (default 256) matches\n"
+    "the M shapes whose signatures are nearest the query's (0: every shape).\n";
+
 static const tool_command COMMANDS[] = {
     {"contour", C_CONTOUR, 1, "IMG [-o FILE]", "trace a silhouette's outer contour, or every contour (--all)", HELP_CONTOUR, 0,
      cmd_contour},
@@ -119,6 +138,8 @@ static const tool_command COMMANDS[] = {
     {"matrix", C_MATRIX, 1, "COLLECTION -o FILE", "all-pairs distance matrix (.tsv or .npy)", HELP_MATRIX, 1,
      cmd_matrix},
     {"eval", C_EVAL, 1, "COLLECTION", "retrieval scores: bull's eye, top-k table, 1-NN", HELP_EVAL, 1, cmd_eval},
+    {"index", C_INDEX, 1, "COLLECTION -o FILE", "prepare a collection once: an index file for search/matrix/eval",
+     HELP_INDEX, 1, cmd_index},
 };
 enum { NUM_COMMANDS = sizeof COMMANDS / sizeof COMMANDS[0] };
 
@@ -162,7 +183,7 @@ void print_main_help(void)
            "\n"
            "Shapes are PNG or PGM silhouettes (detected by their magic bytes) or text point\n"
            "lists (one \"x y\" or \"x,y\" per line, '#' comments). A COLLECTION is a folder of\n"
-           "shapes or a manifest.tsv with 'file' and 'class' columns.\n"
+           "shapes, a manifest.tsv with 'file' and 'class' columns, or an index (amscr index).\n"
            "Exit status: 0 success, 1 bad input or failure, 2 usage error.\n",
            "amscr --version", "amscr COMMAND --help");
 }

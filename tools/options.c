@@ -22,6 +22,8 @@ typedef enum opt_id {
     O_ALL,
     O_MIN_AREA,
     O_COMPONENT,
+    O_ADD,
+    O_CANDIDATES,
     O_NAMES,
     O_TOP,
     O_PROTOCOL,
@@ -54,8 +56,10 @@ typedef struct optdef {
 } optdef;
 
 static const optdef OPTS[] = {
-    {"-o", O_OUTPUT, 1, C_CONTOUR | C_MATRIX, "FILE"},
-    {"--output", O_OUTPUT, 1, C_CONTOUR | C_MATRIX, "FILE"},
+    {"-o", O_OUTPUT, 1, C_CONTOUR | C_MATRIX | C_INDEX, "FILE"},
+    {"--output", O_OUTPUT, 1, C_CONTOUR | C_MATRIX | C_INDEX, "FILE"},
+    {"--add", O_ADD, 0, C_INDEX, NULL},
+    {"--candidates", O_CANDIDATES, 1, C_SEARCH, "M"},
     {"--threshold", O_THRESHOLD, 1, C_ALL, "N|auto"},
     {"--json", O_JSON, 0, C_CONTOUR | C_REGISTER | C_SEARCH | C_EVAL, NULL},
     {"--overlay", O_OVERLAY, 1, C_REGISTER, "FILE"},
@@ -114,6 +118,7 @@ void opts_init(opts *o, const tool_command *c)
     o->seed = TOOL_SEED_DEFAULT;
     o->min_area = TOOL_MIN_AREA_DEFAULT;
     o->component = -1;
+    o->candidates = TOOL_CANDIDATES_DEFAULT;
 }
 
 static int parse_size(const char *opt, const char *s, size_t lo, size_t hi, size_t *out)
@@ -251,6 +256,8 @@ static int set_option(opts *o, const optdef *d, const char *v)
         return 0;
     }
     case O_ALL: o->all = 1; return 0;
+    case O_ADD: o->add = 1; return 0;
+    case O_CANDIDATES: return parse_size(n, v, 0, TOOL_TOP_MAX, &o->candidates) != 0 ? TOOL_EXIT_USAGE : 0;
     case O_MIN_AREA: {
         char *end;
         errno = 0;

@@ -1,0 +1,58 @@
+/* index_file.h — the index of `amscr index`: a prepared collection with its file names,
+ * classes and groups, the shape options it was built with (the db's params), a shape
+ * signature per shape (the candidate filter of large collections) and each shape's K nearest
+ * neighbours under the symmetrized distance (what contextual re-ranking needs, so one query
+ * never recomputes the collection's matrix).
+ *
+ * File format, little-endian, version 1:
+ *   "AMSCRIDX" u32 version u32 0
+ *   u64 n, i32 threshold, u32 rerank_iters, u64 k, f64 dmax
+ *   u64 nclasses, nclasses strings; u64 ngroups, ngroups strings   (string: u32 len, bytes)
+ *   n x (string name, i32 class, i32 group or -1)
+ *   u32 sig_dim, n x sig_dim f64 signatures
+ *   n x k x (u32 neighbour, f64 distance)        (each row: itself first, then by distance)
+ *   u64 len, the db (amscr_db_save_memory: params and prepared shapes)
+ *   u64 FNV-1a 64 of every byte before it.
+ * Written to a temporary name and renamed. Tool-internal. */
+#ifndef AMSCR_TOOL_INDEX_FILE_H
+#define AMSCR_TOOL_INDEX_FILE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "amscr.h"
+#include "collection.h"
+
+enum { INDEX_VERSION = 1, INDEX_SIG_DIM = 24 };
+
+typedef struct tool_index {
+    amscr_db *db;
+    collection coll;         /* names, classes, groups (item paths are the names) */
+    int threshold;           /* used to trace the collection's images */
+    unsigned rerank_iters;
+    size_t k;                /* neighbours per shape (0: built with --no-rerank) */
+    double dmax;             /* largest symmetrized distance of the collection */
+    double *sig;             /* n x INDEX_SIG_DIM */
+    uint32_t *nb_idx;        /* n x k */
+    double *nb_dist;         /* n x k */
+} tool_index;
+
+/* Non-zero when the file at path starts with the index magic. */
+int index_file_is(const char *path);
+/* Serializes into a malloc'ed buffer; 0 or -1 (out of memory printed). */
+int index_serialize(const tool_index *x, unsigned char **out, size_t *out_len);
+/* Parses a buffer; 0, or -1 with a message (naming `what`) in msg. */
+int index_parse(const unsigned char *buf, size_t len, tool_index *out, char *msg, size_t cap);
+/* Reads and parses a file; 0, or -1 after printing one error line naming path. */
+int index_load(const char *path, tool_index *out);
+/* Writes atomically; 0, or -1 after printing one error line. */
+int index_save(const char *path, const tool_index *x);
+void index_free(tool_index *x);
+
+/* The signature of a prepared shape: magnitudes of harmonics 1..INDEX_SIG_DIM of its radius
+ * function (distance of the normalized samples from their centroid, divided by its mean):
+ * invariant to the start point, rotation, scale and mirror images, so similar shapes have
+ * near signatures. */
+void index_signature(const amscr_descriptor *d, double *out);
+
+#endif
