@@ -153,12 +153,14 @@ static int open_target(const opts *o, tool_index *x, int *is_index, amscr_params
     }
     *c = &x->coll;
     *db = x->db;
+    if ((r = index_params(o, cpath, x, p)) != 0)
+        return r;
     size_t n = x->coll.n, need = o->rerank_k < n ? o->rerank_k : n;
     if (x->k < need)
         return usage_error("--rerank", "the index '%s' holds %zu neighbours a shape (built with %s); use --rerank K "
                            "with K <= %zu, --no-rerank, or rebuild the index with --rerank %zu", cpath, x->k,
                            x->k ? "a smaller --rerank" : "--no-rerank", x->k, o->rerank_k);
-    return index_params(o, cpath, x, p);
+    return 0;
 }
 
 int cmd_search(opts *o)

@@ -67,19 +67,21 @@ static int merge_names(const char *ipath, tool_index *x, collection *c)
 }
 
 /* Neighbour lists of all N shapes from the old lists and the cross distances: a[in*N + j] =
- * d(new in -> j), b[j*nn + in] = d(j -> new in). */
-static int merge_knn(tool_index *x, size_t nold, const double *a, const double *b)
+ * d(new in -> j), b[j*nn + in] = d(j -> new in). An index smaller than its K (every shape in
+ * every list, so nothing is unknown) grows its lists up to want_k. */
+static int merge_knn(tool_index *x, size_t nold, size_t want_k, const double *a, const double *b)
 {
-    size_t N = x->coll.n, nn = N - nold, k = x->k;
+    size_t N = x->coll.n, nn = N - nold, kold = x->k;
+    size_t k = kold == nold && want_k > kold ? (want_k < N ? want_k : N) : kold;
     uint32_t *idx = xmalloc_array(N * k > 0 ? N * k : 1, sizeof *idx);
-    double *dist = xmalloc_array(N * k > 0 ? N * k : 1, sizeof *dist), *cd = xmalloc_array(N + k, sizeof(double));
-    size_t *cj = xmalloc_array(N + k, sizeof(size_t));
+    double *dist = xmalloc_array(N * k > 0 ? N * k : 1, sizeof *dist), *cd = xmalloc_array(N + kold, sizeof(double));
+    size_t *cj = xmalloc_array(N + kold, sizeof(size_t));
     int ok = idx && dist && cd && cj;
     for (size_t i = 0; ok && i < N; i++) {
         size_t m = 0;
         if (i < nold) { /* its old list and the new shapes */
-            for (size_t t = 0; t < k; t++)
-                cj[m] = x->nb_idx[i * k + t], cd[m++] = x->nb_dist[i * k + t];
+            for (size_t t = 0; t < kold; t++)
+                cj[m] = x->nb_idx[i * kold + t], cd[m++] = x->nb_dist[i * kold + t];
             for (size_t jn = 0; jn < nn; jn++)
                 cj[m] = nold + jn, cd[m++] = 0.5 * (b[i * nn + jn] + a[jn * N + i]);
         } else {
@@ -103,6 +105,7 @@ static int merge_knn(tool_index *x, size_t nold, const double *a, const double *
     free(x->nb_dist);
     x->nb_idx = idx;
     x->nb_dist = dist;
+    x->k = k;
     return 0;
 }
 
@@ -148,7 +151,7 @@ int index_add(const opts *o, tool_index *x, collection *c)
             tool_lib_error(o->out, AMSCR_E_NOMEM);
             r = TOOL_EXIT_FAIL;
         }
-    if (r == 0 && (index_signatures_from(x, nold) != 0 || cross(x, dnew, &a, &b) != 0 || merge_knn(x, nold, a, b) != 0))
+    if (r == 0 && (index_signatures_from(x, nold) != 0 || cross(x, dnew, &a, &b) != 0 || merge_knn(x, nold, o->rerank_k, a, b) != 0))
         r = TOOL_EXIT_FAIL;
     free(a);
     free(b);

@@ -67,7 +67,7 @@ static void w_str(wbuf *w, const char *s)
     w_bytes(w, s, n);
 }
 
-static uint64_t fnv1a(const unsigned char *p, size_t n)
+uint64_t index_checksum(const unsigned char *p, size_t n)
 {
     uint64_t h = 0xcbf29ce484222325ull;
     for (size_t i = 0; i < n; i++) {
@@ -118,7 +118,7 @@ int index_serialize(const tool_index *x, unsigned char **out, size_t *out_len)
     w_bytes(&w, blob, blen);
     amscr_free(blob);
     if (!w.oom)
-        w_u64(&w, fnv1a(w.p, w.len));
+        w_u64(&w, index_checksum(w.p, w.len));
     if (w.oom) {
         free(w.p);
         tool_error(NULL, "out of memory");
@@ -320,7 +320,7 @@ int index_parse(const unsigned char *buf, size_t len, tool_index *x, char *msg, 
         return -1;
     }
     rbuf tail = {buf, len, len - 8, 0};
-    if (len < 24 || fnv1a(buf, len - 8) != r_u64(&tail))
+    if (len < 24 || index_checksum(buf, len - 8) != r_u64(&tail))
         return fail(msg, cap, "truncated or corrupt index (checksum mismatch)");
     r.len = len - 8; /* the checksum is not part of the sections */
     r.pos = 16;      /* past the reserved word */

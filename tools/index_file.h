@@ -48,6 +48,8 @@ int index_load(const char *path, tool_index *out);
 /* Writes atomically; 0, or -1 after printing one error line. */
 int index_save(const char *path, const tool_index *x);
 void index_free(tool_index *x);
+/* FNV-1a 64 of n bytes (the file's last 8 bytes hold it for the bytes before). */
+uint64_t index_checksum(const unsigned char *p, size_t n);
 
 /* The signature of a prepared shape: magnitudes of harmonics 1..INDEX_SIG_DIM of its radius
  * function (distance of the normalized samples from their centroid, divided by its mean):
