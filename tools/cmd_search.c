@@ -105,9 +105,10 @@ static int hit_tile(const amscr_db *db, const amscr_descriptor *dq, size_t j, do
     return 0;
 }
 
-/* --sheet: the query and its k hits. */
-static int draw_search_sheet(const opts *o, const amscr_db *db, const amscr_contour *q, const amscr_descriptor *dq,
-                             const collection *c, const double *dist, const size_t *idx, size_t k)
+/* --sheet: the query and its k hits (shape pos[i] of db is hit i). */
+static int draw_search_sheet(const opts *o, const amscr_db *db, const size_t *pos, const amscr_contour *q,
+                             const amscr_descriptor *dq, const collection *c, const double *dist, const size_t *idx,
+                             size_t k)
 {
     size_t ns = amscr_descriptor_num_samples(dq);
     sheet_tile *t = xcalloc_array(k + 1, sizeof *t);
@@ -123,7 +124,7 @@ static int draw_search_sheet(const opts *o, const amscr_db *db, const amscr_cont
     snprintf(t[0].name, sizeof t[0].name, "%s", path_base(o->pos[0]));
     for (size_t i = 0; i < k; i++) {
         const coll_item *it = &c->items[idx[i]];
-        if (hit_tile(db, dq, idx[i], pts + i * 2 * ns, &t[i + 1]) != 0)
+        if (hit_tile(db, dq, pos[i], pts + i * 2 * ns, &t[i + 1]) != 0)
             goto done;
         snprintf(t[i + 1].title, sizeof t[i + 1].title, "%zu %.9s %.3g", i + 1, c->classes[it->label],
                  dist[idx[i]]);
@@ -136,15 +137,35 @@ done:
     return ret;
 }
 
+/* --sheet: the hits from the folder's db, or read from the index (x non-NULL). */
+static int sheet_of(const opts *o, const tool_index *x, const amscr_db *db, const amscr_contour *q,
+                    const amscr_descriptor *dq, const collection *c, const double *dist, const size_t *idx, size_t k)
+{
+    size_t *pos = xmalloc_array(k ? k : 1, sizeof(size_t));
+    amscr_db *hits = NULL;
+    int r = -1;
+    if (pos == NULL || (x && index_fetch(x, NULL, idx, k, &hits) != 0)) {
+        free(pos);
+        return -1;
+    }
+    for (size_t i = 0; i < k; i++)
+        pos[i] = x ? i : idx[i];
+    r = draw_search_sheet(o, x ? hits : db, pos, q, dq, c, dist, idx, k);
+    amscr_db_free(hits);
+    free(pos);
+    return r;
+}
+
 /* The collection to search: an index (x, is_index set; c and db point into it) or a folder /
  * manifest prepared now (c and db owned by the caller). Returns 0 or an exit code. */
 static int open_target(const opts *o, tool_index *x, int *is_index, amscr_params **p, collection **c,
                        amscr_db **db, collection *own)
 {
     const char *cpath = o->pos[1];
-    int r = open_shapes(o, cpath, x, is_index);
-    if (r != 0)
-        return r;
+    int r = 0;
+    *is_index = index_file_is(cpath);
+    if (*is_index && index_open_lazy(cpath, x) != 0)
+        return TOOL_EXIT_FAIL;
     if (!*is_index) {
         *c = own;
         if ((r = make_params(o, 0, p)) != 0)
@@ -189,7 +210,7 @@ int cmd_search(opts *o)
     }
     if (shape_load_opts(o, qpath, &q) != 0 || prepare(is_index ? p : amscr_db_params(db), qpath, q, &dq) != 0)
         goto done;
-    size_t n = amscr_db_size(db);
+    size_t n = c->n;
     dist = xmalloc_array(n, sizeof(double));
     size_t k = o->top < n ? o->top : n;
     idx = xmalloc_array(k ? k : 1, sizeof(size_t));
@@ -204,7 +225,7 @@ int cmd_search(opts *o)
         tool_lib_error(qpath, st);
         goto done;
     }
-    if (o->sheet && draw_search_sheet(o, db, q, dq, c, dist, idx, k) != 0)
+    if (o->sheet && sheet_of(o, is_index ? &x : NULL, db, q, dq, c, dist, idx, k) != 0)
         goto done;
     format_results(&b, o, c, dist, idx, k, n, now_seconds() - t0);
     if (sb_write_stdout(&b) == 0)

@@ -219,24 +219,6 @@ static size_t candidates(const tool_index *x, const amscr_descriptor *dq, size_t
     return m;
 }
 
-/* A db of the candidates (or the index's own when they are every shape). */
-static amscr_db *candidate_db(const tool_index *x, const amscr_params *p, const size_t *cand, size_t m, int *own)
-{
-    *own = m < x->coll.n;
-    if (!*own)
-        return x->db;
-    amscr_db *db = NULL;
-    amscr_status st = amscr_db_new(p, &db);
-    for (size_t t = 0; st == AMSCR_OK && t < m; t++)
-        st = amscr_db_add_descriptor(db, amscr_db_descriptor(x->db, cand[t]), amscr_db_label(x->db, cand[t]), NULL);
-    if (st != AMSCR_OK) {
-        amscr_db_free(db);
-        tool_lib_error(NULL, st);
-        return NULL;
-    }
-    return db;
-}
-
 /* d(q -> cand) into fwd and, for re-ranking, the symmetrized distances into sym. */
 static int match(const amscr_db *cdb, const amscr_params *p, const amscr_descriptor *dq, int both, double *fwd,
                  double *sym, size_t m)
@@ -273,11 +255,11 @@ int index_search(const tool_index *x, const amscr_params *p, const amscr_descrip
     size_t *cand = xmalloc_array(n, sizeof(size_t));
     double *fwd = xmalloc_array(n, sizeof(double)), *sym = xmalloc_array(n, sizeof(double));
     amscr_db *cdb = NULL;
-    int own = 0, ret = -1;
+    int ret = -1;
     if (!cand || !fwd || !sym)
         goto done;
     m = candidates(x, dq, m, cand);
-    if (m == 0 || (cdb = candidate_db(x, p, cand, m, &own)) == NULL || match(cdb, p, dq, k > 0, fwd, sym, m) != 0)
+    if (m == 0 || index_fetch(x, p, cand, m, &cdb) != 0 || match(cdb, p, dq, k > 0, fwd, sym, m) != 0)
         goto done;
     if (k == 0) {
         for (size_t j = 0; j < n; j++)
@@ -291,8 +273,7 @@ int index_search(const tool_index *x, const amscr_params *p, const amscr_descrip
         ret = rerank_query_row(x, k, iters, cand, sym, m, out);
     }
 done:
-    if (own)
-        amscr_db_free(cdb);
+    amscr_db_free(cdb);
     free(cand);
     free(fwd);
     free(sym);

@@ -1,6 +1,6 @@
 /* fuzz_index.c — the index loader of `amscr index` (tools/index_file.c: index_parse) on
- * arbitrary bytes, as given and with the checksum made right (so the sections behind it are
- * reached). Properties on success: at least one shape, as many prepared shapes as names,
+ * arbitrary bytes, as given and with the file length and the meta section's checksum made
+ * right (so the sections behind them are reached). Properties on success: at least one shape, as many prepared shapes as names,
  * classes in range, neighbour lists starting with the shape itself, and the index serializes
  * into bytes that parse again to the same counts. On failure: a message. */
 #include <stdlib.h>
@@ -41,14 +41,21 @@ static void one(const uint8_t *data, size_t size)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     one(data, size);
-    if (size >= 24) {
+    if (size >= 40) { /* the file length and the meta section's checksum made right */
         uint8_t *fixed = malloc(size);
         if (fixed == NULL)
             return 0;
         memcpy(fixed, data, size);
-        uint64_t h = index_checksum(fixed, size - 8);
+        uint64_t mlen = 0;
+        for (int i = 7; i >= 0; i--)
+            mlen = mlen << 8 | fixed[24 + i];
         for (int i = 0; i < 8; i++)
-            fixed[size - 8 + (size_t)i] = (uint8_t)(h >> (8 * i));
+            fixed[16 + i] = (uint8_t)((uint64_t)size >> (8 * i));
+        if (mlen <= size - 40) {
+            uint64_t h = index_checksum(fixed + 32, (size_t)mlen);
+            for (int i = 0; i < 8; i++)
+                fixed[32 + mlen + (size_t)i] = (uint8_t)(h >> (8 * i));
+        }
         one(fixed, size);
         free(fixed);
     }

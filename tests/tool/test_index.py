@@ -118,8 +118,10 @@ def test_corrupt_index(tmp_path, damage):
     q = tmp_path / "shapes" / "star_1.txt"
     r = run("search", q, bad)
     assert r.returncode == 1 and r.stdout == "" and r.stderr.count("\n") == 1
-    if damage in ("truncate", "flip"):
-        assert "checksum" in r.stderr
+    if damage == "truncate":
+        assert "truncated" in r.stderr
+    if damage == "flip":  # the names and tables are checksummed, every shape is checked by the library
+        assert "checksum" in r.stderr or "damaged shape" in r.stderr
     if damage == "version":
         assert "version 9" in r.stderr
     for args in (("eval", bad), ("matrix", bad, "-o", "-"), ("index", m, "-o", bad, "--add")):
