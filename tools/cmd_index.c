@@ -104,9 +104,13 @@ static int build(const opts *o, collection *c, tool_index *x)
     double *d = NULL;
     opts plain = *o;
     plain.rerank_k = 0;
-    if (load_db(p, &x->coll, o->threshold, &x->db) == 0 && index_signatures_from(x, 0) == 0 &&
-        compute_matrix(x->db, o->pos[0], &plain, &d) == 0 && knn_from_matrix(x, d, x->coll.n) == 0)
-        ret = 0;
+    size_t n = x->coll.n, m = o->candidates;
+    if (load_db(p, &x->coll, o->threshold, &x->db) == 0 && index_signatures_from(x, 0) == 0) {
+        if (m > 0 && m < n - 1) /* a large collection: each shape's candidates only */
+            ret = knn_from_candidates(x, p, m) == 0 ? 0 : TOOL_EXIT_FAIL;
+        else if (compute_matrix(x->db, o->pos[0], &plain, &d) == 0 && knn_from_matrix(x, d, n) == 0)
+            ret = 0;
+    }
     free(d);
     amscr_params_free(p);
     return ret;

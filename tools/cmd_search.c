@@ -216,7 +216,7 @@ int cmd_search(opts *o)
     idx = xmalloc_array(k ? k : 1, sizeof(size_t));
     if (dist == NULL || idx == NULL)
         goto done;
-    if (is_index ? index_search(&x, p, dq, o->candidates < k ? k : o->candidates, o->rerank_k, o->rerank_iters,
+    if (is_index ? index_search(&x, p, dq, o->candidates && o->candidates < k ? k : o->candidates, o->rerank_k, o->rerank_iters,
                                 dist) != 0
                  : query_distances(db, dq, qpath, cpath, o, dist) != 0)
         goto done;

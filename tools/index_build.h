@@ -19,6 +19,10 @@ int index_signatures_from(tool_index *x, size_t from);
 /* --add: appends the collection c to the loaded index x (cmd_index.c writes it). */
 int index_add(const opts *o, tool_index *x, collection *c);
 
+/* The neighbour lists (x->k a shape) and x->dmax from each shape's m signature-nearest
+ * shapes, matched both ways on the threads of p (index_knn.c). 0 or -1 (error printed). */
+int knn_from_candidates(tool_index *x, const amscr_params *p, size_t m);
+
 /* Opens the COLLECTION argument: an index (its db and names; params from the index, options
  * the user set checked against it) or a folder / manifest (prepared with make_params).
  * *x is zeroed for a folder. Returns 0, or an exit code after printing one error line. */

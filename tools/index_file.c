@@ -577,7 +577,10 @@ void index_free(tool_index *x)
 void index_signature(const amscr_descriptor *d, double *out)
 {
     size_t n = amscr_descriptor_num_samples(d);
-    const double *p = amscr_descriptor_base_points(d);
+    /* under the affine group the whitened points (aspect and shear normalized away); else the
+     * sampled input points, whose aspect tells shapes apart */
+    int affine = amscr_params_get_invariance(amscr_descriptor_params(d)) == AMSCR_INVARIANCE_AFFINE;
+    const double *p = affine ? amscr_descriptor_base_points(d) : amscr_descriptor_input_points(d);
     double cx = 0.0, cy = 0.0, mean = 0.0;
     for (size_t i = 0; i < n; i++) {
         cx += p[2 * i] / (double)n;

@@ -67,9 +67,10 @@ void index_free(tool_index *x);
 uint64_t index_checksum(const unsigned char *p, size_t n);
 
 /* The signature of a prepared shape: magnitudes of harmonics 1..INDEX_SIG_DIM of its radius
- * function (distance of the normalized samples from their centroid, divided by its mean):
- * invariant to the start point, rotation, scale and mirror images, so similar shapes have
- * near signatures. */
+ * function (distance of the samples from their centroid, divided by its mean): invariant to
+ * the start point, rotation, scale and mirror images, so similar shapes have near signatures.
+ * The samples are the input points, or the whitened ones under the affine group (so the
+ * signature is affine-invariant too). */
 void index_signature(const amscr_descriptor *d, double *out);
 
 #endif

@@ -59,7 +59,7 @@ static const optdef OPTS[] = {
     {"-o", O_OUTPUT, 1, C_CONTOUR | C_MATRIX | C_INDEX, "FILE"},
     {"--output", O_OUTPUT, 1, C_CONTOUR | C_MATRIX | C_INDEX, "FILE"},
     {"--add", O_ADD, 0, C_INDEX, NULL},
-    {"--candidates", O_CANDIDATES, 1, C_SEARCH, "M"},
+    {"--candidates", O_CANDIDATES, 1, C_SEARCH | C_INDEX, "M"},
     {"--threshold", O_THRESHOLD, 1, C_ALL, "N|auto"},
     {"--json", O_JSON, 0, C_CONTOUR | C_REGISTER | C_SEARCH | C_EVAL, NULL},
     {"--overlay", O_OVERLAY, 1, C_REGISTER, "FILE"},

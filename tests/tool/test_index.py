@@ -144,3 +144,20 @@ def test_sheet_from_an_index(tmp_path):
     out = tmp_path / "s.svg"
     r = run("search", tmp_path / "shapes" / "wave_2.txt", idx, "--no-rerank", "--top", "3", "--sheet", out)
     assert r.returncode == 0 and out.read_text().count('<g class="hit">') == 3
+
+
+def test_candidates(tmp_path):
+    """--candidates 0 matches every shape, whatever --top; an index built from each shape's
+    signature candidates only still finds the query itself first."""
+    m = make_manifest(tmp_path)
+    idx = build(tmp_path, m, "--refine", "0")
+    q = tmp_path / "shapes" / "wave_1.txt"
+    a = json.loads(run("search", q, idx, "--json", "--top", "2", "--candidates", "0").stdout)["results"]
+    b = json.loads(run("search", q, m, "--json", "--top", "2", "--refine", "0").stdout)["results"]
+    same_results(a, b)
+    few = build(tmp_path, m, "--refine", "0", "--candidates", "3", "--rerank", "3", name="few.idx")
+    r = run("search", q, few, "--json", "--candidates", "4", "--rerank", "3", "--top", "3")
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)["results"]
+    assert res[0]["file"].endswith("wave_1.txt") and all(x["class"] == "wave" for x in res[:1])
+    assert run("search", q, few, "--candidates", "-1").returncode == 2
