@@ -104,7 +104,7 @@ static int build(const opts *o, collection *c, tool_index *x)
     double *d = NULL;
     opts plain = *o;
     plain.rerank_k = 0;
-    size_t n = x->coll.n, m = o->candidates;
+    size_t n = x->coll.n, m = o->candidates_set ? o->candidates : 0; /* default: every pair */
     if (load_db(p, &x->coll, o->threshold, &x->db) == 0 && index_signatures_from(x, 0) == 0) {
         if (m > 0 && m < n - 1) /* a large collection: each shape's candidates only */
             ret = knn_from_candidates(x, p, m) == 0 ? 0 : TOOL_EXIT_FAIL;

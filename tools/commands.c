@@ -54,7 +54,7 @@ static const char HELP_REGISTER[] =
 static const char HELP_SEARCH[] =
     "usage: amscr search QUERY COLLECTION [--top K] [--json] [--sheet FILE] [options]\n"
     "\n"
-    "Ranks the shapes of COLLECTION (a folder or a manifest.tsv) by their distance\n"
+    "Ranks the shapes of COLLECTION (a folder, a manifest.tsv or an index) by their distance\n"
     "from QUERY and prints the K closest (default 10). Reflections are on by default.\n"
     "\n"
     "  --top K                 how many results (default 10)\n"
@@ -62,6 +62,8 @@ static const char HELP_SEARCH[] =
     "  --sheet FILE            contact sheet (.png or .svg): the query and its hits as\n"
     "                          thumbnails with rank, class and distance, each hit drawn\n"
     "                          (red) registered onto the query (grey)\n"
+    "  --candidates M          against an index: match the M shapes whose signatures are\n"
+    "                          nearest the query's (default 64; 0: every shape)\n"
     "  --component N           the query is contour N of 'amscr contour --all' (default:\n"
     "                          the largest outer contour); --min-area A as there\n";
 
@@ -121,13 +123,13 @@ static const char HELP_INDEX[] =
     "\n"
     "  -o, --output FILE       the index file\n"
     "  --candidates M          neighbours are sought among each shape's M nearest by\n"
-    "                          signature, matched both ways (default 256; 0: every pair,\n"
-    "                          which a collection of at most M + 1 shapes always gets)\n"
+    "                          signature only, matched both ways: for collections too\n"
+    "                          large for every pair (default 0: every pair)\n"
     "  --add                   append the shapes of COLLECTION to the index FILE: only the\n"
     "                          new shapes are prepared, and only pairs with a new shape\n"
     "                          matched; the shape options must be the index's\n"
     "A command given an index uses the index's shape options; an option that differs from\n"
-    "them is an error (rebuild the index). search --candidates M (default 256) matches\n"
+    "them is an error (rebuild the index). search --candidates M (default 64) matches\n"
     "the M shapes whose signatures are nearest the query's (0: every shape).\n";
 
 static const tool_command COMMANDS[] = {

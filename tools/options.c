@@ -257,7 +257,9 @@ static int set_option(opts *o, const optdef *d, const char *v)
     }
     case O_ALL: o->all = 1; return 0;
     case O_ADD: o->add = 1; return 0;
-    case O_CANDIDATES: return parse_size(n, v, 0, TOOL_TOP_MAX, &o->candidates) != 0 ? TOOL_EXIT_USAGE : 0;
+    case O_CANDIDATES:
+        o->candidates_set = 1;
+        return parse_size(n, v, 0, TOOL_TOP_MAX, &o->candidates) != 0 ? TOOL_EXIT_USAGE : 0;
     case O_MIN_AREA: {
         char *end;
         errno = 0;
