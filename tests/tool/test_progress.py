@@ -40,11 +40,12 @@ def run_on_pty(*args):
     ("matrix", "{m}", "-o", "-"),
     ("search", "{q}", "{m}"),
     ("search", "{q}", "{m}", "--no-rerank"),
+    ("index", "{m}", "-o", "{t}/s.idx"),
 ])
 def test_progress_on_a_terminal(tmp_path, cmd):
     m = make_manifest(tmp_path)
     q = tmp_path / "shapes" / "star_2.txt"
-    args = [a.format(m=m, q=q) for a in cmd]
+    args = [a.format(m=m, q=q, t=tmp_path) for a in cmd]
     code, out, term = run_on_pty(*args)
     assert code == 0 and out
     assert "amscr: matching [" in term and "/s" in term and " left" in term
@@ -56,6 +57,7 @@ def test_progress_on_a_terminal(tmp_path, cmd):
 
 def test_no_progress_without_a_terminal(tmp_path):
     m = make_manifest(tmp_path)
-    for args in (("eval", m), ("matrix", m, "-o", "-"), ("search", tmp_path / "shapes" / "star_2.txt", m)):
+    for args in (("eval", m), ("matrix", m, "-o", "-"), ("search", tmp_path / "shapes" / "star_2.txt", m),
+                 ("index", m, "-o", tmp_path / "s.idx")):
         r = run(*args)
         assert r.returncode == 0 and r.stderr == ""
