@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
-"""Runs the speed benchmark, then (when ../shared/datasets exists and the tool is built)
-`amscr eval` on Kimia-99 and Kimia-216, printing the top-k tables beside the paper's rows."""
+"""Runs the speed benchmark, then (when the tool is built) the query time against a synthetic
+10,000-shape index (bench/index_bench.py; the index is built once and cached in
+--index-work), then (when ../shared/datasets exists) `amscr eval` on Kimia-99 and Kimia-216,
+printing the top-k tables beside the paper's rows."""
 import argparse
 import json
 import os
@@ -17,12 +19,20 @@ ap.add_argument('--bench', required=True)
 ap.add_argument('--tool')
 ap.add_argument('--datasets')
 ap.add_argument('--shapes', default='1400')
+ap.add_argument('--index-shapes', default='10000', help='shapes of the synthetic index (0: skip)')
+ap.add_argument('--index-work', default=os.path.join('build', 'bench-index'))
 args, rest = ap.parse_known_args()
 
 sys.stdout.flush()
 rc = subprocess.call([args.bench, '--shapes', args.shapes] + rest)
 if rc != 0:
     sys.exit(rc)
+if args.tool and args.index_shapes != '0':
+    sys.stdout.flush()
+    rc = subprocess.call([sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), 'index_bench.py'),
+                          '--tool', args.tool, '--shapes', args.index_shapes, '--work', args.index_work])
+    if rc != 0:
+        sys.exit(rc)
 if not args.tool or not args.datasets or not os.path.isdir(args.datasets):
     print('(Kimia tables skipped: no tool or no ../shared/datasets)')
     sys.exit(0)

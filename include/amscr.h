@@ -937,6 +937,56 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_channel_matrix(const amscr_db *d
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn progress,
                                                                  void *user, double *out_dist);
 
+/* ======================================================================
+ * Every contour of an image, with its hierarchy (0.2)
+ * ====================================================================== */
+
+/** A list of contours with their hierarchy (amscr_contours_from_mask). Opaque. */
+typedef struct amscr_contour_set amscr_contour_set;
+
+/** Parent index of a top-level contour (amscr_contour_set_parent). */
+#define AMSCR_NO_PARENT SIZE_MAX
+
+/**
+ * @brief Traces every 8-connected foreground component of an 8-bit image and every hole
+ *        (4-connected background region not connected to the border), each with its parent:
+ *        the hierarchy of OpenCV's findContours with RETR_TREE.
+ *
+ * Threshold and polarity as amscr_contour_from_mask. Outer contours go through the boundary
+ * pixel centres of their component, counter-clockwise (positive signed area); a hole's
+ * contour goes through the centres of its own boundary (background) pixels, clockwise
+ * (negative signed area). The parent of a hole is the component around it; the parent of a
+ * component is the hole it lies in, or AMSCR_NO_PARENT. Contours are listed in raster order
+ * of their first pixel, so a parent comes before its children.
+ * A contour is kept when it has at least 3 points, its polygon area (pixels^2, |signed area|)
+ * is >= min_area and its parent is kept; contours of no area (single pixels, lines) are
+ * always dropped.
+ *
+ * @param[in] pixels, width, height, stride, threshold  as amscr_contour_from_mask.
+ * @param[in] min_area  >= 0 and finite (0 keeps every contour with an area).
+ * @param[out] out  new set with at least one contour.
+ * @return AMSCR_OK, AMSCR_E_INVALID_ARG, AMSCR_E_LIMIT, AMSCR_E_NOT_FOUND (no foreground,
+ *         foreground everywhere, or no contour of min_area), AMSCR_E_NOMEM.
+ * Ownership: caller frees *out with amscr_contour_set_free. Thread-safety: reentrant.
+ * @since 0.2
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_contours_from_mask(const uint8_t *pixels, size_t width,
+                                                                size_t height, size_t stride, int threshold,
+                                                                double min_area, amscr_contour_set **out);
+/** @brief Releases a set and its contours; accepts NULL. @since 0.2 */
+AMSCR_API void amscr_contour_set_free(amscr_contour_set *s);
+/** @brief Number of contours (0 for NULL). @since 0.2 */
+AMSCR_API size_t amscr_contour_set_size(const amscr_contour_set *s);
+/** @brief Contour i, borrowed: valid until the set is freed (NULL if out of range). @since 0.2 */
+AMSCR_API const amscr_contour *amscr_contour_set_contour(const amscr_contour_set *s, size_t i);
+/** @brief Index of the parent of contour i (< i), or AMSCR_NO_PARENT (also if out of range).
+ *  @since 0.2 */
+AMSCR_API size_t amscr_contour_set_parent(const amscr_contour_set *s, size_t i);
+/** @brief 1 when contour i is a hole, else 0. @since 0.2 */
+AMSCR_API int amscr_contour_set_is_hole(const amscr_contour_set *s, size_t i);
+/** @brief Polygon area of contour i (pixels^2, >= 0; 0 if out of range). @since 0.2 */
+AMSCR_API double amscr_contour_set_area(const amscr_contour_set *s, size_t i);
+
 #ifdef __cplusplus
 }
 #endif

@@ -365,3 +365,33 @@ amscr_status amscr_contour_from_mask(const uint8_t *pixels, size_t width, size_t
     /* amscr__contour_wrap takes ownership of xy (also on failure). */
     return amscr__contour_wrap(xy, n, out);
 }
+
+/* ------------------------------------------------------------------ shared with trace_all.c */
+#include "trace_all.h"
+
+void amscr__mask_threshold(const uint8_t *pixels, size_t w, size_t h, size_t stride, int threshold, int *out_t,
+                           int *out_invert)
+{
+    int t = threshold;
+    if (t == AMSCR_THRESHOLD_AUTO) {
+        uint64_t hist[256];
+        memset(hist, 0, sizeof hist);
+        for (size_t y = 0; y < h; y++)
+            for (size_t x = 0; x < w; x++)
+                hist[pixels[y * stride + x]]++;
+        t = tr_otsu(hist);
+    }
+    /* polarity as amscr_contour_from_mask: each border pixel counted once */
+    size_t border = 0, border_on = 0;
+    for (size_t y = 0; y < h; y++) {
+        const uint8_t *row = pixels + y * stride;
+        for (size_t x = 0; x < w; x++) {
+            if (y != 0 && y != h - 1 && x != 0 && x != w - 1)
+                continue;
+            border_on += row[x] > (uint8_t)t;
+            border++;
+        }
+    }
+    *out_t = t;
+    *out_invert = 2 * border_on > border;
+}

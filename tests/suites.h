@@ -24,5 +24,6 @@ Suite *amscr_suite_invariance(void);
 /* issue 14 (registration) */
 Suite *amscr_suite_robust(void);
 Suite *amscr_suite_channel(void);
+Suite *amscr_suite_trace_all(void);
 
 #endif

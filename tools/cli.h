@@ -19,9 +19,10 @@ enum {
     C_SEARCH = 4,
     C_MATRIX = 8,
     C_EVAL = 16,
-    C_SHAPES = C_REGISTER | C_SEARCH | C_MATRIX | C_EVAL,
-    C_RETRIEVAL = C_SEARCH | C_MATRIX | C_EVAL,
-    C_ALL = 31
+    C_INDEX = 32,
+    C_SHAPES = C_REGISTER | C_SEARCH | C_MATRIX | C_EVAL | C_INDEX,
+    C_RETRIEVAL = C_SEARCH | C_MATRIX | C_EVAL | C_INDEX,
+    C_ALL = 63
 };
 
 /* Defaults and limits of the tool's own options (the shape parameters' defaults are the
@@ -42,7 +43,18 @@ enum {
     TOOL_POINTS_MIN = 16,         /* the library's range of samples: 16..AMSCR_MAX_SAMPLES */
     TOOL_REFINE_MAX = 50,         /* the library's range of refinement iterations */
     TOOL_KMAX_MAX = 16,           /* the library's range of the elbow's Kmax */
-    TOOL_THREADS_MAX = 1024       /* the library's range of threads */
+    TOOL_THREADS_MAX = 1024,      /* the library's range of threads */
+    TOOL_SPLITS_DEFAULT = 10,     /* eval --protocol split: random splits averaged */
+    TOOL_SPLITS_MAX = 100000,     /* a bound on the work, far above any useful spread estimate */
+    TOOL_SEED_DEFAULT = 1,        /* eval --protocol split: the splits are reproducible */
+    /* contour --all: contours enclosing fewer pixels^2 are specks of noise (a 4 x 4 square
+     * through pixel centres has area 9) */
+    TOOL_MIN_AREA_DEFAULT = 10,
+    /* search against an index: the 64 shapes whose signatures are nearest the query's are
+     * matched (mpeg7-dev, 60 queries: 97.5 % of the re-ranked top 10 of matching every
+     * shape, the same first hit for all; README: index); every shape when the index is no
+     * larger. An index is built from every pair unless told --candidates M. */
+    TOOL_CANDIDATES_DEFAULT = 64
 };
 
 typedef struct opts {
@@ -55,11 +67,21 @@ typedef struct opts {
     int json;
     const char *overlay;
     const char *plot;
+    const char *sheet; /* search --sheet FILE */
+    int all;           /* contour --all */
+    double min_area;   /* --min-area A (pixels^2) */
+    long component;    /* --component N; -1: the largest outer contour */
+    int add;           /* index --add */
+    size_t candidates; /* search against an index: shapes matched (0: all) */
+    int candidates_set;
     const char *names;
     size_t top;
     const char *protocol; /* as given (printed back by eval --json); NULL: all */
     int protocol_id;      /* PROTO_* (names.h) */
     size_t ranks;
+    size_t train;       /* --train K: training shapes per class (protocol split); 0: not given */
+    size_t splits;      /* --splits R (default TOOL_SPLITS_DEFAULT) */
+    unsigned long long seed; /* --seed S (default TOOL_SEED_DEFAULT) */
     /* shape parameters (set only when given) */
     int method_set;
     amscr_method method;
@@ -120,5 +142,6 @@ int cmd_register(opts *o);
 int cmd_search(opts *o);
 int cmd_matrix(opts *o);
 int cmd_eval(opts *o);
+int cmd_index(opts *o);
 
 #endif

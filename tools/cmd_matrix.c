@@ -26,11 +26,12 @@ int cmd_matrix(opts *o)
     double *d = NULL;
     int ret = TOOL_EXIT_FAIL;
     memset(&c, 0, sizeof c);
-    int r = make_params(o, 0, &p);
-    if (r != 0)
-        return r;
-    if (collection_open(cpath, &c) != 0 || load_db(p, &c, o->threshold, &db) != 0 ||
-        compute_matrix(db, cpath, o, &d) != 0)
+    int r = open_collection_db(o, cpath, NULL, &p, &c, &db);
+    if (r != 0) {
+        ret = r;
+        goto done;
+    }
+    if (compute_matrix(db, cpath, o, &d) != 0)
         goto done;
     size_t n = c.n;
     tool_out out;

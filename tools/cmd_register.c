@@ -6,6 +6,7 @@
 
 #include "amscr.h"
 #include "cli.h"
+#include "components.h"
 #include "draw.h"
 #include "image.h"
 #include "json.h"
@@ -69,7 +70,7 @@ static int register_pair(const opts *o, const amscr_params *p, amscr_contour **s
     const char *spath = o->pos[0], *tpath = o->pos[1];
     amscr_descriptor *ds = NULL, *dt = NULL;
     int ret = -1;
-    if (shape_load(spath, o->threshold, src) != 0 || shape_load(tpath, o->threshold, tgt) != 0)
+    if (shape_load_opts(o, spath, src) != 0 || shape_load_opts(o, tpath, tgt) != 0)
         goto done;
     if (prepare_pair(p, o, *src, *tgt, &ds, &dt) != 0)
         goto done;

@@ -1,15 +1,20 @@
 /* cmd_search.c — `amscr search QUERY COLLECTION`: the closest shapes of a collection. */
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "amscr.h"
 #include "cli.h"
+#include "components.h"
 #include "collection.h"
 #include "image.h"
+#include "index_build.h"
+#include "index_query.h"
 #include "json.h"
 #include "params.h"
 #include "retrieval.h"
+#include "sheet.h"
 
 /* The distances from the query dq to every shape of db (n of them) into dist: plain, or read
  * from the re-ranked matrix of the collection plus the query (dq is added to db). */
@@ -77,11 +82,115 @@ static void format_results(sbuf *b, const opts *o, const collection *c, const do
     }
 }
 
+/* One hit's tile: its sampled points registered onto the query (the retrieval params: the
+ * registration that the distance measured). */
+static int hit_tile(const amscr_db *db, const amscr_descriptor *dq, size_t j, double *after, sheet_tile *t)
+{
+    const amscr_descriptor *h = amscr_db_descriptor(db, j);
+    size_t n = amscr_descriptor_num_samples(h);
+    amscr_result *res = NULL;
+    double m[6];
+    amscr_status st = amscr_register(amscr_db_params(db), h, dq, NULL, &res);
+    if (st == AMSCR_OK)
+        st = amscr_result_affine(res, m);
+    if (st == AMSCR_OK)
+        st = amscr_affine_apply(m, amscr_descriptor_input_points(h), n, after);
+    amscr_result_free(res);
+    if (st != AMSCR_OK) {
+        tool_lib_error("--sheet", st);
+        return -1;
+    }
+    t->over = after;
+    t->no = n;
+    return 0;
+}
+
+/* --sheet: the query and its k hits (shape pos[i] of db is hit i). */
+static int draw_search_sheet(const opts *o, const amscr_db *db, const size_t *pos, const amscr_contour *q,
+                             const amscr_descriptor *dq, const collection *c, const double *dist, const size_t *idx,
+                             size_t k)
+{
+    size_t ns = amscr_descriptor_num_samples(dq);
+    sheet_tile *t = xcalloc_array(k + 1, sizeof *t);
+    double *pts = xmalloc_array(k ? k : 1, 2 * ns * sizeof(double));
+    int ret = -1;
+    if (t == NULL || pts == NULL)
+        goto done;
+    for (size_t i = 0; i <= k; i++) {
+        t[i].base = amscr_contour_xy(q);
+        t[i].nb = amscr_contour_size(q);
+    }
+    snprintf(t[0].title, sizeof t[0].title, "query");
+    snprintf(t[0].name, sizeof t[0].name, "%s", path_base(o->pos[0]));
+    for (size_t i = 0; i < k; i++) {
+        const coll_item *it = &c->items[idx[i]];
+        if (hit_tile(db, dq, pos[i], pts + i * 2 * ns, &t[i + 1]) != 0)
+            goto done;
+        snprintf(t[i + 1].title, sizeof t[i + 1].title, "%zu %.9s %.3g", i + 1, c->classes[it->label],
+                 dist[idx[i]]);
+        snprintf(t[i + 1].name, sizeof t[i + 1].name, "%s", path_base(it->name));
+    }
+    ret = draw_sheet(o->sheet, t, k + 1, amscr_params_get_closed(amscr_db_params(db)));
+done:
+    free(t);
+    free(pts);
+    return ret;
+}
+
+/* --sheet: the hits from the folder's db, or read from the index (x non-NULL). */
+static int sheet_of(const opts *o, const tool_index *x, const amscr_db *db, const amscr_contour *q,
+                    const amscr_descriptor *dq, const collection *c, const double *dist, const size_t *idx, size_t k)
+{
+    size_t *pos = xmalloc_array(k ? k : 1, sizeof(size_t));
+    amscr_db *hits = NULL;
+    int r = -1;
+    if (pos == NULL || (x && index_fetch(x, NULL, idx, k, &hits) != 0)) {
+        free(pos);
+        return -1;
+    }
+    for (size_t i = 0; i < k; i++)
+        pos[i] = x ? i : idx[i];
+    r = draw_search_sheet(o, x ? hits : db, pos, q, dq, c, dist, idx, k);
+    amscr_db_free(hits);
+    free(pos);
+    return r;
+}
+
+/* The collection to search: an index (x, is_index set; c and db point into it) or a folder /
+ * manifest prepared now (c and db owned by the caller). Returns 0 or an exit code. */
+static int open_target(const opts *o, tool_index *x, int *is_index, amscr_params **p, collection **c,
+                       amscr_db **db, collection *own)
+{
+    const char *cpath = o->pos[1];
+    int r = 0;
+    *is_index = index_file_is(cpath);
+    if (*is_index && index_open_lazy(cpath, x) != 0)
+        return TOOL_EXIT_FAIL;
+    if (!*is_index) {
+        *c = own;
+        if ((r = make_params(o, 0, p)) != 0)
+            return r;
+        return collection_open(cpath, own) == 0 && load_db(*p, own, o->threshold, db) == 0 ? 0 : TOOL_EXIT_FAIL;
+    }
+    *c = &x->coll;
+    *db = x->db;
+    if ((r = index_params(o, cpath, x, p)) != 0)
+        return r;
+    size_t n = x->coll.n, need = o->rerank_k < n ? o->rerank_k : n;
+    if (x->k < need)
+        return usage_error("--rerank", "the index '%s' holds %zu neighbours a shape (built with %s); use --rerank K "
+                           "with K <= %zu, --no-rerank, or rebuild the index with --rerank %zu", cpath, x->k,
+                           x->k ? "a smaller --rerank" : "--no-rerank", x->k, o->rerank_k);
+    return 0;
+}
+
 int cmd_search(opts *o)
 {
     const char *qpath = o->pos[0], *cpath = o->pos[1];
     amscr_params *p = NULL;
-    collection c;
+    collection own, *c = &own;
+    tool_index x;
+    int is_index = 0;
     amscr_db *db = NULL;
     amscr_contour *q = NULL;
     amscr_descriptor *dq = NULL;
@@ -90,27 +199,35 @@ int cmd_search(opts *o)
     int ret = TOOL_EXIT_FAIL;
     sbuf b;
     sb_init(&b);
-    memset(&c, 0, sizeof c);
+    memset(&own, 0, sizeof own);
+    memset(&x, 0, sizeof x);
     double t0 = now_seconds();
 
-    int r = make_params(o, 0, &p);
-    if (r != 0)
-        return r;
-    if (shape_load(qpath, o->threshold, &q) != 0 || collection_open(cpath, &c) != 0 ||
-        load_db(p, &c, o->threshold, &db) != 0 || prepare(amscr_db_params(db), qpath, q, &dq) != 0)
+    int r = open_target(o, &x, &is_index, &p, &c, &db, &own);
+    if (r != 0) {
+        ret = r;
         goto done;
-    size_t n = amscr_db_size(db);
+    }
+    if (shape_load_opts(o, qpath, &q) != 0 || prepare(is_index ? p : amscr_db_params(db), qpath, q, &dq) != 0)
+        goto done;
+    size_t n = c->n;
     dist = xmalloc_array(n, sizeof(double));
     size_t k = o->top < n ? o->top : n;
     idx = xmalloc_array(k ? k : 1, sizeof(size_t));
-    if (dist == NULL || idx == NULL || query_distances(db, dq, qpath, cpath, o, dist) != 0)
+    if (dist == NULL || idx == NULL)
+        goto done;
+    if (is_index ? index_search(&x, p, dq, o->candidates && o->candidates < k ? k : o->candidates, o->rerank_k, o->rerank_iters,
+                                dist) != 0
+                 : query_distances(db, dq, qpath, cpath, o, dist) != 0)
         goto done;
     amscr_status st = amscr_topk(dist, n, k, SIZE_MAX, idx);
     if (st != AMSCR_OK) {
         tool_lib_error(qpath, st);
         goto done;
     }
-    format_results(&b, o, &c, dist, idx, k, n, now_seconds() - t0);
+    if (o->sheet && sheet_of(o, is_index ? &x : NULL, db, q, dq, c, dist, idx, k) != 0)
+        goto done;
+    format_results(&b, o, c, dist, idx, k, n, now_seconds() - t0);
     if (sb_write_stdout(&b) == 0)
         ret = TOOL_EXIT_OK;
 done:
@@ -119,8 +236,10 @@ done:
     free(idx);
     amscr_descriptor_free(dq);
     amscr_contour_free(q);
-    amscr_db_free(db);
-    collection_free(&c);
+    if (!is_index)
+        amscr_db_free(db);
+    collection_free(&own);
+    index_free(&x);
     amscr_params_free(p);
     return ret;
 }

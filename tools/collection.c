@@ -44,33 +44,38 @@ void collection_free(collection *c)
     }
     for (size_t i = 0; i < c->nclasses; i++)
         free(c->classes[i]);
+    for (size_t i = 0; i < c->ngroups; i++)
+        free(c->groups[i]);
     free(c->items);
     free(c->classes);
+    free(c->groups);
     c->items = NULL;
     c->classes = NULL;
-    c->n = c->nclasses = 0;
+    c->groups = NULL;
+    c->n = c->nclasses = c->ngroups = 0;
 }
 
-static int32_t class_index(collection *c, const char *cls, size_t *cap)
+/* The index of `name` in the list (*names, *n), appended when new. */
+static int32_t name_index(char ***names, size_t *n, const char *name, size_t *cap)
 {
-    for (size_t i = 0; i < c->nclasses; i++)
-        if (strcmp(c->classes[i], cls) == 0)
+    for (size_t i = 0; i < *n; i++)
+        if (strcmp((*names)[i], name) == 0)
             return (int32_t)i;
-    if (c->nclasses == *cap) {
+    if (*n == *cap) {
         size_t ncap = *cap ? *cap * 2 : 16;
-        char **p = realloc(c->classes, ncap * sizeof *p);
+        char **p = realloc(*names, ncap * sizeof *p);
         if (p == NULL) {
             tool_error(NULL, "out of memory");
             return -1;
         }
-        c->classes = p;
+        *names = p;
         *cap = ncap;
     }
-    char *s = xstrdup(cls);
+    char *s = xstrdup(name);
     if (s == NULL)
         return -1;
-    c->classes[c->nclasses] = s;
-    return (int32_t)c->nclasses++;
+    (*names)[*n] = s;
+    return (int32_t)(*n)++;
 }
 
 /* Appends the entry `entry` (a name in dir's listing or a manifest's file column) of class cls. */
@@ -83,7 +88,7 @@ static int add_item(collection *c, size_t *icap, size_t *ccap, const char *dir, 
         free(name);
         return -1;
     }
-    int32_t label = class_index(c, cls, ccap);
+    int32_t label = name_index(&c->classes, &c->nclasses, cls, ccap);
     if (label < 0) {
         free(path);
         free(name);
@@ -104,6 +109,7 @@ static int add_item(collection *c, size_t *icap, size_t *ccap, const char *dir, 
     c->items[c->n].path = path;
     c->items[c->n].name = name;
     c->items[c->n].label = label;
+    c->items[c->n].group = -1;
     c->n++;
     return 0;
 }
@@ -205,6 +211,21 @@ static void trim(char *s)
         memmove(s, s + i, n - i + 1);
 }
 
+/* The group of the last item added (a manifest's `group` column). */
+static int set_group(collection *c, char *g, size_t *gcap, const char *mpath, size_t lineno)
+{
+    trim(g);
+    if (g[0] == '\0') {
+        tool_error(mpath, "line %zu: empty group", lineno);
+        return -1;
+    }
+    int32_t gi = name_index(&c->groups, &c->ngroups, g, gcap);
+    if (gi < 0)
+        return -1;
+    c->items[c->n - 1].group = gi;
+    return 0;
+}
+
 static int open_manifest(const char *mpath, collection *c)
 {
     FILE *fp = fopen(mpath, "rb");
@@ -220,8 +241,8 @@ static int open_manifest(const char *mpath, collection *c)
     size_t lcap = 4096;
     char *line = malloc(lcap);
     int ok = line != NULL, header = 1;
-    long fcol = -1, ccol = -1;
-    size_t lineno = 0, icap = 0, ccap = 0;
+    long fcol = -1, ccol = -1, gcol = -1;
+    size_t lineno = 0, icap = 0, ccap = 0, gcap = 0;
     if (!ok)
         tool_error(NULL, "out of memory");
     while (ok) {
@@ -264,6 +285,8 @@ static int open_manifest(const char *mpath, collection *c)
                     fcol = (long)i;
                 else if (strcmp(f[i], "class") == 0)
                     ccol = (long)i;
+                else if (strcmp(f[i], "group") == 0)
+                    gcol = (long)i;
             }
             if (fcol < 0 || ccol < 0) {
                 tool_error(mpath, "line %zu: the header must name the columns 'file' and 'class' (tab-separated)",
@@ -274,9 +297,11 @@ static int open_manifest(const char *mpath, collection *c)
             header = 0;
             continue;
         }
-        if ((size_t)fcol >= nf || (size_t)ccol >= nf) {
-            tool_error(mpath, "line %zu: expected %ld tab-separated columns, found %zu", lineno,
-                       (fcol > ccol ? fcol : ccol) + 1, nf);
+        long need = fcol > ccol ? fcol : ccol;
+        if (gcol > need)
+            need = gcol;
+        if ((size_t)need >= nf) {
+            tool_error(mpath, "line %zu: expected %ld tab-separated columns, found %zu", lineno, need + 1, nf);
             ok = 0;
             break;
         }
@@ -288,6 +313,8 @@ static int open_manifest(const char *mpath, collection *c)
             break;
         }
         if (add_item(c, &icap, &ccap, dir, f[fcol], f[ccol]) != 0)
+            ok = 0;
+        else if (gcol >= 0 && set_group(c, f[gcol], &gcap, mpath, lineno) != 0)
             ok = 0;
     }
     if (ok && ferror(fp)) {

@@ -10,7 +10,9 @@
  *
  * Manifest: a tab-separated file with a header line naming (at least) the columns `file`
  * and `class`, in any order; paths are relative to the manifest's folder (absolute paths
- * are kept); blank lines and lines starting with '#' are skipped. Rows keep their order. */
+ * are kept); blank lines and lines starting with '#' are skipped. Rows keep their order.
+ * An optional column `group` names the object or source each shape belongs to (eval
+ * --protocol groups leaves one group out at a time). */
 #ifndef AMSCR_TOOL_COLLECTION_H
 #define AMSCR_TOOL_COLLECTION_H
 
@@ -21,6 +23,7 @@ typedef struct coll_item {
     char *path;    /* path to open */
     char *name;    /* as listed (file name or manifest entry) */
     int32_t label; /* index into classes */
+    int32_t group; /* index into groups; -1 without a group column */
 } coll_item;
 
 typedef struct collection {
@@ -28,6 +31,8 @@ typedef struct collection {
     size_t n;
     char **classes; /* class names, in order of first appearance */
     size_t nclasses;
+    char **groups; /* group names (manifest column `group`), in order of first appearance */
+    size_t ngroups; /* 0: no group column */
 } collection;
 
 /* Reads a folder or a manifest. Returns 0, or -1 after printing one error line. */

@@ -10,6 +10,7 @@
 
 static const char HELP_CONTOUR[] =
     "usage: amscr contour IMG [-o FILE] [--threshold N|auto]\n"
+    "       amscr contour IMG --all [--json] [--min-area A] [-o FILE]\n"
     "\n"
     "Traces the outer boundary of the largest 8-connected foreground component of a\n"
     "PNG or PGM silhouette (holes and specks are ignored) and prints its points, one\n"
@@ -21,7 +22,17 @@ static const char HELP_CONTOUR[] =
     "coloured image on a transparent background is traced by its alpha channel.\n"
     "\n"
     "  -o, --output FILE       write the points to FILE instead of stdout\n"
-    "  --threshold N|auto      pixels > N are 'on' (0..254, default 127); auto = Otsu\n";
+    "  --threshold N|auto      pixels > N are 'on' (0..254, default 127); auto = Otsu\n"
+    "  --all                   every contour: each 8-connected component's outer boundary\n"
+    "                          (counter-clockwise) and each hole's (clockwise, through the\n"
+    "                          hole's own pixels), with its parent (findContours' tree):\n"
+    "                          a hole's parent is the component around it, a component's\n"
+    "                          the hole it lies in. Text: '# contour I: outer|hole, parent\n"
+    "                          P|-, area A, N points' then the points; blank lines between\n"
+    "  --json                  (with --all) {image, count, contours: [{index, parent,\n"
+    "                          hole, area, points}]}\n"
+    "  --min-area A            (with --all) drop contours enclosing less than A pixels^2\n"
+    "                          (and what lies inside them; default 10)\n";
 
 static const char HELP_REGISTER[] =
     "usage: amscr register SRC TGT [options]\n"
@@ -39,19 +50,28 @@ static const char HELP_REGISTER[] =
     "                          kept scales, and the elbow curve SSE(K)\n"
     "  --partial               SRC is an open fragment of TGT's closed boundary: also\n"
     "                          prints where on TGT it lies (start, end as fractions)\n"
+    "  --component N           use contour N of 'amscr contour --all' of each image\n"
+    "                          (default: the largest outer contour); --min-area A as there\n"
     "\n"
     "Every result prints its confidence in [0, 1] ((1 - ambiguity) x inlier fraction;\n"
     "reject maps below about 0.25) and, with --json, the matched target boundary\n"
     "parameter and point of every source sample (\"correspondences\").\n";
 
 static const char HELP_SEARCH[] =
-    "usage: amscr search QUERY COLLECTION [--top K] [--json] [options]\n"
+    "usage: amscr search QUERY COLLECTION [--top K] [--json] [--sheet FILE] [options]\n"
     "\n"
-    "Ranks the shapes of COLLECTION (a folder or a manifest.tsv) by their distance\n"
+    "Ranks the shapes of COLLECTION (a folder, a manifest.tsv or an index) by their distance\n"
     "from QUERY and prints the K closest (default 10). Reflections are on by default.\n"
     "\n"
     "  --top K                 how many results (default 10)\n"
-    "  --json                  print one JSON object\n";
+    "  --json                  print one JSON object\n"
+    "  --sheet FILE            contact sheet (.png or .svg): the query and its hits as\n"
+    "                          thumbnails with rank, class and distance, each hit drawn\n"
+    "                          (red) registered onto the query (grey)\n"
+    "  --candidates M          against an index: match the M shapes whose signatures are\n"
+    "                          nearest the query's (default 64; 0: every shape)\n"
+    "  --component N           the query is contour N of 'amscr contour --all' (default:\n"
+    "                          the largest outer contour); --min-area A as there\n";
 
 static const char HELP_MATRIX[] =
     "usage: amscr matrix COLLECTION -o FILE [--names FILE] [options]\n"
@@ -67,6 +87,8 @@ static const char HELP_MATRIX[] =
 
 static const char HELP_EVAL[] =
     "usage: amscr eval COLLECTION [--protocol P] [--ranks K] [--json] [options]\n"
+    "       amscr eval COLLECTION --protocol split --train K [--splits R] [--seed S]\n"
+    "       amscr eval MANIFEST --protocol groups\n"
     "\n"
     "Retrieval scores of a labelled collection from its full distance matrix:\n"
     "  bullseye  bull's eye (MPEG-7): same-class shapes among the 2*Nc nearest,\n"
@@ -75,17 +97,49 @@ static const char HELP_EVAL[] =
     "            neighbour (query excluded; Kimia tables)\n"
     "  nn        leave-one-out nearest-neighbour accuracy\n"
     "  all       all three (default)\n"
+    "  split     per-class random split: K shapes of every class train, the rest are\n"
+    "            classified by 1-NN; mean and spread over R splits (Swedish leaf: K 25)\n"
+    "  groups    leave one group out: each group's shapes are classified by 1-NN\n"
+    "            against the other groups (ETH-80: one object out); needs a manifest\n"
+    "            with a 'group' column\n"
     "Classes: a folder's file names (\"bird-3.png\" -> bird) or the manifest's column.\n"
     "Reflections are on by default.\n"
     "\n"
-    "  --protocol P            all | bullseye | topk | nn\n"
+    "  --protocol P            all | bullseye | topk | nn | split | groups\n"
+    "  --train K               split: training shapes per class (each class needs > K)\n"
+    "  --splits R              split: random splits averaged (default 10)\n"
+    "  --seed S                split: seed of the random splits (default 1)\n"
     "  --ranks K               ranks of the top-k table (default 10; Kimia-216 uses 11;\n"
     "                          alias --topk-ranks)\n"
+    "  --plot FILE             SVG: each class's scores as bars and the precision-recall\n"
+    "                          curve (each shape querying the others)\n"
     "  --json                  one JSON object: n, classes, seconds and bullseye,\n"
-    "                          topk, nn_accuracy (those the protocol computes)\n";
+    "                          topk, nn_accuracy, split, groups (those the protocol\n"
+    "                          computes) and per_class: each class's scores\n";
+
+static const char HELP_INDEX[] =
+    "usage: amscr index COLLECTION -o FILE [--add] [options]\n"
+    "\n"
+    "Prepares every shape of COLLECTION (a folder or a manifest.tsv) once and writes an\n"
+    "index: the prepared shapes with their file names, classes and groups, the shape\n"
+    "options, a signature per shape and each shape's K nearest neighbours (--rerank K,\n"
+    "default 5), so that search, matrix and eval take FILE wherever they take a\n"
+    "collection, and one search never recomputes the collection's matrix. The file is\n"
+    "versioned and checksummed, and written under a temporary name then renamed.\n"
+    "\n"
+    "  -o, --output FILE       the index file\n"
+    "  --candidates M          neighbours are sought among each shape's M nearest by\n"
+    "                          signature only, matched both ways: for collections too\n"
+    "                          large for every pair (default 0: every pair)\n"
+    "  --add                   append the shapes of COLLECTION to the index FILE: only the\n"
+    "                          new shapes are prepared, and only pairs with a new shape\n"
+    "                          matched; the shape options must be the index's\n"
+    "A command given an index uses the index's shape options; an option that differs from\n"
+    "them is an error (rebuild the index). search --candidates M (default 64) matches\n"
+    "the M shapes whose signatures are nearest the query's (0: every shape).\n";
 
 static const tool_command COMMANDS[] = {
-    {"contour", C_CONTOUR, 1, "IMG [-o FILE]", "trace the outer contour of a silhouette image", HELP_CONTOUR, 0,
+    {"contour", C_CONTOUR, 1, "IMG [-o FILE]", "trace a silhouette's outer contour, or every contour (--all)", HELP_CONTOUR, 0,
      cmd_contour},
     {"register", C_REGISTER, 2, "SRC TGT", "register SRC onto TGT: affine map, distance, scales", HELP_REGISTER,
      1, cmd_register},
@@ -94,6 +148,8 @@ static const tool_command COMMANDS[] = {
     {"matrix", C_MATRIX, 1, "COLLECTION -o FILE", "all-pairs distance matrix (.tsv or .npy)", HELP_MATRIX, 1,
      cmd_matrix},
     {"eval", C_EVAL, 1, "COLLECTION", "retrieval scores: bull's eye, top-k table, 1-NN", HELP_EVAL, 1, cmd_eval},
+    {"index", C_INDEX, 1, "COLLECTION -o FILE", "prepare a collection once: an index file for search/matrix/eval",
+     HELP_INDEX, 1, cmd_index},
 };
 enum { NUM_COMMANDS = sizeof COMMANDS / sizeof COMMANDS[0] };
 
@@ -137,7 +193,7 @@ void print_main_help(void)
            "\n"
            "Shapes are PNG or PGM silhouettes (detected by their magic bytes) or text point\n"
            "lists (one \"x y\" or \"x,y\" per line, '#' comments). A COLLECTION is a folder of\n"
-           "shapes or a manifest.tsv with 'file' and 'class' columns.\n"
+           "shapes, a manifest.tsv with 'file' and 'class' columns, or an index (amscr index).\n"
            "Exit status: 0 success, 1 bad input or failure, 2 usage error.\n",
            "amscr --version", "amscr COMMAND --help");
 }

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "raster.h"
 #include "util.h"
 
 #if defined(AMSCR_TOOL_HAVE_PNG)
@@ -88,16 +89,10 @@ static void to_canvas(const layout *L, double x, double y, double *cx, double *c
     *cy = (y - L->miny) * L->scale + L->oy;
 }
 
-/* ============================================================ raster */
-typedef struct raster {
-    int w, h;
-    float *rgb; /* 3 floats per pixel, 0..255 */
-    float *cov; /* coverage of the current layer */
-} raster;
+/* ============================================================ raster (raster.h) */
+void cov_clear(raster *r) { memset(r->cov, 0, sizeof(float) * (size_t)r->w * (size_t)r->h); }
 
-static void cov_clear(raster *r) { memset(r->cov, 0, sizeof(float) * (size_t)r->w * (size_t)r->h); }
-
-static void cov_composite(raster *r, const unsigned char col[3])
+void cov_composite(raster *r, const unsigned char col[3])
 {
     size_t n = (size_t)r->w * (size_t)r->h;
     for (size_t i = 0; i < n; i++) {
@@ -120,7 +115,7 @@ static int clamp_px(double v, int n)
 }
 
 /* Thick anti-aliased polyline into the coverage buffer; dash = {on, off} in pixels or NULL. */
-static void cov_polyline(raster *r, const double *cxy, size_t n, int closed, double width, const double *dash)
+void cov_polyline(raster *r, const double *cxy, size_t n, int closed, double width, const double *dash)
 {
     if (n < 2)
         return;
@@ -164,7 +159,7 @@ static void cov_polyline(raster *r, const double *cxy, size_t n, int closed, dou
 }
 
 /* Even-odd polygon fill (4x vertical supersampling for soft edges). */
-static void cov_fill(raster *r, const double *cxy, size_t n)
+void cov_fill(raster *r, const double *cxy, size_t n)
 {
     if (n < 3)
         return;
@@ -273,7 +268,7 @@ static const char *glyph_rows(char c)
 }
 
 /* Draws text with its top-left at (x, y), pixel size `px` per font dot. */
-static void raster_text(raster *r, int x, int y, const char *text, int px, const unsigned char col[3])
+void raster_text(raster *r, int x, int y, const char *text, int px, const unsigned char col[3])
 {
     for (const char *t = text; *t; t++, x += 6 * px) {
         const char *rows = glyph_rows(*t);
@@ -437,7 +432,7 @@ static int write_png_lib(FILE *fp, const unsigned char *rgb, int w, int h)
 }
 #endif
 
-static int write_png_file(const char *path, const unsigned char *rgb, int w, int h)
+int write_png_file(const char *path, const unsigned char *rgb, int w, int h)
 {
     tool_out o;
     if (tool_out_open(&o, path) != 0)
@@ -533,7 +528,7 @@ done:
     return ret;
 }
 
-static void svg_escape(sbuf *b, const char *s)
+void svg_escape(sbuf *b, const char *s)
 {
     for (; s && *s; s++) {
         switch (*s) {
@@ -562,7 +557,7 @@ static void svg_poly(sbuf *b, const layout *L, const double *xy, size_t n, int c
     sb_puts(b, "\"/>\n");
 }
 
-static int write_text_file(const char *path, const sbuf *b)
+int write_text_file(const char *path, const sbuf *b)
 {
     if (b->oom) {
         tool_error(path, "out of memory");

@@ -7,7 +7,8 @@ Writes small 8-bit grayscale PNGs (shape white on black, written with zlib + str
 PGM, text point lists of the exact polygons, an affine-distorted pair with a known map, a
 tiny labelled collection, and examples/README.md stating the pair's true map. When the
 amscr tool is built (build/tools/amscr, or $AMSCR_TOOL), it also registers the pair and
-writes the pictures pair-overlay.png and pair-plot.svg.
+writes the pictures pair-overlay.png and pair-plot.svg, the contact sheet of a search of the
+collection (search-sheet.png) and the plot of its evaluation (eval-plot.svg).
 
 Coordinates are pixel coordinates: x = column, y = row (y down), pixel centres at
 integers, as amscr_contour_from_mask reports them. A pixel is inside a shape when its
@@ -229,6 +230,8 @@ coordinates: x = column, y = row (pointing down), pixel centres at integers.
 | `pair-source.txt`, `pair-target.txt` | the exact polygons of the pair, as text point lists |
 | `collection/` | 4 classes (fish, bird, leaf, star) x 3 random affine copies, for `search` and `eval` |
 | `pair-overlay.png`, `pair-plot.svg` | `amscr register` pictures of the pair (written when the tool is built) |
+| `search-sheet.png` | `amscr search fish.png collection --top 7 --sheet search-sheet.png` (written when the tool is built) |
+| `eval-plot.svg` | `amscr eval collection --plot eval-plot.svg` (written when the tool is built) |
 
 ## The affine pair
 
@@ -245,12 +248,20 @@ B = [{bx}, {by}]. `amscr register pair-source.png pair-target.png` should report
 
 ![scale selection](pair-plot.svg)
 
+## A search and an evaluation of the collection
+
+Every hit is drawn in red registered onto the query (grey), with its rank, class and distance:
+
+![contact sheet](search-sheet.png)
+
+![per-class scores and precision-recall](eval-plot.svg)
+
 Try:
 
     amscr register examples/pair-source.png examples/pair-target.png --overlay overlay.png --plot plot.svg
     amscr register examples/pair-source.txt examples/pair-target.txt --json
-    amscr search examples/fish.png examples/collection --top 5
-    amscr eval examples/collection
+    amscr search examples/fish.png examples/collection --top 5 --sheet sheet.png
+    amscr eval examples/collection --plot plot.svg
 """.format(a11=a11, a12=a12, a21=a21, a22=a22, bx=bx, by=by, det=a11 * a22 - a12 * a21,
            sbx=("- %g" % -bx) if bx < 0 else ("+ %g" % bx), sby=("- %g" % -by) if by < 0 else ("+ %g" % by))
     write(os.path.join(out, "README.md"), readme.encode())
@@ -265,6 +276,15 @@ Try:
             print("wrote pair-overlay.png and pair-plot.svg with %s" % tool)
         else:
             print("amscr register failed, pictures not written: %s" % r.stderr.strip(), file=sys.stderr)
+        coll = os.path.join(out, "collection")
+        for cmd, what in (([tool, "search", os.path.join(out, "fish.png"), coll, "--top", "7", "--sheet",
+                            os.path.join(out, "search-sheet.png")], "search-sheet.png"),
+                          ([tool, "eval", coll, "--plot", os.path.join(out, "eval-plot.svg")], "eval-plot.svg")):
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            if r.returncode == 0:
+                print("wrote %s with %s" % (what, tool))
+            else:
+                print("%s failed: %s" % (" ".join(cmd[:2]), r.stderr.strip()), file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -29,6 +29,8 @@ static const tool_name PROTOCOLS[] = {
     {"bullseye", PROTO_BULLSEYE},
     {"topk", PROTO_TOPK},
     {"nn", PROTO_NN},
+    {"split", PROTO_SPLIT},
+    {"groups", PROTO_GROUPS},
 };
 
 const name_table METHOD_NAMES = TABLE(METHODS);

@@ -17,7 +17,7 @@ typedef struct name_table {
 } name_table;
 
 /* Evaluation protocols of `amscr eval`. */
-enum { PROTO_ALL, PROTO_BULLSEYE, PROTO_TOPK, PROTO_NN };
+enum { PROTO_ALL, PROTO_BULLSEYE, PROTO_TOPK, PROTO_NN, PROTO_SPLIT, PROTO_GROUPS };
 
 extern const name_table METHOD_NAMES;     /* amscr_method */
 extern const name_table PARAM_NAMES;      /* amscr_parametrization */

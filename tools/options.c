@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,10 +18,19 @@ typedef enum opt_id {
     O_JSON,
     O_OVERLAY,
     O_PLOT,
+    O_SHEET,
+    O_ALL,
+    O_MIN_AREA,
+    O_COMPONENT,
+    O_ADD,
+    O_CANDIDATES,
     O_NAMES,
     O_TOP,
     O_PROTOCOL,
     O_RANKS,
+    O_TRAIN,
+    O_SPLITS,
+    O_SEED,
     O_METHOD,
     O_POINTS,
     O_SCALES,
@@ -47,17 +57,26 @@ typedef struct optdef {
 } optdef;
 
 static const optdef OPTS[] = {
-    {"-o", O_OUTPUT, 1, C_CONTOUR | C_MATRIX, "FILE"},
-    {"--output", O_OUTPUT, 1, C_CONTOUR | C_MATRIX, "FILE"},
+    {"-o", O_OUTPUT, 1, C_CONTOUR | C_MATRIX | C_INDEX, "FILE"},
+    {"--output", O_OUTPUT, 1, C_CONTOUR | C_MATRIX | C_INDEX, "FILE"},
+    {"--add", O_ADD, 0, C_INDEX, NULL},
+    {"--candidates", O_CANDIDATES, 1, C_SEARCH | C_INDEX, "M"},
     {"--threshold", O_THRESHOLD, 1, C_ALL, "N|auto"},
-    {"--json", O_JSON, 0, C_REGISTER | C_SEARCH | C_EVAL, NULL},
+    {"--json", O_JSON, 0, C_CONTOUR | C_REGISTER | C_SEARCH | C_EVAL, NULL},
     {"--overlay", O_OVERLAY, 1, C_REGISTER, "FILE"},
-    {"--plot", O_PLOT, 1, C_REGISTER, "FILE"},
+    {"--plot", O_PLOT, 1, C_REGISTER | C_EVAL, "FILE"},
+    {"--sheet", O_SHEET, 1, C_SEARCH, "FILE"},
+    {"--all", O_ALL, 0, C_CONTOUR, NULL},
+    {"--min-area", O_MIN_AREA, 1, C_CONTOUR | C_REGISTER | C_SEARCH, "A"},
+    {"--component", O_COMPONENT, 1, C_REGISTER | C_SEARCH, "N"},
     {"--names", O_NAMES, 1, C_MATRIX, "FILE"},
     {"--top", O_TOP, 1, C_SEARCH, "K"},
     {"--protocol", O_PROTOCOL, 1, C_EVAL, "NAME"},
     {"--ranks", O_RANKS, 1, C_EVAL, "K"},
     {"--topk-ranks", O_RANKS, 1, C_EVAL, "K"},
+    {"--train", O_TRAIN, 1, C_EVAL, "K"},
+    {"--splits", O_SPLITS, 1, C_EVAL, "R"},
+    {"--seed", O_SEED, 1, C_EVAL, "S"},
     {"--method", O_METHOD, 1, C_SHAPES, "NAME"},
     {"--points", O_POINTS, 1, C_SHAPES, "N"},
     {"--scales", O_SCALES, 1, C_SHAPES, "S1,S2,..."},
@@ -97,6 +116,11 @@ void opts_init(opts *o, const tool_command *c)
     o->protocol_id = PROTO_ALL;
     o->rerank_k = TOOL_RERANK_K;
     o->rerank_iters = TOOL_RERANK_ITERS;
+    o->splits = TOOL_SPLITS_DEFAULT;
+    o->seed = TOOL_SEED_DEFAULT;
+    o->min_area = TOOL_MIN_AREA_DEFAULT;
+    o->component = -1;
+    o->candidates = TOOL_CANDIDATES_DEFAULT;
 }
 
 static int parse_size(const char *opt, const char *s, size_t lo, size_t hi, size_t *out)
@@ -191,15 +215,16 @@ static int parse_name(const char *opt, const char *v, const name_table *t, int *
 
 static int set_picture(opts *o, opt_id id, const char *v)
 {
-    if (id == O_OVERLAY) {
+    if (id == O_OVERLAY || id == O_SHEET) {
+        const char *opt = id == O_OVERLAY ? "--overlay" : "--sheet";
         if (!draw_overlay_ext_ok(v))
-            return usage_error("--overlay", "'%s': the picture must be a .png or .svg file", v);
-        o->overlay = v;
+            return usage_error(opt, "'%s': the picture must be a .png or .svg file", v);
+        *(id == O_OVERLAY ? &o->overlay : &o->sheet) = v;
         return 0;
     }
     char ext[16];
     path_ext(v, ext);
-    if (strcmp(ext, ".svg") != 0)
+    if (strcmp(ext, ".svg") != 0) /* register's and eval's plots */
         return usage_error("--plot", "'%s': the plot is an .svg file", v);
     o->plot = v;
     return 0;
@@ -215,6 +240,7 @@ static int set_option(opts *o, const optdef *d, const char *v)
     case O_THRESHOLD: return parse_threshold(n, v, &o->threshold);
     case O_JSON: o->json = 1; return 0;
     case O_OVERLAY:
+    case O_SHEET:
     case O_PLOT: return set_picture(o, d->id, v);
     case O_NAMES: o->names = v; return 0;
     case O_TOP: return parse_size(n, v, 1, TOOL_TOP_MAX, &o->top) != 0 ? TOOL_EXIT_USAGE : 0;
@@ -222,6 +248,36 @@ static int set_option(opts *o, const optdef *d, const char *v)
         o->protocol = v;
         return parse_name(n, v, &PROTOCOL_NAMES, NULL, &o->protocol_id);
     case O_RANKS: return parse_size(n, v, 1, TOOL_RANKS_MAX, &o->ranks) != 0 ? TOOL_EXIT_USAGE : 0;
+    case O_TRAIN: return parse_size(n, v, 1, TOOL_TOP_MAX, &o->train) != 0 ? TOOL_EXIT_USAGE : 0;
+    case O_SPLITS: return parse_size(n, v, 1, TOOL_SPLITS_MAX, &o->splits) != 0 ? TOOL_EXIT_USAGE : 0;
+    case O_SEED: {
+        size_t sd;
+        if (parse_size(n, v, 0, SIZE_MAX, &sd) != 0)
+            return TOOL_EXIT_USAGE;
+        o->seed = sd;
+        return 0;
+    }
+    case O_ALL: o->all = 1; return 0;
+    case O_ADD: o->add = 1; return 0;
+    case O_CANDIDATES:
+        o->candidates_set = 1;
+        return parse_size(n, v, 0, TOOL_TOP_MAX, &o->candidates) != 0 ? TOOL_EXIT_USAGE : 0;
+    case O_MIN_AREA: {
+        char *end;
+        errno = 0;
+        double a = strtod(v, &end);
+        if (end == v || *end != '\0' || errno != 0 || !(a >= 0.0) || !isfinite(a))
+            return usage_error(n, "expected an area >= 0 in pixels^2, got '%s'", v);
+        o->min_area = a;
+        return 0;
+    }
+    case O_COMPONENT: {
+        size_t k;
+        if (parse_size(n, v, 0, 100000000, &k) != 0)
+            return TOOL_EXIT_USAGE;
+        o->component = (long)k;
+        return 0;
+    }
     case O_METHOD:
         r = parse_name(n, v, &METHOD_NAMES, &o->method_set, &e);
         o->method = (amscr_method)e;

@@ -56,9 +56,11 @@ int compute_matrix(const amscr_db *db, const char *what, const opts *o, double *
     tool_progress pr;
     progress_init(&pr, "matching");
     amscr_status st = amscr_db_distance_matrix(db, progress_cb, &pr, d);
-    progress_end(&pr);
-    if (st == AMSCR_OK && o->rerank_k > 0 && n > 0)
+    if (st == AMSCR_OK && o->rerank_k > 0 && n > 0) {
+        progress_note(&pr, "re-ranking");
         st = amscr_rerank_diffusion(d, n, o->rerank_k < n ? o->rerank_k : n, o->rerank_iters, d);
+    }
+    progress_end(&pr);
     if (st != AMSCR_OK) {
         tool_lib_error(what, st);
         free(d);

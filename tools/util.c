@@ -357,8 +357,23 @@ void progress_init(tool_progress *p, const char *label)
 {
     p->enabled = isatty(2);
     p->label = label;
+    p->start = now_seconds();
     p->last = 0.0;
     p->shown = 0;
+}
+
+/* "12s", "3m05s" or "1h02m" into out. */
+static void format_duration(char out[32], double s)
+{
+    if (!(s >= 0.0) || s > 359999.0)
+        s = 359999.0;
+    unsigned long t = (unsigned long)(s + 0.5);
+    if (t < 60)
+        snprintf(out, 32, "%lus", t);
+    else if (t < 3600)
+        snprintf(out, 32, "%lum%02lus", t / 60, t % 60);
+    else
+        snprintf(out, 32, "%luh%02lum", t / 3600, t / 60 % 60);
 }
 
 void progress_update(tool_progress *p, size_t done, size_t total)
@@ -370,15 +385,30 @@ void progress_update(tool_progress *p, size_t done, size_t total)
         return;
     p->last = t;
     p->shown = 1;
-    double frac = (double)done / (double)total;
+    double frac = (double)done / (double)total, el = t - p->start;
     int width = 30, fill = (int)(frac * width + 0.5);
-    char bar[32];
+    char bar[32], left[32];
     for (int i = 0; i < width; i++)
         bar[i] = i < fill ? '#' : '.';
     bar[width] = '\0';
-    fprintf(stderr, "\ramscr: %s [%s] %3d%% (%zu/%zu)", p->label, bar, (int)(100.0 * frac + 0.5), done,
-            total);
+    double rate = el > 0.0 ? (double)done / el : 0.0;
+    if (done > 0 && rate > 0.0)
+        format_duration(left, (double)(total - done) / rate);
+    else
+        snprintf(left, sizeof left, "?");
+    fprintf(stderr, "\r\033[Kamscr: %s [%s] %3d%% %zu/%zu  %.0f/s  %s left", p->label, bar,
+            (int)(100.0 * frac + 0.5), done, total, rate, left);
     fflush(stderr);
+}
+
+void progress_note(tool_progress *p, const char *label)
+{
+    p->label = label;
+    if (!p->enabled)
+        return;
+    fprintf(stderr, "\r\033[Kamscr: %s ...", label);
+    fflush(stderr);
+    p->shown = 1;
 }
 
 void progress_end(tool_progress *p)

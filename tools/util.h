@@ -83,16 +83,19 @@ char *path_join(const char *dir, const char *rel);
 /* Seconds from a monotonic clock. */
 double now_seconds(void);
 
-/* Progress line on stderr when it is a terminal (isatty(2)), quiet otherwise. */
+/* Progress line on stderr when it is a terminal (isatty(2)), quiet otherwise: a bar, the
+ * count, the rate (items per second since progress_init) and the time left at that rate. */
 typedef struct tool_progress {
     int enabled;
     const char *label;
-    double last;
+    double start, last;
     int shown;
 } tool_progress;
 void progress_init(tool_progress *p, const char *label);
 void progress_update(tool_progress *p, size_t done, size_t total);
 void progress_end(tool_progress *p);
+/* A step without a count ("re-ranking ..."), shown until the next update or progress_end. */
+void progress_note(tool_progress *p, const char *label);
 /* amscr_progress_fn adaptor: user = tool_progress*. Never cancels. */
 int progress_cb(void *user, size_t done, size_t total);
 

@@ -22,7 +22,7 @@ if pkg-config --exists libpng; then
 fi
 mkdir -p "$OUT/obj"
 
-HEADERS="include/amscr.h src/internal.h src/fft.h tools/image.h tools/util.h tests/fuzz/fuzz_common.h tests/fuzz/fuzz_image.h"
+HEADERS="include/amscr.h src/internal.h src/fft.h tools/image.h tools/util.h tools/collection.h tools/index_file.h tests/fuzz/fuzz_common.h tests/fuzz/fuzz_image.h"
 newest_header=$(ls -t $HEADERS | head -1)
 
 # compile SRC OBJ EXTRA_FLAGS...: only when the object is missing or older than SRC or a header.
@@ -48,7 +48,7 @@ for src in src/*.c; do
   lib_objs+=("$obj")
 done
 tool_objs=()
-for src in tools/image.c tools/util.c; do
+for src in tools/image.c tools/util.c tools/collection.c tools/index_file.c; do
   obj="$OUT/obj/tool_$(basename "${src%.c}").o"
   throttle
   # shellcheck disable=SC2086
@@ -60,11 +60,11 @@ fail=0
 for p in "${pids[@]}"; do wait "$p" || fail=1; done
 [ $fail = 0 ] || { echo "fuzz/build.sh: compilation failed" >&2; exit 1; }
 
-targets=(text pgm png mask register dbload)
+targets=(text pgm png mask register dbload contours index)
 for t in "${targets[@]}"; do
   src=tests/fuzz/fuzz_$t.c
   extra=()
-  case $t in pgm|png) extra=("${tool_objs[@]}") ;; esac
+  case $t in pgm|png|index) extra=("${tool_objs[@]}") ;; esac
   exe="$OUT/fuzz_$t"
   rebuild=0
   [ -f "$exe" ] || rebuild=1

@@ -92,6 +92,24 @@ line = blank(9, 5, 0)
 fill_rect(line, 1, 2, 7, 2, 255)
 put('mask', 'thin-line', mask_input(line, 0, 0))
 
+# ------------------------------------------------------------------ contours (every component)
+def contours_input(img, stride_extra=0, threshold=255, min_area=0):
+    m = mask_input(img, stride_extra, threshold)
+    return m[:4] + bytes([min_area]) + m[4:]
+
+
+put('contours', 'rect-auto', contours_input(shape_img()))
+put('contours', 'ring-with-core', contours_input(ring, 1, 100))
+put('contours', 'ring-min-area', contours_input(ring, 0, 100, 30))
+nest = blank(20, 16, 0)
+fill_rect(nest, 1, 1, 18, 14, 255)
+fill_rect(nest, 3, 3, 16, 12, 0)
+fill_rect(nest, 5, 5, 14, 10, 255)
+fill_rect(nest, 7, 7, 12, 8, 0)
+fill_rect(nest, 2, 2, 2, 2, 0)
+put('contours', 'nested-holes', contours_input(nest, 2, 127))
+put('contours', 'thin-line', contours_input(line, 0, 0))
+
 # ------------------------------------------------------------------ register
 def reg(b0, b1, a, b=None):
     s = text(a) + ('|' + text(b) if b is not None else '')

@@ -13,7 +13,7 @@ cd "$(dirname "$0")/../.."
 OUT=${AMSCR_FUZZ_BUILD:-build-fuzz}
 SECS=${1:-${AMSCR_FUZZ_SECONDS:-30}}
 [ $# -gt 0 ] && shift
-ALL=(text pgm png mask register dbload)
+ALL=(text pgm png mask register dbload contours index)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -gt 0 ] || TARGETS=("${ALL[@]}")
 JOBS=${AMSCR_FUZZ_JOBS:-$(nproc 2>/dev/null || echo 1)}

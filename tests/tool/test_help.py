@@ -81,8 +81,8 @@ def test_main_help_lists_every_command():
     r = run("--help")
     cmds = re.findall(r"^  (\w+) ", r.stdout.split("commands:")[1], re.M)
     cmds = [c for c in cmds if c != "amscr"]
-    assert cmds == ["contour", "register", "search", "matrix", "eval"]
+    assert cmds == ["contour", "register", "search", "matrix", "eval", "index"]
     missing = run()
-    assert missing.returncode == 2 and "contour, register, search, matrix or eval" in missing.stderr
+    assert missing.returncode == 2 and "contour, register, search, matrix, eval or index" in missing.stderr
     for c in cmds:
         assert run("help", c).stdout == run(c, "--help").stdout

@@ -1,0 +1,96 @@
+#!/usr/bin/env python3
+"""Query time against a large index: builds a synthetic collection of --shapes shapes (100
+classes of smooth closed curves, each shape a class prototype with its own small shape noise
+under a random similarity map, as text point lists), indexes it once with `amscr index`
+(cached in --work: rebuilt only when missing), then times `amscr search` of a few queries
+(wall clock of the whole command: reading the index, preparing the query, matching the
+candidates, re-ranking). Prints the times and whether the target (0.5 s) is met.
+
+    python3 bench/index_bench.py --tool build/tools/amscr [--shapes 10000] [--work build/bench-index]
+"""
+import argparse
+import math
+import os
+import random
+import statistics
+import subprocess
+import sys
+import time
+
+TARGET = 0.5  # seconds for one query against a 10,000-shape index (issue 15)
+
+
+def curve(coef, rng, noise, m=120):
+    """A closed curve r(t) = 1 + sum a_k cos(k t + p_k), perturbed, under a random similarity."""
+    c = [(a * (1 + noise * rng.gauss(0, 1)), p + noise * rng.gauss(0, 1)) for a, p in coef]
+    ang, s = rng.uniform(0, 2 * math.pi), rng.uniform(40, 120)
+    tx, ty = rng.uniform(-50, 50), rng.uniform(-50, 50)
+    pts = []
+    for i in range(m):
+        t = 2 * math.pi * i / m
+        r = 1 + sum(a * math.cos((k + 2) * t + p) for k, (a, p) in enumerate(c))
+        x, y = r * math.cos(t), r * math.sin(t)
+        pts.append((s * (x * math.cos(ang) - y * math.sin(ang)) + tx, s * (x * math.sin(ang) + y * math.cos(ang)) + ty))
+    return pts
+
+
+def make_collection(folder, n, classes=100):
+    rng = random.Random(15)
+    os.makedirs(os.path.join(folder, "shapes"), exist_ok=True)
+    protos = [[(rng.uniform(0.02, 0.18) / (k + 1) ** 0.5, rng.uniform(0, 2 * math.pi)) for k in range(6)]
+              for _ in range(classes)]
+    rows = ["file\tclass"]
+    for i in range(n):
+        c = i % classes
+        rel = "shapes/c%03d_%05d.txt" % (c, i)
+        with open(os.path.join(folder, rel), "w") as f:
+            f.write("".join("%.3f %.3f\n" % p for p in curve(protos[c], rng, 0.15)))
+        rows.append("%s\tc%03d" % (rel, c))
+    with open(os.path.join(folder, "manifest.tsv"), "w") as f:
+        f.write("\n".join(rows) + "\n")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--tool", required=True)
+    ap.add_argument("--shapes", type=int, default=10000)
+    ap.add_argument("--work", default=os.path.join("build", "bench-index"))
+    ap.add_argument("--build-candidates", default="8",
+                    help="index --candidates (neighbours sought among each shape's M nearest signatures)")
+    ap.add_argument("--queries", type=int, default=5)
+    args = ap.parse_args()
+    folder = os.path.join(args.work, "n%d" % args.shapes)
+    idx = os.path.join(folder, "shapes.idx")
+    if not os.path.exists(os.path.join(folder, "manifest.tsv")):
+        make_collection(folder, args.shapes)
+    if not os.path.exists(idx):
+        t = time.time()
+        r = subprocess.run([args.tool, "index", os.path.join(folder, "manifest.tsv"), "-o", idx, "--candidates",
+                            args.build_candidates], capture_output=True, text=True)
+        if r.returncode != 0:
+            sys.exit("amscr index failed: " + r.stderr.strip())
+        print("index: %d shapes built in %.1f s (once; cached in %s), %.0f MB" %
+              (args.shapes, time.time() - t, idx, os.path.getsize(idx) / 1e6))
+    rng = random.Random(7)
+    qdir = os.path.join(folder, "queries")
+    os.makedirs(qdir, exist_ok=True)
+    for variant, extra in (("re-ranked (default)", []), ("--no-rerank", ["--no-rerank"])):
+        times = []
+        for qi in range(args.queries):
+            q = os.path.join(qdir, "q%d.txt" % qi)
+            src = os.path.join(folder, "shapes", sorted(os.listdir(os.path.join(folder, "shapes")))[qi * 997 % args.shapes])
+            with open(src) as f, open(q, "w") as g:  # a new shape near a collection shape
+                g.write("".join("%.3f %.3f\n" % (float(a) + rng.uniform(-0.3, 0.3), float(b) + rng.uniform(-0.3, 0.3))
+                                for a, b in (line.split() for line in f)))
+            t = time.time()
+            r = subprocess.run([args.tool, "search", q, idx, "--top", "10"] + extra, capture_output=True, text=True)
+            times.append(time.time() - t)
+            if r.returncode != 0:
+                sys.exit("amscr search failed: " + r.stderr.strip())
+        print("query %-20s against %d shapes: median %.3f s, max %.3f s (%d queries, wall clock) -> %s" %
+              (variant, args.shapes, statistics.median(times), max(times), len(times),
+               "meets" if max(times) <= TARGET else "MISSES", ) + " the %.1f s target" % TARGET)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,85 @@
+"""`amscr search --sheet FILE.png|svg` and `amscr eval --plot FILE.svg`."""
+import re
+import struct
+
+import pytest
+
+from imgutil import run
+from test_collection import AFFINE
+from test_protocols import make_manifest
+
+
+def polygon_points(svg_fragment):
+    pts = re.search(r'points="([^"]*)"', svg_fragment).group(1).split()
+    return [tuple(float(v) for v in p.split(",")) for p in pts]
+
+
+def bbox(pts):
+    xs, ys = [p[0] for p in pts], [p[1] for p in pts]
+    return min(xs), min(ys), max(xs), max(ys)
+
+
+def test_sheet_svg_draws_each_hit_registered_onto_the_query(tmp_path):
+    m = make_manifest(tmp_path)
+    q = tmp_path / "shapes" / "star_2.txt"
+    out = tmp_path / "sheet.svg"
+    r = run("search", q, m, "--top", "3", "--sheet", out, *AFFINE)
+    assert r.returncode == 0, r.stderr
+    svg = out.read_text()
+    groups = re.findall(r'<g class="(query|hit)">(.*?)</g>', svg, re.S)
+    assert [g[0] for g in groups] == ["query", "hit", "hit", "hit"]
+    assert "star_2.txt" in groups[0][1] and ">1 star " in groups[1][1]
+    for _, body in groups[1:]:
+        polys = re.findall(r"<polygon[^>]*>", body)
+        assert len(polys) == 2  # the query, and the hit registered onto it
+        qb, hb = bbox(polygon_points(polys[0])), bbox(polygon_points(polys[1]))
+        # affine copies under the affine group: the registered hit covers the query
+        assert all(abs(a - b) < 4.0 for a, b in zip(qb, hb)), (qb, hb)
+
+
+@pytest.mark.png
+def test_sheet_png(tmp_path):
+    m = make_manifest(tmp_path)
+    out = tmp_path / "sheet.png"
+    r = run("search", tmp_path / "shapes" / "blob_1.txt", m, "--top", "5", "--sheet", out, *AFFINE)
+    assert r.returncode == 0, r.stderr
+    data = out.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    w, h = struct.unpack(">II", data[16:24])
+    assert w == 2 * 12 + 4 * 240 and h == 2 * 12 + 2 * 264  # 6 tiles: two rows of up to 4
+
+
+@pytest.mark.parametrize("args,msg", [
+    (("search", "{q}", "{m}", "--sheet", "{t}/s.jpg"), "--sheet"),
+    (("search", "{q}", "{m}", "--sheet", "{t}/missing/s.png"), "s.png"),
+    (("eval", "{m}", "--plot", "{t}/p.png"), "--plot"),
+])
+def test_picture_bad_input(tmp_path, args, msg):
+    m = make_manifest(tmp_path)
+    a = [x.format(q=tmp_path / "shapes" / "star_1.txt", m=m, t=tmp_path) for x in args]
+    r = run(*a, *AFFINE)
+    assert r.returncode in (1, 2) and msg in r.stderr and r.stdout == ""
+    assert not list(tmp_path.glob("s.*")) and not list(tmp_path.glob("p.*"))
+
+
+def test_eval_plot_bars_and_precision_recall(tmp_path):
+    m = make_manifest(tmp_path)
+    out = tmp_path / "plot.svg"
+    r = run("eval", m, "--plot", out, *AFFINE)
+    assert r.returncode == 0, r.stderr
+    svg = out.read_text()
+    bars = re.findall(r'<rect x="[^"]*" y="[^"]*" width="([^"]*)"[^>]*><title>(\w+) ([^<]*)</title>', svg)
+    assert len(bars) == 3 * 2  # 3 classes x (1-NN, bull's eye)
+    assert all(float(w) == pytest.approx(300.0) for w, _, _ in bars)  # every score is 1 here
+    pr = polygon_points(re.search(r'<polyline id="pr"[^>]*>', svg).group(0))
+    assert len(pr) == 21
+    ys = [p[1] for p in pr]
+    assert ys == sorted(ys)  # interpolated precision never rises with recall (y grows downwards)
+
+
+def test_eval_plot_split_protocol(tmp_path):
+    m = make_manifest(tmp_path)
+    out = tmp_path / "plot.svg"
+    r = run("eval", m, "--protocol", "split", "--train", "1", "--plot", out, *AFFINE)
+    assert r.returncode == 0, r.stderr
+    assert "random split" in out.read_text()

@@ -1,0 +1,24 @@
+/* index_query.h — one query against an index (see index_query.c). Tool-internal. */
+#ifndef AMSCR_TOOL_INDEX_QUERY_H
+#define AMSCR_TOOL_INDEX_QUERY_H
+
+#include <stddef.h>
+
+#include "amscr.h"
+#include "index_file.h"
+
+/* out[j] (n entries) = the query's distance to shape j: d(q -> j) without re-ranking
+ * (rerank_k 0), else its re-ranked row (amscr_rerank_diffusion on the collection plus the
+ * query, K = rerank_k, `iters` iterations). Only `ncand` candidates are matched (the shapes
+ * whose signatures are nearest; 0 or >= n: every shape); shapes neither matched nor reached
+ * by the diffusion get +inf. The index must hold at least min(rerank_k, n) neighbours a
+ * shape (the caller checks). Returns 0, or -1 after printing one error line. */
+int index_search(const tool_index *x, const amscr_params *p, const amscr_descriptor *dq, size_t ncand, size_t rerank_k,
+                 unsigned iters, double *out);
+
+/* The re-ranked row of the query from the neighbour lists and the symmetrized distances to
+ * the m candidates (ascending indices cand[], at least k - 1 of them). */
+int rerank_query_row(const tool_index *x, size_t k, unsigned iters, const size_t *cand, const double *dsym, size_t m,
+                     double *out);
+
+#endif
