@@ -30,7 +30,7 @@ int cmd_matrix(opts *o)
     if (r != 0)
         return r;
     if (collection_open(cpath, &c) != 0 || load_db(p, &c, o->threshold, &db) != 0 ||
-        compute_matrix(db, cpath, o, &d) != 0)
+        compute_matrix(db, cpath, &d) != 0)
         goto done;
     size_t n = c.n;
     tool_out out;
