@@ -62,6 +62,11 @@ static const char HELP_SEARCH[] =
     "\n"
     "Ranks the shapes of COLLECTION (a folder, a manifest.tsv or an index) by their distance\n"
     "from QUERY and prints the K closest (default 10). Reflections are on by default.\n"
+    "With re-ranking (the default) the distances are scores in [0, 1]: 0 for the\n"
+    "query itself (when it is in the collection), below 0.5 for the shapes its\n"
+    "nearest-neighbour context reaches (half of 1 - affinity / the row's largest),\n"
+    "0.5 and above for the others, in the order of the fused distance. They rank;\n"
+    "they are not a metric. --no-rerank prints the fused pairwise distances.\n"
     "\n"
     "  --top K                 how many results (default 10)\n"
     "  --json                  print one JSON object\n"
@@ -198,6 +203,27 @@ void print_main_help(void)
            "amscr --version", "amscr COMMAND --help");
 }
 
+/* The retrieval options of search/matrix/eval, their defaults read from ret. */
+static void print_retrieval_options(const amscr_params *ret)
+{
+    printf("retrieval options (search/matrix/eval):\n"
+           "  --channel-weight W      share of the shape channel (height functions matched by\n"
+           "                          dynamic programming; tolerates articulation) against the\n"
+           "                          AMSCR distance, 0..1 (default %g: the channel alone;\n"
+           "                          0 with --open)\n"
+           "  --affine-share S        share of the channel computed in the affine (whitened)\n"
+           "                          frame, the rest in the similarity frame (default %g)\n"
+           "  --fast                  --affine-share 0: the channel in one frame, half the time\n"
+           "  --rerank K[,ITER]       contextual re-ranking: diffusion on the K-nearest-neighbour\n"
+           "                          graph, ITER iterations (default %u,%u; ITER default %d)\n"
+           "  --no-rerank             the fused pairwise distances\n"
+           "  --paper                 the paper's method: the AMSCR distance alone, affine group,\n"
+           "                          no refinement, no re-ranking (= --channel-weight 0\n"
+           "                          --no-rerank --invariance affine --refine 0)\n",
+           amscr_params_get_channel_weight(ret), amscr_params_get_channel_affine_share(ret),
+           amscr_params_get_rerank_k(ret), amscr_params_get_rerank_iterations(ret), TOOL_RERANK_ITERS);
+}
+
 /* The image and shape options, their defaults read from reg (register's params) and ret
  * (search/matrix/eval's). */
 static void print_shape_options(const amscr_params *reg, const amscr_params *ret)
@@ -230,11 +256,7 @@ static void print_shape_options(const amscr_params *reg, const amscr_params *ret
            name_choices(&INVARIANCE_NAMES, none, invs, sizeof invs),
            name_of(&INVARIANCE_NAMES, (int)amscr_params_get_invariance(reg)),
            name_of(&INVARIANCE_NAMES, (int)amscr_params_get_invariance(ret)));
-    printf("  --rerank K[,ITER]       (search/matrix/eval) contextual re-ranking: diffusion on the\n"
-           "                          K-nearest-neighbour graph, ITER iterations (default %d,%d);\n"
-           "  --no-rerank             the plain pairwise distances\n"
-           "  --threads N             threads for batch work (0 = all cores, the default)\n",
-           TOOL_RERANK_K, TOOL_RERANK_ITERS);
+    printf("  --threads N             threads for batch work (0 = all cores, the default)\n");
 }
 
 int print_command_help(const tool_command *c)
@@ -249,6 +271,8 @@ int print_command_help(const tool_command *c)
     if (r == 0) {
         fputs("\n", stdout);
         print_shape_options(reg, ret);
+        if (c->bit & C_RETRIEVAL)
+            print_retrieval_options(ret);
     }
     amscr_params_free(reg);
     amscr_params_free(ret);
