@@ -11,6 +11,7 @@
 #include "../src/channel.h"
 #include "../tools/collection.h"
 #include "../tools/image.h"
+#include "mcd_set.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -45,57 +46,6 @@ static double now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* xorshift64* */
-static double urand(unsigned long long *s)
-{
-    *s ^= *s >> 12;
-    *s ^= *s << 25;
-    *s ^= *s >> 27;
-    return (double)((*s * 2685821657736338717ull) >> 11) / 9007199254740992.0;
-}
-
-static double nrand(unsigned long long *s)
-{
-    double u = urand(s), v = urand(s);
-    if (u < 1e-300)
-        u = 1e-300;
-    return sqrt(-2.0 * log(u)) * cos(6.283185307179586 * v);
-}
-
-/* A random affine copy: rotation any, axis scales x0.5..2 (log-uniform), shear +-0.5, noise
- * 0.5 % of the RMS radius per point. */
-static amscr_contour *affine_copy(const amscr_contour *c, unsigned long long *seed)
-{
-    size_t n = amscr_contour_size(c);
-    const double *xy = amscr_contour_xy(c);
-    double th = 6.283185307179586 * urand(seed);
-    double sx = exp(log(0.5) + log(4.0) * urand(seed)), sy = exp(log(0.5) + log(4.0) * urand(seed));
-    double sh = -0.5 + urand(seed);
-    double cs = cos(th), sn = sin(th);
-    /* A = R * diag(sx, sy) * [[1 sh] [0 1]] */
-    double a = cs * sx, b = cs * sx * sh - sn * sy, c2 = sn * sx, d = sn * sx * sh + cs * sy;
-    double *out = malloc(2 * n * sizeof *out);
-    double cx = 0, cy = 0, r = 0;
-    for (size_t i = 0; i < n; i++) {
-        out[2 * i] = a * xy[2 * i] + b * xy[2 * i + 1];
-        out[2 * i + 1] = c2 * xy[2 * i] + d * xy[2 * i + 1];
-        cx += out[2 * i];
-        cy += out[2 * i + 1];
-    }
-    cx /= (double)n;
-    cy /= (double)n;
-    for (size_t i = 0; i < n; i++)
-        r += (out[2 * i] - cx) * (out[2 * i] - cx) + (out[2 * i + 1] - cy) * (out[2 * i + 1] - cy);
-    r = sqrt(r / (double)n);
-    for (size_t i = 0; i < 2 * n; i++)
-        out[i] += 0.005 * r * nrand(seed);
-    amscr_contour *ct = NULL;
-    if (amscr_contour_new(out, n, &ct) != AMSCR_OK)
-        ct = NULL;
-    free(out);
-    return ct;
-}
-
 typedef struct {
     amscr_contour **c;
     int32_t *labels;
@@ -111,40 +61,14 @@ static int load_set(const char *spec, set_t *s, double *t_load)
         return -1;
     int mcd = strncmp(spec, "mcd", 3) == 0;
     s->kind = strncmp(spec, "topk", 4) == 0;
-    collection col;
-    if (collection_open(colon + 1, &col) != 0)
-        return -1;
     double t0 = now();
-    if (mcd) {
-        s->c = calloc(col.nclasses * 14, sizeof *s->c);
-        s->labels = calloc(col.nclasses * 14, sizeof *s->labels);
-        s->n = 0;
-        unsigned long long seed = 0x9E3779B97F4A7C15ull;
-        for (size_t k = 0; k < col.nclasses; k++) {
-            size_t first = 0;
-            while (col.items[first].label != (int32_t)k)
-                first++;
-            amscr_contour *ct = NULL;
-            if (shape_load(col.items[first].path, 127, &ct) != 0)
-                return -1;
-            for (int r = 0; r < 14; r++) {
-                s->c[s->n] = affine_copy(ct, &seed);
-                s->labels[s->n++] = (int32_t)k;
-            }
-            amscr_contour_free(ct);
-        }
-    } else {
-        s->c = calloc(col.n, sizeof *s->c);
-        s->labels = calloc(col.n, sizeof *s->labels);
-        s->n = col.n;
-        for (size_t i = 0; i < col.n; i++) {
-            if (shape_load(col.items[i].path, 127, &s->c[i]) != 0)
-                return -1;
-            s->labels[i] = col.items[i].label;
-        }
-    }
+    shape_set ss;
+    if ((mcd ? shape_set_mcd(colon + 1, MCD_SEED, &ss) : shape_set_load(colon + 1, &ss)) != 0)
+        return -1;
+    s->c = ss.c; /* the set's arrays move into s */
+    s->labels = ss.labels;
+    s->n = ss.n;
     *t_load = now() - t0;
-    collection_free(&col);
     return 0;
 }
 

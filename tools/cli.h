@@ -32,13 +32,11 @@ enum {
     TOOL_THRESHOLD_MAX = 254,     /* > 254 leaves no pixel on */
     TOOL_TOP_DEFAULT = 10,        /* search results */
     TOOL_RANKS_DEFAULT = 10,      /* ranks of the top-k table (Kimia-99's table has 10) */
-    /* retrieval defaults, chosen by the Kimia measurements in the README: contextual re-ranking
-     * with K = 5 neighbours and 20 iterations; --no-rerank for the plain pairwise distance */
-    TOOL_RERANK_K = 5,
-    TOOL_RERANK_ITERS = 20,
+    /* --rerank K without ITER: the iterations of the library's retrieval preset (10) */
+    TOOL_RERANK_ITERS = 10,
     TOOL_TOP_MAX = 1000000000,    /* --top: a bound that keeps k * sizeof(size_t) small */
     TOOL_RANKS_MAX = 1000000,     /* --ranks: likewise for the top-k table */
-    TOOL_RERANK_K_MAX = 100000,   /* --rerank K: neighbours; clamped to the collection at use */
+    TOOL_RERANK_K_MAX = 1000,     /* --rerank K: the library's range; clamped to the collection at use */
     TOOL_RERANK_ITERS_MAX = 1000, /* --rerank ITER: diffusion converges long before */
     TOOL_POINTS_MIN = 16,         /* the library's range of samples: 16..AMSCR_MAX_SAMPLES */
     TOOL_REFINE_MAX = 50,         /* the library's range of refinement iterations */
@@ -104,8 +102,14 @@ typedef struct opts {
     amscr_parametrization param;
     int inv_set;
     amscr_invariance inv;
+    /* retrieval (search/matrix/eval; set only when given, else the library's retrieval preset) */
+    int rerank_set;
     size_t rerank_k; /* 0: no contextual re-ranking */
     unsigned rerank_iters;
+    int channel_weight_set;
+    double channel_weight;
+    int affine_share_set;
+    double affine_share;
 } opts;
 
 typedef struct tool_command {

@@ -267,7 +267,7 @@ int cmd_eval(opts *o)
         goto done;
     }
     s.t1 = now_seconds();
-    if (compute_matrix(db, cpath, o, &d) != 0)
+    if (compute_matrix(db, cpath, &d) != 0)
         goto done;
     s.t2 = now_seconds();
     s.ranks = o->ranks ? o->ranks : TOOL_RANKS_DEFAULT;

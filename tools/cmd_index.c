@@ -8,6 +8,7 @@
 #include "cli.h"
 #include "collection.h"
 #include "index_build.h"
+#include "index_dist.h"
 #include "index_file.h"
 #include "params.h"
 #include "retrieval.h"
@@ -88,7 +89,8 @@ static int knn_from_matrix(tool_index *x, const double *d, size_t n)
     return ok ? 0 : -1;
 }
 
-/* A new index of collection c (moved into x). */
+/* A new index of collection c (moved into x): the neighbour lists of the base distance of
+ * the retrieval matrix (index_dist.h), K = the params' rerank_k. */
 static int build(const opts *o, collection *c, tool_index *x)
 {
     amscr_params *p = NULL;
@@ -98,24 +100,25 @@ static int build(const opts *o, collection *c, tool_index *x)
     x->coll = *c;
     memset(c, 0, sizeof *c);
     x->threshold = o->threshold;
-    x->rerank_iters = o->rerank_iters;
-    x->k = o->rerank_k < x->coll.n ? o->rerank_k : x->coll.n;
+    size_t n = x->coll.n, kp = amscr_params_get_rerank_k(p), m = o->candidates_set ? o->candidates : 0;
+    x->k = kp < n ? kp : n;
     int ret = TOOL_EXIT_FAIL;
     double *d = NULL;
-    opts plain = *o;
-    plain.rerank_k = 0;
-    size_t n = x->coll.n, m = o->candidates_set ? o->candidates : 0; /* default: every pair */
+    base_dist b = {p, amscr_params_get_channel_weight(p), 0.0, 0.0};
     if (load_db(p, &x->coll, o->threshold, &x->db) == 0 && index_signatures_from(x, 0) == 0) {
-        if (m > 0 && m < n - 1) /* a large collection: each shape's candidates only */
-            ret = knn_from_candidates(x, p, m) == 0 ? 0 : TOOL_EXIT_FAIL;
-        else if (compute_matrix(x->db, o->pos[0], &plain, &d) == 0 && knn_from_matrix(x, d, n) == 0)
+        if (m > 0 && m < n - 1) { /* a large collection: each shape's candidates only */
+            if (base_medians_sampled(x->db, &b, INDEX_MEDIAN_SAMPLE) == 0 && knn_from_candidates(x, &b, m) == 0)
+                ret = 0;
+        } else if (base_matrix(x->db, &b, o->pos[0], &d) == 0 && knn_from_matrix(x, d, n) == 0) {
             ret = 0;
+        }
+        x->med_a = b.med_a;
+        x->med_h = b.med_h;
     }
     free(d);
     amscr_params_free(p);
     return ret;
 }
-
 
 int cmd_index(opts *o)
 {

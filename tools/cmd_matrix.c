@@ -31,7 +31,7 @@ int cmd_matrix(opts *o)
         ret = r;
         goto done;
     }
-    if (compute_matrix(db, cpath, o, &d) != 0)
+    if (compute_matrix(db, cpath, &d) != 0)
         goto done;
     size_t n = c.n;
     tool_out out;

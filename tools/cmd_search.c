@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "amscr.h"
 #include "cli.h"
@@ -16,34 +17,72 @@
 #include "retrieval.h"
 #include "sheet.h"
 
-/* The distances from the query dq to every shape of db (n of them) into dist: plain, or read
- * from the re-ranked matrix of the collection plus the query (dq is added to db). */
-static int query_distances(amscr_db *db, const amscr_descriptor *dq, const char *qpath, const char *cpath,
-                           const opts *o, double *dist)
+/* The channel distances from dq to every shape of db (n of them) into dist: the retrieval
+ * matrix's entries when the channel is used alone without re-ranking. */
+static int channel_distances(const amscr_db *db, const amscr_descriptor *dq, const char *qpath, double *dist)
 {
     size_t n = amscr_db_size(db);
-    if (o->rerank_k > 0) {
-        /* contextual re-ranking needs the whole matrix of the collection and the query */
-        double *full = NULL;
-        if (amscr_db_add_descriptor(db, dq, -1, NULL) != AMSCR_OK) {
-            tool_lib_error(qpath, AMSCR_E_NOMEM);
-            return -1;
-        }
-        if (compute_matrix(db, cpath, o, &full) != 0)
-            return -1;
-        for (size_t j = 0; j < n; j++)
-            dist[j] = full[n * (n + 1) + j]; /* the query's row (last), collection columns */
-        free(full);
-        return 0;
-    }
     tool_progress pr;
     progress_init(&pr, "matching");
-    amscr_status st = amscr_db_query(db, dq, progress_cb, &pr, dist);
+    for (size_t j = 0; j < n; j++) {
+        amscr_status st = amscr_channel_distance(NULL, amscr_db_descriptor(db, j), dq, &dist[j]);
+        if (st != AMSCR_OK) {
+            progress_end(&pr);
+            tool_lib_error(qpath, st);
+            return -1;
+        }
+        progress_update(&pr, j + 1, n);
+    }
     progress_end(&pr);
-    if (st != AMSCR_OK) {
-        tool_lib_error(qpath, st);
+    return 0;
+}
+
+/* The index of the collection's item that is the query's file (same device and inode), or
+ * SIZE_MAX: a member query is ranked by its own row, so its score against itself is 0. */
+static size_t member_index(const collection *c, const char *qpath)
+{
+    struct stat q, m;
+    if (stat(qpath, &q) != 0)
+        return SIZE_MAX;
+    for (size_t i = 0; i < c->n; i++)
+        if (stat(c->items[i].path, &m) == 0 && m.st_dev == q.st_dev && m.st_ino == q.st_ino)
+            return i;
+    return SIZE_MAX;
+}
+
+/* The distances from the query dq to every shape of db (n of them) into dist: the plain AMSCR
+ * distance (query -> shape), the channel alone, or read from the retrieval matrix (fusion and
+ * re-ranking need the whole matrix): row `member` of the collection's when the query is one of
+ * its shapes, else the last row of the collection's plus the query (dq is added to db). */
+static int query_distances(amscr_db *db, const amscr_descriptor *dq, size_t member, const char *qpath,
+                           const char *cpath, double *dist)
+{
+    size_t n = amscr_db_size(db);
+    const amscr_params *p = amscr_db_params(db);
+    if (retrieval_is_plain(p)) {
+        tool_progress pr;
+        progress_init(&pr, "matching");
+        amscr_status st = amscr_db_query(db, dq, progress_cb, &pr, dist);
+        progress_end(&pr);
+        if (st != AMSCR_OK) {
+            tool_lib_error(qpath, st);
+            return -1;
+        }
+        return 0;
+    }
+    if (amscr_params_get_channel_weight(p) >= 1.0 && amscr_params_get_rerank_k(p) == 0)
+        return channel_distances(db, dq, qpath, dist);
+    double *full = NULL;
+    if (member == SIZE_MAX && amscr_db_add_descriptor(db, dq, -1, NULL) != AMSCR_OK) {
+        tool_lib_error(qpath, AMSCR_E_NOMEM);
         return -1;
     }
+    if (compute_matrix(db, cpath, &full) != 0)
+        return -1;
+    size_t cols = amscr_db_size(db), row = member == SIZE_MAX ? n : member;
+    for (size_t j = 0; j < n; j++)
+        dist[j] = full[row * cols + j]; /* collection columns */
+    free(full);
     return 0;
 }
 
@@ -176,11 +215,11 @@ static int open_target(const opts *o, tool_index *x, int *is_index, amscr_params
     *db = x->db;
     if ((r = index_params(o, cpath, x, p)) != 0)
         return r;
-    size_t n = x->coll.n, need = o->rerank_k < n ? o->rerank_k : n;
+    size_t n = x->coll.n, want = amscr_params_get_rerank_k(*p), need = want < n ? want : n;
     if (x->k < need)
         return usage_error("--rerank", "the index '%s' holds %zu neighbours a shape (built with %s); use --rerank K "
                            "with K <= %zu, --no-rerank, or rebuild the index with --rerank %zu", cpath, x->k,
-                           x->k ? "a smaller --rerank" : "--no-rerank", x->k, o->rerank_k);
+                           x->k ? "a smaller --rerank" : "--no-rerank", x->k, want);
     return 0;
 }
 
@@ -216,9 +255,8 @@ int cmd_search(opts *o)
     idx = xmalloc_array(k ? k : 1, sizeof(size_t));
     if (dist == NULL || idx == NULL)
         goto done;
-    if (is_index ? index_search(&x, p, dq, o->candidates && o->candidates < k ? k : o->candidates, o->rerank_k, o->rerank_iters,
-                                dist) != 0
-                 : query_distances(db, dq, qpath, cpath, o, dist) != 0)
+    if (is_index ? index_search(&x, p, dq, o->candidates && o->candidates < k ? k : o->candidates, dist) != 0
+                 : query_distances(db, dq, member_index(c, qpath), qpath, cpath, dist) != 0)
         goto done;
     amscr_status st = amscr_topk(dist, n, k, SIZE_MAX, idx);
     if (st != AMSCR_OK) {

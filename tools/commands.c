@@ -62,6 +62,11 @@ static const char HELP_SEARCH[] =
     "\n"
     "Ranks the shapes of COLLECTION (a folder, a manifest.tsv or an index) by their distance\n"
     "from QUERY and prints the K closest (default 10). Reflections are on by default.\n"
+    "With re-ranking (the default) the distances are scores in [0, 1]: 0 for the\n"
+    "query itself (when it is in the collection), below 0.5 for the shapes its\n"
+    "nearest-neighbour context reaches (half of 1 - affinity / the row's largest),\n"
+    "0.5 and above for the others, in the order of the fused distance. They rank;\n"
+    "they are not a metric. --no-rerank prints the fused pairwise distances.\n"
     "\n"
     "  --top K                 how many results (default 10)\n"
     "  --json                  print one JSON object\n"
@@ -122,20 +127,24 @@ static const char HELP_INDEX[] =
     "\n"
     "Prepares every shape of COLLECTION (a folder or a manifest.tsv) once and writes an\n"
     "index: the prepared shapes with their file names, classes and groups, the shape\n"
-    "options, a signature per shape and each shape's K nearest neighbours (--rerank K,\n"
-    "default 5), so that search, matrix and eval take FILE wherever they take a\n"
-    "collection, and one search never recomputes the collection's matrix. The file is\n"
-    "versioned and checksummed, and written under a temporary name then renamed.\n"
+    "and retrieval options (channel weight, affine share, re-ranking), a signature per\n"
+    "shape and each shape's K nearest neighbours under the retrieval distance before\n"
+    "re-ranking (--rerank K, default the preset's 8), so that search, matrix and eval\n"
+    "take FILE wherever they take a collection with the same results, and one search\n"
+    "never recomputes the collection's matrix (with a fused --channel-weight below 1 the\n"
+    "query is scaled by the medians of the build). The file is versioned and\n"
+    "checksummed, and written under a temporary name then renamed.\n"
     "\n"
     "  -o, --output FILE       the index file\n"
     "  --candidates M          neighbours are sought among each shape's M nearest by\n"
-    "                          signature only, matched both ways: for collections too\n"
+    "                          signature only: for collections too\n"
     "                          large for every pair (default 0: every pair)\n"
     "  --add                   append the shapes of COLLECTION to the index FILE: only the\n"
     "                          new shapes are prepared, and only pairs with a new shape\n"
     "                          matched; the shape options must be the index's\n"
     "A command given an index uses the index's shape options; an option that differs from\n"
-    "them is an error (rebuild the index). search --candidates M (default 64) matches\n"
+    "them is an error (rebuild the index); --rerank K[,ITER] and --no-rerank may differ\n"
+    "(K up to the neighbours stored). search --candidates M (default 64) matches\n"
     "the M shapes whose signatures are nearest the query's (0: every shape).\n";
 
 static const tool_command COMMANDS[] = {
@@ -198,6 +207,27 @@ void print_main_help(void)
            "amscr --version", "amscr COMMAND --help");
 }
 
+/* The retrieval options of search/matrix/eval, their defaults read from ret. */
+static void print_retrieval_options(const amscr_params *ret)
+{
+    printf("retrieval options (search/matrix/eval):\n"
+           "  --channel-weight W      share of the shape channel (height functions matched by\n"
+           "                          dynamic programming; tolerates articulation) against the\n"
+           "                          AMSCR distance, 0..1 (default %g: the channel alone;\n"
+           "                          0 with --open)\n"
+           "  --affine-share S        share of the channel computed in the affine (whitened)\n"
+           "                          frame, the rest in the similarity frame (default %g)\n"
+           "  --fast                  --affine-share 0: the channel in one frame, half the time\n"
+           "  --rerank K[,ITER]       contextual re-ranking: diffusion on the K-nearest-neighbour\n"
+           "                          graph, ITER iterations (default %u,%u; ITER default %d)\n"
+           "  --no-rerank             the fused pairwise distances\n"
+           "  --paper                 the paper's method: the AMSCR distance alone, affine group,\n"
+           "                          no refinement, no re-ranking (= --channel-weight 0\n"
+           "                          --no-rerank --invariance affine --refine 0)\n",
+           amscr_params_get_channel_weight(ret), amscr_params_get_channel_affine_share(ret),
+           amscr_params_get_rerank_k(ret), amscr_params_get_rerank_iterations(ret), TOOL_RERANK_ITERS);
+}
+
 /* The image and shape options, their defaults read from reg (register's params) and ret
  * (search/matrix/eval's). */
 static void print_shape_options(const amscr_params *reg, const amscr_params *ret)
@@ -230,11 +260,7 @@ static void print_shape_options(const amscr_params *reg, const amscr_params *ret
            name_choices(&INVARIANCE_NAMES, none, invs, sizeof invs),
            name_of(&INVARIANCE_NAMES, (int)amscr_params_get_invariance(reg)),
            name_of(&INVARIANCE_NAMES, (int)amscr_params_get_invariance(ret)));
-    printf("  --rerank K[,ITER]       (search/matrix/eval) contextual re-ranking: diffusion on the\n"
-           "                          K-nearest-neighbour graph, ITER iterations (default %d,%d);\n"
-           "  --no-rerank             the plain pairwise distances\n"
-           "  --threads N             threads for batch work (0 = all cores, the default)\n",
-           TOOL_RERANK_K, TOOL_RERANK_ITERS);
+    printf("  --threads N             threads for batch work (0 = all cores, the default)\n");
 }
 
 int print_command_help(const tool_command *c)
@@ -249,6 +275,8 @@ int print_command_help(const tool_command *c)
     if (r == 0) {
         fputs("\n", stdout);
         print_shape_options(reg, ret);
+        if (c->bit & C_RETRIEVAL)
+            print_retrieval_options(ret);
     }
     amscr_params_free(reg);
     amscr_params_free(ret);

@@ -1,6 +1,7 @@
 /* index_add.c — `amscr index COLLECTION -o FILE --add`: new shapes prepared and appended;
  * the old ones are not prepared again and their distances among themselves not recomputed
- * (only old x new and new x new pairs are matched). */
+ * (only old x new and new x new pairs are matched, under the index's base distance with the
+ * medians of its build: index_dist.h). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -66,10 +67,10 @@ static int merge_names(const char *ipath, tool_index *x, collection *c)
     return 0;
 }
 
-/* Neighbour lists of all N shapes from the old lists and the cross distances: a[in*N + j] =
- * d(new in -> j), b[j*nn + in] = d(j -> new in). An index smaller than its K (every shape in
+/* Neighbour lists of all N shapes from the old lists and the base distances a[in*N + j] of
+ * new shape in and shape j (index_dist.h). An index smaller than its K (every shape in
  * every list, so nothing is unknown) grows its lists up to want_k. */
-static int merge_knn(tool_index *x, size_t nold, size_t want_k, const double *a, const double *b)
+static int merge_knn(tool_index *x, size_t nold, size_t want_k, const double *a)
 {
     size_t N = x->coll.n, nn = N - nold, kold = x->k;
     size_t k = kold == nold && want_k > kold ? (want_k < N ? want_k : N) : kold;
@@ -83,10 +84,10 @@ static int merge_knn(tool_index *x, size_t nold, size_t want_k, const double *a,
             for (size_t t = 0; t < kold; t++)
                 cj[m] = x->nb_idx[i * kold + t], cd[m++] = x->nb_dist[i * kold + t];
             for (size_t jn = 0; jn < nn; jn++)
-                cj[m] = nold + jn, cd[m++] = 0.5 * (b[i * nn + jn] + a[jn * N + i]);
+                cj[m] = nold + jn, cd[m++] = a[jn * N + i];
         } else {
             for (size_t j = 0; j < N; j++)
-                cj[m] = j, cd[m++] = j == i ? 0.0 : 0.5 * (a[(i - nold) * N + j] + b[j * nn + (i - nold)]);
+                cj[m] = j, cd[m++] = j == i ? 0.0 : a[(i - nold) * N + j];
         }
         for (size_t t = 0; t < m; t++)
             if (cd[t] > x->dmax)
@@ -109,20 +110,32 @@ static int merge_knn(tool_index *x, size_t nold, size_t want_k, const double *a,
     return 0;
 }
 
-/* The cross distances of the new shapes (dnew) with every shape of the index. */
-static int cross(const tool_index *x, const amscr_db *dnew, double **a, double **b)
+/* The base distances a[in*N + j] of each new shape in (index nold + in) and every shape j
+ * of the index (the new ones already appended to x->db), lower index first. */
+static int cross(const tool_index *x, size_t nold, const amscr_params *p, double **a)
 {
-    size_t N = amscr_db_size(x->db), nn = amscr_db_size(dnew);
-    *a = xmalloc_array(nn * N, sizeof(double));
-    *b = xmalloc_array(nn * N, sizeof(double));
-    if (*a == NULL || *b == NULL)
-        return -1;
+    size_t N = amscr_db_size(x->db), nn = N - nold;
+    base_dist b = {p, amscr_params_get_channel_weight(p), x->med_a, x->med_h};
+    amscr_workspace *ws = NULL;
+    *a = xmalloc_array(nn * N > 0 ? nn * N : 1, sizeof(double));
+    amscr_status st = *a ? amscr_workspace_new(&ws) : AMSCR_E_NOMEM;
     tool_progress pr;
     progress_init(&pr, "matching new shapes");
-    amscr_status st = amscr_db_cross_distances(dnew, x->db, progress_cb, &pr, *a);
-    if (st == AMSCR_OK)
-        st = amscr_db_cross_distances(x->db, dnew, progress_cb, &pr, *b);
+    for (size_t in = 0; st == AMSCR_OK && in < nn; in++) {
+        size_t i = nold + in;
+        const amscr_descriptor *di = amscr_db_descriptor(x->db, i);
+        for (size_t j = 0; st == AMSCR_OK && j < N; j++) {
+            const amscr_descriptor *dj = amscr_db_descriptor(x->db, j);
+            (*a)[in * N + j] = 0.0;
+            if (j < i)
+                st = base_pair(&b, dj, di, ws, &(*a)[in * N + j]);
+            else if (j > i)
+                st = base_pair(&b, di, dj, ws, &(*a)[in * N + j]);
+        }
+        progress_update(&pr, in + 1, nn);
+    }
     progress_end(&pr);
+    amscr_workspace_free(ws);
     if (st != AMSCR_OK) {
         tool_lib_error("index", st);
         return -1;
@@ -142,7 +155,7 @@ int index_add(const opts *o, tool_index *x, collection *c)
     }
     size_t nold = x->coll.n;
     amscr_db *dnew = NULL;
-    double *a = NULL, *b = NULL;
+    double *a = NULL;
     r = merge_names(o->out, x, c);
     if (r == 0 && load_db(p, c, x->threshold, &dnew) != 0)
         r = TOOL_EXIT_FAIL;
@@ -151,10 +164,10 @@ int index_add(const opts *o, tool_index *x, collection *c)
             tool_lib_error(o->out, AMSCR_E_NOMEM);
             r = TOOL_EXIT_FAIL;
         }
-    if (r == 0 && (index_signatures_from(x, nold) != 0 || cross(x, dnew, &a, &b) != 0 || merge_knn(x, nold, o->rerank_k, a, b) != 0))
+    size_t want_k = amscr_params_get_rerank_k(amscr_db_params(x->db)); /* as built */
+    if (r == 0 && (index_signatures_from(x, nold) != 0 || cross(x, nold, p, &a) != 0 || merge_knn(x, nold, want_k, a) != 0))
         r = TOOL_EXIT_FAIL;
     free(a);
-    free(b);
     amscr_db_free(dnew);
     amscr_params_free(p);
     return r;

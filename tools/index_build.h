@@ -7,7 +7,11 @@
 #include <stdint.h>
 
 #include "cli.h"
+#include "index_dist.h"
 #include "index_file.h"
+
+/* Shapes on which a candidate-only build estimates the medians of a fused distance. */
+enum { INDEX_MEDIAN_SAMPLE = 256 };
 
 /* Row i's k nearest neighbours (itself first, then by distance, ties by index) among m
  * candidates (cj[t], cd[t] its symmetrized distance; i itself may be among them). */
@@ -20,8 +24,9 @@ int index_signatures_from(tool_index *x, size_t from);
 int index_add(const opts *o, tool_index *x, collection *c);
 
 /* The neighbour lists (x->k a shape) and x->dmax from each shape's m signature-nearest
- * shapes, matched both ways on the threads of p (index_knn.c). 0 or -1 (error printed). */
-int knn_from_candidates(tool_index *x, const amscr_params *p, size_t m);
+ * shapes under the base distance b, on the threads of b->p (index_knn.c). 0 or -1 (error
+ * printed). */
+int knn_from_candidates(tool_index *x, const base_dist *b, size_t m);
 
 /* Opens the COLLECTION argument: an index (its db and names; params from the index, options
  * the user set checked against it) or a folder / manifest (prepared with make_params).

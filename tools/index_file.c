@@ -104,9 +104,11 @@ static void w_meta(wbuf *w, const tool_index *x, const uint64_t *off, const uint
     size_t n = c->n;
     w_u64(w, n);
     w_u32(w, (uint32_t)x->threshold);
-    w_u32(w, x->rerank_iters);
+    w_u32(w, 0); /* reserved */
     w_u64(w, x->k);
     w_f64(w, x->dmax);
+    w_f64(w, x->med_a);
+    w_f64(w, x->med_h);
     if (w_db_blob(w, x->db, SIZE_MAX) != 0)
         w->oom = 1;
     w_u64(w, c->nclasses);
@@ -359,11 +361,13 @@ static int parse_meta(rbuf *r, tool_index *x, uint64_t blobs_len, char *msg, siz
 {
     size_t n = r_count(r, 13);
     x->threshold = (int32_t)r_u32(r);
-    x->rerank_iters = r_u32(r);
+    uint32_t reserved = r_u32(r);
     uint64_t k = r_u64(r);
     x->dmax = r_f64(r);
-    if (r->bad || n == 0 || k > n || k > 100000 || !(x->dmax >= 0.0) || !isfinite(x->dmax) ||
-        x->rerank_iters > 1000 || (x->threshold != AMSCR_THRESHOLD_AUTO && (x->threshold < 0 || x->threshold > 254)))
+    x->med_a = r_f64(r);
+    x->med_h = r_f64(r);
+    if (r->bad || n == 0 || k > n || k > 100000 || !(x->dmax >= 0.0) || !isfinite(x->dmax) || reserved != 0 ||
+        !(x->med_a >= 0.0) || !isfinite(x->med_a) || !(x->med_h >= 0.0) || !isfinite(x->med_h) || (x->threshold != AMSCR_THRESHOLD_AUTO && (x->threshold < 0 || x->threshold > 254)))
         return fail(msg, cap, "bad index header");
     x->k = (size_t)k;
     if (parse_params(r, x, msg, cap) != 0)

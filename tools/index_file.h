@@ -1,15 +1,17 @@
 /* index_file.h — the index of `amscr index`: a prepared collection with its file names,
  * classes and groups, the shape options it was built with (the db's params), a shape
  * signature per shape (the candidate filter of large collections) and each shape's K nearest
- * neighbours under the symmetrized distance (what contextual re-ranking needs, so one query
- * never recomputes the collection's matrix).
+ * neighbours under the base distance of the retrieval matrix (index_dist.h: the shape channel
+ * with the default channel weight 1, the fused distance below it; what contextual re-ranking
+ * needs, so one query never recomputes the collection's matrix). The params (the library's
+ * collection format 2) hold the channel and re-ranking settings the index was built with.
  *
- * File format, little-endian, version 1:
+ * File format, little-endian, version 2 (version 1, before the shape channel, is refused):
  *   "AMSCRIDX" u32 version u32 0 u64 file length
  *   u64 meta length, the meta section, u64 FNV-1a 64 of the meta section
  *   the shapes: n blobs, each a one-shape amscr_db_save_memory (checksummed by the library)
  * Meta section:
- *   u64 n, i32 threshold, u32 rerank_iters, u64 k, f64 dmax
+ *   u64 n, i32 threshold, u32 0, u64 k, f64 dmax, f64 median AMSCR, f64 median channel
  *   u64 len, the params (amscr_db_save_memory of an empty db)
  *   u64 nclasses, nclasses strings; u64 ngroups, ngroups strings   (string: u32 len, bytes)
  *   n x (string name, i32 class, i32 group or -1, u64 blob offset, u64 blob length)
@@ -28,15 +30,15 @@
 #include "amscr.h"
 #include "collection.h"
 
-enum { INDEX_VERSION = 1, INDEX_SIG_DIM = 24 };
+enum { INDEX_VERSION = 2, INDEX_SIG_DIM = 24 };
 
 typedef struct tool_index {
     amscr_db *db;            /* every shape, or (index_open_lazy) none: the params only */
     collection coll;         /* names, classes, groups (item paths are the names) */
     int threshold;           /* used to trace the collection's images */
-    unsigned rerank_iters;
-    size_t k;                /* neighbours per shape (0: built with --no-rerank) */
-    double dmax;             /* largest symmetrized distance of the collection */
+    size_t k;                /* neighbours per shape: min(the params' rerank_k, n) */
+    double dmax;             /* largest base distance of the collection (index_dist.h) */
+    double med_a, med_h;     /* the base distance's medians (fused channel weights only, else 0) */
     double *sig;             /* n x INDEX_SIG_DIM */
     uint32_t *nb_idx;        /* n x k */
     double *nb_dist;         /* n x k */

@@ -1,5 +1,5 @@
 /* index_knn.c — the neighbour lists of a large collection without its full matrix: each
- * shape is matched (both ways) with the `m` shapes whose signatures are nearest its own, and
+ * shape is matched (the base distance, index_dist.h) with the `m` shapes whose signatures are nearest its own, and
  * its K nearest are taken among those. Rows are split over threads (amscr_distance is
  * reentrant with a workspace per thread). */
 #include <math.h>
@@ -13,7 +13,7 @@
 
 typedef struct knn_job {
     tool_index *x;
-    const amscr_params *p;
+    const base_dist *b;
     size_t m;            /* candidates a shape */
     size_t from, step;   /* rows from, from + step, ... */
     double dmax;         /* this thread's largest distance */
@@ -55,11 +55,8 @@ static void *knn_rows(void *arg)
         size_t m = sig_candidates(x, i, jb->m, sd, cand);
         for (size_t t = 0; jb->st == AMSCR_OK && t < m; t++) {
             const amscr_descriptor *dj = amscr_db_descriptor(x->db, cand[t]);
-            double a = 0.0, b = 0.0;
-            jb->st = amscr_distance(jb->p, di, dj, ws, &a);
-            if (jb->st == AMSCR_OK)
-                jb->st = amscr_distance(jb->p, dj, di, ws, &b);
-            cd[t] = 0.5 * (a + b);
+            cd[t] = 0.0;
+            jb->st = i < cand[t] ? base_pair(jb->b, di, dj, ws, &cd[t]) : base_pair(jb->b, dj, di, ws, &cd[t]);
             jb->dmax = cd[t] > jb->dmax ? cd[t] : jb->dmax;
         }
         knn_select(i, cand, cd, m, k, x->nb_idx + i * k, x->nb_dist + i * k);
@@ -74,8 +71,9 @@ static void *knn_rows(void *arg)
     return NULL;
 }
 
-int knn_from_candidates(tool_index *x, const amscr_params *p, size_t m)
+int knn_from_candidates(tool_index *x, const base_dist *b, size_t m)
 {
+    const amscr_params *p = b->p;
     size_t n = x->coll.n, k = x->k;
     unsigned nt = amscr_params_get_num_threads(p);
     if (nt == 0) {
@@ -92,7 +90,7 @@ int knn_from_candidates(tool_index *x, const amscr_params *p, size_t m)
         return -1;
     unsigned started = 0;
     for (unsigned t = 0; t < nt; t++) {
-        jobs[t] = (knn_job){x, p, m, t, nt, 0.0, 0, AMSCR_OK};
+        jobs[t] = (knn_job){x, b, m, t, nt, 0.0, 0, AMSCR_OK};
         if (t > 0 && pthread_create(&th[t], NULL, knn_rows, &jobs[t]) != 0)
             break;
         started = t + 1;

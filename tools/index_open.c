@@ -48,6 +48,9 @@ static int check_options(const opts *o, const char *path, const amscr_params *p)
     NAME(o->method_set, "--method", METHOD_NAMES, amscr_params_get_method(p), o->method)
     NAME(o->param_set, "--parametrization", PARAM_NAMES, amscr_params_get_parametrization(p), o->param)
     NAME(o->inv_set, "--invariance", INVARIANCE_NAMES, amscr_params_get_invariance(p), o->inv)
+    /* the neighbour lists are of the base distance these two define (index_dist.h) */
+    NUM(o->channel_weight_set, "--channel-weight", amscr_params_get_channel_weight(p), o->channel_weight)
+    NUM(o->affine_share_set, "--affine-share", amscr_params_get_channel_affine_share(p), o->affine_share)
 #undef NUM
 #undef NAME
     if (o->reflections >= 0 && o->reflections != amscr_params_get_reflections(p))
@@ -72,6 +75,12 @@ int index_params(const opts *o, const char *path, const tool_index *x, amscr_par
     amscr_status st = amscr_params_copy(p, out);
     if (st == AMSCR_OK && o->threads_set)
         st = amscr_params_set_num_threads(*out, o->threads);
+    /* --rerank / --no-rerank: a query-time setting (search needs the index to hold K
+     * neighbours a shape: cmd_search.c checks) */
+    if (st == AMSCR_OK && o->rerank_set)
+        st = amscr_params_set_rerank_k(*out, (unsigned)o->rerank_k);
+    if (st == AMSCR_OK && o->rerank_set && o->rerank_k > 0)
+        st = amscr_params_set_rerank_iterations(*out, o->rerank_iters);
     if (st != AMSCR_OK) {
         amscr_params_free(*out);
         *out = NULL;

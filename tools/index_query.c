@@ -1,6 +1,12 @@
-/* index_query.c — one query against an index (`amscr search QUERY INDEX`): distances to the
- * candidate shapes and, with re-ranking, the query's row of amscr_rerank_diffusion on the
- * collection plus the query, from the stored neighbour lists alone.
+/* index_query.c — one query against an index (`amscr search QUERY INDEX`): base distances
+ * (index_dist.h) to the candidate shapes and, with re-ranking, the query's row of the
+ * retrieval matrix's diffusion (amscr_db_retrieval_matrix: amscr_rerank_diffusion halved into
+ * [0, 1], 0 for the query itself) on the collection plus the query, from the stored neighbour
+ * lists alone. A query that is one of the index's shapes (the same prepared samples, bit for
+ * bit) gets that shape's row of the collection's matrix instead, as a folder search does for
+ * a member file; so with every shape a candidate (--candidates 0), an index built from the
+ * full matrix gives the folder's scores (fused channel weights: with the medians of the
+ * index's build, where the folder's matrix recomputes them with the query).
  *
  * The diffusion's row of the query: with P the row-normalized kNN affinities of the n + 1
  * shapes, Q_0 = P and Q <- P Q P^T + I for T iterations give
@@ -107,8 +113,8 @@ static void apply_rows(const graph *g, double *a, double *tmp)
     memcpy(a, tmp, g->n * sizeof *a);
 }
 
-/* The query's row of Q_T into r (n + 1 entries). */
-static int diffusion_row(const graph *g, unsigned iters, double *r)
+/* Row `start` of Q_T into r (g->n entries). */
+static int diffusion_row(const graph *g, size_t start, unsigned iters, double *r)
 {
     size_t n = g->n;
     double *a = xcalloc_array(n, sizeof(double)), *v = xmalloc_array(n, sizeof(double));
@@ -120,7 +126,7 @@ static int diffusion_row(const graph *g, unsigned iters, double *r)
         return -1;
     }
     memset(r, 0, n * sizeof *r);
-    a[n - 1] = 1.0;
+    a[start] = 1.0;
     for (unsigned t = 0; t <= iters; t++) {
         memcpy(v, a, n * sizeof *v);
         if (t == iters)
@@ -136,6 +142,62 @@ static int diffusion_row(const graph *g, unsigned iters, double *r)
     free(v);
     free(tmp);
     return 0;
+}
+
+/* out[j] (j < n) from the diffused row r (len entries): halved 1 - r / max r where reached,
+ * 0.5 + half the base distance / dmax for the matched shapes it does not reach, +inf for the
+ * others; 0 for `self` (the library's normalization of the retrieval matrix). */
+static void scores(const double *r, size_t len, size_t n, size_t self, const double *dq, const unsigned char *have,
+                   double dmax, double *out)
+{
+    double rmax = 0.0;
+    for (size_t i = 0; i < len; i++)
+        rmax = r[i] > rmax ? r[i] : rmax;
+    for (size_t j = 0; j < n; j++) {
+        if (j == self)
+            out[j] = 0.0;
+        else if (r[j] > 0.0 && rmax > 0.0)
+            out[j] = 0.5 * (1.0 - r[j] / rmax);
+        else
+            out[j] = have[j] ? 0.5 * (1.0 + (dmax > 0.0 ? dq[j] / dmax : 0.0)) : INFINITY;
+    }
+}
+
+/* Row `member` of the collection's re-ranked matrix (the query is that shape): the stored
+ * lists alone, K = k <= x->k; dsym[t] the base distance of the member and cand[t]. */
+static int member_row(const tool_index *x, size_t k, unsigned iters, size_t member, const size_t *cand,
+                      const double *dsym, size_t m, double *out)
+{
+    size_t n = x->coll.n;
+    graph g = {n, k, NULL, NULL, NULL, NULL};
+    g.j = xmalloc_array(n, k * sizeof(uint32_t));
+    g.d = xmalloc_array(n, k * sizeof(double));
+    g.w = xmalloc_array(n, k * sizeof(double));
+    g.s = xmalloc_array(n, sizeof(double));
+    double *dq = xmalloc_array(n, sizeof(double)), *r = xmalloc_array(n, sizeof(double));
+    unsigned char *have = xcalloc_array(n, 1);
+    int ret = -1;
+    if (g.j && g.d && g.w && g.s && dq && r && have) {
+        for (size_t t = 0; t < m; t++) {
+            dq[cand[t]] = dsym[t];
+            have[cand[t]] = 1;
+        }
+        for (size_t i = 0; i < n; i++)
+            collection_row(x, i, 0.0, 0, &g);
+        weights(&g, x->dmax);
+        if (diffusion_row(&g, member, iters, r) == 0) {
+            scores(r, n, n, member, dq, have, x->dmax, out);
+            ret = 0;
+        }
+    }
+    free(g.j);
+    free(g.d);
+    free(g.w);
+    free(g.s);
+    free(dq);
+    free(r);
+    free(have);
+    return ret;
 }
 
 int rerank_query_row(const tool_index *x, size_t k, unsigned iters, const size_t *cand, const double *dsym, size_t m,
@@ -164,17 +226,9 @@ int rerank_query_row(const tool_index *x, size_t k, unsigned iters, const size_t
     if (query_row(cand, dsym, m, &g) != 0)
         goto done;
     weights(&g, dmax);
-    if (diffusion_row(&g, iters, r) != 0)
+    if (diffusion_row(&g, n, iters, r) != 0)
         goto done;
-    double rmax = 0.0;
-    for (size_t i = 0; i < g.n; i++)
-        rmax = r[i] > rmax ? r[i] : rmax;
-    for (size_t j = 0; j < n; j++) {
-        if (r[j] > 0.0 && rmax > 0.0)
-            out[j] = 1.0 - r[j] / rmax;
-        else
-            out[j] = have[j] ? 1.0 + (dmax > 0.0 ? dq[j] / dmax : 0.0) : INFINITY;
-    }
+    scores(r, g.n, n, SIZE_MAX, dq, have, dmax, out);
     ret = 0;
 done:
     free(g.j);
@@ -219,24 +273,50 @@ static size_t candidates(const tool_index *x, const amscr_descriptor *dq, size_t
     return m;
 }
 
-/* d(q -> cand) into fwd and, for re-ranking, the symmetrized distances into sym. */
-static int match(const amscr_db *cdb, const amscr_params *p, const amscr_descriptor *dq, int both, double *fwd,
-                 double *sym, size_t m)
+/* The candidate (position in cand) whose prepared samples are the query's, bit for bit, or
+ * SIZE_MAX: the query is that shape of the index. */
+static size_t member_of(const amscr_db *cdb, const amscr_descriptor *dq, size_t m)
 {
+    size_t ns = amscr_descriptor_num_samples(dq);
+    const double *q = amscr_descriptor_input_points(dq);
+    for (size_t t = 0; t < m; t++) {
+        const amscr_descriptor *d = amscr_db_descriptor(cdb, t);
+        if (amscr_descriptor_num_samples(d) == ns && memcmp(amscr_descriptor_input_points(d), q, 2 * ns * sizeof *q) == 0)
+            return t;
+    }
+    return SIZE_MAX;
+}
+
+/* d(q -> cand) into fwd (the plain distance) and, when `base`, the base distances of the
+ * candidates and the query into bd: the query last (index_dist.h), or, when it is shape
+ * `member` of the index, in that shape's place (the channel's lower index first). */
+static int match(const tool_index *x, const amscr_db *cdb, const size_t *cand, size_t member, const amscr_params *p,
+                 const amscr_descriptor *dq, int base, double *fwd, double *bd, size_t m)
+{
+    base_dist b = {p, amscr_params_get_channel_weight(p), x->med_a, x->med_h};
     tool_progress pr;
     progress_init(&pr, "matching");
-    amscr_status st = amscr_db_query(cdb, dq, progress_cb, &pr, fwd);
+    amscr_status st = AMSCR_OK;
+    int amscr = !base || base_uses_amscr(&b);
+    if (amscr)
+        st = amscr_db_query(cdb, dq, progress_cb, &pr, fwd);
     amscr_db *qdb = NULL;
-    if (st == AMSCR_OK && both && !amscr_params_get_symmetric(p)) {
+    if (st == AMSCR_OK && base && amscr) { /* d(cand -> q), symmetrized */
         st = amscr_db_new(p, &qdb);
         if (st == AMSCR_OK)
             st = amscr_db_add_descriptor(qdb, dq, -1, NULL);
         if (st == AMSCR_OK)
-            st = amscr_db_cross_distances(cdb, qdb, progress_cb, &pr, sym); /* d(cand -> q) */
+            st = amscr_db_cross_distances(cdb, qdb, progress_cb, &pr, bd);
         for (size_t t = 0; st == AMSCR_OK && t < m; t++)
-            sym[t] = 0.5 * (fwd[t] + sym[t]);
-    } else if (st == AMSCR_OK && both) {
-        memcpy(sym, fwd, m * sizeof *sym);
+            bd[t] = 0.5 * (bd[t] + fwd[t]);
+    }
+    for (size_t t = 0; st == AMSCR_OK && base && t < m; t++) {
+        double h = 0.0;
+        const amscr_descriptor *dc = amscr_db_descriptor(cdb, t);
+        if (base_uses_channel(&b))
+            st = member != SIZE_MAX && cand[t] > member ? amscr_channel_distance(p, dq, dc, &h)
+                                                        : amscr_channel_distance(p, dc, dq, &h);
+        bd[t] = base_combine(&b, amscr ? bd[t] : 0.0, h);
     }
     progress_end(&pr);
     amscr_db_free(qdb);
@@ -247,35 +327,44 @@ static int match(const amscr_db *cdb, const amscr_params *p, const amscr_descrip
     return 0;
 }
 
-int index_search(const tool_index *x, const amscr_params *p, const amscr_descriptor *dq, size_t ncand, size_t rerank_k,
-                 unsigned iters, double *out)
+int index_search(const tool_index *x, const amscr_params *p, const amscr_descriptor *dq, size_t ncand, double *out)
 {
-    size_t n = x->coll.n, k = rerank_k < n + 1 ? rerank_k : n + 1;
+    size_t n = x->coll.n, rk = amscr_params_get_rerank_k(p), k = rk < n + 1 ? rk : n + 1;
+    unsigned iters = amscr_params_get_rerank_iterations(p);
+    int plain = amscr_params_get_channel_weight(p) <= 0.0 && k == 0; /* as the folder's search */
     size_t m = ncand == 0 || ncand >= n || k > n ? n : ncand;
     size_t *cand = xmalloc_array(n, sizeof(size_t));
-    double *fwd = xmalloc_array(n, sizeof(double)), *sym = xmalloc_array(n, sizeof(double));
+    double *fwd = xmalloc_array(n, sizeof(double)), *bd = xmalloc_array(n, sizeof(double));
     amscr_db *cdb = NULL;
     int ret = -1;
-    if (!cand || !fwd || !sym)
+    if (!cand || !fwd || !bd)
         goto done;
     m = candidates(x, dq, m, cand);
-    if (m == 0 || index_fetch(x, p, cand, m, &cdb) != 0 || match(cdb, p, dq, k > 0, fwd, sym, m) != 0)
+    if (m == 0 || index_fetch(x, p, cand, m, &cdb) != 0)
+        goto done;
+    /* a member query: ranked by its row of the collection's matrix, as a folder search (which
+     * reads the matrix unless the channel alone is used without re-ranking) */
+    int by_matrix = k > 0 || amscr_params_get_channel_weight(p) < 1.0;
+    size_t member = by_matrix ? member_of(cdb, dq, m) : SIZE_MAX;
+    if (match(x, cdb, cand, member == SIZE_MAX ? SIZE_MAX : cand[member], p, dq, !plain, fwd, bd, m) != 0)
         goto done;
     if (k == 0) {
         for (size_t j = 0; j < n; j++)
             out[j] = INFINITY;
         for (size_t t = 0; t < m; t++)
-            out[cand[t]] = fwd[t];
+            out[cand[t]] = plain ? fwd[t] : bd[t];
         ret = 0;
+    } else if (member != SIZE_MAX) {
+        ret = member_row(x, rk < n ? rk : n, iters, cand[member], cand, bd, m, out);
     } else if (k - 1 > m) {
         tool_error(NULL, "--rerank %zu needs at least %zu candidates", k, k - 1);
     } else {
-        ret = rerank_query_row(x, k, iters, cand, sym, m, out);
+        ret = rerank_query_row(x, k, iters, cand, bd, m, out);
     }
 done:
     amscr_db_free(cdb);
     free(cand);
     free(fwd);
-    free(sym);
+    free(bd);
     return ret;
 }

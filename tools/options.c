@@ -45,7 +45,11 @@ typedef enum opt_id {
     O_INVARIANCE,
     O_PARTIAL,
     O_RERANK,
-    O_NO_RERANK
+    O_NO_RERANK,
+    O_CHANNEL_WEIGHT,
+    O_AFFINE_SHARE,
+    O_FAST,
+    O_PAPER
 } opt_id;
 
 typedef struct optdef {
@@ -92,6 +96,10 @@ static const optdef OPTS[] = {
     {"--partial", O_PARTIAL, 0, C_REGISTER, NULL},
     {"--rerank", O_RERANK, 1, C_RETRIEVAL, "K[,ITER]"},
     {"--no-rerank", O_NO_RERANK, 0, C_RETRIEVAL, NULL},
+    {"--channel-weight", O_CHANNEL_WEIGHT, 1, C_RETRIEVAL, "W"},
+    {"--affine-share", O_AFFINE_SHARE, 1, C_RETRIEVAL, "S"},
+    {"--fast", O_FAST, 0, C_RETRIEVAL, NULL},
+    {"--paper", O_PAPER, 0, C_RETRIEVAL, NULL},
 };
 
 int usage_error(const char *what, const char *fmt, ...)
@@ -114,8 +122,6 @@ void opts_init(opts *o, const tool_command *c)
     o->reflections = -1;
     o->top = TOOL_TOP_DEFAULT;
     o->protocol_id = PROTO_ALL;
-    o->rerank_k = TOOL_RERANK_K;
-    o->rerank_iters = TOOL_RERANK_ITERS;
     o->splits = TOOL_SPLITS_DEFAULT;
     o->seed = TOOL_SEED_DEFAULT;
     o->min_area = TOOL_MIN_AREA_DEFAULT;
@@ -197,9 +203,37 @@ static int parse_rerank(const char *opt, const char *v, opts *o)
         v[0] == '-')
         return usage_error(opt, "expected K[,ITER] with K >= 1 and 1 <= ITER <= %d, got '%s'",
                            TOOL_RERANK_ITERS_MAX, v);
+    o->rerank_set = 1;
     o->rerank_k = (size_t)k;
     o->rerank_iters = (unsigned)it;
     return 0;
+}
+
+/* A fraction 0..1 (--channel-weight, --affine-share) into *out, setting *set. */
+static int parse_fraction(const char *opt, const char *v, int *set, double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    double x = strtod(v, &end);
+    if (end == v || *end != '\0' || errno != 0 || !(x >= 0.0 && x <= 1.0))
+        return usage_error(opt, "expected a number 0..1, got '%s'", v);
+    *set = 1;
+    *out = x;
+    return 0;
+}
+
+/* --paper: the paper's method exactly as 0.1 computed it (the AMSCR distance alone in the
+ * affine group, no refinement, no re-ranking); later options still override. */
+static void set_paper(opts *o)
+{
+    o->channel_weight_set = 1;
+    o->channel_weight = 0.0;
+    o->rerank_set = 1;
+    o->rerank_k = 0;
+    o->inv_set = 1;
+    o->inv = AMSCR_INVARIANCE_AFFINE;
+    o->refine_set = 1;
+    o->refine = 0;
 }
 
 /* A value of a name table into *out (an enum field), setting *set. */
@@ -305,7 +339,17 @@ static int set_option(opts *o, const optdef *d, const char *v)
         o->inv = (amscr_invariance)e;
         return r;
     case O_RERANK: return parse_rerank(n, v, o);
-    case O_NO_RERANK: o->rerank_k = 0; return 0;
+    case O_NO_RERANK:
+        o->rerank_set = 1;
+        o->rerank_k = 0;
+        return 0;
+    case O_CHANNEL_WEIGHT: return parse_fraction(n, v, &o->channel_weight_set, &o->channel_weight);
+    case O_AFFINE_SHARE: return parse_fraction(n, v, &o->affine_share_set, &o->affine_share);
+    case O_FAST:
+        o->affine_share_set = 1;
+        o->affine_share = 0.0;
+        return 0;
+    case O_PAPER: set_paper(o); return 0;
     }
     return 0;
 }

@@ -4,37 +4,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Retrieval (search/matrix/eval) compares shapes that are rarely affine-distorted copies: the
- * similarity group keeps aspect and shear that tell classes apart (README: retrieval table);
- * registration keeps the library's full affine group. */
-#define RETRIEVAL_INVARIANCE AMSCR_INVARIANCE_SIMILARITY
-/* Two refinement iterations for retrieval: with them the Kimia-99/216 tables meet the paper's
- * rows (985/990, 2355/2376) at ~15x the time of --refine 0 (911, 2358). */
-#define RETRIEVAL_REFINE 2u
-
 /* registration: the library's registration preset (N 256, 20 refinement iterations: measured
- * in the README). Retrieval: the library's defaults (N 128) with the similarity group and 2
- * refinement iterations. make_params adds the mirror images (retrieval only) and the options. */
-static amscr_status base_params(const opts *o, int registration, amscr_params **out)
+ * in the README). Retrieval (search/matrix/eval): the library's retrieval preset (the shape
+ * channel in the similarity frame with 0.2 of the affine frame, re-ranking k 8, 10 iterations,
+ * reflections on: bench/RESULTS-retrieval.md); the AMSCR distance in it (a channel weight
+ * below 1) is the affine group without refinement, the paper's method. make_params adds the
+ * options. */
+static amscr_status base_params(int registration, amscr_params **out)
 {
-    amscr_params *p = NULL;
-    amscr_status st = registration ? amscr_params_new_registration(&p) : amscr_params_new(&p);
-    if (st == AMSCR_OK && !registration && !o->inv_set)
-        st = amscr_params_set_invariance(p, RETRIEVAL_INVARIANCE);
-    if (st == AMSCR_OK && !registration && !o->refine_set)
-        st = amscr_params_set_refine(p, RETRIEVAL_REFINE);
-    if (st != AMSCR_OK) {
-        amscr_params_free(p);
-        return st;
-    }
-    *out = p;
-    return AMSCR_OK;
+    return registration ? amscr_params_new_registration(out) : amscr_params_new_retrieval(out);
 }
 
 int make_params(const opts *o, int registration, amscr_params **out)
 {
     amscr_params *p = NULL;
-    amscr_status st = base_params(o, registration, &p);
+    amscr_status st = base_params(registration, &p);
     if (st != AMSCR_OK) {
         tool_lib_error(NULL, st);
         return TOOL_EXIT_FAIL;
@@ -59,6 +43,12 @@ int make_params(const opts *o, int registration, amscr_params **out)
     SET(o->symmetric, "--symmetric", amscr_params_set_symmetric(p, 1));
     SET(o->param_set, "--parametrization", amscr_params_set_parametrization(p, o->param));
     SET(o->inv_set, "--invariance", amscr_params_set_invariance(p, o->inv));
+    /* the shape channel needs closed curves: open ones get the AMSCR distance alone */
+    SET(o->open && !registration && !o->channel_weight_set, "--open", amscr_params_set_channel_weight(p, 0.0));
+    SET(o->channel_weight_set, "--channel-weight", amscr_params_set_channel_weight(p, o->channel_weight));
+    SET(o->affine_share_set, "--affine-share", amscr_params_set_channel_affine_share(p, o->affine_share));
+    SET(o->rerank_set, "--rerank", amscr_params_set_rerank_k(p, (unsigned)o->rerank_k));
+    SET(o->rerank_set && o->rerank_k > 0, "--rerank", amscr_params_set_rerank_iterations(p, o->rerank_iters));
 #undef SET
     if (st != AMSCR_OK) {
         const char *d = lib_detail(); /* valid until the next library call: report first */

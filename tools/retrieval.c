@@ -43,7 +43,12 @@ int load_db(const amscr_params *p, const collection *c, int threshold, amscr_db 
     return 0;
 }
 
-int compute_matrix(const amscr_db *db, const char *what, const opts *o, double **out)
+int retrieval_is_plain(const amscr_params *p)
+{
+    return amscr_params_get_channel_weight(p) <= 0.0 && amscr_params_get_rerank_k(p) == 0;
+}
+
+int compute_matrix(const amscr_db *db, const char *what, double **out)
 {
     size_t n = amscr_db_size(db);
     if (n != 0 && n > SIZE_MAX / n / sizeof(double)) {
@@ -55,11 +60,8 @@ int compute_matrix(const amscr_db *db, const char *what, const opts *o, double *
         return -1;
     tool_progress pr;
     progress_init(&pr, "matching");
-    amscr_status st = amscr_db_distance_matrix(db, progress_cb, &pr, d);
-    if (st == AMSCR_OK && o->rerank_k > 0 && n > 0) {
-        progress_note(&pr, "re-ranking");
-        st = amscr_rerank_diffusion(d, n, o->rerank_k < n ? o->rerank_k : n, o->rerank_iters, d);
-    }
+    amscr_status st = retrieval_is_plain(amscr_db_params(db)) ? amscr_db_distance_matrix(db, progress_cb, &pr, d)
+                                                              : amscr_db_retrieval_matrix(db, progress_cb, &pr, d);
     progress_end(&pr);
     if (st != AMSCR_OK) {
         tool_lib_error(what, st);
@@ -69,4 +71,3 @@ int compute_matrix(const amscr_db *db, const char *what, const opts *o, double *
     *out = d;
     return 0;
 }
-

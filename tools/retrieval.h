@@ -1,5 +1,5 @@
 /* retrieval.h — the collection steps that search, matrix and eval share: a db of every shape
- * of a collection, and its distance matrix (re-ranked as the options say). */
+ * of a collection, and its retrieval distance matrix (as the db's params say). */
 #ifndef AMSCR_TOOL_RETRIEVAL_H
 #define AMSCR_TOOL_RETRIEVAL_H
 
@@ -10,9 +10,13 @@
 /* Loads every shape of collection c into a new db (params p); on failure prints the error
  * naming the file and returns -1. */
 int load_db(const amscr_params *p, const collection *c, int threshold, amscr_db **out);
-/* The n x n distance matrix of db (malloc'ed), re-ranked when o->rerank_k > 0; on failure
- * prints the error naming `what` and returns -1. */
-int compute_matrix(const amscr_db *db, const char *what, const opts *o, double **out);
+/* 1 when the params ask for the AMSCR distance alone (channel weight 0, no re-ranking): the
+ * plain, directional matrix of 0.1 (amscr_db_distance_matrix), bit for bit. */
+int retrieval_is_plain(const amscr_params *p);
+/* The n x n retrieval matrix of db (malloc'ed): amscr_db_retrieval_matrix (shape channel,
+ * fusion, re-ranking), or the plain matrix when retrieval_is_plain; on failure prints the
+ * error naming `what` and returns -1. */
+int compute_matrix(const amscr_db *db, const char *what, double **out);
 
 /* The db of the COLLECTION argument: an index (its prepared shapes; params from the index,
  * the options the user set checked against it) or a folder / manifest (prepared with the

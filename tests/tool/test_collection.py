@@ -14,22 +14,52 @@ MAPS = [((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
         ((0.6, -0.5, -3.0), (0.7, 0.8, 2.0))]
 
 
-# Retrieval commands default to the similarity group, 2 refinement iterations and re-ranking
-# (README: retrieval table);
-# these collections are affine-distorted copies, the case for the affine group.
-AFFINE = ("--invariance", "affine", "--no-rerank", "--refine", "0")
+# Retrieval commands default to the library's retrieval preset (the shape channel, re-ranking);
+# these collections are affine-distorted copies: --paper is the AMSCR distance alone in the
+# affine group, no refinement, no re-ranking.
+AFFINE = ("--paper",)
 
 
 def test_retrieval_defaults_and_rerank(manifest):
-    """The defaults (similarity + re-ranking) run, and --rerank changes the matrix."""
+    """The defaults (shape channel + re-ranking) run, and --rerank changes the matrix."""
     import json as _json
     j = _json.loads(run("eval", manifest, "--json").stdout)
     assert j["n"] == 9 and len(j["topk"]) == 8
+    assert j["bullseye"] == 1.0  # the channel's affine share ranks affine copies together
     a = run("matrix", manifest, "-o", "-", "--no-rerank").stdout
     b = run("matrix", manifest, "-o", "-", "--rerank", "3,10").stdout
     assert a != b
     assert run("eval", manifest, "--rerank", "0").returncode == 2
     assert run("eval", manifest, "--rerank", "3,0").returncode == 2
+
+
+def test_paper_is_the_explicit_options(manifest):
+    explicit = ("--invariance", "affine", "--no-rerank", "--refine", "0", "--channel-weight", "0")
+    assert run("matrix", manifest, "-o", "-", "--paper").stdout == run("matrix", manifest, "-o", "-", *explicit).stdout
+
+
+def test_retrieval_options(manifest):
+    base = run("matrix", manifest, "-o", "-").stdout
+    for opts in (("--fast",), ("--affine-share", "0.5"), ("--channel-weight", "0.5")):
+        r = run("matrix", manifest, "-o", "-", *opts)
+        assert r.returncode == 0, r.stderr
+        assert r.stdout != base, opts
+    assert run("matrix", manifest, "-o", "-", "--fast").stdout == \
+        run("matrix", manifest, "-o", "-", "--affine-share", "0").stdout
+    for bad in (("--channel-weight", "1.5"), ("--affine-share", "-0.1"), ("--channel-weight", "x")):
+        r = run("matrix", manifest, "-o", "-", *bad)
+        assert r.returncode == 2 and bad[0] in r.stderr
+    assert run("register", "a.txt", "b.txt", "--fast").returncode == 2  # a retrieval option
+
+
+def test_search_scores_self_zero(manifest, tmp_path):
+    """After re-ranking a member's own score is 0 and the others lie in (0, 1]."""
+    q = tmp_path / "shapes" / "wave_2.txt"
+    j = json.loads(run("search", q, manifest, "--top", "9", "--json").stdout)
+    res = j["results"]
+    assert res[0]["file"].endswith("wave_2.txt") and res[0]["distance"] == 0.0
+    assert [x["class"] for x in res[:3]] == ["WAVE"] * 3
+    assert all(0.0 < x["distance"] <= 1.0 for x in res[1:])
 
 
 def base_shapes():

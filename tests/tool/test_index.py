@@ -90,12 +90,17 @@ def test_options_that_conflict_with_the_index(tmp_path, cmd, opt, msg):
 
 
 def test_no_rerank_index(tmp_path):
+    """An index remembers its re-ranking settings: built without re-ranking (--paper), it
+    searches without it by default, and a --rerank it holds no neighbour lists for is refused."""
     m = make_manifest(tmp_path)
     idx = build(tmp_path, m, *AFFINE)
     q = tmp_path / "shapes" / "star_1.txt"
-    r = run("search", q, idx)  # re-ranking by default: the index has no neighbour lists
-    assert r.returncode == 2 and "--no-rerank" in r.stderr
-    assert run("search", q, idx, "--no-rerank").returncode == 0
+    r = run("search", q, idx, "--json")
+    assert r.returncode == 0, r.stderr
+    plain = run("search", q, idx, "--json", "--no-rerank")
+    assert json.loads(r.stdout)["results"] == json.loads(plain.stdout)["results"]
+    r = run("search", q, idx, "--rerank", "3")
+    assert r.returncode == 2 and "--no-rerank" in r.stderr and r.stdout == ""
 
 
 @pytest.mark.parametrize("damage", ["truncate", "flip", "version", "magic-only", "empty"])
@@ -161,3 +166,47 @@ def test_candidates(tmp_path):
     res = json.loads(r.stdout)["results"]
     assert res[0]["file"].endswith("wave_1.txt") and all(x["class"] == "wave" for x in res[:1])
     assert run("search", q, few, "--candidates", "-1").returncode == 2
+
+
+@pytest.mark.parametrize("opts", [(), ("--channel-weight", "0.5"), ("--affine-share", "0", "--rerank", "4,5")])
+def test_retrieval_defaults_from_an_index(tmp_path, opts):
+    """The retrieval preset (shape channel, fusion, re-ranking) holds for an index: matrix and
+    eval of the index equal the manifest's with the same options, and a search against it
+    (every shape a candidate) gives the manifest's scores in [0, 1], the query itself 0, for a
+    member query and for a new shape (weight 1: exactly; fused weights use the medians of the
+    index's build, so a new shape's scores keep their order but not their digits)."""
+    m = make_manifest(tmp_path)
+    idx = build(tmp_path, m, *opts)
+    a = run("matrix", idx, "-o", "-").stdout
+    b = run("matrix", m, "-o", "-", *opts).stdout
+    assert a.splitlines()[1:] == b.splitlines()[1:] and len(a.splitlines()) == 10
+    ja = json.loads(run("eval", idx, "--json", "--protocol", "groups").stdout)
+    jb = json.loads(run("eval", m, "--json", "--protocol", "groups", *opts).stdout)
+    assert ja["groups"] == jb["groups"] and ja["per_class"] == jb["per_class"]
+    member = tmp_path / "shapes" / "blob_2.txt"
+    new = tmp_path / "new.txt"
+    write_points(new, affine(((0.8, 0.3, 4.0), (-0.2, 1.2, 1.0)), base_shapes()["wave"]))
+    for q in (member, new):
+        a = json.loads(run("search", q, idx, "--json", "--candidates", "0").stdout)["results"]
+        b = json.loads(run("search", q, m, "--json", *opts).stdout)["results"]
+        assert all(0.0 <= r["distance"] <= 1.0 for r in a)
+        if q == member:
+            assert a[0]["file"].endswith("blob_2.txt") and a[0]["distance"] == 0.0
+        if q == member or "--channel-weight" not in opts:
+            same_results(a, b)
+        else:
+            assert [r["class"] for r in a] == [r["class"] for r in b]
+
+
+def test_channel_options_that_conflict_with_the_index(tmp_path):
+    m = make_manifest(tmp_path)
+    idx = build(tmp_path, m)
+    q = tmp_path / "shapes" / "star_1.txt"
+    for opt, msg in ((("--channel-weight", "0.5"), "built with --channel-weight 1"),
+                     (("--affine-share", "0"), "--affine-share"), (("--fast",), "--affine-share"),
+                     (("--paper",), "--channel-weight")):
+        r = run("search", q, idx, *opt)
+        assert r.returncode == 2 and msg in r.stderr and r.stdout == "", r.stderr
+    # re-ranking is a query-time setting up to the neighbours the index holds (8 by default)
+    assert run("search", q, idx, "--rerank", "4,3").returncode == 0
+    assert run("search", q, idx, "--no-rerank").returncode == 0

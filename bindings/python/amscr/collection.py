@@ -240,6 +240,48 @@ class Collection:
             progress_call(lib.amscr_db_distance_matrix, (src._db,), (dbuf(out),), progress)
             return out
 
+    def channel_matrix(self, threads: Optional[int] = None, progress: ProgressArg = False) -> np.ndarray:
+        """All pairwise distances of the shape channel (C ``amscr_db_channel_matrix``): height
+        functions matched by banded dynamic programming, in the frame(s) of the collection's
+        ``channel_invariance`` / ``channel_affine_share``; closed curves only.
+
+        Args:
+            threads: threads for this call (None: the collection's).
+            progress: as in :meth:`query`.
+        Returns:
+            (n, n) float array, symmetric, zero diagonal.
+        Raises:
+            InvalidArgumentError: open curves; CancelledError: cancelled by `progress`.
+        """
+        return self._matrix(lib.amscr_db_channel_matrix, threads, progress)
+
+    def retrieval_matrix(self, threads: Optional[int] = None, progress: ProgressArg = False) -> np.ndarray:
+        """The retrieval distance (C ``amscr_db_retrieval_matrix``): the AMSCR matrix
+        (symmetrized) and the shape channel, each divided by its median off-diagonal value and
+        mixed by ``channel_weight``, then diffusion re-ranking when ``rerank_k`` > 0 (scores
+        in [0, 1], 0 for a shape itself). With :meth:`Params.retrieval` this is the project's
+        default retrieval; with channel weight 0 and no re-ranking it is the symmetrized
+        :meth:`distance_matrix`.
+
+        Args:
+            threads: threads for this call (None: the collection's).
+            progress: as in :meth:`query`.
+        Returns:
+            (n, n) float array for ranking, zero diagonal.
+        Raises:
+            InvalidArgumentError: open curves with a channel weight; CancelledError: cancelled
+            by `progress`.
+        """
+        return self._matrix(lib.amscr_db_retrieval_matrix, threads, progress)
+
+    def _matrix(self, fn: Any, threads: Optional[int], progress: ProgressArg) -> np.ndarray:
+        with self._lock.read():
+            src, _ = self._with_threads(threads)
+            n = len(self)
+            out = np.zeros((n, n), dtype=np.float64)
+            progress_call(fn, (src._db,), (dbuf(out),), progress)
+            return out
+
     def cross_matrix(self, other: 'Collection', threads: Optional[int] = None,
                      progress: ProgressArg = False) -> np.ndarray:
         """Distances from this collection's shapes (queries) to `other`'s (targets), with this

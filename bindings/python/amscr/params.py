@@ -104,6 +104,20 @@ class Params:
     invariance = _Option('invariance', _enum(INVARIANCES), "'affine' (default), 'similarity' or 'penalized'")
     penalty = _Option('penalty', _FLOAT, "weight of the 'penalized' invariance")
     partial = _Option('partial', _BOOL, "the source is an open fragment of the target's closed boundary (register)")
+    channel_weight = _Option('channel_weight', _FLOAT,
+                             'share of the shape channel in Collection.retrieval_matrix, 0..1 (0 = the AMSCR '
+                             'distance alone, the default; 1 = the channel alone, the retrieval preset)')
+    channel_invariance = _Option('channel_invariance', _enum(INVARIANCES),
+                                 "frame of the shape channel: 'similarity' (default) or 'affine' (whitened)")
+    channel_affine_share = _Option('channel_affine_share', _FLOAT,
+                                   'with the similarity frame: the share, 0..1, of the channel computed in the '
+                                   'affine frame (default 0.2; 0 = one frame, half the time)')
+    channel_band = _Option('channel_band', _FLOAT,
+                           "half width of the channel's dynamic-programming band, fraction of N in (0, 0.5]")
+    channel_skip = _Option('channel_skip', _FLOAT, "the channel's cost of a skipped sample (>= 0)")
+    channel_locality = _Option('channel_locality', _FLOAT, "the channel's locality of the height functions (>= 0)")
+    rerank_k = _Option('rerank_k', _UINT, 'neighbours of the re-ranking of retrieval_matrix (0 = none; preset 8)')
+    rerank_iterations = _Option('rerank_iterations', _UINT, 'diffusion iterations of that re-ranking (1..1000)')
 
     #: The option names, in the order of the table above.
     OPTIONS: Tuple[str, ...] = ()
@@ -129,6 +143,25 @@ class Params:
         """
         self = cls.__new__(cls)
         self._p = _new_params(lib.amscr_params_new_registration)
+        self.update(**options)
+        return self
+
+    @classmethod
+    def retrieval(cls, **options: Any) -> 'Params':
+        """The retrieval preset (C ``amscr_params_new_retrieval``): the defaults with mirror
+        images, the shape channel alone (channel weight 1: height functions matched by banded
+        dynamic programming, in the similarity frame with 0.2 of the affine frame) and
+        re-ranking (k 8, 10 iterations); use it with :meth:`Collection.retrieval_matrix`.
+
+        Args:
+            **options: options to change from the preset.
+        Returns:
+            a new :class:`Params`.
+        Raises:
+            TypeError: an unknown option; InvalidArgumentError: a bad value.
+        """
+        self = cls.__new__(cls)
+        self._p = _new_params(lib.amscr_params_new_retrieval)
         self.update(**options)
         return self
 

@@ -214,3 +214,29 @@ def distance(src: PointsLike, tgt: PointsLike, *, params: Optional[Params] = Non
     out = ffi.new('double *')
     _check(lib.amscr_distance(p._p, s._d, t._d, _workspace(), out))
     return float(out[0])
+
+
+def channel_distance(src: PointsLike, tgt: PointsLike, *, params: Optional[Params] = None, order: str = 'xy',
+                     **options: Any) -> float:
+    """The shape channel's distance of two closed shapes (C ``amscr_channel_distance``): height
+    functions matched by banded dynamic programming in the channel's frame; 0 for a shape
+    against itself, invariant to the channel's group, tolerant of articulation.
+
+    Args:
+        src, tgt: (n, 2) point arrays, OpenCV (n, 1, 2) contours or prepared :class:`Shape` s.
+        params: a :class:`Params` to start from (None: a prepared shape's own, else the
+            retrieval preset, :meth:`Params.retrieval`).
+        order: 'xy' (default) or 'rc' for (row, col) points.
+        **options: options of :class:`Params`.
+    Returns:
+        the channel distance, a float >= 0.
+    Raises:
+        InvalidArgumentError: bad points or options, open curves; DegenerateError: a degenerate
+        shape.
+    """
+    if params is None and not isinstance(src, Shape) and not isinstance(tgt, Shape):
+        params = Params.retrieval()
+    p, s, t = _pair(src, tgt, params, options, order)
+    out = ffi.new('double *')
+    _check(lib.amscr_channel_distance(p._p, s._d, t._d, out))
+    return float(out[0])

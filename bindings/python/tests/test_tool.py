@@ -34,9 +34,8 @@ def test_matrix_of_point_files_equals_tool(tmp_path):
             pts = affine(base, np.eye(2) + 0.3 * rng.normal(size=(2, 2)), rng.normal(size=2))
             amscr.write_points(folder / ('class%d-%d.txt' % (c, i + 1)), pts)
     out = tmp_path / 'D.npy'
-    # the tool's retrieval defaults are similarity + re-ranking; the plain affine matrix first
-    _tool('matrix', str(folder), '-o', str(out), '--points', '64', '--threads', '2', '--invariance', 'affine',
-          '--no-rerank', '--refine', '0')
+    # the tool's retrieval defaults are the retrieval preset; the paper's plain matrix first
+    _tool('matrix', str(folder), '-o', str(out), '--points', '64', '--threads', '2', '--paper')
     D_tool = np.load(out)
     names = sorted(os.listdir(folder), key=os.fsencode)  # the tool sorts by byte order
     db = amscr.Collection(points=64, reflections=True)  # reflections: on by default in `amscr matrix`
@@ -47,17 +46,16 @@ def test_matrix_of_point_files_equals_tool(tmp_path):
     np.testing.assert_array_equal(D, D_tool)
     # the tool's text output agrees too (to its printed precision)
     tsv = _tool('matrix', str(folder), '-o', '-', '--points', '64', '--invariance', 'affine', '--no-rerank', '--refine',
-                '0').stdout
+                '0', '--channel-weight', '0').stdout
     rows = [list(map(float, line.split('\t'))) for line in tsv.splitlines() if line and not line.startswith('#')]
     np.testing.assert_allclose(np.array(rows), D, rtol=1e-9, atol=1e-12)
-    # and the tool's defaults are the similarity group, 2 refinement iterations, then re-ranking
-    # (k 5, 20 iterations)
+    # and the tool's defaults are the retrieval preset (Collection.retrieval_matrix)
     out2 = tmp_path / 'D2.npy'
     _tool('matrix', str(folder), '-o', str(out2), '--points', '64')
-    dbs = amscr.Collection(points=64, reflections=True, invariance='similarity', refine=2)
+    dbs = amscr.Collection(amscr.Params.retrieval(points=64))
     for n in names:
         dbs.add(amscr.read_points(folder / n), label=n.split('-')[0])
-    np.testing.assert_array_equal(amscr.rerank_diffusion(dbs.distance_matrix(), 5, 20), np.load(out2))
+    np.testing.assert_array_equal(dbs.retrieval_matrix(), np.load(out2))
 
 
 def _read_png_gray8(path):
@@ -120,8 +118,7 @@ def test_matrix_of_images_equals_tool(tmp_path):
     manifest.write_text('file\tclass\n' + ''.join('%s\t%s\n' % (os.path.join(os.path.abspath(folder), f),
                                                                  f.split('-')[0]) for f in pick))
     out = tmp_path / 'D.npy'
-    _tool('matrix', str(manifest), '-o', str(out), '--points', '64', '--invariance', 'affine', '--no-rerank',
-          '--refine', '0')
+    _tool('matrix', str(manifest), '-o', str(out), '--points', '64', '--paper')
     D_tool = np.load(out)
     db = amscr.Collection(points=64, reflections=True)
     for f, img in zip(pick, imgs):

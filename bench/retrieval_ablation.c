@@ -1,0 +1,240 @@
+/* retrieval_ablation.c — the ablation table of the retrieval default (issue 13; run by
+ * `amscr-retrieval-bench ablation DATASETS`): on each set the three base matrices are computed
+ * once through the library — the AMSCR distance (the paper's method: affine group, no
+ * refinement, mirror images), the shape channel in the similarity frame and in the affine
+ * (whitened) frame — and every row is composed from them exactly as amscr_db_retrieval_matrix
+ * composes them (channel frames mixed 0.8 / 0.2, fusion = each matrix over its median
+ * off-diagonal value, re-ranking k 8, 10 iterations). A row's time is the wall time of the base
+ * matrices it needs plus its fusion and re-ranking (decode, trace and preparation are listed
+ * once per set). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "../src/internal.h"
+#include "mcd_set.h"
+
+enum { M_AMSCR, M_SIM, M_AFF, NBASE };
+
+typedef struct {
+    const char *name;
+    int use[NBASE];     /* base matrices: AMSCR, channel similarity, channel affine */
+    double weight;      /* channel weight of the fusion with AMSCR (used when both are in) */
+    double share;       /* affine share of the channel (when both frames are in) */
+    int rerank;         /* re-ranking k 8, 10 iterations */
+} row_t;
+
+static const row_t ROWS[] = {
+    {"paper's method (AMSCR, affine, no re-ranking)", {1, 0, 0}, 0, 0, 0},
+    {"AMSCR + re-ranking", {1, 0, 0}, 0, 0, 1},
+    {"channel, similarity frame", {0, 1, 0}, 1, 0, 0},
+    {"channel, affine frame", {0, 0, 1}, 1, 1, 0},
+    {"channel, both frames (0.8 / 0.2)", {0, 1, 1}, 1, 0.2, 0},
+    {"AMSCR + channel fused (w 0.5)", {1, 1, 1}, 0.5, 0.2, 0},
+    {"channel, similarity frame + re-ranking (--fast)", {0, 1, 0}, 1, 0, 1},
+    {"channel, affine frame + re-ranking", {0, 0, 1}, 1, 1, 1},
+    {"AMSCR + channel fused (w 0.5) + re-ranking", {1, 1, 1}, 0.5, 0.2, 1},
+    {"**default: channel, both frames + re-ranking**", {0, 1, 1}, 1, 0.2, 1},
+};
+enum { NROWS = sizeof ROWS / sizeof ROWS[0] };
+
+typedef struct {
+    const char *title;
+    int kind; /* 0 bull's eye %, 1 top-k sum */
+    shape_set s;
+    double t_load, t_prep, t_base[NBASE];
+    double *base[NBASE];
+    double score[NROWS], secs[NROWS];
+} set_run;
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void die(const char *what)
+{
+    fprintf(stderr, "amscr-retrieval-bench ablation: %s: %s\n", what, amscr_last_error_detail());
+    exit(1);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double offdiag_median(const double *M, size_t n)
+{
+    size_t m = n * n - n, k = 0;
+    double *v = malloc(m * sizeof *v);
+    if (!v)
+        die("memory");
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < n; j++)
+            if (i != j)
+                v[k++] = M[i * n + j];
+    qsort(v, m, sizeof *v, cmp_double);
+    double med = v[m / 2];
+    free(v);
+    return med;
+}
+
+/* The base matrices of r->s through the library (one db per channel frame). */
+static void compute_bases(set_run *r)
+{
+    size_t n = r->s.n;
+    amscr_params *p = NULL;
+    if (amscr_params_new_retrieval(&p) != AMSCR_OK || amscr_params_set_channel_affine_share(p, 0.0) != AMSCR_OK)
+        die("params");
+    for (int b = 0; b < NBASE; b++) {
+        if (b == M_AFF && amscr_params_set_channel_invariance(p, AMSCR_INVARIANCE_AFFINE) != AMSCR_OK)
+            die("params");
+        double t0 = now();
+        amscr_db *db = NULL;
+        if (amscr_db_new(p, &db) != AMSCR_OK)
+            die("db");
+        for (size_t i = 0; i < n; i++)
+            if (amscr_db_add_contour(db, r->s.c[i], r->s.labels[i], NULL) != AMSCR_OK)
+                die("prepare");
+        if (b == 0)
+            r->t_prep = now() - t0;
+        r->base[b] = malloc(n * n * sizeof(double));
+        if (!r->base[b])
+            die("memory");
+        t0 = now();
+        amscr_status st = b == M_AMSCR ? amscr_db_distance_matrix(db, NULL, NULL, r->base[b])
+                                       : amscr_db_channel_matrix(db, NULL, NULL, r->base[b]);
+        if (st != AMSCR_OK)
+            die("matrix");
+        r->t_base[b] = now() - t0;
+        amscr_db_free(db);
+    }
+    amscr_params_free(p);
+}
+
+/* Row w of the table into out (n x n), as amscr_db_retrieval_matrix composes it. */
+static void compose(const set_run *r, const row_t *w, double *out)
+{
+    size_t n = r->s.n, nn = n * n;
+    double *H = malloc(nn * sizeof *H);
+    if (!H)
+        die("memory");
+    int ch = w->use[M_SIM] || w->use[M_AFF];
+    for (size_t i = 0; ch && i < nn; i++)
+        H[i] = !w->use[M_AFF] ? r->base[M_SIM][i]
+             : !w->use[M_SIM] ? r->base[M_AFF][i]
+                              : (1.0 - w->share) * r->base[M_SIM][i] + w->share * r->base[M_AFF][i];
+    if (!w->use[M_AMSCR]) {
+        memcpy(out, H, nn * sizeof *out);
+    } else {
+        memcpy(out, r->base[M_AMSCR], nn * sizeof *out);
+        if (ch || w->rerank) { /* the plain paper's row keeps the directional matrix */
+            for (size_t i = 0; i < n; i++) {
+                out[i * n + i] = 0.0;
+                for (size_t j = i + 1; j < n; j++)
+                    out[i * n + j] = out[j * n + i] = 0.5 * (out[i * n + j] + out[j * n + i]);
+            }
+        }
+        if (ch) {
+            double sa = (1.0 - w->weight) / offdiag_median(out, n), sh = w->weight / offdiag_median(H, n);
+            for (size_t i = 0; i < nn; i++)
+                out[i] = sa * out[i] + sh * H[i];
+        }
+    }
+    free(H);
+    if (w->rerank && amscr__rerank_normalized(out, n, n < 8 ? n : 8, 10, out) != AMSCR_OK)
+        die("re-ranking");
+}
+
+static void run_set(set_run *r)
+{
+    size_t n = r->s.n;
+    compute_bases(r);
+    double *D = malloc(n * n * sizeof *D);
+    if (!D)
+        die("memory");
+    for (int k = 0; k < NROWS; k++) {
+        double t0 = now();
+        compose(r, &ROWS[k], D);
+        r->secs[k] = now() - t0;
+        for (int b = 0; b < NBASE; b++)
+            r->secs[k] += ROWS[k].use[b] ? r->t_base[b] : 0.0;
+        r->score[k] = 0;
+        if (r->kind == 1) {
+            size_t counts[16] = {0}, kmax = n > 100 ? 11 : 10;
+            if (amscr_score_topk_table(D, n, r->s.labels, kmax, counts) != AMSCR_OK)
+                die("top-k");
+            for (size_t q = 0; q < kmax; q++)
+                r->score[k] += (double)counts[q];
+        } else if (amscr_score_bullseye(D, n, r->s.labels, 0, &r->score[k]) != AMSCR_OK) {
+            die("bull's eye");
+        } else {
+            r->score[k] *= 100.0;
+        }
+    }
+    free(D);
+    for (int b = 0; b < NBASE; b++)
+        free(r->base[b]);
+}
+
+int ablation_main(const char *dir);
+
+int ablation_main(const char *dir)
+{
+    static set_run sets[4];
+    const char *titles[4] = {"mpeg7-dev (bull's eye %)", "MCD-style (bull's eye %)", "Kimia-99 (top-10 sum /990)",
+                             "Kimia-216 (top-11 sum /2376)"};
+    const char *dirs[4] = {"mpeg7-dev", "mpeg7-dev", "kimia99", "kimia216"};
+    for (int k = 0; k < 4; k++) {
+        sets[k].title = titles[k];
+        sets[k].kind = k >= 2;
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s/manifest.tsv", dir, dirs[k]);
+        if (access(path, R_OK) != 0) {
+            fprintf(stderr, "amscr-retrieval-bench: %s not found\n", path);
+            return 77;
+        }
+        double t0 = now();
+        if ((k == 1 ? shape_set_mcd(path, MCD_SEED, &sets[k].s) : shape_set_load(path, &sets[k].s)) != 0)
+            return 1;
+        sets[k].t_load = now() - t0;
+        run_set(&sets[k]);
+        fprintf(stderr, "ablation: %s done\n", dirs[k]);
+    }
+    double la[3] = {-1, -1, -1};
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (f) {
+        if (fscanf(f, "%lf %lf %lf", &la[0], &la[1], &la[2]) != 3)
+            la[0] = -1;
+        fclose(f);
+    }
+    printf("Ablation (amscr-retrieval-bench ablation; %ld cores online, load average at the end %.2f %.2f %.2f). "
+           "Score, then wall seconds of the matrices the row needs plus its fusion and re-ranking.\n\n",
+           sysconf(_SC_NPROCESSORS_ONLN), la[0], la[1], la[2]);
+    printf("| setting |");
+    for (int k = 0; k < 4; k++)
+        printf(" %s | s |", sets[k].title);
+    printf("\n|---|");
+    for (int k = 0; k < 4; k++)
+        printf("---|---|");
+    printf("\n");
+    for (int r = 0; r < NROWS; r++) {
+        printf("| %s |", ROWS[r].name);
+        for (int k = 0; k < 4; k++)
+            printf(sets[k].kind ? " %.0f | %.1f |" : " %.2f | %.1f |", sets[k].score[r], sets[k].secs[r]);
+        printf("\n");
+    }
+    printf("| (decode + trace, prepare: s) |");
+    for (int k = 0; k < 4; k++)
+        printf(" %.1f + %.1f | |", sets[k].t_load, sets[k].t_prep);
+    printf("\n");
+    for (int k = 0; k < 4; k++)
+        shape_set_free(&sets[k].s);
+    return 0;
+}

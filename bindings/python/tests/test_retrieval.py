@@ -1,0 +1,111 @@
+"""The retrieval preset: the shape channel (amscr.channel_distance, Collection.channel_matrix)
+and the fused, re-ranked Collection.retrieval_matrix."""
+import numpy as np
+import pytest
+
+import amscr
+from helpers import affine, blob
+
+
+def _rotation(theta, s=1.0):
+    c, n = np.cos(theta), np.sin(theta)
+    return s * np.array([[c, -n], [n, c]])
+
+
+def _bent(points, amount):
+    """A non-affine deformation: the upper half pushed sideways by a bend."""
+    p = np.array(points, dtype=float)
+    p[:, 0] += amount * np.maximum(p[:, 1], 0.0) ** 2
+    return p
+
+
+def test_the_preset():
+    p = amscr.Params.retrieval()
+    assert p.channel_weight == 1.0 and p.rerank_k == 8 and p.rerank_iterations == 10
+    assert p.reflections and p.channel_invariance == 'similarity' and p.channel_affine_share == 0.2
+    assert p.invariance == 'affine' and p.refine == 0
+    assert amscr.Params.retrieval(rerank_k=0).rerank_k == 0
+    d = amscr.Params()
+    assert d.channel_weight == 0.0 and d.rerank_k == 0  # the plain defaults keep 0.1's distance
+
+
+def test_channel_distance_is_zero_to_itself_and_invariant():
+    a, b = blob(300, seed=1), blob(300, seed=2)
+    assert amscr.channel_distance(a, a) == pytest.approx(0.0, abs=1e-12)
+    d_ab = amscr.channel_distance(a, b)
+    assert d_ab > 0.0
+    # the similarity frame: a rotated, scaled, moved copy is the same shape
+    moved = affine(a, _rotation(1.1, 2.5), [3.0, -7.0])
+    assert amscr.channel_distance(moved, b) == pytest.approx(d_ab, rel=0.02, abs=1e-6)
+    # the affine frame: a sheared copy too
+    sheared = affine(a, [[1.4, 0.6], [-0.2, 0.7]], [1.0, 2.0])
+    assert amscr.channel_distance(sheared, a, channel_invariance='affine') < 0.05 * \
+        amscr.channel_distance(b, a, channel_invariance='affine')
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.channel_distance(a, b, closed=False)
+
+
+def test_the_channel_tolerates_a_bend_more_than_the_amscr_distance():
+    a, b = blob(300, seed=4), blob(300, seed=5)
+    bent = _bent(a, 0.25)
+    p = amscr.Params.retrieval()
+    ratio_channel = amscr.channel_distance(a, bent, params=p) / amscr.channel_distance(a, b, params=p)
+    ratio_amscr = amscr.distance(a, bent, params=p) / amscr.distance(a, b, params=p)
+    assert ratio_channel < ratio_amscr
+
+
+def _collection(params, classes=3, copies=4, seed=0):
+    rng = np.random.default_rng(seed)
+    db = amscr.Collection(params)
+    for c in range(classes):
+        base = blob(300, seed=20 + c)
+        for _ in range(copies):
+            A = _rotation(rng.uniform(0, 2 * np.pi), rng.uniform(0.5, 2.0)) @ (np.eye(2) + 0.2 * rng.normal(size=(2, 2)))
+            db.add(affine(base, A, rng.normal(size=2)) + 0.002 * rng.normal(size=(300, 2)), label=c)
+    return db
+
+
+def test_channel_matrix_is_the_pairwise_channel_distance():
+    db = _collection(amscr.Params.retrieval(points=64))
+    H = db.channel_matrix()
+    n = len(db)
+    assert H.shape == (n, n) and np.all(np.diag(H) == 0.0)
+    np.testing.assert_array_equal(H, H.T)
+    for i, j in [(0, 1), (2, 9), (5, 11)]:
+        assert H[i, j] == pytest.approx(amscr.channel_distance(db.shape(i), db.shape(j)), rel=1e-12)
+
+
+def test_retrieval_matrix_fuses_and_reranks():
+    p = amscr.Params.retrieval(points=64)
+    db = _collection(p, copies=10)  # classes larger than the preset's 8 neighbours
+    n, labels = len(db), db.label_codes
+    calls = []
+    R = db.retrieval_matrix(progress=lambda done, total: calls.append((done, total)))
+    assert calls and calls[-1][0] == calls[-1][1]
+    assert np.all(np.diag(R) == 0.0) and np.all((R >= 0.0) & (R <= 1.0))
+    assert amscr.bullseye(R, labels) == 1.0
+    # the pieces: channel alone without re-ranking is the channel matrix
+    alone = _collection(p.copy(rerank_k=0))
+    np.testing.assert_array_equal(alone.retrieval_matrix(), alone.channel_matrix())
+    # weight 0 without re-ranking: the symmetrized AMSCR matrix
+    plain = _collection(p.copy(rerank_k=0, channel_weight=0.0))
+    D = plain.distance_matrix()
+    S = 0.5 * (D + D.T)
+    np.fill_diagonal(S, 0.0)
+    np.testing.assert_allclose(plain.retrieval_matrix(), S, rtol=1e-15, atol=0)
+    # a fused matrix differs from both and is symmetric before re-ranking
+    fused = _collection(p.copy(rerank_k=0, channel_weight=0.5)).retrieval_matrix()
+    np.testing.assert_allclose(fused, fused.T, rtol=1e-12)
+    assert n == 30
+
+
+def test_open_curves_need_weight_zero():
+    db = amscr.Collection(amscr.Params.retrieval(closed=False, points=64))
+    db.add(blob(200, seed=1)[:150])
+    db.add(blob(200, seed=2)[:150])
+    with pytest.raises(amscr.InvalidArgumentError):
+        db.retrieval_matrix()
+    db2 = amscr.Collection(amscr.Params.retrieval(closed=False, points=64, channel_weight=0.0, rerank_k=0))
+    db2.add(blob(200, seed=1)[:150])
+    db2.add(blob(200, seed=2)[:150])
+    assert db2.retrieval_matrix().shape == (2, 2)
