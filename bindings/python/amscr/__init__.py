@@ -32,8 +32,8 @@ from .errors import (AmscrError, CancelledError, DegenerateError, Error, FileErr
 from ._util import ArrayLike, ProgressArg
 from .library import has_threads, library_version
 from .params import Params
-from .contour import (as_points, contour_from_mask, orient_ccw, parse_points, read_points, signed_area,
-                      validate_contour, write_points)
+from .contour import (ImageContour, as_points, contour_from_mask, contours_from_mask, orient_ccw, parse_points,
+                      read_points, signed_area, validate_contour, write_points)
 from .shape import PointsLike, Shape
 from .result import Mixture, Registration, channel_distance, distance, register
 from .collection import Collection, distance_matrix
@@ -59,7 +59,7 @@ __all__ = [
     'distance_matrix',
     'bullseye', 'topk_table', 'nn_accuracy', 'nn_split', 'topk', 'rerank_diffusion',
     # contours
-    'as_points', 'contour_from_mask', 'read_points', 'parse_points', 'write_points', 'signed_area', 'orient_ccw',
+    'as_points', 'contour_from_mask', 'contours_from_mask', 'ImageContour', 'read_points', 'parse_points', 'write_points', 'signed_area', 'orient_ccw',
     'validate_contour',
     # building blocks
     'smooth', 'gaussian_kernel', 'resample_euclidean', 'resample_affine', 'affine_arclength',

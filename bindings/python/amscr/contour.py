@@ -9,12 +9,12 @@ The C contour is a private carrier here: functions take and return (n, 2) NumPy 
 from __future__ import annotations
 
 import os
-from typing import Any, Union
+from typing import Any, List, NamedTuple, Optional, Tuple, Union
 
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ArrayLike, as_bool, as_count, bad, copy_points, dbuf, new_object
+from ._util import ArrayLike, as_bool, as_count, as_scalar, bad, copy_points, dbuf, new_object
 from ._util import as_points as _as_points
 from .errors import _check
 
@@ -59,6 +59,32 @@ def _take(c) -> np.ndarray:
     return pts
 
 
+def _mask_and_threshold(mask: ArrayLike, threshold: Union[int, str, None]) -> Tuple[np.ndarray, int]:
+    """A C-contiguous uint8 copy of `mask` and the C threshold (see :func:`contour_from_mask`)."""
+    a = np.asarray(mask)
+    if a.ndim != 2:
+        raise bad('mask: expected a 2-D array, got shape %s' % (a.shape,))
+    if a.dtype == np.bool_:
+        a = np.where(a, np.uint8(255), np.uint8(0))
+    elif a.dtype != np.uint8:
+        if a.dtype.kind not in 'iu':
+            raise bad('mask: expected a bool or uint8 array, got dtype %s' % a.dtype)
+        if a.size and (a.min() < 0 or a.max() > 255):
+            raise bad('mask: values must be in 0..255 for dtype %s (got %d..%d)' % (a.dtype, a.min(), a.max()))
+        a = a.astype(np.uint8)
+    a = np.ascontiguousarray(a)
+    if threshold is None:
+        return a, 127
+    if isinstance(threshold, str):
+        if threshold.strip().lower() not in ('auto', 'otsu'):
+            raise bad("threshold: expected 0..254, 'auto' or None, got %r" % threshold)
+        return a, lib.AMSCR_THRESHOLD_AUTO
+    thr = as_count(threshold, 'threshold', 0)
+    if thr > 0x7FFFFFFF:
+        raise bad('threshold: expected 0..254, got %d' % thr)
+    return a, thr
+
+
 def contour_from_mask(mask: ArrayLike, threshold: Union[int, str, None] = None) -> np.ndarray:
     """Outer boundary of the largest 8-connected foreground component of a 2-D image.
 
@@ -75,30 +101,54 @@ def contour_from_mask(mask: ArrayLike, threshold: Union[int, str, None] = None) 
         NotFoundError: no foreground (or foreground everywhere); DegenerateError: too small;
         LimitError: image too large.
     """
-    a = np.asarray(mask)
-    if a.ndim != 2:
-        raise bad('mask: expected a 2-D array, got shape %s' % (a.shape,))
-    if a.dtype == np.bool_:
-        a = np.where(a, np.uint8(255), np.uint8(0))
-    elif a.dtype != np.uint8:
-        if a.dtype.kind not in 'iu':
-            raise bad('mask: expected a bool or uint8 array, got dtype %s' % a.dtype)
-        if a.size and (a.min() < 0 or a.max() > 255):
-            raise bad('mask: values must be in 0..255 for dtype %s (got %d..%d)' % (a.dtype, a.min(), a.max()))
-        a = a.astype(np.uint8)
-    a = np.ascontiguousarray(a)
-    if threshold is None:
-        thr = 127
-    elif isinstance(threshold, str):
-        if threshold.strip().lower() not in ('auto', 'otsu'):
-            raise bad("threshold: expected 0..254, 'auto' or None, got %r" % threshold)
-        thr = lib.AMSCR_THRESHOLD_AUTO
-    else:
-        thr = as_count(threshold, 'threshold', 0)
-        if thr > 0x7FFFFFFF:
-            raise bad('threshold: expected 0..254, got %d' % thr)
+    a, thr = _mask_and_threshold(mask, threshold)
     h, w = a.shape
     return _take(_new_contour(lib.amscr_contour_from_mask, ffi.from_buffer('uint8_t[]', a), w, h, w, thr))
+
+
+class ImageContour(NamedTuple):
+    """One contour of :func:`contours_from_mask`: its points, its parent's index in the list
+    (None for a top-level component), whether it is a hole, and its polygon area (pixels^2)."""
+    points: np.ndarray
+    parent: Optional[int]
+    is_hole: bool
+    area: float
+
+
+def contours_from_mask(mask: ArrayLike, threshold: Union[int, str, None] = None,
+                       min_area: float = 10.0) -> List[ImageContour]:
+    """Every contour of a 2-D image with its hierarchy, as OpenCV's ``findContours`` with
+    ``RETR_TREE``: each 8-connected foreground component's outer boundary and each hole's.
+
+    Args:
+        mask, threshold: as :func:`contour_from_mask`.
+        min_area: contours of a smaller polygon area (pixels^2) are dropped, with everything
+            inside them (default 10, the ``amscr contour --all`` default; 0 keeps all).
+    Returns:
+        A list of :class:`ImageContour` in raster order of their first pixel, so a parent
+        comes before its children. Outer contours run counter-clockwise (positive signed area)
+        through their component's boundary pixel centres; a hole's contour runs clockwise
+        through its own boundary (background) pixels. A hole's parent is the component around
+        it; a component's parent is the hole it lies in, or None.
+    Raises:
+        NotFoundError: no foreground, foreground everywhere, or no contour of `min_area`;
+        InvalidArgumentError: a bad mask, threshold or min_area; LimitError: image too large.
+    """
+    a, thr = _mask_and_threshold(mask, threshold)
+    area = as_scalar(min_area, 'min_area')
+    h, w = a.shape
+    out = ffi.new('amscr_contour_set **')
+    _check(lib.amscr_contours_from_mask(ffi.from_buffer('uint8_t[]', a), w, h, w, thr, area, out))
+    cs = ffi.gc(out[0], lib.amscr_contour_set_free)
+    result = []
+    for i in range(int(lib.amscr_contour_set_size(cs))):
+        parent = int(lib.amscr_contour_set_parent(cs, i))
+        result.append(ImageContour(contour_points(lib.amscr_contour_set_contour(cs, i)),
+                                   None if parent == int(ffi.cast('size_t', -1)) else parent,
+                                   bool(lib.amscr_contour_set_is_hole(cs, i)),
+                                   float(lib.amscr_contour_set_area(cs, i))))
+    ffi.release(cs)
+    return result
 
 
 def read_points(path: Union[str, os.PathLike]) -> np.ndarray:

@@ -152,3 +152,35 @@ def test_skimage_contours_register_and_warp_the_mask():
     wrong = transform.AffineTransform(matrix=amscr.register(src_rc, tgt_rc).matrix)
     warped_wrong = transform.warp(src_mask.astype(float), wrong.inverse, output_shape=tgt_mask.shape, order=0)
     assert _iou(warped_wrong > 0.5, tgt_mask) < 0.8
+
+
+def test_contours_from_mask_gives_the_hierarchy():
+    # two squares, the left one with a square hole holding a small square component
+    m = np.zeros((60, 100), np.uint8)
+    m[5:55, 5:55] = 255
+    m[15:45, 15:45] = 0
+    m[25:35, 25:35] = 255
+    m[10:40, 65:95] = 255
+    cs = amscr.contours_from_mask(m, min_area=0)
+    assert [(c.is_hole, c.parent) for c in cs] == [(False, None), (False, None), (True, 0), (False, 2)] or \
+        [(c.is_hole, c.parent) for c in cs] == [(False, None), (True, 0), (False, None), (False, 1)]
+    outer = [c for c in cs if not c.is_hole]
+    holes = [c for c in cs if c.is_hole]
+    assert len(outer) == 3 and len(holes) == 1
+    for c in outer:
+        assert amscr.signed_area(c.points) > 0 and c.area > 0
+    assert amscr.signed_area(holes[0].points) < 0
+    # the largest outer contour is what contour_from_mask gives
+    big = max(outer, key=lambda c: c.area)
+    np.testing.assert_array_equal(big.points, amscr.contour_from_mask(m))
+    # min_area drops the small inner component only
+    assert len(amscr.contours_from_mask(m, min_area=200)) == 3
+
+
+def test_contours_from_mask_bad_input():
+    with pytest.raises(amscr.NotFoundError):
+        amscr.contours_from_mask(np.zeros((10, 10), np.uint8))
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.contours_from_mask(np.zeros((10, 10), np.uint8), min_area=-1)
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.contours_from_mask(np.zeros(10, np.uint8))
