@@ -124,6 +124,8 @@ static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *
         return st == AMSCR_OK && report ? amscr__final_solve(prm, src, tgt, ws, m) : st;
     }
     amscr_status st = amscr__match_dir(prm, src, tgt, ws, m);
+    if (st == AMSCR_OK && report && prm->invariance == AMSCR_INVARIANCE_AFFINE && src->params.closed)
+        st = amscr__recover_missing(prm, src, tgt, ws, m); /* issue 14: part of the target missing */
     if (st == AMSCR_OK && report && prm->invariance == AMSCR_INVARIANCE_AFFINE)
         st = amscr__final_solve(prm, src, tgt, ws, m);
     if (st == AMSCR_OK && prm->symmetric) {
