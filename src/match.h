@@ -177,6 +177,10 @@ int amscr__plane_solve(const amscr_params *prm, const double *f, const double *q
  * winner's pairs. */
 amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                     amscr_workspace *ws, match_t *m);
+/* recover.c: the adaptive trimmed closest-point refinement of m (global partners first) on a
+ * closed target; ws->rbuf keeps the pairs. */
+amscr_status amscr__refine_adaptive(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                    amscr_workspace *ws, match_t *m);
 /* Mean squared displacement between the maps X1 and X2 over the samples of f's base level. */
 double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6]);
 /* A candidate map differing from the chosen one by more than this RMS displacement (10 % of

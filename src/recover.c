@@ -164,23 +164,76 @@ static int fragment_start(const amscr_params *prm, const amscr_descriptor *f, co
     return ok;
 }
 
+/* Refines `best` once more, stores the map in m and its pairs in ws->rbuf (the reported
+ * solve reads them). */
+static amscr_status finish(const amscr_params *prm, const amscr_descriptor *f, scratch_t *s, amscr_workspace *ws,
+                           double best[6], match_t *m)
+{
+    size_t n = f->n;
+    amscr_status st = amscr__ws_reserve_refine(ws, n);
+    if (st != AMSCR_OK)
+        return st;
+    double cut = refine_adaptive(prm, f, s, best), all = 0.0, kept = 0.0, sum = 0.0;
+    memcpy(ws->rbuf, s->q, 2 * n * sizeof *s->q);
+    memcpy(ws->rbuf + 2 * n, s->r2, n * sizeof *s->r2);
+    for (size_t a = 0; a < n; a++) {
+        all += s->r2[a];
+        if (s->r2[a] <= cut) {
+            sum += s->r2[a];
+            kept += 1.0;
+        }
+    }
+    memcpy(m->X, best, 6 * sizeof *best);
+    m->rcut = cut;
+    m->rcost = sum / kept;
+    m->dist = amscr__distance_of(prm, best, all, n);
+    m->refined = 1;
+    return AMSCR_OK;
+}
+
+static amscr_status scratch_new(const amscr_descriptor *f, const amscr_descriptor *h, scratch_t *s)
+{
+    size_t n = f->n;
+    double *buf = amscr__malloc_array(2 * AMSCR__DENSE * n + 10 * n, sizeof *buf);
+    if (!buf)
+        return amscr__fail(AMSCR_E_NOMEM, "registration: out of memory");
+    scratch_t t = {buf, buf + 2 * n, buf + 3 * n, buf + 4 * n, buf + 5 * n, buf + 5 * n + 2 * AMSCR__DENSE * n, 0};
+    *s = t;
+    s->nd = amscr__densify(h->base, n, 1, s->Hd);
+    return AMSCR_OK;
+}
+
+amscr_status amscr__refine_adaptive(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                    amscr_workspace *ws, match_t *m)
+{
+    if (f->n != h->n || !h->params.closed)
+        return AMSCR_OK;
+    scratch_t s = {0};
+    amscr_status st = scratch_new(f, h, &s);
+    if (st != AMSCR_OK)
+        return st;
+    double best[6];
+    memcpy(best, m->X, sizeof best);
+    st = finish(prm, f, &s, ws, best, m);
+    free(s.q);
+    return st;
+}
+
 amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                     amscr_workspace *ws, match_t *m)
 {
     size_t n = f->n;
     if (!m->refined || n != h->n || inlier_share(ws->rbuf + 2 * n, n) >= RECOVER_INLIERS)
         return AMSCR_OK;
-    double *buf = amscr__malloc_array(2 * AMSCR__DENSE * n + 10 * n, sizeof *buf);
-    if (!buf)
-        return amscr__fail(AMSCR_E_NOMEM, "registration: out of memory");
-    scratch_t s = {buf, buf + 2 * n, buf + 3 * n, buf + 4 * n, buf + 5 * n, buf + 5 * n + 2 * AMSCR__DENSE * n, 0};
-    double *pts = s.P + 2 * n;
-    s.nd = amscr__densify(h->base, n, 1, s.Hd);
+    scratch_t s = {0};
+    amscr_status st = scratch_new(f, h, &s);
+    if (st != AMSCR_OK)
+        return st;
+    double *buf = s.q, *pts = s.P + 2 * n;
     double best[6], X[6], best_cost;
     memcpy(best, m->X, sizeof best);
     refine_adaptive(prm, f, &s, best);
     best_cost = two_way_cost(f, h, &s, best);
-    amscr_status st = AMSCR_OK;
     for (size_t k = 0; k < RECOVER_FRAGS; k++) {
         if (!fragment_start(prm, f, h, k, ws, pts, X))
             continue;
@@ -192,24 +245,7 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
         }
     }
     amscr__clear_error();
-    st = amscr__ws_reserve_refine(ws, n);
-    if (st == AMSCR_OK) { /* the winner's pairs into ws->rbuf for the reported solve */
-        double cut = refine_adaptive(prm, f, &s, best), all = 0.0;
-        memcpy(ws->rbuf, s.q, 2 * n * sizeof *s.q);
-        memcpy(ws->rbuf + 2 * n, s.r2, n * sizeof *s.r2);
-        for (size_t a = 0; a < n; a++)
-            all += s.r2[a];
-        double kept = 0.0, sum = 0.0;
-        for (size_t a = 0; a < n; a++)
-            if (s.r2[a] <= cut) {
-                sum += s.r2[a];
-                kept += 1.0;
-            }
-        memcpy(m->X, best, sizeof best);
-        m->rcut = cut;
-        m->rcost = sum / kept;
-        m->dist = amscr__distance_of(prm, best, all, n);
-    }
+    st = finish(prm, f, &s, ws, best, m);
     free(buf);
     return st;
 }
