@@ -813,7 +813,7 @@ AMSCR_API int amscr_params_get_partial(const amscr_params *p);
  *        to place), or most source samples found no target boundary near them. Measured on the
  *        held-out benchmark (bench/registration_heldout.py, 560 maps, all conditions): of the
  *        maps with confidence >= 0.25, 99.6 % were within 10 % of the shape size (no wrong
- *        rotation or placement) and 96.6 % within 2 %. It flags wrong maps, not small biases:
+ *        rotation or placement) and 97.0 % within 2 %. It flags wrong maps, not small biases:
  *        a slightly inaccurate map of a noisy contour still reads near 1. NaN for NULL. @since 0.2
  */
 AMSCR_API double amscr_result_confidence(const amscr_result *r);
