@@ -165,7 +165,8 @@ static int fragment_start(const amscr_params *prm, const amscr_descriptor *f, co
 }
 
 /* Refines `best` once more, stores the map in m and its pairs in ws->rbuf (the reported
- * solve reads them). */
+ * solve reads them). m->dist stays the one the batch path computes (amscr_distance agrees with
+ * the result's distance, amscr.h): the distance ranks shapes, the map is what is recovered. */
 static amscr_status finish(const amscr_params *prm, const amscr_descriptor *f, scratch_t *s, amscr_workspace *ws,
                            double best[6], match_t *m)
 {
@@ -173,11 +174,10 @@ static amscr_status finish(const amscr_params *prm, const amscr_descriptor *f, s
     amscr_status st = amscr__ws_reserve_refine(ws, n);
     if (st != AMSCR_OK)
         return st;
-    double cut = refine_adaptive(prm, f, s, best), all = 0.0, kept = 0.0, sum = 0.0;
+    double cut = refine_adaptive(prm, f, s, best), kept = 0.0, sum = 0.0;
     memcpy(ws->rbuf, s->q, 2 * n * sizeof *s->q);
     memcpy(ws->rbuf + 2 * n, s->r2, n * sizeof *s->r2);
     for (size_t a = 0; a < n; a++) {
-        all += s->r2[a];
         if (s->r2[a] <= cut) {
             sum += s->r2[a];
             kept += 1.0;
@@ -186,7 +186,6 @@ static amscr_status finish(const amscr_params *prm, const amscr_descriptor *f, s
     memcpy(m->X, best, 6 * sizeof *best);
     m->rcut = cut;
     m->rcost = sum / kept;
-    m->dist = amscr__distance_of(prm, best, all, n);
     m->refined = 1;
     return AMSCR_OK;
 }
