@@ -194,6 +194,10 @@ double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const doub
  * into m (refined; ws->rbuf holds the final closest-point pairs as after amscr__refine_match). */
 amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                   amscr_workspace *ws, match_t *m);
+/* The same with the fragment's share of the target's affine length searched from phi_min up (a
+ * caller that knows the fragment is long: fewer placements to try). */
+amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                      double phi_min, amscr_workspace *ws, match_t *m);
 
 /* correspond.c: the dense correspondences, inlier fraction and part of a finished result r of
  * f -> h (fills r->corr, r->ncorr, r->inlier, r->part). */
