@@ -171,6 +171,16 @@ size_t amscr__densify(const double *H, size_t n, int closed, double *out);
  * pairs f_a -> q_a with r2_a <= cut, seg_a the dense target edge of q_a. Returns 0 if singular. */
 int amscr__plane_solve(const amscr_params *prm, const double *f, const double *q, const double *r2,
                        const double *seg, const double *Hd, size_t nd, size_t n, double cut, double X[6]);
+/* recover.c: re-examines a refined closed-curve map that leaves many source samples without a
+ * target boundary near them (part of the target missing): fragments of the source placed by
+ * partial matching as further starts, ranked by a two-way trimmed cost; ws->rbuf keeps the
+ * winner's pairs. */
+amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                    amscr_workspace *ws, match_t *m);
+/* recover.c: the adaptive trimmed closest-point refinement of m (global partners first) on a
+ * closed target; ws->rbuf keeps the pairs. */
+amscr_status amscr__refine_adaptive(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                    amscr_workspace *ws, match_t *m);
 /* Mean squared displacement between the maps X1 and X2 over the samples of f's base level. */
 double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6]);
 /* A candidate map differing from the chosen one by more than this RMS displacement (10 % of
@@ -184,6 +194,10 @@ double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const doub
  * into m (refined; ws->rbuf holds the final closest-point pairs as after amscr__refine_match). */
 amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                   amscr_workspace *ws, match_t *m);
+/* The same with the fragment's share of the target's affine length searched from phi_min up (a
+ * caller that knows the fragment is long: fewer placements to try). */
+amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                      double phi_min, amscr_workspace *ws, match_t *m);
 
 /* correspond.c: the dense correspondences, inlier fraction and part of a finished result r of
  * f -> h (fills r->corr, r->ncorr, r->inlier, r->part). */

@@ -201,7 +201,8 @@ static void initial_partners(const placement *pl, const double *cumF, double LF,
 }
 
 /* The placement search over (start, length, orientation); best[] ascending. */
-static size_t search_placements(const amscr_params *prm, const double *F, const double *Hu, placement *best)
+static size_t search_placements(const amscr_params *prm, const double *F, const double *Hu, double phi_min,
+                                placement *best)
 {
     double mom[6] = {0, 0, 0, 0, 0, 0}, M9[9], Minv[9];
     for (size_t j = 0; j < PART_K; j++)
@@ -212,7 +213,7 @@ static size_t search_placements(const amscr_params *prm, const double *F, const 
     size_t nb = 0;
     int norient = prm->reflections ? 2 : 1;
     for (int o = 0; o < norient; o++)
-        for (double phi = PART_PHI_MIN; phi <= 1.0 + 1e-9; phi *= PART_PHI_STEP)
+        for (double phi = phi_min; phi <= 1.0 + 1e-9; phi *= PART_PHI_STEP)
             for (size_t k = 0; k < PART_STARTS; k++) {
                 placement c = {k * (PART_U / PART_STARTS), phi, o, 0.0, {0}, {0}, 0.0};
                 c.cost = place_cost(prm, F, mom, Minv, Hu, c.s, phi, o, c.X);
@@ -224,6 +225,12 @@ static size_t search_placements(const amscr_params *prm, const double *F, const 
 
 amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                   amscr_workspace *ws, match_t *m)
+{
+    return amscr__match_partial_min(prm, f, h, PART_PHI_MIN, ws, m);
+}
+
+amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                      double phi_min, amscr_workspace *ws, match_t *m)
 {
     size_t n = f->n;
     /* no per-scale systems here: the scale diagnostics are zero, nothing kept, no threshold */
@@ -260,7 +267,7 @@ amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descripto
     for (size_t i = 0; i < PART_U; i++)
         point_at(h->base, cumH, n, 1, LH, LH * (double)i / (double)PART_U, &Hu[2 * i], &Hu[2 * i + 1], &Hp[i]);
     placement best[PART_KEEP];
-    size_t nb = search_placements(prm, F, Hu, best);
+    size_t nb = search_placements(prm, F, Hu, phi_min, best);
     double *q = ws->rbuf, *r2 = q + 2 * n, *sorted = r2 + n, *Hd = q + 8 * n;
     size_t nd = amscr__densify(h->base, n, 1, Hd);
     size_t win = 0;

@@ -14,6 +14,8 @@
  *   synthetic 5 % occlusion:              err < 2 % in >= 90 % of the cases
  *   Kimia-99 + Kimia-216 pixel contours:  err < 2 % in >= 99 % (clean), >= 97 % (noise),
  *                                         >= 95 % (occlusion)
+ *   and issue 14's heavier conditions on the same contours (one map each): 2 % noise,
+ *   10 % and 20 % of the boundary missing, at the measured levels (KIMIA_T_*)
  * The measured rates, the worst cases (seed / file) and the mean time per registration are
  * printed so they show in the test log; time is never asserted.
  */
@@ -34,7 +36,14 @@
 
 
 #define SYN_CASES 240 /* >= 200 seeded shapes per condition */
-#define KIMIA_REPEATS 2 /* random affine maps per image and condition */
+#define KIMIA_REPEATS 2 /* random affine maps per image and condition (issue 3's conditions) */
+#define KIMIA_CONDS 6
+/* issue 14's heavier conditions (one map per image), asserted a few points below the levels
+ * measured on this suite (registration-2: 2 % noise 84.1 %, 10 % missing 100 %, 20 % missing
+ * 97.8 %; issue 14's goals are 99 / 95 / 85 %: 2 % noise is not there yet) */
+#define KIMIA_T_NOISE2 0.80
+#define KIMIA_T_MISSING10 0.97
+#define KIMIA_T_MISSING20 0.92
 
 /* ------------------------------------------------------------------ helpers */
 
@@ -61,8 +70,17 @@ static double median_of(double *v, size_t n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-typedef enum { COND_CLEAN = 0, COND_MIRROR = 1, COND_NOISE = 2, COND_OCCLUSION = 3 } condition;
-static const char *const cond_name[] = {"clean", "mirror (det<0)", "1% noise", "5% occlusion"};
+typedef enum {
+    COND_CLEAN = 0,
+    COND_MIRROR = 1,
+    COND_NOISE = 2,
+    COND_OCCLUSION = 3,
+    COND_NOISE2 = 4,   /* issue 14: 2 % noise */
+    COND_MISSING10 = 5, /* issue 14: 10 % of the boundary missing */
+    COND_MISSING20 = 6  /* issue 14: 20 % of the boundary missing */
+} condition;
+static const char *const cond_name[] = {"clean",    "mirror (det<0)", "1% noise",   "5% occlusion",
+                                        "2% noise", "10% missing",    "20% missing"};
 
 /* Timing accumulators of one run (prepare both shapes + register, and register only) and the
  * run's workspace (reused, as a batch caller would). */
@@ -148,11 +166,12 @@ static size_t degrade_target(amscr_test_rng *rng, condition cond, const double *
             out[2 * i] = mapped[2 * (n - 1 - i)];
             out[2 * i + 1] = mapped[2 * (n - 1 - i) + 1];
         }
-    } else if (cond == COND_NOISE) {
-        amscr_test_add_noise(rng, out, n, 0.01 * amscr_test_shape_size(mapped, n));
-    } else if (cond == COND_OCCLUSION) {
-        /* drop a contiguous run of 5 % of the points; the rest stays a closed curve */
-        size_t drop = (size_t)ceil(0.05 * (double)n);
+    } else if (cond == COND_NOISE || cond == COND_NOISE2) {
+        amscr_test_add_noise(rng, out, n, (cond == COND_NOISE ? 0.01 : 0.02) * amscr_test_shape_size(mapped, n));
+    } else if (cond == COND_OCCLUSION || cond == COND_MISSING10 || cond == COND_MISSING20) {
+        /* drop a contiguous run of 5 / 10 / 20 % of the points; the rest stays a closed curve */
+        double share = cond == COND_OCCLUSION ? 0.05 : (cond == COND_MISSING10 ? 0.10 : 0.20);
+        size_t drop = (size_t)ceil(share * (double)n);
         size_t start = (size_t)(amscr_test_uniform(rng) * (double)n) % n;
         size_t m = 0;
         for (size_t k = drop; k < n; k++) {
@@ -485,16 +504,19 @@ START_TEST(kimia_pixel_contours)
 
     amscr_params *prm = NULL;
     ck_assert_int_eq(amscr_params_new_registration(&prm), AMSCR_OK);
-    const condition conds[3] = {COND_CLEAN, COND_NOISE, COND_OCCLUSION};
-    const double targets[3] = {0.99, 0.97, 0.95};
-    kimia_stats ks[3];
-    for (int ci = 0; ci < 3; ci++) {
+    /* issue 3's three conditions on every image twice; issue 14's heavier ones once each */
+    const condition conds[KIMIA_CONDS] = {COND_CLEAN, COND_NOISE, COND_OCCLUSION, COND_NOISE2, COND_MISSING10,
+                                          COND_MISSING20};
+    const double targets[KIMIA_CONDS] = {0.99, 0.97, 0.95, KIMIA_T_NOISE2, KIMIA_T_MISSING10, KIMIA_T_MISSING20};
+    const unsigned repeats[KIMIA_CONDS] = {KIMIA_REPEATS, KIMIA_REPEATS, KIMIA_REPEATS, 1, 1, 1};
+    kimia_stats ks[KIMIA_CONDS];
+    for (int ci = 0; ci < KIMIA_CONDS; ci++) {
         condition cond = conds[ci];
         kimia_stats *s = &ks[ci];
         memset(s, 0, sizeof *s);
         ck_assert_int_eq(amscr_workspace_new(&s->tm.ws), AMSCR_OK);
         for (size_t i = 0; i < files.n; i++) {
-            for (unsigned rep = 0; rep < KIMIA_REPEATS; rep++) {
+            for (unsigned rep = 0; rep < repeats[ci]; rep++) {
                 uint64_t seed = 100000u * (uint64_t)(ci + 1) + 10u * i + rep;
                 amscr_status st;
                 double err = kimia_case(prm, cond, pts[i], npts[i], seed, &s->tm, &st);
@@ -527,15 +549,18 @@ START_TEST(kimia_pixel_contours)
     free(pts);
     free(npts);
     list_free(&files);
-    double rate[3];
+    double rate[KIMIA_CONDS];
     int ok = 1;
-    for (int ci = 0; ci < 3; ci++) {
+    for (int ci = 0; ci < KIMIA_CONDS; ci++) {
         rate[ci] = (double)ks[ci].within / (double)ks[ci].cases;
         ok = ok && rate[ci] >= targets[ci];
     }
-    ck_assert_msg(ok, "kimia pairs within 2 %%: clean %.2f %% (target 99), 1 %% noise %.2f %% (target 97), "
-                      "5 %% occlusion %.2f %% (target 95)",
-                  100.0 * rate[0], 100.0 * rate[1], 100.0 * rate[2]);
+    ck_assert_msg(ok,
+                  "kimia pairs within 2 %%: clean %.2f %% (target 99), 1 %% noise %.2f %% (target 97), "
+                  "5 %% occlusion %.2f %% (target 95), 2 %% noise %.2f %% (target %.0f), 10 %% missing %.2f %% "
+                  "(target %.0f), 20 %% missing %.2f %% (target %.0f)",
+                  100.0 * rate[0], 100.0 * rate[1], 100.0 * rate[2], 100.0 * rate[3], 100.0 * KIMIA_T_NOISE2,
+                  100.0 * rate[4], 100.0 * KIMIA_T_MISSING10, 100.0 * rate[5], 100.0 * KIMIA_T_MISSING20);
 }
 END_TEST
 
