@@ -27,6 +27,18 @@ static inline void amscr__moment_add(double m[6], double x, double y)
     m[5] += 1.0;
 }
 
+/* Adds the target point (u, v) matched to the source point (x, y) to the cross sums
+ * R = [sum u x, sum u y, sum u, sum v x, sum v y, sum v] of a least-squares affine fit. */
+static inline void amscr__cross_add(double R[6], double u, double v, double x, double y)
+{
+    R[0] += u * x;
+    R[1] += u * y;
+    R[2] += u;
+    R[3] += v * x;
+    R[4] += v * y;
+    R[5] += v;
+}
+
 /* The moment sums of n points (see amscr__moment_add). */
 void amscr__moments(const double *xy, size_t n, double m[6]);
 

@@ -93,12 +93,7 @@ static double place_cost(const amscr_params *prm, const double *F, const double 
         size_t off = (size_t)((double)j * step + 0.5) % PART_U;
         size_t i = o ? (s + PART_U - off) % PART_U : (s + off) % PART_U;
         double u = Hu[2 * i], v = Hu[2 * i + 1], x = F[2 * j], y = F[2 * j + 1];
-        R[0] += u * x;
-        R[1] += u * y;
-        R[2] += u;
-        R[3] += v * x;
-        R[4] += v * y;
-        R[5] += v;
+        amscr__cross_add(R, u, v, x, y);
         hh += u * u + v * v;
     }
     if (!amscr__fit_x(prm, mom, Minv, R, X))

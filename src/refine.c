@@ -106,12 +106,7 @@ static int trimmed_solve(const amscr_params *prm, const double *f, const double 
             continue;
         double x = f[2 * a], y = f[2 * a + 1], u = q[2 * a], v = q[2 * a + 1];
         amscr__moment_add(m, x, y);
-        R[0] += u * x;
-        R[1] += u * y;
-        R[2] += u;
-        R[3] += v * x;
-        R[4] += v * y;
-        R[5] += v;
+        amscr__cross_add(R, u, v, x, y);
     }
     return amscr__fit_x(prm, m, NULL, R, X);
 }
