@@ -206,7 +206,7 @@ typedef struct rbuf {
 
 static int r_need(rbuf *r, size_t n)
 {
-    if (r->bad || r->len - r->pos < n) {
+    if (r->bad || r->pos > r->len || r->len - r->pos < n) {  /* pos may lie past the end */
         r->bad = 1;
         return 0;
     }
