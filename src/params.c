@@ -45,16 +45,23 @@ void amscr__params_defaults(amscr_params *p)
     retrieval_defaults(p);
 }
 
-amscr_status amscr_params_new(amscr_params **out)
+/* A new params filled by `preset`; `who` names the public call in the error detail. */
+static amscr_status new_preset(void (*preset)(amscr_params *), const char *who, amscr_params **out)
 {
     amscr__clear_error();
-    AMSCR_CHECK_NULL(out);
+    if (out == NULL)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: out is NULL", who);
     amscr_params *p = malloc(sizeof *p);
     if (!p)
-        return amscr__fail(AMSCR_E_NOMEM, "amscr_params_new: out of memory");
-    amscr__params_defaults(p);
+        return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", who);
+    preset(p);
     *out = p;
     return AMSCR_OK;
+}
+
+amscr_status amscr_params_new(amscr_params **out)
+{
+    return new_preset(amscr__params_defaults, "amscr_params_new", out);
 }
 
 void amscr__params_registration(amscr_params *p)
@@ -66,14 +73,7 @@ void amscr__params_registration(amscr_params *p)
 
 amscr_status amscr_params_new_registration(amscr_params **out)
 {
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(out);
-    amscr_params *p = malloc(sizeof *p);
-    if (!p)
-        return amscr__fail(AMSCR_E_NOMEM, "amscr_params_new_registration: out of memory");
-    amscr__params_registration(p);
-    *out = p;
-    return AMSCR_OK;
+    return new_preset(amscr__params_registration, "amscr_params_new_registration", out);
 }
 
 void amscr__params_retrieval(amscr_params *p)
@@ -86,14 +86,7 @@ void amscr__params_retrieval(amscr_params *p)
 
 amscr_status amscr_params_new_retrieval(amscr_params **out)
 {
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(out);
-    amscr_params *p = malloc(sizeof *p);
-    if (!p)
-        return amscr__fail(AMSCR_E_NOMEM, "amscr_params_new_retrieval: out of memory");
-    amscr__params_retrieval(p);
-    *out = p;
-    return AMSCR_OK;
+    return new_preset(amscr__params_retrieval, "amscr_params_new_retrieval", out);
 }
 
 amscr_status amscr_params_copy(const amscr_params *p, amscr_params **out)

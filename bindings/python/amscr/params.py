@@ -141,10 +141,7 @@ class Params:
         Raises:
             TypeError: an unknown option; InvalidArgumentError: a bad value.
         """
-        self = cls.__new__(cls)
-        self._p = _new_params(lib.amscr_params_new_registration)
-        self.update(**options)
-        return self
+        return cls._preset(lib.amscr_params_new_registration, options)
 
     @classmethod
     def retrieval(cls, **options: Any) -> 'Params':
@@ -160,8 +157,13 @@ class Params:
         Raises:
             TypeError: an unknown option; InvalidArgumentError: a bad value.
         """
+        return cls._preset(lib.amscr_params_new_retrieval, options)
+
+    @classmethod
+    def _preset(cls, make: Any, options: Dict[str, Any]) -> 'Params':
+        """A new Params from the C preset constructor `make`, with `options` changed."""
         self = cls.__new__(cls)
-        self._p = _new_params(lib.amscr_params_new_retrieval)
+        self._p = _new_params(make)
         self.update(**options)
         return self
 
