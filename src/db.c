@@ -79,6 +79,9 @@ amscr_status amscr_db_add_contour(amscr_db *db, const amscr_contour *c, int32_t 
     amscr_status st = amscr_descriptor_new(&db->params, c, &d);
     if (st != AMSCR_OK)
         return st;
+    free(d->raw); /* a collection keeps no input points: it never polishes a registration */
+    d->raw = NULL;
+    d->nraw = 0;
     st = db_push(db, d, label, out_index);
     if (st != AMSCR_OK)
         amscr_descriptor_free(d);

@@ -35,6 +35,7 @@ void amscr_descriptor_free(amscr_descriptor *d)
     if (!d)
         return;
     free(d->input);
+    free(d->raw);
     free(d->base);
     free(d->scaled);
     free(d->mom);
@@ -171,6 +172,18 @@ static amscr_status normalize_similarity(const double *xy, size_t n, double *out
     return AMSCR_OK;
 }
 
+/* Hands the m input points pts (malloc'ed) to d for the polish, every k-th when many. */
+static void keep_points(amscr_descriptor *d, double *pts, size_t m)
+{
+    size_t k = (m + AMSCR__POLISH_MAX_POINTS - 1) / AMSCR__POLISH_MAX_POINTS, n = 0;
+    for (size_t i = 0; i < m; i += k, n++) {
+        pts[2 * n] = pts[2 * i];
+        pts[2 * n + 1] = pts[2 * i + 1];
+    }
+    d->raw = pts;
+    d->nraw = n;
+}
+
 amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out)
 {
     amscr__clear_error();
@@ -213,7 +226,10 @@ amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c,
         st = amscr__smooth(d->base, N, closed, p->scales[k], d->scaled + 2 * N * k);
     if (st == AMSCR_OK)
         st = amscr__descriptor_finish(d);
-    free(pts);
+    if (st == AMSCR_OK && closed && p->invariance == AMSCR_INVARIANCE_AFFINE)
+        keep_points(d, pts, m);
+    else
+        free(pts);
     if (st != AMSCR_OK) {
         amscr_descriptor_free(d);
         return st;

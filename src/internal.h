@@ -65,6 +65,8 @@ struct amscr_params {
     double penalty;
     /* issue 14 (registration): the source is an open fragment of the target's closed boundary */
     int partial;
+    /* issue 14 (0.3): polish the reported map on the input points (polish.c) */
+    int polish;
     /* retrieval (0.2, channel.c / fuse.c) */
     double channel_weight;             /* share of the shape channel in the fused distance, 0..1 */
     amscr_invariance channel_invariance; /* frame of the shape channel (affine or similarity) */
@@ -134,7 +136,15 @@ struct amscr_descriptor {
     double norm2;  /* sum |base|^2 */
     double nyq2;   /* even N: (|X(N/2)|^2 + |Y(N/2)|^2) / N, the Nyquist term's energy */
     size_t finest; /* index of the smallest scale */
+    /* issue 14 (0.3): the input points (deduplicated, counter-clockwise, every k-th when over
+     * AMSCR__POLISH_MAX_POINTS) kept for the polish (polish.c): closed curves under affine
+     * invariance; NULL in collections (amscr_db) and after a load. */
+    double *raw;
+    size_t nraw;
 };
+
+/* Most input points a descriptor keeps for the polish: a fit on more is not measurably better. */
+#define AMSCR__POLISH_MAX_POINTS 4096
 
 /* Builds the derived arrays of a descriptor whose params, n, p, input, base, scaled, fwd,
  * inv are set (used by amscr_descriptor_new and by db load). */

@@ -20,6 +20,10 @@
  * a coarse polygon do not bias the fit. */
 #define AMSCR__DENSE 4
 
+/* Candidate start shifts per orientation: a shape's criterion rarely has more than a few deep
+ * minima (symmetries); three keeps the right one among them at a small cost. */
+#define AMSCR__CANDIDATES 3
+
 /* Per-stage timing, compiled only into the benchmark's copy of the library
  * (-DAMSCR_STAGE_TIMING): the product's hot path has no clock calls. */
 #ifdef AMSCR_STAGE_TIMING
@@ -79,6 +83,9 @@ typedef struct {
     double threshold;
     /* issue 14: confidence of the match (see amscr_result_ambiguity / _inlier_fraction) */
     double ambiguity;
+    /* the search's scored start candidates (registration with refinement; else ncand 0) */
+    double cand[2 * AMSCR__CANDIDATES][6];
+    size_t ncand;
 } match_t;
 
 struct amscr_result {
@@ -198,6 +205,12 @@ amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descripto
  * caller that knows the fragment is long: fewer placements to try). */
 amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                       double phi_min, amscr_workspace *ws, match_t *m);
+
+/* polish.c: m's map polished on the input points the descriptors kept (f->raw, h->raw; closed,
+ * affine invariance): the chosen map and the search's other distinct candidates, point-to-line
+ * both ways weighted by each curve's measured noise, ranked by a two-way trimmed cost; m->X and
+ * m->ambiguity updated when a polished map wins. */
+amscr_status amscr__polish(const amscr_descriptor *f, const amscr_descriptor *h, match_t *m);
 
 /* correspond.c: the dense correspondences, inlier fraction and part of a finished result r of
  * f -> h (fills r->corr, r->ncorr, r->inlier, r->part). */

@@ -69,6 +69,7 @@ void amscr__params_registration(amscr_params *p)
     amscr__params_defaults(p);
     p->num_samples = 256;
     p->refine = 20;
+    p->polish = 1;
 }
 
 amscr_status amscr_params_new_registration(amscr_params **out)
@@ -167,6 +168,8 @@ GETTER(rerank_iterations, unsigned, rerank_iterations)
 /* ---- issue 14 (registration): partial matching ---- */
 SETTER(partial, int, partial, v == 0 || v == 1, "%d is not 0 or 1")
 GETTER(partial, int, partial)
+SETTER(polish, int, polish, v == 0 || v == 1, "%d is not 0 or 1")
+GETTER(polish, int, polish)
 
 amscr_status amscr_params_set_scales(amscr_params *p, const double *sigmas, size_t n)
 {

@@ -19,9 +19,6 @@
 #include <math.h>
 #include <string.h>
 
-/* Candidate start shifts per orientation: a shape's criterion rarely has more than a few deep
- * minima (symmetries); three keeps the right one among them at a small cost. */
-#define AMSCR__CANDIDATES 3
 /* Criterion ranking only: a candidate is refined only when its residual is within this factor
  * of the best one's — refinement to a continuous shift moves the residual far less than that. */
 #define AMSCR__PRUNE_RATIO 1.25
@@ -450,6 +447,9 @@ amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f
     st = run_start(prm, f, h, &starts[best], &prepared_o, prm->refine, ws, m);
     if (st == AMSCR_OK)
         m->ambiguity = kind == SCORE_CRITERION ? 0.0 : ambiguity_of(f, cand_X, cand_score, count, best);
+    m->ncand = kind == SCORE_CRITERION ? 0 : count; /* further starts for polish.c */
+    if (m->ncand)
+        memcpy(m->cand, cand_X, count * sizeof cand_X[0]);
     if (st == AMSCR_OK && !isfinite(m->dist))
         st = amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
     return st;

@@ -91,6 +91,7 @@ typedef struct opts {
     int reflections; /* -1: the command's default */
     int open;
     int partial; /* register --partial (issue 14) */
+    int no_polish; /* register --no-polish (0.3) */
     int refine_set;
     unsigned refine;
     int threads_set;

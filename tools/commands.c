@@ -50,6 +50,8 @@ static const char HELP_REGISTER[] =
     "                          kept scales, and the elbow curve SSE(K)\n"
     "  --partial               SRC is an open fragment of TGT's closed boundary: also\n"
     "                          prints where on TGT it lies (start, end as fractions)\n"
+    "  --no-polish             skip the final fit on the input points themselves (it\n"
+    "                          fits the noisier curve onto the cleaner one; on by default)\n"
     "  --component N           use contour N of 'amscr contour --all' of each image\n"
     "                          (default: the largest outer contour); --min-area A as there\n"
     "\n"

@@ -44,6 +44,7 @@ typedef enum opt_id {
     O_PARAMETRIZATION,
     O_INVARIANCE,
     O_PARTIAL,
+    O_NO_POLISH,
     O_RERANK,
     O_NO_RERANK,
     O_CHANNEL_WEIGHT,
@@ -94,6 +95,7 @@ static const optdef OPTS[] = {
     {"--parametrization", O_PARAMETRIZATION, 1, C_SHAPES, "NAME"},
     {"--invariance", O_INVARIANCE, 1, C_SHAPES, "NAME"},
     {"--partial", O_PARTIAL, 0, C_REGISTER, NULL},
+    {"--no-polish", O_NO_POLISH, 0, C_REGISTER, NULL},
     {"--rerank", O_RERANK, 1, C_RETRIEVAL, "K[,ITER]"},
     {"--no-rerank", O_NO_RERANK, 0, C_RETRIEVAL, NULL},
     {"--channel-weight", O_CHANNEL_WEIGHT, 1, C_RETRIEVAL, "W"},
@@ -326,6 +328,7 @@ static int set_option(opts *o, const optdef *d, const char *v)
     case O_NO_REFLECTIONS: o->reflections = 0; return 0;
     case O_OPEN: o->open = 1; return 0;
     case O_PARTIAL: o->partial = 1; return 0;
+    case O_NO_POLISH: o->no_polish = 1; return 0;
     case O_REFINE: return parse_unsigned(n, v, 0, TOOL_REFINE_MAX, &o->refine_set, &o->refine);
     case O_THREADS: return parse_unsigned(n, v, 0, TOOL_THREADS_MAX, &o->threads_set, &o->threads);
     case O_KMAX: return parse_unsigned(n, v, 1, TOOL_KMAX_MAX, &o->kmax_set, &o->kmax);

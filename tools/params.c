@@ -37,6 +37,7 @@ int make_params(const opts *o, int registration, amscr_params **out)
     SET(1, "--reflections", amscr_params_set_reflections(p, o->reflections < 0 ? !registration : o->reflections));
     SET(o->open, "--open", amscr_params_set_closed(p, 0));
     SET(o->partial, "--partial", amscr_params_set_partial(p, 1));
+    SET(o->no_polish, "--no-polish", amscr_params_set_polish(p, 0));
     SET(o->refine_set, "--refine", amscr_params_set_refine(p, o->refine));
     SET(o->threads_set, "--threads", amscr_params_set_num_threads(p, o->threads));
     SET(o->kmax_set, "--kmax", amscr_params_set_kmax(p, o->kmax));

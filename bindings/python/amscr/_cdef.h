@@ -2,9 +2,9 @@
 /* Regenerate with: python3 scripts/gen_cdef.py -o bindings/python/amscr/_cdef.h */
 
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 2
+#define AMSCR_VERSION_MINOR 3
 #define AMSCR_VERSION_PATCH 0
-#define AMSCR_VERSION_NUMBER 200
+#define AMSCR_VERSION_NUMBER 300
 #define AMSCR_MAX_IMAGE_SIDE 32768
 #define AMSCR_MAX_IMAGE_PIXELS 268435456
 #define AMSCR_MAX_POINTS 16777216
@@ -205,6 +205,8 @@ amscr_status amscr_score_nn_split(const double *dist, size_t ntest, size_t ntrai
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);
 amscr_status amscr_params_set_partial(amscr_params *p, int on);
 int amscr_params_get_partial(const amscr_params *p);
+amscr_status amscr_params_set_polish(amscr_params *p, int on);
+int amscr_params_get_polish(const amscr_params *p);
 double amscr_result_confidence(const amscr_result *r);
 double amscr_result_ambiguity(const amscr_result *r);
 double amscr_result_inlier_fraction(const amscr_result *r);

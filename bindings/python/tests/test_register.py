@@ -96,7 +96,7 @@ def test_shape_prepared_once(pair):
         s.scale_points(s.num_scales)
     t = amscr.Shape(tgt, points=64)
     r1 = amscr.register(s, t)
-    r2 = amscr.register(src, tgt, points=64)
+    r2 = amscr.register(src, tgt, params=s.params)  # the Shape's settings, prepared on the fly
     np.testing.assert_array_equal(r1.matrix, r2.matrix)
     assert r1.distance == r2.distance
     # mixed: the array is prepared with the Shape's options
