@@ -43,6 +43,10 @@
 #define RESID_K 25.0
 /* Each direction of the ranking cost keeps this share of its pairs (recover.c's rule). */
 #define RANK_KEEP 0.7
+/* The search's other candidates are polished too when its ambiguity is at least this: another
+ * start scored within a factor 2 of the chosen one (near-symmetric shapes, where noise decides;
+ * measured on the held-out pairs: 0.6-1.0 for those, below 0.35 for every other pair). */
+#define AMBIGUOUS_SEARCH 0.5
 /* Partners after the first (global) search are looked for within ±HINT vertices of the last,
  * and further along while they keep getting closer. */
 #define HINT 3
@@ -467,12 +471,13 @@ static int polish_prepare(polish_t *w, const amscr_descriptor *f, const amscr_de
     return grid_build(&w->gt, w->t.p, w->t.n);
 }
 
-/* The start maps: the chosen one first, then each search candidate that differs from all before. */
+/* The start maps: the chosen one first, then — when the search could not tell its candidates
+ * apart (ambiguity at least AMBIGUOUS_SEARCH) — each candidate that differs from all before. */
 static size_t polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6])
 {
     size_t count = 1;
     memcpy(S[0], m->X, sizeof S[0]);
-    for (size_t c = 0; c < m->ncand; c++) {
+    for (size_t c = 0; m->ambiguity >= AMBIGUOUS_SEARCH && c < m->ncand; c++) {
         int fresh = 1;
         for (size_t k = 0; k < count && fresh; k++)
             fresh = amscr__map_gap2(f, m->cand[c], S[k]) > AMSCR__DISTINCT_GAP2;
