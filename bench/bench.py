@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Runs the speed benchmark, then (when the tool is built) the query time against a synthetic
+"""Runs the speed benchmark, then single registrations per stage (amscr-registration-bench), then
+(when the tool is built) the query time against a synthetic
 10,000-shape index (bench/index_bench.py; the index is built once and cached in
 --index-work), then (when ../shared/datasets exists) `amscr eval` on Kimia-99 and Kimia-216,
 printing the top-k tables beside the paper's rows."""
@@ -16,6 +17,7 @@ PAPER = {
 
 ap = argparse.ArgumentParser()
 ap.add_argument('--bench', required=True)
+ap.add_argument('--registration-bench')
 ap.add_argument('--tool')
 ap.add_argument('--datasets')
 ap.add_argument('--shapes', default='1400')
@@ -27,6 +29,11 @@ sys.stdout.flush()
 rc = subprocess.call([args.bench, '--shapes', args.shapes] + rest)
 if rc != 0:
     sys.exit(rc)
+if args.registration_bench:
+    sys.stdout.flush()
+    rc = subprocess.call([args.registration_bench])
+    if rc != 0:
+        sys.exit(rc)
 if args.tool and args.index_shapes != '0':
     sys.stdout.flush()
     rc = subprocess.call([sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), 'index_bench.py'),
