@@ -39,9 +39,10 @@
 #define KIMIA_REPEATS 2 /* random affine maps per image and condition (issue 3's conditions) */
 #define KIMIA_CONDS 6
 /* issue 14's heavier conditions (one map per image), asserted a few points below the levels
- * measured on this suite (registration-2: 2 % noise 84.1 %, 10 % missing 100 %, 20 % missing
- * 97.8 %; issue 14's goals are 99 / 95 / 85 %: 2 % noise is not there yet) */
-#define KIMIA_T_NOISE2 0.80
+ * measured on this suite (0.3 with the polish: 2 % noise 93.65 % (84.1 % before it), 10 %
+ * missing 100 %, 20 % missing 98.1 %; issue 14's goals are 99 / 95 / 85 %: 2 % noise is not
+ * there yet) */
+#define KIMIA_T_NOISE2 0.90
 #define KIMIA_T_MISSING10 0.97
 #define KIMIA_T_MISSING20 0.92
 
@@ -507,7 +508,8 @@ START_TEST(kimia_pixel_contours)
     /* issue 3's three conditions on every image twice; issue 14's heavier ones once each */
     const condition conds[KIMIA_CONDS] = {COND_CLEAN, COND_NOISE, COND_OCCLUSION, COND_NOISE2, COND_MISSING10,
                                           COND_MISSING20};
-    const double targets[KIMIA_CONDS] = {0.99, 0.97, 0.95, KIMIA_T_NOISE2, KIMIA_T_MISSING10, KIMIA_T_MISSING20};
+    /* 1 % noise: 99.84 % measured with the polish (99.05 % before) */
+    const double targets[KIMIA_CONDS] = {0.99, 0.98, 0.95, KIMIA_T_NOISE2, KIMIA_T_MISSING10, KIMIA_T_MISSING20};
     const unsigned repeats[KIMIA_CONDS] = {KIMIA_REPEATS, KIMIA_REPEATS, KIMIA_REPEATS, 1, 1, 1};
     kimia_stats ks[KIMIA_CONDS];
     for (int ci = 0; ci < KIMIA_CONDS; ci++) {
@@ -556,7 +558,7 @@ START_TEST(kimia_pixel_contours)
         ok = ok && rate[ci] >= targets[ci];
     }
     ck_assert_msg(ok,
-                  "kimia pairs within 2 %%: clean %.2f %% (target 99), 1 %% noise %.2f %% (target 97), "
+                  "kimia pairs within 2 %%: clean %.2f %% (target 99), 1 %% noise %.2f %% (target 98), "
                   "5 %% occlusion %.2f %% (target 95), 2 %% noise %.2f %% (target %.0f), 10 %% missing %.2f %% "
                   "(target %.0f), 20 %% missing %.2f %% (target %.0f)",
                   100.0 * rate[0], 100.0 * rate[1], 100.0 * rate[2], 100.0 * rate[3], 100.0 * KIMIA_T_NOISE2,
