@@ -25,5 +25,6 @@ Suite *amscr_suite_invariance(void);
 Suite *amscr_suite_robust(void);
 Suite *amscr_suite_channel(void);
 Suite *amscr_suite_trace_all(void);
+Suite *amscr_suite_polish(void);
 
 #endif
