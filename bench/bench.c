@@ -8,6 +8,8 @@
  * Not a test: it prints numbers. Run through `meson compile -C build bench`. */
 #include <amscr.h>
 
+#include "bench_util.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,27 +18,6 @@
 #include <unistd.h>
 
 void amscr__workspace_stage_times(const amscr_workspace *ws, double out[4]);
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static uint64_t rng_state;
-static double uni(void)
-{
-    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
-}
-static double gauss(void)
-{
-    double u = uni(), v = uni();
-    return sqrt(-2.0 * log(u > 1e-300 ? u : 1e-300)) * cos(6.283185307179586 * v);
-}
 
 #define H 8
 /* Class prototype: radius harmonics; instance: prototype + small perturbation, affine map,

@@ -342,20 +342,6 @@ START_TEST(partial_not_polished)
 }
 END_TEST
 
-/* A closed polygon through v (nv vertices), each edge split into m points. */
-static size_t polygon(const double *v, size_t nv, size_t m, double *out)
-{
-    size_t k = 0;
-    for (size_t i = 0; i < nv; i++)
-        for (size_t j = 0; j < m; j++, k++) {
-            double s = (double)j / (double)m;
-            size_t b = (i + 1) % nv;
-            out[2 * k] = (1 - s) * v[2 * i] + s * v[2 * b];
-            out[2 * k + 1] = (1 - s) * v[2 * i + 1] + s * v[2 * b + 1];
-        }
-    return k;
-}
-
 /* The shape s (n points) onto an affine copy with a new start and `noise` x its size of noise,
  * polish on: confidence (and ambiguity) of the result. */
 static double noisy_confidence(const double *s, size_t n, double noise, uint64_t seed, double *out_amb)
@@ -387,17 +373,13 @@ START_TEST(symmetric_stay_ambiguous)
     double xy[2 * 400], amb;
     const double sq[8] = {0, 0, 1, 0, 1, 1, 0, 1};
     double star[20];
-    for (int k = 0; k < 10; k++) {
-        double r = k % 2 ? 0.4 : 1.0, ang = 1.5707963267948966 + k * 0.6283185307179586;
-        star[2 * k] = r * cos(ang);
-        star[2 * k + 1] = r * sin(ang);
-    }
+    amscr_test_star5(star);
     const double noise[2] = {0.01, 0.02};
     for (int k = 0; k < 2; k++) {
-        double c = noisy_confidence(xy, polygon(sq, 4, 90, xy), noise[k], 61 + (uint64_t)k, &amb);
+        double c = noisy_confidence(xy, amscr_test_polygon(sq, 4, 90, xy), noise[k], 61 + (uint64_t)k, &amb);
         printf("polish: square, %.0f %% noise: confidence %.3f ambiguity %.3f\n", 100 * noise[k], c, amb);
         ck_assert_msg(amb > 0.8 && c < 0.2, "square: confidence %.3f ambiguity %.3f", c, amb);
-        c = noisy_confidence(xy, polygon(star, 10, 36, xy), noise[k], 71 + (uint64_t)k, &amb);
+        c = noisy_confidence(xy, amscr_test_polygon(star, 10, 36, xy), noise[k], 71 + (uint64_t)k, &amb);
         printf("polish: star, %.0f %% noise: confidence %.3f ambiguity %.3f\n", 100 * noise[k], c, amb);
         ck_assert_msg(amb > 0.8 && c < 0.2, "star: confidence %.3f ambiguity %.3f", c, amb);
     }

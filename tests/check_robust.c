@@ -91,20 +91,6 @@ END_TEST
 START_TEST(partial_fragment_50) { fragments(0.5, 0.85); }
 END_TEST
 
-/* A closed polygon through v (nv vertices), each edge split into m points. */
-static size_t polygon(const double *v, size_t nv, size_t m, double *out)
-{
-    size_t k = 0;
-    for (size_t i = 0; i < nv; i++)
-        for (size_t j = 0; j < m; j++, k++) {
-            double s = (double)j / (double)m;
-            size_t b = (i + 1) % nv;
-            out[2 * k] = (1 - s) * v[2 * i] + s * v[2 * b];
-            out[2 * k + 1] = (1 - s) * v[2 * i + 1] + s * v[2 * b + 1];
-        }
-    return k;
-}
-
 static double confidence_of(const double *s, size_t n, double *out_amb)
 {
     static const double T[6] = {1.2, 0.4, 3.0, -0.2, 0.8, -1.0};
@@ -132,15 +118,11 @@ START_TEST(symmetric_shapes_ambiguous)
     double c = confidence_of(xy, 360, &amb);
     ck_assert_msg(amb > 0.8 && c < 0.2, "circle: confidence %.3f ambiguity %.3f", c, amb);
     const double sq[8] = {0, 0, 1, 0, 1, 1, 0, 1};
-    c = confidence_of(xy, polygon(sq, 4, 90, xy), &amb);
+    c = confidence_of(xy, amscr_test_polygon(sq, 4, 90, xy), &amb);
     ck_assert_msg(amb > 0.8 && c < 0.2, "square: confidence %.3f ambiguity %.3f", c, amb);
     double star[20];
-    for (int k = 0; k < 10; k++) {
-        double r = k % 2 ? 0.4 : 1.0, ang = 1.5707963267948966 + k * 0.6283185307179586;
-        star[2 * k] = r * cos(ang);
-        star[2 * k + 1] = r * sin(ang);
-    }
-    c = confidence_of(xy, polygon(star, 10, 36, xy), &amb);
+    amscr_test_star5(star);
+    c = confidence_of(xy, amscr_test_polygon(star, 10, 36, xy), &amb);
     ck_assert_msg(amb > 0.8 && c < 0.2, "star: confidence %.3f ambiguity %.3f", c, amb);
     amscr_test_rng rng;
     amscr_test_rng_seed(&rng, 4242);

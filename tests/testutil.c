@@ -191,3 +191,25 @@ int amscr_test_read_png_gray(const char *path, unsigned char **out_pixels, size_
     *out_h = img.height;
     return 0;
 }
+
+size_t amscr_test_polygon(const double *v, size_t nv, size_t m, double *out)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < nv; i++)
+        for (size_t j = 0; j < m; j++, k++) {
+            double s = (double)j / (double)m;
+            size_t b = (i + 1) % nv;
+            out[2 * k] = (1 - s) * v[2 * i] + s * v[2 * b];
+            out[2 * k + 1] = (1 - s) * v[2 * i + 1] + s * v[2 * b + 1];
+        }
+    return k;
+}
+
+void amscr_test_star5(double *v)
+{
+    for (int k = 0; k < 10; k++) {
+        double r = k % 2 ? 0.4 : 1.0, ang = 1.5707963267948966 + k * 0.6283185307179586;
+        v[2 * k] = r * cos(ang);
+        v[2 * k + 1] = r * sin(ang);
+    }
+}

@@ -1,0 +1,35 @@
+/* bench_util.h — the benchmarks' wall clock and seeded random numbers (splitmix64; one
+ * generator per program: each benchmark is single-threaded where it draws). */
+#ifndef AMSCR_BENCH_UTIL_H
+#define AMSCR_BENCH_UTIL_H
+
+#include <math.h>
+#include <stdint.h>
+#include <time.h>
+
+static inline double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static uint64_t rng_state;
+
+/* Uniform in [0, 1). */
+static inline double uni(void)
+{
+    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+}
+
+/* Standard normal (Box-Muller). */
+static inline double gauss(void)
+{
+    double u = uni(), v = uni();
+    return sqrt(-2.0 * log(u > 1e-300 ? u : 1e-300)) * cos(6.283185307179586 * v);
+}
+
+#endif
