@@ -810,17 +810,19 @@ AMSCR_API int amscr_params_get_partial(const amscr_params *p);
  * @brief Polish the reported map on the input points (default 0; 1 in the registration preset,
  *        so amscr_register_contours(NULL, ...), the tool's register and Python's register() use
  *        it). After the method and its refinement on the N samples, the map is re-fitted on the
- *        input points themselves by point-to-line steps in both directions — target points onto
- *        the mapped source, mapped source points onto the target — each direction weighted by
- *        the other curve's measured roughness, so a noisy curve is fitted onto the clean one (the
- *        closest point ON a noisy curve is biased); pairs beyond 5x the median distance are
- *        trimmed (missing runs). The search's other distinct start candidates are polished
- *        alike; the lowest two-way trimmed cost wins and sets the ambiguity. Needs the input
- *        points: amscr_descriptor_new keeps up to 4096 of them (64 KiB) for closed curves under
- *        affine invariance; descriptors in a collection (amscr_db) or loaded from a file have
- *        none, and are then registered unpolished. Closed curves under affine invariance, not
- *        partial matching; the distance stays the batch path's. Measured in the README
- *        (held-out 1 % / 2 % noise: 95.7 / 88.6 % -> 100 / 97.1 %). @since 0.3
+ *        input points themselves by point-to-line steps. The smoother of the two curves is the
+ *        one moved (noisy points as regressors would shrink the map); the points of each curve
+ *        are paired with the closest point of the other, each direction weighted by its curve's
+ *        measured roughness, so a noisy curve is fitted onto the clean one (the closest point ON
+ *        a noisy curve is biased); pairs beyond 5x the median distance, and pairs on the chord
+ *        across a missing run, are left out. When the start-point search was ambiguous its other
+ *        distinct candidates are polished alike; the lowest two-way trimmed cost wins and sets
+ *        the ambiguity. Partial matching: the fragment's points alone. Needs the input points:
+ *        amscr_descriptor_new keeps up to 4096 of them (64 KiB) under affine invariance;
+ *        descriptors in a collection (amscr_db) or loaded from a file have none and are then
+ *        registered unpolished. A closed target, affine invariance; the distance stays the batch
+ *        path's. Measured in the README (held-out 1 % / 2 % noise: 95.7 / 88.6 % -> 100 / 97.1 %;
+ *        50 % fragments 90.0 -> 95.7 %). @since 0.3
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_polish(amscr_params *p, int on);
 /** @brief The polish flag (0 for NULL). @since 0.3 */

@@ -226,7 +226,7 @@ amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c,
         st = amscr__smooth(d->base, N, closed, p->scales[k], d->scaled + 2 * N * k);
     if (st == AMSCR_OK)
         st = amscr__descriptor_finish(d);
-    if (st == AMSCR_OK && closed && p->invariance == AMSCR_INVARIANCE_AFFINE)
+    if (st == AMSCR_OK && p->invariance == AMSCR_INVARIANCE_AFFINE)
         keep_points(d, pts, m);
     else
         free(pts);

@@ -206,11 +206,12 @@ amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descripto
 amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                       double phi_min, amscr_workspace *ws, match_t *m);
 
-/* polish.c: m's map polished on the input points the descriptors kept (f->raw, h->raw; closed,
- * affine invariance): the chosen map and the search's other distinct candidates, point-to-line
- * both ways weighted by each curve's measured noise, ranked by a two-way trimmed cost; m->X and
- * m->ambiguity updated when a polished map wins. */
-amscr_status amscr__polish(const amscr_descriptor *f, const amscr_descriptor *h, match_t *m);
+/* polish.c: m's map polished on the input points the descriptors kept (f->raw, h->raw; a closed
+ * target, affine invariance): the chosen map and the search's other distinct candidates,
+ * point-to-line both ways weighted by each curve's measured noise (partial: f an open fragment,
+ * its points alone), ranked by a two-way trimmed cost; m->X and m->ambiguity updated when a
+ * polished map wins. */
+amscr_status amscr__polish(const amscr_descriptor *f, const amscr_descriptor *h, int partial, match_t *m);
 
 /* correspond.c: the dense correspondences, inlier fraction and part of a finished result r of
  * f -> h (fills r->corr, r->ncorr, r->inlier, r->part). */

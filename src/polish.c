@@ -79,6 +79,7 @@ typedef struct {
     double *moved;   /* 2 a->n: Y a */
     double *sorted;  /* scratch of the larger count */
     double wb, wa;   /* weights: b's points onto the moved a, and the moved a's points onto b */
+    int partial;     /* a is an open fragment of the closed b: only its points are paired */
     amscr__grid gb, gm; /* grids over b and over the moved a */
     double *block;
     size_t *iblock;
@@ -237,10 +238,12 @@ static int pair_all(polish_t *w, const double Y[6], int global)
         w->moved[2 * i] = Y[0] * a->p[2 * i] + Y[1] * a->p[2 * i + 1] + Y[2];
         w->moved[2 * i + 1] = Y[3] * a->p[2 * i] + Y[4] * a->p[2 * i + 1] + Y[5];
     }
-    amscr__edge_normals(w->moved, a->n, w->a->en);
-    if (global && !amscr__grid_build(&w->gm, w->moved, a->n))
-        return 0;
-    pair_side(w->b->p, w->b->n, w->moved, w->a, &w->gm, global, w->b);
+    if (!w->partial) { /* b's points onto the moved a */
+        amscr__edge_normals(w->moved, a->n, w->a->en);
+        if (global && !amscr__grid_build(&w->gm, w->moved, a->n))
+            return 0;
+        pair_side(w->b->p, w->b->n, w->moved, w->a, &w->gm, global, w->b);
+    }
     pair_side(w->moved, a->n, w->b->p, w->b, &w->gb, global, w->a);
     return 1;
 }
@@ -281,8 +284,8 @@ static void edge_point(const double *p, size_t n, size_t seg, double t, double *
 static void step_system(const polish_t *w, double N[36], double rhs[6])
 {
     const curve_t *a = w->a, *b = w->b;
-    double kept, cut = side_cut(b, w->sorted, &kept), x, y;
-    for (size_t j = 0; j < b->n; j++) /* b's points onto the moved a's edges */
+    double kept = 0.0, cut = w->partial ? -1.0 : side_cut(b, w->sorted, &kept), x, y;
+    for (size_t j = 0; j < b->n && !w->partial; j++) /* b's points onto the moved a's edges */
         if (b->d2[j] <= cut && isfinite(b->d2[j])) {
             size_t s = b->part[j];
             edge_point(a->p, a->n, s, b->ft[j], &x, &y);
@@ -339,7 +342,7 @@ static double kept_mean(const curve_t *c, double *sorted)
 /* The two-way trimmed cost of the current pairs. */
 static double rank_cost(polish_t *w)
 {
-    return w->wb * kept_mean(w->b, w->sorted) + w->wa * kept_mean(w->a, w->sorted);
+    return (w->partial ? 0.0 : w->wb * kept_mean(w->b, w->sorted)) + w->wa * kept_mean(w->a, w->sorted);
 }
 
 /* Polishes Y (a -> b) in place with at most `iters` steps; returns its ranking cost (INFINITY
@@ -365,9 +368,11 @@ static double polish_one(polish_t *w, double Y[6], int iters)
 
 /* Loads both curves, measures their noise, picks the moved curve (the smoother, in the target's
  * units under X) and the weights; builds the grid of the other. Returns 0 when it cannot. */
-static int polish_prepare(polish_t *w, const amscr_descriptor *f, const amscr_descriptor *h, const double X[6])
+static int polish_prepare(polish_t *w, const amscr_descriptor *f, const amscr_descriptor *h, const double X[6],
+                          int partial)
 {
     double Y[6];
+    w->partial = partial;
     load_curve(f, &w->src);
     load_curve(h, &w->tgt);
     if (w->src.n < 3 || w->tgt.n < 3)
@@ -379,11 +384,12 @@ static int polish_prepare(polish_t *w, const amscr_descriptor *f, const amscr_de
     w->a = &w->src; /* to_frames below: source -> target */
     to_frames(w, f, h, X, Y);
     double rs = w->src.rough * fabs(Y[0] * Y[4] - Y[1] * Y[3]), rt = w->tgt.rough;
-    w->a = rs <= rt ? &w->src : &w->tgt;
-    w->b = rs <= rt ? &w->tgt : &w->src;
-    double ra = rs <= rt ? rs : rt, rb = rs <= rt ? rt : rs;
-    w->wb = rb / (ra + rb);
-    w->wa = ra / (ra + rb);
+    int keep = rs <= rt || partial; /* a fragment is always the moved curve, paired alone */
+    w->a = keep ? &w->src : &w->tgt;
+    w->b = keep ? &w->tgt : &w->src;
+    double ra = keep ? rs : rt, rb = keep ? rt : rs;
+    w->wb = partial ? 0.0 : rb / (ra + rb);
+    w->wa = partial ? 1.0 : ra / (ra + rb);
     amscr__edge_normals(w->b->p, w->b->n, w->b->en);
     return amscr__grid_build(&w->gb, w->b->p, w->b->n);
 }
@@ -418,7 +424,7 @@ static double polished_ambiguity(const amscr_descriptor *f, double S[][6], const
     return amb;
 }
 
-amscr_status amscr__polish(const amscr_descriptor *f, const amscr_descriptor *h, match_t *m)
+amscr_status amscr__polish(const amscr_descriptor *f, const amscr_descriptor *h, int partial, match_t *m)
 {
     polish_t w;
     amscr_status st = polish_alloc(f->nraw, h->nraw, &w);
@@ -426,7 +432,7 @@ amscr_status amscr__polish(const amscr_descriptor *f, const amscr_descriptor *h,
         return st;
     double S[1 + 2 * AMSCR__CANDIDATES][6], Y[1 + 2 * AMSCR__CANDIDATES][6], cost[1 + 2 * AMSCR__CANDIDATES];
     size_t count = polish_starts(f, m, S), best = count;
-    if (polish_prepare(&w, f, h, m->X)) {
+    if (polish_prepare(&w, f, h, m->X, partial)) {
         for (size_t k = 0; k < count; k++) { /* every start a few steps, ranked */
             to_frames(&w, f, h, S[k], Y[k]);
             cost[k] = polish_one(&w, Y[k], SCORE_ITERS);

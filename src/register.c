@@ -37,9 +37,9 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
         st = match_pair(p, src, tgt, 1, w, &r->m);
     if (!ws)
         amscr__ws_release(&local);
-    if (st == AMSCR_OK && p->polish && src->raw && tgt->raw && !p->partial &&
-        p->invariance == AMSCR_INVARIANCE_AFFINE) /* issue 14: on the input points */
-        st = amscr__polish(src, tgt, &r->m);
+    if (st == AMSCR_OK && p->polish && src->raw && tgt->raw && tgt->params.closed &&
+        (p->partial || src->params.closed) && p->invariance == AMSCR_INVARIANCE_AFFINE) /* on the input points */
+        st = amscr__polish(src, tgt, p->partial, &r->m);
     if (st == AMSCR_OK)
         st = amscr__correspond(src, tgt, r);
     if (st != AMSCR_OK) {
