@@ -171,7 +171,9 @@ def register(src: PointsLike, tgt: PointsLike, *, method: Optional[str] = None, 
         order: 'xy' (default: x = column, y = row for image contours) or 'rc' for (row, col)
             points such as scikit-image's ``measure.find_contours`` gives. Either way the
             result is in the (x, y) frame: 'rc' points are swapped on the way in.
-        **options: other options of :class:`Params`.
+        **options: other options of :class:`Params`, e.g. ``partial=True`` (the source an open
+            fragment of the target) or ``polish=False`` (skip the final fit on the input points,
+            on in the preset: it fits the noisier curve onto the cleaner one).
 
     Returns:
         a :class:`Registration`: the affine map (``A``, ``B``, ``matrix``), the distance and the
