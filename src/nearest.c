@@ -21,17 +21,20 @@ void amscr__grid_free(amscr__grid *g)
     g->start = g->item = NULL;
 }
 
-/* Cells about as wide as sqrt(area / n): a few points per occupied cell of a curve. */
+/* Cells about as wide as sqrt(area / n), and never so narrow that a thin set spreads over more
+ * than about 3n cells: a few points per occupied cell of a curve. Returns 0 for non-finite points. */
 int amscr__grid_build(amscr__grid *g, const double *p, size_t n)
 {
     double lo[2] = {p[0], p[1]}, hi[2] = {p[0], p[1]};
-    for (size_t i = 1; i < n; i++)
-        for (int d = 0; d < 2; d++) {
-            lo[d] = p[2 * i + d] < lo[d] ? p[2 * i + d] : lo[d];
-            hi[d] = p[2 * i + d] > hi[d] ? p[2 * i + d] : hi[d];
-        }
-    double w = hi[0] - lo[0], h = hi[1] - lo[1], cell = sqrt((w * h > 0.0 ? w * h : (w + h) * (w + h)) / (double)n);
-    if (!(cell > 0.0))
+    for (size_t i = 0; i < 2 * n; i++) {
+        if (!isfinite(p[i]))
+            return 0;
+        lo[i % 2] = p[i] < lo[i % 2] ? p[i] : lo[i % 2];
+        hi[i % 2] = p[i] > hi[i % 2] ? p[i] : hi[i % 2];
+    }
+    double w = hi[0] - lo[0], h = hi[1] - lo[1], cell = sqrt(w * h / (double)n), thin = (w + h) / (2.0 * (double)n);
+    cell = cell > thin ? cell : thin;
+    if (!(cell > 0.0) || !isfinite(cell))
         cell = 1.0;
     g->x0 = lo[0];
     g->y0 = lo[1];
@@ -61,17 +64,23 @@ int amscr__grid_build(amscr__grid *g, const double *p, size_t n)
     return 1;
 }
 
-/* Rings of cells around the query's cell until the ring cannot hold a nearer point. */
+/* The cell index of coordinate v clamped to 0..n-1 (a query outside the grid starts at the
+ * grid's nearest cell: every cell r rings away is still at least r cells from the query). */
+static long clamp_cell(double v, long n)
+{
+    return !(v > 0.0) ? 0 : (v >= (double)(n - 1) ? n - 1 : (long)v);
+}
+
+/* Rings of cells around the query's (clamped) cell until the ring cannot hold a nearer point. */
 size_t amscr__grid_nearest(const amscr__grid *g, const double *p, double qx, double qy, double *d2)
 {
-    long cx = (long)floor((qx - g->x0) * g->inv), cy = (long)floor((qy - g->y0) * g->inv);
+    long cx = clamp_cell((qx - g->x0) * g->inv, g->nx), cy = clamp_cell((qy - g->y0) * g->inv, g->ny);
+    long far = g->nx > g->ny ? g->nx : g->ny;
     double best = INFINITY;
     size_t bi = 0;
-    long far = (g->nx > g->ny ? g->nx : g->ny) + labs(cx) + labs(cy) + 1;
     for (long r = 0; r <= far; r++) {
-        for (long y = cy - r; y <= cy + r; y++) {
-            if (y < 0 || y >= g->ny)
-                continue;
+        long y0 = cy - r > 0 ? cy - r : 0, y1 = cy + r < g->ny - 1 ? cy + r : g->ny - 1;
+        for (long y = y0; y <= y1; y++) {
             long step = (y == cy - r || y == cy + r) ? 1 : 2 * r;
             for (long x = cx - r; x <= cx + r; x += step ? step : 1) {
                 if (x < 0 || x >= g->nx)

@@ -14,10 +14,10 @@ typedef struct {
 } amscr__grid;
 
 /* (Re)builds g over the n points p (2n), cells about sqrt(area / n) wide. Returns 0 when out of
- * memory. amscr__grid_free releases; a zeroed grid is empty. */
+ * memory or a point is not finite. amscr__grid_free releases; a zeroed grid is empty. */
 int amscr__grid_build(amscr__grid *g, const double *p, size_t n);
 void amscr__grid_free(amscr__grid *g);
-/* Index of the point of g's set p nearest to (qx, qy); *d2 its squared distance. */
+/* Index of the point of g's set p nearest to (qx, qy) (finite); *d2 its squared distance. */
 size_t amscr__grid_nearest(const amscr__grid *g, const double *p, double qx, double qy, double *d2);
 /* The vertex of the closed polyline p (n) nearest to (qx, qy) near vertex i0: ±3 vertices, then
  * on along the polyline while closer. */

@@ -402,6 +402,8 @@ static size_t polish_starts(const amscr_descriptor *f, const match_t *m, double 
     memcpy(S[0], m->X, sizeof S[0]);
     for (size_t c = 0; m->ambiguity >= AMBIGUOUS_SEARCH && c < m->ncand; c++) {
         int fresh = 1;
+        for (int k = 0; k < 6; k++)
+            fresh = fresh && isfinite(m->cand[c][k]);
         for (size_t k = 0; k < count && fresh; k++)
             fresh = amscr__map_gap2(f, m->cand[c], S[k]) > AMSCR__DISTINCT_GAP2;
         if (fresh)

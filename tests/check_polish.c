@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "nearest.h"
 #include "suites.h"
 #include "testutil.h"
 
@@ -404,6 +405,43 @@ START_TEST(symmetric_stay_ambiguous)
 }
 END_TEST
 
+/* The polish's global partner search (nearest.c) equals brute force: random clouds, a thin
+ * (nearly collinear) set, a single repeated point, and queries far outside the grid. */
+START_TEST(grid_nearest_is_exact)
+{
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, 77);
+    double p[2 * 500], q[2];
+    for (int set = 0; set < 4; set++) {
+        size_t n = set == 3 ? 7 : 500;
+        for (size_t i = 0; i < n; i++) {
+            double u = amscr_test_uniform(&rng), v = amscr_test_uniform(&rng);
+            p[2 * i] = set == 3 ? 1.5 : 100.0 * u;
+            p[2 * i + 1] = set == 3 ? -2.0 : (set == 1 ? 1e-6 * v : 100.0 * v) + (set == 2 ? 5.0 * u : 0.0);
+        }
+        amscr__grid g = {0};
+        ck_assert(amscr__grid_build(&g, p, n));
+        for (int k = 0; k < 200; k++) {
+            double spread = k % 4 == 0 ? 1e6 : 150.0;
+            q[0] = spread * (amscr_test_uniform(&rng) - 0.3);
+            q[1] = spread * (amscr_test_uniform(&rng) - 0.3);
+            double d, best = INFINITY;
+            size_t i = amscr__grid_nearest(&g, p, q[0], q[1], &d);
+            for (size_t j = 0; j < n; j++) {
+                double dx = p[2 * j] - q[0], dy = p[2 * j + 1] - q[1];
+                best = dx * dx + dy * dy < best ? dx * dx + dy * dy : best;
+            }
+            ck_assert_msg(d == best && i < n, "set %d query %d: %g vs brute force %g", set, k, d, best);
+        }
+        amscr__grid_free(&g);
+    }
+    p[0] = NAN;
+    amscr__grid g = {0};
+    ck_assert(!amscr__grid_build(&g, p, 10)); /* non-finite points are refused */
+    amscr__grid_free(&g);
+}
+END_TEST
+
 Suite *amscr_suite_polish(void)
 {
     Suite *s = suite_create("polish");
@@ -416,6 +454,7 @@ Suite *amscr_suite_polish(void)
     tcase_add_test(tc, no_polish_without_input_points);
     tcase_add_test(tc, partial_polished);
     tcase_add_test(tc, symmetric_stay_ambiguous);
+    tcase_add_test(tc, grid_nearest_is_exact);
     suite_add_tcase(s, tc);
     return s;
 }
