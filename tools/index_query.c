@@ -163,21 +163,38 @@ static void scores(const double *r, size_t len, size_t n, size_t self, const dou
     }
 }
 
+/* A graph of n rows of k neighbours; returns 0 when out of memory (graph_free releases). */
+static int graph_alloc(graph *g, size_t n, size_t k)
+{
+    graph e = {n, k, NULL, NULL, NULL, NULL};
+    *g = e;
+    g->j = xmalloc_array(n, k * sizeof(uint32_t));
+    g->d = xmalloc_array(n, k * sizeof(double));
+    g->w = xmalloc_array(n, k * sizeof(double));
+    g->s = xmalloc_array(n, sizeof(double));
+    return g->j && g->d && g->w && g->s;
+}
+
+static void graph_free(graph *g)
+{
+    free(g->j);
+    free(g->d);
+    free(g->w);
+    free(g->s);
+}
+
 /* Row `member` of the collection's re-ranked matrix (the query is that shape): the stored
  * lists alone, K = k <= x->k; dsym[t] the base distance of the member and cand[t]. */
 static int member_row(const tool_index *x, size_t k, unsigned iters, size_t member, const size_t *cand,
                       const double *dsym, size_t m, double *out)
 {
     size_t n = x->coll.n;
-    graph g = {n, k, NULL, NULL, NULL, NULL};
-    g.j = xmalloc_array(n, k * sizeof(uint32_t));
-    g.d = xmalloc_array(n, k * sizeof(double));
-    g.w = xmalloc_array(n, k * sizeof(double));
-    g.s = xmalloc_array(n, sizeof(double));
+    graph g;
+    int ok = graph_alloc(&g, n, k);
     double *dq = xmalloc_array(n, sizeof(double)), *r = xmalloc_array(n, sizeof(double));
     unsigned char *have = xcalloc_array(n, 1);
     int ret = -1;
-    if (g.j && g.d && g.w && g.s && dq && r && have) {
+    if (ok && dq && r && have) {
         for (size_t t = 0; t < m; t++) {
             dq[cand[t]] = dsym[t];
             have[cand[t]] = 1;
@@ -190,10 +207,7 @@ static int member_row(const tool_index *x, size_t k, unsigned iters, size_t memb
             ret = 0;
         }
     }
-    free(g.j);
-    free(g.d);
-    free(g.w);
-    free(g.s);
+    graph_free(&g);
     free(dq);
     free(r);
     free(have);
@@ -204,15 +218,12 @@ int rerank_query_row(const tool_index *x, size_t k, unsigned iters, const size_t
                      double *out)
 {
     size_t n = x->coll.n;
-    graph g = {n + 1, k, NULL, NULL, NULL, NULL};
-    g.j = xmalloc_array(g.n, k * sizeof(uint32_t));
-    g.d = xmalloc_array(g.n, k * sizeof(double));
-    g.w = xmalloc_array(g.n, k * sizeof(double));
-    g.s = xmalloc_array(g.n, sizeof(double));
+    graph g;
+    int ok = graph_alloc(&g, n + 1, k);
     double *dq = xmalloc_array(n, sizeof(double)), *r = xmalloc_array(g.n, sizeof(double));
     unsigned char *have = xcalloc_array(n, 1);
     int ret = -1;
-    if (!g.j || !g.d || !g.w || !g.s || !dq || !r || !have)
+    if (!ok || !dq || !r || !have)
         goto done;
     double dmax = x->dmax;
     for (size_t t = 0; t < m; t++) {
@@ -231,10 +242,7 @@ int rerank_query_row(const tool_index *x, size_t k, unsigned iters, const size_t
     scores(r, g.n, n, SIZE_MAX, dq, have, dmax, out);
     ret = 0;
 done:
-    free(g.j);
-    free(g.d);
-    free(g.w);
-    free(g.s);
+    graph_free(&g);
     free(dq);
     free(r);
     free(have);
