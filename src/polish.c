@@ -20,12 +20,14 @@
  *
  * When the start-point search could not tell its candidates apart, the other distinct
  * candidates are polished alike and ranked by a two-way trimmed cost, so a noisy
- * symmetric-looking shape gets the start the points favour. Runs on closed curves under affine
- * invariance when the params ask for it (the registration preset does); the reported distance
- * stays the batch path's. */
+ * symmetric-looking shape gets the start the points favour. When the rougher curve is markedly
+ * the noisier, the winner is refined by the order of its points (ordered.c). Runs on closed
+ * curves under affine invariance when the params ask for it (the registration preset does);
+ * the reported distance stays the batch path's. */
 #include "dense.h"
 #include "match.h"
 #include "nearest.h"
+#include "ordered.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -53,6 +55,11 @@
 /* An edge longer than GAP_RATIO times the curve's median edge is a gap (the chord that closes a
  * contour across a missing run), not boundary: nothing is paired onto it. */
 #define GAP_RATIO 8.0
+/* The order of the rougher curve's points refines the polished map (ordered.c) when that curve
+ * is markedly the noisier — its noise variance at least ORDER_NOISIER times the smoother one's
+ * (weight wb >= 0.8) — so that the smoother is a clean model of the curve the points scatter
+ * about; never across a gap (a missing run breaks the order's even advance). */
+#define ORDER_NOISIER 4.0
 /* Roughness: for Gaussian noise of variance s^2 per coordinate, a second difference has
  * variance 6 s^2 per coordinate, and its squared length's median is 6 s^2 * 2 ln 2. */
 #define ROUGH_DIV (6.0 * 2.0 * 0.6931471805599453)
@@ -394,6 +401,23 @@ static int polish_prepare(polish_t *w, const amscr_descriptor *f, const amscr_de
     return amscr__grid_build(&w->gb, w->b->p, w->b->n);
 }
 
+/* Whether a curve has a gap edge. */
+static int has_gap(const curve_t *c)
+{
+    for (size_t i = 0; i < c->n; i++)
+        if (c->gap[i])
+            return 1;
+    return 0;
+}
+
+/* The polished Y refined by the order of b's points, where that applies (ORDER_NOISIER). */
+static void order_refine(const polish_t *w, double Y[6])
+{
+    if (w->partial || w->wb < ORDER_NOISIER * w->wa || has_gap(w->a) || has_gap(w->b))
+        return;
+    amscr__ordered_fit(w->a->p, w->a->n, w->b->p, w->b->n, w->b->rough, Y);
+}
+
 /* The start maps: the chosen one first, then — when the search could not tell its candidates
  * apart (ambiguity at least AMBIGUOUS_SEARCH) — each candidate that differs from all before. */
 static size_t polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6])
@@ -446,8 +470,10 @@ amscr_status amscr__polish(const amscr_descriptor *f, const amscr_descriptor *h,
     if (best < count) { /* the winner polished on */
         if (count > 1)
             m->ambiguity = polished_ambiguity(f, S, cost, count, best);
-        if (polish_one(&w, Y[best], POLISH_ITERS - SCORE_ITERS) < INFINITY)
+        if (polish_one(&w, Y[best], POLISH_ITERS - SCORE_ITERS) < INFINITY) {
+            order_refine(&w, Y[best]);
             from_frames(&w, f, h, Y[best], S[best]);
+        }
         memcpy(m->X, S[best], sizeof m->X);
     }
     polish_free(&w);

@@ -26,5 +26,6 @@ Suite *amscr_suite_robust(void);
 Suite *amscr_suite_channel(void);
 Suite *amscr_suite_trace_all(void);
 Suite *amscr_suite_polish(void);
+Suite *amscr_suite_ordered(void);
 
 #endif
