@@ -40,7 +40,7 @@
  * measured the same). */
 #define ORDER_BAND 3.0
 /* The widest band (states); beyond it the noise is too large for the order to say much. */
-#define ORDER_MAX_WIDTH 255
+#define ORDER_MAX_WIDTH 127
 /* The stage runs when the points' noise sigma is at least this share of their median spacing:
  * for noise much larger than the spacing the median edge is 1.66 sigma (ratio 0.6); a pixel
  * chain's staircase reads below 0.35; the clean resampled curves of the held-out pairs 0.04. */
