@@ -818,12 +818,17 @@ AMSCR_API int amscr_params_get_partial(const amscr_params *p);
  *        a noisy curve is biased); pairs beyond 5x the median distance, and pairs on the chord
  *        across a missing run, are left out. When the start-point search was ambiguous its other
  *        distinct candidates are polished alike; the lowest two-way trimmed cost wins and sets
- *        the ambiguity. Partial matching: the fragment's points alone. Needs the input points:
+ *        the ambiguity. When one curve is markedly the noisier (4x the other's noise variance)
+ *        and its noise is as large as its point spacing, the map is then refined by the ORDER of
+ *        its points (0.3.1: each point a little further along the curve than the one before; a
+ *        hidden Markov model fitted by EM), which pins where long and thin parts end. Partial
+ *        matching: the fragment's points alone. Needs the input points:
  *        amscr_descriptor_new keeps up to 4096 of them (64 KiB) under affine invariance;
  *        descriptors in a collection (amscr_db) or loaded from a file have none and are then
  *        registered unpolished. A closed target, affine invariance; the distance stays the batch
  *        path's. Measured in the README (held-out 1 % / 2 % noise: 95.7 / 88.6 % -> 100 / 97.1 %;
- *        50 % fragments 90.0 -> 95.7 %). @since 0.3
+ *        over 280 pairs at 2 % noise the order stage takes 96.8 to 97.9 %; 50 % fragments
+ *        90.0 -> 95.7 %). @since 0.3
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_polish(amscr_params *p, int on);
 /** @brief The polish flag (0 for NULL). @since 0.3 */
