@@ -89,3 +89,33 @@ def test_tool_no_polish_equals_polish_false(tmp_path):
         r = amscr.register(amscr.read_points(s), amscr.read_points(t), polish=polish)
         np.testing.assert_allclose(j['A'], r.A, rtol=1e-12, atol=1e-12)
         np.testing.assert_allclose(j['B'], r.B, rtol=1e-12, atol=1e-9)
+
+
+def test_partial_polish_never_collapses():
+    """A fragment paired only onto the target could always shrink onto a small piece of it; the
+    polish refuses a result that changed the map's area by more than 2x (a 50 % fragment of
+    MPEG-7's device6 was polished onto 0.2 % of the target with confidence 0.64 before). Only
+    an ambiguous search (confidence < 0.25) may end at another candidate of another area."""
+    repo = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..')
+    data = os.path.join(os.environ.get('AMSCR_DATASETS') or os.path.join(repo, '..', 'shared', 'datasets'),
+                        'mpeg7-dev')
+    if not os.path.exists(os.path.join(data, 'manifest.tsv')):
+        pytest.skip('mpeg7-dev not found (%s)' % data)
+    import sys
+    sys.path.insert(0, os.path.join(repo, 'bench'))
+    import registration_heldout as heldout
+    ci = [c[0] for c in heldout.CONDITIONS].index('frag50')
+    checked = 0
+    for si, (cls, f) in enumerate(heldout.load_shapes(data, 35)):
+        for d in range(2):
+            rng = np.random.default_rng([14, ci, si, d])
+            src, tgt, _, _, _ = heldout.make_case(f, 'frag50', 0.5, rng)
+            on = amscr.register(src, tgt, partial=True)
+            off = amscr.register(src, tgt, partial=True, polish=False)
+            ratio = np.linalg.det(on.A) / np.linalg.det(off.A)
+            start, end = on.part
+            if on.confidence >= 0.25:
+                assert 0.5 <= ratio <= 2.0, (cls, d, ratio, on.confidence)
+                assert (end - start) % 1.0 > 0.05, (cls, d, on.part)
+            checked += 1
+    assert checked == 70
