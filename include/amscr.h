@@ -827,7 +827,7 @@ AMSCR_API int amscr_params_get_partial(const amscr_params *p);
  *        descriptors in a collection (amscr_db) or loaded from a file have none and are then
  *        registered unpolished. A closed target, affine invariance; the distance stays the batch
  *        path's. Measured in the README (held-out 1 % / 2 % noise: 95.7 / 88.6 % -> 100 / 97.1 %;
- *        over 280 pairs at 2 % noise the order stage takes 96.8 to 97.9 %; 50 % fragments
+ *        over 280 pairs at 2 % noise the order stage takes 96.8 to 98.2 %; 50 % fragments
  *        90.0 -> 95.7 %). @since 0.3
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_polish(amscr_params *p, int on);

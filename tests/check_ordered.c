@@ -88,8 +88,9 @@ static double make_case(uint64_t seed, int reversed, double noise, double *a, do
 }
 
 /* Over CASES long shapes: how many starts the stage brought below 0.8 of their error, and the
- * mean errors before and after (fractions of the size). EM moves slowly along a long axis (the
- * likelihood is flat there): 8 rounds take a 6.7 % start to about 3 %. */
+ * mean errors before and after (fractions of the size). Plain EM moves slowly along a long
+ * axis (the likelihood is flat there: 8 rounds took a 6.7 % start to 2.9 %); over-relaxed, the
+ * stage ends near 1.1 %. */
 static void run(int reversed, size_t *better, double *mean_after, double *mean_before)
 {
     double *a = malloc(2 * POINTS * sizeof *a), *b = malloc(2 * POINTS * sizeof *b);
@@ -116,7 +117,7 @@ START_TEST(order_pins_the_long_axis)
     run(0, &better, &after, &before);
     printf("ordered: forward: %zu of %d lowered, mean %.2f %% -> %.2f %%\n", better, CASES, 100 * before, 100 * after);
     ck_assert_uint_ge(better, CASES - 1);
-    ck_assert(after < 0.5 * before);
+    ck_assert(after < 0.3 * before);
 }
 END_TEST
 
@@ -127,7 +128,7 @@ START_TEST(order_either_direction)
     run(1, &better, &after, &before);
     printf("ordered: reversed: %zu of %d lowered, mean %.2f %% -> %.2f %%\n", better, CASES, 100 * before, 100 * after);
     ck_assert_uint_ge(better, CASES - 1);
-    ck_assert(after < 0.5 * before);
+    ck_assert(after < 0.3 * before);
 }
 END_TEST
 
