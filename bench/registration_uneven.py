@@ -40,6 +40,8 @@ def main():
     ap.add_argument('--density', type=float, default=6.0)
     ap.add_argument('--noise', type=float, default=0.02)
     ap.add_argument('--draws', type=int, default=4)
+    ap.add_argument('--outliers', type=float, default=0.0,
+                    help='share of the target points moved to random places in its bounding box')
     args = ap.parse_args()
     if not os.path.exists(os.path.join(args.data, 'manifest.tsv')):
         print('no manifest in %s: skipped' % args.data)
@@ -54,6 +56,10 @@ def main():
             m = int(len(f) * rng.uniform(0.6, 1.4))
             tgt = np.roll(uneven(tgt, m, args.density, rng), rng.integers(m), axis=0)
             tgt = tgt + rng.normal(0, args.noise * size, tgt.shape)
+            k = int(round(args.outliers * m))
+            if k:
+                lo, hi = tgt.min(axis=0), tgt.max(axis=0)
+                tgt[rng.choice(m, k, replace=False)] = lo + (hi - lo) * rng.uniform(0, 1, (k, 2))
             try:
                 r = amscr.register(f, tgt)
                 errs.append(100 * H.map_error(np.hstack([r.A, r.B[:, None]]), T, f, size))
@@ -61,8 +67,8 @@ def main():
                 errs.append(np.inf)
     e = np.sort(errs)
     n = len(e)
-    print('density %.1f, noise %.1f %%: %d pairs, within 2 %%: %.1f %%, median %.3f %%, 90th pct %.3f %%, '
-          '95th pct %.3f %%' % (args.density, 100 * args.noise, n, 100 * np.mean(e < 2), e[n // 2], e[9 * n // 10],
+    print('density %.1f, noise %.1f %%, outliers %.1f %%: %d pairs, within 2 %%: %.1f %%, median %.3f %%, 90th pct %.3f %%, '
+          '95th pct %.3f %%' % (args.density, 100 * args.noise, 100 * args.outliers, n, 100 * np.mean(e < 2), e[n // 2], e[9 * n // 10],
                                 e[95 * n // 100]))
     return 0
 

@@ -27,5 +27,6 @@ Suite *amscr_suite_channel(void);
 Suite *amscr_suite_trace_all(void);
 Suite *amscr_suite_polish(void);
 Suite *amscr_suite_ordered(void);
+Suite *amscr_suite_despike(void);
 
 #endif
