@@ -30,8 +30,7 @@ static double dist(const double *p, size_t i, size_t j)
     return hypot(p[2 * j] - p[2 * i], p[2 * j + 1] - p[2 * i + 1]);
 }
 
-/* The median edge of the closed list p (n points; scratch: n values). */
-static double median_edge(const double *p, size_t n, double *scratch)
+double amscr__median_edge(const double *p, size_t n, double *scratch)
 {
     for (size_t i = 0; i < n; i++)
         scratch[i] = dist(p, i, (i + 1) % n);
@@ -65,7 +64,7 @@ size_t amscr__despike(double *p, size_t n, double *scratch)
 {
     size_t removed = 0;
     for (int pass = 0; pass < SPIKE_PASSES && n >= SPIKE_MIN_POINTS; pass++) {
-        double med = median_edge(p, n, scratch);
+        double med = amscr__median_edge(p, n, scratch);
         if (!(med > 0.0))
             break;
         size_t count = mark_spikes(p, n, med, scratch);

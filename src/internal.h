@@ -88,6 +88,8 @@ size_t amscr__dedupe_points(const double *xy, size_t n, int closed, double *out)
 /* despike.c: drops isolated spikes (runs of <= 3 points the closed list p leaves and re-enters by
  * edges 8x its median) in place; returns the new count. scratch: n doubles. */
 size_t amscr__despike(double *p, size_t n, double *scratch);
+/* The median edge length of the closed list p (n points; scratch: n doubles, reordered). */
+double amscr__median_edge(const double *p, size_t n, double *scratch);
 amscr_status amscr__validate_points(const double *xy, size_t n, int closed, const char *what);
 size_t amscr__kernel_radius(double sigma);
 void amscr__kernel_fill(double sigma, size_t r, double *taps);

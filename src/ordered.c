@@ -116,17 +116,6 @@ static int order_alloc(order_t *o)
     return 1;
 }
 
-/* The median length of the closed polyline p's edges (scratch: n values). */
-static double median_edge(const double *p, size_t n, double *scratch)
-{
-    for (size_t i = 0; i < n; i++) {
-        size_t e = (i + 1) % n;
-        scratch[i] = hypot(p[2 * e] - p[2 * i], p[2 * e + 1] - p[2 * i + 1]);
-    }
-    amscr__select_kth(scratch, n, n / 2);
-    return scratch[n / 2];
-}
-
 /* K states evenly spaced along Y a: sp (moved), sa (a's frame). Returns the step, 0 if none. */
 static double build_states(order_t *o, const double Y[6])
 {
@@ -505,7 +494,7 @@ int amscr__ordered_fit(const double *a, size_t na, const double *b, size_t nb, d
     double *scratch = amscr__malloc_array(nb, sizeof *scratch), sigma = sqrt(rough_b), Z[6];
     if (!scratch)
         return 0;
-    double spacing = median_edge(b, nb, scratch), speed = measured_speed(b, nb, scratch);
+    double spacing = amscr__median_edge(b, nb, scratch), speed = measured_speed(b, nb, scratch);
     free(scratch);
     o.S = (size_t)ceil(speed * ORDER_STATES);
     if (!(sigma >= ORDER_MIN_SCATTER * spacing))
