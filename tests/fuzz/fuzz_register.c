@@ -6,7 +6,9 @@
  *   byte 1: bit 0 open curves; bit 1 symmetric; bits 2-3 refine 0/1/3/10;
  *           bits 4-5 oversampling 1/2/4/8; bits 6-7 arc-length passes 1..4
  * Scales {0, 1, 2, 3}. Properties on success: finite distance >= 0, equal (to rounding) to
- * amscr_distance on the same descriptors, finite maps, shift < N, kept <= scales. */
+ * amscr_distance on the same descriptors, finite maps, shift < N, kept <= scales. Closed curves
+ * under affine invariance are registered again with the polish on (stray points dropped, the
+ * fit on the input points, the order of noisy points): a finite map or a clean error. */
 #include <math.h>
 #include <string.h>
 
@@ -14,6 +16,27 @@
 #include "fuzz_common.h"
 
 static void set_ok(amscr_status st) { FUZZ_CHECK(st == AMSCR_OK); }
+
+/* The same registration with the polish on: a finite map or a clean error. */
+static void polished(const amscr_params *p, const amscr_contour *a, const amscr_contour *tgt)
+{
+    amscr_params *q = NULL;
+    amscr_result *r = NULL;
+    set_ok(amscr_params_copy(p, &q));
+    set_ok(amscr_params_set_polish(q, 1));
+    amscr_status st = amscr_register_contours(q, a, tgt, &r);
+    if (st == AMSCR_OK) {
+        double m[6];
+        FUZZ_CHECK(amscr_result_affine(r, m) == AMSCR_OK);
+        for (int i = 0; i < 6; i++)
+            FUZZ_CHECK(isfinite(m[i]));
+        amscr_result_free(r);
+    } else {
+        FUZZ_CHECK(r == NULL);
+        FUZZ_CHECK(st == AMSCR_E_DEGENERATE || st == AMSCR_E_INVALID_ARG || st == AMSCR_E_NUMERIC);
+    }
+    amscr_params_free(q);
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -86,6 +109,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FUZZ_CHECK(r == NULL);
         FUZZ_CHECK(st == AMSCR_E_DEGENERATE || st == AMSCR_E_INVALID_ARG || st == AMSCR_E_NUMERIC);
     }
+    if (!(b1 & 1) && ((b0 >> 6) & 3) % 3 == 0) /* closed, affine */
+        polished(p, a, tgt);
     amscr_params_free(p);
     amscr_contour_free(a);
     amscr_contour_free(b);
