@@ -822,10 +822,11 @@ AMSCR_API int amscr_params_get_partial(const amscr_params *p);
  *        and its noise is as large as its point spacing, the map is then refined by the ORDER of
  *        its points (0.3.1: each point a little further along the curve than the one before; a
  *        hidden Markov model fitted by EM), which pins where long and thin parts end. Partial
- *        matching: the fragment's points alone. With the polish on, a closed contour of 32 or
- *        more points also loses its isolated stray points first (0.3.1: runs of at most 3 points
- *        the curve leaves and re-enters by edges 8x its median edge; a few stray points wrecked
- *        the arc-length parametrization). Needs the input points:
+ *        matching: the fragment's points alone. With the polish on, a contour of 32 or more
+ *        points also loses its isolated stray points first (0.3.1: runs of at most 3 points the
+ *        curve leaves and re-enters by edges 8x its median edge, and an open curve's end that
+ *        jumps away so; a few stray points wrecked the arc-length parametrization). Needs the
+ *        input points:
  *        amscr_descriptor_new keeps up to 4096 of them (64 KiB) under affine invariance;
  *        descriptors in a collection (amscr_db) or loaded from a file have none and are then
  *        registered unpolished. A closed target, affine invariance; the distance stays the batch

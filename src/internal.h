@@ -85,11 +85,11 @@ void amscr__reverse_points(double *xy, size_t n);
 /* Copies xy dropping repeated consecutive points (and, closed, a repeated closing point);
  * returns the count. out: room for 2n doubles. */
 size_t amscr__dedupe_points(const double *xy, size_t n, int closed, double *out);
-/* despike.c: drops isolated spikes (runs of <= 3 points the closed list p leaves and re-enters by
- * edges 8x its median) in place; returns the new count. scratch: n doubles. */
-size_t amscr__despike(double *p, size_t n, double *scratch);
-/* The median edge length of the closed list p (n points; scratch: n doubles, reordered). */
-double amscr__median_edge(const double *p, size_t n, double *scratch);
+/* despike.c: drops isolated spikes (runs of <= 3 points the list p leaves and re-enters by edges
+ * 8x its median; open: also a stray end) in place; returns the new count. scratch: n doubles. */
+size_t amscr__despike(double *p, size_t n, int closed, double *scratch);
+/* The median edge length of the list p (n >= 2 points; scratch: n doubles, reordered). */
+double amscr__median_edge(const double *p, size_t n, int closed, double *scratch);
 amscr_status amscr__validate_points(const double *xy, size_t n, int closed, const char *what);
 size_t amscr__kernel_radius(double sigma);
 void amscr__kernel_fill(double sigma, size_t r, double *taps);

@@ -494,7 +494,7 @@ int amscr__ordered_fit(const double *a, size_t na, const double *b, size_t nb, d
     double *scratch = amscr__malloc_array(nb, sizeof *scratch), sigma = sqrt(rough_b), Z[6];
     if (!scratch)
         return 0;
-    double spacing = amscr__median_edge(b, nb, scratch), speed = measured_speed(b, nb, scratch);
+    double spacing = amscr__median_edge(b, nb, 1, scratch), speed = measured_speed(b, nb, scratch);
     free(scratch);
     o.S = (size_t)ceil(speed * ORDER_STATES);
     if (!(sigma >= ORDER_MIN_SCATTER * spacing))

@@ -1,5 +1,6 @@
 /* check_despike.c — isolated stray points dropped before registration (src/despike.c): runs of
- * 1-3 points far off the curve go, the curve's own points stay exactly (pixel chains, noisy
+ * 1-3 points far off the curve go (and a fragment's stray end), the curve's own points stay
+ * exactly (pixel chains, noisy
  * curves, densely sampled needles, short polygons), and the registration preset registers
  * contours with stray points as if they had none. */
 #include <amscr.h>
@@ -37,16 +38,21 @@ static size_t insert_run(double *p, size_t n, size_t at, size_t run, double angl
     return n + run;
 }
 
-/* despike on a copy of p (n); returns the count kept and checks the kept points are p's own. */
-static size_t despiked(const double *p, size_t n, double **out)
+/* despike on a copy of p (n, closed or open); returns the count kept. */
+static size_t despiked_as(const double *p, size_t n, int closed, double **out)
 {
     double *q = malloc(2 * n * sizeof *q), *scratch = malloc(n * sizeof *scratch);
     ck_assert(q && scratch);
     memcpy(q, p, 2 * n * sizeof *q);
-    size_t m = amscr__despike(q, n, scratch);
+    size_t m = amscr__despike(q, n, closed, scratch);
     free(scratch);
     *out = q;
     return m;
+}
+
+static size_t despiked(const double *p, size_t n, double **out)
+{
+    return despiked_as(p, n, 1, out);
 }
 
 START_TEST(stray_runs_removed)
@@ -110,6 +116,29 @@ START_TEST(curves_kept)
 }
 END_TEST
 
+/* An open fragment: runs inside it and a stray first or last point go, its own ends stay. */
+START_TEST(open_fragment)
+{
+    double *p = shape(8, N), *frag = malloc(2 * (N / 2 + 4) * sizeof *frag), *q;
+    ck_assert(frag);
+    memcpy(frag + 2, p, 2 * (N / 2) * sizeof *p); /* half the curve, after a stray first point */
+    frag[0] = 4.0, frag[1] = 4.0;
+    size_t n = 1 + N / 2;
+    n = insert_run(frag, n, 120, 2, 1.0);
+    frag[2 * n] = -4.0, frag[2 * n + 1] = 3.0; /* a stray last point */
+    n++;
+    size_t m = despiked_as(frag, n, 0, &q);
+    ck_assert_uint_eq(m, N / 2);
+    ck_assert(memcmp(q, p, 2 * (N / 2) * sizeof *p) == 0);
+    free(q);
+    m = despiked_as(p, N / 2, 0, &q); /* a clean fragment keeps both its ends */
+    ck_assert_uint_eq(m, N / 2);
+    free(q);
+    free(frag);
+    free(p);
+}
+END_TEST
+
 /* Every other point far away is no isolated spike: nothing (or at most 1/8) is removed. */
 START_TEST(never_more_than_an_eighth)
 {
@@ -162,6 +191,48 @@ START_TEST(register_through_stray_points)
 }
 END_TEST
 
+/* Partial matching of a 70 % fragment with three stray points (1 % stray points in 70 %
+ * fragments: 4.3 % of held-out pairs within 2 % before, 97.1 % with the despiking). */
+START_TEST(partial_through_stray_points)
+{
+    enum { F = 7 * N / 10 };
+    size_t ok = 0;
+    for (uint64_t c = 0; c < 10; c++) {
+        amscr_test_rng rng;
+        amscr_test_rng_seed(&rng, 500 + c);
+        double *s = shape(600 + c, N), *t = malloc(2 * N * sizeof *t), *f = malloc(2 * (F + 3) * sizeof *f), T[6], M[6];
+        ck_assert(t && f);
+        amscr_test_random_affine(&rng, 2.0, 0.5, 10.0, 0, T);
+        amscr_test_apply_affine(T, s, N, t);
+        memcpy(f, s, 2 * F * sizeof *f);
+        size_t n = F;
+        for (int k = 0; k < 3; k++)
+            n = insert_run(f, n, 20 + (size_t)(amscr_test_uniform(&rng) * (double)(n - 40)), 1,
+                           6.283185307179586 * amscr_test_uniform(&rng));
+        amscr_params *p = NULL;
+        amscr_contour *cs = NULL, *ct = NULL;
+        amscr_result *r = NULL;
+        ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+        ck_assert_int_eq(amscr_params_set_partial(p, 1), AMSCR_OK);
+        ck_assert_int_eq(amscr_contour_new(f, n, &cs), AMSCR_OK);
+        ck_assert_int_eq(amscr_contour_new(t, N, &ct), AMSCR_OK);
+        ck_assert_int_eq(amscr_register_contours(p, cs, ct, &r), AMSCR_OK);
+        ck_assert_int_eq(amscr_result_affine(r, M), AMSCR_OK);
+        double e = amscr_test_max_map_error(M, T, s, F) / amscr_test_shape_size(t, N);
+        printf("despike: fragment %d: error %.4f %%\n", (int)c, 100.0 * e);
+        ok += e < 0.005;
+        amscr_result_free(r);
+        amscr_contour_free(cs);
+        amscr_contour_free(ct);
+        amscr_params_free(p);
+        free(s);
+        free(t);
+        free(f);
+    }
+    ck_assert_uint_ge(ok, 9);
+}
+END_TEST
+
 Suite *amscr_suite_despike(void)
 {
     Suite *s = suite_create("despike");
@@ -169,8 +240,10 @@ Suite *amscr_suite_despike(void)
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, stray_runs_removed);
     tcase_add_test(tc, curves_kept);
+    tcase_add_test(tc, open_fragment);
     tcase_add_test(tc, never_more_than_an_eighth);
     tcase_add_test(tc, register_through_stray_points);
+    tcase_add_test(tc, partial_through_stray_points);
     suite_add_tcase(s, tc);
     return s;
 }
