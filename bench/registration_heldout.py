@@ -17,7 +17,7 @@ ECC (optional, --ecc; needs opencv-python-headless): cv2.findTransformECC with M
 rendered, blurred masks (the fragment closed by its chord), from 8 starting rotations with
 centroid and area matched, the best correlation kept.
 
-Usage: nice python3 bench/registration_heldout.py [--data DIR] [--ecc] [--draws 2] [--json OUT]
+Usage: nice python3 bench/registration_heldout.py [--data DIR] [--ecc] [--draws 2] [--stray F] [--json OUT]
 Deterministic: every draw is seeded by (condition, class index, draw).
 """
 import argparse
@@ -95,6 +95,18 @@ def make_case(f, key, amount, rng):
         start = int(rng.integers(n))
         src = np.roll(f, -start, axis=0)[:k]
     return src, tgt, T, size, key.startswith('frag')
+
+
+def with_strays(src, share, rng):
+    """src with round(share * n) of its inner points (not the first or last two) moved to random
+    places in its bounding box."""
+    k = int(round(share * len(src)))
+    if k == 0:
+        return src
+    out = src.copy()
+    lo, hi = src.min(axis=0), src.max(axis=0)
+    out[rng.choice(np.arange(2, len(src) - 2), k, replace=False)] = lo + (hi - lo) * rng.uniform(0, 1, (k, 2))
+    return out
 
 
 def map_error(M, T, src, size):
@@ -191,6 +203,9 @@ def main():
     ap.add_argument('--mode', choices=['partial', 'open'], default='partial',
                     help='fragments: the partial option (default) or both curves open (0.1 behaviour)')
     ap.add_argument('--only', help='comma-separated condition keys')
+    ap.add_argument('--stray', type=float, default=0.0,
+                    help='share of the SOURCE points moved to random places in its bounding box (stray points); '
+                         'the error is still measured on the clean source')
     ap.add_argument('--json', help='write per-case results here')
     ap.add_argument('-v', '--verbose', action='store_true')
     args = ap.parse_args()
@@ -216,8 +231,9 @@ def main():
             for d in range(args.draws):
                 rng = np.random.default_rng([14, ci, si, d])
                 src, tgt, T, size, partial = make_case(f, key, amount, rng)
+                seen = with_strays(src, args.stray, np.random.default_rng([15, ci, si, d]))
                 t0 = time.perf_counter()
-                M, res = amscr_register(src, tgt, partial, args.mode)
+                M, res = amscr_register(seen, tgt, partial, args.mode)
                 t_reg += time.perf_counter() - t0
                 ea = map_error(M, T, src, size) if M is not None else math.inf
                 ee = None
