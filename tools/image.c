@@ -46,6 +46,11 @@ void image_free(tool_image *img)
     }
 }
 
+/* Ancillary PNG chunks: at most this many bytes each and this many in all (libpng's own
+ * defaults in builds that set them; Debian's libpng sets no byte limit). */
+#define PNG_CHUNK_MAX_BYTES 8000000u
+#define PNG_CHUNK_MAX_COUNT 1000u
+
 static int check_limits(const char *path, const char *fmt, size_t w, size_t h)
 {
     if (w == 0 || h == 0) {
@@ -385,6 +390,14 @@ static int read_png(FILE *fp, const char *path, tool_image *out)
     }
     png_set_read_fn(png, &ctx, png_read_fn);
     png_set_user_limits(png, 0x7fffffffu, 0x7fffffffu); /* our own limits are checked below */
+#ifdef PNG_SET_CHUNK_MALLOC_LIMIT_SUPPORTED
+    /* An ancillary chunk may claim up to 2 GiB, which libpng would allocate before reading it
+     * (found by fuzz_png: a 16 x 12 image with a 2 GB text chunk); none we need is large. */
+    png_set_chunk_malloc_max(png, PNG_CHUNK_MAX_BYTES);
+#endif
+#ifdef PNG_SET_CHUNK_CACHE_LIMIT_SUPPORTED
+    png_set_chunk_cache_max(png, PNG_CHUNK_MAX_COUNT);
+#endif
     png_read_info(png, info);
 
     png_uint_32 w = png_get_image_width(png, info);
