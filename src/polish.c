@@ -25,6 +25,7 @@
  * curves under affine invariance when the params ask for it (the registration preset does);
  * the reported distance stays the batch path's. */
 #include "dense.h"
+#include "even.h"
 #include "match.h"
 #include "nearest.h"
 #include "ordered.h"
@@ -415,12 +416,14 @@ static int has_gap(const curve_t *c)
     return 0;
 }
 
-/* The polished Y refined by the order of b's points, where that applies (ORDER_NOISIER). */
+/* The polished Y refined by the order of b's points, where that applies (ORDER_NOISIER), then
+ * by their even spacing where the points bear that out (even.c). */
 static void order_refine(const polish_t *w, double Y[6])
 {
     if (w->partial || w->wb < ORDER_NOISIER * w->wa || has_gap(w->a) || has_gap(w->b))
         return;
     amscr__ordered_fit(w->a->p, w->a->n, w->b->p, w->b->n, w->b->rough, Y);
+    amscr__even_fit(w->a->p, w->a->n, w->b->p, w->b->n, w->b->rough, Y);
 }
 
 /* The start maps: the chosen one first, then — when the search could not tell its candidates
