@@ -8,84 +8,37 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "longshape.h"
 #include "ordered.h"
 #include "suites.h"
 #include "testutil.h"
 
-enum { DENSE = 4096, POINTS = 600, CASES = 20 };
+enum { POINTS = 600, CASES = 20 };
 
-/* n points along the closed dense curve d (DENSE points), `density` times denser on the first
- * and third quarters of its length than on the others (1: evenly spaced in arc length). */
-static void resample(const double *d, size_t n, double density, double *out)
-{
-    double *cum = malloc((DENSE + 1) * sizeof *cum);
-    ck_assert(cum);
-    cum[0] = 0.0;
-    for (size_t i = 0; i < DENSE; i++) {
-        size_t e = (i + 1) % DENSE;
-        double w = (i * 4 / DENSE) % 2 == 0 ? density : 1.0;
-        cum[i + 1] = cum[i] + w * hypot(d[2 * e] - d[2 * i], d[2 * e + 1] - d[2 * i + 1]);
-    }
-    for (size_t j = 0, i = 0; j < n; j++) {
-        double s = cum[DENSE] * (double)j / (double)n;
-        while (cum[i + 1] < s)
-            i++;
-        size_t e = (i + 1) % DENSE;
-        double w = (s - cum[i]) / (cum[i + 1] - cum[i]);
-        out[2 * j] = (1 - w) * d[2 * i] + w * d[2 * e];
-        out[2 * j + 1] = (1 - w) * d[2 * i + 1] + w * d[2 * e + 1];
-    }
-    free(cum);
-}
-
-/* A smooth random shape stretched 5:1 (a long shape), POINTS points (resample's density). */
-static void long_shape(amscr_test_rng *rng, double density, double *out)
-{
-    double *d = malloc(2 * DENSE * sizeof *d);
-    ck_assert(d);
-    amscr_test_random_shape(rng, DENSE, 4, d);
-    for (size_t i = 0; i < DENSE; i++)
-        d[2 * i] *= 5.0;
-    resample(d, POINTS, density, out);
-    free(d);
-}
-
-/* One case: the clean shape a, the truth Y, the noisy observed points b (2 % of the size, in
- * reversed order when `reversed`; sampled with resample's `density`), a start Z stretched 4 % along the target's long axis, and
- * the target's size; returns the noise variance per coordinate. */
+/* One case: the clean shape a (a long shape, POINTS points sampled with `density`), the truth Y,
+ * the noisy observed points b = Y a (noise of `noise` times the size, in reversed order when
+ * `reversed`), a start Z stretched 4 % along the target's long axis, and the target's size;
+ * returns the noise variance per coordinate. */
 static double make_case(uint64_t seed, int reversed, double density, double noise, double *a, double *b, double Y[6],
                         double Z[6], double *size)
 {
     amscr_test_rng rng;
     amscr_test_rng_seed(&rng, seed);
-    long_shape(&rng, density, a);
+    double *d = malloc(2 * AMSCR_TEST_DENSE * sizeof *d), *t = malloc(2 * POINTS * sizeof *t);
+    ck_assert(d && t);
+    amscr_test_long_dense(&rng, d);
+    amscr_test_resample_uneven(d, POINTS, density, 0.0, a);
     amscr_test_random_affine(&rng, 2.0, 0.5, 10.0, 0, Y);
-    double *t = malloc(2 * POINTS * sizeof *t);
-    ck_assert(t);
     amscr_test_cyclic_shift(a, POINTS, (size_t)(amscr_test_uniform(&rng) * POINTS) % POINTS, t);
     amscr_test_apply_affine(Y, t, POINTS, b);
     *size = amscr_test_shape_size(b, POINTS);
     double sigma = noise * *size;
     amscr_test_add_noise(&rng, b, POINTS, sigma);
-    for (size_t i = 0, j = POINTS - 1; reversed && i < j; i++, j--) /* the points run backwards */
-        for (int q = 0; q < 2; q++) {
-            double v = b[2 * i + q];
-            b[2 * i + q] = b[2 * j + q], b[2 * j + q] = v;
-        }
+    if (reversed) /* the points run backwards */
+        amscr_test_reverse(b, POINTS);
     free(t);
-    /* the start: Y followed by a 4 % stretch along the target's long axis (through its centroid) */
-    double cx = 0, cy = 0, sxx = 0, sxy = 0, syy = 0;
-    for (size_t i = 0; i < POINTS; i++)
-        cx += b[2 * i] / POINTS, cy += b[2 * i + 1] / POINTS;
-    for (size_t i = 0; i < POINTS; i++) {
-        double x = b[2 * i] - cx, y = b[2 * i + 1] - cy;
-        sxx += x * x, sxy += x * y, syy += y * y;
-    }
-    double th = 0.5 * atan2(2 * sxy, sxx - syy), ux = cos(th), uy = sin(th), k = 0.04;
-    double S[6] = {1 + k * ux * ux, k * ux * uy, 0, k * ux * uy, 1 + k * uy * uy, 0};
-    S[2] = cx - (S[0] * cx + S[1] * cy), S[5] = cy - (S[3] * cx + S[4] * cy);
-    Z[0] = S[0] * Y[0] + S[1] * Y[3], Z[1] = S[0] * Y[1] + S[1] * Y[4], Z[2] = S[0] * Y[2] + S[1] * Y[5] + S[2];
-    Z[3] = S[3] * Y[0] + S[4] * Y[3], Z[4] = S[3] * Y[1] + S[4] * Y[4], Z[5] = S[3] * Y[2] + S[4] * Y[5] + S[5];
+    free(d);
+    amscr_test_long_axis_stretch(b, POINTS, Y, 0.04, Z);
     return sigma * sigma;
 }
 

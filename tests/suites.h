@@ -28,5 +28,6 @@ Suite *amscr_suite_trace_all(void);
 Suite *amscr_suite_polish(void);
 Suite *amscr_suite_ordered(void);
 Suite *amscr_suite_despike(void);
+Suite *amscr_suite_even(void);
 
 #endif
