@@ -280,14 +280,16 @@ static double wrap_share(double v)
     return v - floor(v + 0.5);
 }
 
-/* Sets e->dir (the net advance of the places) and x[6] (the circular median of place minus even
+/* Sets e->dir (the way most steps between the places go) and x[6] (the circular median of place minus even
  * advance) from the places k (of K probes) of b's points; s (nb) is scratch. */
 static void start_offset(even_t *e, const long *k, size_t K, double x[EVEN_NP], double *s)
 {
     size_t nb = e->nb;
     double turn = 0.0, c = 0.0, si = 0.0;
-    for (size_t i = 1; i < nb; i++)
-        turn += wrap_share((double)(k[i] - k[i - 1]) / (double)K);
+    for (size_t i = 1; i < nb; i++) { /* the majority of the steps (noise makes big ones both ways) */
+        double d = wrap_share((double)(k[i] - k[i - 1]) / (double)K);
+        turn += (d > 0.0) - (d < 0.0);
+    }
     e->dir = turn < 0.0 ? -1.0 : 1.0;
     for (size_t i = 0; i < nb; i++) {
         s[i] = (double)k[i] / (double)K - e->dir * (double)i / (double)nb;

@@ -182,8 +182,10 @@ static int first_bands(order_t *o)
     }
     o->sig2 = s2 / (double)o->nb;
     long turn = 0;
-    for (size_t i = 1; i < o->nb; i++)
-        turn += wrap(o->c[i] - o->c[i - 1], K);
+    for (size_t i = 1; i < o->nb; i++) { /* the majority of the steps (noise makes big ones both ways) */
+        long d = wrap(o->c[i] - o->c[i - 1], K);
+        turn += (d > 0) - (d < 0);
+    }
     o->reversed = turn < 0;
     if (o->reversed) {
         reverse_states(o);
