@@ -6,11 +6,12 @@
  * handle, a car stretched 5:1). Contours resampled to a point count are evenly spaced, though,
  * and then the index says where along the curve each point was taken: point i lies at the share
  * off + i / nb (or off - i / nb) of the moved curve's length. This stage fits the map and off to
- * that model by Levenberg-Marquardt (the residual of each point against its place; forward
- * differences: the places move with the map, since the moved curve's arc length does), and
- * keeps the result only where the points bear the model out (even.h): unevenly sampled points
- * (a pen that slowed down, 1.25 : 1 on alternating quarters already) leave residuals 5 to 800
- * times their distances from the curve; evenly sampled ones 1.7 to 2.6 times.
+ * that model by Levenberg-Marquardt (the residual of each point against its place; the places
+ * move with the map, since the moved curve's arc length does: the Jacobian has both parts), and
+ * keeps the result only where the points bear the model out (the gates below): unevenly sampled
+ * points (a pen that slowed down, 1.25 : 1 on alternating quarters already) leave residuals 5 to
+ * 800 times their distances from the curve, evenly sampled ones 1.7 to 2.6 times; points spaced
+ * evenly along another version of the curve drift along it (Kuiper's test).
  *
  * Measured (bench/RESULTS-registration.md, 280 held-out pairs, after the order stage): 2 % noise
  * within 2 %: 98.2 -> 99.6 %, median error 0.43 -> 0.27 %; 1 % noise median 0.22 -> 0.13 %. */

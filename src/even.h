@@ -6,14 +6,16 @@
 #include <stddef.h>
 
 /* Refines Y (2x3, a -> b) in place: a (na points, closed) is a clean model of the curve, b (nb
- * points, closed, in order along it) noisy observations of Y a. Point i of b is taken to lie at
- * the share off +- i / nb of the moved curve's length (the sign: b's running direction), and Y
- * and off are fitted by least squares. The result is kept only when the points bear the model
- * out: their mean squared residual at most EVEN_MAX_RATIO times their mean squared distance from
- * the curve at the map given (even sampling leaves twice that: the noise's along-curve half
- * joins its across-curve half; uneven sampling leaves many times more). Returns 1 when Y was
- * refined, 0 when it was left as given (uneven sampling, too few points, out of memory, a
- * degenerate or area-changing result). */
+ * points, closed, in order along it) noisy observations of Y a with noise variance rough_b per
+ * coordinate. Point i of b is taken to lie at the share off +- i / nb of the moved curve's length
+ * (the sign: b's running direction), and Y and off are fitted by least squares. Runs only on
+ * points that scatter across the curve (EVEN_MIN_SCATTER of their spacing) and that Y already
+ * explains within their noise; the result is kept only when the points bear the model out:
+ * their mean squared residual at most EVEN_MAX_RATIO times their mean squared distance from the
+ * curve (even sampling leaves twice that: the noise's along-curve half joins its across-curve
+ * half; uneven sampling many times more), and their residuals along the curve white (Kuiper's
+ * test). Returns 1 when Y was refined, 0 when it was left as given (outside that regime, too few
+ * points, out of memory, a degenerate or area-changing result). */
 int amscr__even_fit(const double *a, size_t na, const double *b, size_t nb, double rough_b, double Y[6]);
 
 #endif

@@ -105,7 +105,7 @@ class Params:
     penalty = _Option('penalty', _FLOAT, "weight of the 'penalized' invariance")
     partial = _Option('partial', _BOOL, "the source is an open fragment of the target's closed boundary (register)")
     polish = _Option('polish', _BOOL, 'polish the map on the input points, fitting the noisier curve onto the '
-                     'cleaner and, for markedly noisy points, using their order (register; on in the '
+                     'cleaner and, for markedly noisy points, using their order and even spacing (register; on in the '
                      'registration preset)')
     channel_weight = _Option('channel_weight', _FLOAT,
                              'share of the shape channel in Collection.retrieval_matrix, 0..1 (0 = the AMSCR '
