@@ -24,7 +24,6 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import registration_heldout as H  # noqa: E402
-import amscr  # noqa: E402
 
 
 def smoothed(f, s=2.0):
@@ -70,17 +69,8 @@ def main():
     if not os.path.exists(os.path.join(args.data, 'manifest.tsv')):
         print('no manifest in %s: skipped' % args.data)
         return 0
-    errs = []
-    for _, _, f, tgt, T, size in cases(args.data, args.curve, args.noise, args.draws):
-        try:
-            r = amscr.register(f, tgt)
-            errs.append(100 * H.map_error(np.hstack([r.A, r.B[:, None]]), T, f, size))
-        except amscr.AmscrError:
-            errs.append(np.inf)
-    e = np.sort(errs)
-    n = len(e)
-    print('curve %s, noise %.1f %%: %d pairs, within 2 %%: %.1f %%, median %.3f %%, 90th pct %.3f %%, 95th pct %.3f %%'
-          % (args.curve, 100 * args.noise, n, 100 * np.mean(e < 2), e[n // 2], e[9 * n // 10], e[95 * n // 100]))
+    errs = [H.preset_error(f, tgt, T, size) for _, _, f, tgt, T, size in cases(args.data, args.curve, args.noise, args.draws)]
+    print('curve %s, noise %.1f %%: %s' % (args.curve, 100 * args.noise, H.error_summary(errs)))
     return 0
 
 

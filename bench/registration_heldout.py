@@ -114,6 +114,23 @@ def map_error(M, T, src, size):
     return float(np.sqrt((d * d).sum(axis=1)).max() / size)
 
 
+def preset_error(src, tgt, T, size):
+    """The map error (% of the size) of amscr.register(src, tgt) against T; inf when it fails."""
+    try:
+        r = amscr.register(src, tgt)
+    except amscr.AmscrError:
+        return np.inf
+    return 100 * map_error(np.hstack([r.A, r.B[:, None]]), T, src, size)
+
+
+def error_summary(errs):
+    """'N pairs, within 2 %: ..., median ..., 90th pct ..., 95th pct ...' of errors in %."""
+    e = np.sort(errs)
+    n = len(e)
+    return '%d pairs, within 2 %%: %.1f %%, median %.3f %%, 90th pct %.3f %%, 95th pct %.3f %%' % (
+        n, 100 * np.mean(e < 2), e[n // 2], e[9 * n // 10], e[95 * n // 100])
+
+
 def amscr_register(src, tgt, partial, mode):
     """The recovered 2x3 map, or None when the call fails."""
     try:

@@ -115,27 +115,9 @@ START_TEST(order_leaves_what_it_cannot_help)
         ck_assert(isfinite(Z[k]));
     if (!done)
         ck_assert(memcmp(Z, Z0, sizeof Z) == 0);
-    /* degenerate maps and curves: a zero or non-finite map, a curve of one repeated point */
+    /* degenerate maps and curves, and points that are no curve at all */
     s2 = make_case(80, 0, 1.0, 0.02, a, b, Y, Z, &size);
-    double zero[6] = {0}, nan6[6] = {NAN, 0, 0, 0, 1, 0};
-    ck_assert_int_eq(amscr__ordered_fit(a, POINTS, b, POINTS, s2, zero), 0);
-    ck_assert_int_eq(amscr__ordered_fit(a, POINTS, b, POINTS, s2, nan6), 0);
-    double *dot = calloc(2 * POINTS, sizeof *dot);
-    ck_assert(dot);
-    memcpy(Z0, Z, sizeof Z);
-    ck_assert_int_eq(amscr__ordered_fit(dot, POINTS, b, POINTS, s2, Z), 0);
-    ck_assert(memcmp(Z, Z0, sizeof Z) == 0);
-    /* points that are no curve at all (a random cloud): finite, or left as given */
-    amscr_test_rng rng;
-    amscr_test_rng_seed(&rng, 81);
-    for (size_t i = 0; i < 2 * POINTS; i++)
-        b[i] = size * (2.0 * amscr_test_uniform(&rng) - 1.0);
-    done = amscr__ordered_fit(a, POINTS, b, POINTS, 0.1 * size * size, Z);
-    for (int k = 0; k < 6; k++)
-        ck_assert(isfinite(Z[k]));
-    if (!done)
-        ck_assert(memcmp(Z, Z0, sizeof Z) == 0);
-    free(dot);
+    amscr_test_stage_degenerate(amscr__ordered_fit, a, b, POINTS, s2, size, Z);
     free(a);
     free(b);
 }

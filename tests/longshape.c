@@ -4,6 +4,7 @@
 #include <check.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 void amscr_test_long_dense(amscr_test_rng *rng, double *d)
 {
@@ -58,4 +59,27 @@ void amscr_test_reverse(double *p, size_t n)
             double v = p[2 * i + q];
             p[2 * i + q] = p[2 * j + q], p[2 * j + q] = v;
         }
+}
+
+void amscr_test_stage_degenerate(amscr_test_stage stage, const double *a, double *b, size_t n, double s2, double size,
+                                 double Z[6])
+{
+    double zero[6] = {0}, nan6[6] = {NAN, 0, 0, 0, 1, 0}, Z0[6];
+    double *dot = calloc(2 * n, sizeof *dot);
+    ck_assert(dot);
+    ck_assert_int_eq(stage(a, n, b, n, s2, zero), 0);
+    ck_assert_int_eq(stage(a, n, b, n, s2, nan6), 0);
+    memcpy(Z0, Z, sizeof Z0);
+    ck_assert_int_eq(stage(dot, n, b, n, s2, Z), 0);
+    ck_assert(memcmp(Z, Z0, sizeof Z0) == 0);
+    amscr_test_rng rng; /* points that are no curve at all */
+    amscr_test_rng_seed(&rng, 81);
+    for (size_t i = 0; i < 2 * n; i++)
+        b[i] = size * (2.0 * amscr_test_uniform(&rng) - 1.0);
+    int done = stage(a, n, b, n, 0.1 * size * size, Z);
+    for (int k = 0; k < 6; k++)
+        ck_assert(isfinite(Z[k]));
+    if (!done)
+        ck_assert(memcmp(Z, Z0, sizeof Z0) == 0);
+    free(dot);
 }

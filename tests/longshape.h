@@ -24,6 +24,17 @@ void amscr_test_resample_uneven(const double *d, size_t n, double density, doubl
  * the map Y. */
 void amscr_test_long_axis_stretch(const double *b, size_t n, const double Y[6], double k, double Z[6]);
 
+/* A refining stage's signature (ordered.h, even.h): Y (a -> b) refined in place; 1 when it was. */
+typedef int (*amscr_test_stage)(const double *a, size_t na, const double *b, size_t nb, double rough_b,
+                                double Y[6]);
+
+/* Asserts what every such stage must do on degenerate input, with a (n points) a clean curve, b
+ * (n points) scratch, s2 a noise variance and Z a map: a zero or non-finite map and a one-point
+ * curve are refused with Z left exactly as given; on a random cloud of points (size wide) Z
+ * stays finite, and exactly as given when refused. */
+void amscr_test_stage_degenerate(amscr_test_stage stage, const double *a, double *b, size_t n, double s2, double size,
+                                 double Z[6]);
+
 /* Reverses the order of n points in place. */
 void amscr_test_reverse(double *p, size_t n);
 
