@@ -281,8 +281,8 @@ static double wrap_share(double v)
     return v - floor(v + 0.5);
 }
 
-/* Sets e->dir (the way most steps between the places go) and x[6] (the circular median of place minus even
- * advance) from the places k (of K probes) of b's points; s (nb) is scratch. */
+/* Sets e->dir (the way most steps between the places go) and x[6] (the circular median of place
+ * minus even advance) from the places k (of K probes) of b's points; s (nb) is scratch. */
 static void start_offset(even_t *e, const long *k, size_t K, double x[EVEN_NP], double *s)
 {
     size_t nb = e->nb;
@@ -344,8 +344,8 @@ static int scattered(const double *b, size_t nb, double rough_b)
 }
 
 /* Kuiper's statistic of b's residuals along the moved curve (their component along the tangent
- * at each place) for the parameters x: the range of their running sum less its trend, over
- * their sd times sqrt(nb); tau (nb) is scratch. */
+ * at each place) for the parameters x: the range of the running sum of their deviations from
+ * their mean, over their sd times sqrt(nb); tau (nb) is scratch. */
 static double along_kuiper(const even_t *e, const double x[EVEN_NP], double *tau)
 {
     double L = moved_cum(e, x, 1), Jx[EVEN_NP], Jy[EVEN_NP], r[2], mean = 0.0, var = 0.0;
@@ -366,6 +366,23 @@ static double along_kuiper(const even_t *e, const double x[EVEN_NP], double *tau
     return var > 0.0 ? (hi - lo) / sqrt(var * (double)e->nb) : INFINITY;
 }
 
+/* The fit from x (the starting parameters) and from its result with the offset shifted by
+ * +-EVEN_START_SHIFT of a spacing; the lowest-cost parameters into best. Returns their cost. */
+static double fit_from_starts(const even_t *e, double x[EVEN_NP], double best[EVEN_NP])
+{
+    double low = levenberg_marquardt(e, x);
+    memcpy(best, x, EVEN_NP * sizeof *best);
+    for (int s = -1; s <= 1 && low < INFINITY; s += 2) {
+        double y[EVEN_NP];
+        memcpy(y, x, sizeof y);
+        y[6] += EVEN_START_SHIFT * (double)s / (double)e->nb;
+        double c = levenberg_marquardt(e, y);
+        if (c < low)
+            low = c, memcpy(best, y, sizeof y);
+    }
+    return low;
+}
+
 int amscr__even_fit(const double *a, size_t na, const double *b, size_t nb, double rough_b, double Y[6])
 {
     if (na < 3 || nb < EVEN_MIN_POINTS || !(rough_b > 0.0) || !scattered(b, nb, rough_b))
@@ -375,19 +392,8 @@ int amscr__even_fit(const double *a, size_t na, const double *b, size_t nb, doub
     if (!block)
         return 0;
     e.cum = block, e.grad = block + na + 1;
-    double d2 = start_places(&e, Y, x), low = INFINITY;
-    if (d2 <= EVEN_MAX_FIT * rough_b) {
-        low = levenberg_marquardt(&e, x);
-        memcpy(best, x, sizeof best);
-    }
-    for (int s = -1; s <= 1 && low < INFINITY; s += 2) { /* from the result, shifted */
-        double y[EVEN_NP];
-        memcpy(y, x, sizeof y);
-        y[6] += EVEN_START_SHIFT * (double)s / (double)nb;
-        double c = levenberg_marquardt(&e, y);
-        if (c < low)
-            low = c, memcpy(best, y, sizeof best);
-    }
+    double d2 = start_places(&e, Y, x);
+    double low = d2 <= EVEN_MAX_FIT * rough_b ? fit_from_starts(&e, x, best) : INFINITY;
     int white = low < INFINITY && along_kuiper(&e, best, block + 5 * (na + 1)) <= EVEN_MAX_KUIPER;
     free(block);
     if (!white || !(low / (double)nb <= EVEN_MAX_RATIO * d2))

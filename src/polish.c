@@ -21,7 +21,8 @@
  * When the start-point search could not tell its candidates apart, the other distinct
  * candidates are polished alike and ranked by a two-way trimmed cost, so a noisy
  * symmetric-looking shape gets the start the points favour. When the rougher curve is markedly
- * the noisier, the winner is refined by the order of its points (ordered.c). Runs on closed
+ * the noisier, the winner is refined by the order of its points (ordered.c), then by their even
+ * spacing where the points bear that out (even.c). Runs on closed
  * curves under affine invariance when the params ask for it (the registration preset does);
  * the reported distance stays the batch path's. */
 #include "dense.h"

@@ -103,7 +103,8 @@ START_TEST(even_refuses_uneven_spacing)
 {
     double *a = malloc(2 * POINTS * sizeof *a), *b = malloc(2 * POINTS * sizeof *b);
     ck_assert(a && b);
-    const sampling kinds[] = {{2.0, 0.0, 1.0, 0.03, 0.02, 0}, {1.0, 0.1, 1.0, 0.03, 0.02, 0}, {1.0, 0.1, 1.0, 0.03, 0.01, 1}};
+    const sampling kinds[] = {
+        {2.0, 0.0, 1.0, 0.03, 0.02, 0}, {1.0, 0.1, 1.0, 0.03, 0.02, 0}, {1.0, 0.1, 1.0, 0.03, 0.01, 1}};
     for (size_t k = 0; k < sizeof kinds / sizeof *kinds; k++)
         for (uint64_t c = 0; c < CASES; c++) {
             double Y[6], Z[6], Z0[6], size, s2 = make_case(1600 + c, kinds[k], a, b, Y, Z, &size);
@@ -123,7 +124,8 @@ START_TEST(even_refuses_a_missing_run)
     double *a = malloc(2 * POINTS * sizeof *a), *b = malloc(2 * POINTS * sizeof *b);
     ck_assert(a && b);
     for (uint64_t c = 0; c < CASES; c++) {
-        double Y[6], Z[6], Z0[6], size, s2 = make_case(1700 + c, (sampling){1.0, 0.0, 1.0, 0.03, 0.02, 0}, a, b, Y, Z, &size);
+        double Y[6], Z[6], Z0[6], size;
+        double s2 = make_case(1700 + c, (sampling){1.0, 0.0, 1.0, 0.03, 0.02, 0}, a, b, Y, Z, &size);
         size_t keep = POINTS - POINTS / 10;
         memcpy(Z0, Z, sizeof Z);
         ck_assert_msg(amscr__even_fit(a, POINTS, b, keep, s2, Z) == 0, "case %d refined", (int)c);
