@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Registration of noisy contours whose points were taken evenly along ANOTHER version of the curve.
 
-The even-spacing stage (src/even.c) reads a noisy curve's point index as arc length along the
+The even-spacing stage (src/register/even.c) reads a noisy curve's point index as arc length along the
 other curve, the one it is registered to. That holds when both come from the same polyline (the
 held-out pairs: the target is the moved pixel contour resampled evenly); a target resampled along
 a smoothed contour or a 4-connected (crack-following) trace of the same shape is spaced along a

@@ -14,7 +14,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "../src/internal.h"
+#include "internal.h"
 #include "mcd_set.h"
 
 enum { M_AMSCR, M_SIM, M_AFF, NBASE };

@@ -18,7 +18,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "../src/internal.h"
+#include "internal.h"
 #include "mcd_set.h"
 
 static double now(void)

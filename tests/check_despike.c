@@ -1,4 +1,4 @@
-/* check_despike.c — isolated stray points dropped before registration (src/despike.c): runs of
+/* check_despike.c — isolated stray points dropped before registration (src/shape/despike.c): runs of
  * 1-3 points far off the curve go (and a fragment's stray end), the curve's own points stay
  * exactly (pixel chains, noisy
  * curves, densely sampled needles, short polygons), and the registration preset registers

@@ -1,5 +1,5 @@
 /* check_even.c — the map refined on the evidence that a noisy curve's points were taken evenly
- * along it (src/even.c): long shapes whose position along their long axis a closest-point fit
+ * along it (src/register/even.c): long shapes whose position along their long axis a closest-point fit
  * cannot pin down, either running direction, and what it must leave alone (uneven sampling, a
  * drifting spacing, a missing run, clean points, degenerate input). */
 #include <amscr.h>

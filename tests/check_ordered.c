@@ -1,5 +1,5 @@
 /* check_ordered.c — the polished map refined by the order of a noisy curve's points
- * (src/ordered.c): on long shapes whose position along their long axis a closest-point fit
+ * (src/register/ordered.c): on long shapes whose position along their long axis a closest-point fit
  * cannot pin down, either running direction of the points, and the cases it must leave alone. */
 #include <amscr.h>
 #include <check.h>

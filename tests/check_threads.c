@@ -5,7 +5,7 @@
  * threads), and provoke errors whose thread-local details must stay their own. Every result
  * is compared bit for bit with the one computed beforehand on a single thread.
  *
- * A normal Check suite (area "threads"); tools/hardening.sh also runs it in a
+ * A normal Check suite (area "threads"); scripts/hardening.sh also runs it in a
  * ThreadSanitizer build (build-tsan), where any data race fails the run. Workers never call
  * ck_assert (Check is not thread-safe): they count mismatches, and the main thread asserts.
  * Only the public API (plus testutil) is used. */

@@ -4,7 +4,7 @@
 # directly (no Meson), once, and rebuilt only when a source or header is newer.
 #   tests/fuzz/build.sh            build every target
 # Needs clang and libclang-rt-<version>-dev (Debian: apt-get install clang libclang-rt-14-dev);
-# tools/hardening.sh installs them.
+# scripts/hardening.sh installs them.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 OUT=${AMSCR_FUZZ_BUILD:-build-fuzz}
@@ -13,7 +13,7 @@ command -v "$CC" >/dev/null || { echo "fuzz/build.sh: $CC not found (apt-get ins
 
 SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 CFLAGS="-std=c99 -g -O1 -Wall -Wno-unused-parameter -D_POSIX_C_SOURCE=200809L -DAMSCR_HAVE_THREAD_LOCAL_KEYWORD
-        -Iinclude -Isrc -Itools -Itests/fuzz"
+        -Iinclude -Isrc/base -Isrc/numeric -Isrc/shape -Isrc/register -Isrc/retrieval -Itools/cli -Itests/fuzz"
 LIBS="$(pkg-config --libs lapacke 2>/dev/null || echo -llapacke) $(pkg-config --libs openblas 2>/dev/null || true) -lm -lpthread"
 TOOL_DEFS=""
 if pkg-config --exists libpng; then
@@ -22,7 +22,7 @@ if pkg-config --exists libpng; then
 fi
 mkdir -p "$OUT/obj"
 
-HEADERS="include/amscr.h src/internal.h src/fft.h tools/image.h tools/util.h tools/collection.h tools/index_file.h tests/fuzz/fuzz_common.h tests/fuzz/fuzz_image.h"
+HEADERS="include/amscr.h src/*/*.h tools/cli/image.h tools/cli/util.h tools/cli/collection.h tools/cli/index_file.h tests/fuzz/fuzz_common.h tests/fuzz/fuzz_image.h"
 newest_header=$(ls -t $HEADERS | head -1)
 
 # compile SRC OBJ EXTRA_FLAGS...: only when the object is missing or older than SRC or a header.
@@ -40,7 +40,7 @@ throttle() {
   while [ "$(jobs -rp | wc -l)" -ge "${AMSCR_FUZZ_BUILD_JOBS:-2}" ]; do sleep 0.05; done
 }
 lib_objs=()
-for src in src/*.c; do
+for src in src/*/*.c; do
   obj="$OUT/obj/lib_$(basename "${src%.c}").o"
   throttle
   compile "$src" "$obj" -fsanitize=fuzzer-no-link -DAMSCR_BUILDING -DAMSCR_STATIC &
@@ -48,7 +48,7 @@ for src in src/*.c; do
   lib_objs+=("$obj")
 done
 tool_objs=()
-for src in tools/image.c tools/util.c tools/collection.c tools/index_file.c; do
+for src in tools/cli/image.c tools/cli/util.c tools/cli/collection.c tools/cli/index_file.c; do
   obj="$OUT/obj/tool_$(basename "${src%.c}").o"
   throttle
   # shellcheck disable=SC2086

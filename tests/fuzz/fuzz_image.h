@@ -1,6 +1,6 @@
-/* fuzz_image.h — the image decoders of the tool (tools/image.c) on arbitrary bytes.
+/* fuzz_image.h — the image decoders of the tool (tools/cli/image.c) on arbitrary bytes.
  *
- * tools/image.h decodes files only (image_read(path, ...)), so each input is written to one
+ * tools/cli/image.h decodes files only (image_read(path, ...)), so each input is written to one
  * scratch file per process (in /dev/shm when it exists: no disk traffic) and decoded from
  * there: this is the tool's real entry point, format sniffing included. A decoded image is
  * then traced with amscr_contour_from_mask, as `amscr contour` does.

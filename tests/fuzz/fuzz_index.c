@@ -1,4 +1,4 @@
-/* fuzz_index.c — the index loader of `amscr index` (tools/index_file.c: index_parse) on
+/* fuzz_index.c — the index loader of `amscr index` (tools/cli/index_file.c: index_parse) on
  * arbitrary bytes, as given and with the file length and the meta section's checksum made
  * right (so the sections behind them are reached). Properties on success: at least one shape, as many prepared shapes as names,
  * classes in range, neighbour lists starting with the shape itself, and the index serializes

@@ -13,7 +13,7 @@ def rerank_diffusion(D: ArrayLike, k: int = 5, iterations: int = 20) -> np.ndarr
     k-nearest-neighbour tensor-product graph (Yang, Prasad, Latecki, CVPR 2012), as
     ``amscr_rerank_diffusion``. Returns a new (n, n) dissimilarity for ranking: values in [0, 1)
     for pairs the diffusion reaches, 1 + D/max(D) for the others. The defaults (k = 5,
-    20 iterations) are the ones the README's Kimia measurements chose.
+    20 iterations) are the ones the Kimia measurements chose (docs/measurements.md).
 
     Args:
         D: (n, n) distance matrix, finite.

@@ -60,7 +60,7 @@ class Registration:
         reflected: True when the match used the mirrored target.
         method: the method used.
         confidence: how sure the map is, in [0, 1] ((1 - ambiguity) x inlier_fraction; see the
-            README's accuracy section for what a low value means).
+            docs/measurements.md, "Confidence", for what a low value means).
         ambiguity: cost of the chosen map over that of the best clearly different candidate
             (1: a symmetric shape or a fragment that fits several places).
         inlier_fraction: share of source samples within 5 % of the target's size of its boundary.

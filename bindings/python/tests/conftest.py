@@ -1,6 +1,6 @@
 """pytest setup: use the installed amscr if there is one, else the source tree.
 
-* installed (``pip install ./bindings/python``; ``meson test`` and ``tools/test.sh`` run the suite
+* installed (``pip install ./bindings/python``; ``meson test`` and ``scripts/test.sh`` run the suite
   in .venv with AMSCR_TEST_INSTALLED=1, which makes an amscr imported from this source tree an
   error): nothing to do;
 * not installed, or AMSCR_TEST_SOURCE=1: bindings/python goes first on sys.path and, unless
@@ -26,7 +26,7 @@ def _installed():
 
 if os.environ.get('AMSCR_TEST_INSTALLED', '') not in ('', '0'):
     if not _installed():
-        raise RuntimeError('AMSCR_TEST_INSTALLED is set but amscr is not installed in %s (tools/setup.sh '
+        raise RuntimeError('AMSCR_TEST_INSTALLED is set but amscr is not installed in %s (scripts/setup.sh '
                            'installs it into .venv: pip install ./bindings/python)' % sys.executable)
 elif os.environ.get('AMSCR_TEST_SOURCE', '') not in ('', '0') or not _installed():
     if PKG_ROOT not in sys.path:

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Builds the Python package for distribution and checks what it built, in the project's .venv:
+#   1. `python -m build bindings/python`: the sdist (meson dist: the COMMITTED sources, HEAD, with
+#      a copy of the C sources in subprojects/amscr) and a wheel built from that sdist;
+#   2. `auditwheel repair`: a manylinux wheel carrying its own OpenBLAS, LAPACKE and libpng
+#      (amscr.libs/), then tagged cp38-abi3: meson-python names an abi3 wheel after the building
+#      interpreter, but the extension is compiled for the Limited API of 3.8 (Py_LIMITED_API =
+#      0x03080000), so one wheel serves every CPython >= 3.8;
+#   3. `auditwheel show`, then the repaired wheel installed on its own into a temporary folder:
+#      `import amscr` (API mode, from there) and its `amscr --version`.
+# Output: dist/amscr-V.tar.gz, dist/amscr-V-cp3XX-abi3-linux_x86_64.whl,
+#         dist/wheelhouse/amscr-V-cp38-abi3-manylinux_2_NN_x86_64.whl
+set -euo pipefail
+cd "$(dirname "$0")/.."
+[ -x .venv/bin/python3 ] || scripts/setup.sh
+export PATH="$PWD/.venv/bin:$PATH"
+git rev-parse --git-dir >/dev/null 2>&1 || { echo "wheel: not a git checkout (the sdist is made by git archive)" >&2; exit 1; }
+[ -z "$(git status --porcelain -- bindings/python src include tools scripts meson.build meson_options.txt)" ] ||
+  echo "wheel: note: uncommitted changes are not in the sdist (it holds HEAD)" >&2
+
+rm -rf dist
+log=$(mktemp)
+tmp=$(mktemp -d)
+trap 'rm -rf "$log" "$tmp"' EXIT
+if ! python3 -m build --no-isolation --outdir dist bindings/python >"$log" 2>&1; then
+  cat "$log" >&2; echo "wheel: python -m build failed" >&2; exit 1
+fi
+whl=$(ls dist/amscr-*.whl)
+if ! auditwheel repair -w dist/wheelhouse "$whl" >"$log" 2>&1; then
+  cat "$log" >&2; echo "wheel: auditwheel repair failed" >&2; exit 1
+fi
+python3 -m wheel tags --python-tag cp38 --remove dist/wheelhouse/amscr-*.whl >/dev/null
+repaired=$(ls dist/wheelhouse/amscr-*.whl)
+ls -l dist/*.tar.gz "$whl" "$repaired" | awk '{print "wheel: " $5 " bytes  " $NF}'
+auditwheel show "$repaired"
+
+pip install -q --no-deps --target "$tmp/site" "$repaired" >"$log" 2>&1 || { cat "$log" >&2; exit 1; }
+(cd "$tmp" && PYTHONPATH="$tmp/site" python3 -c '
+import os, sys, amscr
+here = os.path.join(sys.argv[1], "site")
+assert amscr.__file__.startswith(here), amscr.__file__
+assert amscr.API_MODE and amscr.LIBRARY_PATH.endswith(".abi3.so"), amscr.LIBRARY_PATH
+libs = sorted(os.listdir(os.path.join(here, "amscr.libs")))
+assert any("openblas" in n for n in libs) and any("lapacke" in n for n in libs) and any("png" in n for n in libs), libs
+print("wheel: installed on its own: import amscr %s (API mode), amscr.libs: %s" % (amscr.__version__, " ".join(libs)))
+' "$tmp")
+echo "wheel: amscr --version: $(cd "$tmp" && PYTHONPATH="$tmp/site" "$tmp/site/bin/amscr" --version)"

@@ -1,0 +1,205 @@
+/* params.c — the registration options object: documented defaults, validating setters. */
+#include "internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Defaults: chosen by measurement (docs/measurements.md, "Choosing the defaults"). */
+static const double default_scales[] = {1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 11.0, 16.0};
+
+/* The retrieval options (0.2): off in the plain defaults (amscr_db_distance_matrix is the
+ * AMSCR distance exactly as in 0.1); the channel's own settings are those measured in
+ * docs/results-retrieval.md, so turning the channel on needs only a weight. */
+static void retrieval_defaults(amscr_params *p)
+{
+    p->channel_weight = 0.0;
+    p->channel_invariance = AMSCR_INVARIANCE_SIMILARITY;
+    p->channel_affine_share = 0.2;
+    p->channel_band = 0.08;
+    p->channel_skip = 1.0;
+    p->channel_locality = 4.0;
+    p->rerank_k = 0;
+    p->rerank_iterations = 10;
+}
+
+void amscr__params_defaults(amscr_params *p)
+{
+    memset(p, 0, sizeof *p);
+    p->num_samples = 128;
+    p->num_scales = sizeof default_scales / sizeof default_scales[0];
+    memcpy(p->scales, default_scales, sizeof default_scales);
+    p->method = AMSCR_METHOD_MULTICLASS_EM;
+    p->closed = 1;
+    p->reflections = 0;
+    p->parametrization = AMSCR_PARAM_WHITENED;
+    p->presmooth = 0.01;
+    p->arclength_passes = 3;
+    p->oversampling = 8;
+    p->kmax = 5;
+    p->symmetric = 0;
+    p->refine = 0;
+    p->num_threads = 0;
+    p->invariance = AMSCR_INVARIANCE_AFFINE;
+    p->penalty = 0.5;
+    retrieval_defaults(p);
+}
+
+/* A new params filled by `preset`; `who` names the public call in the error detail. */
+static amscr_status new_preset(void (*preset)(amscr_params *), const char *who, amscr_params **out)
+{
+    amscr__clear_error();
+    if (out == NULL)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: out is NULL", who);
+    amscr_params *p = malloc(sizeof *p);
+    if (!p)
+        return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", who);
+    preset(p);
+    *out = p;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_params_new(amscr_params **out)
+{
+    return new_preset(amscr__params_defaults, "amscr_params_new", out);
+}
+
+void amscr__params_registration(amscr_params *p)
+{
+    amscr__params_defaults(p);
+    p->num_samples = 256;
+    p->refine = 20;
+    p->polish = 1;
+}
+
+amscr_status amscr_params_new_registration(amscr_params **out)
+{
+    return new_preset(amscr__params_registration, "amscr_params_new_registration", out);
+}
+
+void amscr__params_retrieval(amscr_params *p)
+{
+    amscr__params_defaults(p);
+    p->reflections = 1;
+    p->channel_weight = 1.0;
+    p->rerank_k = 8;
+}
+
+amscr_status amscr_params_new_retrieval(amscr_params **out)
+{
+    return new_preset(amscr__params_retrieval, "amscr_params_new_retrieval", out);
+}
+
+amscr_status amscr_params_copy(const amscr_params *p, amscr_params **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(p);
+    AMSCR_CHECK_NULL(out);
+    amscr_params *q = malloc(sizeof *q);
+    if (!q)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_params_copy: out of memory");
+    *q = *p;
+    *out = q;
+    return AMSCR_OK;
+}
+
+void amscr_params_free(amscr_params *p) { free(p); }
+
+#define SETTER(name, type, field, cond, fmt)                                                      \
+    amscr_status amscr_params_set_##name(amscr_params *p, type v)                                  \
+    {                                                                                              \
+        amscr__clear_error();                                                                      \
+        AMSCR_CHECK_NULL(p);                                                                       \
+        if (!(cond))                                                                               \
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_params_set_" #name ": " fmt, v);        \
+        p->field = v;                                                                              \
+        return AMSCR_OK;                                                                           \
+    }
+#define GETTER(name, type, field)                                                                 \
+    type amscr_params_get_##name(const amscr_params *p) { return p ? p->field : (type)0; }
+
+SETTER(num_samples, size_t, num_samples, v >= 16 && v <= AMSCR_MAX_SAMPLES, "%zu is outside 16..65536")
+GETTER(num_samples, size_t, num_samples)
+SETTER(method, amscr_method, method, (int)v >= 0 && (int)v <= 3, "unknown method %d")
+GETTER(method, amscr_method, method)
+SETTER(closed, int, closed, v == 0 || v == 1, "%d is not 0 or 1")
+GETTER(closed, int, closed)
+SETTER(reflections, int, reflections, v == 0 || v == 1, "%d is not 0 or 1")
+GETTER(reflections, int, reflections)
+SETTER(parametrization, amscr_parametrization, parametrization, (int)v >= 0 && (int)v <= 2,
+       "unknown parametrization %d")
+GETTER(parametrization, amscr_parametrization, parametrization)
+SETTER(presmooth, double, presmooth, v >= 0.0 && v <= 0.25, "%g is outside 0..0.25")
+GETTER(presmooth, double, presmooth)
+SETTER(arclength_passes, unsigned, arclength_passes, v >= 1 && v <= 10, "%u is outside 1..10")
+GETTER(arclength_passes, unsigned, arclength_passes)
+SETTER(oversampling, unsigned, oversampling, v >= 1 && v <= 64, "%u is outside 1..64")
+GETTER(oversampling, unsigned, oversampling)
+SETTER(kmax, unsigned, kmax, v >= 1 && v <= AMSCR__KMAX, "%u is outside 1..16")
+GETTER(kmax, unsigned, kmax)
+SETTER(symmetric, int, symmetric, v == 0 || v == 1, "%d is not 0 or 1")
+GETTER(symmetric, int, symmetric)
+SETTER(refine, unsigned, refine, v <= 50, "%u is outside 0..50")
+GETTER(refine, unsigned, refine)
+SETTER(num_threads, unsigned, num_threads, v <= 1024, "%u is outside 0..1024")
+GETTER(num_threads, unsigned, num_threads)
+SETTER(invariance, amscr_invariance, invariance, (int)v >= 0 && (int)v <= 2, "unknown invariance %d")
+GETTER(invariance, amscr_invariance, invariance)
+SETTER(penalty, double, penalty, v >= 0.0 && v <= 1e6, "%g is not in 0..1e6")
+GETTER(penalty, double, penalty)
+SETTER(channel_weight, double, channel_weight, v >= 0.0 && v <= 1.0, "%g is not in 0..1")
+GETTER(channel_weight, double, channel_weight)
+SETTER(channel_invariance, amscr_invariance, channel_invariance,
+       v == AMSCR_INVARIANCE_AFFINE || v == AMSCR_INVARIANCE_SIMILARITY, "%d is not affine (0) or similarity (1)")
+GETTER(channel_invariance, amscr_invariance, channel_invariance)
+SETTER(channel_affine_share, double, channel_affine_share, v >= 0.0 && v <= 1.0, "%g is not in 0..1")
+GETTER(channel_affine_share, double, channel_affine_share)
+SETTER(channel_band, double, channel_band, v > 0.0 && v <= 0.5, "%g is not in (0, 0.5]")
+GETTER(channel_band, double, channel_band)
+SETTER(channel_skip, double, channel_skip, v >= 0.0 && v <= 1e3, "%g is not in 0..1000")
+GETTER(channel_skip, double, channel_skip)
+SETTER(channel_locality, double, channel_locality, v >= 0.0 && v <= 1e3, "%g is not in 0..1000")
+GETTER(channel_locality, double, channel_locality)
+SETTER(rerank_k, unsigned, rerank_k, v <= 1000, "%u is outside 0..1000")
+GETTER(rerank_k, unsigned, rerank_k)
+SETTER(rerank_iterations, unsigned, rerank_iterations, v >= 1 && v <= 1000, "%u is outside 1..1000")
+GETTER(rerank_iterations, unsigned, rerank_iterations)
+
+/* ---- issue 14 (registration): partial matching ---- */
+SETTER(partial, int, partial, v == 0 || v == 1, "%d is not 0 or 1")
+GETTER(partial, int, partial)
+SETTER(polish, int, polish, v == 0 || v == 1, "%d is not 0 or 1")
+GETTER(polish, int, polish)
+
+amscr_status amscr_params_set_scales(amscr_params *p, const double *sigmas, size_t n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(p);
+    AMSCR_CHECK_NULL(sigmas);
+    if (n == 0 || n > AMSCR_MAX_SCALES)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_params_set_scales: %zu scales (1..%u allowed)", n,
+                           (unsigned)AMSCR_MAX_SCALES);
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(sigmas[i]) || sigmas[i] < 0.0 || sigmas[i] > (double)p->num_samples)
+            return amscr__fail(AMSCR_E_INVALID_ARG,
+                               "amscr_params_set_scales: scale %zu = %g is not in 0..N (N = %zu)", i, sigmas[i],
+                               p->num_samples);
+    memcpy(p->scales, sigmas, n * sizeof *sigmas);
+    p->num_scales = n;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_params_get_scales(const amscr_params *p, double *out_sigmas, size_t *inout_n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(p);
+    AMSCR_CHECK_NULL(inout_n);
+    if (out_sigmas) {
+        if (*inout_n < p->num_scales)
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_params_get_scales: room for %zu, %zu needed", *inout_n,
+                               p->num_scales);
+        memcpy(out_sigmas, p->scales, p->num_scales * sizeof *out_sigmas);
+    }
+    *inout_n = p->num_scales;
+    return AMSCR_OK;
+}

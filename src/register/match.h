@@ -1,0 +1,220 @@
+/* match.h — internals of the registration engine (never installed): the workspace, one match
+ * and the steps of docs/method.md §12, one file each:
+ *   shift_search.c  spectral start-point search: candidates and their one ranking rule
+ *   method.c        the method at one start point: per-scale solves, scale selection, stacked solve
+ *   scale_select.c  which scales enter the stacked solve (all, finest, EM + Bayes threshold)
+ *   group_fit.c     the least-squares map of one system within the invariance group; the distance
+ *   refine.c        trimmed closest-point refinement
+ *   final_solve.c   the reported solve by LAPACKE QR
+ *   workspace.c     the caller-owned scratch of all of the above
+ *   result.c        the result object and its getters
+ *   register.c      the public entry points, top-down. */
+#ifndef AMSCR_MATCH_H
+#define AMSCR_MATCH_H
+
+#include "fft.h"
+#include "internal.h"
+
+/* The target polygon the refinement takes closest points on: the N samples densified 4x by
+ * Catmull-Rom interpolation (through the samples, following the curvature), so that chords of
+ * a coarse polygon do not bias the fit. */
+#define AMSCR__DENSE 4
+
+/* Candidate start shifts per orientation: a shape's criterion rarely has more than a few deep
+ * minima (symmetries); three keeps the right one among them at a small cost. */
+#define AMSCR__CANDIDATES 3
+
+/* Per-stage timing, compiled only into the benchmark's copy of the library
+ * (-DAMSCR_STAGE_TIMING): the product's hot path has no clock calls. */
+#ifdef AMSCR_STAGE_TIMING
+double amscr__stage_now(void);
+#define STAGE_T0 double stage_t = amscr__stage_now()
+#define STAGE_MARK(ws, i)                                                                                      \
+    do {                                                                                                       \
+        double stage_t1 = amscr__stage_now();                                                                  \
+        (ws)->stage[i] += stage_t1 - stage_t;                                                                  \
+        stage_t = stage_t1;                                                                                    \
+    } while (0)
+#else
+#define STAGE_T0 ((void)0)
+#define STAGE_MARK(ws, i) ((void)0)
+#endif
+
+struct amscr_workspace {
+    size_t n, p;
+    amscr__fft_plan plan;
+    double *z;       /* 4N: two complex arrays */
+    double *crit;    /* N */
+    double *P;       /* 8 (N/2+1): products H_i conj(F_j) for ij = xx, xy, yx, yy (complex) */
+    double *q;       /* 4 (N/2+1): their real parts at the current fractional shift */
+    double *curve;   /* 2N: a shifted target curve for the reported solve */
+    double *scratch; /* selection scratch */
+    size_t scratch_cap;
+    /* QR of the final stacked system */
+    double *qa, *qb, *qw;
+    int *qi;
+    size_t qcap;
+    /* refinement in the aligned frame: closest-point pairs and residuals */
+    double *rbuf;
+    size_t rcap;
+#ifdef AMSCR_STAGE_TIMING
+    double stage[4]; /* shift search, per-scale solves, selection, final solve */
+#endif
+};
+
+typedef struct {
+    double X[6]; /* h ≈ A f + B in the normalized frames: {a11, a12, b1, a21, a22, b2} */
+    double dist;
+    size_t shift;
+    double fshift; /* continuous shift (closed curves) */
+    double rcut;   /* refined: the trimming cut-off of the closest-point pairs in ws->rbuf */
+    double rcost;  /* refinement on: the trimmed closest-point cost of the final map */
+    int refined;   /* the refinement replaced the method's solution */
+    int reflected;
+    size_t p;
+    double resid[AMSCR__MAX_SCALES];
+    int kept[AMSCR__MAX_SCALES];
+    size_t nkept;
+    size_t k;
+    double sse[AMSCR__KMAX];
+    size_t nsse;
+    double w[AMSCR__KMAX], mu[AMSCR__KMAX], var[AMSCR__KMAX];
+    size_t ncomp;
+    double threshold;
+    /* issue 14: confidence of the match (see amscr_result_ambiguity / _inlier_fraction) */
+    double ambiguity;
+    /* the search's scored start candidates (registration with refinement; else ncand 0) */
+    double cand[2 * AMSCR__CANDIDATES][6];
+    size_t ncand;
+} match_t;
+
+struct amscr_result {
+    amscr_method method;
+    match_t m;
+    double affine_in[6];
+    double affine_norm[6];
+    /* issue 14: dense correspondences (see correspond.c), malloc'ed, n samples */
+    size_t ncorr;
+    double *corr;  /* 5n: source xy (input), target parameter, target xy (input) */
+    double inlier; /* inlier fraction */
+    double part[2];
+};
+
+/* ---- workspace.c ---- */
+void amscr__ws_release(amscr_workspace *ws);
+/* Room for the search and the method at n samples and p scales. */
+amscr_status amscr__ws_reserve(amscr_workspace *ws, size_t n, size_t p);
+/* Room for a stacked QR of `rows` rows (3 unknowns, 2 right-hand sides). */
+amscr_status amscr__ws_reserve_qr(amscr_workspace *ws, size_t rows);
+/* Room for the refinement's closest-point buffers at n samples. */
+amscr_status amscr__ws_reserve_refine(amscr_workspace *ws, size_t n);
+
+/* ---- group_fit.c ---- */
+/* Target index of source sample a under (shift s, orientation o): o = 0 -> (a+s) mod n;
+ * o = 1 (reversed target, closed) -> -(a+s) mod n; open: o = 1 -> n-1-a. */
+static inline size_t amscr__tgt_index(size_t a, size_t s, int o, int closed, size_t n)
+{
+    if (!closed)
+        return o ? n - 1 - a : a;
+    size_t b = a + s;
+    if (b >= n)
+        b -= n;
+    return o ? (b == 0 ? 0 : n - b) : b;
+}
+/* Cross sums of one level at an integer shift: R = Σ h [f, 1]^T (2x3 row-major). */
+void amscr__cross_sums(const double *f, const double *h, size_t n, size_t s, int o, int closed, double R[6]);
+/* The least-squares map X of moments mom and cross sums R within the params' invariance
+ * group (Minv: the inverse normal matrix when known, else NULL). Returns 0 when singular. */
+int amscr__fit_x(const amscr_params *prm, const double mom[6], const double *Minv, const double R[6], double X[6]);
+/* Σ_a |X [f;1] - h|^2 from the moments of f, the cross sums R and |h|^2 (clamped at 0). */
+double amscr__resid_sum(const double X[6], const double mom[6], const double R[6], double hn2);
+/* The distance of map X with squared residual sum `sq` over n samples: (sq + penalty) / n. */
+double amscr__distance_of(const amscr_params *prm, const double X[6], double sq, size_t n);
+
+/* ---- scale_select.c ---- */
+void amscr__select_scales(const amscr_params *prm, size_t finest, match_t *m, double *scratch);
+/* Scratch (doubles) of the selection at p scales. */
+size_t amscr__select_scratch(size_t p);
+
+/* ---- shift_search.c ---- */
+/* P_ij(w) = H_i(w) conj(F_j(w)) of orientation o into ws->P (closed curves). */
+void amscr__spectral_prepare(const amscr_descriptor *f, const amscr_descriptor *h, int o, amscr_workspace *ws);
+/* Cross sums R_0 (unsmoothed) .. R_p (scale k) at the continuous shift s from ws->P. */
+void amscr__spectral_cross_sums(const amscr_descriptor *f, const amscr_descriptor *h, double s, amscr_workspace *ws,
+                                double R[][6]);
+/* The best start point of f -> h (one ranking rule), run through the method and refined. */
+amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                              amscr_workspace *ws, match_t *m);
+
+/* ---- method.c ---- */
+/* The whole method at one (shift, orientation): fills m (normalized-frame solution by the
+ * closed form). Closed curves: continuous shift s through the spectra in ws->P (prepared
+ * for orientation o). Open curves: s is ignored (orientation only). */
+void amscr__run_method(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h, double s, int o,
+                       amscr_workspace *ws, match_t *m);
+
+/* ---- refine.c ---- */
+/* Refines m in place with at most `iters` closest-point iterations; sets m->rcost (and, when
+ * a step was taken, m->X, m->dist, m->refined, m->rcut). */
+amscr_status amscr__refine_match(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                 amscr_workspace *ws, match_t *m, unsigned iters);
+
+/* ---- final_solve.c ---- */
+/* The reported solve of m by LAPACKE QR (affine invariance): the stacked system of the kept
+ * scales, or after refinement the kept closest-point pairs. */
+amscr_status amscr__final_solve(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                amscr_workspace *ws, match_t *m);
+
+/* ---- issue 14 (registration): robust, partial, confidence, correspondences ---- */
+/* Exported pieces of refine.c: the closest point on a polygon within edges b0 ± w; quickselect;
+ * the trimmed solve of the pairs with r2 <= cut; Catmull-Rom densification by AMSCR__DENSE. */
+double amscr__closest_on_polygon(const double *H, size_t n, int closed, size_t b0, size_t w, double px, double py,
+                                 double *qx, double *qy, size_t *seg);
+void amscr__select_kth(double *v, size_t n, size_t k);
+int amscr__trimmed_solve(const amscr_params *prm, const double *f, const double *q, const double *r2, size_t n,
+                         double cut, double X[6]);
+size_t amscr__densify(const double *H, size_t n, int closed, double *out);
+/* The trimmed point-to-line solve (affine invariance; the other groups: point-to-point) of the
+ * pairs f_a -> q_a with r2_a <= cut, seg_a the dense target edge of q_a. Returns 0 if singular. */
+int amscr__plane_solve(const amscr_params *prm, const double *f, const double *q, const double *r2,
+                       const double *seg, const double *Hd, size_t nd, size_t n, double cut, double X[6]);
+/* recover.c: re-examines a refined closed-curve map that leaves many source samples without a
+ * target boundary near them (part of the target missing): fragments of the source placed by
+ * partial matching as further starts, ranked by a two-way trimmed cost; ws->rbuf keeps the
+ * winner's pairs. */
+amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                    amscr_workspace *ws, match_t *m);
+/* recover.c: the adaptive trimmed closest-point refinement of m (global partners first) on a
+ * closed target; ws->rbuf keeps the pairs. */
+amscr_status amscr__refine_adaptive(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                    amscr_workspace *ws, match_t *m);
+/* Mean squared displacement between the maps X1 and X2 over the samples of f's base level. */
+double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6]);
+/* A candidate map differing from the chosen one by more than this RMS displacement (10 % of
+ * the normalized frame's RMS radius sqrt 2) is a different answer for the ambiguity. */
+#define AMSCR__DISTINCT_GAP2 0.02
+/* Cost differences below an RMS misfit of 0.5 % of the RMS radius are no evidence for one map
+ * over another: the ambiguity compares (cost + floor) of the two. */
+#define AMSCR__AMBIGUITY_FLOOR (0.005 * 0.005 * 2.0)
+
+/* partial.c: source f an open fragment of the closed target h: the whole search and refinement
+ * into m (refined; ws->rbuf holds the final closest-point pairs as after amscr__refine_match). */
+amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                  amscr_workspace *ws, match_t *m);
+/* The same with the fragment's share of the target's affine length searched from phi_min up (a
+ * caller that knows the fragment is long: fewer placements to try). */
+amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                      double phi_min, amscr_workspace *ws, match_t *m);
+
+/* polish.c: m's map polished on the input points the descriptors kept (f->raw, h->raw; a closed
+ * target, affine invariance): the chosen map and the search's other distinct candidates,
+ * point-to-line both ways weighted by each curve's measured noise (partial: f an open fragment,
+ * its points alone), ranked by a two-way trimmed cost; m->X and m->ambiguity updated when a
+ * polished map wins. */
+amscr_status amscr__polish(const amscr_descriptor *f, const amscr_descriptor *h, int partial, match_t *m);
+
+/* correspond.c: the dense correspondences, inlier fraction and part of a finished result r of
+ * f -> h (fills r->corr, r->ncorr, r->inlier, r->part). */
+amscr_status amscr__correspond(const amscr_descriptor *f, const amscr_descriptor *h, amscr_result *r);
+
+#endif

@@ -1,0 +1,177 @@
+/* register.c — matching a prepared source onto a prepared target (docs/method.md §3, §9), top-down:
+ *   amscr_register / amscr_distance  check the pair, then match_pair:
+ *   match_pair        one direction f -> h, the reported solve, and (symmetric) h -> f;
+ *   amscr__match_dir  (shift_search.c) candidate start points ranked by one rule, the winner
+ *                     through the method (method.c: per-scale solves, scale_select.c, stacked
+ *                     solve) and the trimmed closest-point refinement (refine.c);
+ *   amscr__final_solve (final_solve.c) the reported stacked solve by LAPACKE QR.
+ * The distance of the batch path (amscr_distance) is the method's closed form; amscr_register
+ * reports the QR solve; tests check they agree. */
+#include "match.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static amscr_status check_partial(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt);
+static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor *src, const amscr_descriptor *tgt);
+static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                               int report, amscr_workspace *ws, match_t *m);
+
+amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                            amscr_workspace *ws, amscr_result **out_result)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(src);
+    AMSCR_CHECK_NULL(tgt);
+    AMSCR_CHECK_NULL(out_result);
+    amscr_status st = check_pair(&p, src, tgt);
+    if (st != AMSCR_OK)
+        return st;
+    amscr_workspace local = {0};
+    amscr_workspace *w = ws ? ws : &local;
+    amscr_result *r = calloc(1, sizeof *r);
+    if (!r)
+        st = amscr__fail(AMSCR_E_NOMEM, "amscr_register: out of memory");
+    if (st == AMSCR_OK)
+        st = match_pair(p, src, tgt, 1, w, &r->m);
+    if (!ws)
+        amscr__ws_release(&local);
+    if (st == AMSCR_OK && p->polish && src->raw && tgt->raw && tgt->params.closed &&
+        (p->partial || src->params.closed) && p->invariance == AMSCR_INVARIANCE_AFFINE) /* on the input points */
+        st = amscr__polish(src, tgt, p->partial, &r->m);
+    if (st == AMSCR_OK)
+        st = amscr__correspond(src, tgt, r);
+    if (st != AMSCR_OK) {
+        free(r);
+        return st;
+    }
+    r->method = p->method;
+    memcpy(r->affine_norm, r->m.X, sizeof r->affine_norm);
+    /* input coordinates: inv_h ∘ X ∘ fwd_f */
+    double t[6];
+    amscr__affine_compose(r->m.X, src->fwd, t);
+    amscr__affine_compose(tgt->inv, t, r->affine_in);
+    *out_result = r;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_distance(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                            amscr_workspace *ws, double *out_distance)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(src);
+    AMSCR_CHECK_NULL(tgt);
+    AMSCR_CHECK_NULL(out_distance);
+    amscr_status st = check_pair(&p, src, tgt);
+    if (st != AMSCR_OK)
+        return st;
+    amscr_workspace local = {0};
+    amscr_workspace *w = ws ? ws : &local;
+    st = amscr__distance_ws(p, src, tgt, w, out_distance);
+    if (!ws)
+        amscr__ws_release(&local);
+    return st;
+}
+
+amscr_status amscr__distance_ws(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                                amscr_workspace *ws, double *out)
+{
+    match_t m;
+    amscr_status st = match_pair(prm, src, tgt, 0, ws, &m);
+    if (st == AMSCR_OK)
+        *out = m.dist;
+    return st;
+}
+
+/* Partial matching: an open source and a closed target, otherwise compatible. */
+static amscr_status check_partial(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt)
+{
+    if (src->params.closed || !tgt->params.closed)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "partial registration: the source must be prepared open and the "
+                                                "target closed (source %s, target %s)",
+                           src->params.closed ? "closed" : "open", tgt->params.closed ? "closed" : "open");
+    amscr_params a = src->params, b = tgt->params, c = *prm;
+    a.closed = b.closed = c.closed = 1;
+    if (!amscr__params_compatible(&a, &b, "partial registration (source vs target)") ||
+        !amscr__params_compatible(&c, &a, "partial registration (params vs descriptors)"))
+        return AMSCR_E_INVALID_ARG;
+    return AMSCR_OK;
+}
+
+/* Null params: the source's. Both descriptors and the params must describe compatible shapes. */
+static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor *src, const amscr_descriptor *tgt)
+{
+    if (!*prm)
+        *prm = &src->params;
+    if ((*prm)->partial)
+        return check_partial(*prm, src, tgt);
+    if (!amscr__params_compatible(&src->params, &tgt->params, "registration (source vs target)"))
+        return AMSCR_E_INVALID_ARG;
+    if (!amscr__params_compatible(*prm, &src->params, "registration (params vs descriptors)"))
+        return AMSCR_E_INVALID_ARG;
+    return AMSCR_OK;
+}
+
+/* The match src -> tgt; `report`: replaced by the reported QR solve (affine invariance; the
+ * constrained groups keep their closed form). Symmetric: the distance is the mean of both
+ * directions' (the reported solve comes first: the way back reuses the workspace). */
+static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                               int report, amscr_workspace *ws, match_t *m)
+{
+    if (prm->partial) { /* issue 14: the fragment's place, then the reported QR of its pairs */
+        amscr_status st = amscr__match_partial(prm, src, tgt, ws, m);
+        if (st == AMSCR_OK && report) /* the place is known: refine on with an adaptive trim */
+            st = amscr__refine_adaptive(prm, src, tgt, ws, m);
+        return st == AMSCR_OK && report ? amscr__final_solve(prm, src, tgt, ws, m) : st;
+    }
+    amscr_status st = amscr__match_dir(prm, src, tgt, ws, m);
+    if (st == AMSCR_OK && report && prm->invariance == AMSCR_INVARIANCE_AFFINE && src->params.closed)
+        st = amscr__recover_missing(prm, src, tgt, ws, m); /* issue 14: part of the target missing */
+    if (st == AMSCR_OK && report && prm->invariance == AMSCR_INVARIANCE_AFFINE)
+        st = amscr__final_solve(prm, src, tgt, ws, m);
+    if (st == AMSCR_OK && prm->symmetric) {
+        match_t back;
+        st = amscr__match_dir(prm, tgt, src, ws, &back);
+        if (st == AMSCR_OK)
+            m->dist = 0.5 * (m->dist + back.dist);
+    }
+    return st;
+}
+
+amscr_status amscr_register_contours(const amscr_params *p, const amscr_contour *src, const amscr_contour *tgt,
+                                     amscr_result **out_result)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(src);
+    AMSCR_CHECK_NULL(tgt);
+    AMSCR_CHECK_NULL(out_result);
+    amscr_descriptor *a = NULL, *b = NULL;
+    char detail[400];
+    amscr_params preset;
+    if (!p) {
+        amscr__params_registration(&preset);
+        p = &preset;
+    }
+    amscr_params ps = *p, pt = *p; /* partial: the source open, the target closed */
+    if (p->partial) {
+        ps.closed = 0;
+        pt.closed = 1;
+    }
+    amscr_status st = amscr_descriptor_new(&ps, src, &a);
+    if (st == AMSCR_OK) {
+        st = amscr_descriptor_new(&pt, tgt, &b);
+        if (st != AMSCR_OK) {
+            snprintf(detail, sizeof detail, "%s", amscr_last_error_detail());
+            amscr__fail(st, "target: %s", detail);
+        }
+    } else {
+        snprintf(detail, sizeof detail, "%s", amscr_last_error_detail());
+        amscr__fail(st, "source: %s", detail);
+    }
+    if (st == AMSCR_OK)
+        st = amscr_register(p, a, b, NULL, out_result);
+    amscr_descriptor_free(a);
+    amscr_descriptor_free(b);
+    return st;
+}

@@ -1,0 +1,456 @@
+/* shift_search.c — the start point of a match f -> h (docs/method.md §3, §9): which cyclic shift of
+ * the target (closed curves) and which orientation the method starts from.
+ *
+ * For closed curves the 2x2 cross-correlation R(s) = Σ_a h(a+s) f(a)^T over all N cyclic shifts
+ * comes from one FFT product (the reversed target is the conjugate spectrum); circular
+ * smoothing of both curves at σ_k multiplies its spectrum by |G_k|^2, so the stacked
+ * least-squares residual of every shift costs O(N log N) per pair (the search criterion). The
+ * lowest few local minima of that criterion per orientation are the candidates, each refined to
+ * a continuous shift. Open curves have one candidate per orientation (no shift).
+ *
+ * One ranking rule picks the winner: the lowest score, ties broken by the lower distance, then
+ * by the earlier candidate (orientations in order, each one's candidates best criterion first).
+ * The score is the cheapest quantity that judges the start point (see score_start). The winner
+ * gets the whole method and the refinement.
+ */
+#include "dense.h"
+#include "match.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Criterion ranking only: a candidate is refined only when its residual is within this factor
+ * of the best one's — refinement to a continuous shift moves the residual far less than that. */
+#define AMSCR__PRUNE_RATIO 1.25
+/* The rotation recurrence e^{iθw} is re-computed exactly every 256 frequencies (mask 255) so
+ * its rounding does not grow with N. */
+#define AMSCR__REANCHOR 255
+/* With refinement on, each candidate is scored after at most this many closest-point steps
+ * (the winner then gets all of them). */
+#define AMSCR__SCORE_REFINE 2
+
+/* ---------------------------------------------------- spectral cross sums
+ * For closed curves every cross sum R_k(s) = Σ_a h_k(a+s) [f_k(a), 1]^T is a trigonometric
+ * polynomial in the shift s: R_k,ij(s) = (1/N) Σ_w |G_k(w)|^2 H_i(w) conj(F_j(w)) e^{2πiws/N}.
+ * Evaluated at integer s it equals the direct sum; between samples it is the band-limited
+ * interpolation, which makes the start point continuous instead of quantized to 1/N. */
+
+/* P_ij(w) = H_i(w) conj(F_j(w)) for w = 0..N/2 (reversed target: conj(H)). */
+void amscr__spectral_prepare(const amscr_descriptor *f, const amscr_descriptor *h, int o, amscr_workspace *ws)
+{
+    size_t n = f->n, half = n / 2 + 1;
+    const double *Fx = f->spec, *Fy = f->spec + 2 * n, *Hx = h->spec, *Hy = h->spec + 2 * n;
+    double sg = o ? -1.0 : 1.0;
+    for (size_t w = 0; w < half; w++) {
+        double fxr = Fx[2 * w], fxi = -Fx[2 * w + 1], fyr = Fy[2 * w], fyi = -Fy[2 * w + 1];
+        double hr[2] = {Hx[2 * w], Hy[2 * w]}, hi[2] = {sg * Hx[2 * w + 1], sg * Hy[2 * w + 1]};
+        double *P = ws->P + 8 * w;
+        for (int i = 0; i < 2; i++) {
+            P[4 * i + 0] = hr[i] * fxr - hi[i] * fxi;
+            P[4 * i + 1] = hr[i] * fxi + hi[i] * fxr;
+            P[4 * i + 2] = hr[i] * fyr - hi[i] * fyi;
+            P[4 * i + 3] = hr[i] * fyi + hi[i] * fyr;
+        }
+    }
+}
+
+/* q_ij(w) = c_w Re(P_ij(w) e^{2πiws/N}) / N, c = 1 at w = 0 and N/2 (even N), else 2. */
+static void spectral_q(amscr_workspace *ws, size_t n, double s)
+{
+    size_t half = n / 2 + 1;
+    double th = 2.0 * AMSCR__PI * s / (double)n;
+    double cs = cos(th), sn = sin(th), er = 1.0, ei = 0.0, inv_n = 1.0 / (double)n;
+    for (size_t w = 0; w < half; w++) {
+        if ((w & AMSCR__REANCHOR) == 0 && w > 0) { /* re-anchor the rotation recurrence (large N only) */
+            er = cos(th * (double)w);
+            ei = sin(th * (double)w);
+        }
+        double c = (w == 0 || (2 * w == n)) ? inv_n : 2.0 * inv_n;
+        const double *P = ws->P + 8 * w;
+        double *q = ws->q + 4 * w;
+        for (int j = 0; j < 4; j++)
+            q[j] = c * (P[2 * j] * er - P[2 * j + 1] * ei);
+        double t = er * cs - ei * sn;
+        ei = er * sn + ei * cs;
+        er = t;
+    }
+}
+
+/* R (2x3) of one level from ws->q; gain NULL = unsmoothed. dc: Σ h_x, Σ h_y. */
+static void spectral_level(const amscr_workspace *ws, size_t n, const double *gain, const double dc[2], double R[6])
+{
+    size_t half = n / 2 + 1;
+    double r0 = 0, r1 = 0, r3 = 0, r4 = 0;
+    for (size_t w = 0; w < half; w++) {
+        const double *q = ws->q + 4 * w;
+        double g = gain ? gain[w] : 1.0;
+        r0 += g * q[0];
+        r1 += g * q[1];
+        r3 += g * q[2];
+        r4 += g * q[3];
+    }
+    R[0] = r0;
+    R[1] = r1;
+    R[2] = dc[0];
+    R[3] = r3;
+    R[4] = r4;
+    R[5] = dc[1];
+}
+
+void amscr__spectral_cross_sums(const amscr_descriptor *f, const amscr_descriptor *h, double s, amscr_workspace *ws,
+                                double R[][6])
+{
+    size_t n = f->n;
+    double dc[2] = {h->spec[0], h->spec[2 * n]};
+    spectral_q(ws, n, s);
+    spectral_level(ws, n, NULL, dc, R[0]);
+    for (size_t k = 0; k < f->p; k++)
+        spectral_level(ws, n, f->gain + k * n, dc, R[k + 1]);
+}
+
+/* The search criterion: minus the explained part of the stacked smoothed least-squares
+ * problem, -tr(C S^-1 C^T) with C = Σ_k R_k(s) (2x2) and S = Σ_k S_k over all scales (or the
+ * finest scale for acma). Minimizing it over s minimizes that least-squares residual. */
+static void crit_matrix(const amscr_descriptor *f, int use_finest, int sim, double Sinv[4])
+{
+    double Sxx = 0, Sxy = 0, Syy = 0;
+    if (use_finest) {
+        const double *mo = f->mom + 6 * (f->finest + 1);
+        Sxx = mo[0];
+        Sxy = mo[1];
+        Syy = mo[2];
+    } else {
+        for (size_t k = 0; k < f->p; k++) {
+            const double *mo = f->mom + 6 * (k + 1);
+            Sxx += mo[0];
+            Sxy += mo[1];
+            Syy += mo[2];
+        }
+    }
+    double det = Sxx * Syy - Sxy * Sxy;
+    Sinv[0] = Syy / det;
+    Sinv[1] = -Sxy / det;
+    Sinv[2] = Sxx / det;
+    Sinv[3] = 0.0;
+    if (sim) { /* similarity: the explained part is ((Cxx + Cyy)^2 + (Cyx - Cxy)^2) / tr S */
+        Sinv[0] = 1.0 / (Sxx + Syy);
+        Sinv[3] = 1.0;
+    }
+}
+
+static inline double crit_value(const double C[4], const double Si[4])
+{
+    if (Si[3] != 0.0) {
+        double u = C[0] + C[3], v = C[2] - C[1];
+        return -(u * u + v * v) * Si[0];
+    }
+    /* tr(C Si C^T) = Σ_i c_i^T Si c_i over the rows c_i of C */
+    double t = 0.0;
+    for (int i = 0; i < 2; i++) {
+        double x = C[2 * i], y = C[2 * i + 1];
+        t += x * (Si[0] * x + Si[1] * y) + y * (Si[1] * x + Si[2] * y);
+    }
+    return -t;
+}
+
+/* The criterion and its first two derivatives in s in one spectral pass:
+ * d/ds Re(P e^{iks}) = -k Im(P e^{iks}), d2/ds2 = -k^2 Re(P e^{iks}), k = 2πw/N. */
+static void crit_newton(const amscr_descriptor *f, int use_finest, const double Si[4], amscr_workspace *ws, double s,
+                        double *val, double *d1, double *d2)
+{
+    size_t n = f->n, half = n / 2 + 1;
+    const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
+    double base = 2.0 * AMSCR__PI / (double)n, th = base * s;
+    double cs = cos(th), sn = sin(th), er = 1.0, ei = 0.0;
+    double C[4] = {0, 0, 0, 0}, D[4] = {0, 0, 0, 0}, E[4] = {0, 0, 0, 0};
+    for (size_t w = 0; w < half; w++) {
+        if ((w & AMSCR__REANCHOR) == 0 && w > 0) {
+            er = cos(th * (double)w);
+            ei = sin(th * (double)w);
+        }
+        double g = (w == 0 || 2 * w == n) ? gain[w] : 2.0 * gain[w];
+        double k = base * (double)w;
+        const double *P = ws->P + 8 * w;
+        for (int j = 0; j < 4; j++) {
+            double re = P[2 * j] * er - P[2 * j + 1] * ei, im = P[2 * j] * ei + P[2 * j + 1] * er;
+            C[j] += g * re;
+            D[j] -= g * k * im;
+            E[j] -= g * k * k * re;
+        }
+        double t = er * cs - ei * sn;
+        ei = er * sn + ei * cs;
+        er = t;
+    }
+    double inv_n = 1.0 / (double)n;
+    for (int j = 0; j < 4; j++) {
+        C[j] *= inv_n;
+        D[j] *= inv_n;
+        E[j] *= inv_n;
+    }
+    if (Si[3] != 0.0) { /* similarity: crit = -(u^2 + v^2) / tr S */
+        double u = C[0] + C[3], v = C[2] - C[1], du = D[0] + D[3], dv = D[2] - D[1], eu = E[0] + E[3],
+               ev = E[2] - E[1];
+        *val = -(u * u + v * v) * Si[0];
+        *d1 = -2.0 * (u * du + v * dv) * Si[0];
+        *d2 = -2.0 * (du * du + u * eu + dv * dv + v * ev) * Si[0];
+        return;
+    }
+    /* crit = -tr(C Si C^T); crit' = -2 tr(D Si C^T); crit'' = -2 [tr(E Si C^T) + tr(D Si D^T)] */
+    double t1 = 0, t2 = 0, t3 = 0;
+    for (int i = 0; i < 2; i++) {
+        double cx = C[2 * i], cy = C[2 * i + 1], dx = D[2 * i], dy = D[2 * i + 1], ex = E[2 * i], ey = E[2 * i + 1];
+        double scx = Si[0] * cx + Si[1] * cy, scy = Si[1] * cx + Si[2] * cy;
+        t1 += dx * scx + dy * scy;
+        t2 += ex * scx + ey * scy;
+        t3 += dx * (Si[0] * dx + Si[1] * dy) + dy * (Si[1] * dx + Si[2] * dy);
+    }
+    *val = crit_value(C, Si);
+    *d1 = -2.0 * t1;
+    *d2 = -2.0 * (t2 + t3);
+}
+
+/* Newton on the shift: an integer local minimum's basin is one sample wide, so a step stays
+ * within half a sample; two passes reach well below a sample from the parabola's vertex; a
+ * step under a thousandth of a sample has converged. */
+#define AMSCR__SHIFT_MAX_STEP 0.5
+#define AMSCR__SHIFT_PASSES 2
+#define AMSCR__SHIFT_TOL 1e-3
+
+/* Refinement of an integer shift s (a local minimum of the criterion) to a continuous one
+ * by Newton's method with exact derivatives (at most two passes, steps within ±0.5; the last
+ * step is taken with its quadratic prediction of the criterion, which only ranks candidates —
+ * the distance is computed exactly afterwards). */
+static double refine_shift(const amscr_descriptor *f, int use_finest, const double Si[4], amscr_workspace *ws,
+                           size_t s, double *out_crit)
+{
+    size_t n = f->n;
+    double x = (double)s, best_x = x, best_v = ws->crit[s];
+    /* start: the vertex of the parabola through the integer neighbours (free: from the FFT) */
+    double cm = ws->crit[(s + n - 1) % n], cp = ws->crit[(s + 1) % n], curv = cp - 2.0 * best_v + cm;
+    if (curv > 0.0) {
+        double step = -0.5 * (cp - cm) / curv;
+        x += step > AMSCR__SHIFT_MAX_STEP ? AMSCR__SHIFT_MAX_STEP
+                                          : (step < -AMSCR__SHIFT_MAX_STEP ? -AMSCR__SHIFT_MAX_STEP : step);
+    }
+    for (int it = 0; it < AMSCR__SHIFT_PASSES; it++) {
+        double v, d1, d2;
+        crit_newton(f, use_finest, Si, ws, x, &v, &d1, &d2);
+        if (v <= best_v) {
+            best_v = v;
+            best_x = x;
+        } else if (it > 0) {
+            break; /* the last step went uphill: keep the best point */
+        } else {
+            x = best_x; /* the parabola overshot: restart Newton from the integer shift */
+            crit_newton(f, use_finest, Si, ws, x, &v, &d1, &d2);
+        }
+        if (!(d2 > 0.0))
+            break;
+        double step = -d1 / d2;
+        if (step > AMSCR__SHIFT_MAX_STEP)
+            step = AMSCR__SHIFT_MAX_STEP;
+        if (step < -AMSCR__SHIFT_MAX_STEP)
+            step = -AMSCR__SHIFT_MAX_STEP;
+        x += step;
+        if (fabs(step) < AMSCR__SHIFT_TOL) { /* converged to well below a sample: take the step as is */
+            best_v = v + 0.5 * d1 * step;
+            best_x = x;
+            break;
+        }
+        if (it == AMSCR__SHIFT_PASSES - 1) { /* no pass left: accept the Newton prediction only if lower */
+            double pred = v + d1 * step + 0.5 * d2 * step * step;
+            if (pred < best_v) {
+                best_v = pred;
+                best_x = x;
+            }
+        }
+    }
+    *out_crit = best_v;
+    return best_x;
+}
+
+/* Criterion of every integer cyclic shift for one orientation (closed curves): one FFT
+ * product and two complex inverse FFTs (x and y rows packed as real + imaginary parts); also
+ * leaves the spectral products of this orientation in ws->P. */
+static void shift_criterion(const amscr_descriptor *f, const amscr_descriptor *h, int o, int use_finest,
+                            const double Si[4], amscr_workspace *ws)
+{
+    size_t n = f->n;
+    amscr__spectral_prepare(f, h, o, ws);
+    const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
+    double *z1 = ws->z, *z2 = ws->z + 2 * n;
+    for (size_t w = 0; w < n; w++) {
+        size_t wf = w <= n / 2 ? w : n - w;
+        double cj = w <= n / 2 ? 1.0 : -1.0; /* Hermitian completion */
+        const double *P = ws->P + 8 * wf;
+        double g = gain[w];
+        /* z = (P_ix + i P_iy) g */
+        z1[2 * w] = g * (P[0] - cj * P[3]);
+        z1[2 * w + 1] = g * (cj * P[1] + P[2]);
+        z2[2 * w] = g * (P[4] - cj * P[7]);
+        z2[2 * w + 1] = g * (cj * P[5] + P[6]);
+    }
+    amscr__fft(&ws->plan, z1, 1);
+    amscr__fft(&ws->plan, z2, 1);
+    double inv_n = 1.0 / (double)n;
+    for (size_t s = 0; s < n; s++) {
+        double C[4] = {z1[2 * s] * inv_n, z1[2 * s + 1] * inv_n, z2[2 * s] * inv_n, z2[2 * s + 1] * inv_n};
+        ws->crit[s] = crit_value(C, Si);
+    }
+}
+
+/* The lowest (at most AMSCR__CANDIDATES) circular local minima of ws->crit, ascending. */
+static size_t integer_candidates(const amscr_workspace *ws, size_t n, size_t *cand)
+{
+    size_t nc = 0;
+    for (size_t s = 0; s < n; s++) {
+        double v = ws->crit[s];
+        double l = ws->crit[(s + n - 1) % n], r = ws->crit[(s + 1) % n];
+        if (!(v <= l && v <= r))
+            continue;
+        size_t pos = nc;
+        while (pos > 0 && ws->crit[cand[pos - 1]] > v)
+            pos--;
+        if (pos >= AMSCR__CANDIDATES)
+            continue;
+        size_t last = nc < AMSCR__CANDIDATES ? nc : AMSCR__CANDIDATES - 1;
+        for (size_t j = last; j > pos; j--)
+            cand[j] = cand[j - 1];
+        cand[pos] = s;
+        if (nc < AMSCR__CANDIDATES)
+            nc++;
+    }
+    if (nc == 0) { /* flat criterion: take shift 0 */
+        cand[0] = 0;
+        nc = 1;
+    }
+    return nc;
+}
+
+
+/* One start point: orientation, continuous shift (closed curves) and the shift criterion. */
+typedef struct {
+    int o;
+    double s;
+} start_t;
+
+/* The candidates of f -> h, in ranking order of ties (orientation, then criterion). Closed
+ * curves: per orientation the lowest local minima of the criterion refined to a continuous
+ * shift; `prune` drops those far above the orientation's best (criterion ranking). On return
+ * ws->P holds orientation `norient - 1`'s spectra; crit[i] is candidate i's criterion. */
+static size_t collect_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                             int prune, amscr_workspace *ws, start_t *out, double *crit)
+{
+    int norient = prm->reflections ? 2 : 1, use_finest = prm->method == AMSCR_METHOD_ACMA;
+    size_t n = f->n, count = 0;
+    if (!f->params.closed) {
+        for (int o = 0; o < norient; o++) {
+            out[count].o = o;
+            out[count].s = 0.0;
+            crit[count++] = 0.0;
+        }
+        return count;
+    }
+    double Si[4];
+    crit_matrix(f, use_finest, prm->invariance != AMSCR_INVARIANCE_AFFINE, Si);
+    /* The residual is Σ_k |h_k|^2 + criterion; Σ_k |h_k|^2 is bounded by p |h|^2. The pruning
+     * test allows a rounding-sized 1e-12 of it so that equal residuals always stay in. */
+    double hk2 = (use_finest ? 1.0 : (double)f->p) * h->norm2;
+    for (int o = 0; o < norient; o++) {
+        shift_criterion(f, h, o, use_finest, Si, ws);
+        size_t cand[AMSCR__CANDIDATES];
+        size_t nc = integer_candidates(ws, n, cand);
+        double r0 = ws->crit[cand[0]] + hk2;
+        for (size_t c = 0; c < nc; c++) {
+            if (prune && c > 0 && ws->crit[cand[c]] + hk2 > AMSCR__PRUNE_RATIO * r0 + 1e-12 * hk2)
+                break;
+            out[count].o = o;
+            out[count].s = refine_shift(f, use_finest, Si, ws, cand[c], &crit[count]);
+            count++;
+        }
+    }
+    return count;
+}
+
+/* The ways to score a start point, cheapest first. */
+typedef enum {
+    SCORE_CRITERION, /* closed, no refinement: the refined shift criterion (the batch path) */
+    SCORE_METHOD,    /* open curves: no criterion, two starts at most; the method's distance */
+    SCORE_GEOMETRY   /* closed with refinement: the trimmed closest-point cost after a short
+                        refinement — a wrong start caused by a missing part of a contour is caught by
+                        the geometry rather than by the criterion alone */
+} score_kind;
+
+/* Runs the method (and the refinement) at start st into m, with ws->P prepared for it. */
+static amscr_status run_start(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                              const start_t *st, int *prepared_o, unsigned iters, amscr_workspace *ws, match_t *m)
+{
+    if (f->params.closed && *prepared_o != st->o) {
+        amscr__spectral_prepare(f, h, st->o, ws);
+        *prepared_o = st->o;
+    }
+    amscr__run_method(prm, f, h, st->s, st->o, ws, m);
+    return amscr__refine_match(prm, f, h, ws, m, iters);
+}
+
+/* issue 14: the chosen candidate's score over the best score of a clearly different candidate
+ * map (1: as good; 0: none, or far worse). */
+static double ambiguity_of(const amscr_descriptor *f, double X[][6], const double *score, size_t count, size_t best)
+{
+    double amb = 0.0;
+    for (size_t i = 0; i < count; i++) {
+        if (i == best || !(amscr__map_gap2(f, X[i], X[best]) > AMSCR__DISTINCT_GAP2))
+            continue;
+        double r = (score[best] + AMSCR__AMBIGUITY_FLOOR) / (score[i] + AMSCR__AMBIGUITY_FLOOR);
+        if (r > amb)
+            amb = r > 1.0 ? 1.0 : r;
+    }
+    return amb;
+}
+
+amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                              amscr_workspace *ws, match_t *m)
+{
+    amscr_status st = amscr__ws_reserve(ws, f->n, f->p);
+    if (st != AMSCR_OK)
+        return st;
+    score_kind kind = !f->params.closed ? SCORE_METHOD : prm->refine > 0 ? SCORE_GEOMETRY : SCORE_CRITERION;
+    start_t starts[2 * AMSCR__CANDIDATES];
+    double crit[2 * AMSCR__CANDIDATES];
+    STAGE_T0;
+    size_t count = collect_starts(prm, f, h, kind == SCORE_CRITERION, ws, starts, crit);
+    int prepared_o = (prm->reflections ? 2 : 1) - 1;
+    size_t best = 0;
+    double best_score = INFINITY, best_dist = INFINITY;
+    double cand_X[2 * AMSCR__CANDIDATES][6], cand_score[2 * AMSCR__CANDIDATES]; /* issue 14: ambiguity */
+    for (size_t i = 0; i < count; i++) {
+        double score = crit[i], dist = crit[i];
+        if (kind != SCORE_CRITERION) {
+            match_t cur;
+            unsigned iters = prm->refine < AMSCR__SCORE_REFINE ? prm->refine : AMSCR__SCORE_REFINE;
+            st = run_start(prm, f, h, &starts[i], &prepared_o, kind == SCORE_GEOMETRY ? iters : 0, ws, &cur);
+            if (st != AMSCR_OK)
+                return st;
+            score = kind == SCORE_GEOMETRY ? cur.rcost : cur.dist;
+            dist = cur.dist;
+            memcpy(cand_X[i], cur.X, sizeof cand_X[i]);
+        }
+        cand_score[i] = score;
+        /* the one ranking rule: lower score, then lower distance, then the earlier candidate */
+        if (i == 0 || score < best_score || (score == best_score && dist < best_dist)) {
+            best = i;
+            best_score = score;
+            best_dist = dist;
+        }
+    }
+    STAGE_MARK(ws, 0);
+    st = run_start(prm, f, h, &starts[best], &prepared_o, prm->refine, ws, m);
+    if (st == AMSCR_OK)
+        m->ambiguity = kind == SCORE_CRITERION ? 0.0 : ambiguity_of(f, cand_X, cand_score, count, best);
+    m->ncand = kind == SCORE_CRITERION ? 0 : count; /* further starts for polish.c */
+    if (m->ncand)
+        memcpy(m->cand, cand_X, count * sizeof cand_X[0]);
+    if (st == AMSCR_OK && !isfinite(m->dist))
+        st = amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
+    return st;
+}

@@ -1,0 +1,282 @@
+/* channel.c — the articulation-tolerant second distance channel (docs/method.md §10): height
+ * functions along the prepared curve (Wang, Bai, Wang, Zhou, Liu, Tu, "Shape matching and
+ * classification using height functions", Pattern Recognition Letters 2012), compared by an
+ * order-preserving dynamic-programming correspondence in a narrow band around the best
+ * cyclic shift and orientation.
+ *
+ * Per shape (once): for every sample i of the N normalized points (the descriptor's frame:
+ * whitened under the affine group, similarity-normalized otherwise), the signed distances
+ * of all other samples to the tangent line at i, averaged in AMSCR__HF_BINS bins of equal
+ * index width and weighted by how close the bin lies along the curve (local detail counts
+ * more than far parts, which articulation moves). Because the frame is normalized and the
+ * samples follow the prepared (group-invariant) parametrization, the sequence changes with
+ * the group only by a cyclic shift; a reflection reverses it, so the mirrored sequence is
+ * kept as well. The DFT of every bin column is kept for the shift search.
+ *
+ * Per pair: the cyclic shift (and orientation) that maximizes the correlation of the two
+ * sequences, low-passed to the first N/8 frequencies (the band absorbs the coarser shift;
+ * one inverse FFT per orientation), then a banded DTW with a cost `skip` for
+ * every sample matched twice (a skipped stretch on the other side) and free start/end
+ * within the band (the difference of the end and start offsets pays `skip` per sample, so
+ * a path that does not close costs what its missing samples would). Heights are quantized
+ * to bytes (AMSCR__HF_QUANT), so the cell cost is an exact integer sum of absolute
+ * differences (one SSE2 instruction per 16 bins) and the result is the same on every
+ * platform. Cost O(N * band * bins) per pair; 0 for a shape against itself; d(a, b) and
+ * d(b, a) agree unless the two shift searches pick different candidates. */
+#include "channel.h"
+
+#include <float.h>
+#include <stdint.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void amscr__hf_free(amscr__hf *h)
+{
+    if (!h)
+        return;
+    free(h->seq[0]);
+    free(h->seq[1]);
+    free(h->spec[0]);
+    free(h->spec[1]);
+    memset(h, 0, sizeof *h);
+}
+
+/* Bin weight for a bin whose centre lies `frac` of the curve away (0..0.5). */
+static double bin_weight(double frac, double locality) { return 1.0 / (1.0 + locality * frac); }
+
+/* Heights of the closed curve P (n points) into seq (n * AMSCR__HF_BINS floats). */
+static void heights(const double *P, size_t n, double locality, uint8_t *seq, double *acc, size_t *cnt)
+{
+    const size_t D = AMSCR__HF_BINS;
+    for (size_t i = 0; i < n; i++) {
+        size_t ip = (i + 1) % n, im = (i + n - 1) % n;
+        double tx = P[2 * ip] - P[2 * im], ty = P[2 * ip + 1] - P[2 * im + 1];
+        double tl = sqrt(tx * tx + ty * ty);
+        double nx = tl > 0.0 ? -ty / tl : 0.0, ny = tl > 0.0 ? tx / tl : 0.0;
+        memset(acc, 0, D * sizeof *acc);
+        memset(cnt, 0, D * sizeof *cnt);
+        for (size_t j = 1; j < n; j++) {
+            size_t q = (i + j) % n;
+            size_t b = (j - 1) * D / (n - 1);
+            acc[b] += (P[2 * q] - P[2 * i]) * nx + (P[2 * q + 1] - P[2 * i + 1]) * ny;
+            cnt[b]++;
+        }
+        for (size_t b = 0; b < D; b++) {
+            double centre = ((double)b + 0.5) / (double)D; /* fraction of the curve ahead */
+            double frac = centre < 0.5 ? centre : 1.0 - centre;
+            double v = cnt[b] ? acc[b] / (double)cnt[b] : 0.0;
+            double q = 128.0 + AMSCR__HF_QUANT * v * bin_weight(frac, locality);
+            seq[i * D + b] = (uint8_t)(q < 0.0 ? 0.0 : q > 255.0 ? 255.0 : floor(q + 0.5));
+        }
+    }
+}
+
+static amscr_status spectra(const uint8_t *seq, size_t n, double *spec, amscr__fft_plan *plan, double *z)
+{
+    const size_t D = AMSCR__HF_BINS;
+    for (size_t b = 0; b < D; b++) {
+        for (size_t i = 0; i < n; i++) {
+            z[2 * i] = (double)seq[i * D + b] - 128.0;
+            z[2 * i + 1] = 0.0;
+        }
+        amscr__fft(plan, z, 0);
+        memcpy(spec + b * 2 * n, z, 2 * n * sizeof *z);
+    }
+    return AMSCR_OK;
+}
+
+amscr_status amscr__hf_build(const double *base, size_t n, double locality, amscr__hf *out)
+{
+    const size_t D = AMSCR__HF_BINS;
+    memset(out, 0, sizeof *out);
+    if (n < D + 1)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "shape channel: N = %zu is below %zu", n, D + 1);
+    out->n = n;
+    double *mir = amscr__malloc_array(2 * n, sizeof *mir), *z = amscr__malloc_array(2 * n, sizeof *z);
+    double *acc = amscr__malloc_array(D, sizeof *acc);
+    size_t *cnt = amscr__malloc_array(D, sizeof *cnt);
+    amscr__fft_plan plan;
+    int have_plan = amscr__fft_plan_init(&plan, n) == 0;
+    amscr_status st = AMSCR_OK;
+    for (int o = 0; o < 2; o++) {
+        out->seq[o] = amscr__malloc_array(n * D, sizeof(uint8_t));
+        out->spec[o] = amscr__malloc_array(D * 2 * n, sizeof(double));
+        if (!out->seq[o] || !out->spec[o])
+            st = AMSCR_E_NOMEM;
+    }
+    if (!mir || !z || !acc || !cnt || !have_plan || st != AMSCR_OK) {
+        st = amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
+    } else {
+        /* mirror image (x -> -x), traversed backwards so it stays counter-clockwise */
+        for (size_t i = 0; i < n; i++) {
+            mir[2 * i] = -base[2 * (n - 1 - i)];
+            mir[2 * i + 1] = base[2 * (n - 1 - i) + 1];
+        }
+        heights(base, n, locality, out->seq[0], acc, cnt);
+        heights(mir, n, locality, out->seq[1], acc, cnt);
+        for (int o = 0; o < 2; o++)
+            spectra(out->seq[o], n, out->spec[o], &plan, z);
+    }
+    if (have_plan)
+        amscr__fft_plan_free(&plan);
+    free(mir);
+    free(z);
+    free(acc);
+    free(cnt);
+    if (st != AMSCR_OK)
+        amscr__hf_free(out);
+    return st;
+}
+
+amscr_status amscr__hf_ws_init(amscr__hf_ws *ws, size_t n, size_t band)
+{
+    memset(ws, 0, sizeof *ws);
+    size_t W = 2 * band + 1;
+    ws->n = n;
+    ws->z = amscr__malloc_array(2 * n, sizeof *ws->z);
+    ws->row = amscr__malloc_array(4 * W, sizeof *ws->row);
+    ws->start = amscr__malloc_array(4 * W, sizeof *ws->start);
+    int ok = amscr__fft_plan_init(&ws->plan, n) == 0;
+    ws->have_plan = ok;
+    if (!ws->z || !ws->row || !ws->start || !ok) {
+        amscr__hf_ws_free(ws);
+        return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
+    }
+    return AMSCR_OK;
+}
+
+void amscr__hf_ws_free(amscr__hf_ws *ws)
+{
+    if (ws->have_plan)
+        amscr__fft_plan_free(&ws->plan);
+    free(ws->z);
+    free(ws->row);
+    free(ws->start);
+    memset(ws, 0, sizeof *ws);
+}
+
+/* Best cyclic shift of b's orientation o against a (max correlation), and that correlation. */
+static size_t best_shift(const amscr__hf *a, const amscr__hf *b, int o, amscr__hf_ws *ws, double *out_corr)
+{
+    const size_t D = AMSCR__HF_BINS, n = a->n;
+    double *z = ws->z;
+    memset(z, 0, 2 * n * sizeof *z);
+    size_t half = n / 2, fmax = AMSCR__HF_FREQS(n);
+    for (size_t bin = 0; bin < D; bin++) {
+        const double *fa = a->spec[0] + bin * 2 * n, *fb = b->spec[o] + bin * 2 * n;
+        for (size_t f = 0; f <= fmax; f++) {
+            double ar = fa[2 * f], ai = fa[2 * f + 1], br = fb[2 * f], bi = fb[2 * f + 1];
+            z[2 * f] += ar * br + ai * bi; /* conj(A) B */
+            z[2 * f + 1] += ar * bi - ai * br;
+        }
+    }
+    for (size_t f = n - fmax; f < n && f > half; f++) { /* Hermitian: the inputs are real */
+        z[2 * f] = z[2 * (n - f)];
+        z[2 * f + 1] = -z[2 * (n - f) + 1];
+    }
+    amscr__fft(&ws->plan, z, 1);
+    size_t best = 0;
+    for (size_t s = 1; s < n; s++)
+        if (z[2 * s] > z[2 * best])
+            best = s;
+    *out_corr = z[2 * best];
+    return best;
+}
+
+/* L1 distance of two quantized height vectors (integer: the same on every platform). */
+static inline int32_t l1(const uint8_t *x, const uint8_t *y)
+{
+#if defined(__SSE2__)
+    __m128i s = _mm_setzero_si128();
+    for (size_t d = 0; d < AMSCR__HF_BINS; d += 16) {
+        __m128i a = _mm_loadu_si128((const __m128i *)(const void *)(x + d));
+        __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(y + d));
+        s = _mm_add_epi64(s, _mm_sad_epu8(a, b));
+    }
+    return _mm_cvtsi128_si32(s) + _mm_extract_epi16(s, 4);
+#else
+    int32_t s = 0;
+    for (size_t d = 0; d < AMSCR__HF_BINS; d++)
+        s += x[d] > y[d] ? x[d] - y[d] : y[d] - x[d];
+    return s;
+#endif
+}
+
+/* Banded DTW of a against b (orientation o) cyclically shifted by s; see the file comment. */
+static double band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, size_t band, size_t stride,
+                      int32_t skip, amscr__hf_ws *ws)
+{
+    const size_t D = AMSCR__HF_BINS, m = n / stride;
+    const long w = (long)(band / stride > 0 ? band / stride : 1), W = 2 * w + 1;
+    int32_t *prev = ws->row, *cur = ws->row + W;
+    int *ps = ws->start, *cs = ws->start + W;
+    int32_t *cost = ws->row + 2 * W;
+    for (size_t i = 0; i < m; i++) {
+        const uint8_t *ai = A + i * stride * D;
+        size_t jb = (s + i * stride + n * stride - (size_t)w * stride) % n;
+        for (long kk = 0; kk < W; kk++) { /* the row's costs first: independent, pipelined */
+            cost[kk] = l1(ai, B + jb * D);
+            jb += stride;
+            if (jb >= n)
+                jb -= n;
+        }
+        for (long kk = 0; kk < W; kk++) {
+            int32_t best;
+            int st;
+            if (i == 0) {
+                best = 0;
+                st = (int)(kk - w);
+            } else {
+                best = prev[kk];
+                st = ps[kk];
+                int32_t v = kk + 1 < W ? prev[kk + 1] + skip : INT32_MAX;
+                if (v < best) {
+                    best = v;
+                    st = ps[kk + 1];
+                }
+            }
+            int32_t h = kk > 0 ? cur[kk - 1] + skip : INT32_MAX;
+            if (h < best) {
+                best = h;
+                st = cs[kk - 1];
+            }
+            cur[kk] = cost[kk] + best;
+            cs[kk] = st;
+        }
+        int32_t *t = prev;
+        prev = cur;
+        cur = t;
+        int *u = ps;
+        ps = cs;
+        cs = u;
+    }
+    double best = DBL_MAX;
+    for (long kk = 0; kk < W; kk++) {
+        double v = (double)prev[kk] + (double)skip * (double)labs((kk - w) - ps[kk]);
+        if (v < best)
+            best = v;
+    }
+    return best / ((double)m * AMSCR__HF_QUANT);
+}
+
+double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__hf_cfg *cfg, amscr__hf_ws *ws)
+{
+    const size_t n = a->n;
+    size_t band = cfg->band < n / 2 ? cfg->band : n / 2;
+    double c0 = 0.0, c1 = -DBL_MAX;
+    size_t s0 = best_shift(a, b, 0, ws, &c0), s1 = 0;
+    if (cfg->reflections)
+        s1 = best_shift(a, b, 1, ws, &c1);
+    int32_t skip = (int32_t)lround(cfg->skip * AMSCR__HF_QUANT);
+    if (cfg->reflections && cfg->both_orientations) {
+        double d0 = band_dp(a->seq[0], b->seq[0], n, s0, band, cfg->stride, skip, ws);
+        double d1 = band_dp(a->seq[0], b->seq[1], n, s1, band, cfg->stride, skip, ws);
+        return d0 < d1 ? d0 : d1;
+    }
+    int o = c1 > c0 ? 1 : 0;
+    return band_dp(a->seq[0], b->seq[o], n, o ? s1 : s0, band, cfg->stride, skip, ws);
+}

@@ -1,0 +1,57 @@
+/* amscr.c — the amscr command-line tool (docs/method.md §6): dispatch through the command table.
+ * Uses the public API only (STYLE.md rule 25): no src/ internals.
+ *
+ *   amscr contour IMG [-o FILE]
+ *   amscr register SRC TGT [--json] [--overlay FILE] [--plot FILE] [shape options]
+ *   amscr search QUERY COLLECTION [--top K] [--json]
+ *   amscr matrix COLLECTION -o FILE.tsv|FILE.npy
+ *   amscr eval COLLECTION [--protocol all|bullseye|topk|nn] [--ranks K] [--json]
+ *
+ * Layout: cli.h (options.c: the options; commands.c: the command table and help; cmd_*.c: one
+ * handler per command), params.c (library params from the options), retrieval.c (collection
+ * steps of search/matrix/eval), names.c (name/value tables), json.c, matrix_file.c, and the
+ * image, collection, drawing and utility modules.
+ *
+ * Exit codes: 0 success, 1 bad input or failure (one line on stderr naming the file),
+ * 2 usage error. */
+#include <stdio.h>
+#include <string.h>
+
+#include "amscr.h"
+#include "cli.h"
+
+static int is_any(const char *s, const char *a, const char *b, const char *c)
+{
+    return strcmp(s, a) == 0 || strcmp(s, b) == 0 || strcmp(s, c) == 0;
+}
+
+int main(int argc, char **argv)
+{
+    char list[128];
+    if (argc < 2)
+        return usage_error(NULL, "missing command: %s (see 'amscr --help')", command_list(list, sizeof list));
+    const char *name = argv[1];
+    if (is_any(name, "--help", "-h", "help")) {
+        const tool_command *c = strcmp(name, "help") == 0 && argc > 2 ? command_find(argv[2]) : NULL;
+        if (c != NULL)
+            return print_command_help(c);
+        print_main_help();
+        return TOOL_EXIT_OK;
+    }
+    if (is_any(name, "--version", "-V", "version")) {
+        printf("%s\n", amscr_version_string());
+        return TOOL_EXIT_OK;
+    }
+    const tool_command *c = command_find(name);
+    if (c == NULL)
+        return usage_error(NULL, "unknown command '%s' (see 'amscr --help')", name);
+    opts o;
+    opts_init(&o, c);
+    int help_status = TOOL_EXIT_OK;
+    int r = parse_args(&o, c, argc, argv, &help_status);
+    if (r < 0)
+        return help_status;
+    if (r != 0)
+        return r;
+    return c->run(&o);
+}

@@ -1,0 +1,71 @@
+/* cmd_matrix.c — `amscr matrix COLLECTION -o FILE`: the all-pairs distance matrix. */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "amscr.h"
+#include "cli.h"
+#include "collection.h"
+#include "matrix_file.h"
+#include "cmd_params.h"
+#include "shape_db.h"
+int cmd_matrix(opts *o)
+{
+    const char *cpath = o->pos[0];
+    if (o->out == NULL)
+        return usage_error("matrix", "missing -o FILE (.tsv, .npy, or - for stdout)");
+    char ext[16];
+    path_ext(o->out, ext);
+    int npy = strcmp(ext, ".npy") == 0;
+    if (!npy && strcmp(ext, ".tsv") != 0 && strcmp(ext, ".txt") != 0 && strcmp(o->out, "-") != 0)
+        return usage_error("-o", "'%s': the matrix file must end in .tsv or .npy (or be - for stdout)", o->out);
+    amscr_params *p = NULL;
+    collection c;
+    amscr_db *db = NULL;
+    double *d = NULL;
+    int ret = TOOL_EXIT_FAIL;
+    memset(&c, 0, sizeof c);
+    int r = open_collection_db(o, cpath, NULL, &p, &c, &db);
+    if (r != 0) {
+        ret = r;
+        goto done;
+    }
+    if (compute_matrix(db, cpath, &d) != 0)
+        goto done;
+    size_t n = c.n;
+    tool_out out;
+    if (tool_out_open(&out, o->out) != 0)
+        goto done;
+    if ((npy ? write_npy(out.fp, d, n) : write_tsv(out.fp, d, n, &c)) != 0) {
+        tool_error(o->out, "write error: %s", strerror(errno));
+        tool_out_abort(&out);
+        goto done;
+    }
+    if (o->names) {
+        tool_out nf;
+        if (tool_out_open(&nf, o->names) != 0) {
+            tool_out_abort(&out);
+            goto done;
+        }
+        fputs("file\tclass\n", nf.fp);
+        for (size_t i = 0; i < n; i++)
+            fprintf(nf.fp, "%s\t%s\n", c.items[i].name, c.classes[c.items[i].label]);
+        if (tool_out_commit(&nf) != 0) {
+            tool_out_abort(&out);
+            goto done;
+        }
+    }
+    if (tool_out_commit(&out) != 0)
+        goto done;
+    if (isatty(2) && strcmp(o->out, "-") != 0)
+        fprintf(stderr, "amscr: wrote %s (%zu x %zu)\n", o->out, n, n);
+    ret = TOOL_EXIT_OK;
+done:
+    free(d);
+    amscr_db_free(db);
+    collection_free(&c);
+    amscr_params_free(p);
+    return ret;
+}
+

@@ -1,0 +1,288 @@
+/* commands.c — the command table of the amscr tool (name, usage, help, handler) and the help
+ * texts. The defaults the help names are read from the params the commands use (cmd_params.c) and
+ * the names from the tables that the parser reads (names.c). */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+#include "names.h"
+#include "cmd_params.h"
+
+static const char HELP_CONTOUR[] =
+    "usage: amscr contour IMG [-o FILE] [--threshold N|auto]\n"
+    "       amscr contour IMG --all [--json] [--min-area A] [-o FILE]\n"
+    "\n"
+    "Traces the outer boundary of the largest 8-connected foreground component of a\n"
+    "PNG or PGM silhouette (holes and specks are ignored) and prints its points, one\n"
+    "\"x y\" per line (x = column, y = row, pixel centres), counter-clockwise in a y-up\n"
+    "frame. A text point list is passed through. -o writes to FILE (atomically).\n"
+    "\n"
+    "Images are converted to 8-bit luminance (RGB: Rec. 601 weights; 16-bit scaled).\n"
+    "With transparency, transparent pixels (alpha < 128) are background: a uniformly\n"
+    "coloured image on a transparent background is traced by its alpha channel.\n"
+    "\n"
+    "  -o, --output FILE       write the points to FILE instead of stdout\n"
+    "  --threshold N|auto      pixels > N are 'on' (0..254, default 127); auto = Otsu\n"
+    "  --all                   every contour: each 8-connected component's outer boundary\n"
+    "                          (counter-clockwise) and each hole's (clockwise, through the\n"
+    "                          hole's own pixels), with its parent (findContours' tree):\n"
+    "                          a hole's parent is the component around it, a component's\n"
+    "                          the hole it lies in. Text: '# contour I: outer|hole, parent\n"
+    "                          P|-, area A, N points' then the points; blank lines between\n"
+    "  --json                  (with --all) {image, count, contours: [{index, parent,\n"
+    "                          hole, area, points}]}\n"
+    "  --min-area A            (with --all) drop contours enclosing less than A pixels^2\n"
+    "                          (and what lies inside them; default 10)\n";
+
+static const char HELP_REGISTER[] =
+    "usage: amscr register SRC TGT [options]\n"
+    "\n"
+    "Registers the source shape SRC onto the target TGT: the affine map (A, B) with\n"
+    "TGT ~ A SRC + B in input coordinates, the affine-invariant distance, the residual\n"
+    "of every scale, the scales kept by the selection, the start shift and whether a\n"
+    "mirror match was used. Reflections are off by default here.\n"
+    "\n"
+    "  --json                  print one JSON object (keys A, B, distance, method,\n"
+    "                          scales, residuals, kept, shift, reflected, k,\n"
+    "                          threshold, sse, mixture, ...)\n"
+    "  --overlay FILE          picture (.png or .svg): target, source before and after\n"
+    "  --plot FILE             SVG: residual per scale with the Bayes threshold and the\n"
+    "                          kept scales, and the elbow curve SSE(K)\n"
+    "  --partial               SRC is an open fragment of TGT's closed boundary: also\n"
+    "                          prints where on TGT it lies (start, end as fractions)\n"
+    "  --no-polish             skip the final fit on the input points themselves (it\n"
+    "                          fits the noisier curve onto the cleaner one, and uses the\n"
+    "                          order and even spacing of markedly noisy points; on by\n"
+    "                          default)\n"
+    "  --component N           use contour N of 'amscr contour --all' of each image\n"
+    "                          (default: the largest outer contour); --min-area A as there\n"
+    "\n"
+    "Every result prints its confidence in [0, 1] ((1 - ambiguity) x inlier fraction;\n"
+    "reject maps below about 0.25) and, with --json, the matched target boundary\n"
+    "parameter and point of every source sample (\"correspondences\").\n";
+
+static const char HELP_SEARCH[] =
+    "usage: amscr search QUERY COLLECTION [--top K] [--json] [--sheet FILE] [options]\n"
+    "\n"
+    "Ranks the shapes of COLLECTION (a folder, a manifest.tsv or an index) by their distance\n"
+    "from QUERY and prints the K closest (default 10). Reflections are on by default.\n"
+    "With re-ranking (the default) the distances are scores in [0, 1]: 0 for the\n"
+    "query itself (when it is in the collection), below 0.5 for the shapes its\n"
+    "nearest-neighbour context reaches (half of 1 - affinity / the row's largest),\n"
+    "0.5 and above for the others, in the order of the fused distance. They rank;\n"
+    "they are not a metric. --no-rerank prints the fused pairwise distances.\n"
+    "\n"
+    "  --top K                 how many results (default 10)\n"
+    "  --json                  print one JSON object\n"
+    "  --sheet FILE            contact sheet (.png or .svg): the query and its hits as\n"
+    "                          thumbnails with rank, class and distance, each hit drawn\n"
+    "                          (red) registered onto the query (grey)\n"
+    "  --candidates M          against an index: match the M shapes whose signatures are\n"
+    "                          nearest the query's (default 64; 0: every shape)\n"
+    "  --component N           the query is contour N of 'amscr contour --all' (default:\n"
+    "                          the largest outer contour); --min-area A as there\n";
+
+static const char HELP_MATRIX[] =
+    "usage: amscr matrix COLLECTION -o FILE [--names FILE] [options]\n"
+    "\n"
+    "Computes the n x n matrix D[i][j] = distance(shape i -> shape j) of a collection\n"
+    "(rows in collection order: folder files sorted by name, or manifest order).\n"
+    "FILE ending in .npy: NumPy .npy v1.0, little-endian float64, C order;\n"
+    "otherwise (.tsv, or - for stdout): tab-separated text, one row per line, after a\n"
+    "'#' comment line listing the files. Reflections are on by default.\n"
+    "\n"
+    "  -o, --output FILE       the matrix file (.tsv, .npy or -)\n"
+    "  --names FILE            also write the row order: 'file<TAB>class' lines\n";
+
+static const char HELP_EVAL[] =
+    "usage: amscr eval COLLECTION [--protocol P] [--ranks K] [--json] [options]\n"
+    "       amscr eval COLLECTION --protocol split --train K [--splits R] [--seed S]\n"
+    "       amscr eval MANIFEST --protocol groups\n"
+    "\n"
+    "Retrieval scores of a labelled collection from its full distance matrix:\n"
+    "  bullseye  bull's eye (MPEG-7): same-class shapes among the 2*Nc nearest,\n"
+    "            query included, divided by the sum of class sizes\n"
+    "  topk      for rank r = 1..K, how many queries have a same-class r-th nearest\n"
+    "            neighbour (query excluded; Kimia tables)\n"
+    "  nn        leave-one-out nearest-neighbour accuracy\n"
+    "  all       all three (default)\n"
+    "  split     per-class random split: K shapes of every class train, the rest are\n"
+    "            classified by 1-NN; mean and spread over R splits (Swedish leaf: K 25)\n"
+    "  groups    leave one group out: each group's shapes are classified by 1-NN\n"
+    "            against the other groups (ETH-80: one object out); needs a manifest\n"
+    "            with a 'group' column\n"
+    "Classes: a folder's file names (\"bird-3.png\" -> bird) or the manifest's column.\n"
+    "Reflections are on by default.\n"
+    "\n"
+    "  --protocol P            all | bullseye | topk | nn | split | groups\n"
+    "  --train K               split: training shapes per class (each class needs > K)\n"
+    "  --splits R              split: random splits averaged (default 10)\n"
+    "  --seed S                split: seed of the random splits (default 1)\n"
+    "  --ranks K               ranks of the top-k table (default 10; Kimia-216 uses 11;\n"
+    "                          alias --topk-ranks)\n"
+    "  --plot FILE             SVG: each class's scores as bars and the precision-recall\n"
+    "                          curve (each shape querying the others)\n"
+    "  --json                  one JSON object: n, classes, seconds and bullseye,\n"
+    "                          topk, nn_accuracy, split, groups (those the protocol\n"
+    "                          computes) and per_class: each class's scores\n";
+
+static const char HELP_INDEX[] =
+    "usage: amscr index COLLECTION -o FILE [--add] [options]\n"
+    "\n"
+    "Prepares every shape of COLLECTION (a folder or a manifest.tsv) once and writes an\n"
+    "index: the prepared shapes with their file names, classes and groups, the shape\n"
+    "and retrieval options (channel weight, affine share, re-ranking), a signature per\n"
+    "shape and each shape's K nearest neighbours under the retrieval distance before\n"
+    "re-ranking (--rerank K, default the preset's 8), so that search, matrix and eval\n"
+    "take FILE wherever they take a collection with the same results, and one search\n"
+    "never recomputes the collection's matrix (with a fused --channel-weight below 1 the\n"
+    "query is scaled by the medians of the build). The file is versioned and\n"
+    "checksummed, and written under a temporary name then renamed.\n"
+    "\n"
+    "  -o, --output FILE       the index file\n"
+    "  --candidates M          neighbours are sought among each shape's M nearest by\n"
+    "                          signature only: for collections too\n"
+    "                          large for every pair (default 0: every pair)\n"
+    "  --add                   append the shapes of COLLECTION to the index FILE: only the\n"
+    "                          new shapes are prepared, and only pairs with a new shape\n"
+    "                          matched; the shape options must be the index's\n"
+    "A command given an index uses the index's shape options; an option that differs from\n"
+    "them is an error (rebuild the index); --rerank K[,ITER] and --no-rerank may differ\n"
+    "(K up to the neighbours stored). search --candidates M (default 64) matches\n"
+    "the M shapes whose signatures are nearest the query's (0: every shape).\n";
+
+static const tool_command COMMANDS[] = {
+    {"contour", C_CONTOUR, 1, "IMG [-o FILE]", "trace a silhouette's outer contour, or every contour (--all)", HELP_CONTOUR, 0,
+     cmd_contour},
+    {"register", C_REGISTER, 2, "SRC TGT", "register SRC onto TGT: affine map, distance, scales", HELP_REGISTER,
+     1, cmd_register},
+    {"search", C_SEARCH, 2, "QUERY COLLECTION", "the shapes of a collection closest to QUERY", HELP_SEARCH, 1,
+     cmd_search},
+    {"matrix", C_MATRIX, 1, "COLLECTION -o FILE", "all-pairs distance matrix (.tsv or .npy)", HELP_MATRIX, 1,
+     cmd_matrix},
+    {"eval", C_EVAL, 1, "COLLECTION", "retrieval scores: bull's eye, top-k table, 1-NN", HELP_EVAL, 1, cmd_eval},
+    {"index", C_INDEX, 1, "COLLECTION -o FILE", "prepare a collection once: an index file for search/matrix/eval",
+     HELP_INDEX, 1, cmd_index},
+};
+enum { NUM_COMMANDS = sizeof COMMANDS / sizeof COMMANDS[0] };
+
+const tool_command *command_find(const char *name)
+{
+    for (size_t i = 0; i < NUM_COMMANDS; i++)
+        if (strcmp(name, COMMANDS[i].name) == 0)
+            return &COMMANDS[i];
+    return NULL;
+}
+
+const char *command_list(char *buf, size_t cap)
+{
+    size_t len = 0;
+    buf[0] = '\0';
+    for (size_t i = 0; i < NUM_COMMANDS && len < cap; i++) {
+        const char *sep = i == 0 ? "" : i + 1 == NUM_COMMANDS ? " or " : ", ";
+        int w = snprintf(buf + len, cap - len, "%s%s", sep, COMMANDS[i].name);
+        if (w < 0)
+            break;
+        len += (size_t)w;
+    }
+    return buf;
+}
+
+void print_main_help(void)
+{
+    printf("usage: amscr COMMAND [options] ...\n"
+           "\n"
+           "Affine multi-scale curve registration (AMSCR) of 2-D shapes.\n"
+           "\n"
+           "commands:\n");
+    for (size_t i = 0; i < NUM_COMMANDS; i++) {
+        char usage[64];
+        snprintf(usage, sizeof usage, "%s %s", COMMANDS[i].name, COMMANDS[i].args);
+        printf("  %-32s  %s\n", usage, COMMANDS[i].summary);
+    }
+    printf("\n"
+           "  %-32s  print the library version\n"
+           "  %-32s  options of a command\n"
+           "\n"
+           "Shapes are PNG or PGM silhouettes (detected by their magic bytes) or text point\n"
+           "lists (one \"x y\" or \"x,y\" per line, '#' comments). A COLLECTION is a folder of\n"
+           "shapes, a manifest.tsv with 'file' and 'class' columns, or an index (amscr index).\n"
+           "Exit status: 0 success, 1 bad input or failure, 2 usage error.\n",
+           "amscr --version", "amscr COMMAND --help");
+}
+
+/* The retrieval options of search/matrix/eval, their defaults read from ret. */
+static void print_retrieval_options(const amscr_params *ret)
+{
+    printf("retrieval options (search/matrix/eval):\n"
+           "  --channel-weight W      share of the shape channel (height functions matched by\n"
+           "                          dynamic programming; tolerates articulation) against the\n"
+           "                          AMSCR distance, 0..1 (default %g: the channel alone;\n"
+           "                          0 with --open)\n"
+           "  --affine-share S        share of the channel computed in the affine (whitened)\n"
+           "                          frame, the rest in the similarity frame (default %g)\n"
+           "  --fast                  --affine-share 0: the channel in one frame, half the time\n"
+           "  --rerank K[,ITER]       contextual re-ranking: diffusion on the K-nearest-neighbour\n"
+           "                          graph, ITER iterations (default %u,%u; ITER default %d)\n"
+           "  --no-rerank             the fused pairwise distances\n"
+           "  --paper                 the paper's method: the AMSCR distance alone, affine group,\n"
+           "                          no refinement, no re-ranking (= --channel-weight 0\n"
+           "                          --no-rerank --invariance affine --refine 0)\n",
+           amscr_params_get_channel_weight(ret), amscr_params_get_channel_affine_share(ret),
+           amscr_params_get_rerank_k(ret), amscr_params_get_rerank_iterations(ret), TOOL_RERANK_ITERS);
+}
+
+/* The image and shape options, their defaults read from reg (register's params) and ret
+ * (search/matrix/eval's). */
+static void print_shape_options(const amscr_params *reg, const amscr_params *ret)
+{
+    char methods[200], params[200], invs[200];
+    const int none = -1; /* no "(default)" mark */
+    printf("image options:\n"
+           "  --threshold N|auto      pixels > N are 'on' (0..%d, default %d); auto = Otsu.\n"
+           "                          Polarity is automatic: the image border is background.\n"
+           "shape options:\n",
+           TOOL_THRESHOLD_MAX, TOOL_THRESHOLD_DEFAULT);
+    printf("  --method NAME           %s\n",
+           name_choices(&METHOD_NAMES, (int)amscr_params_get_method(reg), methods, sizeof methods));
+    printf("  --points N              samples per curve (default %zu for register, %zu otherwise)\n",
+           amscr_params_get_num_samples(reg), amscr_params_get_num_samples(ret));
+    printf("  --scales S1,S2,...      smoothing scales in samples (default: the library's)\n"
+           "  --reflections           also try mirror matches (default: %s for register,\n"
+           "  --no-reflections          %s for search, matrix and eval)\n"
+           "  --open                  open curves (default closed)\n",
+           amscr_params_get_reflections(reg) ? "on" : "off", amscr_params_get_reflections(ret) ? "on" : "off");
+    printf("  --refine N              refinement iterations in the aligned frame (0..%d; default:\n"
+           "                          %u for register, %u for search/matrix/eval; 0 is fastest)\n"
+           "  --kmax K                largest K of the elbow (1..%d)\n"
+           "  --symmetric             average the distance over both directions\n",
+           TOOL_REFINE_MAX, amscr_params_get_refine(reg), amscr_params_get_refine(ret), TOOL_KMAX_MAX);
+    printf("  --parametrization NAME  %s\n",
+           name_choices(&PARAM_NAMES, (int)amscr_params_get_parametrization(reg), params, sizeof params));
+    printf("  --invariance NAME       %s (default: %s for register,\n"
+           "                          %s for search/matrix/eval)\n",
+           name_choices(&INVARIANCE_NAMES, none, invs, sizeof invs),
+           name_of(&INVARIANCE_NAMES, (int)amscr_params_get_invariance(reg)),
+           name_of(&INVARIANCE_NAMES, (int)amscr_params_get_invariance(ret)));
+    printf("  --threads N             threads for batch work (0 = all cores, the default)\n");
+}
+
+int print_command_help(const tool_command *c)
+{
+    fputs(c->help, stdout);
+    if (!c->shape_options)
+        return TOOL_EXIT_OK;
+    amscr_params *reg = NULL, *ret = NULL;
+    int r = default_params(1, &reg);
+    if (r == 0)
+        r = default_params(0, &ret);
+    if (r == 0) {
+        fputs("\n", stdout);
+        print_shape_options(reg, ret);
+        if (c->bit & C_RETRIEVAL)
+            print_retrieval_options(ret);
+    }
+    amscr_params_free(reg);
+    amscr_params_free(ret);
+    return r;
+}

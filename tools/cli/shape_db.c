@@ -1,0 +1,73 @@
+/* shape_db.c — the collection steps that search, matrix and eval share (see shape_db.h). */
+#include "shape_db.h"
+
+#include <stdint.h>
+#include <stdlib.h>
+
+#include "image.h"
+
+/* Loads every shape of a collection into a new db (params p). */
+int load_db(const amscr_params *p, const collection *c, int threshold, amscr_db **out)
+{
+    amscr_db *db = NULL;
+    amscr_status st = amscr_db_new(p, &db);
+    if (st != AMSCR_OK) {
+        tool_lib_error(NULL, st);
+        return -1;
+    }
+    tool_progress pr;
+    progress_init(&pr, "preparing shapes");
+    for (size_t i = 0; i < c->n; i++) {
+        amscr_contour *ct = NULL;
+        if (shape_load(c->items[i].path, threshold, &ct) != 0) {
+            progress_end(&pr);
+            amscr_db_free(db);
+            return -1;
+        }
+        st = amscr_db_add_contour(db, ct, c->items[i].label, NULL);
+        amscr_contour_free(ct);
+        if (st != AMSCR_OK) {
+            progress_end(&pr);
+            const char *d = lib_detail();
+            if (st == AMSCR_E_DEGENERATE)
+                tool_error(c->items[i].path, "cannot use this shape: %s", d[0] ? d : "degenerate");
+            else
+                tool_lib_error(c->items[i].path, st);
+            amscr_db_free(db);
+            return -1;
+        }
+        progress_update(&pr, i + 1, c->n);
+    }
+    progress_end(&pr);
+    *out = db;
+    return 0;
+}
+
+int retrieval_is_plain(const amscr_params *p)
+{
+    return amscr_params_get_channel_weight(p) <= 0.0 && amscr_params_get_rerank_k(p) == 0;
+}
+
+int compute_matrix(const amscr_db *db, const char *what, double **out)
+{
+    size_t n = amscr_db_size(db);
+    if (n != 0 && n > SIZE_MAX / n / sizeof(double)) {
+        tool_error(what, "too many shapes for a matrix (%zu)", n);
+        return -1;
+    }
+    double *d = xmalloc_array(n * n, sizeof(double));
+    if (d == NULL)
+        return -1;
+    tool_progress pr;
+    progress_init(&pr, "matching");
+    amscr_status st = retrieval_is_plain(amscr_db_params(db)) ? amscr_db_distance_matrix(db, progress_cb, &pr, d)
+                                                              : amscr_db_retrieval_matrix(db, progress_cb, &pr, d);
+    progress_end(&pr);
+    if (st != AMSCR_OK) {
+        tool_lib_error(what, st);
+        free(d);
+        return -1;
+    }
+    *out = d;
+    return 0;
+}
