@@ -2109,6 +2109,235 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_save_memory(const amscr_db *db, 
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, size_t len, amscr_db **out);
 
+/**
+ * @brief One query's retrieval scores against a collection: exactly the query's row of
+ *        amscr_db_retrieval_matrix computed on the collection plus the query (the query last;
+ *        its collection columns), without the collection's matrix in memory when the channel
+ *        weight is 0 or 1: the collection's neighbour lists are built once for the call (as
+ *        amscr_index_build) and the query's re-ranked row is computed from them. With a channel
+ *        weight strictly between 0 and 1 the fusion's medians move with the query, and the call
+ *        computes the matrix of the collection plus the query. To query a collection many
+ *        times, build an amscr_index once instead.
+ * @param[in]  q  a shape prepared with params compatible with the collection's.
+ * @param[in]  progress, user  optional progress callback (may be NULL).
+ * @param[out] out_scores  n scores, lower is better (see amscr_db_retrieval_matrix).
+ * @param[in]  n  must equal amscr_db_size(db).
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, incompatible params, open curves with a
+ *         channel weight); AMSCR_E_CANCELLED; AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: const; runs on the db's threads.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_query_retrieval(const amscr_db *db, const amscr_descriptor *q,
+                                                                amscr_progress_fn progress, void *user,
+                                                                double *out_scores, size_t n);
+
+/* ============================================================================
+ * Retrieval index: a collection with what one-vs-many retrieval needs
+ * ============================================================================ */
+
+/** A retrieval index: a collection, each shape's nearest shapes under the retrieval matrix's
+ *  base distance, shape signatures, optional names (amscr_index_build). @since 0.4 */
+typedef struct amscr_index amscr_index;
+
+/**
+ * @brief Builds the index of a collection (its params say the retrieval: channel weight,
+ *        re-ranking k and iterations): a copy of the shapes, a signature per shape, and each
+ *        shape's K = min(rerank_k, n) nearest shapes under the base distance of
+ *        amscr_db_retrieval_matrix (the fused distance before re-ranking), with the fusion's
+ *        medians and the largest distance. candidates 0 computes the whole base matrix (the
+ *        lists are exact: a query then gives exactly amscr_db_query_retrieval's scores);
+ *        candidates M > 0 seeks each shape's neighbours among its M signature-nearest shapes
+ *        only (O(n M) distances, for large collections; at least K - 1; fused medians
+ *        estimated on 256 shapes). Runs on the params' threads; the result does not depend
+ *        on the thread count.
+ * @param[in]  db  the collection (copied; may be freed afterwards).
+ * @param[in]  candidates  0, or the shortlist size M.
+ * @param[in]  progress, user  optional progress callback (may be NULL).
+ * @param[out] out  the new index.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, open curves with a channel weight);
+ *         AMSCR_E_LIMIT (2^32 shapes or more); AMSCR_E_CANCELLED; AMSCR_E_NOMEM.
+ * Ownership: caller frees *out with amscr_index_free.
+ * Thread-safety: const on db.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_build(const amscr_db *db, size_t candidates,
+                                                         amscr_progress_fn progress, void *user, amscr_index **out);
+
+/**
+ * @brief Adds the shapes of a collection (labels kept, unnamed) to the index: each new shape's
+ *        list from its base distances to every shape (or to its M signature-nearest, for an
+ *        index built with candidates), and the older lists it enters; runs on the threads of
+ *        the index's params. With candidates 0 and a channel weight of 0 or 1 the result
+ *        equals a rebuild's; with a channel weight strictly between 0 and 1 the fusion keeps
+ *        the medians of the build.
+ * @param[in] shapes  prepared with exactly the index's params (threads aside).
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL; params that differ: the detail names the
+ *         option); AMSCR_E_STATE (the index holds fewer than min(rerank_k, n) neighbours a
+ *         shape: rebuild it); AMSCR_E_LIMIT; AMSCR_E_CANCELLED; AMSCR_E_NOMEM. After
+ *         AMSCR_E_CANCELLED or AMSCR_E_NOMEM the index holds the shapes but not all their
+ *         lists: free it.
+ * Ownership: none (shapes is copied).
+ * Thread-safety: exclusive on x.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes,
+                                                       amscr_progress_fn progress, void *user);
+
+/**
+ * @brief The query's retrieval scores against every shape of the index: the query's row of
+ *        amscr_db_retrieval_matrix on the collection plus the query, from the stored lists (the
+ *        query's K nearest entering them). candidates 0 (or >= n) matches the query with every
+ *        shape: with an index built with candidates 0 and a channel weight of 0 or 1 the scores
+ *        equal amscr_db_query_retrieval's (to rounding, ~1e-12); with a channel weight strictly
+ *        between 0 and 1 the fusion uses the build's medians. candidates M matches the query
+ *        with its M signature-nearest shapes only (at least K - 1); the others get +inf unless
+ *        the re-ranking reaches them.
+ * @param[in]  q  a shape prepared with params compatible with the index's.
+ * @param[out] out_scores  n scores, lower is better.
+ * @param[in]  n  must equal amscr_index_size(x).
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, incompatible params); AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: const; runs on the params' threads.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_query_scores(const amscr_index *x, const amscr_descriptor *q,
+                                                                size_t candidates, double *out_scores, size_t n);
+
+/**
+ * @brief The `top` best shapes of amscr_index_query_scores, best first (ties by index).
+ * @param[out] out_idx, out_scores  room for `top` entries each.
+ * @param[out] out_count  min(top, n) entries written.
+ * @return as amscr_index_query_scores.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_query(const amscr_index *x, const amscr_descriptor *q,
+                                                         size_t candidates, size_t top, size_t *out_idx,
+                                                         double *out_scores, size_t *out_count);
+
+/**
+ * @brief Row i of the collection's own retrieval matrix (amscr_db_retrieval_matrix of the
+ *        indexed collection; 0 for shape i itself): what a search with a member of the
+ *        collection as the query shows. candidates as amscr_index_query_scores.
+ * @param[out] out_scores  n scores.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, i >= n, n); AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t candidates,
+                                                                 double *out_scores, size_t n);
+
+/**
+ * @brief Shapes in the index (0 for NULL).
+ * Ownership: none. Thread-safety: const.
+ * @since 0.4
+ */
+AMSCR_API size_t amscr_index_size(const amscr_index *x);
+
+/**
+ * @brief The index's collection (its shapes, labels and params).
+ * @return borrowed; NULL for NULL. Valid until the index changes or is freed.
+ * Ownership: the index. Thread-safety: const.
+ * @since 0.4
+ */
+AMSCR_API const amscr_db *amscr_index_db(const amscr_index *x);
+
+/**
+ * @brief Label of shape i (0 for NULL or i out of range).
+ * Ownership: none. Thread-safety: const.
+ * @since 0.4
+ */
+AMSCR_API int32_t amscr_index_label(const amscr_index *x, size_t i);
+
+/**
+ * @brief Neighbours stored a shape: min(rerank_k, n) at the build (0 for NULL).
+ * Ownership: none. Thread-safety: const.
+ * @since 0.4
+ */
+AMSCR_API size_t amscr_index_neighbours(const amscr_index *x);
+
+/**
+ * @brief Sets (NULL: clears) the name of shape i, e.g. its file name; saved with the index.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL x, i out of range); AMSCR_E_NOMEM.
+ * Ownership: name is copied. Thread-safety: exclusive on x.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_set_name(amscr_index *x, size_t i, const char *name);
+
+/**
+ * @brief The name of shape i, or NULL (unnamed, NULL x, i out of range).
+ * Ownership: the index; valid until the name changes or the index is freed.
+ * Thread-safety: const.
+ * @since 0.4
+ */
+AMSCR_API const char *amscr_index_name(const amscr_index *x, size_t i);
+
+/**
+ * @brief Sets (NULL: clears) the name of class `label` (0..1000000); saved with the index.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_NOMEM.
+ * Ownership: name is copied. Thread-safety: exclusive on x.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_set_class_name(amscr_index *x, int32_t label, const char *name);
+
+/**
+ * @brief The name of class `label`, or NULL (unnamed, NULL x).
+ * Ownership: the index; valid until the name changes or the index is freed.
+ * Thread-safety: const.
+ * @since 0.4
+ */
+AMSCR_API const char *amscr_index_class_name(const amscr_index *x, int32_t label);
+
+/**
+ * @brief Writes the index (the collection file format, version 3: amscr_db_load of it gives the
+ *        collection) to a temporary name in the same folder and renames it.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.
+ * Ownership: none. Thread-safety: const.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_save(const amscr_index *x, const char *path);
+
+/**
+ * @brief Serializes the index (the amscr_index_save format) into a new buffer.
+ * @param[out] out_buf, out_len  the buffer and its size in bytes.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_NOMEM.
+ * Ownership: caller frees *out_buf with amscr_free. Thread-safety: const.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf,
+                                                               size_t *out_len);
+
+/**
+ * @brief Reads an index file. A collection file without an index (amscr_db_save) and the
+ *        index files of the tool before 0.4 are AMSCR_E_FORMAT with a detail saying to build
+ *        the index again.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_LIMIT; AMSCR_E_FORMAT (wrong
+ *         magic, version, checksum, truncated or inconsistent content); AMSCR_E_NOMEM.
+ * Ownership: caller frees *out with amscr_index_free.
+ * Thread-safety: reentrant.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load(const char *path, amscr_index **out);
+
+/**
+ * @brief Deserializes a buffer made by amscr_index_save_memory (or an index file's bytes).
+ * @return as amscr_index_load (no AMSCR_E_IO).
+ * Ownership: caller frees *out with amscr_index_free; buf is not kept.
+ * Thread-safety: reentrant.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out);
+
+/**
+ * @brief Frees an index. Accepts NULL.
+ * Ownership: x. Thread-safety: exclusive on x.
+ * @since 0.4
+ */
+AMSCR_API void amscr_index_free(amscr_index *x);
+
 /* ============================================================================
  * Retrieval: shape channel, scores, re-ranking
  * (pure functions on descriptors, distance matrices and labels)

@@ -56,4 +56,19 @@ amscr_status amscr__hf_of_descriptor(const amscr_params *p, amscr_invariance fra
 /* The channel's pair settings from p for N samples. */
 void amscr__hf_cfg_from(const amscr_params *p, size_t n, amscr__hf_cfg *cfg);
 
+/* The frames of the channel and their shares (fuse.c): the primary frame, plus the whitened
+ * frame with channel_affine_share when the primary one is the similarity frame. Returns the
+ * count (1 or 2); the channel distance is the shares' sum of the frames' distances. */
+int amscr__channel_frames(const amscr_params *p, amscr_invariance frames[2], double share[2]);
+/* The weights sa, sh of the fusion (fuse.c) for channel weight w and the medians. */
+void amscr__fuse_scales(double w, double med_a, double med_h, double *sa, double *sh);
+/* The base distance of one pair, as the fusion computes its cell: sym (the symmetrized AMSCR
+ * distance, lower index's direction first) alone for w <= 0, ch (the channel) alone for
+ * w >= 1, else sa sym + sh ch. */
+double amscr__fuse_pair(double w, double sa, double sh, double sym, double ch);
+/* The retrieval matrix before its re-ranking (the fused base matrix, n x n) into out_dist,
+ * and the fusion's medians into med[0] (AMSCR) and med[1] (channel), 0 when unused. */
+amscr_status amscr__base_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out_dist,
+                                double med[2]);
+
 #endif

@@ -66,7 +66,7 @@ amscr_status amscr__hf_of_descriptor(const amscr_params *p, amscr_invariance fra
 
 /* The frames of the channel and their shares: the primary frame, plus the whitened frame with
  * channel_affine_share when the primary one is the similarity frame. Returns the count. */
-static int channel_frames(const amscr_params *p, amscr_invariance frames[2], double share[2])
+int amscr__channel_frames(const amscr_params *p, amscr_invariance frames[2], double share[2])
 {
     frames[0] = frames[1] = AMSCR_INVARIANCE_AFFINE;
     share[0] = 1.0;
@@ -119,7 +119,7 @@ amscr_status amscr_channel_distance(const amscr_params *p, const amscr_descripto
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_channel_distance: N differs (%zu vs %zu)", a->n, b->n);
     amscr_invariance frames[2];
     double share[2], sum = 0.0;
-    int nf = channel_frames(p, frames, share);
+    int nf = amscr__channel_frames(p, frames, share);
     for (int f = 0; f < nf; f++) {
         double d = 0.0;
         amscr_status st = pair_in_frame(p, frames[f], a, b, &d);
@@ -185,7 +185,7 @@ static amscr_status channel_matrix(const amscr_db *db, amscr_progress_fn progres
         return amscr__fail(AMSCR_E_INVALID_ARG, "shape channel: needs closed curves (the collection is open)");
     amscr_invariance frames[2];
     double share[2];
-    int nf = channel_frames(p, frames, share);
+    int nf = amscr__channel_frames(p, frames, share);
     stage_progress sp = {progress, user, 0, (size_t)nf};
     amscr_status st = matrix_in_frame(db, frames[0], progress ? stage_cb : NULL, &sp, out);
     if (st != AMSCR_OK || nf == 1)
@@ -238,9 +238,26 @@ static amscr_status offdiag_median(const double *M, size_t n, double *out)
     return AMSCR_OK;
 }
 
-/* A = (1 - w) sym(A) / median(A) + w H / median(H), zero diagonal (A unused when w = 1). */
-static amscr_status fuse(double *A, const double *H, size_t n, double w)
+void amscr__fuse_scales(double w, double med_a, double med_h, double *sa, double *sh)
 {
+    *sa = med_a > 0.0 ? (1.0 - w) / med_a : 1.0 - w;
+    *sh = med_h > 0.0 ? w / med_h : w;
+}
+
+double amscr__fuse_pair(double w, double sa, double sh, double sym, double ch)
+{
+    if (w >= 1.0)
+        return ch;
+    if (w <= 0.0)
+        return sym;
+    return sa * sym + sh * ch;
+}
+
+/* A = (1 - w) sym(A) / median(A) + w H / median(H), zero diagonal (A unused when w = 1); the
+ * medians into med[0], med[1] (0 when unused). */
+static amscr_status fuse(double *A, const double *H, size_t n, double w, double med[2])
+{
+    med[0] = med[1] = 0.0;
     if (H && w >= 1.0) {
         memcpy(A, H, n * n * sizeof *A);
         return AMSCR_OK;
@@ -252,26 +269,25 @@ static amscr_status fuse(double *A, const double *H, size_t n, double w)
     }
     if (!H || n < 2)
         return AMSCR_OK;
-    double ma = 0.0, mh = 0.0;
-    amscr_status st = offdiag_median(A, n, &ma);
+    amscr_status st = offdiag_median(A, n, &med[0]);
     if (st == AMSCR_OK)
-        st = offdiag_median(H, n, &mh);
+        st = offdiag_median(H, n, &med[1]);
     if (st != AMSCR_OK)
         return st;
-    double sa = ma > 0.0 ? (1.0 - w) / ma : 1.0 - w, sh = mh > 0.0 ? w / mh : w;
+    double sa, sh;
+    amscr__fuse_scales(w, med[0], med[1], &sa, &sh);
     for (size_t i = 0; i < n * n; i++)
         A[i] = sa * A[i] + sh * H[i];
     return AMSCR_OK;
 }
 
-amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out_dist)
+amscr_status amscr__base_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out_dist,
+                                double med[2])
 {
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(db);
-    AMSCR_CHECK_NULL(out_dist);
     const amscr_params *p = amscr_db_params(db);
     size_t n = amscr_db_size(db);
     int with_channel = p->channel_weight > 0.0;
+    med[0] = med[1] = 0.0;
     if (with_channel && !p->closed)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_db_retrieval_matrix: the shape channel needs closed curves; "
                                                 "set the channel weight to 0 for open ones");
@@ -293,9 +309,21 @@ amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn pro
             st = channel_matrix(db, progress ? stage_cb : NULL, &sp, H);
     }
     if (st == AMSCR_OK)
-        st = fuse(out_dist, H, n, p->channel_weight);
+        st = fuse(out_dist, H, n, p->channel_weight, med);
     free(H);
-    if (st == AMSCR_OK && p->rerank_k > 0)
+    return st;
+}
+
+amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out_dist)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(db);
+    AMSCR_CHECK_NULL(out_dist);
+    const amscr_params *p = amscr_db_params(db);
+    size_t n = amscr_db_size(db);
+    double med[2];
+    amscr_status st = amscr__base_matrix(db, progress, user, out_dist, med);
+    if (st == AMSCR_OK && n > 0 && p->rerank_k > 0)
         st = amscr__rerank_normalized(out_dist, n, p->rerank_k < n ? p->rerank_k : n, p->rerank_iterations, out_dist);
     if (st != AMSCR_OK)
         for (size_t i = 0; i < n * n; i++)

@@ -1,0 +1,151 @@
+/* bytes.c — little-endian writing and bounds-checked reading (bytes.h). */
+#include "bytes.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void amscr__w_bytes(amscr__wbuf *w, const void *p, size_t n)
+{
+    if (w->oom || n == 0)
+        return;
+    if (n > SIZE_MAX / 2 - w->len) {
+        w->oom = 1;
+        return;
+    }
+    if (w->len + n > w->cap) {
+        size_t cap = w->cap ? w->cap : 4096;
+        while (cap < w->len + n)
+            cap *= 2;
+        unsigned char *nb = realloc(w->buf, cap);
+        if (!nb) {
+            w->oom = 1;
+            return;
+        }
+        w->buf = nb;
+        w->cap = cap;
+    }
+    memcpy(w->buf + w->len, p, n);
+    w->len += n;
+}
+
+void amscr__w_u64(amscr__wbuf *w, uint64_t v)
+{
+    unsigned char b[8];
+    for (int i = 0; i < 8; i++)
+        b[i] = (unsigned char)(v >> (8 * i));
+    amscr__w_bytes(w, b, 8);
+}
+
+void amscr__w_u32(amscr__wbuf *w, uint32_t v)
+{
+    unsigned char b[4];
+    for (int i = 0; i < 4; i++)
+        b[i] = (unsigned char)(v >> (8 * i));
+    amscr__w_bytes(w, b, 4);
+}
+
+void amscr__w_f64(amscr__wbuf *w, double d)
+{
+    uint64_t v;
+    memcpy(&v, &d, 8);
+    amscr__w_u64(w, v);
+}
+
+void amscr__w_f64s(amscr__wbuf *w, const double *d, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        amscr__w_f64(w, d[i]);
+}
+
+void amscr__w_str(amscr__wbuf *w, const char *s)
+{
+    if (!s) {
+        amscr__w_u32(w, 0xffffffffu);
+        return;
+    }
+    size_t n = strlen(s);
+    if (n >= 0xffffffffu) {
+        w->oom = 1;
+        return;
+    }
+    amscr__w_u32(w, (uint32_t)n);
+    amscr__w_bytes(w, s, n);
+}
+
+uint64_t amscr__r_u64(amscr__rbuf *r)
+{
+    if (r->bad || r->len - r->pos < 8) {
+        r->bad = 1;
+        return 0;
+    }
+    uint64_t v = 0;
+    for (int i = 0; i < 8; i++)
+        v |= (uint64_t)r->p[r->pos + i] << (8 * i);
+    r->pos += 8;
+    return v;
+}
+
+uint32_t amscr__r_u32(amscr__rbuf *r)
+{
+    if (r->bad || r->len - r->pos < 4) {
+        r->bad = 1;
+        return 0;
+    }
+    uint32_t v = 0;
+    for (int i = 0; i < 4; i++)
+        v |= (uint32_t)r->p[r->pos + i] << (8 * i);
+    r->pos += 4;
+    return v;
+}
+
+double amscr__r_f64(amscr__rbuf *r)
+{
+    uint64_t v = amscr__r_u64(r);
+    double d;
+    memcpy(&d, &v, 8);
+    return d;
+}
+
+int amscr__r_f64s(amscr__rbuf *r, double *d, size_t n)
+{
+    for (size_t i = 0; i < n && !r->bad; i++) {
+        d[i] = amscr__r_f64(r);
+        if (d[i] != d[i] || d[i] - d[i] != 0.0) /* NaN or infinite */
+            r->bad = 1;
+    }
+    return !r->bad;
+}
+
+int amscr__r_str(amscr__rbuf *r, char **out, int *oom)
+{
+    uint32_t n = amscr__r_u32(r);
+    *out = NULL;
+    if (r->bad)
+        return 0;
+    if (n == 0xffffffffu)
+        return 1;
+    if (r->len - r->pos < n || memchr(r->p + r->pos, 0, n) != NULL) {
+        r->bad = 1;
+        return 0;
+    }
+    char *s = malloc((size_t)n + 1);
+    if (!s) {
+        *oom = 1;
+        return 0;
+    }
+    memcpy(s, r->p + r->pos, n);
+    s[n] = '\0';
+    r->pos += n;
+    *out = s;
+    return 1;
+}
+
+uint64_t amscr__fnv1a(const unsigned char *p, size_t n)
+{
+    uint64_t h = 1469598103934665603ull;
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}

@@ -1,0 +1,339 @@
+/* db_io.c — the collection file, little-endian whatever the host.
+ * Header: "AMSCRDB\0", u32 version, u32 reserved, params, (version >= 2) the retrieval
+ * settings (retrieval_io.c), u64 count, u64 N, u64 p; per shape: i32 label, f64 fwd[6],
+ * f64 inv[6], f64 input[2N], base[2N], scaled[2Np]; (version 3) u64 length and the index
+ * section (index_io.c); trailer: u64 FNV-1a of everything before it. The shape channel is
+ * derived from the prepared shapes on demand and is not stored. */
+#include "db_io.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static void w_params(amscr__wbuf *w, const amscr_params *p)
+{
+    amscr__w_u64(w, p->num_samples);
+    amscr__w_u64(w, p->num_scales);
+    amscr__w_f64s(w, p->scales, p->num_scales);
+    amscr__w_u32(w, (uint32_t)p->method);
+    amscr__w_u32(w, (uint32_t)p->closed);
+    amscr__w_u32(w, (uint32_t)p->reflections);
+    amscr__w_u32(w, (uint32_t)p->parametrization);
+    amscr__w_f64(w, p->presmooth);
+    amscr__w_u32(w, p->arclength_passes);
+    amscr__w_u32(w, p->oversampling);
+    amscr__w_u32(w, p->kmax);
+    amscr__w_u32(w, (uint32_t)p->symmetric);
+    amscr__w_u32(w, p->refine);
+    amscr__w_u32(w, p->num_threads);
+    amscr__w_u32(w, (uint32_t)p->invariance);
+    amscr__w_f64(w, p->penalty);
+}
+
+void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
+{
+    const amscr_params *prm = amscr_db_params(db);
+    amscr__w_bytes(w, AMSCR__DB_MAGIC, 8);
+    amscr__w_u32(w, version);
+    amscr__w_u32(w, 0);
+    w_params(w, prm);
+    unsigned char rblock[AMSCR__RETRIEVAL_BLOCK];
+    amscr__retrieval_block_write(prm, rblock);
+    amscr__w_bytes(w, rblock, sizeof rblock);
+    size_t N = prm->num_samples, p = prm->num_scales, n = amscr_db_size(db);
+    amscr__w_u64(w, n);
+    amscr__w_u64(w, N);
+    amscr__w_u64(w, p);
+    for (size_t i = 0; i < n; i++) {
+        const amscr_descriptor *d = amscr_db_descriptor(db, i);
+        amscr__w_u32(w, (uint32_t)amscr_db_label(db, i));
+        amscr__w_f64s(w, d->fwd, 6);
+        amscr__w_f64s(w, d->inv, 6);
+        amscr__w_f64s(w, d->input, 2 * N);
+        amscr__w_f64s(w, d->base, 2 * N);
+        amscr__w_f64s(w, d->scaled, 2 * N * p);
+    }
+}
+
+amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *out_len)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(db);
+    AMSCR_CHECK_NULL(out_buf);
+    AMSCR_CHECK_NULL(out_len);
+    amscr__wbuf w = {NULL, 0, 0, 0};
+    amscr__db_write(db, AMSCR__DB_VERSION_PLAIN, &w);
+    if (!w.oom)
+        amscr__w_u64(&w, amscr__fnv1a(w.buf, w.len));
+    if (w.oom) {
+        free(w.buf);
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_db_save: out of memory");
+    }
+    *out_buf = w.buf;
+    *out_len = w.len;
+    return AMSCR_OK;
+}
+
+amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t len)
+{
+    size_t plen = strlen(path);
+    char *tmp = malloc(plen + 16);
+    if (!tmp)
+        return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", path);
+    memcpy(tmp, path, plen);
+    memcpy(tmp + plen, ".tmp.XXXXXX", 12);
+    amscr_status st = AMSCR_OK;
+    int fd = mkstemp(tmp);
+    if (fd < 0) {
+        st = amscr__fail(AMSCR_E_IO, "%s: cannot create a temporary file: %s", path, strerror(errno));
+    } else {
+        FILE *f = fdopen(fd, "wb");
+        int ok = f && fwrite(buf, 1, len, f) == len;
+        if (f)
+            ok = (fclose(f) == 0) && ok;
+        else
+            close(fd);
+        if (!ok || rename(tmp, path) != 0) {
+            st = amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, strerror(errno));
+            remove(tmp);
+        }
+    }
+    free(tmp);
+    return st;
+}
+
+amscr_status amscr_db_save(const amscr_db *db, const char *path)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(db);
+    AMSCR_CHECK_NULL(path);
+    void *buf = NULL;
+    size_t len = 0;
+    amscr_status st = amscr_db_save_memory(db, &buf, &len);
+    if (st == AMSCR_OK)
+        st = amscr__file_write_atomic(path, buf, len);
+    free(buf);
+    return st;
+}
+
+/* The params of the header (after magic and version) validated through the setters' rules. */
+static amscr_status r_params(amscr__rbuf *r, uint32_t version, amscr_params *prm)
+{
+    amscr__params_defaults(prm);
+    uint64_t N = amscr__r_u64(r), p = amscr__r_u64(r);
+    if (r->bad || N < 16 || N > AMSCR_MAX_SAMPLES || p < 1 || p > AMSCR_MAX_SCALES)
+        return amscr__fail(AMSCR_E_FORMAT, "collection header: bad N or scale count");
+    prm->num_samples = (size_t)N;
+    prm->num_scales = (size_t)p;
+    if (!amscr__r_f64s(r, prm->scales, (size_t)p))
+        return amscr__fail(AMSCR_E_FORMAT, "collection header: bad scales");
+    for (size_t k = 0; k < (size_t)p; k++)
+        if (!(prm->scales[k] >= 0.0 && prm->scales[k] <= (double)N))
+            return amscr__fail(AMSCR_E_FORMAT, "collection header: scale %g is outside 0..N", prm->scales[k]);
+    amscr_params q = *prm, chk;
+    q.method = (amscr_method)amscr__r_u32(r);
+    q.closed = (int)amscr__r_u32(r);
+    q.reflections = (int)amscr__r_u32(r);
+    q.parametrization = (amscr_parametrization)amscr__r_u32(r);
+    q.presmooth = amscr__r_f64(r);
+    q.arclength_passes = amscr__r_u32(r);
+    q.oversampling = amscr__r_u32(r);
+    q.kmax = amscr__r_u32(r);
+    q.symmetric = (int)amscr__r_u32(r);
+    q.refine = amscr__r_u32(r);
+    q.num_threads = amscr__r_u32(r);
+    q.invariance = (amscr_invariance)amscr__r_u32(r);
+    q.penalty = amscr__r_f64(r);
+    amscr__params_defaults(&chk);
+    if (r->bad || amscr_params_set_method(&chk, q.method) || amscr_params_set_closed(&chk, q.closed) ||
+        amscr_params_set_reflections(&chk, q.reflections) ||
+        amscr_params_set_parametrization(&chk, q.parametrization) || amscr_params_set_presmooth(&chk, q.presmooth) ||
+        amscr_params_set_arclength_passes(&chk, q.arclength_passes) ||
+        amscr_params_set_oversampling(&chk, q.oversampling) || amscr_params_set_kmax(&chk, q.kmax) ||
+        amscr_params_set_symmetric(&chk, q.symmetric) || amscr_params_set_refine(&chk, q.refine) ||
+        amscr_params_set_num_threads(&chk, q.num_threads) || amscr_params_set_invariance(&chk, q.invariance) ||
+        amscr_params_set_penalty(&chk, q.penalty))
+        return amscr__fail(AMSCR_E_FORMAT, "collection header: invalid parameters");
+    amscr__clear_error();
+    if (version >= 2) {
+        if (r->bad || r->len - r->pos < AMSCR__RETRIEVAL_BLOCK ||
+            amscr__retrieval_block_read(r->p + r->pos, &q) != AMSCR_OK)
+            return amscr__fail(AMSCR_E_FORMAT, "collection header: invalid retrieval settings");
+        r->pos += AMSCR__RETRIEVAL_BLOCK;
+    }
+    *prm = q;
+    return AMSCR_OK;
+}
+
+/* The count shapes into db (params prm). */
+static amscr_status r_shapes(amscr__rbuf *r, const amscr_params *prm, uint64_t count, amscr_db *db)
+{
+    size_t N = prm->num_samples, p = prm->num_scales;
+    amscr_status st = AMSCR_OK;
+    for (uint64_t i = 0; i < count && st == AMSCR_OK; i++) {
+        int32_t label = (int32_t)amscr__r_u32(r);
+        amscr_descriptor *d = NULL;
+        st = amscr__descriptor_alloc(N, p, &d);
+        if (st != AMSCR_OK)
+            break;
+        d->params = *prm;
+        if (!amscr__r_f64s(r, d->fwd, 6) || !amscr__r_f64s(r, d->inv, 6) || !amscr__r_f64s(r, d->input, 2 * N) ||
+            !amscr__r_f64s(r, d->base, 2 * N) || !amscr__r_f64s(r, d->scaled, 2 * N * p))
+            st = amscr__fail(AMSCR_E_FORMAT, "collection: shape %llu is truncated or has non-finite values",
+                             (unsigned long long)i);
+        if (st == AMSCR_OK && amscr__descriptor_finish(d) != AMSCR_OK)
+            st = amscr__fail(AMSCR_E_FORMAT, "collection: shape %llu is degenerate", (unsigned long long)i);
+        if (st == AMSCR_OK)
+            st = amscr__db_push(db, d, label, NULL);
+        if (st != AMSCR_OK)
+            amscr_descriptor_free(d);
+    }
+    return st;
+}
+
+/* Magic, version and checksum of buf into *version. */
+static amscr_status check_envelope(const unsigned char *buf, size_t len, uint32_t *version)
+{
+    if (len >= 8 && memcmp(buf, "AMSCRIDX", 8) == 0)
+        return amscr__fail(AMSCR_E_FORMAT, "an index file of the amscr tool before 0.4 (format AMSCRIDX): "
+                                           "rebuild it with `amscr index`");
+    if (len < 8 + 8 + 8 || memcmp(buf, AMSCR__DB_MAGIC, 8) != 0)
+        return amscr__fail(AMSCR_E_FORMAT, "not an amscr collection (bad magic)");
+    amscr__rbuf r = {buf, len, 8, 0}, t = {buf, len, len - 8, 0};
+    *version = amscr__r_u32(&r);
+    if (*version > AMSCR__DB_VERSION_INDEX)
+        return amscr__fail(AMSCR_E_FORMAT, "collection format version %u is newer than this library's (%u)",
+                           (unsigned)*version, AMSCR__DB_VERSION_INDEX);
+    if (*version == 0)
+        return amscr__fail(AMSCR_E_FORMAT, "collection format version 0 is invalid");
+    if (amscr__fnv1a(buf, len - 8) != amscr__r_u64(&t))
+        return amscr__fail(AMSCR_E_FORMAT, "collection checksum mismatch (corrupt or truncated file)");
+    return AMSCR_OK;
+}
+
+amscr_status amscr__db_parse(const unsigned char *buf, size_t len, amscr_db **out, size_t *out_pos,
+                             uint32_t *out_version)
+{
+    uint32_t version = 0;
+    amscr_status st = check_envelope(buf, len, &version);
+    if (st != AMSCR_OK)
+        return st;
+    amscr__rbuf r = {buf, len - 8, 16, 0}; /* the trailer is not content */
+    amscr_params prm;
+    st = r_params(&r, version, &prm);
+    if (st != AMSCR_OK)
+        return st;
+    uint64_t count = amscr__r_u64(&r), N = amscr__r_u64(&r), p = amscr__r_u64(&r);
+    if (r.bad || N != prm.num_samples || p != prm.num_scales)
+        return amscr__fail(AMSCR_E_FORMAT, "collection header: inconsistent sizes");
+    uint64_t per = 4 + 8 * (12 + 4 * N + 2 * N * p);
+    if (count > (r.len - r.pos) / per)
+        return amscr__fail(AMSCR_E_FORMAT, "collection: %llu shapes announced, the file is too short",
+                           (unsigned long long)count);
+    amscr_db *db = NULL;
+    st = amscr_db_new(&prm, &db);
+    if (st == AMSCR_OK)
+        st = r_shapes(&r, &prm, count, db);
+    if (st != AMSCR_OK) {
+        amscr_db_free(db);
+        return st;
+    }
+    *out = db;
+    *out_pos = r.pos;
+    *out_version = version;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_db_load_memory(const void *buf, size_t len, amscr_db **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(buf);
+    AMSCR_CHECK_NULL(out);
+    amscr_db *db = NULL;
+    size_t pos = 0;
+    uint32_t version = 0;
+    amscr_status st = amscr__db_parse(buf, len, &db, &pos, &version);
+    if (st != AMSCR_OK)
+        return st;
+    if (version >= AMSCR__DB_VERSION_INDEX) { /* an index file: its collection, the section skipped */
+        amscr__rbuf r = {buf, len - 8, pos, 0};
+        uint64_t sec = amscr__r_u64(&r);
+        if (r.bad || sec != r.len - r.pos)
+            st = amscr__fail(AMSCR_E_FORMAT, "index file: bad index section length");
+        else
+            pos = r.len;
+    }
+    if (st == AMSCR_OK && pos != len - 8)
+        st = amscr__fail(AMSCR_E_FORMAT, "collection: %zu unexpected trailing bytes", len - 8 - pos);
+    if (st != AMSCR_OK) {
+        amscr_db_free(db);
+        return st;
+    }
+    *out = db;
+    return AMSCR_OK;
+}
+
+amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out_len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return amscr__fail(AMSCR_E_IO, "%s: %s", path, strerror(errno));
+    size_t cap = 1 << 16, len = 0;
+    unsigned char *buf = malloc(cap);
+    amscr_status st = AMSCR_OK;
+    while (buf) {
+        if (len == cap) {
+            if (cap > ((size_t)1 << 40)) {
+                st = amscr__fail(AMSCR_E_LIMIT, "%s: file too large", path);
+                break;
+            }
+            unsigned char *nb = realloc(buf, 2 * cap);
+            if (!nb) {
+                free(buf);
+                buf = NULL;
+                break;
+            }
+            buf = nb;
+            cap *= 2;
+        }
+        size_t got = fread(buf + len, 1, cap - len, f);
+        len += got;
+        if (got == 0)
+            break;
+    }
+    int err = ferror(f);
+    fclose(f);
+    if (!buf)
+        return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", path);
+    if (st == AMSCR_OK && err)
+        st = amscr__fail(AMSCR_E_IO, "%s: read error", path);
+    if (st != AMSCR_OK) {
+        free(buf);
+        return st;
+    }
+    *out = buf;
+    *out_len = len;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_db_load(const char *path, amscr_db **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(path);
+    AMSCR_CHECK_NULL(out);
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    amscr_status st = amscr__file_read(path, &buf, &len);
+    if (st != AMSCR_OK)
+        return st;
+    st = amscr_db_load_memory(buf, len, out);
+    if (st != AMSCR_OK) {
+        char d[400];
+        snprintf(d, sizeof d, "%s", amscr_last_error_detail());
+        amscr__fail(st, "%s: %s", path, d);
+    }
+    free(buf);
+    return st;
+}

@@ -1,0 +1,31 @@
+/* db_io.h — the collection file (db_io.c), shared by amscr_db_save/load and the index file,
+ * which is a collection file of version 3 with an index section after its shapes. Never
+ * installed. */
+#ifndef AMSCR_DB_IO_H
+#define AMSCR_DB_IO_H
+
+#include "bytes.h"
+#include "internal.h"
+
+#define AMSCR__DB_MAGIC "AMSCRDB"
+/* 1 (0.1); 2 (0.2): the retrieval settings follow the params; 3 (0.4): an index section
+ * (u64 length, then index_io.c's bytes) follows the shapes. Every version loads. */
+#define AMSCR__DB_VERSION_PLAIN 2u
+#define AMSCR__DB_VERSION_INDEX 3u
+
+/* Appends db.c's row (db_push) to a collection. */
+amscr_status amscr__db_push(amscr_db *db, amscr_descriptor *d, int32_t label, size_t *out_index);
+
+/* Writes the collection part of a file of `version`: magic, version, params, retrieval
+ * settings, the shapes (no section, no checksum). */
+void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w);
+/* Checks the magic, version and trailing checksum of buf and parses its collection part:
+ * *out (caller frees) and *out_pos just after the shapes, *out_version. */
+amscr_status amscr__db_parse(const unsigned char *buf, size_t len, amscr_db **out, size_t *out_pos,
+                             uint32_t *out_version);
+/* buf written to path through a temporary name and a rename. */
+amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t len);
+/* The whole file at path (caller frees *out). */
+amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out_len);
+
+#endif

@@ -1,0 +1,141 @@
+/* index.c — the retrieval index object: allocation, the per-shape arrays, names, getters. */
+#include "index.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+amscr_status amscr__index_reserve(amscr_index *x, size_t n)
+{
+    if (n <= x->cap)
+        return AMSCR_OK;
+    size_t cap = x->cap ? x->cap : 64, k = x->k ? x->k : 1;
+    while (cap < n)
+        cap *= 2;
+    double *sig = x->sig_dim && cap > SIZE_MAX / x->sig_dim / sizeof(double) ? NULL
+                                                                          : realloc(x->sig, cap * x->sig_dim * sizeof *sig);
+    if (sig)
+        x->sig = sig;
+    uint32_t *ni = cap > SIZE_MAX / k / sizeof *ni ? NULL : realloc(x->nb_idx, cap * k * sizeof *ni);
+    if (ni)
+        x->nb_idx = ni;
+    double *nd = cap > SIZE_MAX / k / sizeof *nd ? NULL : realloc(x->nb_dist, cap * k * sizeof *nd);
+    if (nd)
+        x->nb_dist = nd;
+    char **nm = realloc(x->names, cap * sizeof *nm);
+    if (nm) {
+        x->names = nm;
+        for (size_t i = x->cap; i < cap; i++)
+            nm[i] = NULL;
+    }
+    if (!sig || !ni || !nd || !nm)
+        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory for %zu shapes", n);
+    x->cap = cap;
+    return AMSCR_OK;
+}
+
+amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
+{
+    amscr_index *x = calloc(1, sizeof *x);
+    if (!x)
+        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    const amscr_params *p = amscr_db_params(db);
+    size_t n = amscr_db_size(db);
+    x->sig_dim = AMSCR__SIG_DIM;
+    x->k = p->rerank_k < n ? p->rerank_k : n;
+    amscr_status st = amscr_db_new(p, &x->db);
+    for (size_t i = 0; st == AMSCR_OK && i < n; i++)
+        st = amscr_db_add_descriptor(x->db, amscr_db_descriptor(db, i), amscr_db_label(db, i), NULL);
+    if (st == AMSCR_OK)
+        st = amscr__index_reserve(x, n);
+    if (st != AMSCR_OK) {
+        amscr_index_free(x);
+        return st;
+    }
+    *out = x;
+    return AMSCR_OK;
+}
+
+void amscr_index_free(amscr_index *x)
+{
+    if (!x)
+        return;
+    for (size_t i = 0; x->names && i < x->cap; i++)
+        free(x->names[i]);
+    for (size_t c = 0; c < x->nclasses; c++)
+        free(x->classes[c]);
+    free(x->names);
+    free(x->classes);
+    free(x->sig);
+    free(x->nb_idx);
+    free(x->nb_dist);
+    amscr_db_free(x->db);
+    free(x);
+}
+
+size_t amscr_index_size(const amscr_index *x) { return x ? amscr_db_size(x->db) : 0; }
+const amscr_db *amscr_index_db(const amscr_index *x) { return x ? x->db : NULL; }
+int32_t amscr_index_label(const amscr_index *x, size_t i) { return x ? amscr_db_label(x->db, i) : 0; }
+size_t amscr_index_neighbours(const amscr_index *x) { return x ? x->k : 0; }
+
+const char *amscr_index_name(const amscr_index *x, size_t i)
+{
+    return (x && i < amscr_db_size(x->db)) ? x->names[i] : NULL;
+}
+
+const char *amscr_index_class_name(const amscr_index *x, int32_t label)
+{
+    return (x && label >= 0 && (size_t)label < x->nclasses) ? x->classes[label] : NULL;
+}
+
+/* A copy of s (NULL for NULL) into *out; 0 when out of memory. */
+static int dup_str(const char *s, char **out)
+{
+    *out = NULL;
+    if (!s)
+        return 1;
+    size_t n = strlen(s);
+    *out = malloc(n + 1);
+    if (*out)
+        memcpy(*out, s, n + 1);
+    return *out != NULL;
+}
+
+amscr_status amscr_index_set_name(amscr_index *x, size_t i, const char *name)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    if (i >= amscr_db_size(x->db))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_set_name: shape %zu of %zu", i, amscr_db_size(x->db));
+    char *s = NULL;
+    if (!dup_str(name, &s))
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_index_set_name: out of memory");
+    free(x->names[i]);
+    x->names[i] = s;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_index_set_class_name(amscr_index *x, int32_t label, const char *name)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    if (label < 0 || label > 1000000)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_set_class_name: label %d is outside 0..1000000",
+                           (int)label);
+    char *s = NULL;
+    if (!dup_str(name, &s))
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_index_set_class_name: out of memory");
+    if ((size_t)label >= x->nclasses) {
+        char **c = realloc(x->classes, ((size_t)label + 1) * sizeof *c);
+        if (!c) {
+            free(s);
+            return amscr__fail(AMSCR_E_NOMEM, "amscr_index_set_class_name: out of memory");
+        }
+        for (size_t t = x->nclasses; t <= (size_t)label; t++)
+            c[t] = NULL;
+        x->classes = c;
+        x->nclasses = (size_t)label + 1;
+    }
+    free(x->classes[label]);
+    x->classes[label] = s;
+    return AMSCR_OK;
+}

@@ -1,0 +1,86 @@
+/* index.h — internals of the retrieval index (index*.c): a collection with what one-vs-many
+ * retrieval needs, so that a query never recomputes the collection's matrix (docs/method.md
+ * §10). Never installed. */
+#ifndef AMSCR_INDEX_H
+#define AMSCR_INDEX_H
+
+#include "channel.h"
+#include "internal.h"
+#include "signature.h"
+
+struct amscr_index {
+    amscr_db *db;         /* the collection (owned) */
+    size_t k;             /* neighbours a shape: min(rerank_k, n); 0 without re-ranking */
+    size_t candidates;    /* the build's shortlist M (0: every shape, exact lists) */
+    double dmax;          /* largest base distance of the collection */
+    double med_a, med_h;  /* the fusion's medians (0 < channel weight < 1; else 0) */
+    size_t sig_dim;       /* AMSCR__SIG_DIM */
+    double *sig;          /* n x sig_dim */
+    uint32_t *nb_idx;     /* n x k: itself first, then by (base distance, index) */
+    double *nb_dist;      /* n x k */
+    char **names;         /* n entries (NULL: unnamed) */
+    char **classes;       /* class name of label L (0 <= L < nclasses; NULL: unnamed) */
+    size_t nclasses;
+    size_t cap;           /* allocated rows of sig, nb_*, names */
+};
+
+/* How the base distance of the retrieval matrix (fuse.c) is computed pair by pair. */
+typedef struct {
+    const amscr_params *p;
+    double w, sa, sh;            /* channel weight and the fusion's weights */
+    int nf;                      /* frames of the channel (0: no channel) */
+    amscr_invariance frames[2];
+    double share[2];
+    unsigned threads;
+} amscr__base;
+
+/* Per-thread scratch of the pair distance. */
+typedef struct {
+    amscr_workspace *ws;
+    amscr__hf_cfg cfg;
+    amscr__hf_ws hws;
+    int have_hws;
+} amscr__pair_ws;
+
+void amscr__base_init(amscr__base *b, const amscr_params *p, double med_a, double med_h);
+amscr_status amscr__pair_ws_init(const amscr__base *b, amscr__pair_ws *pw);
+void amscr__pair_ws_free(amscr__pair_ws *pw);
+/* The channel sequences of d in b's frames (hf[0..nf-1]); free with amscr__base_hf_free. */
+amscr_status amscr__base_hf(const amscr__base *b, const amscr_descriptor *d, amscr__hf hf[2]);
+void amscr__base_hf_free(const amscr__base *b, amscr__hf hf[2]);
+/* out[t] = base distance of shape cand[t] of db and q (sequences hq), on this thread. */
+amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const amscr_descriptor *q,
+                               const amscr__hf hq[2], size_t qpos, const size_t *cand, size_t m, amscr__pair_ws *pw,
+                               double *out);
+
+/* out[t] = base distance of shape cand[t] of db and q, computed as the matrix cell of the two
+ * (the lower index first; q counts as index qpos, SIZE_MAX = after every shape), on b->threads
+ * threads. progress (may be NULL) counts pairs. */
+amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const amscr_descriptor *q, size_t qpos,
+                             const size_t *cand, size_t m, amscr_progress_fn progress, void *user, double *out);
+
+/* Row i's k nearest (itself first, then by (distance, index)) among m candidates cj[t] with
+ * distances cd[t] (i may be among them; k <= m + 1). */
+amscr_status amscr__knn_select(size_t i, const size_t *cj, const double *cd, size_t m, size_t k, uint32_t *out_idx,
+                               double *out_dist);
+
+/* Grows the per-shape arrays to hold n rows. */
+amscr_status amscr__index_reserve(amscr_index *x, size_t n);
+/* An empty index of a copy of db (no lists yet). */
+amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out);
+/* The n x m-1 candidates of shape-like q: every shape (m = 0 or >= n) or the m whose
+ * signatures are nearest sig (exclude: an index to leave out or SIZE_MAX), ascending. */
+size_t amscr__index_shortlist(const amscr_index *x, const double *sig, size_t m, size_t exclude, size_t *cand);
+
+/* The scores (n entries) of row `self` (n: a query; < n: that shape of the index) against every
+ * shape from its base distances dq[t] to the m candidates cand[t] (ascending): the row of the
+ * retrieval matrix of the collection plus the query, or of the collection. */
+amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t *cand, const double *dq, size_t m,
+                                 double *out);
+/* Rows first..n-1 from their M signature-nearest shapes (index_build.c); x->dmax grows. */
+amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_progress_fn progress, void *user);
+/* db can be indexed (closed curves for the channel, at most 2^32 - 1 shapes). */
+amscr_status amscr__index_check_db(const amscr_db *db, const char *what);
+
+
+#endif

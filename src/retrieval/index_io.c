@@ -1,0 +1,214 @@
+/* index_io.c — the index file: a collection file (db_io.c) of version 3 whose index section
+ * follows the shapes, so amscr_db_load of an index file gives its collection. Little-endian:
+ *   u64 section length (the bytes up to the trailing checksum), then
+ *   u32 sig_dim, u32 0, u64 k, u64 candidates (0: full lists), f64 dmax, f64 median AMSCR,
+ *   f64 median channel, n x sig_dim f64 signatures, n x k x (u32 neighbour, f64 distance)
+ *   (each row: itself first, then by distance), n names, u64 nclasses, nclasses class names
+ *   (string: u32 length and bytes, 0xffffffff for none).
+ * Every count is bounded by the bytes left before anything is allocated. */
+#include "db_io.h"
+#include "index.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void write_section(const amscr_index *x, amscr__wbuf *w)
+{
+    size_t n = amscr_db_size(x->db), k = x->k;
+    amscr__w_u32(w, (uint32_t)x->sig_dim);
+    amscr__w_u32(w, 0);
+    amscr__w_u64(w, k);
+    amscr__w_u64(w, x->candidates);
+    amscr__w_f64(w, x->dmax);
+    amscr__w_f64(w, x->med_a);
+    amscr__w_f64(w, x->med_h);
+    amscr__w_f64s(w, x->sig, n * x->sig_dim);
+    for (size_t i = 0; i < n * k; i++) {
+        amscr__w_u32(w, x->nb_idx[i]);
+        amscr__w_f64(w, x->nb_dist[i]);
+    }
+    for (size_t i = 0; i < n; i++)
+        amscr__w_str(w, x->names[i]);
+    amscr__w_u64(w, x->nclasses);
+    for (size_t c = 0; c < x->nclasses; c++)
+        amscr__w_str(w, x->classes[c]);
+}
+
+amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_t *out_len)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    AMSCR_CHECK_NULL(out_buf);
+    AMSCR_CHECK_NULL(out_len);
+    amscr__wbuf w = {NULL, 0, 0, 0};
+    amscr__db_write(x->db, AMSCR__DB_VERSION_INDEX, &w);
+    size_t at = w.len;
+    amscr__w_u64(&w, 0); /* the section's length, filled in below */
+    write_section(x, &w);
+    if (!w.oom) {
+        uint64_t sec = (uint64_t)(w.len - at - 8);
+        for (int i = 0; i < 8; i++)
+            w.buf[at + (size_t)i] = (unsigned char)(sec >> (8 * i));
+        amscr__w_u64(&w, amscr__fnv1a(w.buf, w.len));
+    }
+    if (w.oom) {
+        free(w.buf);
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_index_save: out of memory");
+    }
+    *out_buf = w.buf;
+    *out_len = w.len;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_index_save(const amscr_index *x, const char *path)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    AMSCR_CHECK_NULL(path);
+    void *buf = NULL;
+    size_t len = 0;
+    amscr_status st = amscr_index_save_memory(x, &buf, &len);
+    if (st == AMSCR_OK)
+        st = amscr__file_write_atomic(path, buf, len);
+    free(buf);
+    return st;
+}
+
+/* The fixed header of the section into x; the sizes checked against the collection. */
+static amscr_status read_header(amscr__rbuf *r, amscr_index *x)
+{
+    const amscr_params *p = amscr_db_params(x->db);
+    size_t n = amscr_db_size(x->db);
+    uint32_t sig_dim = amscr__r_u32(r);
+    amscr__r_u32(r);
+    uint64_t k = amscr__r_u64(r), m = amscr__r_u64(r);
+    x->dmax = amscr__r_f64(r);
+    x->med_a = amscr__r_f64(r);
+    x->med_h = amscr__r_f64(r);
+    if (r->bad)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: the index section is truncated");
+    if (sig_dim != AMSCR__SIG_DIM)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: signatures of dimension %u, this library's have %u; rebuild "
+                                           "the index", (unsigned)sig_dim, (unsigned)AMSCR__SIG_DIM);
+    if (k != (p->rerank_k < n ? p->rerank_k : n) || (m != 0 && m + 1 >= n))
+        return amscr__fail(AMSCR_E_FORMAT, "index file: %llu neighbours or %llu candidates do not fit %zu shapes "
+                                           "with re-ranking k %u", (unsigned long long)k, (unsigned long long)m, n,
+                           p->rerank_k);
+    if (!(x->dmax >= 0.0 && x->med_a >= 0.0 && x->med_h >= 0.0 && isfinite(x->dmax) && isfinite(x->med_a) &&
+          isfinite(x->med_h)))
+        return amscr__fail(AMSCR_E_FORMAT, "index file: bad largest distance or medians");
+    x->k = (size_t)k;
+    x->candidates = (size_t)m;
+    uint64_t need = (uint64_t)n * (8u * sig_dim + 12u * k);
+    if (need / (n ? n : 1) != 8u * sig_dim + 12u * k || need > r->len - r->pos)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: the index section is truncated");
+    return amscr__index_reserve(x, n);
+}
+
+/* Signatures and neighbour lists. */
+static amscr_status read_lists(amscr__rbuf *r, amscr_index *x)
+{
+    size_t n = amscr_db_size(x->db), k = x->k;
+    if (!amscr__r_f64s(r, x->sig, n * x->sig_dim))
+        return amscr__fail(AMSCR_E_FORMAT, "index file: a signature is not finite");
+    for (size_t i = 0; i < n; i++)
+        for (size_t t = 0; t < k; t++) {
+            uint32_t j = amscr__r_u32(r);
+            double d = amscr__r_f64(r);
+            if (r->bad || j >= n || (t == 0) != (j == i) || !(d >= 0.0) || !isfinite(d) ||
+                (t > 0 && d < x->nb_dist[i * k + t - 1]))
+                return amscr__fail(AMSCR_E_FORMAT, "index file: shape %zu's neighbour %zu is invalid", i, t);
+            x->nb_idx[i * k + t] = j;
+            x->nb_dist[i * k + t] = d;
+        }
+    return AMSCR_OK;
+}
+
+/* Shape names and class names. */
+static amscr_status read_names(amscr__rbuf *r, amscr_index *x)
+{
+    size_t n = amscr_db_size(x->db);
+    int oom = 0;
+    for (size_t i = 0; i < n; i++)
+        if (!amscr__r_str(r, &x->names[i], &oom))
+            return oom ? amscr__fail(AMSCR_E_NOMEM, "index file: out of memory")
+                       : amscr__fail(AMSCR_E_FORMAT, "index file: shape %zu's name is truncated or invalid", i);
+    uint64_t nc = amscr__r_u64(r);
+    if (r->bad || nc > (r->len - r->pos) / 4)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: bad class count");
+    x->classes = nc ? calloc((size_t)nc, sizeof *x->classes) : NULL;
+    if (nc && !x->classes)
+        return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
+    x->nclasses = (size_t)nc;
+    for (size_t c = 0; c < x->nclasses; c++)
+        if (!amscr__r_str(r, &x->classes[c], &oom))
+            return oom ? amscr__fail(AMSCR_E_NOMEM, "index file: out of memory")
+                       : amscr__fail(AMSCR_E_FORMAT, "index file: class name %zu is truncated or invalid", c);
+    if (r->pos != r->len)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: %zu unexpected bytes after the index section",
+                           r->len - r->pos);
+    return AMSCR_OK;
+}
+
+amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(buf);
+    AMSCR_CHECK_NULL(out);
+    amscr_db *db = NULL;
+    size_t pos = 0;
+    uint32_t version = 0;
+    amscr_status st = amscr__db_parse(buf, len, &db, &pos, &version);
+    if (st != AMSCR_OK)
+        return st;
+    amscr_index *x = calloc(1, sizeof *x);
+    if (!x) {
+        amscr_db_free(db);
+        return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
+    }
+    x->db = db;
+    x->sig_dim = AMSCR__SIG_DIM;
+    amscr__rbuf r = {buf, len - 8, pos, 0};
+    uint64_t sec = version >= AMSCR__DB_VERSION_INDEX ? amscr__r_u64(&r) : 0;
+    if (version < AMSCR__DB_VERSION_INDEX)
+        st = amscr__fail(AMSCR_E_FORMAT, "a collection file without an index (format version %u): build one with "
+                                         "amscr_index_build", (unsigned)version);
+    else if (r.bad || sec != r.len - r.pos)
+        st = amscr__fail(AMSCR_E_FORMAT, "index file: bad index section length");
+    if (st == AMSCR_OK)
+        st = amscr__index_check_db(db, "index file");
+    if (st == AMSCR_OK)
+        st = read_header(&r, x);
+    if (st == AMSCR_OK)
+        st = read_lists(&r, x);
+    if (st == AMSCR_OK)
+        st = read_names(&r, x);
+    if (st != AMSCR_OK) {
+        amscr_index_free(x);
+        return st;
+    }
+    *out = x;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_index_load(const char *path, amscr_index **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(path);
+    AMSCR_CHECK_NULL(out);
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    amscr_status st = amscr__file_read(path, &buf, &len);
+    if (st != AMSCR_OK)
+        return st;
+    st = amscr_index_load_memory(buf, len, out);
+    if (st != AMSCR_OK) {
+        char d[400];
+        snprintf(d, sizeof d, "%s", amscr_last_error_detail());
+        amscr__fail(st, "%s: %s", path, d);
+    }
+    free(buf);
+    return st;
+}

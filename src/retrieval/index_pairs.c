@@ -1,0 +1,192 @@
+/* index_pairs.c — the base distance of the retrieval matrix (fuse.c) pair by pair: one shape
+ * against a list of shapes, each value computed as the matrix computes its cell, so the
+ * index's neighbour lists and a query's distances agree with amscr_db_retrieval_matrix to
+ * the bit. Rows of pairs are split over POSIX threads; the calling thread works too and is
+ * the only one that reports progress. */
+#include "index.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void amscr__base_init(amscr__base *b, const amscr_params *p, double med_a, double med_h)
+{
+    b->p = p;
+    b->w = p->channel_weight;
+    amscr__fuse_scales(b->w, med_a, med_h, &b->sa, &b->sh);
+    b->nf = b->w > 0.0 ? amscr__channel_frames(p, b->frames, b->share) : 0;
+    b->threads = amscr__resolve_threads(p->num_threads);
+}
+
+amscr_status amscr__pair_ws_init(const amscr__base *b, amscr__pair_ws *pw)
+{
+    memset(pw, 0, sizeof *pw);
+    amscr_status st = b->w < 1.0 ? amscr_workspace_new(&pw->ws) : AMSCR_OK;
+    if (st == AMSCR_OK && b->nf > 0) {
+        amscr__hf_cfg_from(b->p, b->p->num_samples, &pw->cfg);
+        st = amscr__hf_ws_init(&pw->hws, b->p->num_samples, pw->cfg.band);
+        pw->have_hws = st == AMSCR_OK;
+    }
+    if (st != AMSCR_OK)
+        amscr__pair_ws_free(pw);
+    return st;
+}
+
+void amscr__pair_ws_free(amscr__pair_ws *pw)
+{
+    amscr_workspace_free(pw->ws);
+    if (pw->have_hws)
+        amscr__hf_ws_free(&pw->hws);
+    memset(pw, 0, sizeof *pw);
+}
+
+amscr_status amscr__base_hf(const amscr__base *b, const amscr_descriptor *d, amscr__hf hf[2])
+{
+    memset(hf, 0, 2 * sizeof *hf);
+    amscr_status st = AMSCR_OK;
+    for (int f = 0; f < b->nf && st == AMSCR_OK; f++)
+        st = amscr__hf_of_descriptor(b->p, b->frames[f], d, &hf[f]);
+    if (st != AMSCR_OK)
+        amscr__base_hf_free(b, hf);
+    return st;
+}
+
+void amscr__base_hf_free(const amscr__base *b, amscr__hf hf[2])
+{
+    for (int f = 0; f < b->nf; f++)
+        amscr__hf_free(&hf[f]);
+}
+
+/* The base distance of lo and hi (lo the lower index); hlo, hhi their channel sequences. */
+static amscr_status base_pair(const amscr__base *b, const amscr_descriptor *lo, const amscr__hf *hlo,
+                              const amscr_descriptor *hi, const amscr__hf *hhi, amscr__pair_ws *pw, double *out)
+{
+    double sym = 0.0, ch = 0.0;
+    if (b->w < 1.0) {
+        double f = 0.0, r = 0.0;
+        amscr_status st = amscr__distance_ws(b->p, lo, hi, pw->ws, &f);
+        if (st == AMSCR_OK)
+            st = amscr__distance_ws(b->p, hi, lo, pw->ws, &r);
+        if (st != AMSCR_OK)
+            return st;
+        sym = 0.5 * (f + r);
+    }
+    if (b->nf == 1)
+        ch = amscr__hf_distance(&hlo[0], &hhi[0], &pw->cfg, &pw->hws);
+    else if (b->nf == 2)
+        ch = b->share[0] * amscr__hf_distance(&hlo[0], &hhi[0], &pw->cfg, &pw->hws) +
+             b->share[1] * amscr__hf_distance(&hlo[1], &hhi[1], &pw->cfg, &pw->hws);
+    *out = amscr__fuse_pair(b->w, b->sa, b->sh, sym, ch);
+    return AMSCR_OK;
+}
+
+amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const amscr_descriptor *q,
+                               const amscr__hf hq[2], size_t qpos, const size_t *cand, size_t m, amscr__pair_ws *pw,
+                               double *out)
+{
+    amscr_status st = AMSCR_OK;
+    for (size_t t = 0; t < m && st == AMSCR_OK; t++) {
+        const amscr_descriptor *d = amscr_db_descriptor(db, cand[t]);
+        amscr__hf hd[2];
+        st = amscr__base_hf(b, d, hd);
+        if (st != AMSCR_OK)
+            break;
+        if (cand[t] < qpos)
+            st = base_pair(b, d, hd, q, hq, pw, &out[t]);
+        else
+            st = base_pair(b, q, hq, d, hd, pw, &out[t]);
+        amscr__base_hf_free(b, hd);
+    }
+    return st;
+}
+
+/* ---------------------------------------------------------------- one row on threads */
+
+enum { CHUNK = 8 };
+
+typedef struct {
+    const amscr__base *b;
+    const amscr_db *db;
+    const amscr_descriptor *q;
+    const amscr__hf *hq;
+    size_t qpos, m;
+    const size_t *cand;
+    double *out;
+    pthread_mutex_t lock;
+    size_t next, done;
+    int cancel;
+    amscr_status st;
+    char detail[256];
+} row_job;
+
+/* Runs chunks until none is left; reports (the calling thread only) between them. */
+static void row_work(row_job *j, amscr_progress_fn progress, void *user)
+{
+    amscr__pair_ws pw;
+    amscr_status st = amscr__pair_ws_init(j->b, &pw);
+    int have_pw = st == AMSCR_OK;
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        if (st != AMSCR_OK && j->st == AMSCR_OK) {
+            j->st = st;
+            snprintf(j->detail, sizeof j->detail, "%s", amscr_last_error_detail());
+        }
+        size_t c = j->next, done = j->done;
+        int go = j->st == AMSCR_OK && !j->cancel && c < j->m;
+        if (go)
+            j->next += CHUNK;
+        pthread_mutex_unlock(&j->lock);
+        if (progress && progress(user, done, j->m) != 0) {
+            pthread_mutex_lock(&j->lock);
+            j->cancel = 1;
+            pthread_mutex_unlock(&j->lock);
+        }
+        if (!go)
+            break;
+        size_t e = c + CHUNK < j->m ? c + CHUNK : j->m;
+        st = amscr__base_pairs(j->b, j->db, j->q, j->hq, j->qpos, j->cand + c, e - c, &pw, j->out + c);
+        pthread_mutex_lock(&j->lock);
+        j->done += e - c;
+        pthread_mutex_unlock(&j->lock);
+    }
+    if (have_pw)
+        amscr__pair_ws_free(&pw);
+}
+
+static void *row_worker(void *arg)
+{
+    row_work(arg, NULL, NULL);
+    return NULL;
+}
+
+amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const amscr_descriptor *q, size_t qpos,
+                             const size_t *cand, size_t m, amscr_progress_fn progress, void *user, double *out)
+{
+    amscr__hf hq[2];
+    amscr_status st = amscr__base_hf(b, q, hq);
+    if (st != AMSCR_OK)
+        return st;
+    row_job j = {b, db, q, hq, qpos, m, cand, out, PTHREAD_MUTEX_INITIALIZER, 0, 0, 0, AMSCR_OK, ""};
+    unsigned nt = b->threads, started = 0;
+    size_t chunks = (m + CHUNK - 1) / CHUNK;
+    if (nt > chunks)
+        nt = chunks ? (unsigned)chunks : 1u;
+    pthread_t tid[64];
+    for (unsigned t = 1; t < nt && t < 64; t++)
+        if (pthread_create(&tid[started], NULL, row_worker, &j) == 0)
+            started++;
+    row_work(&j, progress, user);
+    for (unsigned t = 0; t < started; t++)
+        pthread_join(tid[t], NULL);
+    amscr__base_hf_free(b, hq);
+    pthread_mutex_destroy(&j.lock);
+    if (j.st != AMSCR_OK)
+        return amscr__fail(j.st, "%s", j.detail);
+    if (j.cancel)
+        return amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback");
+    if (progress && progress(user, m, m) != 0)
+        return amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback at the end");
+    return AMSCR_OK;
+}

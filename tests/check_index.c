@@ -1,0 +1,329 @@
+/* check_index.c — the retrieval index (amscr_index_*) and the one-vs-many retrieval query
+ * (amscr_db_query_retrieval): the exact query equals the query's row of the retrieval matrix
+ * of the collection plus the query; an index query with every shape a candidate equals it;
+ * member rows; file and memory round trips; damaged files; add; thread-count independence. */
+#include <amscr.h>
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "suites.h"
+#include "testutil.h"
+
+#define NPTS 200
+#define NSHAPES 24
+
+/* Params: the retrieval preset with N = 64 (fast), channel weight w, re-ranking k. */
+static amscr_params *params_of(double w, unsigned k, unsigned threads)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_num_samples(p, 64), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_channel_weight(p, w), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_rerank_k(p, k), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_num_threads(p, threads), AMSCR_OK);
+    return p;
+}
+
+/* Shape `i`: one of 6 random base shapes (classes), affinely warped. */
+static amscr_descriptor *shape(const amscr_params *p, unsigned i)
+{
+    amscr_test_rng r;
+    double xy[2 * NPTS], w[2 * NPTS], m[6];
+    amscr_test_rng_seed(&r, 1000 + i % 6);
+    amscr_test_random_shape(&r, NPTS, 5, xy);
+    amscr_test_rng_seed(&r, 77 + i);
+    amscr_test_random_affine(&r, 2.0, 0.5, 3.0, 0, m);
+    amscr_test_apply_affine(m, xy, NPTS, w);
+    amscr_test_add_noise(&r, w, NPTS, 0.01);
+    amscr_contour *c = NULL;
+    amscr_descriptor *d = NULL;
+    ck_assert_int_eq(amscr_contour_new(w, NPTS, &c), AMSCR_OK);
+    ck_assert_int_eq(amscr_descriptor_new(p, c, &d), AMSCR_OK);
+    amscr_contour_free(c);
+    return d;
+}
+
+static amscr_db *db_of(const amscr_params *p, unsigned n)
+{
+    amscr_db *db = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
+    for (unsigned i = 0; i < n; i++) {
+        amscr_descriptor *d = shape(p, i);
+        ck_assert_int_eq(amscr_db_add_descriptor(db, d, (int32_t)(i % 6), NULL), AMSCR_OK);
+        amscr_descriptor_free(d);
+    }
+    return db;
+}
+
+/* The query's row (its collection columns) of the retrieval matrix of db plus q. */
+static void reference_row(const amscr_db *db, const amscr_descriptor *q, double *out)
+{
+    size_t n = amscr_db_size(db);
+    amscr_db *all = NULL;
+    ck_assert_int_eq(amscr_db_new(amscr_db_params(db), &all), AMSCR_OK);
+    for (size_t i = 0; i < n; i++)
+        ck_assert_int_eq(amscr_db_add_descriptor(all, amscr_db_descriptor(db, i), 0, NULL), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_add_descriptor(all, q, 0, NULL), AMSCR_OK);
+    double *M = malloc((n + 1) * (n + 1) * sizeof *M);
+    ck_assert_int_eq(amscr_db_retrieval_matrix(all, NULL, NULL, M), AMSCR_OK);
+    memcpy(out, M + n * (n + 1), n * sizeof *out);
+    free(M);
+    amscr_db_free(all);
+}
+
+static void assert_close(const double *a, const double *b, size_t n, double tol)
+{
+    for (size_t j = 0; j < n; j++)
+        ck_assert_msg(fabs(a[j] - b[j]) <= tol, "score %zu: %.17g vs %.17g", j, a[j], b[j]);
+}
+
+/* amscr_db_query_retrieval and the index query (every shape a candidate) against the matrix. */
+static void exact_case(double w, unsigned k)
+{
+    amscr_params *p = params_of(w, k, 2);
+    amscr_db *db = db_of(p, NSHAPES);
+    amscr_descriptor *q = shape(p, 1000);
+    double ref[NSHAPES], got[NSHAPES], viax[NSHAPES];
+    reference_row(db, q, ref);
+    ck_assert_int_eq(amscr_db_query_retrieval(db, q, NULL, NULL, got, NSHAPES), AMSCR_OK);
+    assert_close(ref, got, NSHAPES, 1e-12);
+    if (w <= 0.0 || w >= 1.0) {
+        amscr_index *x = NULL;
+        ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
+        ck_assert_int_eq(amscr_index_query_scores(x, q, 0, viax, NSHAPES), AMSCR_OK);
+        assert_close(ref, viax, NSHAPES, 1e-12);
+        amscr_index_free(x);
+    }
+    amscr_descriptor_free(q);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+
+START_TEST(exact_channel_rerank) { exact_case(1.0, 8); }
+END_TEST
+START_TEST(exact_amscr_rerank) { exact_case(0.0, 5); }
+END_TEST
+START_TEST(exact_fused_rerank) { exact_case(0.5, 8); }
+END_TEST
+START_TEST(exact_channel_plain) { exact_case(1.0, 0); }
+END_TEST
+START_TEST(exact_large_k) { exact_case(1.0, 40); }
+END_TEST
+
+/* Row i of the collection's own retrieval matrix. */
+START_TEST(member_rows)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_db *db = db_of(p, NSHAPES);
+    double *M = malloc(NSHAPES * NSHAPES * sizeof *M), got[NSHAPES];
+    ck_assert_int_eq(amscr_db_retrieval_matrix(db, NULL, NULL, M), AMSCR_OK);
+    amscr_index *x = NULL;
+    ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
+    for (size_t i = 0; i < NSHAPES; i += 5) {
+        ck_assert_int_eq(amscr_index_member_scores(x, i, 0, got, NSHAPES), AMSCR_OK);
+        assert_close(M + i * NSHAPES, got, NSHAPES, 1e-12);
+    }
+    ck_assert_int_eq(amscr_index_member_scores(x, NSHAPES, 0, got, NSHAPES), AMSCR_E_INVALID_ARG);
+    amscr_index_free(x);
+    free(M);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+END_TEST
+
+static amscr_index *named_index(const amscr_params *p, size_t candidates)
+{
+    amscr_db *db = db_of(p, NSHAPES);
+    amscr_index *x = NULL;
+    ck_assert_int_eq(amscr_index_build(db, candidates, NULL, NULL, &x), AMSCR_OK);
+    amscr_db_free(db);
+    ck_assert_int_eq(amscr_index_set_name(x, 3, "three.png"), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_set_class_name(x, 2, "bird"), AMSCR_OK);
+    return x;
+}
+
+static void same_query(const amscr_index *a, const amscr_index *b, const amscr_descriptor *q, size_t cand)
+{
+    double sa[NSHAPES], sb[NSHAPES];
+    ck_assert_int_eq(amscr_index_query_scores(a, q, cand, sa, NSHAPES), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_query_scores(b, q, cand, sb, NSHAPES), AMSCR_OK);
+    for (size_t j = 0; j < NSHAPES; j++)
+        ck_assert(sa[j] == sb[j] || (isinf(sa[j]) && isinf(sb[j])));
+}
+
+START_TEST(round_trips)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_index *x = named_index(p, 0), *y = NULL, *z = NULL;
+    amscr_descriptor *q = shape(p, 2000);
+    const char *path = "check_index_tmp.idx";
+    ck_assert_int_eq(amscr_index_save(x, path), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_load(path, &y), AMSCR_OK);
+    void *buf = NULL;
+    size_t len = 0;
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_load_memory(buf, len, &z), AMSCR_OK);
+    same_query(x, y, q, 0);
+    same_query(x, z, q, 0);
+    same_query(x, y, q, 6);
+    ck_assert_str_eq(amscr_index_name(y, 3), "three.png");
+    ck_assert_ptr_null(amscr_index_name(y, 4));
+    ck_assert_str_eq(amscr_index_class_name(z, 2), "bird");
+    ck_assert_ptr_null(amscr_index_class_name(z, 1));
+    ck_assert_int_eq(amscr_index_label(y, 7), 1);
+    /* an index file is a collection file: amscr_db_load gives its collection */
+    amscr_db *db = NULL;
+    ck_assert_int_eq(amscr_db_load(path, &db), AMSCR_OK);
+    ck_assert_uint_eq(amscr_db_size(db), NSHAPES);
+    ck_assert_int_eq(amscr_db_label(db, 7), 1);
+    /* a collection file without an index is refused by the index loader, clearly */
+    ck_assert_int_eq(amscr_db_save(db, path), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_load(path, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "amscr_index_build") != NULL);
+    remove(path);
+    amscr_db_free(db);
+    amscr_free(buf);
+    amscr_index_free(x);
+    amscr_index_free(y);
+    amscr_index_free(z);
+    amscr_descriptor_free(q);
+    amscr_params_free(p);
+}
+END_TEST
+
+START_TEST(bad_files)
+{
+    amscr_params *p = params_of(1.0, 8, 1);
+    amscr_index *x = named_index(p, 0), *y = NULL;
+    void *buf = NULL;
+    size_t len = 0;
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    unsigned char *b = malloc(len);
+    for (size_t cut = 0; cut < len; cut += 1 + cut / 3) { /* truncated */
+        memcpy(b, buf, cut);
+        ck_assert_int_eq(amscr_index_load_memory(b, cut, &y), AMSCR_E_FORMAT);
+    }
+    for (size_t at = 0; at < len; at += 97) { /* damaged */
+        memcpy(b, buf, len);
+        b[at] ^= 0x5a;
+        ck_assert_int_ne(amscr_index_load_memory(b, len, &y), AMSCR_OK);
+    }
+    memcpy(b, buf, len);
+    b[8] = 9; /* a newer version */
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "newer") != NULL);
+    memcpy(b, "AMSCRIDX", 8); /* the tool's index before 0.4 */
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "rebuild") != NULL);
+    ck_assert_int_eq(amscr_index_load_memory(NULL, len, &y), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_index_load("/nonexistent/x.idx", &y), AMSCR_E_IO);
+    free(b);
+    amscr_free(buf);
+    amscr_index_free(x);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* add: refused with other params (the detail names the option); with the same, a full index
+ * gives the scores of a rebuild. */
+START_TEST(add_shapes)
+{
+    amscr_params *p = params_of(1.0, 8, 2), *other = params_of(1.0, 6, 2);
+    amscr_db *first = db_of(p, NSHAPES - 4), *all = db_of(p, NSHAPES), *more = NULL, *wrong = db_of(other, 2);
+    ck_assert_int_eq(amscr_db_new(p, &more), AMSCR_OK);
+    for (size_t i = NSHAPES - 4; i < NSHAPES; i++)
+        ck_assert_int_eq(amscr_db_add_descriptor(more, amscr_db_descriptor(all, i), amscr_db_label(all, i), NULL),
+                         AMSCR_OK);
+    amscr_index *x = NULL, *ref = NULL;
+    ck_assert_int_eq(amscr_index_build(first, 0, NULL, NULL, &x), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_add(x, wrong, NULL, NULL), AMSCR_E_INVALID_ARG);
+    ck_assert(strstr(amscr_last_error_detail(), "rerank_k") != NULL);
+    ck_assert_uint_eq(amscr_index_size(x), NSHAPES - 4);
+    ck_assert_int_eq(amscr_index_add(x, more, NULL, NULL), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_build(all, 0, NULL, NULL, &ref), AMSCR_OK);
+    amscr_descriptor *q = shape(p, 3000);
+    double a[NSHAPES], b[NSHAPES];
+    ck_assert_int_eq(amscr_index_query_scores(x, q, 0, a, NSHAPES), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_query_scores(ref, q, 0, b, NSHAPES), AMSCR_OK);
+    assert_close(a, b, NSHAPES, 1e-12);
+    amscr_descriptor_free(q);
+    amscr_index_free(x);
+    amscr_index_free(ref);
+    amscr_db_free(first);
+    amscr_db_free(all);
+    amscr_db_free(more);
+    amscr_db_free(wrong);
+    amscr_params_free(p);
+    amscr_params_free(other);
+}
+END_TEST
+
+/* The saved bytes do not depend on the thread count (full and shortlist builds). */
+START_TEST(thread_independence)
+{
+    for (size_t cand = 0; cand <= 10; cand += 10) {
+        void *buf[2] = {NULL, NULL};
+        size_t len[2] = {0, 0};
+        for (unsigned t = 0; t < 2; t++) {
+            amscr_params *p = params_of(1.0, 8, t == 0 ? 1 : 3);
+            amscr_index *x = named_index(p, cand);
+            ck_assert_int_eq(amscr_params_set_num_threads(p, 1), AMSCR_OK);
+            ck_assert_int_eq(amscr_index_save_memory(x, &buf[t], &len[t]), AMSCR_OK);
+            amscr_index_free(x);
+            amscr_params_free(p);
+        }
+        ck_assert_uint_eq(len[0], len[1]);
+        /* the params (their thread count) differ; everything after them is the same */
+        ck_assert(memcmp((char *)buf[0] + len[0] / 4, (char *)buf[1] + len[1] / 4, len[0] - len[0] / 4 - 8) == 0);
+        amscr_free(buf[0]);
+        amscr_free(buf[1]);
+    }
+}
+END_TEST
+
+/* A shortlist query returns finite scores for its best shapes; top-k agrees with the scores. */
+START_TEST(top_and_shortlist)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_index *x = named_index(p, 10);
+    amscr_descriptor *q = shape(p, 6); /* class 0 */
+    size_t idx[5], cnt = 0;
+    double sc[5], all[NSHAPES];
+    ck_assert_int_eq(amscr_index_query(x, q, 12, 5, idx, sc, &cnt), AMSCR_OK);
+    ck_assert_uint_eq(cnt, 5);
+    ck_assert_int_eq(amscr_index_query_scores(x, q, 12, all, NSHAPES), AMSCR_OK);
+    for (size_t t = 0; t < cnt; t++) {
+        ck_assert(isfinite(sc[t]) && sc[t] == all[idx[t]]);
+        ck_assert(t == 0 || sc[t] >= sc[t - 1]);
+    }
+    ck_assert_int_eq(amscr_index_label(x, idx[0]), 0);
+    ck_assert_int_eq(amscr_index_query(x, NULL, 0, 5, idx, sc, &cnt), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_index_query_scores(x, q, 0, all, NSHAPES - 1), AMSCR_E_INVALID_ARG);
+    amscr_descriptor_free(q);
+    amscr_index_free(x);
+    amscr_params_free(p);
+}
+END_TEST
+
+Suite *amscr_suite_index(void)
+{
+    Suite *s = suite_create("index");
+    TCase *tc = tcase_create("index");
+    tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, exact_channel_rerank);
+    tcase_add_test(tc, exact_amscr_rerank);
+    tcase_add_test(tc, exact_fused_rerank);
+    tcase_add_test(tc, exact_channel_plain);
+    tcase_add_test(tc, exact_large_k);
+    tcase_add_test(tc, member_rows);
+    tcase_add_test(tc, round_trips);
+    tcase_add_test(tc, bad_files);
+    tcase_add_test(tc, add_shapes);
+    tcase_add_test(tc, thread_independence);
+    tcase_add_test(tc, top_and_shortlist);
+    suite_add_tcase(s, tc);
+    return s;
+}
