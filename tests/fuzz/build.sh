@@ -64,7 +64,7 @@ targets=(text pgm png mask register dbload contours index)
 for t in "${targets[@]}"; do
   src=tests/fuzz/fuzz_$t.c
   extra=()
-  case $t in pgm|png|index) extra=("${tool_objs[@]}") ;; esac
+  case $t in pgm|png) extra=("${tool_objs[@]}") ;; esac
   exe="$OUT/fuzz_$t"
   rebuild=0
   [ -f "$exe" ] || rebuild=1
