@@ -47,6 +47,7 @@ from .gmm import GMM1D, bayes_threshold, gmm1d
 from .params import _params_from_dict
 from .shape import _shape_from_state
 from .collection import _collection_from_state
+from .index import Index
 
 __all__ = [
     '__version__', 'API_MODE', 'SOVERSION', 'LIBRARY_PATH', 'library_version', 'has_threads', 'errors',
@@ -65,4 +66,6 @@ __all__ = [
     'smooth', 'gaussian_kernel', 'resample_euclidean', 'resample_affine', 'affine_arclength',
     'normalize_whiten', 'lstsq', 'affine_fit', 'affine_apply', 'affine_invert',
     'kmeans', 'KMeansResult', 'elbow', 'GMM1D', 'gmm1d', 'bayes_threshold',
+    # one-vs-many retrieval
+    'Index',
 ]

@@ -195,7 +195,13 @@ class Collection:
 
     def query(self, shape: PointsLike, threads: Optional[int] = None, progress: ProgressArg = False, *,
               order: str = 'xy') -> np.ndarray:
-        """Distances from `shape` to every shape of the collection.
+        """Distances from `shape` to every shape of the collection, by the collection's own
+        params: the plain AMSCR distance (query -> shape) with the defaults, and the retrieval
+        scores (C ``amscr_db_query_retrieval``: the query's row of :meth:`retrieval_matrix` on
+        the collection plus the query, shape channel, fusion and re-ranking) when the params
+        ask for retrieval (``channel_weight`` > 0 or ``rerank_k`` > 0, e.g.
+        :meth:`Params.retrieval`). To query a collection many times that way, build an
+        :class:`Index` once.
 
         Args:
             shape: the query: (n, 2) points, an OpenCV (n, 1, 2) contour or a :class:`Shape`.
@@ -213,7 +219,10 @@ class Collection:
             p = self.params
             q = as_shape(shape, p, 'shape', order)
             out = np.zeros(len(self), dtype=np.float64)
-            if threads is None or int(threads) == p.threads:
+            if p.channel_weight > 0 or p.rerank_k > 0:
+                src, _ = self._with_threads(threads)
+                progress_call(lib.amscr_db_query_retrieval, (src._db, q._d), (dbuf(out), len(out)), progress)
+            elif threads is None or int(threads) == p.threads:
                 progress_call(lib.amscr_db_query, (self._db, q._d), (dbuf(out),), progress)
             else:
                 qdb = Collection(p, threads=threads)

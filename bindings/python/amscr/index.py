@@ -1,0 +1,287 @@
+"""Index: a collection prepared for one-vs-many retrieval (C ``amscr_index``)."""
+from __future__ import annotations
+
+import os
+from typing import Any, List, Optional, Tuple, Union
+
+import numpy as np
+
+from ._lib import ffi, lib
+from ._util import ProgressArg, RWLock, bad, dbuf, new_object, progress_call
+from .collection import Collection, _new_db
+from .errors import _check
+from .shape import PointsLike, as_shape
+
+
+def _new_index(make: Any, *args: Any):
+    return new_object('amscr_index', make, lib.amscr_index_free, *args)
+
+
+def _text(p) -> Optional[str]:
+    return None if p == ffi.NULL else ffi.string(p).decode('utf-8', 'surrogateescape')
+
+
+class Index:
+    """A collection prepared for one-vs-many retrieval (C ``amscr_index``): each shape's nearest
+    shapes under the retrieval matrix's base distance, so one query is ranked by the scores of
+    :meth:`Collection.retrieval_matrix` (shape channel, fusion, re-ranking, as the collection's
+    :class:`Params` say) without the collection's matrix. The ``amscr`` tool's ``index``,
+    ``search`` and this class read and write the same files.
+
+    ``Index(collection, progress=False, candidates=0)`` builds the index of a
+    :class:`Collection` on its threads (the collection is copied). ``candidates=0`` computes the
+    whole base matrix (exact lists: a query then ranks exactly as ``collection.query``);
+    ``candidates=M`` seeks each shape's neighbours among its M signature-nearest shapes only
+    (large collections). Thread-safety: any number of threads may query at once; :meth:`add`
+    waits for them.
+
+    Args:
+        collection: the shapes and their params (``Params.retrieval()`` for the project's
+            retrieval).
+        progress: True for a progress bar on stderr, or a callable(done, total).
+        candidates: 0, or the shortlist size M of a large collection.
+    Raises:
+        InvalidArgumentError: open curves with a channel weight; CancelledError: cancelled.
+    """
+
+    def __init__(self, collection: Collection, progress: ProgressArg = False, candidates: int = 0):
+        if not isinstance(collection, Collection):
+            raise TypeError('collection: expected an amscr.Collection, got %s' % type(collection).__name__)
+        out = ffi.new('amscr_index **')
+        with collection._lock.read():
+            progress_call(lib.amscr_index_build, (collection._db, int(candidates)), (out,), progress)
+            names = collection._label_names
+        self._init(ffi.gc(out[0], lib.amscr_index_free))
+        for code, name in enumerate(names or ()):
+            _check(lib.amscr_index_set_class_name(self._x, code, str(name).encode('utf-8', 'surrogateescape')))
+
+    def _init(self, x) -> None:
+        self._x = x
+        self._lock = RWLock()
+
+    @classmethod
+    def _wrap(cls, x) -> 'Index':
+        self = cls.__new__(cls)
+        self._init(x)
+        return self
+
+    # -- persistence ------------------------------------------------------------------
+    @classmethod
+    def load(cls, path: Union[str, os.PathLike]) -> 'Index':
+        """Reads an index file (written by :meth:`save` or ``amscr index``).
+
+        Args:
+            path: the file.
+        Returns:
+            a new :class:`Index`.
+        Raises:
+            FileError: cannot read; FormatError: not an index file (a collection file without
+            an index, an index of the tool before 0.4: build it again), or a corrupt one.
+        """
+        return cls._wrap(_new_index(lib.amscr_index_load, os.fsencode(path)))
+
+    def save(self, path: Union[str, os.PathLike]) -> None:
+        """Writes the index (its collection included; atomic rename). ``Collection.load`` of the
+        file gives the collection.
+
+        Args:
+            path: the file to write.
+        Raises:
+            FileError: the file cannot be written.
+        """
+        with self._lock.read():
+            _check(lib.amscr_index_save(self._x, os.fsencode(path)))
+
+    def to_bytes(self) -> bytes:
+        """The index serialized as :meth:`save` writes it.
+
+        Returns:
+            bytes (give them to :meth:`from_bytes`).
+        """
+        with self._lock.read():
+            buf = ffi.new('void **')
+            n = ffi.new('size_t *')
+            _check(lib.amscr_index_save_memory(self._x, buf, n))
+            try:
+                return bytes(ffi.buffer(buf[0], n[0]))
+            finally:
+                lib.amscr_free(buf[0])
+
+    @classmethod
+    def from_bytes(cls, data: Union[bytes, bytearray, memoryview]) -> 'Index':
+        """The inverse of :meth:`to_bytes`.
+
+        Args:
+            data: bytes from :meth:`to_bytes` or an index file's content.
+        Returns:
+            a new :class:`Index`.
+        Raises:
+            FormatError: not a serialized index, or a corrupt one.
+        """
+        b = bytes(data)
+        return cls._wrap(_new_index(lib.amscr_index_load_memory, ffi.from_buffer(b), len(b)))
+
+    def __reduce__(self):
+        return (Index.from_bytes, (self.to_bytes(),))
+
+    # -- contents ---------------------------------------------------------------------
+    def __len__(self) -> int:
+        """The number of shapes."""
+        return int(lib.amscr_index_size(self._x))
+
+    def __repr__(self) -> str:
+        return 'Index(%d shapes)' % len(self)
+
+    @property
+    def collection(self) -> Collection:
+        """A copy of the indexed collection (labels named by the class names, when set)."""
+        with self._lock.read():
+            buf = ffi.new('void **')
+            n = ffi.new('size_t *')
+            _check(lib.amscr_db_save_memory(lib.amscr_index_db(self._x), buf, n))
+            try:
+                data = bytes(ffi.buffer(buf[0], n[0]))
+            finally:
+                lib.amscr_free(buf[0])
+            classes = self._class_names()
+        db = _new_db(lib.amscr_db_load_memory, ffi.from_buffer(data), len(data))
+        return Collection._wrap(db, classes if classes else None)
+
+    def _class_names(self) -> List[Any]:
+        """The class names by code, up to the last named one ([] without names)."""
+        out: List[Any] = []
+        code = 0
+        while True:
+            name = _text(lib.amscr_index_class_name(self._x, code))
+            if name is None and code >= self._max_code():
+                break
+            out.append(name if name is not None else code)
+            code += 1
+        return out if any(isinstance(v, str) for v in out) else []
+
+    def _max_code(self) -> int:
+        n = len(self)
+        return max((int(lib.amscr_index_label(self._x, i)) for i in range(n)), default=-1) + 1
+
+    @property
+    def names(self) -> List[Optional[str]]:
+        """The shapes' names (file names of ``amscr index``, ``name=`` of :meth:`add`; None
+        when unnamed)."""
+        with self._lock.read():
+            return [_text(lib.amscr_index_name(self._x, i)) for i in range(len(self))]
+
+    @property
+    def labels(self) -> np.ndarray:
+        """The labels: class names (object array) when the index names its classes, else the
+        int32 codes."""
+        with self._lock.read():
+            n = len(self)
+            codes = np.fromiter((lib.amscr_index_label(self._x, i) for i in range(n)), dtype=np.int32, count=n)
+            names = self._class_names()
+        if not names:
+            return codes
+        out = np.empty(n, dtype=object)
+        for i, c in enumerate(codes):
+            out[i] = names[c] if 0 <= c < len(names) else int(c)
+        return out
+
+    # -- adding and querying ----------------------------------------------------------
+    def _label_code(self, label: Any) -> int:
+        names = self._class_names()
+        if isinstance(label, (int, np.integer)) and not isinstance(label, (bool, np.bool_)):
+            if names:
+                raise bad('label: this index names its classes; got the int %r' % (label,))
+            return int(label)
+        if not isinstance(label, str):
+            raise bad('label: expected an int or a class name, got %r' % (label,))
+        if not names and len(self) > 0:
+            raise bad('label: this index uses int labels; got %r' % (label,))
+        if label in names:
+            return names.index(label)
+        code = len(names)
+        _check(lib.amscr_index_set_class_name(self._x, code, label.encode('utf-8', 'surrogateescape')))
+        return code
+
+    def add(self, points: PointsLike, label: Any = 0, name: Optional[str] = None, *, order: str = 'xy') -> int:
+        """Prepares a shape with the index's params and adds it (its list and the lists it
+        enters are updated; with every shape a candidate and a channel weight of 0 or 1 the
+        result equals a rebuild).
+
+        Args:
+            points: (n, 2) points, an OpenCV contour, or a :class:`Shape` prepared with the
+                index's params.
+            label: an int label, or a class name (an index built from a collection with named
+                labels).
+            name: the shape's name (e.g. its file), or None.
+            order: 'xy' (default) or 'rc'.
+        Returns:
+            the index of the new shape.
+        Raises:
+            InvalidArgumentError: bad points or label, or a Shape prepared with other params
+            (the message names the option); StateError: the index must be rebuilt (it holds
+            fewer neighbours a shape than its re-ranking needs).
+        """
+        with self._lock.write():
+            q = as_shape(points, self.collection_params(), 'points', order)
+            from .params import Params
+            one = Collection(Params._copy_of(lib.amscr_descriptor_params(q._d)))  # the index names a differing option
+            code = self._label_code(label)
+            _check(lib.amscr_db_add_descriptor(one._db, q._d, code, ffi.NULL))
+            progress_call(lib.amscr_index_add, (self._x, one._db), (), False)
+            i = len(self) - 1
+            if name is not None:
+                _check(lib.amscr_index_set_name(self._x, i, str(name).encode('utf-8', 'surrogateescape')))
+            return i
+
+    def collection_params(self):
+        """A copy of the index's :class:`Params` (those of its collection)."""
+        from .params import Params
+        return Params._copy_of(lib.amscr_db_params(lib.amscr_index_db(self._x)))
+
+    def scores(self, points: PointsLike, candidates: Optional[int] = None, *, order: str = 'xy') -> np.ndarray:
+        """The query's retrieval score against every shape (lower is better): its row of
+        :meth:`Collection.retrieval_matrix` on the collection plus the query.
+
+        Args:
+            points: the query: points or a :class:`Shape`.
+            candidates: None or 0: match the query with every shape; M: its M
+                signature-nearest only (the others score inf unless the re-ranking reaches
+                them).
+            order: 'xy' (default) or 'rc'.
+        Returns:
+            (len(self),) float array.
+        Raises:
+            InvalidArgumentError: bad points, or a Shape prepared with incompatible params.
+        """
+        with self._lock.read():
+            q = as_shape(points, self.collection_params(), 'points', order)
+            out = np.zeros(len(self), dtype=np.float64)
+            _check(lib.amscr_index_query_scores(self._x, q._d, int(candidates or 0), dbuf(out), len(out)))
+            return out
+
+    def query(self, points: PointsLike, top: int = 10, candidates: Optional[int] = None, *,
+              order: str = 'xy') -> Tuple[np.ndarray, np.ndarray]:
+        """The `top` best shapes for a query, best first (ties by index), as :meth:`scores`.
+
+        Args:
+            points: the query: points or a :class:`Shape`.
+            top: how many results.
+            candidates: as in :meth:`scores`.
+            order: 'xy' (default) or 'rc'.
+        Returns:
+            (indices, scores): an int64 and a float array of min(top, len(self)) entries.
+        Raises:
+            InvalidArgumentError: bad points or `top` < 0.
+        """
+        top = int(top)
+        if top < 0:
+            raise bad('top: %d is negative' % top)
+        with self._lock.read():
+            q = as_shape(points, self.collection_params(), 'points', order)
+            idx = np.zeros(max(top, 1), dtype=np.uintp)
+            sc = np.zeros(max(top, 1), dtype=np.float64)
+            cnt = ffi.new('size_t *')
+            _check(lib.amscr_index_query(self._x, q._d, int(candidates or 0), top,
+                                         ffi.from_buffer('size_t[]', idx), dbuf(sc), cnt))
+            k = int(cnt[0])
+            return idx[:k].astype(np.int64), sc[:k].copy()
