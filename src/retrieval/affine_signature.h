@@ -1,4 +1,4 @@
-/* affine_signature.h — a short vector per prepared shape whose distance predicts the shape
+/* affine_signature.h — a vector per prepared shape whose distance predicts the shape
  * channel's (docs/method.md §10.2), for shortlisting the candidates of an index query
  * (affine_signature.c). Never installed. */
 #ifndef AMSCR_AFFINE_SIGNATURE_H
@@ -6,8 +6,9 @@
 
 #include "internal.h"
 
-/* Frequencies kept of every height-bin column (0 = the bin's mean along the curve). */
-#define AMSCR__SIG_FREQS 3
+/* Frequencies kept of every height-bin column (0 = the bin's mean along the curve): the first
+ * N/8 at the default N = 128, as the channel's shift search (AMSCR__HF_FREQS). */
+#define AMSCR__SIG_FREQS 16
 /* Height bins (the channel's AMSCR__HF_BINS). */
 #define AMSCR__SIG_BINS 16
 /* Doubles in a signature: two frames (similarity, whitened) x two orientations (the shape and
