@@ -30,5 +30,6 @@ Suite *amscr_suite_ordered(void);
 Suite *amscr_suite_despike(void);
 Suite *amscr_suite_even(void);
 Suite *amscr_suite_index(void);
+Suite *amscr_suite_signature(void);
 
 #endif
