@@ -2428,6 +2428,130 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_nn_split(const double *dist, 
                                                             const int32_t *test_labels,
                                                             const int32_t *train_labels, double *out_accuracy);
 
+/*
+ * Evaluation protocols (docs/collections.md). Classes are the distinct label values in
+ * ascending order (amscr_score_classes lists them); every per-class output below has one
+ * entry per class in that order, and its length `nclasses` is checked against the labels.
+ * Ranking as above: distance ascending, ties to the lower index; +inf is allowed, NaN and
+ * -inf are AMSCR_E_INVALID_ARG.
+ */
+
+/**
+ * @brief The distinct labels of n items, ascending, and how many items carry each: the class
+ *        order of the per-class outputs of the protocols (also the group order of
+ *        amscr_score_nn_groups when given the groups).
+ * @param[in]  labels  n labels, n >= 1.
+ * @param[out] out_classes  room for *inout_nclasses labels, or NULL.
+ * @param[out] out_sizes    room for *inout_nclasses counts, or NULL.
+ * @param[in,out] inout_nclasses  capacity in, number of classes out (both outputs NULL: a
+ *        size query).
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL labels or inout_nclasses, n = 0, capacity too
+ *         small); AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: safe.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_classes(const int32_t *labels, size_t n, int32_t *out_classes,
+                                                           size_t *out_sizes, size_t *inout_nclasses);
+
+/**
+ * @brief Per-class leave-one-out scores. For class c of size Nc: out_bullseye[c] = the shapes
+ *        of class c among the min(2 Nc, n) nearest of each of its queries (itself included),
+ *        summed over its queries and divided by Nc^2 (amscr_score_bullseye restricted to the
+ *        class); out_nn_accuracy[c] = the fraction of its queries whose nearest other shape
+ *        is of class c.
+ * @param[in]  dist      n x n row-major (row i = distances from query i), n >= 2.
+ * @param[in]  labels    n labels.
+ * @param[in]  nclasses  the number of distinct labels (amscr_score_classes).
+ * @param[out] out_bullseye, out_nn_accuracy  nclasses fractions each; either may be NULL,
+ *             not both.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n < 2, wrong nclasses, NaN or -inf);
+ *         AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: safe.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_per_class(const double *dist, size_t n, const int32_t *labels,
+                                                             size_t nclasses, double *out_bullseye,
+                                                             double *out_nn_accuracy);
+
+/**
+ * @brief Seeded per-class random split: in each of `splits` splits, `train` shapes of every
+ *        class are the training set and the others are classified by 1-NN against it; the
+ *        mean accuracy over the splits and its sample standard deviation. The draw: a
+ *        splitmix64 generator seeded with `seed` runs on over the splits; in each split,
+ *        class by class (ascending label), a partial Fisher-Yates shuffle of the class's
+ *        members (in index order) takes `train` of them, each step swapping position t with
+ *        t + (next value mod (Nc - t)). The same seed gives the same splits on every platform.
+ * @param[in]  dist      n x n row-major, n >= 2.
+ * @param[in]  labels    n labels.
+ * @param[in]  train     training shapes per class: 1 <= train < the smallest class size.
+ * @param[in]  splits    >= 1.
+ * @param[in]  seed      the generator's seed.
+ * @param[in]  nclasses  the number of distinct labels; read only with out_class_accuracy.
+ * @param[out] out_mean  mean accuracy over the splits, a fraction in [0, 1].
+ * @param[out] out_std   sample standard deviation of the splits' accuracies (0 for one
+ *             split), or NULL.
+ * @param[out] out_accuracies  `splits` accuracies, one per split, or NULL.
+ * @param[out] out_class_accuracy  nclasses values: each class's accuracy averaged over the
+ *             splits, or NULL.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n < 2, train or splits 0, train >= a class's
+ *         size, wrong nclasses, NaN or -inf); AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: safe.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_nn_random_split(const double *dist, size_t n,
+                                                                   const int32_t *labels, size_t train,
+                                                                   size_t splits, uint64_t seed, size_t nclasses,
+                                                                   double *out_mean, double *out_std,
+                                                                   double *out_accuracies,
+                                                                   double *out_class_accuracy);
+
+/**
+ * @brief Leave one group out: the shapes of each group are classified by 1-NN against every
+ *        shape of the other groups (a query never matches a shape of its own group).
+ * @param[in]  dist      n x n row-major, n >= 2.
+ * @param[in]  labels    n class labels.
+ * @param[in]  groups    n group ids (at least 2 distinct); groups are ordered like classes
+ *             (amscr_score_classes on the groups).
+ * @param[in]  ngroups   the number of distinct groups; read only with out_group_accuracy.
+ * @param[in]  nclasses  the number of distinct labels; read only with out_class_accuracy.
+ * @param[out] out_accuracy  the fraction of all n shapes classified right.
+ * @param[out] out_group_accuracy  ngroups fractions (each group's shapes), or NULL.
+ * @param[out] out_class_accuracy  nclasses fractions (each class's shapes), or NULL.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n < 2, one group, wrong ngroups or nclasses,
+ *         NaN or -inf); AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: safe.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_nn_groups(const double *dist, size_t n, const int32_t *labels,
+                                                             const int32_t *groups, size_t ngroups,
+                                                             size_t nclasses, double *out_accuracy,
+                                                             double *out_group_accuracy,
+                                                             double *out_class_accuracy);
+
+/**
+ * @brief Mean interpolated precision at recall levels l / (nlevels - 1), l = 0..nlevels-1:
+ *        each shape queries the others (itself excluded), the other shapes of its class are
+ *        the relevant ones, and its precision at a level is the best precision reached at any
+ *        recall >= the level; averaged over the queries whose class has another shape (NaN
+ *        at every level when there is none).
+ * @param[in]  dist     n x n row-major, n >= 2.
+ * @param[in]  labels   n labels.
+ * @param[in]  nlevels  >= 2 (21: recall 0, 0.05, ..., 1).
+ * @param[out] out_precision  nlevels fractions.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n < 2, nlevels < 2, NaN or -inf);
+ *         AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: safe.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_precision_recall(const double *dist, size_t n,
+                                                                    const int32_t *labels, size_t nlevels,
+                                                                    double *out_precision);
+
 /**
  * @brief Re-ranks a whole distance matrix by affinity diffusion on a k-nearest-neighbour
  *        tensor-product graph (Yang, Prasad, Latecki, CVPR 2012; docs/method.md). The output

@@ -31,5 +31,6 @@ Suite *amscr_suite_despike(void);
 Suite *amscr_suite_even(void);
 Suite *amscr_suite_index(void);
 Suite *amscr_suite_signature(void);
+Suite *amscr_suite_protocols(void);
 
 #endif

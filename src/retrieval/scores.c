@@ -4,6 +4,7 @@
  * Cost: O(n^2 log w) for the matrix scores (w the window or kmax), with one allocation
  * per call. */
 #include "internal.h"
+#include "scores.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -33,10 +34,8 @@ static void rt_sift_down(const double *d, size_t *heap, size_t len, size_t i)
     heap[i] = v;
 }
 
-/* The k first indices of row d[0..n-1] in (distance, index) order, skipping `exclude`
- * (SIZE_MAX or >= n for none), written ascending to out[0..k-1]. k must not exceed the
- * number of candidates. O(n log k). */
-static void rt_select(const double *d, size_t n, size_t k, size_t exclude, size_t *out)
+/* The k first indices of a row (scores.h). */
+void amscr__rank_select(const double *d, size_t n, size_t k, size_t exclude, size_t *out)
 {
     if (k == 0)
         return;
@@ -100,7 +99,7 @@ amscr_status amscr_topk(const double *dist, size_t n, size_t k, size_t exclude, 
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_topk: k = %zu > %zu candidates", k, avail);
     if (rt_has_nan(dist, n))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_topk: NaN distance");
-    rt_select(dist, n, k, exclude, out_indices);
+    amscr__rank_select(dist, n, k, exclude, out_indices);
     return AMSCR_OK;
 }
 
@@ -166,7 +165,7 @@ amscr_status amscr_score_bullseye(const double *dist, size_t n, const int32_t *l
         size_t w = window ? window : 2 * counts[i];
         if (w > n)
             w = n;
-        rt_select(dist + i * n, n, w, SIZE_MAX, idx);
+        amscr__rank_select(dist + i * n, n, w, SIZE_MAX, idx);
         size_t h = 0;
         for (size_t r = 0; r < w; r++)
             h += labels[idx[r]] == labels[i];
@@ -201,7 +200,7 @@ amscr_status amscr_score_topk_table(const double *dist, size_t n, const int32_t 
         return amscr__fail(AMSCR_E_NOMEM, "amscr_score_topk_table: out of memory");
     }
     for (size_t i = 0; i < n; i++) {
-        rt_select(dist + i * n, n, kmax, i, idx);
+        amscr__rank_select(dist + i * n, n, kmax, i, idx);
         for (size_t r = 0; r < kmax; r++)
             counts[r] += labels[idx[r]] == labels[i];
     }
@@ -211,8 +210,8 @@ amscr_status amscr_score_topk_table(const double *dist, size_t n, const int32_t 
     return AMSCR_OK;
 }
 
-/* Index of the smallest of row[0..n-1] other than `exclude` (ties: lower index). */
-static size_t rt_argmin(const double *row, size_t n, size_t exclude)
+/* Index of the smallest of a row other than `exclude` (scores.h). */
+size_t amscr__rank_argmin(const double *row, size_t n, size_t exclude)
 {
     size_t best = SIZE_MAX;
     for (size_t j = 0; j < n; j++) {
@@ -237,7 +236,7 @@ amscr_status amscr_score_nn_accuracy(const double *dist, size_t n, const int32_t
         return st;
     size_t correct = 0;
     for (size_t i = 0; i < n; i++)
-        correct += labels[rt_argmin(dist + i * n, n, i)] == labels[i];
+        correct += labels[amscr__rank_argmin(dist + i * n, n, i)] == labels[i];
     *out_accuracy = (double)correct / (double)n;
     return AMSCR_OK;
 }
@@ -258,7 +257,7 @@ amscr_status amscr_score_nn_split(const double *dist, size_t ntest, size_t ntrai
         return st;
     size_t correct = 0;
     for (size_t i = 0; i < ntest; i++)
-        correct += train_labels[rt_argmin(dist + i * ntrain, ntrain, SIZE_MAX)] == test_labels[i];
+        correct += train_labels[amscr__rank_argmin(dist + i * ntrain, ntrain, SIZE_MAX)] == test_labels[i];
     *out_accuracy = (double)correct / (double)ntest;
     return AMSCR_OK;
 }

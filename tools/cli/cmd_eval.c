@@ -12,7 +12,6 @@
 #include "json.h"
 #include "names.h"
 #include "cmd_params.h"
-#include "protocols.h"
 #include "shape_db.h"
 
 /* The scores the protocol asks for, and the times of the steps. */
@@ -24,45 +23,89 @@ typedef struct eval_scores {
     double t0, t1, t2, secs; /* start, db prepared, matrix done; total seconds */
     double *cls_nn, *cls_be; /* per class (leave-one-out), when nn / bull's eye are computed */
     size_t *sizes;           /* class sizes */
+    int32_t *labels;         /* n class indices (the collection's labels) */
     int want_split, want_groups, want_nn_classes;
-    split_result split;
-    groups_result groups;
+    double split_mean, split_std, *split_acc, *split_cls; /* split: splits and nclasses entries */
+    double groups_acc, *groups_grp, *groups_cls;         /* groups: ngroups and nclasses entries */
 } eval_scores;
 
-/* The per-class scores and the split / groups protocols. */
-static int compute_protocols(const double *d, const collection *c, const opts *o, eval_scores *s)
+/* The collection's class labels (malloc'ed, n entries), and with sizes non-NULL the class sizes
+ * (malloc'ed, nclasses entries, amscr_score_classes: the classes are the labels 0..nclasses-1). */
+static int32_t *collection_labels(const collection *c, size_t **sizes)
 {
+    int32_t *l = xmalloc_array(c->n ? c->n : 1, sizeof(int32_t));
+    if (l == NULL)
+        return NULL;
+    for (size_t i = 0; i < c->n; i++)
+        l[i] = c->items[i].label;
     size_t nc = c->nclasses;
-    if ((s->sizes = class_sizes(c)) == NULL)
-        return -1;
+    if (sizes && ((*sizes = xmalloc_array(nc ? nc : 1, sizeof(size_t))) == NULL ||
+                  amscr_score_classes(l, c->n, NULL, *sizes, &nc) != AMSCR_OK)) {
+        free(*sizes);
+        *sizes = NULL;
+        free(l);
+        return NULL;
+    }
+    return l;
+}
+
+/* Leave one group out (amscr_score_nn_groups). */
+static amscr_status compute_groups(const double *d, const collection *c, eval_scores *s)
+{
+    size_t nc = c->nclasses, n = c->n;
+    int32_t *g = xmalloc_array(n, sizeof(int32_t));
+    s->groups_grp = xmalloc_array(c->ngroups, sizeof(double));
+    s->groups_cls = xmalloc_array(nc, sizeof(double));
+    if (!g || !s->groups_grp || !s->groups_cls) {
+        free(g);
+        return AMSCR_E_NOMEM;
+    }
+    for (size_t i = 0; i < n; i++)
+        g[i] = c->items[i].group;
+    amscr_status st = amscr_score_nn_groups(d, n, s->labels, g, c->ngroups, nc, &s->groups_acc, s->groups_grp,
+                                            s->groups_cls);
+    free(g);
+    return st;
+}
+
+/* The per-class scores and the split / groups protocols (the library's amscr_score_per_class,
+ * amscr_score_nn_random_split, amscr_score_nn_groups). */
+static int compute_protocols(const double *d, const collection *c, const opts *o, const char *cpath, eval_scores *s)
+{
+    size_t nc = c->nclasses, n = c->n;
     if (o->plot && !s->want_be && !s->want_nn && !s->want_split && !s->want_groups)
         s->want_nn_classes = 1; /* the plot's bars */
-    if (s->want_nn_classes && (s->cls_nn = xmalloc_array(nc, sizeof(double))) == NULL)
-        return -1;
-    if (s->want_nn && (s->cls_nn = xmalloc_array(nc, sizeof(double))) == NULL)
+    if ((s->want_nn_classes || s->want_nn) && (s->cls_nn = xmalloc_array(nc, sizeof(double))) == NULL)
         return -1;
     if (s->want_be && (s->cls_be = xmalloc_array(nc, sizeof(double))) == NULL)
         return -1;
-    if ((s->cls_nn || s->cls_be) && per_class_loo(d, c, s->cls_nn, s->cls_be) != 0)
+    amscr_status st = AMSCR_OK;
+    if (s->cls_nn || s->cls_be)
+        st = amscr_score_per_class(d, n, s->labels, nc, s->cls_be, s->cls_nn);
+    if (st == AMSCR_OK && s->want_split) {
+        s->split_acc = xmalloc_array(o->splits, sizeof(double));
+        s->split_cls = xmalloc_array(nc, sizeof(double));
+        if (!s->split_acc || !s->split_cls)
+            return -1;
+        st = amscr_score_nn_random_split(d, n, s->labels, o->train, o->splits, (uint64_t)o->seed, nc, &s->split_mean,
+                                         &s->split_std, s->split_acc, s->split_cls);
+    }
+    if (st == AMSCR_OK && s->want_groups)
+        st = compute_groups(d, c, s);
+    if (st != AMSCR_OK) {
+        tool_lib_error(cpath, st);
         return -1;
-    if (s->want_split && protocol_split(d, c, o->train, o->splits, o->seed, &s->split) != 0)
-        return -1;
-    if (s->want_groups && protocol_groups(d, c, &s->groups) != 0)
-        return -1;
+    }
     return 0;
 }
 
 static int compute_scores(const double *d, const collection *c, const opts *o, const char *cpath, eval_scores *s)
 {
     size_t n = c->n;
-    int32_t *labels = xmalloc_array(n, sizeof(int32_t));
+    const int32_t *labels = s->labels = collection_labels(c, &s->sizes);
     s->counts = xcalloc_array(s->ranks, sizeof(size_t));
-    if (labels == NULL || s->counts == NULL) {
-        free(labels);
+    if (labels == NULL || s->counts == NULL)
         return -1;
-    }
-    for (size_t i = 0; i < n; i++)
-        labels[i] = c->items[i].label;
     amscr_status st = AMSCR_OK;
     if (s->want_be)
         st = amscr_score_bullseye(d, n, labels, 0, &s->be);
@@ -70,37 +113,35 @@ static int compute_scores(const double *d, const collection *c, const opts *o, c
         st = amscr_score_topk_table(d, n, labels, s->ranks, s->counts);
     if (st == AMSCR_OK && s->want_nn)
         st = amscr_score_nn_accuracy(d, n, labels, &s->nn);
-    free(labels);
     if (st != AMSCR_OK) {
         tool_lib_error(cpath, st);
         return -1;
     }
-    return compute_protocols(d, c, o, s);
+    return compute_protocols(d, c, o, cpath, s);
 }
 
 /* ", \"split\": {...}, \"groups\": {...}, \"per_class\": [...]" as computed. */
-static void json_protocols(sbuf *b, const collection *c, const eval_scores *s)
+static void json_protocols(sbuf *b, const opts *o, const collection *c, const eval_scores *s)
 {
-    const split_result *sp = &s->split;
     if (s->want_split) {
-        sb_printf(b, ", \"split\": {\"train\": %zu, \"splits\": %zu, \"seed\": %llu, \"accuracy_mean\": ", sp->train,
-                  sp->splits, sp->seed);
-        sb_json_num(b, sp->mean);
+        sb_printf(b, ", \"split\": {\"train\": %zu, \"splits\": %zu, \"seed\": %llu, \"accuracy_mean\": ", o->train,
+                  o->splits, o->seed);
+        sb_json_num(b, s->split_mean);
         sb_puts(b, ", \"accuracy_std\": ");
-        sb_json_num(b, sp->std);
+        sb_json_num(b, s->split_std);
         sb_puts(b, ", \"accuracies\": ");
-        sb_json_nums(b, sp->acc, NULL, sp->splits);
+        sb_json_nums(b, s->split_acc, NULL, o->splits);
         sb_puts(b, "}");
     }
     if (s->want_groups) {
         sb_printf(b, ", \"groups\": {\"n\": %zu, \"accuracy\": ", c->ngroups);
-        sb_json_num(b, s->groups.acc);
+        sb_json_num(b, s->groups_acc);
         sb_puts(b, ", \"per_group\": [");
         for (size_t g = 0; g < c->ngroups; g++) {
             sb_puts(b, g ? ", {\"group\": " : "{\"group\": ");
             sb_json_str(b, c->groups[g]);
             sb_puts(b, ", \"accuracy\": ");
-            sb_json_num(b, s->groups.grp[g]);
+            sb_json_num(b, s->groups_grp[g]);
             sb_puts(b, "}");
         }
         sb_puts(b, "]}");
@@ -120,11 +161,11 @@ static void json_protocols(sbuf *b, const collection *c, const eval_scores *s)
         }
         if (s->want_split) {
             sb_puts(b, ", \"split_accuracy\": ");
-            sb_json_num(b, s->split.cls[k]);
+            sb_json_num(b, s->split_cls[k]);
         }
         if (s->want_groups) {
             sb_puts(b, ", \"groups_accuracy\": ");
-            sb_json_num(b, s->groups.cls[k]);
+            sb_json_num(b, s->groups_cls[k]);
         }
         sb_puts(b, "}");
     }
@@ -150,7 +191,7 @@ static void format_json(sbuf *b, const opts *o, const collection *c, const amscr
         sb_puts(b, ", \"nn_accuracy\": ");
         sb_json_num(b, s->nn);
     }
-    json_protocols(b, c, s);
+    json_protocols(b, o, c, s);
     sb_puts(b, ", \"method\": ");
     sb_json_str(b, name_of(&METHOD_NAMES, (int)amscr_params_get_method(p)));
     sb_printf(b, ", \"reflections\": %s, \"seconds\": ", amscr_params_get_reflections(p) ? "true" : "false");
@@ -181,23 +222,27 @@ static void format_text(sbuf *b, const opts *o, const collection *c, const amscr
         sb_printf(b, "1-NN        %.2f %%  (leave-one-out)\n", 100.0 * s->nn);
     if (s->want_split)
         sb_printf(b, "split       %.2f %% +- %.2f  (1-NN, %zu per class trained, %zu splits, seed %llu)\n",
-                  100.0 * s->split.mean, 100.0 * s->split.std, s->split.train, s->split.splits, s->split.seed);
+                  100.0 * s->split_mean, 100.0 * s->split_std, o->train, o->splits, o->seed);
     if (s->want_groups)
-        sb_printf(b, "groups      %.2f %%  (1-NN, leave one of %zu groups out)\n", 100.0 * s->groups.acc, c->ngroups);
+        sb_printf(b, "groups      %.2f %%  (1-NN, leave one of %zu groups out)\n", 100.0 * s->groups_acc, c->ngroups);
     sb_printf(b, "seconds     %.2f  (prepare %.2f, matrix %.2f: %.0f pairs/s)\n", s->secs, s->t1 - s->t0, tm,
               s->t2 > s->t1 ? (double)n * (double)(n - 1) / tm : 0.0);
 }
 
 enum { PR_LEVELS = 21 }; /* recall 0, 0.05, ..., 1 */
 
-/* --plot: the per-class scores the protocol computed and the precision-recall curve. */
+/* --plot: the per-class scores the protocol computed and the precision-recall curve
+ * (amscr_score_precision_recall). */
 static int draw_plot(const opts *o, const double *d, const collection *c, const eval_scores *s)
 {
     double rec[PR_LEVELS], prec[PR_LEVELS];
     score_series ser[4];
     size_t ns = 0;
-    if (pr_curve(d, c, PR_LEVELS, prec) != 0)
+    amscr_status st = amscr_score_precision_recall(d, c->n, s->labels, PR_LEVELS, prec);
+    if (st != AMSCR_OK) {
+        tool_lib_error(o->pos[0], st);
         return -1;
+    }
     for (size_t l = 0; l < PR_LEVELS; l++)
         rec[l] = (double)l / (PR_LEVELS - 1);
     if (s->cls_nn)
@@ -205,13 +250,34 @@ static int draw_plot(const opts *o, const double *d, const collection *c, const 
     if (s->cls_be)
         ser[ns++] = (score_series){"bull's eye", s->cls_be};
     if (s->want_split)
-        ser[ns++] = (score_series){"1-NN (random split, mean)", s->split.cls};
+        ser[ns++] = (score_series){"1-NN (random split, mean)", s->split_cls};
     if (s->want_groups)
-        ser[ns++] = (score_series){"1-NN (leave one group out)", s->groups.cls};
+        ser[ns++] = (score_series){"1-NN (leave one group out)", s->groups_cls};
     char title[600];
     snprintf(title, sizeof title, "%s: %zu shapes, %zu classes", path_base(o->pos[0]), c->n, c->nclasses);
     eval_plot_input in = {title, c->classes, c->nclasses, ser, ns, rec, prec, PR_LEVELS};
     return draw_eval_plot(o->plot, &in);
+}
+
+/* 0 when every class has more than `train` shapes; otherwise prints the error naming the
+ * smallest such class and returns TOOL_EXIT_USAGE. */
+static int split_check(const collection *c, size_t train)
+{
+    size_t *sz = NULL, worst = 0;
+    int32_t *l = collection_labels(c, &sz);
+    free(l);
+    if (l == NULL)
+        return TOOL_EXIT_FAIL;
+    for (size_t k = 1; k < c->nclasses; k++)
+        if (sz[k] < sz[worst])
+            worst = k;
+    int r = 0;
+    if (train >= sz[worst])
+        r = usage_error("--train", "%zu training shapes per class leave none to test in class '%s' (%zu shapes); "
+                        "use --train %zu or less",
+                        train, c->classes[worst], sz[worst], sz[worst] - 1);
+    free(sz);
+    return r;
 }
 
 /* What the protocol needs of the collection, checked before any shape is prepared. */
@@ -291,8 +357,11 @@ done:
     free(s.cls_nn);
     free(s.cls_be);
     free(s.sizes);
-    split_result_free(&s.split);
-    groups_result_free(&s.groups);
+    free(s.labels);
+    free(s.split_acc);
+    free(s.split_cls);
+    free(s.groups_grp);
+    free(s.groups_cls);
     amscr_db_free(db);
     collection_free(&c);
     amscr_params_free(p);

@@ -38,6 +38,8 @@ from .shape import PointsLike, Shape
 from .result import Mixture, Registration, channel_distance, distance, register
 from .collection import Collection, distance_matrix
 from .scores import bullseye, nn_accuracy, nn_split, topk, topk_table
+from .scores import (ClassScores, GroupScores, PrecisionRecall, SplitScores, nn_groups, nn_random_split,
+                     per_class_scores, precision_recall)
 from .rerank import rerank_diffusion
 from .curves import affine_arclength, gaussian_kernel, normalize_whiten, resample_affine, resample_euclidean, smooth
 from .linalg import affine_apply, affine_fit, affine_invert, lstsq
@@ -68,4 +70,7 @@ __all__ = [
     'kmeans', 'KMeansResult', 'elbow', 'GMM1D', 'gmm1d', 'bayes_threshold',
     # one-vs-many retrieval
     'Index',
+    # evaluation protocols
+    'per_class_scores', 'nn_random_split', 'nn_groups', 'precision_recall', 'ClassScores', 'SplitScores',
+    'GroupScores', 'PrecisionRecall',
 ]

@@ -259,4 +259,9 @@ amscr_status amscr_score_bullseye(const double *dist, size_t n, const int32_t *l
 amscr_status amscr_score_topk_table(const double *dist, size_t n, const int32_t *labels, size_t kmax, size_t *out_counts);
 amscr_status amscr_score_nn_accuracy(const double *dist, size_t n, const int32_t *labels, double *out_accuracy);
 amscr_status amscr_score_nn_split(const double *dist, size_t ntest, size_t ntrain, const int32_t *test_labels, const int32_t *train_labels, double *out_accuracy);
+amscr_status amscr_score_classes(const int32_t *labels, size_t n, int32_t *out_classes, size_t *out_sizes, size_t *inout_nclasses);
+amscr_status amscr_score_per_class(const double *dist, size_t n, const int32_t *labels, size_t nclasses, double *out_bullseye, double *out_nn_accuracy);
+amscr_status amscr_score_nn_random_split(const double *dist, size_t n, const int32_t *labels, size_t train, size_t splits, uint64_t seed, size_t nclasses, double *out_mean, double *out_std, double *out_accuracies, double *out_class_accuracy);
+amscr_status amscr_score_nn_groups(const double *dist, size_t n, const int32_t *labels, const int32_t *groups, size_t ngroups, size_t nclasses, double *out_accuracy, double *out_group_accuracy, double *out_class_accuracy);
+amscr_status amscr_score_precision_recall(const double *dist, size_t n, const int32_t *labels, size_t nlevels, double *out_precision);
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);
