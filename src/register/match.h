@@ -81,7 +81,7 @@ typedef struct {
     double w[AMSCR__KMAX], mu[AMSCR__KMAX], var[AMSCR__KMAX];
     size_t ncomp;
     double threshold;
-    /* issue 14: confidence of the match (see amscr_result_ambiguity / _inlier_fraction) */
+    /* confidence of the match (see amscr_result_ambiguity / _inlier_fraction) */
     double ambiguity;
     /* the search's scored start candidates (registration with refinement; else ncand 0) */
     double cand[2 * AMSCR__CANDIDATES][6];
@@ -93,7 +93,7 @@ struct amscr_result {
     match_t m;
     double affine_in[6];
     double affine_norm[6];
-    /* issue 14: dense correspondences (see correspond.c), malloc'ed, n samples */
+    /* dense correspondences (see correspond.c), malloc'ed, n samples */
     size_t ncorr;
     double *corr;  /* 5n: source xy (input), target parameter, target xy (input) */
     double inlier; /* inlier fraction */
@@ -165,7 +165,7 @@ amscr_status amscr__refine_match(const amscr_params *prm, const amscr_descriptor
 amscr_status amscr__final_solve(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                 amscr_workspace *ws, match_t *m);
 
-/* ---- issue 14 (registration): robust, partial, confidence, correspondences ---- */
+/* ---- robust registration: robust, partial, confidence, correspondences ---- */
 /* Exported pieces of refine.c: the closest point on a polygon within edges b0 ± w; quickselect;
  * the trimmed solve of the pairs with r2 <= cut; Catmull-Rom densification by AMSCR__DENSE. */
 double amscr__closest_on_polygon(const double *H, size_t n, int closed, size_t b0, size_t w, double px, double py,

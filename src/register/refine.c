@@ -231,7 +231,7 @@ amscr_status amscr__refine_match(const amscr_params *prm, const amscr_descriptor
 }
 
 
-/* ---- issue 14 (registration): the closest-point pieces shared with partial.c and
+/* ---- robust registration: the closest-point pieces shared with partial.c and
  * correspond.c (thin exported names of the statics above) ---- */
 double amscr__closest_on_polygon(const double *H, size_t n, int closed, size_t b0, size_t w, double px, double py,
                                  double *qx, double *qy, size_t *seg)

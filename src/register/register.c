@@ -119,7 +119,7 @@ static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor 
 static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                int report, amscr_workspace *ws, match_t *m)
 {
-    if (prm->partial) { /* issue 14: the fragment's place, then the reported QR of its pairs */
+    if (prm->partial) { /* partial matching: the fragment's place, then the reported QR of its pairs */
         amscr_status st = amscr__match_partial(prm, src, tgt, ws, m);
         if (st == AMSCR_OK && report) /* the place is known: refine on with an adaptive trim */
             st = amscr__refine_adaptive(prm, src, tgt, ws, m);
@@ -127,7 +127,7 @@ static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *
     }
     amscr_status st = amscr__match_dir(prm, src, tgt, ws, m);
     if (st == AMSCR_OK && report && prm->invariance == AMSCR_INVARIANCE_AFFINE && src->params.closed)
-        st = amscr__recover_missing(prm, src, tgt, ws, m); /* issue 14: part of the target missing */
+        st = amscr__recover_missing(prm, src, tgt, ws, m); /* part of the target missing */
     if (st == AMSCR_OK && report && prm->invariance == AMSCR_INVARIANCE_AFFINE)
         st = amscr__final_solve(prm, src, tgt, ws, m);
     if (st == AMSCR_OK && prm->symmetric) {

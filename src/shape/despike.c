@@ -1,4 +1,4 @@
-/* despike.c — isolated spikes removed from a point list before registration (issue 14).
+/* despike.c — isolated spikes removed from a point list before registration (robust registration).
  *
  * A few stray points in a contour (a detector's glitch, a mis-clicked vertex) wreck everything
  * that follows: each adds two long edges, so the arc-length parametrization, the affine
