@@ -166,13 +166,10 @@ amscr_status amscr__final_solve(const amscr_params *prm, const amscr_descriptor 
                                 amscr_workspace *ws, match_t *m);
 
 /* ---- robust registration: robust, partial, confidence, correspondences ---- */
-/* Exported pieces of refine.c: the closest point on a polygon within edges b0 ± w; quickselect;
- * the trimmed solve of the pairs with r2 <= cut; Catmull-Rom densification by AMSCR__DENSE. */
+/* Exported pieces of refine.c: the closest point on a polygon within edges b0 ± w; Catmull-Rom
+ * densification by AMSCR__DENSE. */
 double amscr__closest_on_polygon(const double *H, size_t n, int closed, size_t b0, size_t w, double px, double py,
                                  double *qx, double *qy, size_t *seg);
-void amscr__select_kth(double *v, size_t n, size_t k);
-int amscr__trimmed_solve(const amscr_params *prm, const double *f, const double *q, const double *r2, size_t n,
-                         double cut, double X[6]);
 size_t amscr__densify(const double *H, size_t n, int closed, double *out);
 /* The trimmed point-to-line solve (affine invariance; the other groups: point-to-point) of the
  * pairs f_a -> q_a with r2_a <= cut, seg_a the dense target edge of q_a. Returns 0 if singular. */

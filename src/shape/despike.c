@@ -15,8 +15,8 @@
  * Lists of fewer than
  * SPIKE_MIN_POINTS points (polygons) are left alone. Never removes more than 1/SPIKE_MAX_SHARE
  * of the points (more would not be isolated spikes). */
+#include "dense.h"
 #include "internal.h"
-#include "match.h"
 
 #include <math.h>
 #include <string.h>
