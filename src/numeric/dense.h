@@ -1,4 +1,13 @@
-/* dense.h — small dense numerics shared by the geometry and the registration (never installed):
+/* The numeric area (src/numeric/): the numerical building blocks, independent of shapes:
+ *   lstsq.c   least squares by Householder QR through LAPACKE
+ *   fft.c     a small complex FFT with plans (fft.h)
+ *   dense.c   small dense numerics (this header)
+ *   kmeans.c  deterministic K-means (exact in 1-D) and the elbow choice of K
+ *   gmm1d.c   1-D Gaussian mixture by EM and the Bayes threshold
+ *   smooth.c  FIR Gaussian smoothing of curves
+ *   affine.c  fitting, applying and inverting 2-D affine maps
+ *
+ * dense.h — small dense numerics shared by the geometry and the registration (never installed):
  * centroid and scatter of a point set, the moment sums of a least-squares fit, 3x3 inverse,
  * a small Gaussian elimination, the sort of a short array and the k-th smallest of an array. */
 #ifndef AMSCR_DENSE_H

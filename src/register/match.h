@@ -1,14 +1,23 @@
 /* match.h — internals of the registration engine (never installed): the workspace, one match
- * and the steps of docs/method.md §12, one file each:
- *   shift_search.c  spectral start-point search: candidates and their one ranking rule
- *   method.c        the method at one start point: per-scale solves, scale selection, stacked solve
- *   scale_select.c  which scales enter the stacked solve (all, finest, EM + Bayes threshold)
- *   group_fit.c     the least-squares map of one system within the invariance group; the distance
- *   refine.c        trimmed closest-point refinement
- *   final_solve.c   the reported solve by LAPACKE QR
- *   workspace.c     the caller-owned scratch of all of the above
- *   result.c        the result object and its getters
- *   register.c      the public entry points, top-down. */
+ * and the stages of docs/method.md §12, one file each, in pipeline order:
+ *   shape/descriptor.c  (per shape, once) validate, orient, parametrize, sample, whiten, smooth
+ *   shape/despike.c     (per shape, once) isolated stray points dropped before parametrizing
+ *   register.c          the public entry points: check the pair, run the stages below, top-down
+ *   shift_search.c      spectral start-point search: candidates and their one ranking rule
+ *   method.c            the method at one start point: per-scale solves, residuals, stacked solve
+ *   scale_select.c      which scales enter the stacked solve (all, finest, EM + Bayes threshold)
+ *   group_fit.c         the least-squares map of one system within the invariance group; the distance
+ *   refine.c            trimmed closest-point (point-to-line) refinement
+ *   partial.c           partial matching: an open fragment placed on the closed target (no shift search)
+ *   recover.c           part of the target missing: source fragments placed as further starts
+ *   final_solve.c       the reported solve by LAPACKE QR; the distance
+ *   polish.c            the reported map polished on the input points (amscr_register only)
+ *   nearest.c           closest points on the input polylines, for the polish (nearest.h)
+ *   ordered.c           the polish's order stage: a noisy curve's point order (ordered.h)
+ *   even.c              the polish's even-spacing stage: points taken evenly along it (even.h)
+ *   correspond.c        confidence, inliers, the part covered, dense correspondences
+ *   result.c            the result object and its getters
+ * and base/workspace.c, the caller-owned scratch of all of the above. */
 #ifndef AMSCR_MATCH_H
 #define AMSCR_MATCH_H
 

@@ -1,4 +1,8 @@
-/* register.c — matching a prepared source onto a prepared target (docs/method.md §3, §9), top-down:
+/* The register area (src/register/): the registration engine, matching one prepared shape onto
+ * another. match.h is its internal header and names every stage file in pipeline order
+ * (docs/method.md §12); this file holds the public entry points.
+ *
+ * register.c — matching a prepared source onto a prepared target (docs/method.md §3, §9), top-down:
  *   amscr_register / amscr_distance  check the pair, then match_pair:
  *   match_pair        one direction f -> h, the reported solve, and (symmetric) h -> f;
  *   amscr__match_dir  (shift_search.c) candidate start points ranked by one rule, the winner
