@@ -17,7 +17,7 @@ import subprocess
 import sys
 import time
 
-TARGET = 0.5  # seconds for one query against a 10,000-shape index (issue 15)
+TARGET = 0.5  # seconds for one query against a 10,000-shape index
 
 
 def curve(coef, rng, noise, m=120):

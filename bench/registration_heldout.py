@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Held-out registration check (issue 14): amscr against OpenCV's ECC on MPEG-7-like contours.
+"""Held-out registration check: amscr against OpenCV's ECC on MPEG-7-like contours.
 
 For each of the first 35 classes of a manifest (one shape per class, the class's first file) and
 2 seeded draws per condition: the traced pixel contour f, a random affine map T (any rotation,

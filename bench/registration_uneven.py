@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Registration of noisy contours sampled UNEVENLY along the curve (issue 14, the order stage).
+"""Registration of noisy contours sampled UNEVENLY along the curve (the order stage).
 
 For each of the first 35 classes of a manifest (one shape per class) and 4 seeded draws: the traced
 pixel contour f, a random affine map T (registration_heldout.py's), the target T(f) resampled to

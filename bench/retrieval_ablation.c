@@ -1,4 +1,4 @@
-/* retrieval_ablation.c — the ablation table of the retrieval default (issue 13; run by
+/* retrieval_ablation.c — the ablation table of the retrieval default (run by
  * `amscr-retrieval-bench ablation DATASETS`): on each set the three base matrices are computed
  * once through the library — the AMSCR distance (the paper's method: affine group, no
  * refinement, mirror images), the shape channel in the similarity frame and in the affine

@@ -1,4 +1,4 @@
-/* retrieval_bench.c — the default retrieval pipeline measured (issue 13):
+/* retrieval_bench.c — the default retrieval pipeline measured:
  *
  *   amscr-retrieval-bench timing DATASETS    the retrieval preset and its fast setting (affine
  *       share 0) on a 1400-shape MPEG-7-size collection (mpeg7-dev loaded twice; without it

@@ -1,4 +1,4 @@
-/* retrieval_exp.c — the retrieval experiment driver (issue 13): loads labelled collections
+/* retrieval_exp.c — the retrieval experiment driver: loads labelled collections
  * (manifest.tsv), builds the MCD-style affine set from one (seeded), prepares, computes the
  * AMSCR matrix and the shape channel, fuses, re-ranks and prints bull's eye / top-k sums and
  * per-stage times. Deterministic.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Hardening checks (issue 7), run by CI after the normal tests; one entry point:
+# Hardening checks, run by CI after the normal tests; one entry point:
 #   1. asan      build-asan/ (AddressSanitizer + UBSan, debugoptimized): every C suite (unit, abi),
 #                the fuzz-corpus replays and the tool tests, with leak detection
 #   2. abi       tests/abi/check-abi.sh: abidiff against tests/abi/amscr-<version>.abi

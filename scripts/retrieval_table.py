@@ -5,7 +5,7 @@ rows (docs/method.md §4). One command reproduces the tables of docs/measurement
     python3 scripts/retrieval_table.py [--datasets ../shared/datasets] [--tool build/tools/amscr]
 
 Table 1: the paper's four methods with the library's registration defaults (affine group, no
-re-ranking). Table 2: invariance modes x contextual re-ranking (issue 8) of the AMSCR distance
+re-ranking). Table 2: invariance modes x contextual re-ranking of the AMSCR distance
 alone (`--channel-weight 0`), which chose the 0.1 retrieval defaults; the 0.2 defaults (the
 shape channel, fused and re-ranked) and their ablation come from `meson compile -C build
 ablation` (bench/retrieval_ablation.c). Prints Markdown."""

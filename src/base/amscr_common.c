@@ -1,4 +1,10 @@
-/* amscr_common.c — errors, version, features, allocation helpers. */
+/* The base area (src/base/): what every other area builds on:
+ *   amscr_common.c  errors (status strings, the thread-local detail), version, features, allocation
+ *   params.c        the options object: documented defaults, presets, validating setters
+ *   workspace.c     the caller-owned scratch of a registration
+ *   internal.h      the shared internals of libamscr (never installed)
+ *
+ * amscr_common.c — errors, version, features, allocation helpers. */
 #include "internal.h"
 
 #include <math.h>

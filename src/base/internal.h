@@ -63,9 +63,9 @@ struct amscr_params {
     unsigned num_threads;
     amscr_invariance invariance;
     double penalty;
-    /* issue 14 (registration): the source is an open fragment of the target's closed boundary */
+    /* partial matching: the source is an open fragment of the target's closed boundary */
     int partial;
-    /* issue 14 (0.3): polish the reported map on the input points (polish.c) */
+    /* polish the reported map on the input points (polish.c) */
     int polish;
     /* retrieval (0.2, channel.c / fuse.c) */
     double channel_weight;             /* share of the shape channel in the fused distance, 0..1 */
@@ -141,7 +141,7 @@ struct amscr_descriptor {
     double norm2;  /* sum |base|^2 */
     double nyq2;   /* even N: (|X(N/2)|^2 + |Y(N/2)|^2) / N, the Nyquist term's energy */
     size_t finest; /* index of the smallest scale */
-    /* issue 14 (0.3): the input points (deduplicated, counter-clockwise, every k-th when over
+    /* the input points (deduplicated, counter-clockwise, every k-th when over
      * AMSCR__POLISH_MAX_POINTS) kept for the polish (polish.c): closed curves under affine
      * invariance; NULL in collections (amscr_db) and after a load. */
     double *raw;

@@ -165,7 +165,7 @@ GETTER(rerank_k, unsigned, rerank_k)
 SETTER(rerank_iterations, unsigned, rerank_iterations, v >= 1 && v <= 1000, "%u is outside 1..1000")
 GETTER(rerank_iterations, unsigned, rerank_iterations)
 
-/* ---- issue 14 (registration): partial matching ---- */
+/* ---- robust registration: partial matching, polish ---- */
 SETTER(partial, int, partial, v == 0 || v == 1, "%d is not 0 or 1")
 GETTER(partial, int, partial)
 SETTER(polish, int, polish, v == 0 || v == 1, "%d is not 0 or 1")

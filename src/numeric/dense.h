@@ -1,6 +1,15 @@
-/* dense.h — small dense numerics shared by the geometry and the registration (never installed):
+/* The numeric area (src/numeric/): the numerical building blocks, independent of shapes:
+ *   lstsq.c   least squares by Householder QR through LAPACKE
+ *   fft.c     a small complex FFT with plans (fft.h)
+ *   dense.c   small dense numerics (this header)
+ *   kmeans.c  deterministic K-means (exact in 1-D) and the elbow choice of K
+ *   gmm1d.c   1-D Gaussian mixture by EM and the Bayes threshold
+ *   smooth.c  FIR Gaussian smoothing of curves
+ *   affine.c  fitting, applying and inverting 2-D affine maps
+ *
+ * dense.h — small dense numerics shared by the geometry and the registration (never installed):
  * centroid and scatter of a point set, the moment sums of a least-squares fit, 3x3 inverse,
- * a small Gaussian elimination and the sort of a short array. */
+ * a small Gaussian elimination, the sort of a short array and the k-th smallest of an array. */
 #ifndef AMSCR_DENSE_H
 #define AMSCR_DENSE_H
 
@@ -55,5 +64,9 @@ int amscr__gauss_solve(double *a, double *b, int n);
 
 /* Sorts n values ascending in place (insertion sort when short, qsort otherwise). */
 void amscr__sort_doubles(double *v, size_t n);
+
+/* Partially orders v (n >= 1) so that v[k] is the k-th smallest and v[0..k) are the smaller
+ * ones (quickselect, median-of-three pivots): O(n), no allocation. */
+void amscr__select_kth(double *v, size_t n, size_t k);
 
 #endif

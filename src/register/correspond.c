@@ -1,4 +1,4 @@
-/* correspond.c — what a finished registration says beyond the map (issue 14): for every source
+/* correspond.c — what a finished registration says beyond the map: for every source
  * sample the closest point of the target's boundary to its image (dense correspondences, for
  * landmark transfer), the share of samples that found the boundary near them (inliers), and
  * where the source's first and last samples fall on the target (the part it covers). */

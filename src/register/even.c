@@ -1,5 +1,5 @@
 /* even.c — the polished map refined on the evidence that a noisy curve's points were taken
- * evenly along it (issue 14).
+ * evenly along it.
  *
  * The order stage (ordered.c) lets each step of a noisy curve's order advance anywhere from 0 to
  * a few mean steps, so a long or thin part's position along itself stays loosely held (a spoon's

@@ -1,14 +1,23 @@
 /* match.h — internals of the registration engine (never installed): the workspace, one match
- * and the steps of docs/method.md §12, one file each:
- *   shift_search.c  spectral start-point search: candidates and their one ranking rule
- *   method.c        the method at one start point: per-scale solves, scale selection, stacked solve
- *   scale_select.c  which scales enter the stacked solve (all, finest, EM + Bayes threshold)
- *   group_fit.c     the least-squares map of one system within the invariance group; the distance
- *   refine.c        trimmed closest-point refinement
- *   final_solve.c   the reported solve by LAPACKE QR
- *   workspace.c     the caller-owned scratch of all of the above
- *   result.c        the result object and its getters
- *   register.c      the public entry points, top-down. */
+ * and the stages of docs/method.md §12, one file each, in pipeline order:
+ *   shape/descriptor.c  (per shape, once) validate, orient, parametrize, sample, whiten, smooth
+ *   shape/despike.c     (per shape, once) isolated stray points dropped before parametrizing
+ *   register.c          the public entry points: check the pair, run the stages below, top-down
+ *   shift_search.c      spectral start-point search: candidates and their one ranking rule
+ *   method.c            the method at one start point: per-scale solves, residuals, stacked solve
+ *   scale_select.c      which scales enter the stacked solve (all, finest, EM + Bayes threshold)
+ *   group_fit.c         the least-squares map of one system within the invariance group; the distance
+ *   refine.c            trimmed closest-point (point-to-line) refinement
+ *   partial.c           partial matching: an open fragment placed on the closed target (no shift search)
+ *   recover.c           part of the target missing: source fragments placed as further starts
+ *   final_solve.c       the reported solve by LAPACKE QR; the distance
+ *   polish.c            the reported map polished on the input points (amscr_register only)
+ *   nearest.c           closest points on the input polylines, for the polish (nearest.h)
+ *   ordered.c           the polish's order stage: a noisy curve's point order (ordered.h)
+ *   even.c              the polish's even-spacing stage: points taken evenly along it (even.h)
+ *   correspond.c        confidence, inliers, the part covered, dense correspondences
+ *   result.c            the result object and its getters
+ * and base/workspace.c, the caller-owned scratch of all of the above. */
 #ifndef AMSCR_MATCH_H
 #define AMSCR_MATCH_H
 
@@ -81,7 +90,7 @@ typedef struct {
     double w[AMSCR__KMAX], mu[AMSCR__KMAX], var[AMSCR__KMAX];
     size_t ncomp;
     double threshold;
-    /* issue 14: confidence of the match (see amscr_result_ambiguity / _inlier_fraction) */
+    /* confidence of the match (see amscr_result_ambiguity / _inlier_fraction) */
     double ambiguity;
     /* the search's scored start candidates (registration with refinement; else ncand 0) */
     double cand[2 * AMSCR__CANDIDATES][6];
@@ -93,7 +102,7 @@ struct amscr_result {
     match_t m;
     double affine_in[6];
     double affine_norm[6];
-    /* issue 14: dense correspondences (see correspond.c), malloc'ed, n samples */
+    /* dense correspondences (see correspond.c), malloc'ed, n samples */
     size_t ncorr;
     double *corr;  /* 5n: source xy (input), target parameter, target xy (input) */
     double inlier; /* inlier fraction */
@@ -165,14 +174,11 @@ amscr_status amscr__refine_match(const amscr_params *prm, const amscr_descriptor
 amscr_status amscr__final_solve(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                 amscr_workspace *ws, match_t *m);
 
-/* ---- issue 14 (registration): robust, partial, confidence, correspondences ---- */
-/* Exported pieces of refine.c: the closest point on a polygon within edges b0 ± w; quickselect;
- * the trimmed solve of the pairs with r2 <= cut; Catmull-Rom densification by AMSCR__DENSE. */
+/* ---- robust registration: robust, partial, confidence, correspondences ---- */
+/* Exported pieces of refine.c: the closest point on a polygon within edges b0 ± w; Catmull-Rom
+ * densification by AMSCR__DENSE. */
 double amscr__closest_on_polygon(const double *H, size_t n, int closed, size_t b0, size_t w, double px, double py,
                                  double *qx, double *qy, size_t *seg);
-void amscr__select_kth(double *v, size_t n, size_t k);
-int amscr__trimmed_solve(const amscr_params *prm, const double *f, const double *q, const double *r2, size_t n,
-                         double cut, double X[6]);
 size_t amscr__densify(const double *H, size_t n, int closed, double *out);
 /* The trimmed point-to-line solve (affine invariance; the other groups: point-to-point) of the
  * pairs f_a -> q_a with r2_a <= cut, seg_a the dense target edge of q_a. Returns 0 if singular. */

@@ -1,4 +1,4 @@
-/* ordered.c — the polished map refined by the order of a noisy curve's points (issue 14).
+/* ordered.c — the polished map refined by the order of a noisy curve's points.
  *
  * A point-to-curve fit sees only how far each noisy point lies from the moved clean curve, not
  * where along it the point was taken: when the noise is as large as the spacing of the points,

@@ -1,4 +1,4 @@
-/* partial.c — partial matching (issue 14): the source f is an open fragment of the closed
+/* partial.c — partial matching: the source f is an open fragment of the closed
  * target h. Where on h the fragment lies and how long it is are unknown; the method's one-to-one
  * correspondence of whole curves does not apply.
  *

@@ -1,4 +1,4 @@
-/* polish.c — the reported map polished on the input points themselves (issue 14).
+/* polish.c — the reported map polished on the input points themselves.
  *
  * The method and its refinement see N resampled samples, and the refinement pairs each source
  * sample with the closest point of the target. Both are right for clean contours; under noise

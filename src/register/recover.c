@@ -1,4 +1,4 @@
-/* recover.c — registration when part of the target's boundary is missing (issue 14).
+/* recover.c — registration when part of the target's boundary is missing.
  *
  * The method's one-to-one correspondence of whole curves assumes both boundaries complete. When a
  * run of the target is missing (occlusion, a broken trace), the target's parametrization is

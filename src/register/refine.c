@@ -65,40 +65,6 @@ static double closest_on_polygon(const double *H, size_t n, int closed, size_t b
     return best;
 }
 
-/* Partially orders v so that v[k] is the k-th smallest and v[0..k) are the smaller ones
- * (quickselect, median-of-three pivots): O(n), no allocation. */
-static void select_kth(double *v, size_t n, size_t k)
-{
-    size_t lo = 0, hi = n - 1;
-    while (hi > lo) {
-        size_t mid = lo + (hi - lo) / 2;
-        double a = v[lo], b = v[mid], c = v[hi];
-        double pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
-        size_t i = lo, j = hi;
-        while (i <= j) {
-            while (v[i] < pivot)
-                i++;
-            while (v[j] > pivot)
-                j--;
-            if (i <= j) {
-                double t = v[i];
-                v[i] = v[j];
-                v[j] = t;
-                i++;
-                if (j == 0)
-                    break;
-                j--;
-            }
-        }
-        if (k <= j)
-            hi = j;
-        else if (k >= i)
-            lo = i;
-        else
-            return;
-    }
-}
-
 /* Trimmed least squares X from pairs (f_a -> q_a) with r2_a <= cut. Returns 0 if singular. */
 static int trimmed_solve(const amscr_params *prm, const double *f, const double *q, const double *r2, size_t n,
                          double cut, double X[6])
@@ -170,7 +136,7 @@ static double icp_pairs(const amscr_descriptor *f, const double *Hd, size_t nd, 
     size_t keep = (size_t)(AMSCR__TRIM * (double)n);
     if (keep < AMSCR__TRIM_MIN_PAIRS)
         keep = n < AMSCR__TRIM_MIN_PAIRS ? n : AMSCR__TRIM_MIN_PAIRS;
-    select_kth(sorted, n, keep - 1);
+    amscr__select_kth(sorted, n, keep - 1);
     double cost = 0.0;
     for (size_t a = 0; a < keep; a++)
         cost += sorted[a];
@@ -231,20 +197,12 @@ amscr_status amscr__refine_match(const amscr_params *prm, const amscr_descriptor
 }
 
 
-/* ---- issue 14 (registration): the closest-point pieces shared with partial.c and
+/* ---- robust registration: the closest-point pieces shared with partial.c and
  * correspond.c (thin exported names of the statics above) ---- */
 double amscr__closest_on_polygon(const double *H, size_t n, int closed, size_t b0, size_t w, double px, double py,
                                  double *qx, double *qy, size_t *seg)
 {
     return closest_on_polygon(H, n, closed, b0, w, px, py, qx, qy, seg);
-}
-
-void amscr__select_kth(double *v, size_t n, size_t k) { select_kth(v, n, k); }
-
-int amscr__trimmed_solve(const amscr_params *prm, const double *f, const double *q, const double *r2, size_t n,
-                         double cut, double X[6])
-{
-    return trimmed_solve(prm, f, q, r2, n, cut, X);
 }
 
 size_t amscr__densify(const double *H, size_t n, int closed, double *out) { return densify(H, n, closed, out); }

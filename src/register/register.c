@@ -1,4 +1,8 @@
-/* register.c — matching a prepared source onto a prepared target (docs/method.md §3, §9), top-down:
+/* The register area (src/register/): the registration engine, matching one prepared shape onto
+ * another. match.h is its internal header and names every stage file in pipeline order
+ * (docs/method.md §12); this file holds the public entry points.
+ *
+ * register.c — matching a prepared source onto a prepared target (docs/method.md §3, §9), top-down:
  *   amscr_register / amscr_distance  check the pair, then match_pair:
  *   match_pair        one direction f -> h, the reported solve, and (symmetric) h -> f;
  *   amscr__match_dir  (shift_search.c) candidate start points ranked by one rule, the winner
@@ -119,7 +123,7 @@ static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor 
 static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                int report, amscr_workspace *ws, match_t *m)
 {
-    if (prm->partial) { /* issue 14: the fragment's place, then the reported QR of its pairs */
+    if (prm->partial) { /* partial matching: the fragment's place, then the reported QR of its pairs */
         amscr_status st = amscr__match_partial(prm, src, tgt, ws, m);
         if (st == AMSCR_OK && report) /* the place is known: refine on with an adaptive trim */
             st = amscr__refine_adaptive(prm, src, tgt, ws, m);
@@ -127,7 +131,7 @@ static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *
     }
     amscr_status st = amscr__match_dir(prm, src, tgt, ws, m);
     if (st == AMSCR_OK && report && prm->invariance == AMSCR_INVARIANCE_AFFINE && src->params.closed)
-        st = amscr__recover_missing(prm, src, tgt, ws, m); /* issue 14: part of the target missing */
+        st = amscr__recover_missing(prm, src, tgt, ws, m); /* part of the target missing */
     if (st == AMSCR_OK && report && prm->invariance == AMSCR_INVARIANCE_AFFINE)
         st = amscr__final_solve(prm, src, tgt, ws, m);
     if (st == AMSCR_OK && prm->symmetric) {

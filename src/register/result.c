@@ -102,7 +102,7 @@ amscr_status amscr_result_mixture(const amscr_result *r, double *out_weights, do
     return AMSCR_OK;
 }
 
-/* ---- issue 14 (registration): confidence, part, dense correspondences ---- */
+/* ---- robust registration: confidence, part, dense correspondences ---- */
 double amscr_result_ambiguity(const amscr_result *r) { return r ? r->m.ambiguity : NAN; }
 double amscr_result_inlier_fraction(const amscr_result *r) { return r ? r->inlier : NAN; }
 double amscr_result_confidence(const amscr_result *r)

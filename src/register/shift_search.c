@@ -393,7 +393,7 @@ static amscr_status run_start(const amscr_params *prm, const amscr_descriptor *f
     return amscr__refine_match(prm, f, h, ws, m, iters);
 }
 
-/* issue 14: the chosen candidate's score over the best score of a clearly different candidate
+/* Ambiguity: the chosen candidate's score over the best score of a clearly different candidate
  * map (1: as good; 0: none, or far worse). */
 static double ambiguity_of(const amscr_descriptor *f, double X[][6], const double *score, size_t count, size_t best)
 {
@@ -422,7 +422,7 @@ amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f
     int prepared_o = (prm->reflections ? 2 : 1) - 1;
     size_t best = 0;
     double best_score = INFINITY, best_dist = INFINITY;
-    double cand_X[2 * AMSCR__CANDIDATES][6], cand_score[2 * AMSCR__CANDIDATES]; /* issue 14: ambiguity */
+    double cand_X[2 * AMSCR__CANDIDATES][6], cand_score[2 * AMSCR__CANDIDATES]; /* for the ambiguity */
     for (size_t i = 0; i < count; i++) {
         double score = crit[i], dist = crit[i];
         if (kind != SCORE_CRITERION) {

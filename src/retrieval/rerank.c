@@ -23,10 +23,9 @@ static int cmp_nb(const void *a, const void *b)
 /* Output normalizations of the diffused affinity Q. */
 enum { NORM_ROW_MAX = 0, NORM_UNIT = 1 };
 
-static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iterations, int norm, double *out_dist,
-                           const char *what)
+static amscr_status check_args(const double *dist, size_t n, size_t k, unsigned iterations, const double *out_dist,
+                               const char *what)
 {
-    amscr__clear_error();
     AMSCR_CHECK_NULL(dist);
     AMSCR_CHECK_NULL(out_dist);
     if (n == 0 || k < 1 || k > n || iterations < 1 || iterations > 1000)
@@ -38,21 +37,46 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
     for (size_t i = 0; i < n * n; i++)
         if (!isfinite(dist[i]) || dist[i] < 0.0)
             return amscr__fail(AMSCR_E_INVALID_ARG, "%s: distance %zu is negative or not finite", what, i);
-    double *D = amscr__malloc_array(n * n, sizeof *D), *Q = amscr__malloc_array(n * n, sizeof *Q);
-    double *T = amscr__malloc_array(n * n, sizeof *T), *sc = amscr__malloc_array(n, sizeof *sc);
-    double *pw = amscr__malloc_array(n * k, sizeof *pw);
-    size_t *pj = amscr__malloc_array(n * k, sizeof *pj);
-    nb_t *row = amscr__malloc_array(n, sizeof *row);
-    if (!D || !Q || !T || !sc || !pw || !pj || !row) {
-        free(D);
-        free(Q);
-        free(T);
-        free(sc);
-        free(pw);
-        free(pj);
-        free(row);
-        return amscr__fail(AMSCR_E_NOMEM, "amscr_rerank_diffusion: out of memory");
-    }
+    return AMSCR_OK;
+}
+
+/* The working buffers: D the symmetrized distances, Q the diffused affinity, T a product,
+ * sc the self-tuning scales, (pj, pw) the kNN graph P (k neighbours and weights a row). */
+typedef struct {
+    double *D, *Q, *T, *sc, *pw;
+    size_t *pj;
+    nb_t *row;
+} rerank_buf;
+
+static void buf_free(rerank_buf *b)
+{
+    free(b->D);
+    free(b->Q);
+    free(b->T);
+    free(b->sc);
+    free(b->pw);
+    free(b->pj);
+    free(b->row);
+}
+
+static int buf_alloc(rerank_buf *b, size_t n, size_t k)
+{
+    b->D = amscr__malloc_array(n * n, sizeof *b->D);
+    b->Q = amscr__malloc_array(n * n, sizeof *b->Q);
+    b->T = amscr__malloc_array(n * n, sizeof *b->T);
+    b->sc = amscr__malloc_array(n, sizeof *b->sc);
+    b->pw = amscr__malloc_array(n * k, sizeof *b->pw);
+    b->pj = amscr__malloc_array(n * k, sizeof *b->pj);
+    b->row = amscr__malloc_array(n, sizeof *b->row);
+    if (b->D && b->Q && b->T && b->sc && b->pw && b->pj && b->row)
+        return 1;
+    buf_free(b);
+    return 0;
+}
+
+/* D = the symmetrized input with a zero diagonal; returns its largest entry. */
+static double symmetrize(const double *dist, size_t n, double *D)
+{
     double dmax = 0.0;
     for (size_t i = 0; i < n; i++)
         for (size_t j = 0; j < n; j++) {
@@ -60,31 +84,45 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
             if (D[i * n + j] > dmax)
                 dmax = D[i * n + j];
         }
-    /* neighbours (itself first: distance 0, ties by index) and self-tuning scales */
+    return dmax;
+}
+
+/* The kNN graph P: each row's k neighbours (itself first: distance 0, ties by index), weighted
+ * by exp(-d / s) with self-tuning scales s and normalized to sum 1. */
+static void knn_graph(rerank_buf *b, size_t n, size_t k, double dmax)
+{
+    const double *D = b->D;
     for (size_t i = 0; i < n; i++) {
         for (size_t j = 0; j < n; j++) {
-            row[j].d = D[i * n + j];
-            row[j].j = j;
+            b->row[j].d = D[i * n + j];
+            b->row[j].j = j;
         }
-        row[i].d = -1.0; /* itself is always its own first neighbour */
-        qsort(row, n, sizeof *row, cmp_nb);
+        b->row[i].d = -1.0; /* itself is always its own first neighbour */
+        qsort(b->row, n, sizeof *b->row, cmp_nb);
         for (size_t t = 0; t < k; t++)
-            pj[i * k + t] = row[t].j;
-        sc[i] = D[i * n + row[k - 1].j];
+            b->pj[i * k + t] = b->row[t].j;
+        b->sc[i] = D[i * n + b->row[k - 1].j];
     }
     double tiny = dmax > 0.0 ? 1e-12 * dmax : 1e-300;
     for (size_t i = 0; i < n; i++) {
         double sum = 0.0;
         for (size_t t = 0; t < k; t++) {
-            size_t j = pj[i * k + t];
-            double s = sqrt((sc[i] + tiny) * (sc[j] + tiny));
-            pw[i * k + t] = exp(-D[i * n + j] / s);
-            sum += pw[i * k + t];
+            size_t j = b->pj[i * k + t];
+            double s = sqrt((b->sc[i] + tiny) * (b->sc[j] + tiny));
+            b->pw[i * k + t] = exp(-D[i * n + j] / s);
+            sum += b->pw[i * k + t];
         }
         for (size_t t = 0; t < k; t++)
-            pw[i * k + t] /= sum;
+            b->pw[i * k + t] /= sum;
     }
-    /* Q = P, then Q <- P Q P^T + I (P sparse: k entries a row) */
+}
+
+/* Q = P, then `iterations` times Q <- P Q P^T + I (P sparse: k entries a row). */
+static void diffuse(rerank_buf *b, size_t n, size_t k, unsigned iterations)
+{
+    double *Q = b->Q, *T = b->T;
+    const double *pw = b->pw;
+    const size_t *pj = b->pj;
     memset(Q, 0, n * n * sizeof *Q);
     for (size_t i = 0; i < n; i++)
         for (size_t t = 0; t < k; t++)
@@ -112,6 +150,12 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
             }
         }
     }
+}
+
+/* The output distances from the diffused affinity Q, row by row: 1 - q / (the row's largest q),
+ * shapes the diffusion does not reach after them in the order of the input distance D. */
+static void to_distances(const double *Q, const double *D, size_t n, double dmax, int norm, double *out_dist)
+{
     for (size_t i = 0; i < n; i++) {
         double qmax = 0.0;
         for (size_t j = 0; j < n; j++)
@@ -129,13 +173,23 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
                 out_dist[i * n + j] = i == j ? 0.0 : 0.5 * out_dist[i * n + j];
         }
     }
-    free(D);
-    free(Q);
-    free(T);
-    free(sc);
-    free(pw);
-    free(pj);
-    free(row);
+}
+
+static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iterations, int norm, double *out_dist,
+                           const char *what)
+{
+    amscr__clear_error();
+    amscr_status st = check_args(dist, n, k, iterations, out_dist, what);
+    if (st != AMSCR_OK)
+        return st;
+    rerank_buf b;
+    if (!buf_alloc(&b, n, k))
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_rerank_diffusion: out of memory");
+    double dmax = symmetrize(dist, n, b.D);
+    knn_graph(&b, n, k, dmax);
+    diffuse(&b, n, k, iterations);
+    to_distances(b.Q, b.D, n, dmax, norm, out_dist);
+    buf_free(&b);
     return AMSCR_OK;
 }
 

@@ -1,4 +1,15 @@
-/* scores.c — retrieval scores on a distance matrix (docs/method.md §4): top-k selection,
+/* The retrieval area (src/retrieval/): collections and what ranks their shapes (docs/method.md
+ * §4, §10):
+ *   db.c            the collection object (amscr_db): prepared shapes with labels, distance
+ *                   matrices on threads, progress and cancellation, the versioned binary format
+ *   retrieval_io.c  the retrieval settings block of the saved collection
+ *   channel.c       the shape channel (height functions) of one pair
+ *   hf_matrix.c     the shape channel over a whole collection
+ *   fuse.c          the fused, re-ranked retrieval matrix
+ *   rerank.c        contextual re-ranking by affinity diffusion
+ *   scores.c        retrieval scores (this file)
+ *
+ * scores.c — retrieval scores on a distance matrix (docs/method.md §4): top-k selection,
  * bull's eye, the Kimia top-k table and 1-NN accuracies. Ranking is by distance
  * ascending, ties broken by the lower index; +inf is allowed, NaN is rejected.
  * Cost: O(n^2 log w) for the matrix scores (w the window or kmax), with one allocation

@@ -1,4 +1,13 @@
-/* descriptor.c — a prepared shape (docs/method.md §2): validated, oriented, resampled, parametrized,
+/* The shape area (src/shape/): contours and the prepared shape (docs/method.md §2, §5):
+ *   contour.c       the contour object, validation and orientation
+ *   contour_text.c  text point lists: reading, parsing, writing
+ *   trace.c         the outer boundary of the largest component of a mask
+ *   trace_all.c     every contour of a mask with its hierarchy
+ *   resample.c      Euclidean and affine arc-length resampling, whitening normalization
+ *   despike.c       isolated stray points dropped from a point list
+ *   descriptor.c    the prepared shape (this file), built from the others
+ *
+ * descriptor.c — a prepared shape (docs/method.md §2): validated, oriented, resampled, parametrized,
  * sampled at N points, normalized, smoothed at every scale. Immutable once built. */
 #include "dense.h"
 #include "fft.h"

@@ -1,4 +1,4 @@
-/* despike.c — isolated spikes removed from a point list before registration (issue 14).
+/* despike.c — isolated spikes removed from a point list before registration (robust registration).
  *
  * A few stray points in a contour (a detector's glitch, a mis-clicked vertex) wreck everything
  * that follows: each adds two long edges, so the arc-length parametrization, the affine
@@ -15,8 +15,8 @@
  * Lists of fewer than
  * SPIKE_MIN_POINTS points (polygons) are left alone. Never removes more than 1/SPIKE_MAX_SHARE
  * of the points (more would not be isolated spikes). */
+#include "dense.h"
 #include "internal.h"
-#include "match.h"
 
 #include <math.h>
 #include <string.h>

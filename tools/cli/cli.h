@@ -90,7 +90,7 @@ typedef struct opts {
     size_t nscales;
     int reflections; /* -1: the command's default */
     int open;
-    int partial; /* register --partial (issue 14) */
+    int partial; /* register --partial */
     int no_polish; /* register --no-polish (0.3) */
     int refine_set;
     unsigned refine;

@@ -27,7 +27,7 @@ typedef struct reg_report {
     size_t shift, K, nkept, N;
     int refl;
     const char *mname;
-    /* issue 14: confidence, the part of the target covered, dense correspondences */
+    /* confidence, the part of the target covered, dense correspondences */
     double conf, amb, inl, part[2];
     size_t ncorr;
     double *corr_param, *corr_xy; /* ncorr and 2 ncorr */
@@ -194,7 +194,7 @@ static int draw_pictures(const opts *o, const amscr_contour *src, const amscr_co
     return 0;
 }
 
-/* issue 14: confidence, part and correspondences ({"param": [...], "points": [[x, y], ...]}). */
+/* Confidence, part and correspondences ({"param": [...], "points": [[x, y], ...]}). */
 static void json_confidence(sbuf *b, const opts *o, const reg_report *r)
 {
     sb_puts(b, ", \"confidence\": ");

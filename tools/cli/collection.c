@@ -226,6 +226,118 @@ static int set_group(collection *c, char *g, size_t *gcap, const char *mpath, si
     return 0;
 }
 
+/* Reads one line of any length into *line (grown as needed; NUL-terminated, without its '\n').
+ * Returns 1 for a line (its length in *out_len), 0 at the end of the file, -1 out of memory
+ * (reported). */
+static int read_line(FILE *fp, char **line, size_t *lcap, size_t *out_len)
+{
+    size_t len = 0;
+    int ch;
+    while ((ch = getc(fp)) != EOF && ch != '\n') {
+        if (len + 2 > *lcap) {
+            char *p = realloc(*line, *lcap * 2);
+            if (p == NULL) {
+                tool_error(NULL, "out of memory");
+                return -1;
+            }
+            *line = p;
+            *lcap *= 2;
+        }
+        (*line)[len++] = (char)ch;
+    }
+    if (ch == EOF && len == 0)
+        return 0;
+    (*line)[len] = '\0';
+    *out_len = len;
+    return 1;
+}
+
+/* A manifest being read: where it is, its columns (from the header line) and the capacities of
+ * the collection's growing arrays. */
+typedef struct {
+    const char *path;
+    const char *dir;             /* the manifest's folder: file names are relative to it */
+    int header;                  /* 1 until the header line is read */
+    long fcol, ccol, gcol;       /* the columns file, class and (optional, else -1) group */
+    size_t lineno, icap, ccap, gcap;
+} manifest_reader;
+
+/* The header line: finds the columns named file, class and group. */
+static int manifest_header(manifest_reader *r, char **f, size_t nf)
+{
+    for (size_t i = 0; i < nf; i++) {
+        trim(f[i]);
+        if (strcmp(f[i], "file") == 0)
+            r->fcol = (long)i;
+        else if (strcmp(f[i], "class") == 0)
+            r->ccol = (long)i;
+        else if (strcmp(f[i], "group") == 0)
+            r->gcol = (long)i;
+    }
+    if (r->fcol < 0 || r->ccol < 0) {
+        tool_error(r->path, "line %zu: the header must name the columns 'file' and 'class' (tab-separated)",
+                   r->lineno);
+        return -1;
+    }
+    r->header = 0;
+    return 0;
+}
+
+/* A shape line: its file, class and group added to the collection. */
+static int manifest_row(manifest_reader *r, char **f, size_t nf, collection *c)
+{
+    long need = r->fcol > r->ccol ? r->fcol : r->ccol;
+    if (r->gcol > need)
+        need = r->gcol;
+    if ((size_t)need >= nf) {
+        tool_error(r->path, "line %zu: expected %ld tab-separated columns, found %zu", r->lineno, need + 1, nf);
+        return -1;
+    }
+    char *file = f[r->fcol], *cls = f[r->ccol];
+    trim(file);
+    trim(cls);
+    if (file[0] == '\0' || cls[0] == '\0') {
+        tool_error(r->path, "line %zu: empty file or class", r->lineno);
+        return -1;
+    }
+    if (add_item(c, &r->icap, &r->ccap, r->dir, file, cls) != 0)
+        return -1;
+    if (r->gcol >= 0 && set_group(c, f[r->gcol], &r->gcap, r->path, r->lineno) != 0)
+        return -1;
+    return 0;
+}
+
+/* Every line of the manifest: blank lines and '#' comments skipped, the header, then the shapes. */
+static int manifest_lines(manifest_reader *r, FILE *fp, collection *c)
+{
+    size_t lcap = 4096, len = 0;
+    char *line = malloc(lcap);
+    if (line == NULL) {
+        tool_error(NULL, "out of memory");
+        return -1;
+    }
+    int ok = 1, got;
+    while ((got = read_line(fp, &line, &lcap, &len)) > 0) {
+        r->lineno++;
+        if (memchr(line, '\0', len) != NULL) {
+            tool_error(r->path, "line %zu: not a text manifest", r->lineno);
+            ok = 0;
+            break;
+        }
+        trim(line);
+        if (line[0] == '\0' || line[0] == '#')
+            continue;
+        char *f[64];
+        size_t nf = split_tabs(line, f, 64);
+        if ((r->header ? manifest_header(r, f, nf) : manifest_row(r, f, nf, c)) != 0) {
+            ok = 0;
+            break;
+        }
+    }
+    free(line);
+    return ok && got >= 0 ? 0 : -1;
+}
+
 static int open_manifest(const char *mpath, collection *c)
 {
     FILE *fp = fopen(mpath, "rb");
@@ -238,98 +350,20 @@ static int open_manifest(const char *mpath, collection *c)
         fclose(fp);
         return -1;
     }
-    size_t lcap = 4096;
-    char *line = malloc(lcap);
-    int ok = line != NULL, header = 1;
-    long fcol = -1, ccol = -1, gcol = -1;
-    size_t lineno = 0, icap = 0, ccap = 0, gcap = 0;
-    if (!ok)
-        tool_error(NULL, "out of memory");
-    while (ok) {
-        /* read one line of any length */
-        size_t len = 0;
-        int ch;
-        while ((ch = getc(fp)) != EOF && ch != '\n') {
-            if (len + 2 > lcap) {
-                char *p = realloc(line, lcap * 2);
-                if (p == NULL) {
-                    tool_error(NULL, "out of memory");
-                    ok = 0;
-                    break;
-                }
-                line = p;
-                lcap *= 2;
-            }
-            line[len++] = (char)ch;
-        }
-        if (!ok)
-            break;
-        if (ch == EOF && len == 0)
-            break;
-        line[len] = '\0';
-        lineno++;
-        if (memchr(line, '\0', len) != NULL) {
-            tool_error(mpath, "line %zu: not a text manifest", lineno);
-            ok = 0;
-            break;
-        }
-        trim(line);
-        if (line[0] == '\0' || line[0] == '#')
-            continue;
-        char *f[64];
-        size_t nf = split_tabs(line, f, 64);
-        if (header) {
-            for (size_t i = 0; i < nf; i++) {
-                trim(f[i]);
-                if (strcmp(f[i], "file") == 0)
-                    fcol = (long)i;
-                else if (strcmp(f[i], "class") == 0)
-                    ccol = (long)i;
-                else if (strcmp(f[i], "group") == 0)
-                    gcol = (long)i;
-            }
-            if (fcol < 0 || ccol < 0) {
-                tool_error(mpath, "line %zu: the header must name the columns 'file' and 'class' (tab-separated)",
-                           lineno);
-                ok = 0;
-                break;
-            }
-            header = 0;
-            continue;
-        }
-        long need = fcol > ccol ? fcol : ccol;
-        if (gcol > need)
-            need = gcol;
-        if ((size_t)need >= nf) {
-            tool_error(mpath, "line %zu: expected %ld tab-separated columns, found %zu", lineno, need + 1, nf);
-            ok = 0;
-            break;
-        }
-        trim(f[fcol]);
-        trim(f[ccol]);
-        if (f[fcol][0] == '\0' || f[ccol][0] == '\0') {
-            tool_error(mpath, "line %zu: empty file or class", lineno);
-            ok = 0;
-            break;
-        }
-        if (add_item(c, &icap, &ccap, dir, f[fcol], f[ccol]) != 0)
-            ok = 0;
-        else if (gcol >= 0 && set_group(c, f[gcol], &gcap, mpath, lineno) != 0)
-            ok = 0;
-    }
+    manifest_reader r = {mpath, dir, 1, -1, -1, -1, 0, 0, 0, 0};
+    int ok = manifest_lines(&r, fp, c) == 0;
     if (ok && ferror(fp)) {
         tool_error(mpath, "read error");
         ok = 0;
     }
-    if (ok && header) {
-        tool_error(mpath, lineno == 0 ? "empty file" : "no header line with 'file' and 'class' columns");
+    if (ok && r.header) {
+        tool_error(mpath, r.lineno == 0 ? "empty file" : "no header line with 'file' and 'class' columns");
         ok = 0;
     }
     if (ok && c->n == 0) {
         tool_error(mpath, "the manifest lists no shapes");
         ok = 0;
     }
-    free(line);
     free(dir);
     fclose(fp);
     return ok ? 0 : -1;

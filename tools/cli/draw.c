@@ -432,6 +432,16 @@ static int write_png_lib(FILE *fp, const unsigned char *rgb, int w, int h)
 }
 #endif
 
+int raster_write_png(const raster *r, unsigned char *out, const char *path)
+{
+    size_t n = 3 * (size_t)r->w * (size_t)r->h;
+    for (size_t i = 0; i < n; i++) {
+        float v = r->rgb[i];
+        out[i] = (unsigned char)(v < 0 ? 0 : v > 255 ? 255 : (int)(v + 0.5f));
+    }
+    return write_png_file(path, out, r->w, r->h);
+}
+
 int write_png_file(const char *path, const unsigned char *rgb, int w, int h)
 {
     tool_out o;
@@ -513,11 +523,7 @@ static int overlay_png(const char *path, const overlay_input *in, const layout *
     }
     if (in->caption)
         raster_text(&r, 14, 14 + 60, in->caption, 2, black);
-    for (size_t i = 0; i < 3 * npix; i++) {
-        float v = r.rgb[i];
-        out[i] = (unsigned char)(v < 0 ? 0 : v > 255 ? 255 : (int)(v + 0.5f));
-    }
-    ret = write_png_file(path, out, r.w, r.h);
+    ret = raster_write_png(&r, out, path);
 done:
     free(r.rgb);
     free(r.cov);

@@ -104,11 +104,12 @@ static int pgm_int(FILE *fp, unsigned long *out)
     return 0;
 }
 
-static int read_pgm(FILE *fp, const char *path, int ascii, tool_image *out)
+/* The header after the magic number: width, height and maxval, then the one whitespace
+ * character that ends it. */
+static int pgm_header(FILE *fp, const char *path, unsigned long *w, unsigned long *h, unsigned long *maxval)
 {
-    unsigned long w, h, maxval;
     const char *what[3] = {"width", "height", "maxval"};
-    unsigned long *vals[3] = {&w, &h, &maxval};
+    unsigned long *vals[3] = {w, h, maxval};
     (void)getc(fp);
     (void)getc(fp); /* "P5" / "P2" */
     for (int i = 0; i < 3; i++) {
@@ -122,11 +123,11 @@ static int read_pgm(FILE *fp, const char *path, int ascii, tool_image *out)
             return -1;
         }
     }
-    if (maxval < 1 || maxval > 65535) {
-        tool_error(path, "corrupt PGM: maxval %lu out of range 1..65535", maxval);
+    if (*maxval < 1 || *maxval > 65535) {
+        tool_error(path, "corrupt PGM: maxval %lu out of range 1..65535", *maxval);
         return -1;
     }
-    if (check_limits(path, "PGM", w, h) != 0)
+    if (check_limits(path, "PGM", *w, *h) != 0)
         return -1;
     /* Exactly one whitespace character ends the header (a comment may sit before it). */
     int c = getc(fp);
@@ -142,61 +143,75 @@ static int read_pgm(FILE *fp, const char *path, int ascii, tool_image *out)
         tool_error(path, "corrupt PGM: no whitespace after maxval");
         return -1;
     }
-    size_t npix = (size_t)w * (size_t)h;
-    uint8_t *pix = xmalloc_array(npix, 1);
-    if (pix == NULL)
-        return -1;
+    return 0;
+}
+
+/* Binary (P5) samples, 1 or 2 bytes each (big-endian), scaled to 0..255 into pix. */
+static int pgm_binary(FILE *fp, const char *path, size_t w, size_t h, unsigned long maxval, uint8_t *pix)
+{
     unsigned long half = maxval / 2;
-    if (!ascii) {
-        size_t bps = maxval < 256 ? 1 : 2;
-        uint8_t *row = xmalloc_array((size_t)w, bps);
-        if (row == NULL) {
-            free(pix);
+    size_t bps = maxval < 256 ? 1 : 2;
+    uint8_t *row = xmalloc_array(w, bps);
+    if (row == NULL)
+        return -1;
+    for (size_t y = 0; y < h; y++) {
+        size_t got = fread(row, bps, w, fp);
+        if (got != w) {
+            tool_error(path, "truncated PGM: pixel data ends in row %zu of %lu", y + 1, (unsigned long)h);
+            free(row);
             return -1;
         }
-        for (size_t y = 0; y < h; y++) {
-            size_t got = fread(row, bps, (size_t)w, fp);
-            if (got != (size_t)w) {
-                tool_error(path, "truncated PGM: pixel data ends in row %zu of %lu", y + 1, h);
-                free(row);
-                free(pix);
-                return -1;
-            }
-            for (size_t x = 0; x < w; x++) {
-                unsigned long v = bps == 1 ? row[x] : ((unsigned long)row[2 * x] << 8) | row[2 * x + 1];
-                if (v > maxval) {
-                    tool_error(path, "corrupt PGM: sample %lu at (%zu, %zu) exceeds maxval %lu", v, x, y,
-                               maxval);
-                    free(row);
-                    free(pix);
-                    return -1;
-                }
-                pix[y * w + x] = (uint8_t)((v * 255 + half) / maxval);
-            }
-        }
-        free(row);
-    } else {
-        for (size_t i = 0; i < npix; i++) {
-            unsigned long v;
-            int r = pgm_int(fp, &v);
-            if (r == -2) {
-                tool_error(path, "truncated PGM: %zu of %zu samples", i, npix);
-                free(pix);
-                return -1;
-            }
-            if (r != 0) {
-                tool_error(path, "corrupt PGM: sample %zu is not a number", i + 1);
-                free(pix);
-                return -1;
-            }
+        for (size_t x = 0; x < w; x++) {
+            unsigned long v = bps == 1 ? row[x] : ((unsigned long)row[2 * x] << 8) | row[2 * x + 1];
             if (v > maxval) {
-                tool_error(path, "corrupt PGM: sample %lu at (%zu, %zu) exceeds maxval %lu", v,
-                           i % (size_t)w, i / (size_t)w, maxval);
-                free(pix);
+                tool_error(path, "corrupt PGM: sample %lu at (%zu, %zu) exceeds maxval %lu", v, x, y, maxval);
+                free(row);
                 return -1;
             }
-            pix[i] = (uint8_t)((v * 255 + half) / maxval);
+            pix[y * w + x] = (uint8_t)((v * 255 + half) / maxval);
         }
+    }
+    free(row);
+    return 0;
+}
+
+/* ASCII (P2) samples, scaled to 0..255 into pix. */
+static int pgm_ascii(FILE *fp, const char *path, size_t w, size_t h, unsigned long maxval, uint8_t *pix)
+{
+    unsigned long half = maxval / 2;
+    size_t npix = w * h;
+    for (size_t i = 0; i < npix; i++) {
+        unsigned long v;
+        int r = pgm_int(fp, &v);
+        if (r == -2) {
+            tool_error(path, "truncated PGM: %zu of %zu samples", i, npix);
+            return -1;
+        }
+        if (r != 0) {
+            tool_error(path, "corrupt PGM: sample %zu is not a number", i + 1);
+            return -1;
+        }
+        if (v > maxval) {
+            tool_error(path, "corrupt PGM: sample %lu at (%zu, %zu) exceeds maxval %lu", v, i % w, i / w, maxval);
+            return -1;
+        }
+        pix[i] = (uint8_t)((v * 255 + half) / maxval);
+    }
+    return 0;
+}
+
+static int read_pgm(FILE *fp, const char *path, int ascii, tool_image *out)
+{
+    unsigned long w, h, maxval;
+    if (pgm_header(fp, path, &w, &h, &maxval) != 0)
+        return -1;
+    uint8_t *pix = xmalloc_array((size_t)w * (size_t)h, 1);
+    if (pix == NULL)
+        return -1;
+    int r = ascii ? pgm_ascii(fp, path, w, h, maxval, pix) : pgm_binary(fp, path, w, h, maxval, pix);
+    if (r != 0) {
+        free(pix);
+        return -1;
     }
     out->pix = pix;
     out->width = w;
@@ -242,6 +257,12 @@ typedef struct png_ctx {
     FILE *fp;
     int truncated;
     char msg[256];
+    /* What a longjmp must free or report: volatile, as it changes between setjmp and longjmp. */
+    uint8_t *volatile lum;
+    uint8_t *volatile alpha;
+    uint8_t *volatile buf;
+    png_bytep *volatile rows;
+    volatile int limit_failed;
 } png_ctx;
 
 static void png_err_fn(png_structp png, png_const_charp msg)
@@ -348,15 +369,10 @@ static void png_read_pixels(png_structp png, int passes, uint8_t *buf, png_bytep
     }
 }
 
-static int read_png(FILE *fp, const char *path, tool_image *out)
+/* libpng's read and info structs, reporting through ctx; -1 (reported) out of memory. */
+static int png_create(png_ctx *ctx, const char *path, png_structp *out_png, png_infop *out_info)
 {
-    if (png_check_ihdr(fp, path) != 0)
-        return -1;
-    png_ctx ctx;
-    ctx.fp = fp;
-    ctx.truncated = 0;
-    ctx.msg[0] = '\0';
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &ctx, png_err_fn, png_warn_fn);
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, ctx, png_err_fn, png_warn_fn);
     if (png == NULL) {
         tool_error(path, "out of memory (libpng)");
         return -1;
@@ -367,29 +383,16 @@ static int read_png(FILE *fp, const char *path, tool_image *out)
         tool_error(path, "out of memory (libpng)");
         return -1;
     }
-    /* Everything that must survive a longjmp is volatile. */
-    uint8_t *volatile lum = NULL;
-    uint8_t *volatile alpha = NULL;
-    uint8_t *volatile buf = NULL;
-    png_bytep *volatile rows = NULL;
-    volatile int limit_failed = 0;
+    *out_png = png;
+    *out_info = info;
+    return 0;
+}
 
-    if (setjmp(png_jmpbuf(png))) {
-        free(lum);
-        free(alpha);
-        free(buf);
-        free(rows);
-        png_destroy_read_struct(&png, &info, NULL);
-        if (!limit_failed) {
-            if (ctx.truncated)
-                tool_error(path, "truncated PNG: unexpected end of file");
-            else
-                tool_error(path, "corrupt PNG: %s", ctx.msg[0] ? ctx.msg : "unknown error");
-        }
-        return -1;
-    }
-    png_set_read_fn(png, &ctx, png_read_fn);
-    png_set_user_limits(png, 0x7fffffffu, 0x7fffffffu); /* our own limits are checked below */
+/* Reading through ctx's file, with the tool's limits instead of libpng's. */
+static void png_set_input(png_structp png, png_ctx *ctx)
+{
+    png_set_read_fn(png, ctx, png_read_fn);
+    png_set_user_limits(png, 0x7fffffffu, 0x7fffffffu); /* our own limits are checked in png_decode */
 #ifdef PNG_SET_CHUNK_MALLOC_LIMIT_SUPPORTED
     /* An ancillary chunk may claim up to 2 GiB, which libpng would allocate before reading it
      * (found by fuzz_png: a 16 x 12 image with a 2 GB text chunk); none we need is large. */
@@ -398,55 +401,101 @@ static int read_png(FILE *fp, const char *path, tool_image *out)
 #ifdef PNG_SET_CHUNK_CACHE_LIMIT_SUPPORTED
     png_set_chunk_cache_max(png, PNG_CHUNK_MAX_COUNT);
 #endif
-    png_read_info(png, info);
+}
 
+/* The luminance and alpha planes and the read buffer (the whole image when interlaced), into ctx;
+ * longjmps when out of memory. */
+static void png_alloc(png_structp png, png_ctx *ctx, png_uint_32 w, png_uint_32 h, int passes, size_t rowbytes,
+                      int has_alpha)
+{
+    size_t npix = (size_t)w * (size_t)h;
+    ctx->lum = malloc(npix);
+    if (has_alpha)
+        ctx->alpha = malloc(npix);
+    if (ctx->lum == NULL || (has_alpha && ctx->alpha == NULL)) {
+        snprintf(ctx->msg, sizeof ctx->msg, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
+        png_longjmp(png, 1);
+    }
+    if (passes > 1 && rowbytes > SIZE_MAX / h) {
+        snprintf(ctx->msg, sizeof ctx->msg, "image too large");
+        png_longjmp(png, 1);
+    }
+    ctx->buf = malloc(passes > 1 ? rowbytes * h : rowbytes);
+    if (passes > 1)
+        ctx->rows = malloc(sizeof(png_bytep) * h);
+    if (ctx->buf == NULL || (passes > 1 && ctx->rows == NULL)) {
+        if (passes > 1)
+            snprintf(ctx->msg, sizeof ctx->msg, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
+        else
+            snprintf(ctx->msg, sizeof ctx->msg, "out of memory");
+        png_longjmp(png, 1);
+    }
+}
+
+/* The image after the signature: header, size limits, conversion to 8-bit luminance (and
+ * alpha), pixels, alpha policy; longjmps on any failure (ctx says why). */
+static void png_decode(png_structp png, png_infop info, png_ctx *ctx, const char *path, tool_image *out)
+{
+    png_read_info(png, info);
     png_uint_32 w = png_get_image_width(png, info);
     png_uint_32 h = png_get_image_height(png, info);
     if (check_limits(path, "PNG", w, h) != 0) {
-        limit_failed = 1;
+        ctx->limit_failed = 1;
         png_longjmp(png, 1);
     }
     int passes = png_set_transforms(png, info);
     int channels = png_get_channels(png, info);
     size_t rowbytes = png_get_rowbytes(png, info);
     if (png_get_bit_depth(png, info) != 8 || channels < 1 || channels > 4 || rowbytes != (size_t)w * (size_t)channels) {
-        snprintf(ctx.msg, sizeof ctx.msg, "unexpected pixel layout after conversion");
+        snprintf(ctx->msg, sizeof ctx->msg, "unexpected pixel layout after conversion");
         png_longjmp(png, 1);
     }
     int has_alpha = channels == 2 || channels == 4;
-    size_t npix = (size_t)w * (size_t)h;
-    lum = malloc(npix);
-    if (has_alpha)
-        alpha = malloc(npix);
-    if (lum == NULL || (has_alpha && alpha == NULL)) {
-        snprintf(ctx.msg, sizeof ctx.msg, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
-        png_longjmp(png, 1);
-    }
-    if (passes > 1 && rowbytes > SIZE_MAX / h) {
-        snprintf(ctx.msg, sizeof ctx.msg, "image too large");
-        png_longjmp(png, 1);
-    }
-    buf = malloc(passes > 1 ? rowbytes * h : rowbytes);
-    if (passes > 1)
-        rows = malloc(sizeof(png_bytep) * h);
-    if (buf == NULL || (passes > 1 && rows == NULL)) {
-        if (passes > 1)
-            snprintf(ctx.msg, sizeof ctx.msg, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
-        else
-            snprintf(ctx.msg, sizeof ctx.msg, "out of memory");
-        png_longjmp(png, 1);
-    }
-    png_read_pixels(png, passes, buf, rows, rowbytes, channels, w, h, lum, alpha);
+    png_alloc(png, ctx, w, h, passes, rowbytes, has_alpha);
+    png_read_pixels(png, passes, ctx->buf, ctx->rows, rowbytes, channels, w, h, ctx->lum, ctx->alpha);
     /* The image data is complete; the chunks after it are not needed. */
     if (has_alpha)
-        apply_alpha(lum, alpha, npix);
-    free(alpha);
-    free(buf);
-    free(rows);
-    png_destroy_read_struct(&png, &info, NULL);
-    out->pix = lum;
+        apply_alpha(ctx->lum, ctx->alpha, (size_t)w * (size_t)h);
+    free(ctx->alpha);
+    free(ctx->buf);
+    free(ctx->rows);
+    ctx->alpha = NULL;
+    ctx->buf = NULL;
+    ctx->rows = NULL;
+    out->pix = ctx->lum;
     out->width = w;
     out->height = h;
+    ctx->lum = NULL;
+}
+
+static int read_png(FILE *fp, const char *path, tool_image *out)
+{
+    if (png_check_ihdr(fp, path) != 0)
+        return -1;
+    png_ctx ctx;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.fp = fp;
+    png_structp png;
+    png_infop info;
+    if (png_create(&ctx, path, &png, &info) != 0)
+        return -1;
+    if (setjmp(png_jmpbuf(png))) {
+        free(ctx.lum);
+        free(ctx.alpha);
+        free(ctx.buf);
+        free(ctx.rows);
+        png_destroy_read_struct(&png, &info, NULL);
+        if (!ctx.limit_failed) {
+            if (ctx.truncated)
+                tool_error(path, "truncated PNG: unexpected end of file");
+            else
+                tool_error(path, "corrupt PNG: %s", ctx.msg[0] ? ctx.msg : "unknown error");
+        }
+        return -1;
+    }
+    png_set_input(png, &ctx);
+    png_decode(png, info, &ctx, path, out);
+    png_destroy_read_struct(&png, &info, NULL);
     return 0;
 }
 #endif /* AMSCR_TOOL_HAVE_PNG */

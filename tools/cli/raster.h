@@ -26,6 +26,8 @@ void cov_fill(raster *r, const double *cxy, size_t n);
 void raster_text(raster *r, int x, int y, const char *text, int px, const unsigned char col[3]);
 /* Writes w x h RGB bytes as a PNG (atomically). Returns 0, or -1 after printing one error line. */
 int write_png_file(const char *path, const unsigned char *rgb, int w, int h);
+/* Writes the picture as a PNG (as write_png_file), rounded to bytes in out (3 w h of them). */
+int raster_write_png(const raster *r, unsigned char *out, const char *path);
 /* Writes the text of b (atomically). Returns 0, or -1 after printing one error line. */
 int write_text_file(const char *path, const sbuf *b);
 /* Appends s with <, >, & and " escaped. */

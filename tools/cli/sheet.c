@@ -121,11 +121,7 @@ static int sheet_png(const char *path, const sheet_tile *tiles, size_t n, int cl
     for (size_t i = 0; i < n; i++)
         if (png_tile(&r, &tiles[i], i, closed) != 0)
             goto done;
-    for (size_t i = 0; i < 3 * npix; i++) {
-        float v = r.rgb[i];
-        out[i] = (unsigned char)(v < 0 ? 0 : v > 255 ? 255 : (int)(v + 0.5f));
-    }
-    ret = write_png_file(path, out, r.w, r.h);
+    ret = raster_write_png(&r, out, path);
 done:
     free(r.rgb);
     free(r.cov);

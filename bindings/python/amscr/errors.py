@@ -38,7 +38,7 @@ class AmscrError(Exception):
         return self.message
 
 
-#: Alias: the issue's name for the base class.
+#: Alias: a shorter name for the base class (``amscr.Error``).
 Error = AmscrError
 
 
