@@ -480,7 +480,8 @@ AMSCR_API double amscr_contour_set_area(const amscr_contour_set *s, size_t i);
  * @param[in] bits  8 or 16.
  * @param[in] level  the iso-level in sample units, 0 <= level < 2^bits - 1 (T + 0.5 classifies
  *                   pixels as amscr_contour_from_mask's threshold T); negative
- *                   (AMSCR_LEVEL_AUTO): the mean of the two class means of Otsu's split.
+ *                   (AMSCR_LEVEL_AUTO): halfway between the medians of the two classes
+ *                   of Otsu's split.
  * @param[in] flags  0 (sub-pixel) or AMSCR_TRACE_PIXEL_CHAIN.
  * @param[out] out  new contour.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, empty image, bad stride, bits, level or

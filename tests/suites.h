@@ -29,5 +29,6 @@ Suite *amscr_suite_polish(void);
 Suite *amscr_suite_ordered(void);
 Suite *amscr_suite_despike(void);
 Suite *amscr_suite_even(void);
+Suite *amscr_suite_subpixel(void);
 
 #endif

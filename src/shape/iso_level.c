@@ -2,8 +2,8 @@
  *
  * The contour is the iso-line of the grey image at the level halfway between background and
  * foreground: given, or automatic — Otsu's split of the histogram (256 bins for 8-bit images,
- * 65536 for 16-bit), then the mean of the two class means, the level where an antialiased
- * edge (a pixel's value proportional to its covered area) is crossed. Polarity as
+ * 65536 for 16-bit), then halfway between the two classes' medians, the level where an
+ * antialiased edge (a pixel's value proportional to its covered area) is half covered. Polarity as
  * amscr_contour_from_mask: when most of the image border is above the level, the field is
  * negated so the border is background. The padding frame takes the background's mean level,
  * so a shape touching the border closes at the image's edge (half a pixel beyond the border
@@ -49,8 +49,22 @@ static long iso_otsu(const uint64_t *hist, size_t nb)
     return t_first < 0 ? -1 : (t_first + t_last) / 2;
 }
 
-/* The automatic level: the mean of the class means of Otsu's split (the one value, when the
- * image has one value: nothing is then above it). */
+/* The median value of the pixels in bins lo..hi (n of them, n > 0). */
+static double iso_median(const uint64_t *hist, size_t lo, size_t hi, uint64_t n)
+{
+    uint64_t half = (n + 1) / 2, seen = 0;
+    for (size_t v = lo; v <= hi; v++) {
+        seen += hist[v];
+        if (seen >= half)
+            return (double)v;
+    }
+    return (double)hi;
+}
+
+/* The automatic level: halfway between the medians of the two classes of Otsu's split (the
+ * one value, when the image has one value: nothing is then above it). Medians, not means: the
+ * edge pixels of an antialiased image sit in both classes and would pull the means (and the
+ * level) towards them, by a share that grows as the image gets smaller. */
 static amscr_status iso_auto_level(const amscr__iso *f, double *out)
 {
     size_t nb = f->p8 ? 256 : 65536;
@@ -61,18 +75,14 @@ static amscr_status iso_auto_level(const amscr__iso *f, double *out)
         for (size_t x = 0; x < f->w; x++)
             hist[(size_t)iso_sample(f, x, y)]++;
     long t = iso_otsu(hist, nb);
-    double n0 = 0, s0 = 0, n1 = 0, s1 = 0;
-    for (size_t v = 0; v < nb; v++) {
-        if ((long)v <= t) {
-            n0 += (double)hist[v];
-            s0 += (double)v * (double)hist[v];
-        } else {
-            n1 += (double)hist[v];
-            s1 += (double)v * (double)hist[v];
-        }
-    }
+    uint64_t n0 = 0, n = (uint64_t)f->w * f->h;
+    for (long v = 0; v <= t; v++)
+        n0 += hist[v];
+    if (t < 0)
+        *out = iso_median(hist, 0, nb - 1, n);
+    else
+        *out = 0.5 * (iso_median(hist, 0, (size_t)t, n0) + iso_median(hist, (size_t)t + 1, nb - 1, n - n0));
     free(hist);
-    *out = t < 0 ? s1 / n1 : 0.5 * (s0 / n0 + s1 / n1);
     return AMSCR_OK;
 }
 

@@ -20,8 +20,8 @@ typedef struct amscr__iso {
     double pad;          /* the frame's field value: the background's mean level, < 0 */
 } amscr__iso;
 
-/* The level (given, or automatic when level < 0: the mean of the two class means of Otsu's
- * split), the polarity and the frame value. Arguments are validated by the caller. */
+/* The level (given, or automatic when level < 0: halfway between the medians of the two
+ * classes of Otsu's split), the polarity and the frame value. Arguments are validated by the caller. */
 amscr_status amscr__iso_setup(const void *pixels, size_t w, size_t h, size_t stride, int bits, double level,
                               amscr__iso *out);
 
