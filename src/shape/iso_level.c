@@ -5,9 +5,9 @@
  * 65536 for 16-bit), then halfway between the two classes' medians, the level where an
  * antialiased edge (a pixel's value proportional to its covered area) is half covered. Polarity as
  * amscr_contour_from_mask: when most of the image border is above the level, the field is
- * negated so the border is background. The padding frame takes the background's mean level,
- * so a shape touching the border closes at the image's edge (half a pixel beyond the border
- * pixel centres) for a binary image. */
+ * negated so the border is background. The padding frame is background: next to a foreground
+ * border pixel it mirrors that pixel's value, so a shape touching the border closes at the
+ * image's edge (half a pixel beyond the border pixel centres). */
 #include "internal.h"
 #include "iso_level.h"
 

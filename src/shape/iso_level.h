@@ -25,14 +25,18 @@ typedef struct amscr__iso {
 amscr_status amscr__iso_setup(const void *pixels, size_t w, size_t h, size_t stride, int bits, double level,
                               amscr__iso *out);
 
-/* The field at padded coordinates (X, Y), 0 <= X < w + 2, 0 <= Y < h + 2. */
+/* The field at padded coordinates (X, Y), 0 <= X < w + 2, 0 <= Y < h + 2. A frame position
+ * next to a foreground border pixel takes that pixel's value negated, so the iso-line crosses
+ * the image's edge halfway (at -0.5 or side - 0.5); elsewhere the frame is `pad`. */
 static inline double amscr__iso_at(const amscr__iso *f, size_t X, size_t Y)
 {
-    if (X == 0 || Y == 0 || X > f->w || Y > f->h)
-        return f->pad;
-    size_t i = (Y - 1) * f->stride + (X - 1);
-    double v = f->p8 ? (double)f->p8[i] : (double)f->p16[i];
-    return f->sign * (v - f->level);
+    int frame = X == 0 || Y == 0 || X > f->w || Y > f->h;
+    size_t x = X == 0 ? 0 : X > f->w ? f->w - 1 : X - 1, y = Y == 0 ? 0 : Y > f->h ? f->h - 1 : Y - 1;
+    size_t i = y * f->stride + x;
+    double g = f->sign * ((f->p8 ? (double)f->p8[i] : (double)f->p16[i]) - f->level);
+    if (!frame)
+        return g;
+    return g > 0.0 ? -g : f->pad;
 }
 
 /* The padded foreground mask ((w+2) x (h+2) bytes, 1 where f > 0) and its foreground count. */
