@@ -51,7 +51,8 @@ extern "C" {
  *              fail return 0, NULL or NaN (as stated) for a NULL object.
  * Ownership.   Functions whose names contain _new, _copy, _read, _parse or
  *              _load, and amscr_register, amscr_register_contours,
- *              amscr_contour_from_mask, amscr_contours_from_mask and
+ *              amscr_contour_from_mask, amscr_contours_from_mask,
+ *              amscr_contour_from_image, amscr_contours_from_image and
  *              amscr_db_save_memory, hand the caller something to free: an object
  *              with its own amscr_<obj>_free() (each accepts NULL), or for
  *              amscr_db_save_memory a buffer for amscr_free(). Every other pointer
@@ -449,6 +450,72 @@ AMSCR_API int amscr_contour_set_is_hole(const amscr_contour_set *s, size_t i);
  * @since 0.2
  */
 AMSCR_API double amscr_contour_set_area(const amscr_contour_set *s, size_t i);
+
+/* ---------------------------------------- sub-pixel contours of grey images */
+
+/** Automatic level for amscr_contour_from_image (any negative level). @since 0.4 */
+#define AMSCR_LEVEL_AUTO (-1.0)
+/** Flag of amscr_contour_from_image: the pixel-centre chain of amscr_contour_from_mask. @since 0.4 */
+#define AMSCR_TRACE_PIXEL_CHAIN 1
+
+/**
+ * @brief Traces the outer boundary of the largest foreground component of an 8- or 16-bit
+ *        grey image at sub-pixel accuracy: the iso-line at `level`.
+ *
+ * A pixel is foreground when its value is > level. Polarity is automatic, components and
+ * shapes touching the border as amscr_contour_from_mask (foreground 8-connected; the image is
+ * treated as padded with its background level). The result is the iso-line of the image at
+ * `level` through the component's boundary, found by marching squares with linear
+ * interpolation between pixel centres (x = column, y = row; a binary image's boundary runs
+ * halfway between foreground and background pixel centres, an antialiased image's where the
+ * coverage is one half), with positive signed area (counter-clockwise in a y-up frame), no
+ * repeated point. Saddle cells join foreground corners. With AMSCR_TRACE_PIXEL_CHAIN the
+ * pixels are classified the same way and the result is amscr_contour_from_mask's chain of
+ * boundary pixel centres.
+ *
+ * @param[in] pixels  height rows of width samples (uint8_t for bits 8, native-endian uint16_t
+ *                    for bits 16), rows `stride` samples apart.
+ * @param[in] width, height  1..AMSCR_MAX_IMAGE_SIDE, width*height <= AMSCR_MAX_IMAGE_PIXELS.
+ * @param[in] stride  samples between row starts, >= width.
+ * @param[in] bits  8 or 16.
+ * @param[in] level  the iso-level in sample units, 0 <= level < 2^bits - 1 (T + 0.5 classifies
+ *                   pixels as amscr_contour_from_mask's threshold T); negative
+ *                   (AMSCR_LEVEL_AUTO): halfway between the medians of the two classes
+ *                   of Otsu's split.
+ * @param[in] flags  0 (sub-pixel) or AMSCR_TRACE_PIXEL_CHAIN.
+ * @param[out] out  new contour.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, empty image, bad stride, bits, level or
+ *         flags); AMSCR_E_LIMIT; AMSCR_E_NOT_FOUND (no foreground, or foreground
+ *         everywhere); AMSCR_E_DEGENERATE (no area); AMSCR_E_NOMEM.
+ * Ownership: caller frees *out with amscr_contour_free.
+ * Thread-safety: reentrant.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_from_image(const void *pixels, size_t width, size_t height,
+                                                                size_t stride, int bits, double level, int flags,
+                                                                amscr_contour **out);
+
+/**
+ * @brief Every contour of an 8- or 16-bit grey image at sub-pixel accuracy, with the
+ *        hierarchy of amscr_contours_from_mask.
+ *
+ * Level, polarity and flags as amscr_contour_from_image; components, holes, parents, order
+ * and min_area as amscr_contours_from_mask. Each contour is the iso-line at `level` between
+ * its region and the region around it: outer contours counter-clockwise, holes clockwise.
+ * Areas are those of the sub-pixel polygons (a single binary pixel has area 0.5).
+ *
+ * @param[in] pixels, width, height, stride, bits, level, flags  as amscr_contour_from_image.
+ * @param[in] min_area  pixels^2, >= 0 and finite.
+ * @param[out] out  new set with at least one contour.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_LIMIT; AMSCR_E_NOT_FOUND (no foreground,
+ *         foreground everywhere, or no contour of min_area); AMSCR_E_NOMEM.
+ * Ownership: caller frees *out with amscr_contour_set_free.
+ * Thread-safety: reentrant.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_contours_from_image(const void *pixels, size_t width, size_t height,
+                                                                 size_t stride, int bits, double level, int flags,
+                                                                 double min_area, amscr_contour_set **out);
 
 /* ============================================================================
  * Curve processing: smoothing, resampling, normalization

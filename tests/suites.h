@@ -32,5 +32,6 @@ Suite *amscr_suite_even(void);
 Suite *amscr_suite_index(void);
 Suite *amscr_suite_signature(void);
 Suite *amscr_suite_protocols(void);
+Suite *amscr_suite_subpixel(void);
 
 #endif

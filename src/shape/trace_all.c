@@ -40,13 +40,7 @@ static const int ta_dx[8] = {-1, -1, 0, 1, 1, 1, 0, -1};
 static const int ta_dy[8] = {0, -1, -1, -1, 0, 1, 1, 1};
 static const int ta_newback[8] = {6, 6, 0, 0, 2, 2, 4, 4};
 
-/* Regions of the padded mask: their first pixel and whether they are foreground. */
-typedef struct regions {
-    uint32_t *lab; /* W*H labels, 1-based; 1 is the outside */
-    uint32_t *first;
-    unsigned char *fg;
-    size_t n, cap; /* labels 1..n are used; index 0 unused */
-} regions;
+typedef amscr__regions regions;
 
 static int regions_push(regions *R, uint32_t first, unsigned char fg)
 {
@@ -233,17 +227,14 @@ static amscr_status set_new(size_t cap, amscr_contour_set **out)
     return AMSCR_OK;
 }
 
-/* Traces every region of R (labels 2..n) into the set s (room for n entries). */
-static amscr_status trace_all(regions *R, uint8_t *st, size_t W, double min_area, amscr_contour_set *s)
+/* Traces every region of R (labels 2..n) with `tracer` into the set s (room for n entries). */
+static amscr_status trace_all(const regions *R, size_t W, amscr__region_tracer tracer, void *ctx, double min_area,
+                              amscr_contour_set *s)
 {
-    size_t *index = amscr__malloc_array(R->n + 1, sizeof *index), cap = 1024, np = 0; /* region -> set index */
-    uint32_t *pts = malloc(cap * sizeof *pts);
+    size_t *index = amscr__malloc_array(R->n + 1, sizeof *index); /* region -> set index */
     amscr_status e = AMSCR_OK;
-    if (!index || !pts) {
-        free(index);
-        free(pts);
+    if (!index)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_contours_from_mask: out of memory (%zu regions)", R->n);
-    }
     index[1] = AMSCR_NO_PARENT; /* the outside */
     for (size_t r = 2; e == AMSCR_OK && r <= R->n; r++) {
         size_t p = R->first[r];
@@ -251,11 +242,9 @@ static amscr_status trace_all(regions *R, uint8_t *st, size_t W, double min_area
         index[r] = SIZE_MAX - 1; /* dropped */
         if (par == SIZE_MAX - 1)
             continue; /* inside a dropped contour */
-        e = trace_region(R->lab, st, W, p, (uint32_t)r, &pts, &cap, &np);
         amscr_contour *c = NULL;
         double area = 0.0;
-        if (e == AMSCR_OK)
-            e = make_contour(pts, np, W, !R->fg[r], min_area, &c, &area);
+        e = tracer(ctx, R, r, min_area, &c, &area);
         if (e != AMSCR_OK || c == NULL)
             continue;
         index[r] = s->n;
@@ -265,8 +254,25 @@ static amscr_status trace_all(regions *R, uint8_t *st, size_t W, double min_area
         s->area[s->n++] = area;
     }
     free(index);
-    free(pts);
     return e;
+}
+
+/* The pixel-centre tracer of amscr_contours_from_mask (an amscr__region_tracer). */
+typedef struct chain_ctx {
+    uint8_t *st; /* W*H tracing states */
+    size_t W, cap;
+    uint32_t *pts;
+} chain_ctx;
+
+static amscr_status chain_tracer(void *vctx, const regions *R, size_t r, double min_area, amscr_contour **out,
+                                 double *out_area)
+{
+    chain_ctx *c = vctx;
+    size_t np = 0;
+    amscr_status e = trace_region(R->lab, c->st, c->W, R->first[r], (uint32_t)r, &c->pts, &c->cap, &np);
+    if (e != AMSCR_OK)
+        return e;
+    return make_contour(c->pts, np, c->W, !R->fg[r], min_area, out, out_area);
 }
 
 static amscr_status check_args(const uint8_t *pixels, size_t width, size_t height, size_t stride, int threshold,
@@ -290,6 +296,57 @@ static amscr_status check_args(const uint8_t *pixels, size_t width, size_t heigh
     return AMSCR_OK;
 }
 
+amscr_status amscr__regions_label(const uint8_t *on, size_t W, size_t H, amscr__regions *R)
+{
+    uint32_t *queue = amscr__malloc_array(W * H, sizeof *queue);
+    R->lab = amscr__calloc_array(W * H, sizeof *R->lab);
+    R->first = malloc(64 * sizeof *R->first);
+    R->fg = malloc(64);
+    R->n = 0;
+    R->cap = 64;
+    amscr_status e = AMSCR_OK;
+    if (!queue || !R->lab || !R->first || !R->fg)
+        e = amscr__fail(AMSCR_E_NOMEM, "contour tracing: out of memory (%zu x %zu labels)", W, H);
+    else
+        e = label_regions(on, W, H, queue, R);
+    free(queue);
+    if (e != AMSCR_OK)
+        amscr__regions_free(R);
+    return e;
+}
+
+void amscr__regions_free(amscr__regions *R)
+{
+    free(R->lab);
+    free(R->first);
+    free(R->fg);
+    R->lab = R->first = NULL;
+    R->fg = NULL;
+    R->n = 0;
+}
+
+amscr_status amscr__contours_build(const uint8_t *on, size_t W, size_t H, amscr__region_tracer tracer, void *ctx,
+                                   double min_area, const char *fn, amscr_contour_set **out)
+{
+    regions R;
+    amscr_contour_set *s = NULL;
+    amscr_status e = amscr__regions_label(on, W, H, &R);
+    if (e != AMSCR_OK)
+        return e;
+    e = set_new(R.n, &s);
+    if (e == AMSCR_OK)
+        e = trace_all(&R, W, tracer, ctx, min_area, s);
+    if (e == AMSCR_OK && s->n == 0)
+        e = amscr__fail(AMSCR_E_NOT_FOUND, "%s: no contour of area >= %g", fn, min_area);
+    amscr__regions_free(&R);
+    if (e != AMSCR_OK) {
+        amscr_contour_set_free(s);
+        return e;
+    }
+    *out = s;
+    return AMSCR_OK;
+}
+
 amscr_status amscr_contours_from_mask(const uint8_t *pixels, size_t width, size_t height, size_t stride,
                                       int threshold, double min_area, amscr_contour_set **out)
 {
@@ -300,12 +357,10 @@ amscr_status amscr_contours_from_mask(const uint8_t *pixels, size_t width, size_
     int t, invert;
     amscr__mask_threshold(pixels, width, height, stride, threshold, &t, &invert);
     const size_t W = width + 2, H = height + 2;
-    uint8_t *on = amscr__calloc_array(W * H, 1), *st = amscr__calloc_array(W * H, 1);
-    uint32_t *queue = amscr__malloc_array(W * H, sizeof *queue);
-    regions R = {amscr__calloc_array(W * H, sizeof(uint32_t)), malloc(64 * sizeof(uint32_t)), malloc(64), 0, 64};
-    amscr_contour_set *s = NULL;
+    chain_ctx c = {amscr__calloc_array(W * H, 1), W, 1024, malloc(1024 * sizeof(uint32_t))};
+    uint8_t *on = amscr__calloc_array(W * H, 1);
     size_t fg = 0;
-    if (!on || !st || !queue || !R.lab || !R.first || !R.fg) {
+    if (!on || !c.st || !c.pts) {
         e = amscr__fail(AMSCR_E_NOMEM, "amscr_contours_from_mask: out of memory (%zu x %zu mask)", W, H);
         goto done;
     }
@@ -315,33 +370,16 @@ amscr_status amscr_contours_from_mask(const uint8_t *pixels, size_t width, size_
             on[(y + 1) * W + x + 1] = v;
             fg += v;
         }
-    if (fg == 0) {
+    if (fg == 0)
         e = amscr__fail(AMSCR_E_NOT_FOUND, "amscr_contours_from_mask: %s (threshold %d)",
                         invert ? "foreground everywhere" : "no foreground pixels", t);
-        goto done;
-    }
-    e = label_regions(on, W, H, queue, &R);
-    free(queue);
-    queue = NULL;
-    if (e == AMSCR_OK)
-        e = set_new(R.n, &s);
-    if (e == AMSCR_OK)
-        e = trace_all(&R, st, W, min_area, s);
-    if (e == AMSCR_OK && s->n == 0)
-        e = amscr__fail(AMSCR_E_NOT_FOUND, "amscr_contours_from_mask: no contour of area >= %g", min_area);
+    else
+        e = amscr__contours_build(on, W, H, chain_tracer, &c, min_area, "amscr_contours_from_mask", out);
 done:
     free(on);
-    free(st);
-    free(queue);
-    free(R.lab);
-    free(R.first);
-    free(R.fg);
-    if (e != AMSCR_OK) {
-        amscr_contour_set_free(s);
-        return e;
-    }
-    *out = s;
-    return AMSCR_OK;
+    free(c.st);
+    free(c.pts);
+    return e;
 }
 
 void amscr_contour_set_free(amscr_contour_set *s)

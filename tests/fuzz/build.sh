@@ -60,7 +60,7 @@ fail=0
 for p in "${pids[@]}"; do wait "$p" || fail=1; done
 [ $fail = 0 ] || { echo "fuzz/build.sh: compilation failed" >&2; exit 1; }
 
-targets=(text pgm png mask register dbload contours index)
+targets=(text pgm png mask register dbload contours index subpixel)
 for t in "${targets[@]}"; do
   src=tests/fuzz/fuzz_$t.c
   extra=()

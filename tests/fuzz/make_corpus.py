@@ -92,6 +92,25 @@ line = blank(9, 5, 0)
 fill_rect(line, 1, 2, 7, 2, 255)
 put('mask', 'thin-line', mask_input(line, 0, 0))
 
+# ------------------------------------------------------------------ subpixel (iso-lines)
+def subpixel_input(img, stride_extra=0, level=255, mode=0, bits=8):
+    w, h = len(img[0]), len(img)
+    if bits == 8:
+        rows = b''.join(bytes(row) + b'\x99' * stride_extra for row in img)
+    else:
+        rows = b''.join(b''.join(int(v).to_bytes(2, sys.byteorder) for v in row) + b'\x99\x99' * stride_extra
+                        for row in img)
+    return bytes([w - 1, h - 1, stride_extra | (0x80 if bits == 16 else 0), level, mode]) + rows
+
+
+put('subpixel', 'rect-auto', subpixel_input(shape_img()))
+put('subpixel', 'rect-127-stride3-chain', subpixel_input(shape_img(), 3, 127, 2))
+grey = [[min(255, max(0, 128 + 40 * (6 - abs(x - 8)) - 30 * abs(y - 6))) for x in range(17)] for y in range(13)]
+put('subpixel', 'grey-auto', subpixel_input(grey))
+put('subpixel', 'grey16-all', subpixel_input([[v * 257 for v in row] for row in grey], 1, 127, 1, 16))
+put('subpixel', 'ring-all', subpixel_input(ring, 1, 100, 1))
+put('subpixel', 'checker-all', subpixel_input([[255 * ((x + y) % 2) for x in range(6)] for y in range(5)], 0, 127, 1))
+
 # ------------------------------------------------------------------ contours (every component)
 def contours_input(img, stride_extra=0, threshold=255, min_area=0):
     m = mask_input(img, stride_extra, threshold)

@@ -1,5 +1,6 @@
 """`amscr contour --all` (every component and hole with its parent, text and JSON) and the
-`--component N` of register and search."""
+`--component N` of register and search. The exact areas and points below are those of the
+chain of pixel centres (--pixel-chain); the default sub-pixel contours are checked at the end."""
 import json
 
 import pytest
@@ -23,7 +24,7 @@ def nested(tmp_path):
 
 
 def test_all_json_hierarchy(nested):
-    r = run("contour", nested, "--all", "--json", "--min-area", "0")
+    r = run("contour", nested, "--all", "--json", "--min-area", "0", "--pixel-chain")
     assert r.returncode == 0, r.stderr
     j = json.loads(r.stdout)
     got = [(c["index"], c["parent"], c["hole"], c["area"]) for c in j["contours"]]
@@ -34,10 +35,10 @@ def test_all_json_hierarchy(nested):
 
 
 def test_all_text_matches_json_and_min_area(nested, tmp_path):
-    j = json.loads(run("contour", nested, "--all", "--json").stdout)
+    j = json.loads(run("contour", nested, "--all", "--json", "--pixel-chain").stdout)
     assert [c["area"] for c in j["contours"]] == [961, 361, 81]  # the default --min-area 10 drops the speck
     out = tmp_path / "all.txt"
-    r = run("contour", nested, "--all", "-o", out)
+    r = run("contour", nested, "--all", "-o", out, "--pixel-chain")
     assert r.returncode == 0 and r.stdout == ""
     blocks = out.read_text().strip().split("\n\n")
     assert len(blocks) == 3
@@ -48,7 +49,7 @@ def test_all_text_matches_json_and_min_area(nested, tmp_path):
     for b, c in zip(blocks, j["contours"]):
         pts = [tuple(float(v) for v in line.split()) for line in b.splitlines()[1:]]
         assert pts == [tuple(p) for p in c["points"]]
-    assert run("contour", nested, "--all", "--min-area", "400").stdout.count("# contour") == 1
+    assert run("contour", nested, "--all", "--min-area", "400", "--pixel-chain").stdout.count("# contour") == 1
 
 
 @pytest.mark.parametrize("args,code,msg", [
@@ -77,10 +78,10 @@ def test_register_component(nested):
     default = json.loads(run("register", nested, nested, "--json").stdout)
     first = json.loads(run("register", nested, nested, "--json", "--component", "0").stdout)
     assert default["distance"] == first["distance"] and default["A"] == first["A"]
-    hole = run("register", nested, nested, "--json", "--component", "1")
+    hole = run("register", nested, nested, "--json", "--component", "1", "--pixel-chain")
     assert hole.returncode == 0, hole.stderr
     assert json.loads(hole.stdout)["distance"] < 1e-6  # the hole onto itself
-    r = run("register", nested, nested, "--component", "3")
+    r = run("register", nested, nested, "--component", "3", "--pixel-chain")
     assert r.returncode == 1 and "--component 3" in r.stderr and "0..2" in r.stderr
 
 
@@ -91,3 +92,15 @@ def test_search_component(nested, tmp_path):
     assert len(json.loads(r.stdout)["results"]) == 9
     r = run("search", nested, m, "--component", "9", *AFFINE)
     assert r.returncode == 1 and "--component 9" in r.stderr
+
+
+def test_all_subpixel_areas(nested):
+    """The default iso-lines run halfway between foreground and background pixel centres: a
+    square of n x n pixels encloses n^2 less its four cut corners (1/8 each)."""
+    j = json.loads(run("contour", nested, "--all", "--json", "--min-area", "0").stdout)
+    got = [(c["index"], c["parent"], c["hole"], c["area"]) for c in j["contours"]]
+    assert got == [(0, None, False, 1023.5), (1, None, False, 15.5), (2, 0, True, 399.5), (3, 2, False, 99.5)]
+    hole = j["contours"][2]["points"]
+    assert min(x for x, _ in hole) == 9.5 and max(x for x, _ in hole) == 29.5  # between the pixels
+    chain = json.loads(run("contour", nested, "--all", "--json", "--min-area", "0", "--pixel-chain").stdout)
+    assert [c["parent"] for c in chain["contours"]] == [c["parent"] for c in j["contours"]]

@@ -1,5 +1,6 @@
 """Image decoders of the tool: every PNG colour type and bit depth (interlaced too), PGM P2/P5
-(8/16-bit, comments), through `amscr contour` on a known rectangle."""
+(8/16-bit, comments), through `amscr contour --pixel-chain` on a known rectangle (the chain of
+pixel centres reads the decoded classification exactly)."""
 import pytest
 
 from imgutil import (blank, extremes, fill_rect, map_img, pgm_bytes, png_bytes, read_points, rect_mask, run,
@@ -11,7 +12,7 @@ RECT = (5, 7, 24, 19)  # x0, y0, x1, y1 inclusive, in a 40 x 30 image
 def contour_of(tmp_path, data, name="img", *extra):
     p = tmp_path / name
     p.write_bytes(data)
-    r = run("contour", p, *extra)
+    r = run("contour", p, "--pixel-chain", *extra)
     assert r.returncode == 0, r.stderr
     assert r.stderr == ""
     return read_points(r.stdout)
@@ -210,7 +211,7 @@ def test_contour_output_file(tmp_path):
     img = tmp_path / "r.pgm"
     img.write_bytes(pgm_bytes(rect_mask(fg=255)))
     out = tmp_path / "out.txt"
-    r = run("contour", img, "-o", out)
+    r = run("contour", img, "-o", out, "--pixel-chain")
     assert r.returncode == 0, r.stderr
     assert r.stdout == ""
     check_rect(read_points(out.read_text()))
@@ -223,5 +224,5 @@ def test_threshold_option(tmp_path):
     r = run("contour", img)  # default 127: nothing is on
     assert r.returncode == 1
     assert "dim.pgm" in r.stderr
-    check_rect(read_points(run("contour", img, "--threshold", "50").stdout))
-    check_rect(read_points(run("contour", img, "--threshold=auto").stdout))
+    check_rect(read_points(run("contour", img, "--threshold", "50", "--pixel-chain").stdout))
+    check_rect(read_points(run("contour", img, "--threshold=auto", "--pixel-chain").stdout))

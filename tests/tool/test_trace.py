@@ -6,10 +6,12 @@ from imgutil import blank, extremes, fill_rect, image_bytes, img_ext, read_point
 
 
 def trace(tmp_path, img, name=None, *extra):
+    """The chain of boundary pixel centres (--pixel-chain; the default iso-line is tested by the
+    sub-pixel tests at the end)."""
     name = name or "m" + img_ext()
     p = tmp_path / name
     p.write_bytes(image_bytes(img, name))
-    r = run("contour", p, *extra)
+    r = run("contour", p, "--pixel-chain", *extra)
     assert r.returncode == 0, r.stderr
     pts = read_points(r.stdout)
     assert len(pts) >= 3
@@ -104,6 +106,87 @@ def test_single_pixel_rejected_cleanly(tmp_path):
     img[10][10] = 255
     p = tmp_path / "dot.pgm"
     p.write_bytes(image_bytes(img, "dot.pgm"))
-    r = run("contour", p)
+    r = run("contour", p, "--pixel-chain")
     assert r.returncode == 1
     assert len(r.stderr.splitlines()) == 1 and "dot.pgm" in r.stderr
+
+
+# ------------------------------------------------------------------ sub-pixel (the default)
+def subpixel(tmp_path, data, name, *extra):
+    p = tmp_path / name
+    p.write_bytes(data)
+    r = run("contour", p, *extra)
+    assert r.returncode == 0, r.stderr
+    pts = read_points(r.stdout)
+    assert signed_area(pts) > 0
+    assert all(pts[i] != pts[(i + 1) % len(pts)] for i in range(len(pts)))
+    return pts
+
+
+def test_subpixel_binary_edges_between_pixel_centres(tmp_path):
+    img = fill_rect(blank(50, 40), 5, 5, 40, 30, 255)
+    pts = subpixel(tmp_path, image_bytes(img, "r" + img_ext()), "r" + img_ext())
+    assert extremes(pts) == (4.5, 4.5, 40.5, 30.5)
+    assert signed_area(pts) == 36 * 26 - 0.5  # four corners cut by 1/8 each
+    chain = trace(tmp_path, img)
+    assert extremes(chain) == (5, 5, 40, 30)
+
+
+def test_subpixel_single_pixel_is_a_diamond(tmp_path):
+    img = blank(20, 20)
+    img[10][10] = 255
+    pts = subpixel(tmp_path, image_bytes(img, "dot.pgm"), "dot.pgm")
+    assert sorted(pts) == [(9.5, 10.0), (10.0, 9.5), (10.0, 10.5), (10.5, 10.0)]
+
+
+def _grey_step(v):
+    """Columns 5..19 full, column 20 at v, the rest 0 (16-bit values), rows 5..24."""
+    img = blank(40, 30)
+    fill_rect(img, 5, 5, 19, 24, 65535)
+    fill_rect(img, 20, 5, 20, 24, v)
+    return img
+
+
+@pytest.mark.parametrize("fmt", ["png", "pgm"])
+def test_subpixel_keeps_16_bits(tmp_path, fmt):
+    # column 20 at 32800: just above the level (127 + 0.5) * 257 = 32767.5; the edge lies at
+    # 20 + 32.5 / 32800 (8 bits would round the value to 128 and put it at 20 + 0.5 / 128)
+    img = _grey_step(32800)
+    if fmt == "png":
+        from imgutil import have_png, png_bytes
+        if not have_png():
+            pytest.skip("tool built without libpng")
+        data = png_bytes(img, 0, 16)
+    else:
+        from imgutil import pgm_bytes
+        data = pgm_bytes(img, 65535)
+    pts = subpixel(tmp_path, data, "g16." + fmt)
+    right = max(x for x, y in pts if 8 <= y <= 20)
+    assert abs(right - (20 + 32.5 / 32800)) < 1e-9, right
+    chain = read_points(run("contour", tmp_path / ("g16." + fmt), "--pixel-chain").stdout)
+    assert max(x for x, _ in chain) == 20
+
+
+def test_subpixel_antialiased_edge(tmp_path):
+    # column 20 covered 30 % (77 of 255): the iso-line at 127.5 is interpolated between
+    # column 19 (255) and column 20 (77); linear interpolation of a box-filtered edge is off by
+    # c (0.5 - c) / (1 - c) <= 0.09 px (c: the coverage), here 0.086 of the true 19.5 + 0.3
+    img = blank(40, 30)
+    fill_rect(img, 5, 5, 19, 24, 255)
+    fill_rect(img, 20, 5, 20, 24, 77)
+    pts = subpixel(tmp_path, image_bytes(img, "aa.pgm"), "aa.pgm")
+    right = max(x for x, y in pts if 8 <= y <= 20)
+    assert abs(right - (19 + (255 - 127.5) / (255 - 77))) < 1e-9
+    assert abs(right - 19.8) < 0.09
+    fill_rect(img, 20, 5, 20, 24, 128)  # half covered: exact
+    pts = subpixel(tmp_path, image_bytes(img, "ab.pgm"), "ab.pgm")
+    assert abs(max(x for x, y in pts if 8 <= y <= 20) - 20.0) < 0.01
+
+
+def test_pixel_chain_option_everywhere(tmp_path):
+    img = fill_rect(blank(50, 40), 5, 5, 40, 30, 255)
+    p = tmp_path / ("r" + img_ext())
+    p.write_bytes(image_bytes(img, p.name))
+    for cmd in (("contour", p), ("register", p, p)):
+        r = run(*cmd, "--pixel-chain")
+        assert r.returncode == 0, r.stderr

@@ -15,7 +15,11 @@ int shape_contours(const char *path, int threshold, double min_area, amscr_conto
         tool_error(path, "not an image: every contour (--all, --component) needs a PNG or PGM image");
         return -1;
     }
-    amscr_status st = amscr_contours_from_mask(img.pix, img.width, img.height, img.width, threshold, min_area, out);
+    int bits;
+    const void *pixels;
+    double level = image_level(&img, threshold, &bits, &pixels);
+    amscr_status st = amscr_contours_from_image(pixels, img.width, img.height, img.width, bits, level,
+                                                image_trace_flags(), min_area, out);
     image_free(&img);
     if (st != AMSCR_OK) {
         const char *d = lib_detail();

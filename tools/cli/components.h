@@ -1,5 +1,5 @@
 /* components.h — every contour of an image for the tool: `contour --all` and the
- * `--component N` of register and search (amscr_contours_from_mask). Tool-internal. */
+ * `--component N` of register and search (amscr_contours_from_image). Tool-internal. */
 #ifndef AMSCR_TOOL_COMPONENTS_H
 #define AMSCR_TOOL_COMPONENTS_H
 

@@ -1,7 +1,9 @@
 /* image.c — PGM/PNG decoding and shape loading for the amscr tool (see image.h).
  *
  * Luminance conversion:
- *   - gray: as is; 1/2/4-bit gray expanded to 0..255; 16-bit scaled (rounded) to 8 bits;
+ *   - gray: as is; 1/2/4-bit gray expanded to 0..255; 16-bit scaled (rounded) to 8 bits, and
+ *     kept as 16-bit samples too (pix16) for gray and RGB without alpha and PGM maxval > 255,
+ *     which the sub-pixel tracer follows;
  *   - RGB: Y = (299 R + 587 G + 114 B) / 1000 (Rec. 601 weights, on the stored values);
  *   - palette: through the palette's RGB, tRNS entries give alpha;
  *   - PGM: v * 255 / maxval, rounded (maxval 1..65535).
@@ -41,7 +43,9 @@ void image_free(tool_image *img)
 {
     if (img) {
         free(img->pix);
+        free(img->pix16);
         img->pix = NULL;
+        img->pix16 = NULL;
         img->width = img->height = 0;
     }
 }
@@ -146,8 +150,10 @@ static int pgm_header(FILE *fp, const char *path, unsigned long *w, unsigned lon
     return 0;
 }
 
-/* Binary (P5) samples, 1 or 2 bytes each (big-endian), scaled to 0..255 into pix. */
-static int pgm_binary(FILE *fp, const char *path, size_t w, size_t h, unsigned long maxval, uint8_t *pix)
+/* Binary (P5) samples, 1 or 2 bytes each (big-endian), scaled to 0..255 into pix (and to
+ * 0..65535 into pix16 when not NULL). */
+static int pgm_binary(FILE *fp, const char *path, size_t w, size_t h, unsigned long maxval, uint8_t *pix,
+                      uint16_t *pix16)
 {
     unsigned long half = maxval / 2;
     size_t bps = maxval < 256 ? 1 : 2;
@@ -169,14 +175,17 @@ static int pgm_binary(FILE *fp, const char *path, size_t w, size_t h, unsigned l
                 return -1;
             }
             pix[y * w + x] = (uint8_t)((v * 255 + half) / maxval);
+            if (pix16)
+                pix16[y * w + x] = (uint16_t)((v * 65535 + half) / maxval);
         }
     }
     free(row);
     return 0;
 }
 
-/* ASCII (P2) samples, scaled to 0..255 into pix. */
-static int pgm_ascii(FILE *fp, const char *path, size_t w, size_t h, unsigned long maxval, uint8_t *pix)
+/* ASCII (P2) samples, scaled to 0..255 into pix (and to 0..65535 into pix16 when not NULL). */
+static int pgm_ascii(FILE *fp, const char *path, size_t w, size_t h, unsigned long maxval, uint8_t *pix,
+                     uint16_t *pix16)
 {
     unsigned long half = maxval / 2;
     size_t npix = w * h;
@@ -196,6 +205,8 @@ static int pgm_ascii(FILE *fp, const char *path, size_t w, size_t h, unsigned lo
             return -1;
         }
         pix[i] = (uint8_t)((v * 255 + half) / maxval);
+        if (pix16)
+            pix16[i] = (uint16_t)((v * 65535 + half) / maxval);
     }
     return 0;
 }
@@ -205,15 +216,21 @@ static int read_pgm(FILE *fp, const char *path, int ascii, tool_image *out)
     unsigned long w, h, maxval;
     if (pgm_header(fp, path, &w, &h, &maxval) != 0)
         return -1;
-    uint8_t *pix = xmalloc_array((size_t)w * (size_t)h, 1);
-    if (pix == NULL)
-        return -1;
-    int r = ascii ? pgm_ascii(fp, path, w, h, maxval, pix) : pgm_binary(fp, path, w, h, maxval, pix);
-    if (r != 0) {
+    size_t npix = (size_t)w * (size_t)h;
+    uint8_t *pix = xmalloc_array(npix, 1);
+    uint16_t *pix16 = maxval > 255 && pix ? xmalloc_array(npix, sizeof *pix16) : NULL;
+    if (pix == NULL || (maxval > 255 && pix16 == NULL)) {
         free(pix);
         return -1;
     }
+    int r = ascii ? pgm_ascii(fp, path, w, h, maxval, pix, pix16) : pgm_binary(fp, path, w, h, maxval, pix, pix16);
+    if (r != 0) {
+        free(pix);
+        free(pix16);
+        return -1;
+    }
     out->pix = pix;
+    out->pix16 = pix16;
     out->width = w;
     out->height = h;
     return 0;
@@ -259,6 +276,7 @@ typedef struct png_ctx {
     char msg[256];
     /* What a longjmp must free or report: volatile, as it changes between setjmp and longjmp. */
     uint8_t *volatile lum;
+    uint16_t *volatile lum16;
     uint8_t *volatile alpha;
     uint8_t *volatile buf;
     png_bytep *volatile rows;
@@ -326,8 +344,31 @@ static int png_check_ihdr(FILE *fp, const char *path)
     return 0;
 }
 
-/* Asks libpng for 8-bit gray or RGB, with alpha when the file has any; returns the number of
- * interlace passes. */
+/* A 16-bit gray or RGB file without alpha keeps its 16 bits (to_luminance_row16). */
+static int png_keep16(png_structp png, png_infop info)
+{
+    int color = png_get_color_type(png, info);
+    return png_get_bit_depth(png, info) == 16 && (color == PNG_COLOR_TYPE_GRAY || color == PNG_COLOR_TYPE_RGB) &&
+           !png_get_valid(png, info, PNG_INFO_tRNS);
+}
+
+/* 16-bit big-endian gray or RGB samples to 16- and 8-bit luminance (weights as above). */
+static void to_luminance_row16(const uint8_t *src, int channels, size_t w, uint8_t *lum, uint16_t *lum16)
+{
+    for (size_t x = 0; x < w; x++) {
+        const uint8_t *p = src + 2 * (size_t)channels * x;
+        unsigned long v = ((unsigned long)p[0] << 8) | p[1];
+        if (channels == 3) {
+            unsigned long g = ((unsigned long)p[2] << 8) | p[3], b = ((unsigned long)p[4] << 8) | p[5];
+            v = (299ul * v + 587ul * g + 114ul * b + 500ul) / 1000ul;
+        }
+        lum16[x] = (uint16_t)v;
+        lum[x] = (uint8_t)((v * 255ul + 32767ul) / 65535ul);
+    }
+}
+
+/* Asks libpng for 8-bit gray or RGB, with alpha when the file has any (16-bit when png_keep16);
+ * returns the number of interlace passes. */
 static int png_set_transforms(png_structp png, png_infop info)
 {
     int color = png_get_color_type(png, info);
@@ -338,7 +379,7 @@ static int png_set_transforms(png_structp png, png_infop info)
         png_set_expand_gray_1_2_4_to_8(png);
     if (png_get_valid(png, info, PNG_INFO_tRNS))
         png_set_tRNS_to_alpha(png);
-    if (depth == 16) {
+    if (depth == 16 && !png_keep16(png, info)) {
 #if defined(PNG_READ_SCALE_16_TO_8_SUPPORTED)
         png_set_scale_16(png);
 #else
@@ -353,19 +394,21 @@ static int png_set_transforms(png_structp png, png_infop info)
 /* Reads the pixels into lum (and alpha): an interlaced image whole into buf (rows[] pointing
  * into it: libpng fills it over 7 passes), else row by row through buf. */
 static void png_read_pixels(png_structp png, int passes, uint8_t *buf, png_bytep *rows, size_t rowbytes,
-                            int channels, size_t w, size_t h, uint8_t *lum, uint8_t *alpha)
+                            int channels, size_t w, size_t h, uint8_t *lum, uint8_t *alpha, uint16_t *lum16)
 {
     if (passes > 1) {
         for (size_t y = 0; y < h; y++)
             rows[y] = buf + y * rowbytes;
         png_read_image(png, rows);
-        for (size_t y = 0; y < h; y++)
-            to_luminance_row(rows[y], channels, w, lum + y * w, alpha ? alpha + y * w : NULL);
-        return;
     }
     for (size_t y = 0; y < h; y++) {
-        png_read_row(png, buf, NULL);
-        to_luminance_row(buf, channels, w, lum + y * w, alpha ? alpha + y * w : NULL);
+        const uint8_t *src = passes > 1 ? rows[y] : buf;
+        if (passes <= 1)
+            png_read_row(png, buf, NULL);
+        if (lum16)
+            to_luminance_row16(src, channels, w, lum + y * w, lum16 + y * w);
+        else
+            to_luminance_row(src, channels, w, lum + y * w, alpha ? alpha + y * w : NULL);
     }
 }
 
@@ -406,13 +449,15 @@ static void png_set_input(png_structp png, png_ctx *ctx)
 /* The luminance and alpha planes and the read buffer (the whole image when interlaced), into ctx;
  * longjmps when out of memory. */
 static void png_alloc(png_structp png, png_ctx *ctx, png_uint_32 w, png_uint_32 h, int passes, size_t rowbytes,
-                      int has_alpha)
+                      int has_alpha, int keep16)
 {
     size_t npix = (size_t)w * (size_t)h;
     ctx->lum = malloc(npix);
     if (has_alpha)
         ctx->alpha = malloc(npix);
-    if (ctx->lum == NULL || (has_alpha && ctx->alpha == NULL)) {
+    if (keep16)
+        ctx->lum16 = malloc(npix * sizeof *ctx->lum16);
+    if (ctx->lum == NULL || (has_alpha && ctx->alpha == NULL) || (keep16 && ctx->lum16 == NULL)) {
         snprintf(ctx->msg, sizeof ctx->msg, "out of memory for %u x %u pixels", (unsigned)w, (unsigned)h);
         png_longjmp(png, 1);
     }
@@ -443,16 +488,18 @@ static void png_decode(png_structp png, png_infop info, png_ctx *ctx, const char
         ctx->limit_failed = 1;
         png_longjmp(png, 1);
     }
+    int keep16 = png_keep16(png, info);
     int passes = png_set_transforms(png, info);
     int channels = png_get_channels(png, info);
-    size_t rowbytes = png_get_rowbytes(png, info);
-    if (png_get_bit_depth(png, info) != 8 || channels < 1 || channels > 4 || rowbytes != (size_t)w * (size_t)channels) {
+    size_t rowbytes = png_get_rowbytes(png, info), bps = keep16 ? 2 : 1;
+    if (png_get_bit_depth(png, info) != 8 * (int)bps || channels < 1 || channels > 4 ||
+        rowbytes != (size_t)w * (size_t)channels * bps) {
         snprintf(ctx->msg, sizeof ctx->msg, "unexpected pixel layout after conversion");
         png_longjmp(png, 1);
     }
     int has_alpha = channels == 2 || channels == 4;
-    png_alloc(png, ctx, w, h, passes, rowbytes, has_alpha);
-    png_read_pixels(png, passes, ctx->buf, ctx->rows, rowbytes, channels, w, h, ctx->lum, ctx->alpha);
+    png_alloc(png, ctx, w, h, passes, rowbytes, has_alpha, keep16);
+    png_read_pixels(png, passes, ctx->buf, ctx->rows, rowbytes, channels, w, h, ctx->lum, ctx->alpha, ctx->lum16);
     /* The image data is complete; the chunks after it are not needed. */
     if (has_alpha)
         apply_alpha(ctx->lum, ctx->alpha, (size_t)w * (size_t)h);
@@ -463,9 +510,11 @@ static void png_decode(png_structp png, png_infop info, png_ctx *ctx, const char
     ctx->buf = NULL;
     ctx->rows = NULL;
     out->pix = ctx->lum;
+    out->pix16 = ctx->lum16;
     out->width = w;
     out->height = h;
     ctx->lum = NULL;
+    ctx->lum16 = NULL;
 }
 
 static int read_png(FILE *fp, const char *path, tool_image *out)
@@ -481,6 +530,7 @@ static int read_png(FILE *fp, const char *path, tool_image *out)
         return -1;
     if (setjmp(png_jmpbuf(png))) {
         free(ctx.lum);
+        free(ctx.lum16);
         free(ctx.alpha);
         free(ctx.buf);
         free(ctx.rows);
@@ -570,6 +620,7 @@ int file_is_image(const char *path)
 int image_read(const char *path, int text_ok, tool_image *out, tool_format *out_format)
 {
     out->pix = NULL;
+    out->pix16 = NULL;
     out->width = out->height = 0;
     *out_format = TOOL_FMT_TEXT;
     FILE *fp = open_input(path);
@@ -618,10 +669,27 @@ int image_read(const char *path, int text_ok, tool_image *out, tool_format *out_
 #endif
     }
     fclose(fp);
+    if (r < 0)
+        image_free(out);
     return r;
 }
 
 /* ============================================================ shapes */
+static int trace_flags; /* set once by the option parser (--pixel-chain), before any tracing */
+
+void image_set_trace_flags(int flags) { trace_flags = flags; }
+
+int image_trace_flags(void) { return trace_flags; }
+
+double image_level(const tool_image *img, int threshold, int *out_bits, const void **out_pixels)
+{
+    *out_bits = img->pix16 ? 16 : 8;
+    *out_pixels = img->pix16 ? (const void *)img->pix16 : (const void *)img->pix;
+    if (threshold == AMSCR_THRESHOLD_AUTO)
+        return AMSCR_LEVEL_AUTO;
+    return img->pix16 ? (threshold + 0.5) * 257.0 : threshold + 0.5;
+}
+
 int shape_load(const char *path, int threshold, amscr_contour **out)
 {
     tool_image img;
@@ -650,7 +718,10 @@ int shape_load(const char *path, int threshold, amscr_contour **out)
         }
         return 0;
     }
-    amscr_status st = amscr_contour_from_mask(img.pix, img.width, img.height, img.width, threshold, out);
+    int bits;
+    const void *pixels;
+    double level = image_level(&img, threshold, &bits, &pixels);
+    amscr_status st = amscr_contour_from_image(pixels, img.width, img.height, img.width, bits, level, trace_flags, out);
     if (st != AMSCR_OK) {
         const char *d = lib_detail();
         char thr[32];

@@ -9,10 +9,13 @@
 
 #include "amscr.h"
 
-/* An 8-bit luminance image, rows packed (stride == width). */
+/* An 8-bit luminance image, rows packed (stride == width); pix16: the same image with 16-bit
+ * samples when the file had more than 8 bits a sample (16-bit PNG without alpha, PGM with
+ * maxval > 255), else NULL. */
 typedef struct tool_image {
     uint8_t *pix;
     size_t width, height;
+    uint16_t *pix16;
 } tool_image;
 
 typedef enum tool_format {
@@ -29,10 +32,20 @@ typedef enum tool_format {
 int image_read(const char *path, int text_ok, tool_image *out, tool_format *out_format);
 void image_free(tool_image *img);
 
-/* Loads a shape: an image (traced with amscr_contour_from_mask at `threshold`, 0..254 or
- * AMSCR_THRESHOLD_AUTO) or a text point list. On failure prints one error line naming
- * `path` and returns -1. The caller frees *out with amscr_contour_free. */
+/* Loads a shape: an image (traced with amscr_contour_from_image at the level of `threshold`,
+ * 0..254 or AMSCR_THRESHOLD_AUTO: see image_level) or a text point list. On failure prints
+ * one error line naming `path` and returns -1. The caller frees *out with amscr_contour_free. */
 int shape_load(const char *path, int threshold, amscr_contour **out);
+
+/* How the tool traces images: 0 (sub-pixel iso-lines, the default) or AMSCR_TRACE_PIXEL_CHAIN
+ * (--pixel-chain). Set once, while the options are parsed. */
+void image_set_trace_flags(int flags);
+int image_trace_flags(void);
+
+/* The iso-level of amscr_contour_from_image for the tool's 8-bit `threshold` on img: T + 0.5
+ * (the pixels > T), scaled by 257 for 16-bit samples; AMSCR_LEVEL_AUTO for
+ * AMSCR_THRESHOLD_AUTO. *out_bits and *out_pixels: the samples to trace. */
+double image_level(const tool_image *img, int threshold, int *out_bits, const void **out_pixels);
 
 /* Non-zero when the file starts with PNG or PGM (P2/P5) magic bytes. */
 int file_is_image(const char *path);

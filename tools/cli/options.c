@@ -10,6 +10,7 @@
 
 #include "cli.h"
 #include "draw.h"
+#include "image.h"
 #include "names.h"
 
 typedef enum opt_id {
@@ -50,7 +51,8 @@ typedef enum opt_id {
     O_CHANNEL_WEIGHT,
     O_AFFINE_SHARE,
     O_FAST,
-    O_PAPER
+    O_PAPER,
+    O_PIXEL_CHAIN
 } opt_id;
 
 typedef struct optdef {
@@ -102,6 +104,7 @@ static const optdef OPTS[] = {
     {"--affine-share", O_AFFINE_SHARE, 1, C_RETRIEVAL, "S"},
     {"--fast", O_FAST, 0, C_RETRIEVAL, NULL},
     {"--paper", O_PAPER, 0, C_RETRIEVAL, NULL},
+    {"--pixel-chain", O_PIXEL_CHAIN, 0, C_ALL, NULL},
 };
 
 int usage_error(const char *what, const char *fmt, ...)
@@ -353,6 +356,7 @@ static int set_option(opts *o, const optdef *d, const char *v)
         o->affine_share = 0.0;
         return 0;
     case O_PAPER: set_paper(o); return 0;
+    case O_PIXEL_CHAIN: image_set_trace_flags(AMSCR_TRACE_PIXEL_CHAIN); return 0;
     }
     return 0;
 }

@@ -11,6 +11,7 @@
 #define AMSCR_MAX_SAMPLES 65536
 #define AMSCR_MAX_SCALES 64
 #define AMSCR_THRESHOLD_AUTO -1
+#define AMSCR_TRACE_PIXEL_CHAIN 1
 
 typedef enum amscr_status {
     AMSCR_OK = 0,
@@ -65,6 +66,8 @@ const amscr_contour *amscr_contour_set_contour(const amscr_contour_set *s, size_
 size_t amscr_contour_set_parent(const amscr_contour_set *s, size_t i);
 int amscr_contour_set_is_hole(const amscr_contour_set *s, size_t i);
 double amscr_contour_set_area(const amscr_contour_set *s, size_t i);
+amscr_status amscr_contour_from_image(const void *pixels, size_t width, size_t height, size_t stride, int bits, double level, int flags, amscr_contour **out);
+amscr_status amscr_contours_from_image(const void *pixels, size_t width, size_t height, size_t stride, int bits, double level, int flags, double min_area, amscr_contour_set **out);
 amscr_status amscr_gaussian_kernel(double sigma, double *taps, size_t *inout_ntaps);
 amscr_status amscr_smooth_gaussian(const double *xy, size_t n, int closed, double sigma, double *out_xy);
 amscr_status amscr_resample_euclidean(const double *xy, size_t n, int closed, size_t m, double *out_xy);

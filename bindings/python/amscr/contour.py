@@ -59,51 +59,76 @@ def _take(c) -> np.ndarray:
     return pts
 
 
-def _mask_and_threshold(mask: ArrayLike, threshold: Union[int, str, None]) -> Tuple[np.ndarray, int]:
-    """A C-contiguous uint8 copy of `mask` and the C threshold (see :func:`contour_from_mask`)."""
+def _image_and_level(mask: ArrayLike, threshold: Union[int, float, str, None],
+                     subpixel: bool) -> Tuple[np.ndarray, int, float, int]:
+    """A C-contiguous uint8 or uint16 copy of `mask`, its bits, the C level and flags (see
+    :func:`contour_from_mask`)."""
     a = np.asarray(mask)
     if a.ndim != 2:
         raise bad('mask: expected a 2-D array, got shape %s' % (a.shape,))
+    scale = None  # float images: (lo, hi) mapped to 0..65535
     if a.dtype == np.bool_:
         a = np.where(a, np.uint8(255), np.uint8(0))
-    elif a.dtype != np.uint8:
+    elif a.dtype.kind == 'f':
+        if a.size and not np.all(np.isfinite(a)):
+            raise bad('mask: non-finite values')
+        lo, hi = (float(a.min()), float(a.max())) if a.size else (0.0, 1.0)
+        scale = (lo, hi)
+        a = np.zeros(a.shape, np.uint16) if hi <= lo else np.rint((a - lo) * (65535.0 / (hi - lo))).astype(np.uint16)
+    elif a.dtype not in (np.uint8, np.uint16):
         if a.dtype.kind not in 'iu':
-            raise bad('mask: expected a bool or uint8 array, got dtype %s' % a.dtype)
-        if a.size and (a.min() < 0 or a.max() > 255):
-            raise bad('mask: values must be in 0..255 for dtype %s (got %d..%d)' % (a.dtype, a.min(), a.max()))
-        a = a.astype(np.uint8)
+            raise bad('mask: expected a bool, integer or float array, got dtype %s' % a.dtype)
+        if a.size and (a.min() < 0 or a.max() > 65535):
+            raise bad('mask: values must be in 0..65535 for dtype %s (got %d..%d)' % (a.dtype, a.min(), a.max()))
+        a = a.astype(np.uint8 if not a.size or a.max() <= 255 else np.uint16)
     a = np.ascontiguousarray(a)
-    if threshold is None:
-        return a, 127
+    bits = 16 if a.dtype == np.uint16 else 8
+    top = 65535 if bits == 16 else 255
+    flags = 0 if as_bool(subpixel, 'subpixel') else lib.AMSCR_TRACE_PIXEL_CHAIN
     if isinstance(threshold, str):
         if threshold.strip().lower() not in ('auto', 'otsu'):
-            raise bad("threshold: expected 0..254, 'auto' or None, got %r" % threshold)
-        return a, lib.AMSCR_THRESHOLD_AUTO
-    thr = as_count(threshold, 'threshold', 0)
-    if thr > 0x7FFFFFFF:
-        raise bad('threshold: expected 0..254, got %d' % thr)
-    return a, thr
+            raise bad("threshold: expected a level, 'auto' or None, got %r" % threshold)
+        return a, bits, -1.0, flags
+    if scale is not None:  # a level in the array's units
+        lo, hi = scale
+        t = 0.5 if threshold is None else as_scalar(threshold, 'threshold')
+        level = 32767.5 if hi <= lo else (t - lo) * 65535.0 / (hi - lo)
+        if not 0.0 <= level < 65535.0:
+            raise bad('threshold: %g is outside the values of the image (%g..%g)' % (t, lo, hi))
+        return a, bits, level, flags
+    thr = (top // 2) if threshold is None else as_count(threshold, 'threshold', 0)
+    if thr > top - 1:
+        raise bad('threshold: expected 0..%d, got %d' % (top - 1, thr))
+    return a, bits, thr + 0.5, flags
 
 
-def contour_from_mask(mask: ArrayLike, threshold: Union[int, str, None] = None) -> np.ndarray:
+def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] = None,
+                      subpixel: bool = True) -> np.ndarray:
     """Outer boundary of the largest 8-connected foreground component of a 2-D image.
 
     Args:
-        mask: 2-D NumPy array, ``bool`` (True = foreground; stored as 0/255) or ``uint8`` (other
-            integer arrays with values in 0..255 are accepted too); any strides or order.
-        threshold: a pixel is "on" when its value is > threshold (0..254); ``'auto'`` for Otsu's
-            threshold; None for 127 (the ``amscr`` tool's default). The polarity is automatic:
-            if most of the image border is "on", on and off are swapped.
+        mask: 2-D NumPy array, any strides or order: ``bool`` (True = foreground), ``uint8``,
+            ``uint16`` (other integer arrays with values in 0..65535 are accepted too), or
+            ``float`` (any range: mapped linearly onto 16 bits).
+        threshold: integer images: a pixel is "on" when its value is > threshold (0..254 for
+            8 bits, 0..65534 for 16 bits; None: 127, the ``amscr`` tool's default, or 32767);
+            float images: the level in the array's units (None: 0.5); ``'auto'`` for Otsu's
+            split (the level halfway between the two classes' medians). The polarity is
+            automatic: if most of the image border is "on", on and off are swapped.
+        subpixel: True (default): the iso-line at the level (threshold + 0.5 for integer
+            images) by marching squares, to sub-pixel accuracy on grey and antialiased edges
+            (a binary edge lies halfway between pixel centres); False: the chain of boundary
+            pixel centres.
     Returns:
-        (n, 2) float array of boundary pixel centres (x = column, y = row), with positive signed
-        area (counter-clockwise in a y-up frame), no repeated end point.
+        (n, 2) float array (x = column, y = row; pixel centres at integers), with positive
+        signed area (counter-clockwise in a y-up frame), no repeated end point.
     Raises:
         NotFoundError: no foreground (or foreground everywhere); DegenerateError: too small;
-        LimitError: image too large.
+        LimitError: image too large; InvalidArgumentError: a bad mask or threshold.
     """
-    a, thr = _mask_and_threshold(mask, threshold)
+    a, bits, level, flags = _image_and_level(mask, threshold, subpixel)
     h, w = a.shape
-    return _take(_new_contour(lib.amscr_contour_from_mask, ffi.from_buffer('uint8_t[]', a), w, h, w, thr))
+    return _take(_new_contour(lib.amscr_contour_from_image, ffi.from_buffer(a), w, h, w, bits, level, flags))
 
 
 class ImageContour(NamedTuple):
@@ -115,30 +140,30 @@ class ImageContour(NamedTuple):
     area: float
 
 
-def contours_from_mask(mask: ArrayLike, threshold: Union[int, str, None] = None,
-                       min_area: float = 10.0) -> List[ImageContour]:
+def contours_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] = None,
+                       min_area: float = 10.0, subpixel: bool = True) -> List[ImageContour]:
     """Every contour of a 2-D image with its hierarchy, as OpenCV's ``findContours`` with
     ``RETR_TREE``: each 8-connected foreground component's outer boundary and each hole's.
 
     Args:
-        mask, threshold: as :func:`contour_from_mask`.
+        mask, threshold, subpixel: as :func:`contour_from_mask`.
         min_area: contours of a smaller polygon area (pixels^2) are dropped, with everything
             inside them (default 10, the ``amscr contour --all`` default; 0 keeps all).
     Returns:
         A list of :class:`ImageContour` in raster order of their first pixel, so a parent
-        comes before its children. Outer contours run counter-clockwise (positive signed area)
-        through their component's boundary pixel centres; a hole's contour runs clockwise
-        through its own boundary (background) pixels. A hole's parent is the component around
+        comes before its children. Outer contours run counter-clockwise (positive signed area),
+        holes clockwise: iso-lines (subpixel=True), or with subpixel=False through the
+        component's boundary pixel centres and the hole's own boundary (background) pixels. A hole's parent is the component around
         it; a component's parent is the hole it lies in, or None.
     Raises:
         NotFoundError: no foreground, foreground everywhere, or no contour of `min_area`;
         InvalidArgumentError: a bad mask, threshold or min_area; LimitError: image too large.
     """
-    a, thr = _mask_and_threshold(mask, threshold)
+    a, bits, level, flags = _image_and_level(mask, threshold, subpixel)
     area = as_scalar(min_area, 'min_area')
     h, w = a.shape
     out = ffi.new('amscr_contour_set **')
-    _check(lib.amscr_contours_from_mask(ffi.from_buffer('uint8_t[]', a), w, h, w, thr, area, out))
+    _check(lib.amscr_contours_from_image(ffi.from_buffer(a), w, h, w, bits, level, flags, area, out))
     cs = ffi.gc(out[0], lib.amscr_contour_set_free)
     result = []
     for i in range(int(lib.amscr_contour_set_size(cs))):

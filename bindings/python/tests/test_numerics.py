@@ -315,24 +315,24 @@ def _disc_mask(h=40, w=50, cy=20, cx=22, r=12):
 
 def test_contour_from_mask_bool_uint8_and_strides():
     m = _disc_mask()
-    c = amscr.contour_from_mask(m)
+    c = amscr.contour_from_mask(m, subpixel=False)
     assert c.ndim == 2 and c.shape[1] == 2 and len(c) > 40
     assert amscr.signed_area(c) > 0
     # every contour point is a foreground pixel with a background 4-neighbour
     for x, y in c.astype(int):
         assert m[y, x]
-    np.testing.assert_array_equal(amscr.contour_from_mask(m.astype(np.uint8) * 255), c)
-    np.testing.assert_array_equal(amscr.contour_from_mask(m.astype(np.uint8), threshold=0), c)
+    np.testing.assert_array_equal(amscr.contour_from_mask(m.astype(np.uint8) * 255, subpixel=False), c)
+    np.testing.assert_array_equal(amscr.contour_from_mask(m.astype(np.uint8), threshold=0, subpixel=False), c)
     gray = m.astype(np.uint8) * 150 + 40  # 40 outside, 190 inside
-    np.testing.assert_array_equal(amscr.contour_from_mask(gray, threshold='auto'), c)
-    np.testing.assert_array_equal(amscr.contour_from_mask(gray.astype(np.int64)), c)
+    np.testing.assert_array_equal(amscr.contour_from_mask(gray, threshold='auto', subpixel=False), c)
+    np.testing.assert_array_equal(amscr.contour_from_mask(gray.astype(np.int64), subpixel=False), c)
     # a non-contiguous view (every other row and column of an upsampled mask) equals its copy
     big = np.repeat(np.repeat(m, 2, axis=0), 2, axis=1)
     view = big[::2, ::2]
     assert not view.flags.c_contiguous
-    np.testing.assert_array_equal(amscr.contour_from_mask(view), c)
+    np.testing.assert_array_equal(amscr.contour_from_mask(view, subpixel=False), c)
     # Fortran order / transposed
-    ct = amscr.contour_from_mask(np.asfortranarray(m.T))
+    ct = amscr.contour_from_mask(np.asfortranarray(m.T), subpixel=False)
     assert len(ct) == len(c) and amscr.signed_area(ct) > 0
 
 
@@ -341,8 +341,10 @@ def test_contour_from_mask_inverted_polarity_and_border():
     np.testing.assert_array_equal(amscr.contour_from_mask(~m), amscr.contour_from_mask(m))
     touching = np.zeros((20, 20), bool)
     touching[0:10, 0:12] = True
-    c = amscr.contour_from_mask(touching)
+    c = amscr.contour_from_mask(touching, subpixel=False)
     assert c[:, 0].min() == 0 and c[:, 1].min() == 0
+    c = amscr.contour_from_mask(touching)  # the iso-line closes at the image's edge
+    assert c[:, 0].min() == -0.5 and c[:, 1].min() == -0.5
 
 
 def test_points_text_roundtrip(tmp_path):

@@ -1,0 +1,325 @@
+#!/usr/bin/env python3
+"""Registration from images: the amscr tool on traced PNG pairs against OpenCV's ECC.
+
+For each class of mpeg7-dev (one shape per class, the class's first file) and `--draws` seeded
+draws per condition: the silhouette scaled to 140 px in a 200 x 200 image (the source), a random
+affine map T (any rotation, axis scales x0.5-2, shear +-0.5; then scaled and shifted so the
+warped shape again spans 140 px of a 200 x 200 image) applied with cv2.warpAffine (the target),
+then the target damaged in the image:
+
+  clean      the warped silhouette (bilinear, thresholded at half level);
+  noise      segmentation noise: the boundary moved by a smooth random field of 1.5 % of the
+             shape's radius (RMS radius), plus 12 background specks (1-2 px disks);
+  bite       a disk of 0.3 x radius removed at a random boundary point;
+  touching   such a disk added outside, touching the boundary at a random point;
+  lowres     source and target reduced 4x (cv2.INTER_AREA: the shape 35 px across) and thresholded;
+  grey       the same reduction kept as 8-bit antialiased grey (area coverage).
+
+Both PNGs are registered by the tool, `amscr register SRC TGT --json` (the default sub-pixel
+tracer, and with --pixel-chain), and by cv2.findTransformECC (MOTION_AFFINE, 8 starting
+rotations with centroid and area matched, the best correlation kept) on the same images.
+
+Error: max_i |M(f_i) - T(f_i)| / size(T(f)) over the clean source's sub-pixel contour f (in the
+source image's pixels), size = RMS radius about the centroid. Success: error < 2 % (4 % for
+lowres and grey). Wrong + confident: a failure the tool reports with confidence >= 0.25.
+ms/pair: wall time per pair (the tool's includes process start and PNG decoding).
+
+Usage: nice .venv/bin/python bench/registration_traced.py [--data DIR] [--tool PATH] [--draws 2]
+       [--no-ecc] [--json OUT]
+Deterministic: every draw is seeded by (class index, condition, draw).
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+import cv2
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.join(HERE, '..')
+
+CONDITIONS = [  # key, label, success threshold (% of the size)
+    ('clean', 'clean', 2.0),
+    ('noise', 'segmentation noise', 2.0),
+    ('bite', 'bite', 2.0),
+    ('touching', 'touching object', 2.0),
+    ('lowres', 'low resolution, binary', 4.0),
+    ('grey', 'low resolution, antialiased grey', 4.0),
+]
+CANVAS = 200
+SPAN = 140.0
+REDUCE = 4
+CONFIDENT = 0.25
+
+
+def shape_size(xy):
+    c = xy - xy.mean(axis=0)
+    return math.sqrt((c * c).sum(axis=1).mean())
+
+
+def apply(T, xy):
+    return xy @ T[:, :2].T + T[:, 2]
+
+
+def compose(P, Q):  # P after Q
+    return np.hstack([P[:, :2] @ Q[:, :2], P[:, :2] @ Q[:, 2:] + P[:, 2:]])
+
+
+def inv_affine(P):
+    A = np.linalg.inv(P[:, :2])
+    return np.hstack([A, -(A @ P[:, 2:])])
+
+
+def subpixel_contour(img):
+    """The largest iso-line at half level of an 8-bit image, (x, y) rows (skimage)."""
+    from skimage import measure
+    cs = measure.find_contours(np.pad(img.astype(float), 1), 127.5)
+    c = max(cs, key=len)[:, ::-1] - 1.0
+    return c[:-1] if np.all(c[0] == c[-1]) else c
+
+
+def fit_map(xy):
+    """The map (scale, shift) putting xy's bounding box at SPAN px in the middle of CANVAS."""
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    s = SPAN / max(hi - lo)
+    off = 0.5 * (CANVAS - 1) - s * 0.5 * (lo + hi)
+    return np.array([[s, 0, off[0]], [0, s, off[1]]])
+
+
+def load_source(path):
+    """The silhouette (foreground 255) scaled to SPAN px in a CANVAS image."""
+    img = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
+    m = (img > 127).astype(np.uint8) * 255
+    if np.mean(np.concatenate([m[0], m[-1], m[:, 0], m[:, -1]])) > 127:
+        m = 255 - m
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(m, connectivity=8)
+    big = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    m = np.where(lab == big, 255, 0).astype(np.uint8)
+    ys, xs = np.nonzero(m)
+    P = fit_map(np.column_stack([xs, ys]).astype(float))
+    src = cv2.warpAffine(m, P, (CANVAS, CANVAS), flags=cv2.INTER_AREA if P[0, 0] < 1 else cv2.INTER_LINEAR)
+    return np.where(src > 127, 255, 0).astype(np.uint8)
+
+
+def random_affine(rng):
+    th = rng.uniform(0, 2 * math.pi)
+    s1, s2 = rng.uniform(0.5, 2.0, 2)
+    h = rng.uniform(-0.5, 0.5)
+    R = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+    return R @ np.diag([s1, s2]) @ np.array([[1.0, h], [0.0, 1.0]])
+
+
+def make_target(src, f, rng):
+    """The warped source and the true map T (source pixels -> target pixels)."""
+    A = random_affine(rng)
+    T0 = np.hstack([A, np.zeros((2, 1))])
+    T = compose(fit_map(apply(T0, f)), T0)
+    tgt = cv2.warpAffine(src, T, (CANVAS, CANVAS), flags=cv2.INTER_LINEAR)
+    return np.where(tgt > 127, 255, 0).astype(np.uint8), T
+
+
+def disk(img, c, r, v):
+    out = img.copy()
+    cv2.circle(out, (int(round(c[0] * 16)), int(round(c[1] * 16))), int(round(r * 16)), int(v), -1,
+               lineType=cv2.LINE_8, shift=4)
+    return out
+
+
+def damage(key, tgt, g, rng):
+    """The damaged target; g: its sub-pixel contour (target pixels)."""
+    radius = shape_size(g)
+    if key == 'noise':
+        inside = cv2.distanceTransform((tgt > 0).astype(np.uint8), cv2.DIST_L2, 5)
+        outside = cv2.distanceTransform((tgt == 0).astype(np.uint8), cv2.DIST_L2, 5)
+        sd = inside - outside
+        field = cv2.GaussianBlur(rng.normal(0, 1, tgt.shape), (0, 0), 0.1 * radius)
+        field *= 0.015 * radius / max(field.std(), 1e-12)
+        out = np.where(sd + field > 0, 255, 0).astype(np.uint8)
+        for _ in range(12):
+            out = disk(out, rng.uniform(0, CANVAS, 2), rng.uniform(1, 2), 255)
+        return out
+    if key in ('bite', 'touching'):
+        p = g[rng.integers(len(g))]
+        r = 0.3 * radius
+        if key == 'bite':
+            return disk(tgt, p, r, 0)
+        u = p - g.mean(axis=0)
+        u /= max(np.linalg.norm(u), 1e-12)
+        return disk(tgt, p + 0.95 * r * u, r, 255)
+    return tgt
+
+
+def reduce(img, binary):
+    small = cv2.resize(img, (CANVAS // REDUCE, CANVAS // REDUCE), interpolation=cv2.INTER_AREA)
+    return np.where(small > 127, 255, 0).astype(np.uint8) if binary else small
+
+
+# low-res pixel x = (x - 1.5) / 4 for a 4x area reduction (pixel centres)
+S_LOW = np.array([[1.0 / REDUCE, 0, -(REDUCE - 1) / 2 / REDUCE], [0, 1.0 / REDUCE, -(REDUCE - 1) / 2 / REDUCE]])
+
+
+def map_error(M, T, f):
+    if M is None:
+        return math.inf
+    d = apply(M, f) - apply(T, f)
+    return 100 * float(np.sqrt((d * d).sum(axis=1)).max() / shape_size(apply(T, f)))
+
+
+def tool_register(tool, sp, tp, extra):
+    t0 = time.perf_counter()
+    r = subprocess.run([tool, 'register', sp, tp, '--json'] + extra, capture_output=True, text=True)
+    ms = 1000 * (time.perf_counter() - t0)
+    if r.returncode != 0:
+        return None, 0.0, ms
+    j = json.loads(r.stdout)
+    M = np.hstack([np.array(j['A'], float), np.array(j['B'], float)[:, None]])
+    return M, float(j.get('confidence', 0.0)), ms
+
+
+def ecc_register(a8, b8):
+    """W with b(W x) ~ a(x): source pixels -> target pixels; None when every start fails."""
+    sigma = 0.01 * max(a8.shape)
+    a = cv2.GaussianBlur(a8.astype(np.float32) / 255, (0, 0), sigma)
+    b = cv2.GaussianBlur(b8.astype(np.float32) / 255, (0, 0), sigma)
+    ma, mb = cv2.moments(a), cv2.moments(b)
+    if ma['m00'] <= 0 or mb['m00'] <= 0:
+        return None
+    ca = np.array([ma['m10'], ma['m01']]) / ma['m00']
+    cb = np.array([mb['m10'], mb['m01']]) / mb['m00']
+    k = math.sqrt(mb['m00'] / ma['m00'])
+    crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 100, 1e-5)
+    best, best_rho = None, -np.inf
+    for i in range(8):
+        t = 2 * math.pi * i / 8
+        A = k * np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+        W = np.hstack([A, (cb - A @ ca)[:, None]]).astype(np.float32)
+        try:
+            rho, W = cv2.findTransformECC(a, b, W, cv2.MOTION_AFFINE, crit, None, 5)
+        except cv2.error:
+            continue
+        if rho > best_rho:
+            best, best_rho = W.astype(np.float64), rho
+    return best
+
+
+def load_classes(data):
+    rows = [l.rstrip('\n').split('\t') for l in open(os.path.join(data, 'manifest.tsv'))][1:]
+    first = {}
+    for fname, cls in rows:
+        first.setdefault(cls, fname)
+    folds = {}
+    fp = os.path.join(data, 'folds.tsv')
+    if os.path.exists(fp):
+        for line in list(open(fp))[1:]:
+            c, fo = line.rstrip('\n').split('\t')
+            folds[c] = fo
+    return [(c, os.path.join(data, f), folds.get(c, '?')) for c, f in first.items()]
+
+
+METHODS = [('sub', 'amscr sub-pixel'), ('chain', 'amscr --pixel-chain'), ('ecc', 'OpenCV ECC')]
+
+
+def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc):
+    if key in ('lowres', 'grey'):
+        src, tgt = reduce(src, key == 'lowres'), reduce(tgt, key == 'lowres')
+        T = compose(S_LOW, compose(T, inv_affine(S_LOW)))
+        f = apply(S_LOW, f)
+    sp, tp = os.path.join(tmp, 'src.png'), os.path.join(tmp, 'tgt.png')
+    cv2.imwrite(sp, src)
+    cv2.imwrite(tp, tgt)
+    out = {}
+    for m, extra in (('sub', []), ('chain', ['--pixel-chain'])):
+        M, conf, ms = tool_register(tool, sp, tp, extra)
+        out[m] = (map_error(M, T, f), conf, ms)
+    if use_ecc:
+        t0 = time.perf_counter()
+        W = ecc_register(src, tgt)
+        out['ecc'] = (map_error(W, T, f), math.nan, 1000 * (time.perf_counter() - t0))
+    return out
+
+
+def summary(recs, thr):
+    if not recs:
+        return None
+    err = np.array([r[0] for r in recs])
+    conf = np.array([r[1] for r in recs])
+    ok = err < thr
+    wrong_conf = (~ok) & (conf >= CONFIDENT)
+    return (100 * ok.mean(), 100 * wrong_conf.mean(), float(np.median(err)), float(np.mean([r[2] for r in recs])),
+            len(recs))
+
+
+def print_table(title, res, conds, use_ecc):
+    print('\n%s' % title)
+    head = '%-34s' % 'condition'
+    methods = [m for m in METHODS if use_ecc or m[0] != 'ecc']
+    for _, lab in methods:
+        head += ' | %-30s' % lab
+    print(head)
+    print('%-34s' % '' + ''.join(' | %-30s' % 'ok %   w+c %  med err %  ms' for _ in methods))
+    for key, lab, thr in conds:
+        line = '%-34s' % ('%s (%d pairs)' % (lab, len(res[key]['sub'])))
+        for m, _ in methods:
+            s = summary(res[key][m], thr)
+            if m == 'ecc':
+                line += ' | %5.1f      -  %9.3f %5.0f' % (s[0], s[2], s[3])
+            else:
+                line += ' | %5.1f  %5.1f  %9.3f %5.0f' % (s[0], s[1], s[2], s[3])
+        print(line)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    ap.add_argument('--data', default=os.path.join(ROOT, '..', 'shared', 'datasets', 'mpeg7-dev'))
+    ap.add_argument('--tool', default=os.path.join(ROOT, 'build', 'tools', 'amscr'))
+    ap.add_argument('--draws', type=int, default=2)
+    ap.add_argument('--no-ecc', action='store_true')
+    ap.add_argument('--only', default='', help='comma-separated condition keys')
+    ap.add_argument('--classes', type=int, default=0, help='the first N classes only (0: all)')
+    ap.add_argument('--json', default=None)
+    a = ap.parse_args()
+    if not os.path.isdir(a.data):
+        print('registration_traced: no data at %s (skipped)' % a.data)
+        return 0
+    use_ecc = not a.no_ecc
+    classes = load_classes(a.data)
+    if a.classes:
+        classes = classes[:a.classes]
+    conds = [c for c in CONDITIONS if not a.only or c[0] in a.only.split(',')]
+    keys = [c[0] for c in conds]
+    res = {fold: {k: {m: [] for m, _ in METHODS} for k, _, _ in CONDITIONS} for fold in ('A', 'B', 'all')}
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for ci, (cls, path, fold) in enumerate(classes):
+            src = load_source(path)
+            f = subpixel_contour(src)
+            for key in keys:
+                for d in range(a.draws):
+                    rng = np.random.default_rng([ci, [c[0] for c in CONDITIONS].index(key), d, 2024])
+                    tgt, T = make_target(src, f, rng)
+                    tgt = damage(key, tgt, apply(T, f), rng)
+                    out = run_pair(a.tool, tmp, key, src, tgt, f, T, use_ecc)
+                    rows.append({'class': cls, 'fold': fold, 'condition': key, 'draw': d,
+                                 **{m: list(v) for m, v in out.items()}})
+                    for m, v in out.items():
+                        res['all'][key][m].append(v)
+                        if fold in res:
+                            res[fold][key][m].append(v)
+            print('.', end='', file=sys.stderr, flush=True)
+    print(file=sys.stderr)
+    for fold, title in (('A', 'fold 1 (folds.tsv A)'), ('B', 'fold 2 (folds.tsv B)'), ('all', 'both folds')):
+        print_table(title, res[fold], conds, use_ecc)
+    if a.json:
+        with open(a.json, 'w') as fp:
+            json.dump(rows, fp)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

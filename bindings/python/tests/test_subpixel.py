@@ -1,0 +1,57 @@
+"""Sub-pixel contours from Python: bool, uint8, uint16 and float arrays alike; subpixel=False
+gives the chain of pixel centres."""
+import numpy as np
+import pytest
+
+import amscr
+
+
+def _rect(dtype, fg):
+    m = np.zeros((30, 40), dtype)
+    m[6:23, 8:32] = fg
+    return m
+
+
+@pytest.mark.parametrize("dtype,fg", [(bool, True), (np.uint8, 255), (np.uint16, 65535), (np.float64, 1.0),
+                                      (np.float32, 7.5), (np.int32, 255)])
+def test_every_dtype_gives_the_same_binary_contour(dtype, fg):
+    c = amscr.contour_from_mask(_rect(dtype, fg), threshold='auto' if dtype == np.float32 else None)
+    assert c.min(axis=0).tolist() == [7.5, 5.5] and c.max(axis=0).tolist() == [31.5, 22.5]
+    assert amscr.signed_area(c) == pytest.approx(24 * 17 - 0.5)
+
+
+def test_subpixel_false_is_the_pixel_chain():
+    m = _rect(np.uint8, 255)
+    chain = amscr.contour_from_mask(m, subpixel=False)
+    assert chain.min(axis=0).tolist() == [8, 6] and chain.max(axis=0).tolist() == [31, 22]
+    assert np.all(chain == np.round(chain))
+
+
+def test_float_and_uint16_edges_are_interpolated():
+    m = np.zeros((30, 40))
+    m[5:25, 5:20] = 1.0
+    m[5:25, 20] = 0.75  # the iso-line at 0.5 lies between columns 20 and 21
+    c = amscr.contour_from_mask(m)
+    right = c[(c[:, 1] > 8) & (c[:, 1] < 20), 0].max()
+    assert right == pytest.approx(20 + (0.75 - 0.5) / 0.75, abs=1e-4)
+    c16 = amscr.contour_from_mask((m * 65535).round().astype(np.uint16))
+    assert c16[(c16[:, 1] > 8) & (c16[:, 1] < 20), 0].max() == pytest.approx(right, abs=1e-4)
+
+
+def test_contours_from_mask_float_hierarchy():
+    m = np.zeros((40, 50), np.float32)
+    m[4:36, 4:36] = 1
+    m[10:30, 10:30] = 0
+    cs = amscr.contours_from_mask(m, min_area=0)
+    assert [(c.parent, c.is_hole, c.area) for c in cs] == [(None, False, 1023.5), (0, True, 399.5)]
+    chain = amscr.contours_from_mask(m, min_area=0, subpixel=False)
+    assert [c.area for c in chain] == [961.0, 361.0]
+
+
+def test_bad_float_and_threshold():
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.contour_from_mask(np.full((8, 8), np.nan))
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.contour_from_mask(np.zeros((8, 8)) + np.eye(8), threshold=5.0)
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.contour_from_mask(np.zeros((8, 8), np.uint16), threshold=65535)
