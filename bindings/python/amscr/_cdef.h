@@ -11,6 +11,7 @@
 #define AMSCR_MAX_SAMPLES 65536
 #define AMSCR_MAX_SCALES 64
 #define AMSCR_THRESHOLD_AUTO -1
+#define AMSCR_INDEX_CANDIDATES 256
 
 typedef enum amscr_status {
     AMSCR_OK = 0,
