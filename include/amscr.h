@@ -2203,6 +2203,11 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_query_retrieval(const amscr_db *
  * Retrieval index: a collection with what one-vs-many retrieval needs
  * ============================================================================ */
 
+/** The recommended shortlist size M of an index query and of a large collection's build
+ *  (amscr_index_build, amscr_index_query): the M signature-nearest shapes are matched.
+ *  @since 0.4 */
+#define AMSCR_INDEX_CANDIDATES 256
+
 /** A retrieval index: a collection, each shape's nearest shapes under the retrieval matrix's
  *  base distance, shape signatures, optional names (amscr_index_build). @since 0.4 */
 typedef struct amscr_index amscr_index;

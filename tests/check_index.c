@@ -308,6 +308,57 @@ START_TEST(top_and_shortlist)
 }
 END_TEST
 
+/* Shape i of a larger collection: one of `classes` random base shapes, affinely warped. */
+static amscr_descriptor *shape_of(const amscr_params *p, unsigned i, unsigned classes)
+{
+    amscr_test_rng r;
+    double xy[2 * NPTS], w[2 * NPTS], m[6];
+    amscr_test_rng_seed(&r, 5000 + i % classes);
+    amscr_test_random_shape(&r, NPTS, 5, xy);
+    amscr_test_rng_seed(&r, 9000 + i);
+    amscr_test_random_affine(&r, 2.0, 0.5, 3.0, 0, m);
+    amscr_test_apply_affine(m, xy, NPTS, w);
+    amscr_test_add_noise(&r, w, NPTS, 0.01);
+    amscr_contour *c = NULL;
+    amscr_descriptor *d = NULL;
+    ck_assert_int_eq(amscr_contour_new(w, NPTS, &c), AMSCR_OK);
+    ck_assert_int_eq(amscr_descriptor_new(p, c, &d), AMSCR_OK);
+    amscr_contour_free(c);
+    return d;
+}
+
+/* The default shortlist (AMSCR_INDEX_CANDIDATES, build and query) finds the exact first hit of
+ * affine-warped queries in a collection larger than the shortlist. */
+START_TEST(default_shortlist_first_hit)
+{
+    enum { N = 320, CLASSES = 40 };
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_db *db = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
+    for (unsigned i = 0; i < N; i++) {
+        amscr_descriptor *d = shape_of(p, i, CLASSES);
+        ck_assert_int_eq(amscr_db_add_descriptor(db, d, (int32_t)(i % CLASSES), NULL), AMSCR_OK);
+        amscr_descriptor_free(d);
+    }
+    amscr_index *x = NULL, *full = NULL;
+    ck_assert_int_eq(amscr_index_build(db, AMSCR_INDEX_CANDIDATES, NULL, NULL, &x), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &full), AMSCR_OK);
+    for (unsigned q = 0; q < 6; q++) {
+        amscr_descriptor *d = shape_of(p, 100000 + q * 7, CLASSES);
+        size_t a[1], b[1], ca = 0, cb = 0;
+        double sa[1], sb[1];
+        ck_assert_int_eq(amscr_index_query(x, d, AMSCR_INDEX_CANDIDATES, 1, a, sa, &ca), AMSCR_OK);
+        ck_assert_int_eq(amscr_index_query(full, d, 0, 1, b, sb, &cb), AMSCR_OK);
+        ck_assert_uint_eq(a[0], b[0]);
+        amscr_descriptor_free(d);
+    }
+    amscr_index_free(x);
+    amscr_index_free(full);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+END_TEST
+
 Suite *amscr_suite_index(void)
 {
     Suite *s = suite_create("index");
@@ -324,6 +375,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, add_shapes);
     tcase_add_test(tc, thread_independence);
     tcase_add_test(tc, top_and_shortlist);
+    tcase_add_test(tc, default_shortlist_first_hit);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -11,7 +11,8 @@
  * more than far parts, which articulation moves). Because the frame is normalized and the
  * samples follow the prepared (group-invariant) parametrization, the sequence changes with
  * the group only by a cyclic shift; a reflection reverses it, so the mirrored sequence is
- * kept as well. The DFT of every bin column is kept for the shift search.
+ * kept as well. The low frequencies of every bin column's DFT (those the shift search reads)
+ * are kept.
  *
  * Per pair: the cyclic shift (and orientation) that maximizes the correlation of the two
  * sequences, low-passed to the first N/8 frequencies (the band absorbs the coarser shift;
@@ -75,7 +76,8 @@ static void heights(const double *P, size_t n, double locality, uint8_t *seq, do
     }
 }
 
-static amscr_status spectra(const uint8_t *seq, size_t n, double *spec, amscr__fft_plan *plan, double *z)
+static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, double *spec, amscr__fft_plan *plan,
+                            double *z)
 {
     const size_t D = AMSCR__HF_BINS;
     for (size_t b = 0; b < D; b++) {
@@ -84,7 +86,7 @@ static amscr_status spectra(const uint8_t *seq, size_t n, double *spec, amscr__f
             z[2 * i + 1] = 0.0;
         }
         amscr__fft(plan, z, 0);
-        memcpy(spec + b * 2 * n, z, 2 * n * sizeof *z);
+        memcpy(spec + b * 2 * nfreq, z, 2 * nfreq * sizeof *z);
     }
     return AMSCR_OK;
 }
@@ -96,6 +98,7 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
     if (n < D + 1)
         return amscr__fail(AMSCR_E_INVALID_ARG, "shape channel: N = %zu is below %zu", n, D + 1);
     out->n = n;
+    out->nfreq = AMSCR__HF_FREQS(n) + 1;
     double *mir = amscr__malloc_array(2 * n, sizeof *mir), *z = amscr__malloc_array(2 * n, sizeof *z);
     double *acc = amscr__malloc_array(D, sizeof *acc);
     size_t *cnt = amscr__malloc_array(D, sizeof *cnt);
@@ -104,7 +107,7 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
     amscr_status st = AMSCR_OK;
     for (int o = 0; o < 2; o++) {
         out->seq[o] = amscr__malloc_array(n * D, sizeof(uint8_t));
-        out->spec[o] = amscr__malloc_array(D * 2 * n, sizeof(double));
+        out->spec[o] = amscr__malloc_array(D * 2 * out->nfreq, sizeof(double));
         if (!out->seq[o] || !out->spec[o])
             st = AMSCR_E_NOMEM;
     }
@@ -119,7 +122,7 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
         heights(base, n, locality, out->seq[0], acc, cnt);
         heights(mir, n, locality, out->seq[1], acc, cnt);
         for (int o = 0; o < 2; o++)
-            spectra(out->seq[o], n, out->spec[o], &plan, z);
+            spectra(out->seq[o], n, out->nfreq, out->spec[o], &plan, z);
     }
     if (have_plan)
         amscr__fft_plan_free(&plan);
@@ -165,9 +168,9 @@ static size_t best_shift(const amscr__hf *a, const amscr__hf *b, int o, amscr__h
     const size_t D = AMSCR__HF_BINS, n = a->n;
     double *z = ws->z;
     memset(z, 0, 2 * n * sizeof *z);
-    size_t half = n / 2, fmax = AMSCR__HF_FREQS(n);
+    size_t half = n / 2, fmax = AMSCR__HF_FREQS(n), F = a->nfreq;
     for (size_t bin = 0; bin < D; bin++) {
-        const double *fa = a->spec[0] + bin * 2 * n, *fb = b->spec[o] + bin * 2 * n;
+        const double *fa = a->spec[0] + bin * 2 * F, *fb = b->spec[o] + bin * 2 * F;
         for (size_t f = 0; f <= fmax; f++) {
             double ar = fa[2 * f], ai = fa[2 * f + 1], br = fb[2 * f], bi = fb[2 * f + 1];
             z[2 * f] += ar * br + ai * bi; /* conj(A) B */

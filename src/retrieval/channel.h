@@ -15,11 +15,13 @@
  * the coarser shift): the first N/8, at most N/2. */
 #define AMSCR__HF_FREQS(n) ((n) / 8 < (n) / 2 ? (n) / 8 : (n) / 2)
 
-/* A shape's height-function sequences: forward and mirrored, with the DFT of every bin. */
+/* A shape's height-function sequences: forward and mirrored, with the DFT of every bin (only
+ * the frequencies the shift search reads). */
 typedef struct {
     size_t n;
+    size_t nfreq;    /* frequencies kept of each bin's DFT: AMSCR__HF_FREQS(n) + 1 */
     uint8_t *seq[2]; /* n * AMSCR__HF_BINS, weighted heights, quantized: 128 + QUANT * h */
-    double *spec[2]; /* AMSCR__HF_BINS * 2n, complex interleaved */
+    double *spec[2]; /* AMSCR__HF_BINS * 2 nfreq, complex interleaved */
 } amscr__hf;
 
 typedef struct {

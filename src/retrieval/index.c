@@ -11,10 +11,20 @@ amscr_status amscr__index_reserve(amscr_index *x, size_t n)
     size_t cap = x->cap ? x->cap : 64, k = x->k ? x->k : 1;
     while (cap < n)
         cap *= 2;
-    double *sig = x->sig_dim && cap > SIZE_MAX / x->sig_dim / sizeof(double) ? NULL
-                                                                          : realloc(x->sig, cap * x->sig_dim * sizeof *sig);
+    float *sig = x->sig_dim && cap > SIZE_MAX / x->sig_dim / sizeof(float) ? NULL
+                                                                         : realloc(x->sig, cap * x->sig_dim * sizeof *sig);
     if (sig)
         x->sig = sig;
+    float *lb = cap > SIZE_MAX / AMSCR__SIG_LB_DIM / sizeof *lb ? NULL
+                                                                : realloc(x->sig_lb, cap * AMSCR__SIG_LB_DIM * sizeof *lb);
+    if (lb)
+        x->sig_lb = lb;
+    size_t nf = x->nf > 0 ? (size_t)x->nf : 1;
+    amscr__hf *hf = cap > SIZE_MAX / nf / sizeof *hf ? NULL : realloc(x->hf, cap * nf * sizeof *hf);
+    if (hf) {
+        x->hf = hf;
+        memset(hf + x->cap * nf, 0, (cap - x->cap) * nf * sizeof *hf);
+    }
     uint32_t *ni = cap > SIZE_MAX / k / sizeof *ni ? NULL : realloc(x->nb_idx, cap * k * sizeof *ni);
     if (ni)
         x->nb_idx = ni;
@@ -27,10 +37,17 @@ amscr_status amscr__index_reserve(amscr_index *x, size_t n)
         for (size_t i = x->cap; i < cap; i++)
             nm[i] = NULL;
     }
-    if (!sig || !ni || !nd || !nm)
+    if (!sig || !lb || !hf || !ni || !nd || !nm)
         return amscr__fail(AMSCR_E_NOMEM, "index: out of memory for %zu shapes", n);
     x->cap = cap;
     return AMSCR_OK;
+}
+
+int amscr__index_frames(const amscr_params *p)
+{
+    amscr_invariance frames[2];
+    double share[2];
+    return p->channel_weight > 0.0 ? amscr__channel_frames(p, frames, share) : 0;
 }
 
 amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
@@ -41,6 +58,7 @@ amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
     const amscr_params *p = amscr_db_params(db);
     size_t n = amscr_db_size(db);
     x->sig_dim = AMSCR__SIG_DIM;
+    x->nf = amscr__index_frames(p);
     x->k = p->rerank_k < n ? p->rerank_k : n;
     amscr_status st = amscr_db_new(p, &x->db);
     for (size_t i = 0; st == AMSCR_OK && i < n; i++)
@@ -65,7 +83,11 @@ void amscr_index_free(amscr_index *x)
         free(x->classes[c]);
     free(x->names);
     free(x->classes);
+    for (size_t i = 0; x->hf && i < x->cap * (size_t)x->nf; i++)
+        amscr__hf_free(&x->hf[i]);
+    free(x->hf);
     free(x->sig);
+    free(x->sig_lb);
     free(x->nb_idx);
     free(x->nb_dist);
     amscr_db_free(x->db);

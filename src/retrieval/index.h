@@ -15,7 +15,10 @@ struct amscr_index {
     double dmax;          /* largest base distance of the collection */
     double med_a, med_h;  /* the fusion's medians (0 < channel weight < 1; else 0) */
     size_t sig_dim;       /* AMSCR__SIG_DIM */
-    double *sig;          /* n x sig_dim */
+    float *sig;           /* n x sig_dim (signature.h) */
+    float *sig_lb;        /* n x AMSCR__SIG_LB_DIM: their lower-bound vectors */
+    int nf;               /* channel frames whose features are kept (0: no channel) */
+    amscr__hf *hf;        /* n x nf: each shape's channel features, ready for matching */
     uint32_t *nb_idx;     /* n x k: itself first, then by (base distance, index) */
     double *nb_dist;      /* n x k */
     char **names;         /* n entries (NULL: unnamed) */
@@ -48,16 +51,32 @@ void amscr__pair_ws_free(amscr__pair_ws *pw);
 /* The channel sequences of d in b's frames (hf[0..nf-1]); free with amscr__base_hf_free. */
 amscr_status amscr__base_hf(const amscr__base *b, const amscr_descriptor *d, amscr__hf hf[2]);
 void amscr__base_hf_free(const amscr__base *b, amscr__hf hf[2]);
-/* out[t] = base distance of shape cand[t] of db and q (sequences hq), on this thread. */
-amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const amscr_descriptor *q,
-                               const amscr__hf hq[2], size_t qpos, const size_t *cand, size_t m, amscr__pair_ws *pw,
-                               double *out);
+/* out[t] = base distance of shape cand[t] of db and q (sequences hq), on this thread; hfs (n x
+ * b->nf, or NULL: built per pair) the shapes' channel features. */
+amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const amscr__hf *hfs,
+                               const amscr_descriptor *q, const amscr__hf hq[2], size_t qpos, const size_t *cand,
+                               size_t m, amscr__pair_ws *pw, double *out);
 
 /* out[t] = base distance of shape cand[t] of db and q, computed as the matrix cell of the two
  * (the lower index first; q counts as index qpos, SIZE_MAX = after every shape), on b->threads
  * threads. progress (may be NULL) counts pairs. */
-amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const amscr_descriptor *q, size_t qpos,
-                             const size_t *cand, size_t m, amscr_progress_fn progress, void *user, double *out);
+amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const amscr__hf *hfs,
+                             const amscr_descriptor *q, size_t qpos, const size_t *cand, size_t m,
+                             amscr_progress_fn progress, void *user, double *out);
+
+/* Work on rows first..n-1 on threads (index_threads.c): row(ctx, i, scratch) with a scratch
+ * per thread from init (may be NULL) freed by fini. */
+typedef struct {
+    amscr_status (*init)(void *ctx, void **scratch);
+    void (*fini)(void *scratch);
+    amscr_status (*row)(void *ctx, size_t i, void *scratch);
+    void *ctx;
+} amscr__rows_fn;
+amscr_status amscr__run_rows(const amscr__rows_fn *f, size_t first, size_t n, unsigned threads,
+                             amscr_progress_fn progress, void *user);
+/* Signatures, lower-bound vectors (unless have_sig: then the signatures are there) and channel
+ * features of shapes first..n-1 (index_features.c), on the params' threads. */
+amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig);
 
 /* Row i's k nearest (itself first, then by (distance, index)) among m candidates cj[t] with
  * distances cd[t] (i may be among them; k <= m + 1). */
@@ -66,11 +85,15 @@ amscr_status amscr__knn_select(size_t i, const size_t *cj, const double *cd, siz
 
 /* Grows the per-shape arrays to hold n rows. */
 amscr_status amscr__index_reserve(amscr_index *x, size_t n);
+/* The channel frames whose features an index with params p keeps (0: no channel). */
+int amscr__index_frames(const amscr_params *p);
 /* An empty index of a copy of db (no lists yet). */
 amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out);
-/* The n x m-1 candidates of shape-like q: every shape (m = 0 or >= n) or the m whose
- * signatures are nearest sig (exclude: an index to leave out or SIZE_MAX), ascending. */
-size_t amscr__index_shortlist(const amscr_index *x, const double *sig, size_t m, size_t exclude, size_t *cand);
+/* The candidates of shape-like q: every shape (m = 0 or >= n) or the m whose signatures are
+ * nearest sig / lb (exclude: an index to leave out or SIZE_MAX), ascending; 0 when out of
+ * memory. */
+size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,
+                              size_t *cand);
 
 /* The scores (n entries) of row `self` (n: a query; < n: that shape of the index) against every
  * shape from its base distances dq[t] to the m candidates cand[t] (ascending): the row of the

@@ -44,18 +44,69 @@ static void enter_list(amscr_index *x, size_t i, size_t j, double d)
     nd[t] = d;
 }
 
-/* Row j (new) and the older rows it enters, from its shortlist. */
-static amscr_status add_row(amscr_index *x, const amscr__base *b, size_t j, size_t n0, size_t *cand, double *cd)
+/* New rows j0..j1-1 computed on threads: each one's shortlist and base distances. */
+typedef struct {
+    amscr_index *x;
+    amscr__base b;
+    size_t j0, n;
+    size_t *cand; /* (j1 - j0) x n */
+    double *cd;
+    size_t *m;
+} add_ctx;
+
+static amscr_status add_pw_init(void *ctx, void **scratch)
 {
-    size_t m = amscr__index_shortlist(x, x->sig + j * x->sig_dim, x->candidates, j, cand);
-    amscr_status st = amscr__base_row(b, x->db, amscr_db_descriptor(x->db, j), j, cand, m, NULL, NULL, cd);
-    for (size_t t = 0; st == AMSCR_OK && t < m; t++) {
-        x->dmax = cd[t] > x->dmax ? cd[t] : x->dmax;
-        if (cand[t] < n0)
-            enter_list(x, cand[t], j, cd[t]);
+    add_ctx *c = ctx;
+    amscr__pair_ws *pw = malloc(sizeof *pw);
+    if (!pw)
+        return AMSCR_E_NOMEM;
+    amscr_status st = amscr__pair_ws_init(&c->b, pw);
+    if (st != AMSCR_OK)
+        free(pw);
+    else
+        *scratch = pw;
+    return st;
+}
+
+static void add_pw_fini(void *scratch)
+{
+    amscr__pair_ws_free(scratch);
+    free(scratch);
+}
+
+static amscr_status add_distances(void *ctx, size_t j, void *scratch)
+{
+    add_ctx *c = ctx;
+    amscr_index *x = c->x;
+    size_t r = j - c->j0, *cand = c->cand + r * c->n;
+    size_t m = amscr__index_shortlist(x, x->sig + j * x->sig_dim, x->sig_lb + j * AMSCR__SIG_LB_DIM, x->candidates,
+                                      j, cand);
+    if (m == 0 && c->n > 1)
+        return AMSCR_E_NOMEM;
+    c->m[r] = m;
+    const amscr__hf *hq = x->nf ? x->hf + j * (size_t)x->nf : NULL;
+    return amscr__base_pairs(&c->b, x->db, x->hf, amscr_db_descriptor(x->db, j), hq, j, cand, m, scratch,
+                             c->cd + r * c->n);
+}
+
+/* Rows j0..j1-1 (new): their distances on threads, then (in order) the older rows they enter
+ * and their own lists. */
+static amscr_status add_rows(add_ctx *c, size_t j1, size_t n0)
+{
+    amscr_index *x = c->x;
+    amscr__rows_fn f = {add_pw_init, add_pw_fini, add_distances, c};
+    amscr_status st = amscr__run_rows(&f, c->j0, j1, c->b.threads, NULL, NULL);
+    for (size_t j = c->j0; st == AMSCR_OK && j < j1; j++) {
+        size_t r = j - c->j0, m = c->m[r], *cand = c->cand + r * c->n;
+        double *cd = c->cd + r * c->n;
+        for (size_t t = 0; t < m; t++) {
+            x->dmax = cd[t] > x->dmax ? cd[t] : x->dmax;
+            if (cand[t] < n0)
+                enter_list(x, cand[t], j, cd[t]);
+        }
+        if (x->k > 0)
+            st = amscr__knn_select(j, cand, cd, m, x->k, x->nb_idx + j * x->k, x->nb_dist + j * x->k);
     }
-    if (st == AMSCR_OK && x->k > 0)
-        st = amscr__knn_select(j, cand, cd, m, x->k, x->nb_idx + j * x->k, x->nb_dist + j * x->k);
     return st;
 }
 
@@ -81,23 +132,27 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
         st = amscr__index_reserve(x, n);
     for (size_t i = 0; st == AMSCR_OK && i < add; i++)
         st = amscr_db_add_descriptor(x->db, amscr_db_descriptor(shapes, i), amscr_db_label(shapes, i), NULL);
-    for (size_t i = n0; st == AMSCR_OK && i < n; i++)
-        amscr__shape_signature(amscr_db_descriptor(x->db, i), x->sig + i * x->sig_dim);
-    size_t *cand = st == AMSCR_OK ? amscr__malloc_array(n, sizeof *cand) : NULL;
-    double *cd = st == AMSCR_OK ? amscr__malloc_array(n, sizeof *cd) : NULL;
-    if (st == AMSCR_OK && (!cand || !cd))
+    if (st == AMSCR_OK)
+        st = amscr__index_features(x, n0, 0);
+    add_ctx c = {x, {0}, n0, n, NULL, NULL, NULL};
+    amscr__base_init(&c.b, p, x->med_a, x->med_h);
+    size_t batch = 4 * (size_t)c.b.threads; /* rows computed together (memory: batch x n) */
+    c.cand = st == AMSCR_OK ? amscr__malloc_array(batch, n * sizeof *c.cand) : NULL;
+    c.cd = st == AMSCR_OK ? amscr__malloc_array(batch, n * sizeof *c.cd) : NULL;
+    c.m = st == AMSCR_OK ? amscr__malloc_array(batch, sizeof *c.m) : NULL;
+    if (st == AMSCR_OK && (!c.cand || !c.cd || !c.m))
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_index_add: out of memory");
-    amscr__base b;
-    amscr__base_init(&b, p, x->med_a, x->med_h);
-    for (size_t j = n0; st == AMSCR_OK && j < n; j++) {
+    for (size_t j = n0; st == AMSCR_OK && j < n; j += batch) {
         if (progress && progress(user, j - n0, add) != 0)
             st = amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback");
+        c.j0 = j;
         if (st == AMSCR_OK)
-            st = add_row(x, &b, j, n0, cand, cd);
+            st = add_rows(&c, j + batch < n ? j + batch : n, n0);
     }
     if (st == AMSCR_OK && progress && progress(user, add, add) != 0)
         st = amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback");
-    free(cand);
-    free(cd);
+    free(c.cand);
+    free(c.cd);
+    free(c.m);
     return st;
 }

@@ -5,8 +5,6 @@
 #include "index.h"
 
 #include <math.h>
-#include <pthread.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -46,7 +44,8 @@ amscr_status amscr__knn_select(size_t i, const size_t *cj, const double *cd, siz
     return AMSCR_OK;
 }
 
-size_t amscr__index_shortlist(const amscr_index *x, const double *sig, size_t m, size_t exclude, size_t *cand)
+size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,
+                              size_t *cand)
 {
     size_t n = amscr_db_size(x->db), avail = exclude < n ? n - 1 : n;
     if (m == 0 || m >= avail) {
@@ -56,27 +55,7 @@ size_t amscr__index_shortlist(const amscr_index *x, const double *sig, size_t m,
                 cand[c++] = j;
         return c;
     }
-    double *sd = amscr__malloc_array(n, sizeof *sd);
-    if (!sd)
-        return 0;
-    for (size_t j = 0; j < n; j++) {
-        double s = 0.0;
-        for (size_t t = 0; t < x->sig_dim; t++) {
-            double e = x->sig[j * x->sig_dim + t] - sig[t];
-            s += e * e;
-        }
-        sd[j] = s;
-    }
-    if (amscr_topk(sd, n, m, exclude, cand) != AMSCR_OK)
-        m = 0;
-    free(sd);
-    for (size_t i = 1; i < m; i++) { /* ascending indices (insertion sort: m is small) */
-        size_t v = cand[i], t = i;
-        for (; t > 0 && cand[t - 1] > v; t--)
-            cand[t] = cand[t - 1];
-        cand[t] = v;
-    }
-    return m;
+    return amscr__sig_nearest(x->sig, x->sig_lb, n, sig, lb, m, exclude, cand);
 }
 
 /* Lists and dmax from the full base matrix (the retrieval matrix before its re-ranking). */
@@ -130,107 +109,147 @@ static amscr_status sampled_medians(amscr_index *x)
 
 /* ------------------------------------------------ shortlist build: rows on threads */
 
+/* Rows first..n-1: each one's shortlist (m shapes, ascending) into S, the base distances of its
+ * pairs into D (a pair in both rows' shortlists computed once, by the later row's partner:
+ * the row of the lower index), then its k nearest. */
 typedef struct {
     amscr_index *x;
-    const amscr__base *b;
-    size_t m, first; /* shortlist size; rows first..n-1 */
-    pthread_mutex_t lock;
-    size_t next, done;
-    double dmax;
-    int cancel;
-    amscr_status st;
-    char detail[256];
-} rows_job;
+    amscr__base b;
+    size_t first, m;
+    uint32_t *S;
+    double *D;
+} rows_ctx;
 
-/* Row i: its shortlist's base distances and its k nearest; the row's largest distance. */
-static amscr_status one_row(rows_job *j, size_t i, amscr__pair_ws *pw, size_t *cand, double *cd, double *rmax)
+static amscr_status pw_init(void *ctx, void **scratch)
 {
-    amscr_index *x = j->x;
-    const amscr_descriptor *q = amscr_db_descriptor(x->db, i);
-    size_t m = amscr__index_shortlist(x, x->sig + i * x->sig_dim, j->m, i, cand);
-    amscr__hf hq[2];
-    amscr_status st = amscr__base_hf(j->b, q, hq);
+    rows_ctx *c = ctx;
+    amscr__pair_ws *pw = malloc(sizeof *pw);
+    if (!pw)
+        return AMSCR_E_NOMEM;
+    amscr_status st = amscr__pair_ws_init(&c->b, pw);
     if (st != AMSCR_OK)
-        return st;
-    st = amscr__base_pairs(j->b, x->db, q, hq, i, cand, m, pw, cd);
-    amscr__base_hf_free(j->b, hq);
-    *rmax = 0.0;
-    for (size_t t = 0; st == AMSCR_OK && t < m; t++)
-        *rmax = cd[t] > *rmax ? cd[t] : *rmax;
-    if (st == AMSCR_OK && x->k > 0)
-        st = amscr__knn_select(i, cand, cd, m, x->k, x->nb_idx + i * x->k, x->nb_dist + i * x->k);
+        free(pw);
+    else
+        *scratch = pw;
     return st;
 }
 
-static void rows_work(rows_job *j, amscr_progress_fn progress, void *user)
+static void pw_fini(void *scratch)
 {
-    size_t n = amscr_db_size(j->x->db);
-    amscr__pair_ws pw;
-    size_t *cand = amscr__malloc_array(n, sizeof *cand);
-    double *cd = amscr__malloc_array(n, sizeof *cd), rmax = 0.0;
-    amscr_status st = cand && cd ? amscr__pair_ws_init(j->b, &pw) : AMSCR_E_NOMEM;
-    int have_pw = st == AMSCR_OK;
-    for (;;) {
-        pthread_mutex_lock(&j->lock);
-        if (st != AMSCR_OK && j->st == AMSCR_OK) {
-            j->st = st;
-            snprintf(j->detail, sizeof j->detail, "%s", st == AMSCR_E_NOMEM ? "index: out of memory"
-                                                                            : amscr_last_error_detail());
-        }
-        j->dmax = rmax > j->dmax ? rmax : j->dmax;
-        size_t i = j->next, done = j->done;
-        int go = j->st == AMSCR_OK && !j->cancel && i < n;
-        if (go)
-            j->next++;
-        pthread_mutex_unlock(&j->lock);
-        if (progress && progress(user, done - j->first, n - j->first) != 0) {
-            pthread_mutex_lock(&j->lock);
-            j->cancel = 1;
-            pthread_mutex_unlock(&j->lock);
-        }
-        if (!go)
-            break;
-        st = one_row(j, i, &pw, cand, cd, &rmax);
-        pthread_mutex_lock(&j->lock);
-        j->done++;
-        pthread_mutex_unlock(&j->lock);
-    }
-    if (have_pw)
-        amscr__pair_ws_free(&pw);
-    free(cand);
-    free(cd);
+    amscr__pair_ws_free(scratch);
+    free(scratch);
 }
 
-static void *rows_worker(void *arg)
+static amscr_status shortlist_row(void *ctx, size_t i, void *scratch)
 {
-    rows_work(arg, NULL, NULL);
-    return NULL;
+    (void)scratch;
+    rows_ctx *c = ctx;
+    amscr_index *x = c->x;
+    size_t *cand = amscr__malloc_array(c->m, sizeof *cand);
+    size_t got = cand ? amscr__index_shortlist(x, x->sig + i * x->sig_dim, x->sig_lb + i * AMSCR__SIG_LB_DIM, c->m,
+                                               i, cand)
+                      : 0;
+    for (size_t t = 0; t < got; t++)
+        c->S[(i - c->first) * c->m + t] = (uint32_t)cand[t];
+    free(cand);
+    return got == c->m ? AMSCR_OK : AMSCR_E_NOMEM;
+}
+
+/* Whether row j (>= first) holds i in its shortlist. */
+static int row_holds(const rows_ctx *c, size_t j, size_t i)
+{
+    const uint32_t *r = c->S + (j - c->first) * c->m;
+    size_t lo = 0, hi = c->m;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (r[mid] < i)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < c->m && r[lo] == i;
+}
+
+/* Pair (i, j) of row i is computed by row i unless j is a row too, j < i, and holds i. */
+static int computed_by_other(const rows_ctx *c, size_t i, size_t j)
+{
+    return j >= c->first && j < i && row_holds(c, j, i);
+}
+
+static amscr_status distance_row(void *ctx, size_t i, void *scratch)
+{
+    rows_ctx *c = ctx;
+    amscr_index *x = c->x;
+    size_t *cand = amscr__malloc_array(c->m, sizeof *cand), *pos = amscr__malloc_array(c->m, sizeof *pos), u = 0;
+    double *d = amscr__malloc_array(c->m, sizeof *d);
+    amscr_status st = cand && pos && d ? AMSCR_OK : AMSCR_E_NOMEM;
+    const uint32_t *S = c->S + (i - c->first) * c->m;
+    for (size_t t = 0; st == AMSCR_OK && t < c->m; t++)
+        if (!computed_by_other(c, i, S[t])) {
+            cand[u] = S[t];
+            pos[u++] = t;
+        }
+    const amscr__hf *hq = x->nf ? x->hf + i * (size_t)x->nf : NULL;
+    if (st == AMSCR_OK)
+        st = amscr__base_pairs(&c->b, x->db, x->hf, amscr_db_descriptor(x->db, i), hq, i, cand, u, scratch, d);
+    for (size_t t = 0; st == AMSCR_OK && t < u; t++)
+        c->D[(i - c->first) * c->m + pos[t]] = d[t];
+    free(cand);
+    free(pos);
+    free(d);
+    return st;
+}
+
+/* Fills the pairs computed by other rows; row i's k nearest. */
+static amscr_status list_row(void *ctx, size_t i, void *scratch)
+{
+    (void)scratch;
+    rows_ctx *c = ctx;
+    amscr_index *x = c->x;
+    const uint32_t *S = c->S + (i - c->first) * c->m;
+    double *D = c->D + (i - c->first) * c->m;
+    size_t *cand = amscr__malloc_array(c->m, sizeof *cand);
+    if (!cand)
+        return AMSCR_E_NOMEM;
+    for (size_t t = 0; t < c->m; t++) {
+        cand[t] = S[t];
+        if (computed_by_other(c, i, S[t])) {
+            const uint32_t *r = c->S + (S[t] - c->first) * c->m;
+            size_t lo = 0;
+            while (r[lo] != i)
+                lo++;
+            D[t] = c->D[(S[t] - c->first) * c->m + lo];
+        }
+    }
+    amscr_status st = x->k > 0 ? amscr__knn_select(i, cand, D, c->m, x->k, x->nb_idx + i * x->k,
+                                                    x->nb_dist + i * x->k)
+                               : AMSCR_OK;
+    free(cand);
+    return st;
 }
 
 /* Rows first..n-1 from their M signature-nearest shapes; x->dmax grows to their largest. */
 amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_progress_fn progress, void *user)
 {
-    amscr__base b;
-    amscr__base_init(&b, amscr_db_params(x->db), x->med_a, x->med_h);
-    rows_job j = {x, &b, m, first, PTHREAD_MUTEX_INITIALIZER, first, first, x->dmax, 0, AMSCR_OK, ""};
-    size_t n = amscr_db_size(x->db);
-    unsigned nt = b.threads, started = 0;
-    if (nt > n - first)
-        nt = n > first ? (unsigned)(n - first) : 1u;
-    pthread_t tid[64];
-    for (unsigned t = 1; t < nt && t < 64; t++)
-        if (pthread_create(&tid[started], NULL, rows_worker, &j) == 0)
-            started++;
-    rows_work(&j, progress, user);
-    for (unsigned t = 0; t < started; t++)
-        pthread_join(tid[t], NULL);
-    pthread_mutex_destroy(&j.lock);
-    x->dmax = j.dmax;
-    if (j.st != AMSCR_OK)
-        return amscr__fail(j.st, "%s", j.detail);
-    if (j.cancel)
-        return amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback");
-    return AMSCR_OK;
+    size_t n = amscr_db_size(x->db), rows = n - first;
+    rows_ctx c = {x, {0}, first, m, NULL, NULL};
+    amscr__base_init(&c.b, amscr_db_params(x->db), x->med_a, x->med_h);
+    c.S = amscr__malloc_array(rows, m * sizeof *c.S);
+    c.D = amscr__malloc_array(rows, m * sizeof *c.D);
+    amscr_status st = c.S && c.D ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    amscr__rows_fn f1 = {NULL, NULL, shortlist_row, &c}, f2 = {pw_init, pw_fini, distance_row, &c};
+    amscr__rows_fn f3 = {NULL, NULL, list_row, &c};
+    if (st == AMSCR_OK)
+        st = amscr__run_rows(&f1, first, n, c.b.threads, NULL, NULL);
+    if (st == AMSCR_OK)
+        st = amscr__run_rows(&f2, first, n, c.b.threads, progress, user);
+    if (st == AMSCR_OK)
+        st = amscr__run_rows(&f3, first, n, c.b.threads, NULL, NULL);
+    for (size_t t = 0; st == AMSCR_OK && t < rows * m; t++)
+        x->dmax = c.D[t] > x->dmax ? c.D[t] : x->dmax;
+    free(c.S);
+    free(c.D);
+    return st;
 }
 
 amscr_status amscr__index_check_db(const amscr_db *db, const char *what)
@@ -258,8 +277,11 @@ amscr_status amscr_index_build(const amscr_db *db, size_t candidates, amscr_prog
     if (st != AMSCR_OK)
         return st;
     size_t n = amscr_db_size(db);
-    for (size_t i = 0; i < n; i++)
-        amscr__shape_signature(amscr_db_descriptor(x->db, i), x->sig + i * x->sig_dim);
+    st = amscr__index_features(x, 0, 0);
+    if (st != AMSCR_OK) {
+        amscr_index_free(x);
+        return st;
+    }
     if (candidates > 0 && candidates + 1 < x->k)
         candidates = x->k - 1; /* a shortlist holds at least the K - 1 neighbours */
     x->candidates = candidates > 0 && n > 1 && candidates < n - 1 ? candidates : 0;

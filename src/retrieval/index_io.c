@@ -1,11 +1,13 @@
 /* index_io.c — the index file: a collection file (db_io.c) of version 3 whose index section
  * follows the shapes, so amscr_db_load of an index file gives its collection. Little-endian:
  *   u64 section length (the bytes up to the trailing checksum), then
- *   u32 sig_dim, u32 0, u64 k, u64 candidates (0: full lists), f64 dmax, f64 median AMSCR,
- *   f64 median channel, n x sig_dim f64 signatures, n x k x (u32 neighbour, f64 distance)
+ *   u32 sig_dim, u32 4 (bytes of a signature value), u64 k, u64 candidates (0: full lists),
+ *   f64 dmax, f64 median AMSCR, f64 median channel, n x sig_dim f32 signatures (signature.h),
+ *   n x k x (u32 neighbour, f64 distance)
  *   (each row: itself first, then by distance), n names, u64 nclasses, nclasses class names
  *   (string: u32 length and bytes, 0xffffffff for none).
- * Every count is bounded by the bytes left before anything is allocated. */
+ * Every count is bounded by the bytes left before anything is allocated. The shapes' channel
+ * features are not stored: they are rebuilt at load (index_features.c). */
 #include "db_io.h"
 #include "index.h"
 
@@ -18,13 +20,17 @@ static void write_section(const amscr_index *x, amscr__wbuf *w)
 {
     size_t n = amscr_db_size(x->db), k = x->k;
     amscr__w_u32(w, (uint32_t)x->sig_dim);
-    amscr__w_u32(w, 0);
+    amscr__w_u32(w, (uint32_t)sizeof(float));
     amscr__w_u64(w, k);
     amscr__w_u64(w, x->candidates);
     amscr__w_f64(w, x->dmax);
     amscr__w_f64(w, x->med_a);
     amscr__w_f64(w, x->med_h);
-    amscr__w_f64s(w, x->sig, n * x->sig_dim);
+    for (size_t i = 0; i < n * x->sig_dim; i++) {
+        uint32_t u;
+        memcpy(&u, &x->sig[i], sizeof u);
+        amscr__w_u32(w, u);
+    }
     for (size_t i = 0; i < n * k; i++) {
         amscr__w_u32(w, x->nb_idx[i]);
         amscr__w_f64(w, x->nb_dist[i]);
@@ -81,17 +87,17 @@ static amscr_status read_header(amscr__rbuf *r, amscr_index *x)
 {
     const amscr_params *p = amscr_db_params(x->db);
     size_t n = amscr_db_size(x->db);
-    uint32_t sig_dim = amscr__r_u32(r);
-    amscr__r_u32(r);
+    uint32_t sig_dim = amscr__r_u32(r), sig_bytes = amscr__r_u32(r);
     uint64_t k = amscr__r_u64(r), m = amscr__r_u64(r);
     x->dmax = amscr__r_f64(r);
     x->med_a = amscr__r_f64(r);
     x->med_h = amscr__r_f64(r);
     if (r->bad)
         return amscr__fail(AMSCR_E_FORMAT, "index file: the index section is truncated");
-    if (sig_dim != AMSCR__SIG_DIM)
-        return amscr__fail(AMSCR_E_FORMAT, "index file: signatures of dimension %u, this library's have %u; rebuild "
-                                           "the index", (unsigned)sig_dim, (unsigned)AMSCR__SIG_DIM);
+    if (sig_dim != AMSCR__SIG_DIM || sig_bytes != sizeof(float))
+        return amscr__fail(AMSCR_E_FORMAT, "index file: signatures of dimension %u (%u bytes a value), this "
+                                           "library's have %u (%u); rebuild the index", (unsigned)sig_dim,
+                           (unsigned)sig_bytes, (unsigned)AMSCR__SIG_DIM, (unsigned)sizeof(float));
     if (k != (p->rerank_k < n ? p->rerank_k : n) || (m != 0 && m + 1 >= n))
         return amscr__fail(AMSCR_E_FORMAT, "index file: %llu neighbours or %llu candidates do not fit %zu shapes "
                                            "with re-ranking k %u", (unsigned long long)k, (unsigned long long)m, n,
@@ -101,8 +107,8 @@ static amscr_status read_header(amscr__rbuf *r, amscr_index *x)
         return amscr__fail(AMSCR_E_FORMAT, "index file: bad largest distance or medians");
     x->k = (size_t)k;
     x->candidates = (size_t)m;
-    uint64_t need = (uint64_t)n * (8u * sig_dim + 12u * k);
-    if (need / (n ? n : 1) != 8u * sig_dim + 12u * k || need > r->len - r->pos)
+    uint64_t need = (uint64_t)n * (4u * sig_dim + 12u * k);
+    if (need / (n ? n : 1) != 4u * sig_dim + 12u * k || need > r->len - r->pos)
         return amscr__fail(AMSCR_E_FORMAT, "index file: the index section is truncated");
     return amscr__index_reserve(x, n);
 }
@@ -111,8 +117,12 @@ static amscr_status read_header(amscr__rbuf *r, amscr_index *x)
 static amscr_status read_lists(amscr__rbuf *r, amscr_index *x)
 {
     size_t n = amscr_db_size(x->db), k = x->k;
-    if (!amscr__r_f64s(r, x->sig, n * x->sig_dim))
-        return amscr__fail(AMSCR_E_FORMAT, "index file: a signature is not finite");
+    for (size_t i = 0; i < n * x->sig_dim; i++) {
+        uint32_t u = amscr__r_u32(r);
+        memcpy(&x->sig[i], &u, sizeof u);
+        if (r->bad || !isfinite(x->sig[i]))
+            return amscr__fail(AMSCR_E_FORMAT, "index file: a signature is not finite");
+    }
     for (size_t i = 0; i < n; i++)
         for (size_t t = 0; t < k; t++) {
             uint32_t j = amscr__r_u32(r);
@@ -170,6 +180,7 @@ amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **
     }
     x->db = db;
     x->sig_dim = AMSCR__SIG_DIM;
+    x->nf = amscr__index_frames(amscr_db_params(db));
     amscr__rbuf r = {buf, len - 8, pos, 0};
     uint64_t sec = version >= AMSCR__DB_VERSION_INDEX ? amscr__r_u64(&r) : 0;
     if (version < AMSCR__DB_VERSION_INDEX)
@@ -185,6 +196,8 @@ amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **
         st = read_lists(&r, x);
     if (st == AMSCR_OK)
         st = read_names(&r, x);
+    if (st == AMSCR_OK)
+        st = amscr__index_features(x, 0, 1);
     if (st != AMSCR_OK) {
         amscr_index_free(x);
         return st;

@@ -44,7 +44,7 @@ void amscr__pair_ws_free(amscr__pair_ws *pw)
 
 amscr_status amscr__base_hf(const amscr__base *b, const amscr_descriptor *d, amscr__hf hf[2])
 {
-    memset(hf, 0, 2 * sizeof *hf);
+    memset(hf, 0, (size_t)b->nf * sizeof *hf);
     amscr_status st = AMSCR_OK;
     for (int f = 0; f < b->nf && st == AMSCR_OK; f++)
         st = amscr__hf_of_descriptor(b->p, b->frames[f], d, &hf[f]);
@@ -82,33 +82,37 @@ static amscr_status base_pair(const amscr__base *b, const amscr_descriptor *lo, 
     return AMSCR_OK;
 }
 
-amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const amscr_descriptor *q,
-                               const amscr__hf hq[2], size_t qpos, const size_t *cand, size_t m, amscr__pair_ws *pw,
-                               double *out)
+amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const amscr__hf *hfs,
+                               const amscr_descriptor *q, const amscr__hf hq[2], size_t qpos, const size_t *cand,
+                               size_t m, amscr__pair_ws *pw, double *out)
 {
     amscr_status st = AMSCR_OK;
     for (size_t t = 0; t < m && st == AMSCR_OK; t++) {
         const amscr_descriptor *d = amscr_db_descriptor(db, cand[t]);
-        amscr__hf hd[2];
-        st = amscr__base_hf(b, d, hd);
+        amscr__hf built[2];
+        const amscr__hf *hd = hfs ? hfs + cand[t] * (size_t)b->nf : built;
+        if (!hfs)
+            st = amscr__base_hf(b, d, built);
         if (st != AMSCR_OK)
             break;
         if (cand[t] < qpos)
             st = base_pair(b, d, hd, q, hq, pw, &out[t]);
         else
             st = base_pair(b, q, hq, d, hd, pw, &out[t]);
-        amscr__base_hf_free(b, hd);
+        if (!hfs)
+            amscr__base_hf_free(b, built);
     }
     return st;
 }
 
 /* ---------------------------------------------------------------- one row on threads */
 
-enum { CHUNK = 8 };
+enum { CHUNK = 4 };
 
 typedef struct {
     const amscr__base *b;
     const amscr_db *db;
+    const amscr__hf *hfs;
     const amscr_descriptor *q;
     const amscr__hf *hq;
     size_t qpos, m;
@@ -146,7 +150,7 @@ static void row_work(row_job *j, amscr_progress_fn progress, void *user)
         if (!go)
             break;
         size_t e = c + CHUNK < j->m ? c + CHUNK : j->m;
-        st = amscr__base_pairs(j->b, j->db, j->q, j->hq, j->qpos, j->cand + c, e - c, &pw, j->out + c);
+        st = amscr__base_pairs(j->b, j->db, j->hfs, j->q, j->hq, j->qpos, j->cand + c, e - c, &pw, j->out + c);
         pthread_mutex_lock(&j->lock);
         j->done += e - c;
         pthread_mutex_unlock(&j->lock);
@@ -161,14 +165,15 @@ static void *row_worker(void *arg)
     return NULL;
 }
 
-amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const amscr_descriptor *q, size_t qpos,
-                             const size_t *cand, size_t m, amscr_progress_fn progress, void *user, double *out)
+amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const amscr__hf *hfs,
+                             const amscr_descriptor *q, size_t qpos, const size_t *cand, size_t m,
+                             amscr_progress_fn progress, void *user, double *out)
 {
     amscr__hf hq[2];
     amscr_status st = amscr__base_hf(b, q, hq);
     if (st != AMSCR_OK)
         return st;
-    row_job j = {b, db, q, hq, qpos, m, cand, out, PTHREAD_MUTEX_INITIALIZER, 0, 0, 0, AMSCR_OK, ""};
+    row_job j = {b, db, hfs, q, hq, qpos, m, cand, out, PTHREAD_MUTEX_INITIALIZER, 0, 0, 0, AMSCR_OK, ""};
     unsigned nt = b->threads, started = 0;
     size_t chunks = (m + CHUNK - 1) / CHUNK;
     if (nt > chunks)

@@ -249,19 +249,26 @@ static amscr_status query_scores(const amscr_index *x, const amscr_descriptor *q
                                  amscr_progress_fn progress, void *user, double *out)
 {
     size_t n = amscr_db_size(x->db), *cand = amscr__malloc_array(n, sizeof *cand);
-    double *dq = amscr__malloc_array(n, sizeof *dq), sig[AMSCR__SIG_DIM];
+    double *dq = amscr__malloc_array(n, sizeof *dq);
+    float sig[AMSCR__SIG_DIM], lb[AMSCR__SIG_LB_DIM];
     amscr_status st = cand && dq ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     size_t m = 0;
     if (st == AMSCR_OK) {
-        amscr__shape_signature(q, sig);
-        m = amscr__index_shortlist(x, sig, shortlist_size(x, candidates), self, cand);
+        size_t want = shortlist_size(x, candidates);
+        if (want > 0 && self < n) /* a member's signature is stored */
+            memcpy(sig, x->sig + self * x->sig_dim, sizeof sig);
+        else if (want > 0)
+            amscr__shape_signature(q, sig);
+        if (want > 0)
+            amscr__sig_bound_vector(sig, lb);
+        m = amscr__index_shortlist(x, sig, lb, want, self, cand);
         if (m == 0 && n > (self < n ? 1u : 0u))
             st = amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     }
     amscr__base b;
     amscr__base_init(&b, amscr_db_params(x->db), x->med_a, x->med_h);
     if (st == AMSCR_OK)
-        st = amscr__base_row(&b, x->db, q, self == SIZE_MAX ? SIZE_MAX : self, cand, m, progress, user, dq);
+        st = amscr__base_row(&b, x->db, x->hf, q, self == SIZE_MAX ? SIZE_MAX : self, cand, m, progress, user, dq);
     if (st == AMSCR_OK)
         st = amscr__index_scores(x, self == SIZE_MAX ? n : self, cand, dq, m, out);
     free(cand);
@@ -352,7 +359,7 @@ static amscr_status plain_row(const amscr_db *db, const amscr_descriptor *q, ams
         cand[j] = j;
     amscr__base b;
     amscr__base_init(&b, amscr_db_params(db), 0.0, 0.0);
-    amscr_status st = amscr__base_row(&b, db, q, SIZE_MAX, cand, n, progress, user, out);
+    amscr_status st = amscr__base_row(&b, db, NULL, q, SIZE_MAX, cand, n, progress, user, out);
     free(cand);
     return st;
 }

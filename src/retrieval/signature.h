@@ -1,14 +1,35 @@
-/* signature.h — the shortlist signature of a prepared shape (signature.c): a short vector
- * whose Euclidean distance orders the shapes a large index matches first. Never installed. */
+/* signature.h — the shortlist signature of a prepared shape (signature.c): the affine
+ * signature (affine_signature.h) as floats, frequency-major, with a short lower-bound vector,
+ * so an index finds the M shapes whose signatures are nearest a query's without computing
+ * every full distance. Never installed. */
 #ifndef AMSCR_SIGNATURE_H
 #define AMSCR_SIGNATURE_H
 
+#include "affine_signature.h"
 #include "internal.h"
 
-/* Dimension of amscr__shape_signature's output (stored in the index file as sig_dim). */
-#define AMSCR__SIG_DIM 24
+/* Floats of a signature (stored in the index file as sig_dim). */
+#define AMSCR__SIG_DIM AMSCR__AFFINE_SIG_DIM
+/* Frequencies of the lower-bound vector (the first ones: most of the energy). */
+#define AMSCR__SIG_LB_FREQS 2
+/* Floats of the lower-bound vector: frames x bins x AMSCR__SIG_LB_FREQS. */
+#define AMSCR__SIG_LB_DIM (2 * AMSCR__SIG_BINS * AMSCR__SIG_LB_FREQS)
 
-/* The signature of d into out[AMSCR__SIG_DIM]. */
-void amscr__shape_signature(const amscr_descriptor *d, double *out);
+/* The signature of d into out[AMSCR__SIG_DIM]: amscr__affine_signature's values, reordered by
+ * frequency, then frame, orientation and bin. */
+void amscr__shape_signature(const amscr_descriptor *d, float *out);
+/* The lower-bound vector of a signature into lb[AMSCR__SIG_LB_DIM]. */
+void amscr__sig_bound_vector(const float *sig, float *lb);
+/* A lower bound of amscr__sig_distance from the two lower-bound vectors. */
+double amscr__sig_bound(const float *la, const float *lb);
+/* amscr__affine_signature_distance of two signatures (in float). */
+double amscr__sig_distance(const float *a, const float *b);
+
+/* The m signatures nearest sig (lower-bound vector lb) among the n of sigs / lbs (rows of
+ * AMSCR__SIG_DIM and AMSCR__SIG_LB_DIM floats), by (distance, index), leaving out `exclude`
+ * (or SIZE_MAX), into cand in ascending index order; exactly those of the full distances.
+ * Returns m, 0 when out of memory. */
+size_t amscr__sig_nearest(const float *sigs, const float *lbs, size_t n, const float *sig, const float *lb, size_t m,
+                          size_t exclude, size_t *cand);
 
 #endif

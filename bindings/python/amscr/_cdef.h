@@ -12,6 +12,7 @@
 #define AMSCR_MAX_SCALES 64
 #define AMSCR_THRESHOLD_AUTO -1
 #define AMSCR_TRACE_PIXEL_CHAIN 1
+#define AMSCR_INDEX_CANDIDATES 256
 
 typedef enum amscr_status {
     AMSCR_OK = 0,

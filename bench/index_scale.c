@@ -1,0 +1,276 @@
+/* index_scale.c — the library's retrieval index: build time, one query's time and the
+ * shortlist's recall against the exact query, then how build and query grow with the
+ * collection (docs/measurements.md, "The index: build, query, recall").
+ *
+ *   amscr-index-bench DATASETS [SIZES...]      (default sizes: 1000 10000)
+ *
+ * Part 1 (retrieval preset, 2 threads): mpeg7-dev + one seeded affine copy of every shape
+ * (1400 shapes). Build with the default shortlist (AMSCR_INDEX_CANDIDATES) and with every shape
+ * (candidates 0, exact); save / load; 50 seeded affine-warped queries (a random collection shape
+ * under any rotation, axis scales x0.5-2 log-uniform, shear +-0.5, 0.5 % noise): the median
+ * time of one query at the default shortlist, and its recall against the exact query (the full
+ * index, candidates 0): % of the exact top 10 in the shortlist query's top 10, % of queries
+ * with the same first hit.
+ * Part 2: collections of SIZES shapes, each an affine-warped, noisy copy of an mpeg7-dev shape
+ * (shape i % 700, its own seed): build time at the default shortlist, the process's resident
+ * memory per shape after the build, load time, median of 20 queries. Times are wall clock
+ * with the process's CPU seconds (all threads) in parentheses: on a busy machine CPU / threads
+ * is what idle cores would give. Exit 77 without the datasets. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "amscr.h"
+#include "mcd_set.h"
+
+enum { TOP = 10, NQ = 50, NQ_SCALE = 20 };
+
+static void die(const char *what)
+{
+    fprintf(stderr, "amscr-index-bench: %s: %s\n", what, amscr_last_error_detail());
+    exit(1);
+}
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static double cpu(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static double rss_mb(void)
+{
+    long pages = 0, res = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (f) {
+        if (fscanf(f, "%ld %ld", &pages, &res) != 2)
+            res = 0;
+        fclose(f);
+    }
+    return (double)res * (double)sysconf(_SC_PAGESIZE) / 1e6;
+}
+
+static double urand(unsigned long long *s)
+{
+    *s ^= *s >> 12;
+    *s ^= *s << 25;
+    *s ^= *s >> 27;
+    return (double)((*s * 2685821657736338717ull) >> 11) / 9007199254740992.0;
+}
+
+/* A random affine copy of c (mcd_set.h's distortion), prepared with p. */
+static amscr_descriptor *warped(const amscr_params *p, const amscr_contour *c, unsigned long long *seed)
+{
+    size_t n = amscr_contour_size(c);
+    const double *xy = amscr_contour_xy(c);
+    double th = 6.283185307179586 * urand(seed);
+    double sx = exp(log(0.5) + log(4.0) * urand(seed)), sy = exp(log(0.5) + log(4.0) * urand(seed));
+    double sh = -0.5 + urand(seed), cs = cos(th), sn = sin(th);
+    double A[4] = {cs * sx, cs * sx * sh - sn * sy, sn * sx, sn * sx * sh + cs * sy};
+    double *out = malloc(2 * n * sizeof *out), cx = 0, cy = 0, r = 0;
+    if (!out)
+        die("out of memory");
+    for (size_t i = 0; i < n; i++) {
+        out[2 * i] = A[0] * xy[2 * i] + A[1] * xy[2 * i + 1];
+        out[2 * i + 1] = A[2] * xy[2 * i] + A[3] * xy[2 * i + 1];
+        cx += out[2 * i] / (double)n;
+        cy += out[2 * i + 1] / (double)n;
+    }
+    for (size_t i = 0; i < n; i++)
+        r += ((out[2 * i] - cx) * (out[2 * i] - cx) + (out[2 * i + 1] - cy) * (out[2 * i + 1] - cy)) / (double)n;
+    r = sqrt(r);
+    for (size_t i = 0; i < 2 * n; i++) {
+        double u = urand(seed), w = urand(seed);
+        out[i] += 0.005 * r * sqrt(-2.0 * log(u > 1e-300 ? u : 1e-300)) * cos(6.283185307179586 * w);
+    }
+    amscr_contour *ct = NULL;
+    amscr_descriptor *d = NULL;
+    if (amscr_contour_new(out, n, &ct) != AMSCR_OK || amscr_descriptor_new(p, ct, &d) != AMSCR_OK)
+        die("affine copy");
+    amscr_contour_free(ct);
+    free(out);
+    return d;
+}
+
+static amscr_descriptor *plain(const amscr_params *p, const amscr_contour *c)
+{
+    amscr_descriptor *d = NULL;
+    if (amscr_descriptor_new(p, c, &d) != AMSCR_OK)
+        die("prepare");
+    return d;
+}
+
+static void add(amscr_db *db, amscr_descriptor *d, int32_t label)
+{
+    if (amscr_db_add_descriptor(db, d, label, NULL) != AMSCR_OK)
+        die("add");
+    amscr_descriptor_free(d);
+}
+
+static int cmp_dbl(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, size_t n)
+{
+    qsort(v, n, sizeof *v, cmp_dbl);
+    return n ? v[n / 2] : 0.0;
+}
+
+/* Wall and CPU seconds (all threads) of a build. */
+static amscr_index *build(const amscr_db *db, size_t cand, double secs[2])
+{
+    amscr_index *x = NULL;
+    double t = now(), c = cpu();
+    if (amscr_index_build(db, cand, NULL, NULL, &x) != AMSCR_OK)
+        die("build");
+    secs[0] = now() - t;
+    secs[1] = cpu() - c;
+    return x;
+}
+
+/* One query's wall and CPU time into w[q], c[q]. */
+static void timed_query(const amscr_index *x, const amscr_descriptor *d, size_t M, size_t *a, double *sa, double *w,
+                        double *c)
+{
+    size_t ca = 0;
+    double t = now(), u = cpu();
+    if (amscr_index_query(x, d, M, TOP, a, sa, &ca) != AMSCR_OK)
+        die("query");
+    *w = now() - t;
+    *c = cpu() - u;
+}
+
+/* Save to memory and load back: the load time and the file size. */
+static void load_time(const amscr_index *x, double *secs, double *mb)
+{
+    void *buf = NULL;
+    size_t len = 0;
+    amscr_index *y = NULL;
+    if (amscr_index_save_memory(x, &buf, &len) != AMSCR_OK)
+        die("save");
+    double t = now();
+    if (amscr_index_load_memory(buf, len, &y) != AMSCR_OK)
+        die("load");
+    *secs = now() - t;
+    *mb = (double)len / 1e6;
+    amscr_index_free(y);
+    amscr_free(buf);
+}
+
+/* Part 1: the 1400-shape collection. */
+static void part_mixed(const amscr_params *p, const shape_set *s)
+{
+    amscr_db *db = NULL;
+    unsigned long long seed = 0x5DEECE66Dull, qseed = 0xC0FFEEull;
+    if (amscr_db_new(p, &db) != AMSCR_OK)
+        die("db");
+    for (size_t i = 0; i < s->n; i++)
+        add(db, plain(p, s->c[i]), s->labels[i]);
+    for (size_t i = 0; i < s->n; i++)
+        add(db, warped(p, s->c[i], &seed), s->labels[i]);
+    size_t n = amscr_db_size(db), M = AMSCR_INDEX_CANDIDATES;
+    double tb[2], tf[2], tl, mb;
+    amscr_index *x = build(db, M, tb), *full = build(db, 0, tf);
+    load_time(x, &tl, &mb);
+    double times[NQ], ctimes[NQ];
+    size_t top_in = 0, same_first = 0;
+    for (size_t q = 0; q < NQ; q++) {
+        amscr_descriptor *d = warped(p, s->c[(size_t)(urand(&qseed) * (double)s->n) % s->n], &qseed);
+        size_t a[TOP], b[TOP], ca = TOP, cb = 0;
+        double sa[TOP], sb[TOP];
+        timed_query(x, d, M, a, sa, &times[q], &ctimes[q]);
+        if (amscr_index_query(full, d, 0, TOP, b, sb, &cb) != AMSCR_OK)
+            die("exact query");
+        for (size_t u = 0; u < cb; u++)
+            for (size_t v = 0; v < ca; v++)
+                top_in += a[v] == b[u];
+        same_first += a[0] == b[0];
+        amscr_descriptor_free(d);
+    }
+    printf("| mpeg7-dev + affine copies | %zu | %zu | %.1f s (%.1f) | %.1f s (%.1f) | %.2f s, %.0f MB | %.1f ms (%.1f) | "
+           "%.1f %% | %.0f %% |\n", n, M, tb[0], tb[1], tf[0], tf[1], tl, mb, 1e3 * median(times, NQ),
+           1e3 * median(ctimes, NQ), 100.0 * (double)top_in / (double)(TOP * NQ),
+           100.0 * (double)same_first / (double)NQ);
+    fflush(stdout);
+    amscr_index_free(x);
+    amscr_index_free(full);
+    amscr_db_free(db);
+}
+
+/* Part 2: n warped copies. */
+static void part_scale(const amscr_params *p, const shape_set *s, size_t n)
+{
+    amscr_db *db = NULL;
+    unsigned long long seed = 0xABCDEF12345ull + n, qseed = 0x1234ull;
+    if (amscr_db_new(p, &db) != AMSCR_OK)
+        die("db");
+    for (size_t i = 0; i < n; i++)
+        add(db, warped(p, s->c[i % s->n], &seed), s->labels[i % s->n]);
+    size_t M = AMSCR_INDEX_CANDIDATES;
+    double before = rss_mb(), tb[2], tl, mb, times[NQ_SCALE], ctimes[NQ_SCALE];
+    amscr_index *x = build(db, M, tb);
+    double per_shape = (rss_mb() - before) * 1e3 / (double)n;
+    load_time(x, &tl, &mb);
+    for (size_t q = 0; q < NQ_SCALE; q++) {
+        amscr_descriptor *d = warped(p, s->c[(size_t)(urand(&qseed) * (double)s->n) % s->n], &qseed);
+        size_t a[TOP];
+        double sa[TOP];
+        timed_query(x, d, M, a, sa, &times[q], &ctimes[q]);
+        amscr_descriptor_free(d);
+    }
+    printf("| warped copies | %zu | %zu | %.1f s (%.1f) | %.0f KB | %.2f s, %.0f MB | %.1f ms (%.1f) |\n", n, M, tb[0],
+           tb[1], per_shape, tl, mb, 1e3 * median(times, NQ_SCALE), 1e3 * median(ctimes, NQ_SCALE));
+    fflush(stdout);
+    amscr_index_free(x);
+    amscr_db_free(db);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: amscr-index-bench DATASETS [SIZES...]\n");
+        return 2;
+    }
+    char manifest[4096];
+    snprintf(manifest, sizeof manifest, "%s/mpeg7-dev/manifest.tsv", argv[1]);
+    shape_set s;
+    amscr_params *p = NULL;
+    if (shape_set_load(manifest, &s) != 0)
+        return 77;
+    if (amscr_params_new_retrieval(&p) != AMSCR_OK || amscr_params_set_num_threads(p, 2) != AMSCR_OK)
+        die("params");
+    if (!getenv("INDEX_BENCH_NO_MIXED")) {
+        printf("| collection | shapes | M | build (M) | build (exact) | load, file | query (median of %d) | exact top %d "
+               "kept | same first hit |\n|---|---|---|---|---|---|---|---|---|\n", NQ, TOP);
+        part_mixed(p, &s);
+        printf("\n");
+    }
+    printf("| collection | shapes | M | build | memory a shape | load, file | query (median of %d) |\n"
+           "|---|---|---|---|---|---|---|\n", NQ_SCALE);
+    for (int a = 2; a < argc || a == 2; a++) {
+        size_t sizes[2] = {1000, 10000};
+        if (argc > 2)
+            part_scale(p, &s, (size_t)strtoul(argv[a], NULL, 10));
+        else
+            for (int t = 0; t < 2; t++)
+                part_scale(p, &s, sizes[t]);
+        if (argc <= 2)
+            break;
+    }
+    amscr_params_free(p);
+    shape_set_free(&s);
+    return 0;
+}

@@ -1,0 +1,41 @@
+/* index_features.c — what an index keeps of each shape for matching, computed once per shape
+ * (after a build, an add or a load) on the params' threads: its shortlist signature with the
+ * signature's lower-bound vector (signature.h) and its channel features in every frame of the
+ * channel (channel.h), so a query or a row matches a shape without rebuilding anything. */
+#include "index.h"
+
+#include <stdlib.h>
+
+typedef struct {
+    amscr_index *x;
+    amscr__base b;
+    int have_sig;
+} feat_job;
+
+static amscr_status feat_row(void *ctx, size_t i, void *scratch)
+{
+    (void)scratch;
+    feat_job *j = ctx;
+    amscr_index *x = j->x;
+    const amscr_descriptor *d = amscr_db_descriptor(x->db, i);
+    float *sig = x->sig + i * x->sig_dim;
+    if (!j->have_sig)
+        amscr__shape_signature(d, sig);
+    amscr__sig_bound_vector(sig, x->sig_lb + i * AMSCR__SIG_LB_DIM);
+    if (x->nf == 0)
+        return AMSCR_OK;
+    amscr__hf *hf = x->hf + i * (size_t)x->nf;
+    for (int f = 0; f < x->nf; f++)
+        amscr__hf_free(&hf[f]);
+    return amscr__base_hf(&j->b, d, hf);
+}
+
+amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig)
+{
+    feat_job j;
+    j.x = x;
+    j.have_sig = have_sig;
+    amscr__base_init(&j.b, amscr_db_params(x->db), x->med_a, x->med_h);
+    amscr__rows_fn f = {NULL, NULL, feat_row, &j};
+    return amscr__run_rows(&f, first, amscr_db_size(x->db), j.b.threads, NULL, NULL);
+}
