@@ -68,6 +68,10 @@ int folds_sweep_post(const folds_data *fd);
 int folds_sweep_raw(const folds_data *fd);
 int folds_scale(const folds_data *fd);
 int folds_fourier(const folds_data *fd);
+int folds_mcd(const char *datasets);
+double folds_channel_cpu(const coll_t *c, const raw_cfg *r);
+int folds_cost(const folds_data *fd);
+int folds_row(const folds_data *fd, const char *datasets, char **v);
 
 double folds_now(void);
 #endif

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "channel.h"
 
@@ -147,6 +148,22 @@ static double *one(const coll_t *c, const raw_cfg *r, int what, amscr_db **db)
     }
     cache_io(key, M, n, 1);
     return M;
+}
+
+/* CPU microseconds per pair of the similarity-frame channel matrix of c under r (not cached). */
+double folds_channel_cpu(const coll_t *c, const raw_cfg *r)
+{
+    amscr_db *db = make_db(c, r);
+    size_t n = c->s.n;
+    double *M = malloc(n * n * sizeof *M);
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t0);
+    int st = db && M ? channel_in_frame(db, AMSCR_INVARIANCE_SIMILARITY, M) : -1;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t1);
+    amscr_db_free(db);
+    free(M);
+    double cpu = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    return st == 0 ? 1e6 * cpu / (0.5 * (double)n * (double)(n - 1)) : -1.0;
 }
 
 int base_get(const coll_t *c, const raw_cfg *r, int amscr, int fourier, base_t *b)

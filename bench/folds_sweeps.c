@@ -123,3 +123,89 @@ int folds_fourier(const folds_data *fd)
     fast.share = 0.0;
     return run_sweep(fd, &sw, &RAW_DEFAULT, &POST_DEFAULT, "default") || run_sweep(fd, &sw, &RAW_DEFAULT, &fast, "--fast");
 }
+
+/* The MCD-style affine views (mcd_set.h, built from mpeg7-dev): bull's eye by band and affine
+ * share, re-ranking as the default. */
+int folds_mcd(const char *datasets)
+{
+    static const double bands[] = {0.08, 0.11, 0.15}, shares[] = {0.0, 0.1, 0.2, 0.3};
+    char path[1024];
+    coll_t c = {"mcd", {0}, 0};
+    snprintf(path, sizeof path, "%s/mpeg7-dev/manifest.tsv", datasets);
+    if (shape_set_mcd(path, MCD_SEED, &c.s) != 0)
+        return 1;
+    printf("| MCD-style views (%zu) | share 0 | share 0.1 | share 0.2 | share 0.3 |\n|---|---|---|---|---|\n", c.s.n);
+    for (int i = 0; i < 3; i++) {
+        raw_cfg r = RAW_DEFAULT;
+        r.band = bands[i];
+        base_t b;
+        if (base_get(&c, &r, 0, 0, &b) != 0)
+            return 1;
+        printf("| band %g |", bands[i]);
+        for (int j = 0; j < 4; j++) {
+            post_cfg p = POST_DEFAULT;
+            p.share = shares[j];
+            printf(" %.2f |", eval_sub(&b, &c, NULL, 0, &p));
+        }
+        printf("\n");
+        fflush(stdout);
+        base_free(&b);
+    }
+    shape_set_free(&c.s);
+    return 0;
+}
+
+/* One row for a combination: `row N BAND SKIP LOC SHARE K ITERS` -> the five splits and the
+ * MCD-style views (built from mpeg7-dev). */
+int folds_row(const folds_data *fd, const char *datasets, char **v)
+{
+    raw_cfg r = {(size_t)atoi(v[0]), atof(v[1]), atof(v[2]), atof(v[3]), 1};
+    post_cfg p = POST_DEFAULT;
+    p.share = atof(v[4]);
+    p.k = (size_t)atoi(v[5]);
+    p.iters = (unsigned)atoi(v[6]);
+    row_scores rs;
+    if (score_row(fd, &r, &p, &rs) != 0)
+        return 1;
+    char path[1024];
+    coll_t c = {"mcd", {0}, 0};
+    snprintf(path, sizeof path, "%s/mpeg7-dev/manifest.tsv", datasets);
+    base_t b;
+    if (shape_set_mcd(path, MCD_SEED, &c.s) != 0 || base_get(&c, &r, 0, 0, &b) != 0)
+        return 1;
+    printf("| N %zu band %g skip %g loc %g share %g k %zu iters %u | %.2f | %.2f | %.2f | %.0f | %.0f | %.2f |\n", r.N,
+           r.band, r.skip, r.loc, p.share, p.k, p.iters, rs.a, rs.b, rs.dev, rs.k99, rs.k216,
+           eval_sub(&b, &c, NULL, 0, &p));
+    base_free(&b);
+    shape_set_free(&c.s);
+    return 0;
+}
+
+/* CPU cost of the channel (similarity frame) on Kimia-216 per (N, band), in microseconds of
+ * process CPU time per pair (robust to the load of a shared machine, unlike wall time); the
+ * configurations are interleaved `rounds` times and the minimum is kept. */
+int folds_cost(const folds_data *fd)
+{
+    static const size_t Ns[] = {128, 128, 128, 96, 96, 112};
+    static const double bands[] = {0.08, 0.11, 0.15, 0.11, 0.15, 0.13};
+    enum { NCFG = sizeof Ns / sizeof Ns[0], ROUNDS = 3 };
+    double best[NCFG];
+    for (int c = 0; c < NCFG; c++)
+        best[c] = 1e300;
+    for (int round = 0; round < ROUNDS; round++)
+        for (int c = 0; c < NCFG; c++) {
+            raw_cfg r = RAW_DEFAULT;
+            r.N = Ns[c];
+            r.band = bands[c];
+            double us = folds_channel_cpu(&fd->k216, &r);
+            if (us < 0)
+                return 1;
+            if (us < best[c])
+                best[c] = us;
+        }
+    printf("| N | band | channel CPU us / pair (one frame, Kimia-216, min of %d) | relative |\n|---|---|---|---|\n",
+           ROUNDS);
+    for (int c = 0; c < NCFG; c++)
+        printf("| %zu | %g | %.2f | %.2f |\n", Ns[c], bands[c], best[c], best[c] / best[0]);
+    return 0;
+}

@@ -14,7 +14,11 @@
  *   amscr-retrieval-folds DATASETS post    share, re-ranking k / iterations, AMSCR fusion weight
  *   amscr-retrieval-folds DATASETS raw     N samples, band, skip, locality, reflections
  *   amscr-retrieval-folds DATASETS scale   re-ranking k at 350 / 700 / 916 / 1400 shapes
- *   amscr-retrieval-folds DATASETS fd      the global proportion channel (Fourier magnitudes) */
+ *   amscr-retrieval-folds DATASETS fd      the global proportion channel (Fourier magnitudes)
+ *   amscr-retrieval-folds DATASETS mcd     the MCD-style affine views by band and affine share
+ *   amscr-retrieval-folds DATASETS row N BAND SKIP LOC SHARE K ITERS   one combination, all splits
+ *                                          and the MCD-style views
+ *   amscr-retrieval-folds DATASETS cost    the channel's CPU time per pair by N and band */
 #include "folds.h"
 
 #include <math.h>
@@ -25,9 +29,11 @@
 int main(int argc, char **argv)
 {
     if (argc < 3) {
-        fprintf(stderr, "usage: %s DATASETS post|raw|scale|fd\n", argv[0]);
+        fprintf(stderr, "usage: %s DATASETS post|raw|scale|fd|mcd\n", argv[0]);
         return 2;
     }
+    if (strcmp(argv[2], "mcd") == 0)
+        return folds_mcd(argv[1]);
     folds_data fd;
     if (folds_load(argv[1], &fd) != 0)
         return 1;
@@ -39,6 +45,10 @@ int main(int argc, char **argv)
         r = folds_sweep_raw(&fd);
     else if (strcmp(what, "scale") == 0)
         r = folds_scale(&fd);
+    else if (strcmp(what, "row") == 0 && argc == 10)
+        r = folds_row(&fd, argv[1], argv + 3);
+    else if (strcmp(what, "cost") == 0)
+        r = folds_cost(&fd);
     else if (strcmp(what, "fd") == 0)
         r = folds_fourier(&fd);
     else
