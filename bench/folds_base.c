@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include "channel.h"
@@ -20,6 +21,8 @@ static int cache_io(const char *key, double *M, size_t n, int write)
     unsigned long long h = 1469598103934665603ull;
     for (const char *q = key; *q; q++)
         h = (h ^ (unsigned char)*q) * 1099511628211ull;
+    if (write)
+        (void)mkdir("/tmp/amscr-folds-cache", 0777); /* may exist */
     snprintf(path, sizeof path, "/tmp/amscr-folds-cache/%016llx.bin", h);
     FILE *f = fopen(path, write ? "wb" : "rb");
     if (!f)
