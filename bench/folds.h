@@ -13,6 +13,7 @@ typedef struct {
     double skip;    /* channel skip cost */
     double loc;     /* channel locality */
     int refl;       /* mirror images */
+    size_t stride;  /* the channel's DP on every stride-th sample (1 as the library) */
 } raw_cfg;
 
 /* Settings applied on a collection's base matrices. */

@@ -54,7 +54,7 @@ static amscr_db *make_db(const coll_t *c, const raw_cfg *r)
     return db;
 }
 
-static int channel_in_frame(const amscr_db *db, amscr_invariance frame, double *out)
+static int channel_in_frame(const amscr_db *db, amscr_invariance frame, size_t stride, double *out)
 {
     const amscr_params *p = amscr_db_params(db);
     size_t n = amscr_db_size(db);
@@ -65,6 +65,7 @@ static int channel_in_frame(const amscr_db *db, amscr_invariance frame, double *
     if (st == AMSCR_OK) {
         amscr__hf_cfg cfg;
         amscr__hf_cfg_from(p, hf[0].n, &cfg);
+        cfg.stride = stride;
         st = amscr__hf_matrix(hf, n, &cfg, 2, NULL, NULL, out);
     }
     for (size_t i = 0; hf && i < n; i++)
@@ -123,8 +124,11 @@ static double *one(const coll_t *c, const raw_cfg *r, int what, amscr_db **db)
     static const char *names[] = {"channel similarity", "channel affine", "AMSCR", "Fourier"};
     size_t n = c->s.n;
     char key[300];
-    snprintf(key, sizeof key, "%s n%zu N%zu b%g s%g l%g r%d m%d", c->name, n, r->N, r->band, r->skip, r->loc, r->refl,
-             what);
+    char tag[32] = "";
+    if (r->stride > 1)
+        snprintf(tag, sizeof tag, " t%zu", r->stride);
+    snprintf(key, sizeof key, "%s n%zu N%zu b%g s%g l%g r%d m%d%s", c->name, n, r->N, r->band, r->skip, r->loc, r->refl,
+             what, tag);
     double *M = malloc(n * n * sizeof *M);
     if (!M || cache_io(key, M, n, 0) == 0)
         return M;
@@ -137,7 +141,7 @@ static double *one(const coll_t *c, const raw_cfg *r, int what, amscr_db **db)
     t0 = folds_now();
     int st = 0;
     if (what < 2)
-        st = channel_in_frame(*db, what ? AMSCR_INVARIANCE_AFFINE : AMSCR_INVARIANCE_SIMILARITY, M);
+        st = channel_in_frame(*db, what ? AMSCR_INVARIANCE_AFFINE : AMSCR_INVARIANCE_SIMILARITY, r->stride, M);
     else if (what == 2)
         st = amscr_db_distance_matrix(*db, NULL, NULL, M) == AMSCR_OK ? 0 : -1;
     else
@@ -161,7 +165,7 @@ double folds_channel_cpu(const coll_t *c, const raw_cfg *r)
     double *M = malloc(n * n * sizeof *M);
     struct timespec t0, t1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t0);
-    int st = db && M ? channel_in_frame(db, AMSCR_INVARIANCE_SIMILARITY, M) : -1;
+    int st = db && M ? channel_in_frame(db, AMSCR_INVARIANCE_SIMILARITY, r->stride, M) : -1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t1);
     amscr_db_free(db);
     free(M);

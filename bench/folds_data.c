@@ -12,7 +12,7 @@
 #include "channel.h"
 #include "../tools/cli/collection.h"
 
-const raw_cfg RAW_DEFAULT = {128, 0.08, 1.0, 4.0, 1};
+const raw_cfg RAW_DEFAULT = {128, 0.08, 1.0, 4.0, 1, 1};
 const post_cfg POST_DEFAULT = {0.2, 1.0, 8, 10, 0.0, 0, 0.0};
 
 double folds_now(void)

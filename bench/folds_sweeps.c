@@ -155,11 +155,11 @@ int folds_mcd(const char *datasets)
     return 0;
 }
 
-/* One row for a combination: `row N BAND SKIP LOC SHARE K ITERS` -> the five splits and the
+/* One row for a combination: `row N BAND SKIP LOC SHARE K ITERS [STRIDE]` -> the five splits and the
  * MCD-style views (built from mpeg7-dev). */
 int folds_row(const folds_data *fd, const char *datasets, char **v)
 {
-    raw_cfg r = {(size_t)atoi(v[0]), atof(v[1]), atof(v[2]), atof(v[3]), 1};
+    raw_cfg r = {(size_t)atoi(v[0]), atof(v[1]), atof(v[2]), atof(v[3]), 1, v[7] ? (size_t)atoi(v[7]) : 1};
     post_cfg p = POST_DEFAULT;
     p.share = atof(v[4]);
     p.k = (size_t)atoi(v[5]);
@@ -173,21 +173,22 @@ int folds_row(const folds_data *fd, const char *datasets, char **v)
     base_t b;
     if (shape_set_mcd(path, MCD_SEED, &c.s) != 0 || base_get(&c, &r, 0, 0, &b) != 0)
         return 1;
-    printf("| N %zu band %g skip %g loc %g share %g k %zu iters %u | %.2f | %.2f | %.2f | %.0f | %.0f | %.2f |\n", r.N,
-           r.band, r.skip, r.loc, p.share, p.k, p.iters, rs.a, rs.b, rs.dev, rs.k99, rs.k216,
+    printf("| N %zu band %g skip %g loc %g share %g k %zu iters %u%s | %.2f | %.2f | %.2f | %.0f | %.0f | %.2f |\n", r.N,
+           r.band, r.skip, r.loc, p.share, p.k, p.iters, r.stride > 1 ? " stride 2" : "", rs.a, rs.b, rs.dev, rs.k99, rs.k216,
            eval_sub(&b, &c, NULL, 0, &p));
     base_free(&b);
     shape_set_free(&c.s);
     return 0;
 }
 
-/* CPU cost of the channel (similarity frame) on Kimia-216 per (N, band), in microseconds of
+/* CPU cost of the channel (similarity frame) on Kimia-216 per (N, band, stride), in microseconds of
  * process CPU time per pair (robust to the load of a shared machine, unlike wall time); the
  * configurations are interleaved `rounds` times and the minimum is kept. */
 int folds_cost(const folds_data *fd)
 {
-    static const size_t Ns[] = {128, 128, 128, 96, 96, 112};
-    static const double bands[] = {0.08, 0.11, 0.15, 0.11, 0.15, 0.13};
+    static const size_t Ns[] = {128, 128, 128, 96, 96, 112, 128, 128};
+    static const double bands[] = {0.08, 0.11, 0.15, 0.11, 0.15, 0.13, 0.15, 0.08};
+    static const size_t strides[] = {1, 1, 1, 1, 1, 1, 2, 2};
     enum { NCFG = sizeof Ns / sizeof Ns[0], ROUNDS = 3 };
     double best[NCFG];
     for (int c = 0; c < NCFG; c++)
@@ -197,15 +198,16 @@ int folds_cost(const folds_data *fd)
             raw_cfg r = RAW_DEFAULT;
             r.N = Ns[c];
             r.band = bands[c];
+            r.stride = strides[c];
             double us = folds_channel_cpu(&fd->k216, &r);
             if (us < 0)
                 return 1;
             if (us < best[c])
                 best[c] = us;
         }
-    printf("| N | band | channel CPU us / pair (one frame, Kimia-216, min of %d) | relative |\n|---|---|---|---|\n",
-           ROUNDS);
+    printf("| N | band | stride | channel CPU us / pair (one frame, Kimia-216, min of %d) | relative |\n"
+           "|---|---|---|---|---|\n", ROUNDS);
     for (int c = 0; c < NCFG; c++)
-        printf("| %zu | %g | %.2f | %.2f |\n", Ns[c], bands[c], best[c], best[c] / best[0]);
+        printf("| %zu | %g | %zu | %.2f | %.2f |\n", Ns[c], bands[c], strides[c], best[c], best[c] / best[0]);
     return 0;
 }

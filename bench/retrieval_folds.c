@@ -16,7 +16,7 @@
  *   amscr-retrieval-folds DATASETS scale   re-ranking k at 350 / 700 / 916 / 1400 shapes
  *   amscr-retrieval-folds DATASETS fd      the global proportion channel (Fourier magnitudes)
  *   amscr-retrieval-folds DATASETS mcd     the MCD-style affine views by band and affine share
- *   amscr-retrieval-folds DATASETS row N BAND SKIP LOC SHARE K ITERS   one combination, all splits
+ *   amscr-retrieval-folds DATASETS row N BAND SKIP LOC SHARE K ITERS [STRIDE]   one combination, all splits
  *                                          and the MCD-style views
  *   amscr-retrieval-folds DATASETS cost    the channel's CPU time per pair by N and band */
 #include "folds.h"
@@ -45,7 +45,7 @@ int main(int argc, char **argv)
         r = folds_sweep_raw(&fd);
     else if (strcmp(what, "scale") == 0)
         r = folds_scale(&fd);
-    else if (strcmp(what, "row") == 0 && argc == 10)
+    else if (strcmp(what, "row") == 0 && (argc == 10 || argc == 11))
         r = folds_row(&fd, argv[1], argv + 3);
     else if (strcmp(what, "cost") == 0)
         r = folds_cost(&fd);
