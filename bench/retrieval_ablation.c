@@ -6,7 +6,9 @@
  * composes them (channel frames mixed 0.8 / 0.2, fusion = each matrix over its median
  * off-diagonal value, re-ranking k 8, 10 iterations). A row's time is the wall time of the base
  * matrices it needs plus its fusion and re-ranking (decode, trace and preparation are listed
- * once per set). */
+ * once per set). With mpeg7-dev/folds.tsv, two more columns: each class fold of mpeg7-dev as its
+ * own collection (sub-matrices of mpeg7-dev's base matrices; the generalization audit in
+ * docs/results-retrieval.md). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,6 +18,7 @@
 
 #include "internal.h"
 #include "mcd_set.h"
+#include "../tools/cli/collection.h"
 
 enum { M_AMSCR, M_SIM, M_AFF, NBASE };
 
@@ -152,10 +155,9 @@ static void compose(const set_run *r, const row_t *w, double *out)
         die("re-ranking");
 }
 
-static void run_set(set_run *r)
+static void score_rows(set_run *r)
 {
     size_t n = r->s.n;
-    compute_bases(r);
     double *D = malloc(n * n * sizeof *D);
     if (!D)
         die("memory");
@@ -179,15 +181,77 @@ static void run_set(set_run *r)
         }
     }
     free(D);
+}
+
+static void free_bases(set_run *r)
+{
     for (int b = 0; b < NBASE; b++)
         free(r->base[b]);
+}
+
+/* Fold (0 A, 1 B) of every class of the manifest from folds.tsv beside it; -1 without it. */
+static int read_folds(const char *manifest, int32_t *fold_of_class, size_t cap)
+{
+    char path[4096], line[256];
+    collection col;
+    snprintf(path, sizeof path, "%.*s/folds.tsv", (int)(strrchr(manifest, '/') - manifest), manifest);
+    FILE *f = fopen(path, "r");
+    if (!f || collection_open(manifest, &col) != 0) {
+        if (f)
+            fclose(f);
+        return -1;
+    }
+    for (size_t k = 0; k < cap; k++)
+        fold_of_class[k] = 0;
+    while (fgets(line, sizeof line, f)) {
+        char *tab = strchr(line, '\t');
+        if (!tab)
+            continue;
+        *tab = '\0';
+        for (size_t k = 0; k < col.nclasses && k < cap; k++)
+            if (strcmp(col.classes[k], line) == 0)
+                fold_of_class[k] = tab[1] == 'B';
+    }
+    fclose(f);
+    collection_free(&col);
+    return 0;
+}
+
+/* The fold `which` of the set `all` as its own collection: sub-matrices of the base matrices
+ * (a pair's distance does not depend on the rest; the medians and the re-ranking graph are the
+ * fold's own); its times are the fusion and re-ranking only. */
+static void fold_set(const set_run *all, const int32_t *fold_of_class, int which, set_run *f)
+{
+    size_t n = all->s.n, m = 0;
+    size_t *idx = malloc(n * sizeof *idx);
+    if (!idx)
+        die("memory");
+    for (size_t i = 0; i < n; i++)
+        if (fold_of_class[all->s.labels[i]] == which)
+            idx[m++] = i;
+    f->s.c = NULL;
+    f->s.n = m;
+    f->s.labels = malloc(m * sizeof *f->s.labels);
+    for (int b = 0; b < NBASE; b++) {
+        f->base[b] = malloc(m * m * sizeof(double));
+        if (!f->base[b] || !f->s.labels)
+            die("memory");
+        for (size_t i = 0; i < m; i++)
+            for (size_t j = 0; j < m; j++)
+                f->base[b][i * m + j] = all->base[b][idx[i] * n + idx[j]];
+    }
+    for (size_t i = 0; i < m; i++)
+        f->s.labels[i] = all->s.labels[idx[i]];
+    free(idx);
 }
 
 int ablation_main(const char *dir);
 
 int ablation_main(const char *dir)
 {
-    static set_run sets[4];
+    static set_run sets[4], folds[2];
+    static int32_t fold_of_class[4096];
+    int nfolds = 0;
     const char *titles[4] = {"mpeg7-dev (bull's eye %)", "MCD-style (bull's eye %)", "Kimia-99 (top-10 sum /990)",
                              "Kimia-216 (top-11 sum /2376)"};
     const char *dirs[4] = {"mpeg7-dev", "mpeg7-dev", "kimia99", "kimia216"};
@@ -204,7 +268,18 @@ int ablation_main(const char *dir)
         if ((k == 1 ? shape_set_mcd(path, MCD_SEED, &sets[k].s) : shape_set_load(path, &sets[k].s)) != 0)
             return 1;
         sets[k].t_load = now() - t0;
-        run_set(&sets[k]);
+        compute_bases(&sets[k]);
+        score_rows(&sets[k]);
+        if (k == 0 && read_folds(path, fold_of_class, sizeof fold_of_class / sizeof fold_of_class[0]) == 0) {
+            for (int w = 0; w < 2; w++) {
+                fold_set(&sets[0], fold_of_class, w, &folds[w]);
+                folds[w].title = w ? "fold B (bull's eye %)" : "fold A (bull's eye %)";
+                score_rows(&folds[w]);
+                free_bases(&folds[w]);
+            }
+            nfolds = 2;
+        }
+        free_bases(&sets[k]);
         fprintf(stderr, "ablation: %s done\n", dirs[k]);
     }
     double la[3] = {-1, -1, -1};
@@ -220,21 +295,31 @@ int ablation_main(const char *dir)
     printf("| setting |");
     for (int k = 0; k < 4; k++)
         printf(" %s | s |", sets[k].title);
+    for (int w = 0; w < nfolds; w++)
+        printf(" %s |", folds[w].title);
     printf("\n|---|");
     for (int k = 0; k < 4; k++)
         printf("---|---|");
+    for (int w = 0; w < nfolds; w++)
+        printf("---|");
     printf("\n");
     for (int r = 0; r < NROWS; r++) {
         printf("| %s |", ROWS[r].name);
         for (int k = 0; k < 4; k++)
             printf(sets[k].kind ? " %.0f | %.1f |" : " %.2f | %.1f |", sets[k].score[r], sets[k].secs[r]);
+        for (int w = 0; w < nfolds; w++)
+            printf(" %.2f |", folds[w].score[r]);
         printf("\n");
     }
     printf("| (decode + trace, prepare: s) |");
     for (int k = 0; k < 4; k++)
         printf(" %.1f + %.1f | |", sets[k].t_load, sets[k].t_prep);
+    for (int w = 0; w < nfolds; w++)
+        printf(" |");
     printf("\n");
     for (int k = 0; k < 4; k++)
         shape_set_free(&sets[k].s);
+    for (int w = 0; w < nfolds; w++)
+        shape_set_free(&folds[w].s);
     return 0;
 }

@@ -1,0 +1,177 @@
+/* folds_eval.c — a sub-collection's retrieval matrix composed from the base matrices exactly as
+ * amscr_db_retrieval_matrix composes them (channel frames mixed by the affine share; fusion with
+ * AMSCR = each matrix over its median off-diagonal value; re-ranking), plus the optional Fourier
+ * proportion channel, and its score. */
+#include "folds.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double offdiag_median(const double *M, size_t m)
+{
+    double *v = malloc((m * m - m) * sizeof *v);
+    size_t t = 0;
+    for (size_t i = 0; i < m; i++)
+        for (size_t j = 0; j < m; j++)
+            if (i != j)
+                v[t++] = M[i * m + j];
+    qsort(v, t, sizeof *v, cmp_d);
+    double med = v[t / 2];
+    free(v);
+    return med;
+}
+
+/* out = the m x m sub-matrix idx of the n x n matrix M, symmetrized. */
+static void sub(const double *M, size_t n, const size_t *idx, size_t m, double *out)
+{
+    for (size_t i = 0; i < m; i++)
+        for (size_t j = 0; j < m; j++) {
+            size_t a = idx[i], b = idx[j];
+            out[i * m + j] = i == j ? 0.0 : 0.5 * (M[a * n + b] + M[b * n + a]);
+        }
+}
+
+/* F += w * X / median(X) after F /= median(F) (F and X m x m). */
+static void add_normalized(double *F, const double *X, size_t m, double wf, double wx)
+{
+    double mf = offdiag_median(F, m), mx = offdiag_median(X, m);
+    for (size_t i = 0; i < m * m; i++)
+        F[i] = wf * F[i] / mf + wx * X[i] / mx;
+}
+
+static double score_of(const double *F, size_t m, const int32_t *labels, int kind)
+{
+    if (kind == 1) {
+        size_t counts[16] = {0}, kmax = m > 100 ? 11 : 10, sum = 0;
+        if (amscr_score_topk_table(F, m, labels, kmax, counts) != AMSCR_OK)
+            return -1;
+        for (size_t r = 0; r < kmax; r++)
+            sum += counts[r];
+        return (double)sum;
+    }
+    double sc = 0;
+    if (amscr_score_bullseye(F, m, labels, 0, &sc) != AMSCR_OK)
+        return -1;
+    return 100.0 * sc;
+}
+
+static int cmp_sz(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* k from the mutual-kNN graph: each shape's count of mutual neighbours among its K nearest
+ * (itself excluded; shape j is mutual when i is also among j's K nearest); k = the median
+ * count + 1 (itself, the re-ranking's first neighbour). */
+static size_t mutual_k(const double *F, size_t m, size_t K)
+{
+    if (K + 1 > m)
+        K = m - 1;
+    size_t *nb = malloc(m * K * sizeof *nb), *cnt = malloc(m * sizeof *cnt);
+    for (size_t i = 0; i < m; i++) {
+        if (amscr_topk(F + i * m, m, K, i, nb + i * K) != AMSCR_OK)
+            memset(nb + i * K, 0, K * sizeof *nb);
+    }
+    for (size_t i = 0; i < m; i++) {
+        cnt[i] = 0;
+        for (size_t t = 0; t < K; t++) {
+            size_t j = nb[i * K + t];
+            for (size_t u = 0; u < K; u++)
+                if (nb[j * K + u] == i) {
+                    cnt[i]++;
+                    break;
+                }
+        }
+    }
+    qsort(cnt, m, sizeof *cnt, cmp_sz);
+    size_t k = cnt[m / 2] + 1;
+    free(nb);
+    free(cnt);
+    return k;
+}
+
+size_t last_k;
+
+double eval_sub(const base_t *b, const coll_t *c, const size_t *idx, size_t m, const post_cfg *pc)
+{
+    size_t n = b->n, *all = NULL;
+    if (!idx) {
+        all = malloc(n * sizeof *all);
+        for (size_t i = 0; i < n; i++)
+            all[i] = i;
+        idx = all;
+        m = n;
+    }
+    double *F = malloc(m * m * sizeof *F), *X = malloc(m * m * sizeof *X);
+    int32_t *lab = malloc(m * sizeof *lab);
+    for (size_t i = 0; i < m; i++)
+        lab[i] = c->s.labels[idx[i]];
+    sub(b->hs, n, idx, m, F);
+    sub(b->ha, n, idx, m, X);
+    for (size_t i = 0; i < m * m; i++)
+        F[i] = (1.0 - pc->share) * F[i] + pc->share * X[i];
+    if (pc->weight < 1.0) {
+        sub(b->am, n, idx, m, X);
+        add_normalized(F, X, m, pc->weight, 1.0 - pc->weight);
+    }
+    if (pc->wfd > 0.0) {
+        sub(b->fd, n, idx, m, X);
+        add_normalized(F, X, m, 1.0, pc->wfd);
+    }
+    size_t k = pc->kmode == 1 ? (size_t)floor(pc->kfrac * sqrt((double)m) + 0.5)
+               : pc->kmode == 2 ? mutual_k(F, m, (size_t)pc->kfrac) : pc->k;
+    last_k = k;
+    if (k > m)
+        k = m;
+    double s = -1;
+    if (k == 0 || amscr__rerank_normalized(F, m, k, pc->iters, F) == AMSCR_OK)
+        s = score_of(F, m, lab, c->kind);
+    free(F);
+    free(X);
+    free(lab);
+    free(all);
+    return s;
+}
+
+int score_row(const folds_data *fd, const raw_cfg *r, const post_cfg *pc, row_scores *out)
+{
+    size_t n = fd->dev.s.n, na = 0, nb = 0;
+    size_t *ia = malloc(n * sizeof *ia), *ib = malloc(n * sizeof *ib);
+    for (size_t i = 0; i < n; i++) {
+        if (fd->fold[i])
+            ib[nb++] = i;
+        else
+            ia[na++] = i;
+    }
+    base_t b;
+    int am = pc->weight < 1.0, fo = pc->wfd > 0.0, st = -1;
+    if (base_get(&fd->dev, r, am, fo, &b) == 0) {
+        out->a = eval_sub(&b, &fd->dev, ia, na, pc);
+        out->b = eval_sub(&b, &fd->dev, ib, nb, pc);
+        out->dev = eval_sub(&b, &fd->dev, NULL, 0, pc);
+        base_free(&b);
+        if (base_get(&fd->k99, r, am, fo, &b) == 0) {
+            out->k99 = eval_sub(&b, &fd->k99, NULL, 0, pc);
+            base_free(&b);
+            if (base_get(&fd->k216, r, am, fo, &b) == 0) {
+                out->k216 = eval_sub(&b, &fd->k216, NULL, 0, pc);
+                st = 0;
+            }
+        }
+    }
+    base_free(&b);
+    free(ia);
+    free(ib);
+    return st;
+}
