@@ -472,11 +472,9 @@ static double kimia_case(const amscr_params *prm, condition cond, const double *
 
 START_TEST(kimia_pixel_contours)
 {
-    const char *root = amscr_test_datasets_dir();
-    if (!root) {
-        printf("accuracy: datasets not found (AMSCR_DATASETS); Kimia-99/216 protocol skipped\n");
+    const char *root = amscr_test_datasets_or_skip("accuracy");
+    if (!root)
         return;
-    }
     file_list files = {NULL, 0};
     read_manifest(root, "kimia99", &files);
     size_t n99 = files.n;
