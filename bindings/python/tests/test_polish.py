@@ -103,6 +103,11 @@ def heldout_data():
     return data
 
 
+# The frag50 maps with confidence >= 0.25, the ones whose area the test checks: 61 of 70
+# measured (the others are near-symmetric shapes); a few fewer are allowed.
+CONFIDENT_FRAG50 = 58
+
+
 def test_partial_polish_never_collapses():
     """A fragment paired only onto the target could always shrink onto a small piece of it; the
     polish refuses a result that changed the map's area by more than 2x (a 50 % fragment of
@@ -123,8 +128,8 @@ def test_partial_polish_never_collapses():
             if on.confidence >= 0.25:
                 assert 0.5 <= ratio <= 2.0, (cls, d, ratio, on.confidence)
                 assert (end - start) % 1.0 > 0.05, (cls, d, on.part)
-            checked += 1
-    assert checked == 70
+                checked += 1
+    assert checked >= CONFIDENT_FRAG50, checked
 
 
 def test_noisy_resampled_contours_register():
