@@ -97,7 +97,7 @@ def heldout_data():
     data = os.path.join(os.environ.get('AMSCR_DATASETS') or os.path.join(repo, '..', 'shared', 'datasets'),
                         'mpeg7-dev')
     if not os.path.exists(os.path.join(data, 'manifest.tsv')):
-        pytest.skip('mpeg7-dev not found (%s)' % data)
+        pytest.skip('mpeg7-dev: datasets not found (%s; set AMSCR_DATASETS)' % data)
     import sys
     sys.path.insert(0, os.path.join(repo, 'bench'))
     return data
