@@ -1,4 +1,4 @@
-/* check_accuracy.c — the accuracy protocol of issue 3 ("Tests that must exist and pass").
+/* check_accuracy.c — the registration accuracy protocol (docs/measurements.md, "Accuracy suite").
  *
  * Every case: a source contour f, a random affine map T (any rotation, anisotropic scale up to
  * 2, shear up to 0.5, random translation; det < 0 in the mirror cases), and a target that is
@@ -8,7 +8,7 @@
  *
  *     err = max_i |M(f_i) - T(f_i)| / size(T(f))       (size: amscr_test_shape_size)
  *
- * over the source's own input points. Targets (issue 3), asserted as stated:
+ * over the source's own input points. Targets, asserted as stated:
  *   synthetic clean, det > 0 and det < 0:  err < 0.5 % in every case, median <= 0.1 %
  *                                         (asserted tighter, within 10x of the measured:
  *                                         worst < 0.25 %, median <= 0.03 %)
@@ -16,7 +16,7 @@
  *   synthetic 5 % occlusion:              err < 2 % in >= 90 % of the cases
  *   Kimia-99 + Kimia-216 pixel contours:  err < 2 % in >= 99 % (clean), >= 97 % (noise),
  *                                         >= 95 % (occlusion)
- *   and issue 14's heavier conditions on the same contours (one map each): 2 % noise,
+ *   and the heavier conditions of the robust registration on the same contours (one map each): 2 % noise,
  *   10 % and 20 % of the boundary missing, at the measured levels (KIMIA_T_*)
  * The measured rates, the worst cases (seed / file) and the mean time per registration are
  * printed so they show in the test log; time is never asserted.
@@ -38,12 +38,12 @@
 
 
 #define SYN_CASES 240 /* >= 200 seeded shapes per condition */
-#define KIMIA_REPEATS 2 /* random affine maps per image and condition (issue 3's conditions) */
+#define KIMIA_REPEATS 2 /* random affine maps per image and condition (the protocol's three conditions) */
 #define KIMIA_CONDS 6
-/* issue 14's heavier conditions (one map per image), asserted a little below the levels
+/* the heavier conditions (one map per image), asserted a little below the levels
  * measured on this suite (0.3.2 with the polish, the order and the even spacing of noisy points:
  * 2 % noise 98.73 % (0.3.1: 95.87 %, 0.3: 93.65 %, 84.1 % before the polish), 10 % missing
- * 100 %, 20 % missing 98.7 %; issue 14's goals are 99 / 95 / 85 %) */
+ * 100 %, 20 % missing 98.7 %; the goals of the robust registration are 99 / 95 / 85 %) */
 #define KIMIA_T_NOISE2 0.97
 #define KIMIA_T_MISSING10 0.97
 #define KIMIA_T_MISSING20 0.92
@@ -78,9 +78,9 @@ typedef enum {
     COND_MIRROR = 1,
     COND_NOISE = 2,
     COND_OCCLUSION = 3,
-    COND_NOISE2 = 4,   /* issue 14: 2 % noise */
-    COND_MISSING10 = 5, /* issue 14: 10 % of the boundary missing */
-    COND_MISSING20 = 6  /* issue 14: 20 % of the boundary missing */
+    COND_NOISE2 = 4,   /* 2 % noise */
+    COND_MISSING10 = 5, /* 10 % of the boundary missing */
+    COND_MISSING20 = 6  /* 20 % of the boundary missing */
 } condition;
 static const char *const cond_name[] = {"clean",    "mirror (det<0)", "1% noise",   "5% occlusion",
                                         "2% noise", "10% missing",    "20% missing"};
@@ -509,7 +509,7 @@ START_TEST(kimia_pixel_contours)
 
     amscr_params *prm = NULL;
     ck_assert_int_eq(amscr_params_new_registration(&prm), AMSCR_OK);
-    /* issue 3's three conditions on every image twice; issue 14's heavier ones once each */
+    /* the protocol's three conditions on every image twice; the heavier ones once each */
     const condition conds[KIMIA_CONDS] = {COND_CLEAN, COND_NOISE, COND_OCCLUSION, COND_NOISE2, COND_MISSING10,
                                           COND_MISSING20};
     /* 1 % noise: 99.84 % measured with the polish (99.05 % before) */

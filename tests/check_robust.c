@@ -1,4 +1,4 @@
-/* check_robust.c — issue 14: partial matching, confidence (symmetric shapes ambiguous), inlier
+/* check_robust.c — robust registration (docs/method.md §11): partial matching, confidence (symmetric shapes ambiguous), inlier
  * fraction under missing parts, dense correspondences, on generated shapes (seeded) and Kimia
  * pixel contours (skipped cleanly when the datasets are absent). */
 #include <amscr.h>

@@ -1,4 +1,4 @@
-"""register() polishes the map on the input points by default (issue 14); polish=False skips
+"""register() polishes the map on the input points by default (docs/method.md §11.4); polish=False skips
 it. On noisy targets the polished map is closer to the truth; the tool's --no-polish agrees
 with polish=False."""
 import json
