@@ -39,7 +39,7 @@
 
 #define SYN_CASES 240 /* >= 200 seeded shapes per condition */
 #define KIMIA_REPEATS 2 /* random affine maps per image and condition (the protocol's three conditions) */
-#define KIMIA_CONDS 6
+#define KIMIA_CONDS 7
 /* the heavier conditions (one map per image), asserted a little below the levels
  * measured on this suite (0.3.2 with the polish, the order and the even spacing of noisy points:
  * 2 % noise 98.73 % (0.3.1: 95.87 %, 0.3: 93.65 %, 84.1 % before the polish), 10 % missing
@@ -47,6 +47,11 @@
 #define KIMIA_T_NOISE2 0.97
 #define KIMIA_T_MISSING10 0.97
 #define KIMIA_T_MISSING20 0.92
+/* The 2 % noise threshold above followed the measurements on its own draws (seeds 400000 +
+ * 10 i). A seventh row draws the same condition afresh (seeds 700000 + 10 i, never used to
+ * choose anything), so a change tuned to the first draws shows here. It is asserted at the
+ * first row's level, fixed before this row was measured and never to be moved to follow it. */
+#define KIMIA_T_NOISE2_FRESH KIMIA_T_NOISE2
 
 /* ------------------------------------------------------------------ helpers */
 
@@ -511,10 +516,11 @@ START_TEST(kimia_pixel_contours)
     ck_assert_int_eq(amscr_params_new_registration(&prm), AMSCR_OK);
     /* the protocol's three conditions on every image twice; the heavier ones once each */
     const condition conds[KIMIA_CONDS] = {COND_CLEAN, COND_NOISE, COND_OCCLUSION, COND_NOISE2, COND_MISSING10,
-                                          COND_MISSING20};
+                                          COND_MISSING20, COND_NOISE2};
     /* 1 % noise: 99.84 % measured with the polish (99.05 % before) */
-    const double targets[KIMIA_CONDS] = {0.99, 0.98, 0.95, KIMIA_T_NOISE2, KIMIA_T_MISSING10, KIMIA_T_MISSING20};
-    const unsigned repeats[KIMIA_CONDS] = {KIMIA_REPEATS, KIMIA_REPEATS, KIMIA_REPEATS, 1, 1, 1};
+    const double targets[KIMIA_CONDS] = {0.99, 0.98, 0.95, KIMIA_T_NOISE2, KIMIA_T_MISSING10, KIMIA_T_MISSING20,
+                                         KIMIA_T_NOISE2_FRESH};
+    const unsigned repeats[KIMIA_CONDS] = {KIMIA_REPEATS, KIMIA_REPEATS, KIMIA_REPEATS, 1, 1, 1, 1};
     kimia_stats ks[KIMIA_CONDS];
     for (int ci = 0; ci < KIMIA_CONDS; ci++) {
         condition cond = conds[ci];
@@ -543,8 +549,8 @@ START_TEST(kimia_pixel_contours)
         }
         amscr_workspace_free(s->tm.ws);
         s->tm.ws = NULL;
-        printf("accuracy: kimia99+216 %-12s %zu pairs: %.2f %% within 2 %% (target >= %.0f %%), worst %.3g %%; ",
-               cond_name[cond], s->cases, 100.0 * (double)s->within / (double)s->cases, 100.0 * targets[ci],
+        printf("accuracy: kimia99+216 %-12s%s %zu pairs: %.2f %% within 2 %% (target >= %.0f %%), worst %.3g %%; ",
+               cond_name[cond], ci == KIMIA_CONDS - 1 ? " (fresh draws)" : "", s->cases, 100.0 * (double)s->within / (double)s->cases, 100.0 * targets[ci],
                100.0 * s->worst);
         print_timing(&s->tm);
         fflush(stdout);
@@ -564,9 +570,10 @@ START_TEST(kimia_pixel_contours)
     ck_assert_msg(ok,
                   "kimia pairs within 2 %%: clean %.2f %% (target 99), 1 %% noise %.2f %% (target 98), "
                   "5 %% occlusion %.2f %% (target 95), 2 %% noise %.2f %% (target %.0f), 10 %% missing %.2f %% "
-                  "(target %.0f), 20 %% missing %.2f %% (target %.0f)",
+                  "(target %.0f), 20 %% missing %.2f %% (target %.0f), 2 %% noise fresh draws %.2f %% (target %.0f)",
                   100.0 * rate[0], 100.0 * rate[1], 100.0 * rate[2], 100.0 * rate[3], 100.0 * KIMIA_T_NOISE2,
-                  100.0 * rate[4], 100.0 * KIMIA_T_MISSING10, 100.0 * rate[5], 100.0 * KIMIA_T_MISSING20);
+                  100.0 * rate[4], 100.0 * KIMIA_T_MISSING10, 100.0 * rate[5], 100.0 * KIMIA_T_MISSING20,
+                  100.0 * rate[6], 100.0 * KIMIA_T_NOISE2_FRESH);
 }
 END_TEST
 
