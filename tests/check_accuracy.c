@@ -10,8 +10,8 @@
  *
  * over the source's own input points. Targets, asserted as stated:
  *   synthetic clean, det > 0 and det < 0:  err < 0.5 % in every case, median <= 0.1 %
- *                                         (asserted tighter, within 10x of the measured:
- *                                         worst < 0.25 %, median <= 0.03 %)
+ *                                         (asserted tighter, within 4x of the measured:
+ *                                         worst < 0.1 %, median <= 0.01 %)
  *   synthetic 1 % noise:                  err < 2 % in >= 95 % of the cases
  *   synthetic 5 % occlusion:              err < 2 % in >= 90 % of the cases
  *   Kimia-99 + Kimia-216 pixel contours:  err < 2 % in >= 99 % (clean), >= 97 % (noise),
@@ -349,10 +349,12 @@ static void assert_exact_protocol(condition cond)
     /* every case within 0.5 % of the shape size, the median within 0.1 % */
     ck_assert_msg(s.within_half == s.cases, "%s: %zu of %zu cases within 0.5 %% (worst %.4f %%, seed %llu)",
                   cond_name[cond], s.within_half, s.cases, 100.0 * s.worst, (unsigned long long)s.worst_seed);
-    /* tighter than the protocol's 0.1 %: measured median 0.00304 % (clean) and 0.00357 %
-     * (det < 0), worst 0.0259 % and 0.0268 % (CK_RUN_CASE=synthetic build/tests/check_accuracy) */
-    ck_assert_msg(med <= 0.0003, "%s: median error %.5f %% > 0.03 %%", cond_name[cond], 100.0 * med);
-    ck_assert_msg(s.worst < 0.0025, "%s: worst error %.4f %% >= 0.25 %% (seed %llu)", cond_name[cond],
+    /* tighter than the protocol's 0.1 %, within 4x of the measured: median 0.00304 % (clean)
+     * and 0.00357 % (det < 0), worst 0.0259 % and 0.0268 % (CK_RUN_CASE=synthetic
+     * build/tests/check_accuracy). Without the refinement and the polish the preset gives
+     * median 0.0144 / 0.0177 %, worst 0.161 / 0.140 %: these bounds catch that. */
+    ck_assert_msg(med <= 0.0001, "%s: median error %.5f %% > 0.01 %%", cond_name[cond], 100.0 * med);
+    ck_assert_msg(s.worst < 0.001, "%s: worst error %.4f %% >= 0.1 %% (seed %llu)", cond_name[cond],
                   100.0 * s.worst, (unsigned long long)s.worst_seed);
     /* "the distance is ~0": an exact affine image up to re-sampling must sit far below the
      * distance between different shapes: under 1 % of their median */
