@@ -1,4 +1,4 @@
-/* check_accuracy.c — the accuracy protocol of issue 3 ("Tests that must exist and pass").
+/* check_accuracy.c — the registration accuracy protocol (docs/measurements.md, "Accuracy suite").
  *
  * Every case: a source contour f, a random affine map T (any rotation, anisotropic scale up to
  * 2, shear up to 0.5, random translation; det < 0 in the mirror cases), and a target that is
@@ -8,13 +8,15 @@
  *
  *     err = max_i |M(f_i) - T(f_i)| / size(T(f))       (size: amscr_test_shape_size)
  *
- * over the source's own input points. Targets (issue 3), asserted as stated:
+ * over the source's own input points. Targets, asserted as stated:
  *   synthetic clean, det > 0 and det < 0:  err < 0.5 % in every case, median <= 0.1 %
+ *                                         (asserted tighter, within 4x of the measured:
+ *                                         worst < 0.1 %, median <= 0.01 %)
  *   synthetic 1 % noise:                  err < 2 % in >= 95 % of the cases
  *   synthetic 5 % occlusion:              err < 2 % in >= 90 % of the cases
  *   Kimia-99 + Kimia-216 pixel contours:  err < 2 % in >= 99 % (clean), >= 97 % (noise),
  *                                         >= 95 % (occlusion)
- *   and issue 14's heavier conditions on the same contours (one map each): 2 % noise,
+ *   and the heavier conditions of the robust registration on the same contours (one map each): 2 % noise,
  *   10 % and 20 % of the boundary missing, at the measured levels (KIMIA_T_*)
  * The measured rates, the worst cases (seed / file) and the mean time per registration are
  * printed so they show in the test log; time is never asserted.
@@ -36,15 +38,20 @@
 
 
 #define SYN_CASES 240 /* >= 200 seeded shapes per condition */
-#define KIMIA_REPEATS 2 /* random affine maps per image and condition (issue 3's conditions) */
-#define KIMIA_CONDS 6
-/* issue 14's heavier conditions (one map per image), asserted a little below the levels
+#define KIMIA_REPEATS 2 /* random affine maps per image and condition (the protocol's three conditions) */
+#define KIMIA_CONDS 7
+/* the heavier conditions (one map per image), asserted a little below the levels
  * measured on this suite (0.3.2 with the polish, the order and the even spacing of noisy points:
  * 2 % noise 98.73 % (0.3.1: 95.87 %, 0.3: 93.65 %, 84.1 % before the polish), 10 % missing
- * 100 %, 20 % missing 98.7 %; issue 14's goals are 99 / 95 / 85 %) */
+ * 100 %, 20 % missing 98.7 %; the goals of the robust registration are 99 / 95 / 85 %) */
 #define KIMIA_T_NOISE2 0.97
 #define KIMIA_T_MISSING10 0.97
 #define KIMIA_T_MISSING20 0.92
+/* The 2 % noise threshold above followed the measurements on its own draws (seeds 400000 +
+ * 10 i). A seventh row draws the same condition afresh (seeds 700000 + 10 i, never used to
+ * choose anything), so a change tuned to the first draws shows here. It is asserted at the
+ * first row's level, fixed before this row was measured and never to be moved to follow it. */
+#define KIMIA_T_NOISE2_FRESH KIMIA_T_NOISE2
 
 /* ------------------------------------------------------------------ helpers */
 
@@ -76,9 +83,9 @@ typedef enum {
     COND_MIRROR = 1,
     COND_NOISE = 2,
     COND_OCCLUSION = 3,
-    COND_NOISE2 = 4,   /* issue 14: 2 % noise */
-    COND_MISSING10 = 5, /* issue 14: 10 % of the boundary missing */
-    COND_MISSING20 = 6  /* issue 14: 20 % of the boundary missing */
+    COND_NOISE2 = 4,   /* 2 % noise */
+    COND_MISSING10 = 5, /* 10 % of the boundary missing */
+    COND_MISSING20 = 6  /* 20 % of the boundary missing */
 } condition;
 static const char *const cond_name[] = {"clean",    "mirror (det<0)", "1% noise",   "5% occlusion",
                                         "2% noise", "10% missing",    "20% missing"};
@@ -342,7 +349,13 @@ static void assert_exact_protocol(condition cond)
     /* every case within 0.5 % of the shape size, the median within 0.1 % */
     ck_assert_msg(s.within_half == s.cases, "%s: %zu of %zu cases within 0.5 %% (worst %.4f %%, seed %llu)",
                   cond_name[cond], s.within_half, s.cases, 100.0 * s.worst, (unsigned long long)s.worst_seed);
-    ck_assert_msg(med <= 0.001, "%s: median error %.5f %% > 0.1 %%", cond_name[cond], 100.0 * med);
+    /* tighter than the protocol's 0.1 %, within 4x of the measured: median 0.00304 % (clean)
+     * and 0.00357 % (det < 0), worst 0.0259 % and 0.0268 % (CK_RUN_CASE=synthetic
+     * build/tests/check_accuracy). Without the refinement and the polish the preset gives
+     * median 0.0144 / 0.0177 %, worst 0.161 / 0.140 %: these bounds catch that. */
+    ck_assert_msg(med <= 0.0001, "%s: median error %.5f %% > 0.01 %%", cond_name[cond], 100.0 * med);
+    ck_assert_msg(s.worst < 0.001, "%s: worst error %.4f %% >= 0.1 %% (seed %llu)", cond_name[cond],
+                  100.0 * s.worst, (unsigned long long)s.worst_seed);
     /* "the distance is ~0": an exact affine image up to re-sampling must sit far below the
      * distance between different shapes: under 1 % of their median */
     ck_assert_msg(s.max_dist < 0.01 * between, "%s: largest distance %.3g vs median between-shape distance %.3g",
@@ -472,11 +485,9 @@ static double kimia_case(const amscr_params *prm, condition cond, const double *
 
 START_TEST(kimia_pixel_contours)
 {
-    const char *root = amscr_test_datasets_dir();
-    if (!root) {
-        printf("accuracy: datasets not found (AMSCR_DATASETS); Kimia-99/216 protocol skipped\n");
+    const char *root = amscr_test_datasets_or_skip("accuracy");
+    if (!root)
         return;
-    }
     file_list files = {NULL, 0};
     read_manifest(root, "kimia99", &files);
     size_t n99 = files.n;
@@ -505,12 +516,13 @@ START_TEST(kimia_pixel_contours)
 
     amscr_params *prm = NULL;
     ck_assert_int_eq(amscr_params_new_registration(&prm), AMSCR_OK);
-    /* issue 3's three conditions on every image twice; issue 14's heavier ones once each */
+    /* the protocol's three conditions on every image twice; the heavier ones once each */
     const condition conds[KIMIA_CONDS] = {COND_CLEAN, COND_NOISE, COND_OCCLUSION, COND_NOISE2, COND_MISSING10,
-                                          COND_MISSING20};
+                                          COND_MISSING20, COND_NOISE2};
     /* 1 % noise: 99.84 % measured with the polish (99.05 % before) */
-    const double targets[KIMIA_CONDS] = {0.99, 0.98, 0.95, KIMIA_T_NOISE2, KIMIA_T_MISSING10, KIMIA_T_MISSING20};
-    const unsigned repeats[KIMIA_CONDS] = {KIMIA_REPEATS, KIMIA_REPEATS, KIMIA_REPEATS, 1, 1, 1};
+    const double targets[KIMIA_CONDS] = {0.99, 0.98, 0.95, KIMIA_T_NOISE2, KIMIA_T_MISSING10, KIMIA_T_MISSING20,
+                                         KIMIA_T_NOISE2_FRESH};
+    const unsigned repeats[KIMIA_CONDS] = {KIMIA_REPEATS, KIMIA_REPEATS, KIMIA_REPEATS, 1, 1, 1, 1};
     kimia_stats ks[KIMIA_CONDS];
     for (int ci = 0; ci < KIMIA_CONDS; ci++) {
         condition cond = conds[ci];
@@ -539,8 +551,8 @@ START_TEST(kimia_pixel_contours)
         }
         amscr_workspace_free(s->tm.ws);
         s->tm.ws = NULL;
-        printf("accuracy: kimia99+216 %-12s %zu pairs: %.2f %% within 2 %% (target >= %.0f %%), worst %.3g %%; ",
-               cond_name[cond], s->cases, 100.0 * (double)s->within / (double)s->cases, 100.0 * targets[ci],
+        printf("accuracy: kimia99+216 %-12s%s %zu pairs: %.2f %% within 2 %% (target >= %.0f %%), worst %.3g %%; ",
+               cond_name[cond], ci == KIMIA_CONDS - 1 ? " (fresh draws)" : "", s->cases, 100.0 * (double)s->within / (double)s->cases, 100.0 * targets[ci],
                100.0 * s->worst);
         print_timing(&s->tm);
         fflush(stdout);
@@ -560,9 +572,10 @@ START_TEST(kimia_pixel_contours)
     ck_assert_msg(ok,
                   "kimia pairs within 2 %%: clean %.2f %% (target 99), 1 %% noise %.2f %% (target 98), "
                   "5 %% occlusion %.2f %% (target 95), 2 %% noise %.2f %% (target %.0f), 10 %% missing %.2f %% "
-                  "(target %.0f), 20 %% missing %.2f %% (target %.0f)",
+                  "(target %.0f), 20 %% missing %.2f %% (target %.0f), 2 %% noise fresh draws %.2f %% (target %.0f)",
                   100.0 * rate[0], 100.0 * rate[1], 100.0 * rate[2], 100.0 * rate[3], 100.0 * KIMIA_T_NOISE2,
-                  100.0 * rate[4], 100.0 * KIMIA_T_MISSING10, 100.0 * rate[5], 100.0 * KIMIA_T_MISSING20);
+                  100.0 * rate[4], 100.0 * KIMIA_T_MISSING10, 100.0 * rate[5], 100.0 * KIMIA_T_MISSING20,
+                  100.0 * rate[6], 100.0 * KIMIA_T_NOISE2_FRESH);
 }
 END_TEST
 

@@ -66,10 +66,15 @@ START_TEST(test_invariance)
         amscr_descriptor *g = prep(p, radial(0.3, 5, 0.1, 3, 0.0, m));
         amscr_descriptor *o = prep(p, radial(0.35, 3, 0.15, 2, 0.0, ident));
         double same = chan(p, f, g), other = chan(p, f, o);
-        ck_assert_msg(same < 0.15 * other, "frame %d: copy %g vs other shape %g", frame, same, other);
+        /* the copy starts at the same point, so its samples are the map's images of f's: the
+         * distance is exactly 0 in both frames (measured; the other shape: 3.80 / 3.99) */
+        ck_assert_msg(same == 0.0, "frame %d: copy %g (exactly 0 expected) vs other shape %g", frame, same, other);
+        ck_assert_msg(other > 1.0, "frame %d: other shape %g", frame, other);
         if (!frame) {
             amscr_descriptor *r = prep(p, radial(0.3, 5, 0.1, 3, 0.0, mir));
             double mirrored = chan(p, f, r);
+            /* re-oriented counter-clockwise, the mirror image starts elsewhere: measured 0.391
+             * against 3.80 for the other shape (10 %) */
             ck_assert_msg(mirrored < 0.15 * other, "mirror %g vs other %g", mirrored, other);
             amscr_descriptor_free(r);
         }

@@ -1,4 +1,4 @@
-/* check_polish.c — issue 14: the polish stage (src/register/polish.c): the flag's defaults and range,
+/* check_polish.c — the polish stage (docs/method.md §11.4) (src/register/polish.c): the flag's defaults and range,
  * noisy targets and noisy sources registered more accurately with it than without, exact pairs
  * kept exact, no polish without input points (collections, loaded collections), fragments
  * (partial matching) placed better with it, symmetric shapes still reported ambiguous. Generated shapes, seeded. */

@@ -689,7 +689,7 @@ START_TEST(start_point_invariance)
      * continuous shift search follows it (band-limited interpolation of the target). Exact
      * pair: the distance stays ~0 (1e-4 is 0.3 % of the smallest and 0.13 % of the median
      * distance between different random shapes, 0.035 and 0.08 as printed by
-     * distance_affine_invariance; measured 1e-6..1e-5) and the map within the issue's 0.5 %. Different shapes: the distance within 1 %, the map within 1 % of the size. The
+     * distance_affine_invariance; measured 1e-6..1e-5) and the map within the protocol's 0.5 %. Different shapes: the distance within 1 %, the map within 1 % of the size. The
      * reported shifts are consistent: matched samples within one spacing (rounding of the
      * continuous shift to the nearest sample moves each by at most half a spacing). */
     ck_assert_msg(worst_d[0] < 1e-4, "exact pair, new start: distance %.3g", worst_d[0]);

@@ -1,4 +1,4 @@
-/* check_robust.c — issue 14: partial matching, confidence (symmetric shapes ambiguous), inlier
+/* check_robust.c — robust registration (docs/method.md §11): partial matching, confidence (symmetric shapes ambiguous), inlier
  * fraction under missing parts, dense correspondences, on generated shapes (seeded) and Kimia
  * pixel contours (skipped cleanly when the datasets are absent). */
 #include <amscr.h>
@@ -202,17 +202,13 @@ END_TEST
  * Returns the share of the cases within 2 % of the size. */
 static double kimia_run(double share, double missing, const char *label)
 {
-    const char *root = amscr_test_datasets_dir();
+    const char *root = amscr_test_datasets_or_skip("robust");
     char path[4096], line[1024];
-    FILE *fp = NULL;
-    if (root) {
-        snprintf(path, sizeof path, "%s/kimia99/manifest.tsv", root);
-        fp = fopen(path, "r");
-    }
-    if (!fp) {
-        printf("robust: kimia99 absent (AMSCR_DATASETS); %s skipped\n", label);
-        return 1.0;
-    }
+    if (!root)
+        return 1.0; /* "SKIP: robust: ..." printed; run_one.c reports the suite skipped */
+    snprintf(path, sizeof path, "%s/kimia99/manifest.tsv", root);
+    FILE *fp = fopen(path, "r");
+    ck_assert_msg(fp != NULL, "%s: cannot open %s", label, path);
     size_t cases = 0, ok = 0;
     amscr_test_rng rng;
     amscr_test_rng_seed(&rng, 1414);

@@ -676,11 +676,9 @@ static int trace_folder(const char *dir)
 
 START_TEST(kimia_datasets)
 {
-    const char *root = amscr_test_datasets_dir();
-    if (!root) {
-        printf("trace: AMSCR_DATASETS not found; Kimia tracing skipped\n");
+    const char *root = amscr_test_datasets_or_skip("trace");
+    if (!root)
         return;
-    }
     char dir[4096];
     snprintf(dir, sizeof dir, "%s/kimia99", root);
     int n99 = trace_folder(dir);

@@ -21,7 +21,7 @@ Suite *amscr_suite_retrieval(void);
 Suite *amscr_suite_threads(void);
 Suite *amscr_suite_rerank(void);
 Suite *amscr_suite_invariance(void);
-/* issue 14 (registration) */
+/* robust registration */
 Suite *amscr_suite_robust(void);
 Suite *amscr_suite_channel(void);
 Suite *amscr_suite_trace_all(void);

@@ -168,6 +168,25 @@ const char *amscr_test_datasets_dir(void)
     return NULL;
 }
 
+const char *amscr_test_datasets_or_skip(const char *suite)
+{
+    const char *root = amscr_test_datasets_dir();
+    if (!root) {
+        printf("SKIP: %s: datasets not found (set AMSCR_DATASETS)\n", suite);
+        fflush(stdout);
+    }
+    return root;
+}
+
+int amscr_test_suite_reads_datasets(const char *suite)
+{
+    static const char *const readers[] = {"accuracy", "robust", "trace"};
+    for (size_t i = 0; i < sizeof readers / sizeof readers[0]; i++)
+        if (strcmp(suite, readers[i]) == 0)
+            return 1;
+    return 0;
+}
+
 int amscr_test_read_png_gray(const char *path, unsigned char **out_pixels, size_t *out_w, size_t *out_h)
 {
     png_image img;

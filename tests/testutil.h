@@ -40,6 +40,11 @@ double amscr_test_max_map_error(const double m6[6], const double truth[6], const
 
 /* Folder of the shared datasets, or NULL when absent (tests then skip with a message). */
 const char *amscr_test_datasets_dir(void);
+/* The datasets folder, or NULL after printing "SKIP: <suite>: datasets not found" (a test
+ * that needs them then returns; run_one.c turns the suite's exit into meson's SKIP). */
+const char *amscr_test_datasets_or_skip(const char *suite);
+/* Whether the suite of that name (accuracy, robust, trace) reads the datasets. */
+int amscr_test_suite_reads_datasets(const char *suite);
 /* Reads an 8-bit grayscale (or any PNG libpng can expand) into a malloc'ed luminance
  * buffer; returns 0 on success. */
 int amscr_test_read_png_gray(const char *path, unsigned char **out_pixels, size_t *out_w, size_t *out_h);

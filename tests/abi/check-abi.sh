@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# ABI guard (STYLE.md §1.8, issue 7): compares libamscr.so with the committed abidw baseline
+# ABI guard (STYLE.md §1.8): compares libamscr.so with the committed abidw baseline
 # tests/abi/amscr-<version>.abi and fails on any incompatible change.
 #   tests/abi/check-abi.sh [LIB]            check (LIB default: build-abi/libamscr.so, built here)
 #   tests/abi/check-abi.sh --update [LIB]   regenerate the baseline (at a release, or when a

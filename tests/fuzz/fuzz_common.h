@@ -1,4 +1,4 @@
-/* fuzz_common.h — shared bits of the libFuzzer targets in tests/fuzz/ (issue 7).
+/* fuzz_common.h — shared bits of the libFuzzer targets in tests/fuzz/ (hardening, docs/hardening.md).
  *
  * Every target defines LLVMFuzzerTestOneInput. Built two ways:
  *   - with clang -fsanitize=fuzzer,address,undefined by tests/fuzz/build.sh (real fuzzing);

@@ -1,4 +1,4 @@
-"""`amscr register` polishes the map on the input points by default (issue 14); --no-polish
+"""`amscr register` polishes the map on the input points by default (docs/method.md §11.4); --no-polish
 skips it: on noisy targets the default map is closer to the truth, and --no-polish is in the
 help."""
 import json

@@ -1,4 +1,4 @@
-"""register() polishes the map on the input points by default (issue 14); polish=False skips
+"""register() polishes the map on the input points by default (docs/method.md §11.4); polish=False skips
 it. On noisy targets the polished map is closer to the truth; the tool's --no-polish agrees
 with polish=False."""
 import json
@@ -97,10 +97,15 @@ def heldout_data():
     data = os.path.join(os.environ.get('AMSCR_DATASETS') or os.path.join(repo, '..', 'shared', 'datasets'),
                         'mpeg7-dev')
     if not os.path.exists(os.path.join(data, 'manifest.tsv')):
-        pytest.skip('mpeg7-dev not found (%s)' % data)
+        pytest.skip('mpeg7-dev: datasets not found (%s; set AMSCR_DATASETS)' % data)
     import sys
     sys.path.insert(0, os.path.join(repo, 'bench'))
     return data
+
+
+# The frag50 maps with confidence >= 0.25, the ones whose area the test checks: 61 of 70
+# measured (the others are near-symmetric shapes); a few fewer are allowed.
+CONFIDENT_FRAG50 = 58
 
 
 def test_partial_polish_never_collapses():
@@ -123,8 +128,8 @@ def test_partial_polish_never_collapses():
             if on.confidence >= 0.25:
                 assert 0.5 <= ratio <= 2.0, (cls, d, ratio, on.confidence)
                 assert (end - start) % 1.0 > 0.05, (cls, d, on.part)
-            checked += 1
-    assert checked == 70
+                checked += 1
+    assert checked >= CONFIDENT_FRAG50, checked
 
 
 def test_noisy_resampled_contours_register():
