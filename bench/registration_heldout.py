@@ -198,7 +198,10 @@ def ecc_register(src, tgt, cv2):
 
 
 # ------------------------------------------------------------------------ main
-def load_shapes(data, nclass):
+def load_shapes(data, nclass, subpixel=False):
+    """The outer contour of the first silhouette of each of the first nclass classes. The table's
+    sources are the pixel-centre chains (subpixel=False), as published; subpixel=True traces the
+    iso-line instead (amscr's default for images)."""
     from PIL import Image
     rows = [l.rstrip('\n').split('\t') for l in open(os.path.join(data, 'manifest.tsv'))][1:]
     first = {}
@@ -207,7 +210,7 @@ def load_shapes(data, nclass):
     shapes = []
     for cls, fname in list(first.items())[:nclass]:
         img = np.asarray(Image.open(os.path.join(data, fname)).convert('L'))
-        shapes.append((cls, amscr.contour_from_mask(img)))
+        shapes.append((cls, amscr.contour_from_mask(img, subpixel=subpixel)))
     return shapes
 
 
@@ -223,6 +226,8 @@ def main():
     ap.add_argument('--stray', type=float, default=0.0,
                     help='share of the SOURCE points moved to random places in its bounding box (stray points); '
                          'the error is still measured on the clean source')
+    ap.add_argument('--tracer', choices=['pixel-chain', 'subpixel'], default='pixel-chain',
+                    help='how the source silhouettes are traced (the published table: pixel-chain)')
     ap.add_argument('--json', help='write per-case results here')
     ap.add_argument('-v', '--verbose', action='store_true')
     args = ap.parse_args()
@@ -235,7 +240,7 @@ def main():
             import cv2
         except ImportError:
             print('opencv not installed: ECC column skipped')
-    shapes = load_shapes(args.data, args.classes)
+    shapes = load_shapes(args.data, args.classes, args.tracer == 'subpixel')
     conds = [c for c in CONDITIONS if not args.only or c[0] in args.only.split(',')]
     rows, cases = [], []
     for ci, (key, label, amount, goal) in enumerate(CONDITIONS):
