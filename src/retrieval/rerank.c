@@ -1,24 +1,11 @@
 /* rerank.c — contextual re-ranking of a distance matrix by affinity diffusion on a kNN
  * tensor-product graph (Yang, Prasad, Latecki, CVPR 2012). See amscr_rerank_diffusion in
  * amscr.h for the definition. */
-#include "internal.h"
+#include "index.h" /* amscr__knn_select: the neighbour order the index stores too */
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct {
-    double d;
-    size_t j;
-} nb_t;
-
-static int cmp_nb(const void *a, const void *b)
-{
-    const nb_t *x = a, *y = b;
-    if (x->d != y->d)
-        return x->d < y->d ? -1 : 1;
-    return x->j < y->j ? -1 : (x->j > y->j);
-}
 
 /* Output normalizations of the diffused affinity Q. */
 enum { NORM_ROW_MAX = 0, NORM_UNIT = 1 };
@@ -42,8 +29,9 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
     double *T = amscr__malloc_array(n * n, sizeof *T), *sc = amscr__malloc_array(n, sizeof *sc);
     double *pw = amscr__malloc_array(n * k, sizeof *pw);
     size_t *pj = amscr__malloc_array(n * k, sizeof *pj);
-    nb_t *row = amscr__malloc_array(n, sizeof *row);
-    if (!D || !Q || !T || !sc || !pw || !pj || !row) {
+    size_t *row = amscr__malloc_array(n, sizeof *row);
+    uint32_t *nb = amscr__malloc_array(k, sizeof *nb);
+    if (!D || !Q || !T || !sc || !pw || !pj || !row || !nb) {
         free(D);
         free(Q);
         free(T);
@@ -51,6 +39,7 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
         free(pw);
         free(pj);
         free(row);
+        free(nb);
         return amscr__fail(AMSCR_E_NOMEM, "amscr_rerank_diffusion: out of memory");
     }
     double dmax = 0.0;
@@ -61,17 +50,17 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
                 dmax = D[i * n + j];
         }
     /* neighbours (itself first: distance 0, ties by index) and self-tuning scales */
-    for (size_t i = 0; i < n; i++) {
-        for (size_t j = 0; j < n; j++) {
-            row[j].d = D[i * n + j];
-            row[j].j = j;
-        }
-        row[i].d = -1.0; /* itself is always its own first neighbour */
-        qsort(row, n, sizeof *row, cmp_nb);
-        for (size_t t = 0; t < k; t++)
-            pj[i * k + t] = row[t].j;
-        sc[i] = D[i * n + row[k - 1].j];
+    for (size_t j = 0; j < n; j++)
+        row[j] = j;
+    amscr_status st = AMSCR_OK;
+    for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
+        st = amscr__knn_select(i, row, D + i * n, n, k, nb, pw + i * k);
+        for (size_t t = 0; st == AMSCR_OK && t < k; t++)
+            pj[i * k + t] = nb[t];
+        sc[i] = D[i * n + pj[i * k + k - 1]];
     }
+    if (st != AMSCR_OK)
+        goto done;
     double tiny = dmax > 0.0 ? 1e-12 * dmax : 1e-300;
     for (size_t i = 0; i < n; i++) {
         double sum = 0.0;
@@ -129,6 +118,7 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
                 out_dist[i * n + j] = i == j ? 0.0 : 0.5 * out_dist[i * n + j];
         }
     }
+done:
     free(D);
     free(Q);
     free(T);
@@ -136,7 +126,8 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
     free(pw);
     free(pj);
     free(row);
-    return AMSCR_OK;
+    free(nb);
+    return st;
 }
 
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
