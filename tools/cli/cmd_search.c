@@ -89,12 +89,7 @@ static int index_distances(const amscr_index *x, const amscr_params *p, const am
     if (amscr_params_get_rerank_k(p) != amscr_params_get_rerank_k(b) ||
         amscr_params_get_rerank_iterations(p) != amscr_params_get_rerank_iterations(b)) {
         amscr_db *db = NULL;
-        amscr_status st = amscr_db_new(p, &db);
-        for (size_t i = 0; st == AMSCR_OK && i < n; i++)
-            st = amscr_db_add_descriptor(db, amscr_db_descriptor(idb, i), amscr_db_label(idb, i), NULL);
-        int r = st == AMSCR_OK ? query_distances(db, dq, member, qpath, cpath, dist) : -1;
-        if (st != AMSCR_OK)
-            tool_lib_error(cpath, st);
+        int r = index_db_with_params(x, p, cpath, &db) == 0 ? query_distances(db, dq, member, qpath, cpath, dist) : -1;
         amscr_db_free(db);
         return r;
     }

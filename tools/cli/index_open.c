@@ -182,8 +182,7 @@ int index_store_names(amscr_index *x, const collection *c, size_t from)
     return 0;
 }
 
-/* The index's shapes in a new db with params p (the user's threads and re-ranking). */
-static int db_with_params(const amscr_index *x, const amscr_params *p, const char *path, amscr_db **out)
+int index_db_with_params(const amscr_index *x, const amscr_params *p, const char *path, amscr_db **out)
 {
     const amscr_db *src = amscr_index_db(x);
     amscr_status st = amscr_db_new(p, out);
@@ -211,7 +210,7 @@ int open_collection_db(const opts *o, const char *path, int (*check)(const opts 
             r = TOOL_EXIT_FAIL;
         if (r == 0 && check)
             r = check(o, c);
-        if (r == 0 && db_with_params(x, *p, path, db) != 0)
+        if (r == 0 && index_db_with_params(x, *p, path, db) != 0)
             r = TOOL_EXIT_FAIL;
         amscr_index_free(x);
         return r;

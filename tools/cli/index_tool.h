@@ -24,6 +24,9 @@ int index_store_names(amscr_index *x, const collection *c, size_t from);
 /* The params of an index with the options the user set: the same as the index's or a clear
  * error naming the option (threads and --rerank/--no-rerank may differ). 0 or an exit code. */
 int index_params(const opts *o, const char *path, const amscr_params *built, amscr_params **out);
+/* The index's shapes in a new db with params p (the user's threads and re-ranking); 0 or -1
+ * (error printed naming path). */
+int index_db_with_params(const amscr_index *x, const amscr_params *p, const char *path, amscr_db **out);
 /* `index --add`: appends the shapes of collection c to the index (saved by the caller). */
 int index_add(const opts *o, amscr_index *x, collection *c);
 
