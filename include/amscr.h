@@ -2364,6 +2364,24 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_set_class_name(amscr_index *x
 AMSCR_API const char *amscr_index_class_name(const amscr_index *x, int32_t label);
 
 /**
+ * @brief Sets (NULL: clears) the group of shape i: the object or source it shows (e.g. the
+ *        object of a set of views), for protocols that leave one group out; saved with the
+ *        index. Shapes added later have none.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL x, i out of range); AMSCR_E_NOMEM.
+ * Ownership: group is copied. Thread-safety: exclusive on x.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_set_group(amscr_index *x, size_t i, const char *group);
+
+/**
+ * @brief The group of shape i, or NULL (none, NULL x, i out of range).
+ * Ownership: the index; valid until the group changes or the index is freed.
+ * Thread-safety: const.
+ * @since 0.4
+ */
+AMSCR_API const char *amscr_index_group(const amscr_index *x, size_t i);
+
+/**
  * @brief Writes the index (the collection file format, version 3: amscr_db_load of it gives the
  *        collection) to a temporary name in the same folder and renames it.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.

@@ -285,6 +285,42 @@ START_TEST(thread_independence)
 END_TEST
 
 /* A shortlist query returns finite scores for its best shapes; top-k agrees with the scores. */
+START_TEST(groups)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_index *x = named_index(p, 0), *y = NULL;
+    void *b0 = NULL, *b1 = NULL;
+    size_t l0 = 0, l1 = 0;
+    ck_assert_int_eq(amscr_index_save_memory(x, &b0, &l0), AMSCR_OK);
+    ck_assert_ptr_null(amscr_index_group(x, 0));
+    ck_assert_int_eq(amscr_index_set_group(x, NSHAPES, "a"), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_index_set_group(NULL, 0, "a"), AMSCR_E_INVALID_ARG);
+    ck_assert_ptr_null(amscr_index_group(NULL, 0));
+    ck_assert_int_eq(amscr_index_set_group(x, 0, "cup-a"), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_set_group(x, 5, "cup-b"), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_set_group(x, 5, "cup-c"), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_save_memory(x, &b1, &l1), AMSCR_OK);
+    ck_assert_uint_gt(l1, l0); /* an index without groups keeps the format without them */
+    ck_assert_int_eq(amscr_index_load_memory(b1, l1, &y), AMSCR_OK);
+    ck_assert_str_eq(amscr_index_group(y, 0), "cup-a");
+    ck_assert_str_eq(amscr_index_group(y, 5), "cup-c");
+    ck_assert_ptr_null(amscr_index_group(y, 1));
+    ck_assert_str_eq(amscr_index_name(y, 3), "three.png");
+    amscr_index_free(y);
+    y = NULL;
+    ck_assert_int_eq(amscr_index_load_memory(b0, l0, &y), AMSCR_OK);
+    ck_assert_ptr_null(amscr_index_group(y, 0));
+    amscr_index_free(y);
+    y = NULL;
+    ck_assert_int_eq(amscr_index_set_group(x, 0, NULL), AMSCR_OK);
+    ck_assert_ptr_null(amscr_index_group(x, 0));
+    amscr_free(b0);
+    amscr_free(b1);
+    amscr_index_free(x);
+    amscr_params_free(p);
+}
+END_TEST
+
 START_TEST(top_and_shortlist)
 {
     amscr_params *p = params_of(1.0, 8, 2);
@@ -376,6 +412,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, thread_independence);
     tcase_add_test(tc, top_and_shortlist);
     tcase_add_test(tc, default_shortlist_first_hit);
+    tcase_add_test(tc, groups);
     suite_add_tcase(s, tc);
     return s;
 }

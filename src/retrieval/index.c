@@ -37,7 +37,13 @@ amscr_status amscr__index_reserve(amscr_index *x, size_t n)
         for (size_t i = x->cap; i < cap; i++)
             nm[i] = NULL;
     }
-    if (!sig || !lb || !hf || !ni || !nd || !nm)
+    char **gr = realloc(x->groups, cap * sizeof *gr);
+    if (gr) {
+        x->groups = gr;
+        for (size_t i = x->cap; i < cap; i++)
+            gr[i] = NULL;
+    }
+    if (!sig || !lb || !hf || !ni || !nd || !nm || !gr)
         return amscr__fail(AMSCR_E_NOMEM, "index: out of memory for %zu shapes", n);
     x->cap = cap;
     return AMSCR_OK;
@@ -79,6 +85,9 @@ void amscr_index_free(amscr_index *x)
         return;
     for (size_t i = 0; x->names && i < x->cap; i++)
         free(x->names[i]);
+    for (size_t i = 0; x->groups && i < x->cap; i++)
+        free(x->groups[i]);
+    free(x->groups);
     for (size_t c = 0; c < x->nclasses; c++)
         free(x->classes[c]);
     free(x->names);
@@ -102,6 +111,11 @@ size_t amscr_index_neighbours(const amscr_index *x) { return x ? x->k : 0; }
 const char *amscr_index_name(const amscr_index *x, size_t i)
 {
     return (x && i < amscr_db_size(x->db)) ? x->names[i] : NULL;
+}
+
+const char *amscr_index_group(const amscr_index *x, size_t i)
+{
+    return (x && i < amscr_db_size(x->db)) ? x->groups[i] : NULL;
 }
 
 const char *amscr_index_class_name(const amscr_index *x, int32_t label)
@@ -133,6 +147,20 @@ amscr_status amscr_index_set_name(amscr_index *x, size_t i, const char *name)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_index_set_name: out of memory");
     free(x->names[i]);
     x->names[i] = s;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_index_set_group(amscr_index *x, size_t i, const char *group)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    if (i >= amscr_db_size(x->db))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_set_group: shape %zu of %zu", i, amscr_db_size(x->db));
+    char *s = NULL;
+    if (!dup_str(group, &s))
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_index_set_group: out of memory");
+    free(x->groups[i]);
+    x->groups[i] = s;
     return AMSCR_OK;
 }
 

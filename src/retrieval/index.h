@@ -22,6 +22,7 @@ struct amscr_index {
     uint32_t *nb_idx;     /* n x k: itself first, then by (base distance, index) */
     double *nb_dist;      /* n x k */
     char **names;         /* n entries (NULL: unnamed) */
+    char **groups;        /* n entries (NULL: no group) */
     char **classes;       /* class name of label L (0 <= L < nclasses; NULL: unnamed) */
     size_t nclasses;
     size_t cap;           /* allocated rows of sig, nb_*, names */

@@ -5,7 +5,8 @@
  *   f64 dmax, f64 median AMSCR, f64 median channel, n x sig_dim f32 signatures (signature.h),
  *   n x k x (u32 neighbour, f64 distance)
  *   (each row: itself first, then by distance), n names, u64 nclasses, nclasses class names
- *   (string: u32 length and bytes, 0xffffffff for none).
+ *   (string: u32 length and bytes, 0xffffffff for none), then, when a shape has a group,
+ *   n group names (absent: no shape has one).
  * Every count is bounded by the bytes left before anything is allocated. The shapes' channel
  * features are not stored: they are rebuilt at load (index_features.c). */
 #include "db_io.h"
@@ -40,6 +41,11 @@ static void write_section(const amscr_index *x, amscr__wbuf *w)
     amscr__w_u64(w, x->nclasses);
     for (size_t c = 0; c < x->nclasses; c++)
         amscr__w_str(w, x->classes[c]);
+    int groups = 0;
+    for (size_t i = 0; i < n && !groups; i++)
+        groups = x->groups[i] != NULL;
+    for (size_t i = 0; groups && i < n; i++)
+        amscr__w_str(w, x->groups[i]);
 }
 
 amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_t *out_len)
@@ -156,6 +162,10 @@ static amscr_status read_names(amscr__rbuf *r, amscr_index *x)
         if (!amscr__r_str(r, &x->classes[c], &oom))
             return oom ? amscr__fail(AMSCR_E_NOMEM, "index file: out of memory")
                        : amscr__fail(AMSCR_E_FORMAT, "index file: class name %zu is truncated or invalid", c);
+    for (size_t i = 0; r->pos < r->len && i < n; i++) /* the groups, when a shape has one */
+        if (!amscr__r_str(r, &x->groups[i], &oom))
+            return oom ? amscr__fail(AMSCR_E_NOMEM, "index file: out of memory")
+                       : amscr__fail(AMSCR_E_FORMAT, "index file: shape %zu's group is truncated or invalid", i);
     if (r->pos != r->len)
         return amscr__fail(AMSCR_E_FORMAT, "index file: %zu unexpected bytes after the index section",
                            r->len - r->pos);

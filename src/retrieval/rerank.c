@@ -1,24 +1,11 @@
 /* rerank.c — contextual re-ranking of a distance matrix by affinity diffusion on a kNN
  * tensor-product graph (Yang, Prasad, Latecki, CVPR 2012). See amscr_rerank_diffusion in
  * amscr.h for the definition. */
-#include "internal.h"
+#include "index.h" /* amscr__knn_select: the neighbour order the index stores too */
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct {
-    double d;
-    size_t j;
-} nb_t;
-
-static int cmp_nb(const void *a, const void *b)
-{
-    const nb_t *x = a, *y = b;
-    if (x->d != y->d)
-        return x->d < y->d ? -1 : 1;
-    return x->j < y->j ? -1 : (x->j > y->j);
-}
 
 /* Output normalizations of the diffused affinity Q. */
 enum { NORM_ROW_MAX = 0, NORM_UNIT = 1 };
@@ -41,11 +28,12 @@ static amscr_status check_args(const double *dist, size_t n, size_t k, unsigned 
 }
 
 /* The working buffers: D the symmetrized distances, Q the diffused affinity, T a product,
- * sc the self-tuning scales, (pj, pw) the kNN graph P (k neighbours and weights a row). */
+ * sc the self-tuning scales, (pj, pw) the kNN graph P (k neighbours and weights a row); row
+ * (0..n-1) and nb (k) the neighbour selection's scratch. */
 typedef struct {
     double *D, *Q, *T, *sc, *pw;
-    size_t *pj;
-    nb_t *row;
+    size_t *pj, *row;
+    uint32_t *nb;
 } rerank_buf;
 
 static void buf_free(rerank_buf *b)
@@ -57,6 +45,7 @@ static void buf_free(rerank_buf *b)
     free(b->pw);
     free(b->pj);
     free(b->row);
+    free(b->nb);
 }
 
 static int buf_alloc(rerank_buf *b, size_t n, size_t k)
@@ -68,7 +57,8 @@ static int buf_alloc(rerank_buf *b, size_t n, size_t k)
     b->pw = amscr__malloc_array(n * k, sizeof *b->pw);
     b->pj = amscr__malloc_array(n * k, sizeof *b->pj);
     b->row = amscr__malloc_array(n, sizeof *b->row);
-    if (b->D && b->Q && b->T && b->sc && b->pw && b->pj && b->row)
+    b->nb = amscr__malloc_array(k, sizeof *b->nb);
+    if (b->D && b->Q && b->T && b->sc && b->pw && b->pj && b->row && b->nb)
         return 1;
     buf_free(b);
     return 0;
@@ -89,19 +79,18 @@ static double symmetrize(const double *dist, size_t n, double *D)
 
 /* The kNN graph P: each row's k neighbours (itself first: distance 0, ties by index), weighted
  * by exp(-d / s) with self-tuning scales s and normalized to sum 1. */
-static void knn_graph(rerank_buf *b, size_t n, size_t k, double dmax)
+static amscr_status knn_graph(rerank_buf *b, size_t n, size_t k, double dmax)
 {
     const double *D = b->D;
+    for (size_t j = 0; j < n; j++)
+        b->row[j] = j;
     for (size_t i = 0; i < n; i++) {
-        for (size_t j = 0; j < n; j++) {
-            b->row[j].d = D[i * n + j];
-            b->row[j].j = j;
-        }
-        b->row[i].d = -1.0; /* itself is always its own first neighbour */
-        qsort(b->row, n, sizeof *b->row, cmp_nb);
+        amscr_status st = amscr__knn_select(i, b->row, D + i * n, n, k, b->nb, b->pw + i * k);
+        if (st != AMSCR_OK)
+            return st;
         for (size_t t = 0; t < k; t++)
-            b->pj[i * k + t] = b->row[t].j;
-        b->sc[i] = D[i * n + b->row[k - 1].j];
+            b->pj[i * k + t] = b->nb[t];
+        b->sc[i] = D[i * n + b->pj[i * k + k - 1]];
     }
     double tiny = dmax > 0.0 ? 1e-12 * dmax : 1e-300;
     for (size_t i = 0; i < n; i++) {
@@ -115,6 +104,7 @@ static void knn_graph(rerank_buf *b, size_t n, size_t k, double dmax)
         for (size_t t = 0; t < k; t++)
             b->pw[i * k + t] /= sum;
     }
+    return AMSCR_OK;
 }
 
 /* Q = P, then `iterations` times Q <- P Q P^T + I (P sparse: k entries a row). */
@@ -186,7 +176,11 @@ static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iter
     if (!buf_alloc(&b, n, k))
         return amscr__fail(AMSCR_E_NOMEM, "amscr_rerank_diffusion: out of memory");
     double dmax = symmetrize(dist, n, b.D);
-    knn_graph(&b, n, k, dmax);
+    st = knn_graph(&b, n, k, dmax);
+    if (st != AMSCR_OK) {
+        buf_free(&b);
+        return st;
+    }
     diffuse(&b, n, k, iterations);
     to_distances(b.Q, b.D, n, dmax, norm, out_dist);
     buf_free(&b);

@@ -48,11 +48,11 @@ enum {
     /* contour --all: contours enclosing fewer pixels^2 are specks of noise (a 4 x 4 square
      * through pixel centres has area 9) */
     TOOL_MIN_AREA_DEFAULT = 10,
-    /* search against an index: the 64 shapes whose signatures are nearest the query's are
-     * matched (mpeg7-dev, 60 queries: 97.5 % of the re-ranked top 10 of matching every
-     * shape, the same first hit for all; docs/collections.md); every shape when the index is no
-     * larger. An index is built from every pair unless told --candidates M. */
-    TOOL_CANDIDATES_DEFAULT = 64
+    /* search against an index: the library's default shortlist (AMSCR_INDEX_CANDIDATES shapes
+     * whose signatures are nearest the query's; docs/measurements.md, "The index"); every
+     * shape when the index is no larger. An index is built from every pair unless told
+     * --candidates M. */
+    TOOL_CANDIDATES_DEFAULT = AMSCR_INDEX_CANDIDATES
 };
 
 typedef struct opts {

@@ -1,4 +1,5 @@
-/* cmd_search.c — `amscr search QUERY COLLECTION`: the closest shapes of a collection. */
+/* cmd_search.c — `amscr search QUERY COLLECTION`: the closest shapes of a collection (a folder,
+ * a manifest or an index), ranked by the library's retrieval scores. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,32 +11,11 @@
 #include "components.h"
 #include "collection.h"
 #include "image.h"
-#include "index_build.h"
-#include "index_query.h"
+#include "index_tool.h"
 #include "json.h"
 #include "cmd_params.h"
 #include "shape_db.h"
 #include "sheet.h"
-
-/* The channel distances from dq to every shape of db (n of them) into dist: the retrieval
- * matrix's entries when the channel is used alone without re-ranking. */
-static int channel_distances(const amscr_db *db, const amscr_descriptor *dq, const char *qpath, double *dist)
-{
-    size_t n = amscr_db_size(db);
-    tool_progress pr;
-    progress_init(&pr, "matching");
-    for (size_t j = 0; j < n; j++) {
-        amscr_status st = amscr_channel_distance(NULL, amscr_db_descriptor(db, j), dq, &dist[j]);
-        if (st != AMSCR_OK) {
-            progress_end(&pr);
-            tool_lib_error(qpath, st);
-            return -1;
-        }
-        progress_update(&pr, j + 1, n);
-    }
-    progress_end(&pr);
-    return 0;
-}
 
 /* The index of the collection's item that is the query's file (same device and inode), or
  * SIZE_MAX: a member query is ranked by its own row, so its score against itself is 0. */
@@ -50,39 +30,75 @@ static size_t member_index(const collection *c, const char *qpath)
     return SIZE_MAX;
 }
 
-/* The distances from the query dq to every shape of db (n of them) into dist: the plain AMSCR
- * distance (query -> shape), the channel alone, or read from the retrieval matrix (fusion and
- * re-ranking need the whole matrix): row `member` of the collection's when the query is one of
- * its shapes, else the last row of the collection's plus the query (dq is added to db). */
-static int query_distances(amscr_db *db, const amscr_descriptor *dq, size_t member, const char *qpath,
+/* The shape of db whose prepared samples are the query's, bit for bit, or SIZE_MAX: an index
+ * keeps no paths, so a member query is known by its samples. */
+static size_t member_of(const amscr_db *db, const amscr_descriptor *dq)
+{
+    size_t ns = amscr_descriptor_num_samples(dq);
+    const double *q = amscr_descriptor_input_points(dq);
+    for (size_t j = 0; j < amscr_db_size(db); j++) {
+        const amscr_descriptor *d = amscr_db_descriptor(db, j);
+        if (amscr_descriptor_num_samples(d) == ns && memcmp(amscr_descriptor_input_points(d), q, 2 * ns * sizeof *q) == 0)
+            return j;
+    }
+    return SIZE_MAX;
+}
+
+/* The query's scores against every shape of db (n of them) into dist, as the db's params say:
+ * the plain AMSCR distance (query -> shape), or its retrieval scores (amscr_db_query_retrieval);
+ * a member query (shape `member`) gets its row of the collection's retrieval matrix. */
+static int query_distances(const amscr_db *db, const amscr_descriptor *dq, size_t member, const char *qpath,
                            const char *cpath, double *dist)
 {
     size_t n = amscr_db_size(db);
     const amscr_params *p = amscr_db_params(db);
-    if (retrieval_is_plain(p)) {
-        tool_progress pr;
-        progress_init(&pr, "matching");
-        amscr_status st = amscr_db_query(db, dq, progress_cb, &pr, dist);
-        progress_end(&pr);
-        if (st != AMSCR_OK) {
-            tool_lib_error(qpath, st);
+    int channel_only = amscr_params_get_channel_weight(p) >= 1.0 && amscr_params_get_rerank_k(p) == 0;
+    if (member != SIZE_MAX && !retrieval_is_plain(p) && !channel_only) {
+        double *full = NULL;
+        if (compute_matrix(db, cpath, &full) != 0)
             return -1;
-        }
+        memcpy(dist, full + member * n, n * sizeof *dist);
+        free(full);
         return 0;
     }
-    if (amscr_params_get_channel_weight(p) >= 1.0 && amscr_params_get_rerank_k(p) == 0)
-        return channel_distances(db, dq, qpath, dist);
-    double *full = NULL;
-    if (member == SIZE_MAX && amscr_db_add_descriptor(db, dq, -1, NULL) != AMSCR_OK) {
-        tool_lib_error(qpath, AMSCR_E_NOMEM);
+    tool_progress pr;
+    progress_init(&pr, "matching");
+    amscr_status st = retrieval_is_plain(p) ? amscr_db_query(db, dq, progress_cb, &pr, dist)
+                                            : amscr_db_query_retrieval(db, dq, progress_cb, &pr, dist, n);
+    progress_end(&pr);
+    if (st != AMSCR_OK) {
+        tool_lib_error(qpath, st);
         return -1;
     }
-    if (compute_matrix(db, cpath, &full) != 0)
+    return 0;
+}
+
+/* The query's scores against an index: its stored lists (amscr_index_query_scores, or the
+ * member's row) when the user's params are the index's; the collection's matrix (as a folder)
+ * when --rerank/--no-rerank differs from the build's; the plain distance without the channel. */
+static int index_distances(const amscr_index *x, const amscr_params *p, const amscr_descriptor *dq, size_t cand,
+                           const char *qpath, const char *cpath, double *dist)
+{
+    const amscr_db *idb = amscr_index_db(x);
+    const amscr_params *b = amscr_db_params(idb);
+    size_t n = amscr_index_size(x), member = member_of(idb, dq);
+    if (amscr_params_get_channel_weight(p) >= 1.0 && amscr_params_get_rerank_k(p) == 0)
+        member = SIZE_MAX; /* the channel alone: the query's own distances, as a folder search */
+    if (retrieval_is_plain(p))
+        return query_distances(idb, dq, SIZE_MAX, qpath, cpath, dist);
+    if (amscr_params_get_rerank_k(p) != amscr_params_get_rerank_k(b) ||
+        amscr_params_get_rerank_iterations(p) != amscr_params_get_rerank_iterations(b)) {
+        amscr_db *db = NULL;
+        int r = index_db_with_params(x, p, cpath, &db) == 0 ? query_distances(db, dq, member, qpath, cpath, dist) : -1;
+        amscr_db_free(db);
+        return r;
+    }
+    amscr_status st = member != SIZE_MAX ? amscr_index_member_scores(x, member, cand, dist, n)
+                                         : amscr_index_query_scores(x, dq, cand, dist, n);
+    if (st != AMSCR_OK) {
+        tool_lib_error(qpath, st);
         return -1;
-    size_t cols = amscr_db_size(db), row = member == SIZE_MAX ? n : member;
-    for (size_t j = 0; j < n; j++)
-        dist[j] = full[row * cols + j]; /* collection columns */
-    free(full);
+    }
     return 0;
 }
 
@@ -176,60 +192,30 @@ done:
     return ret;
 }
 
-/* --sheet: the hits from the folder's db, or read from the index (x non-NULL). */
-static int sheet_of(const opts *o, const tool_index *x, const amscr_db *db, const amscr_contour *q,
-                    const amscr_descriptor *dq, const collection *c, const double *dist, const size_t *idx, size_t k)
-{
-    size_t *pos = xmalloc_array(k ? k : 1, sizeof(size_t));
-    amscr_db *hits = NULL;
-    int r = -1;
-    if (pos == NULL || (x && index_fetch(x, NULL, idx, k, &hits) != 0)) {
-        free(pos);
-        return -1;
-    }
-    for (size_t i = 0; i < k; i++)
-        pos[i] = x ? i : idx[i];
-    r = draw_search_sheet(o, x ? hits : db, pos, q, dq, c, dist, idx, k);
-    amscr_db_free(hits);
-    free(pos);
-    return r;
-}
-
-/* The collection to search: an index (x, is_index set; c and db point into it) or a folder /
- * manifest prepared now (c and db owned by the caller). Returns 0 or an exit code. */
-static int open_target(const opts *o, tool_index *x, int *is_index, amscr_params **p, collection **c,
-                       amscr_db **db, collection *own)
+/* The collection to search: an index (*x) or a folder / manifest prepared now (*db). The
+ * params: the index's with the user's query-time settings, or the options'. 0 or an exit code. */
+static int open_target(const opts *o, amscr_index **x, amscr_params **p, collection *c, amscr_db **db)
 {
     const char *cpath = o->pos[1];
-    int r = 0;
-    *is_index = index_file_is(cpath);
-    if (*is_index && index_open_lazy(cpath, x) != 0)
-        return TOOL_EXIT_FAIL;
-    if (!*is_index) {
-        *c = own;
+    int r;
+    if (!index_file_is(cpath)) {
         if ((r = make_params(o, 0, p)) != 0)
             return r;
-        return collection_open(cpath, own) == 0 && load_db(*p, own, o->threshold, db) == 0 ? 0 : TOOL_EXIT_FAIL;
+        return collection_open(cpath, c) == 0 && load_db(*p, c, o->threshold, db) == 0 ? 0 : TOOL_EXIT_FAIL;
     }
-    *c = &x->coll;
-    *db = x->db;
-    if ((r = index_params(o, cpath, x, p)) != 0)
+    if (index_open(cpath, x) != 0)
+        return TOOL_EXIT_FAIL;
+    if ((r = index_params(o, cpath, amscr_db_params(amscr_index_db(*x)), p)) != 0)
         return r;
-    size_t n = x->coll.n, want = amscr_params_get_rerank_k(*p), need = want < n ? want : n;
-    if (x->k < need)
-        return usage_error("--rerank", "the index '%s' holds %zu neighbours a shape (built with %s); use --rerank K "
-                           "with K <= %zu, --no-rerank, or rebuild the index with --rerank %zu", cpath, x->k,
-                           x->k ? "a smaller --rerank" : "--no-rerank", x->k, want);
-    return 0;
+    return index_collection(*x, c) == 0 ? 0 : TOOL_EXIT_FAIL;
 }
 
 int cmd_search(opts *o)
 {
     const char *qpath = o->pos[0], *cpath = o->pos[1];
     amscr_params *p = NULL;
-    collection own, *c = &own;
-    tool_index x;
-    int is_index = 0;
+    collection c;
+    amscr_index *x = NULL;
     amscr_db *db = NULL;
     amscr_contour *q = NULL;
     amscr_descriptor *dq = NULL;
@@ -238,34 +224,35 @@ int cmd_search(opts *o)
     int ret = TOOL_EXIT_FAIL;
     sbuf b;
     sb_init(&b);
-    memset(&own, 0, sizeof own);
-    memset(&x, 0, sizeof x);
+    memset(&c, 0, sizeof c);
     double t0 = now_seconds();
 
-    int r = open_target(o, &x, &is_index, &p, &c, &db, &own);
+    int r = open_target(o, &x, &p, &c, &db);
     if (r != 0) {
         ret = r;
         goto done;
     }
-    if (shape_load_opts(o, qpath, &q) != 0 || prepare(is_index ? p : amscr_db_params(db), qpath, q, &dq) != 0)
+    const amscr_db *sdb = x ? amscr_index_db(x) : db;
+    if (shape_load_opts(o, qpath, &q) != 0 || prepare(x ? p : amscr_db_params(db), qpath, q, &dq) != 0)
         goto done;
-    size_t n = c->n;
+    size_t n = c.n;
     dist = xmalloc_array(n, sizeof(double));
     size_t k = o->top < n ? o->top : n;
     idx = xmalloc_array(k ? k : 1, sizeof(size_t));
     if (dist == NULL || idx == NULL)
         goto done;
-    if (is_index ? index_search(&x, p, dq, o->candidates && o->candidates < k ? k : o->candidates, dist) != 0
-                 : query_distances(db, dq, member_index(c, qpath), qpath, cpath, dist) != 0)
+    size_t cand = o->candidates && o->candidates < k ? k : o->candidates;
+    if (x ? index_distances(x, p, dq, cand, qpath, cpath, dist) != 0
+          : query_distances(db, dq, member_index(&c, qpath), qpath, cpath, dist) != 0)
         goto done;
     amscr_status st = amscr_topk(dist, n, k, SIZE_MAX, idx);
     if (st != AMSCR_OK) {
         tool_lib_error(qpath, st);
         goto done;
     }
-    if (o->sheet && sheet_of(o, is_index ? &x : NULL, db, q, dq, c, dist, idx, k) != 0)
+    if (o->sheet && draw_search_sheet(o, sdb, idx, q, dq, &c, dist, idx, k) != 0)
         goto done;
-    format_results(&b, o, c, dist, idx, k, n, now_seconds() - t0);
+    format_results(&b, o, &c, dist, idx, k, n, now_seconds() - t0);
     if (sb_write_stdout(&b) == 0)
         ret = TOOL_EXIT_OK;
 done:
@@ -274,10 +261,9 @@ done:
     free(idx);
     amscr_descriptor_free(dq);
     amscr_contour_free(q);
-    if (!is_index)
-        amscr_db_free(db);
-    collection_free(&own);
-    index_free(&x);
+    amscr_db_free(db);
+    collection_free(&c);
+    amscr_index_free(x);
     amscr_params_free(p);
     return ret;
 }

@@ -56,7 +56,7 @@ void collection_free(collection *c)
 }
 
 /* The index of `name` in the list (*names, *n), appended when new. */
-static int32_t name_index(char ***names, size_t *n, const char *name, size_t *cap)
+int32_t coll_name_index(char ***names, size_t *n, const char *name, size_t *cap)
 {
     for (size_t i = 0; i < *n; i++)
         if (strcmp((*names)[i], name) == 0)
@@ -88,7 +88,7 @@ static int add_item(collection *c, size_t *icap, size_t *ccap, const char *dir, 
         free(name);
         return -1;
     }
-    int32_t label = name_index(&c->classes, &c->nclasses, cls, ccap);
+    int32_t label = coll_name_index(&c->classes, &c->nclasses, cls, ccap);
     if (label < 0) {
         free(path);
         free(name);
@@ -219,7 +219,7 @@ static int set_group(collection *c, char *g, size_t *gcap, const char *mpath, si
         tool_error(mpath, "line %zu: empty group", lineno);
         return -1;
     }
-    int32_t gi = name_index(&c->groups, &c->ngroups, g, gcap);
+    int32_t gi = coll_name_index(&c->groups, &c->ngroups, g, gcap);
     if (gi < 0)
         return -1;
     c->items[c->n - 1].group = gi;

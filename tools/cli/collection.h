@@ -39,6 +39,10 @@ typedef struct collection {
 int collection_open(const char *path, collection *out);
 void collection_free(collection *c);
 
+/* The index of `name` in the list (*names, *n; capacity *cap), appended when new; -1 when out
+ * of memory (printed). */
+int32_t coll_name_index(char ***names, size_t *n, const char *name, size_t *cap);
+
 /* Class of a file name (see above) into out (capacity cap). */
 void class_from_name(const char *filename, char *out, size_t cap);
 

@@ -83,7 +83,7 @@ static const char HELP_SEARCH[] =
     "                          thumbnails with rank, class and distance, each hit drawn\n"
     "                          (red) registered onto the query (grey)\n"
     "  --candidates M          against an index: match the M shapes whose signatures are\n"
-    "                          nearest the query's (default 64; 0: every shape)\n"
+    "                          nearest the query's (default 256; 0: every shape)\n"
     "  --component N           the query is contour N of 'amscr contour --all' (default:\n"
     "                          the largest outer contour); --min-area A as there\n";
 
@@ -134,15 +134,17 @@ static const char HELP_EVAL[] =
 static const char HELP_INDEX[] =
     "usage: amscr index COLLECTION -o FILE [--add] [options]\n"
     "\n"
-    "Prepares every shape of COLLECTION (a folder or a manifest.tsv) once and writes an\n"
-    "index: the prepared shapes with their file names, classes and groups, the shape\n"
-    "and retrieval options (channel weight, affine share, re-ranking), a signature per\n"
-    "shape and each shape's K nearest neighbours under the retrieval distance before\n"
-    "re-ranking (--rerank K, default the preset's 8), so that search, matrix and eval\n"
-    "take FILE wherever they take a collection with the same results, and one search\n"
-    "never recomputes the collection's matrix (with a fused --channel-weight below 1 the\n"
-    "query is scaled by the medians of the build). The file is versioned and\n"
-    "checksummed, and written under a temporary name then renamed.\n"
+    "Prepares every shape of COLLECTION (a folder or a manifest.tsv) once and writes the\n"
+    "library's index (amscr_index_save; Python amscr.Index.load reads it): the prepared\n"
+    "shapes with their file names, classes and groups, the shape and retrieval options\n"
+    "(channel weight, affine share, re-ranking), a signature per shape and each shape's\n"
+    "K nearest neighbours under the retrieval distance before re-ranking (--rerank K,\n"
+    "default the preset's 8), so that search, matrix and eval take FILE wherever they\n"
+    "take a collection with the same results, and one search never recomputes the\n"
+    "collection's matrix (with a fused --channel-weight below 1 the query is scaled by\n"
+    "the medians of the build). The file is versioned and checksummed, and written\n"
+    "under a temporary name then renamed. Index files of amscr before 0.4 are refused:\n"
+    "build them again.\n"
     "\n"
     "  -o, --output FILE       the index file\n"
     "  --candidates M          neighbours are sought among each shape's M nearest by\n"
@@ -150,11 +152,12 @@ static const char HELP_INDEX[] =
     "                          large for every pair (default 0: every pair)\n"
     "  --add                   append the shapes of COLLECTION to the index FILE: only the\n"
     "                          new shapes are prepared, and only pairs with a new shape\n"
-    "                          matched; the shape options must be the index's\n"
+    "                          matched; the options (re-ranking and --threshold\n"
+    "                          included) must be the index's\n"
     "A command given an index uses the index's shape options; an option that differs from\n"
     "them is an error (rebuild the index); --rerank K[,ITER] and --no-rerank may differ\n"
-    "(K up to the neighbours stored). search --candidates M (default 64) matches\n"
-    "the M shapes whose signatures are nearest the query's (0: every shape).\n";
+    "(a search then ranks by the collection's matrix). search --candidates M (default\n"
+    "256) matches the M shapes whose signatures are nearest the query's (0: every shape).\n";
 
 static const tool_command COMMANDS[] = {
     {"contour", C_CONTOUR, 1, "IMG [-o FILE]", "trace a silhouette's outer contour, or every contour (--all)", HELP_CONTOUR, 0,

@@ -1,12 +1,13 @@
-/* index_open.c — an index where a folder or manifest is accepted: the params it was built
- * with against the options the user set (index_build.h, shape_db.h). */
+/* index_open.c — an index where a folder or manifest is accepted: the library's index file
+ * opened, its names as a collection, the params it was built with against the options the
+ * user set (index_tool.h, shape_db.h). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "index_build.h"
-#include "names.h"
 #include "cmd_params.h"
+#include "index_tool.h"
+#include "names.h"
 #include "shape_db.h"
 
 /* "--points: the index 'x' was built with 128; rebuild it to use 256, or drop --points". */
@@ -48,7 +49,7 @@ static int check_options(const opts *o, const char *path, const amscr_params *p)
     NAME(o->method_set, "--method", METHOD_NAMES, amscr_params_get_method(p), o->method)
     NAME(o->param_set, "--parametrization", PARAM_NAMES, amscr_params_get_parametrization(p), o->param)
     NAME(o->inv_set, "--invariance", INVARIANCE_NAMES, amscr_params_get_invariance(p), o->inv)
-    /* the neighbour lists are of the base distance these two define (index_dist.h) */
+    /* the neighbour lists are of the base distance these two define (the retrieval matrix's base distance) */
     NUM(o->channel_weight_set, "--channel-weight", amscr_params_get_channel_weight(p), o->channel_weight)
     NUM(o->affine_share_set, "--affine-share", amscr_params_get_channel_affine_share(p), o->affine_share)
 #undef NUM
@@ -66,17 +67,16 @@ static int check_options(const opts *o, const char *path, const amscr_params *p)
     return 0;
 }
 
-int index_params(const opts *o, const char *path, const tool_index *x, amscr_params **out)
+int index_params(const opts *o, const char *path, const amscr_params *built, amscr_params **out)
 {
-    const amscr_params *p = amscr_db_params(x->db);
-    int r = check_options(o, path, p);
+    int r = check_options(o, path, built);
     if (r != 0)
         return r;
-    amscr_status st = amscr_params_copy(p, out);
+    amscr_status st = amscr_params_copy(built, out);
     if (st == AMSCR_OK && o->threads_set)
         st = amscr_params_set_num_threads(*out, o->threads);
-    /* --rerank / --no-rerank: a query-time setting (search needs the index to hold K
-     * neighbours a shape: cmd_search.c checks) */
+    /* --rerank / --no-rerank: a query-time setting (cmd_search.c ranks by the collection's
+     * matrix when it differs from the index's) */
     if (st == AMSCR_OK && o->rerank_set)
         st = amscr_params_set_rerank_k(*out, (unsigned)o->rerank_k);
     if (st == AMSCR_OK && o->rerank_set && o->rerank_k > 0)
@@ -90,47 +90,129 @@ int index_params(const opts *o, const char *path, const tool_index *x, amscr_par
     return 0;
 }
 
-int open_shapes(const opts *o, const char *path, tool_index *x, int *is_index)
+int index_file_is(const char *path)
 {
-    memset(x, 0, sizeof *x);
-    *is_index = index_file_is(path);
-    if (!*is_index)
+    FILE *f = fopen(path, "rb");
+    char m[8] = {0};
+    if (f == NULL)
         return 0;
-    return index_load(path, x) == 0 ? 0 : TOOL_EXIT_FAIL;
+    size_t got = fread(m, 1, sizeof m, f);
+    fclose(f);
+    return got == sizeof m && (memcmp(m, "AMSCRIDX", 8) == 0 || memcmp(m, "AMSCRDB", 7) == 0);
+}
+
+int index_open(const char *path, amscr_index **out)
+{
+    amscr_status st = amscr_index_load(path, out);
+    if (st != AMSCR_OK) {
+        tool_lib_error(path, st);
+        return -1;
+    }
+    return 0;
+}
+
+/* The classes of the index: label L is named by the index or "L". */
+static int index_classes(const amscr_index *x, collection *c)
+{
+    size_t n = amscr_index_size(x), k = 0;
+    for (size_t i = 0; i < n; i++) {
+        int32_t l = amscr_index_label(x, i);
+        if (l < 0) {
+            tool_error(NULL, "shape %zu of the index has no class (label %d)", i, (int)l);
+            return -1;
+        }
+        k = (size_t)l + 1 > k ? (size_t)l + 1 : k;
+    }
+    for (size_t l = 0; l < k; l++) {
+        char num[24];
+        const char *name = amscr_index_class_name(x, (int32_t)l);
+        snprintf(num, sizeof num, "%zu", l);
+        char **p = realloc(c->classes, (l + 1) * sizeof *p), *s = NULL;
+        if (p != NULL)
+            c->classes = p;
+        if (p == NULL || (s = xstrdup(name ? name : num)) == NULL) {
+            tool_error(NULL, "out of memory");
+            return -1;
+        }
+        c->classes[c->nclasses++] = s;
+    }
+    return 0;
+}
+
+int index_collection(const amscr_index *x, collection *c)
+{
+    size_t n = amscr_index_size(x), gcap = 0;
+    memset(c, 0, sizeof *c);
+    c->items = xcalloc_array(n ? n : 1, sizeof *c->items);
+    int ok = c->items != NULL && index_classes(x, c) == 0, groups = 0;
+    for (size_t i = 0; ok && i < n; i++)
+        groups |= amscr_index_group(x, i) != NULL;
+    for (size_t i = 0; ok && i < n; i++) {
+        char num[32];
+        const char *name = amscr_index_name(x, i), *g = amscr_index_group(x, i);
+        snprintf(num, sizeof num, "#%zu", i); /* an unnamed shape: its index */
+        coll_item *it = &c->items[i];
+        it->name = xstrdup(name ? name : num);
+        it->path = xstrdup(name ? name : num);
+        it->label = amscr_index_label(x, i);
+        it->group = groups ? coll_name_index(&c->groups, &c->ngroups, g ? g : "", &gcap) : -1;
+        c->n = i + 1;
+        ok = it->name && it->path && (!groups || it->group >= 0);
+    }
+    if (!ok) {
+        collection_free(c);
+        return -1;
+    }
+    return 0;
+}
+
+int index_store_names(amscr_index *x, const collection *c, size_t from)
+{
+    amscr_status st = AMSCR_OK;
+    for (size_t i = 0; st == AMSCR_OK && i < c->n; i++) {
+        const coll_item *it = &c->items[i];
+        st = amscr_index_set_name(x, from + i, it->name);
+        if (st == AMSCR_OK && it->group >= 0)
+            st = amscr_index_set_group(x, from + i, c->groups[it->group]);
+    }
+    if (st != AMSCR_OK) {
+        tool_lib_error(NULL, st);
+        return -1;
+    }
+    return 0;
+}
+
+int index_db_with_params(const amscr_index *x, const amscr_params *p, const char *path, amscr_db **out)
+{
+    const amscr_db *src = amscr_index_db(x);
+    amscr_status st = amscr_db_new(p, out);
+    for (size_t i = 0; st == AMSCR_OK && i < amscr_db_size(src); i++)
+        st = amscr_db_add_descriptor(*out, amscr_db_descriptor(src, i), amscr_db_label(src, i), NULL);
+    if (st != AMSCR_OK) {
+        amscr_db_free(*out);
+        *out = NULL;
+        tool_lib_error(path, st);
+        return -1;
+    }
+    return 0;
 }
 
 int open_collection_db(const opts *o, const char *path, int (*check)(const opts *, const collection *),
                        amscr_params **p, collection *c, amscr_db **db)
 {
-    tool_index x;
-    int is_index, r = open_shapes(o, path, &x, &is_index);
-    if (r != 0)
-        return r;
-    if (is_index) {
-        r = index_params(o, path, &x, p);
+    int r;
+    if (index_file_is(path)) {
+        amscr_index *x = NULL;
+        if (index_open(path, &x) != 0)
+            return TOOL_EXIT_FAIL;
+        r = index_params(o, path, amscr_db_params(amscr_index_db(x)), p);
+        if (r == 0 && index_collection(x, c) != 0)
+            r = TOOL_EXIT_FAIL;
         if (r == 0 && check)
-            r = check(o, &x.coll);
-        if (r == 0 && o->threads_set) { /* the db's copy of the params gets the threads */
-            amscr_db *d2 = NULL;
-            amscr_status st = amscr_db_new(*p, &d2);
-            for (size_t i = 0; st == AMSCR_OK && i < amscr_db_size(x.db); i++)
-                st = amscr_db_add_descriptor(d2, amscr_db_descriptor(x.db, i), amscr_db_label(x.db, i), NULL);
-            if (st != AMSCR_OK) {
-                amscr_db_free(d2);
-                tool_lib_error(path, st);
-                r = TOOL_EXIT_FAIL;
-            } else {
-                amscr_db_free(x.db);
-                x.db = d2;
-            }
-        }
-        if (r == 0) {
-            *c = x.coll;
-            *db = x.db;
-            memset(&x.coll, 0, sizeof x.coll);
-            x.db = NULL;
-        }
-        index_free(&x);
+            r = check(o, c);
+        if (r == 0 && index_db_with_params(x, *p, path, db) != 0)
+            r = TOOL_EXIT_FAIL;
+        amscr_index_free(x);
         return r;
     }
     if ((r = make_params(o, 0, p)) != 0)

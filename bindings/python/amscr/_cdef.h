@@ -252,6 +252,8 @@ amscr_status amscr_index_set_name(amscr_index *x, size_t i, const char *name);
 const char *amscr_index_name(const amscr_index *x, size_t i);
 amscr_status amscr_index_set_class_name(amscr_index *x, int32_t label, const char *name);
 const char *amscr_index_class_name(const amscr_index *x, int32_t label);
+amscr_status amscr_index_set_group(amscr_index *x, size_t i, const char *group);
+const char *amscr_index_group(const amscr_index *x, size_t i);
 amscr_status amscr_index_save(const amscr_index *x, const char *path);
 amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_t *out_len);
 amscr_status amscr_index_load(const char *path, amscr_index **out);

@@ -22,7 +22,10 @@ How it runs:
   :meth:`amscr.Collection.distance_matrix`, :meth:`amscr.Collection.cross_matrix` and
   :meth:`amscr.Collection.query` element for element.
 * :func:`topk` keeps the k best of each tile row and merges these partial lists in a tree,
-  without ever materializing the full matrix. Ranking is by (distance, index): the order of
+  without ever materializing the full matrix. When the collection's params ask for retrieval
+  (channel weight > 0 or re-ranking on), a query's scores depend on the whole collection (the
+  retrieval matrix's fusion and re-ranking), so a tile is a block of queries against every
+  shape, each scored by ``amscr_db_query_retrieval`` as :meth:`amscr.Collection.query` does. Ranking is by (distance, index): the order of
   ``np.argsort(row, kind='stable')`` (NaN last), so ties go to the lower index.
 * ``client=None`` starts a local cluster (one single-threaded worker process per core), computes
   and closes it. With a client, :func:`distance_matrix` and :func:`cross_matrix` return a lazy
@@ -60,8 +63,10 @@ except ImportError as e:  # pragma: no cover - exercised only without Dask
     raise ImportError('amscr.distributed needs Dask: pip install "dask[distributed]>=2023" '
                       '(or pip install "amscr[distributed]")') from e
 
+from ._lib import ffi, lib
+from ._util import dbuf
 from .collection import Collection
-from .errors import AmscrError, FormatError
+from .errors import AmscrError, FormatError, _check
 from .shape import Shape
 
 __all__ = ['distance_matrix', 'cross_matrix', 'topk', 'tile_size', 'LostTilesError']
@@ -222,6 +227,25 @@ def _tile_candidates(D: np.ndarray, c0: int, k: int, exclude: Optional[np.ndarra
 def _topk_tile(qpayload: _Payload, tpayload: _Payload, c0: int, c1: int, k: int,
                exclude: Optional[np.ndarray], threads) -> Tuple[np.ndarray, np.ndarray]:
     return _tile_candidates(_cross_tile(qpayload, tpayload, c0, c1, threads), c0, k, exclude)
+
+
+def _retrieval_tile(qpayload: _Payload, tpayload: _Payload, k: int, exclude: Optional[np.ndarray],
+                    threads) -> Tuple[np.ndarray, np.ndarray]:
+    """The k best of each query of a block by its retrieval scores against every target: the
+    scores of :meth:`Collection.query` (C ``amscr_db_query_retrieval``, one query at a time)."""
+    t = _tile_threads(threads)
+    q, coll = qpayload.collection(t), tpayload.collection(t)
+    D = np.empty((len(q), len(coll)), dtype=np.float64)
+    with q._lock.read(), coll._lock.read():
+        for i in range(len(q)):
+            _check(lib.amscr_db_query_retrieval(coll._db, lib.amscr_db_descriptor(q._db, i), ffi.NULL, ffi.NULL,
+                                                dbuf(D[i]), D.shape[1]))
+    return _tile_candidates(D, 0, k, exclude)
+
+
+def _wants_retrieval(p) -> bool:
+    """The params ask for the retrieval scores (as :meth:`Collection.query` decides)."""
+    return p.channel_weight > 0 or p.rerank_k > 0
 
 
 def _merge(k: int, *parts: Tuple[np.ndarray, np.ndarray]) -> Tuple[np.ndarray, np.ndarray]:
@@ -571,7 +595,10 @@ def topk(queries: Union[Collection, Iterable[Any], bytes], collection: Union[Col
     Returns:
         (indices, distances), each (len(queries), k): for query i the targets ordered as
         ``np.argsort(collection.query(q_i), kind='stable')`` (ascending distance, NaN last, ties
-        by lower index), excluded target removed.
+        by lower index), excluded target removed. With params that ask for retrieval
+        (``channel_weight`` > 0 or ``rerank_k`` > 0) the distances are the retrieval scores of
+        :meth:`Collection.query`, each query scored against the whole collection (one tile a
+        query block).
     """
     t = _as_collection(collection, 'collection')
     threads = _check_threads(threads)
@@ -593,16 +620,22 @@ def topk(queries: Union[Collection, Iterable[Any], bytes], collection: Union[Col
     distances = np.zeros((nq, k), dtype=np.float64)
     if nq == 0 or k == 0:
         return indices, distances
+    retrieval = _wants_retrieval(t.params)
     with _client_or_local(client) as c:
         row_b, col_b, th, tmaker, qmakers = _cross_layout(c, q, t, tile, threads)
         tpay, qpays = _Scattered(c, [tmaker], broadcast=True), _Scattered(c, qmakers, broadcast=False)
         token = uuid.uuid4().hex
+        if retrieval:  # a query's scores need the whole collection: one column block
+            col_b = [(0, nt)]
 
         def submit_row(i, attempt):
             """The tiles of query block i and their merge tree; returns the root's future."""
             r0, r1 = row_b[i]
             exi = None if ex is None else ex[r0:r1]
             name = '%s-%d-%d' % (token, i, attempt)
+            if retrieval:
+                return c.submit(_retrieval_tile, qpays[i], tpay[0], k, exi, th, retries=retries, pure=False,
+                                key='amscr-topk-%s-r' % name)
             level = [c.submit(_topk_tile, qpays[i], tpay[0], c0, c1, k, exi, th, retries=retries, pure=False,
                               key='amscr-topk-%s-%d' % (name, j)) for j, (c0, c1) in enumerate(col_b)]
             depth = 0

@@ -163,6 +163,25 @@ def test_topk_equals_single_machine_query(client, db, queries):
     assert np.array_equal(idx2, idx[:3]) and np.array_equal(dist2, dist[:3])
 
 
+@pytest.mark.parametrize('options', [{}, {'channel_weight': 0.5}, {'rerank_k': 0}])
+def test_topk_by_retrieval_scores_equals_collection_query(client, options):
+    """Params that ask for retrieval: top-k by the scores of Collection.query (the retrieval
+    matrix's row of the collection plus the query), element for element, exclusions too."""
+    coll = amscr.Collection(amscr.Params.retrieval(points=POINTS, threads=1, **options))
+    coll.extend(_shapes(30, 500), [i % 5 for i in range(30)])
+    pts = _shapes(5, 20_000) + [coll.shape(3).input_points]
+    k = 7
+    idx, dist = _within(lambda: ad.topk(pts, coll, k=k, client=client, tile=(2, 8)))
+    ex = [-1, 2, -1, -1, 0, 3]
+    idx2, dist2 = _within(lambda: ad.topk(pts, coll, k=k, client=client, exclude=ex))
+    for i, q in enumerate(pts):
+        row = coll.query(q)
+        assert np.array_equal(idx[i], _ranking(row, k)), i
+        assert np.array_equal(dist[i], row[idx[i]]), i
+        assert np.array_equal(idx2[i], _ranking(row, k, exclude=ex[i])), i
+        assert np.array_equal(dist2[i], row[idx2[i]]), i
+
+
 def test_topk_leave_one_out_equals_matrix_rows(client, db, D):
     """A collection against itself, each shape excluded: the ranking of the query rows."""
     n, k = len(db), 12
