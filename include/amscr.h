@@ -2421,6 +2421,31 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load(const char *path, amscr_
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out);
 
+/** Load flag: the shapes' channel features are not computed at load; each query computes those
+ *  of the candidates it matches (for one or a few queries a load, e.g. a command-line search);
+ *  without it a load computes every shape's once, on the params' threads (for many queries).
+ *  Scores are the same either way. @since 0.4 */
+#define AMSCR_INDEX_LAZY 1u
+
+/**
+ * @brief amscr_index_load with flags (0 or AMSCR_INDEX_LAZY).
+ * @return as amscr_index_load; AMSCR_E_INVALID_ARG for an unknown flag.
+ * Ownership: caller frees *out with amscr_index_free.
+ * Thread-safety: reentrant.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index **out);
+
+/**
+ * @brief amscr_index_load_memory with flags (0 or AMSCR_INDEX_LAZY).
+ * @return as amscr_index_load_memory; AMSCR_E_INVALID_ARG for an unknown flag.
+ * Ownership: caller frees *out with amscr_index_free; buf is not kept.
+ * Thread-safety: reentrant.
+ * @since 0.4
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory_with(const void *buf, size_t len, unsigned flags,
+                                                                    amscr_index **out);
+
 /**
  * @brief Frees an index. Accepts NULL.
  * Ownership: x. Thread-safety: exclusive on x.

@@ -154,6 +154,31 @@ static void same_query(const amscr_index *a, const amscr_index *b, const amscr_d
         ck_assert(sa[j] == sb[j] || (isinf(sa[j]) && isinf(sb[j])));
 }
 
+/* A lazy load (AMSCR_INDEX_LAZY: channel features built per query) gives the same scores as an
+ * eager one, for every shape a candidate and for a shortlist; an add on it matches the old
+ * shapes too; an unknown flag is refused. */
+START_TEST(lazy_load)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_index *x = named_index(p, 0), *y = NULL, *z = NULL;
+    amscr_descriptor *q = shape(p, 2000);
+    void *buf = NULL;
+    size_t len = 0;
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_load_memory_with(buf, len, AMSCR_INDEX_LAZY, &y), AMSCR_OK);
+    same_query(x, y, q, 0);
+    same_query(x, y, q, 6);
+    ck_assert_int_eq(amscr_index_load_memory_with(buf, len, 2u, &z), AMSCR_E_INVALID_ARG);
+    ck_assert_ptr_null(z);
+    ck_assert_int_eq(amscr_index_load_with("check_index_no_such.idx", 8u, &z), AMSCR_E_INVALID_ARG);
+    amscr_free(buf);
+    amscr_index_free(x);
+    amscr_index_free(y);
+    amscr_descriptor_free(q);
+    amscr_params_free(p);
+}
+END_TEST
+
 START_TEST(round_trips)
 {
     amscr_params *p = params_of(1.0, 8, 2);
@@ -407,6 +432,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, exact_large_k);
     tcase_add_test(tc, member_rows);
     tcase_add_test(tc, round_trips);
+    tcase_add_test(tc, lazy_load);
     tcase_add_test(tc, bad_files);
     tcase_add_test(tc, add_shapes);
     tcase_add_test(tc, thread_independence);

@@ -18,7 +18,9 @@ struct amscr_index {
     float *sig;           /* n x sig_dim (signature.h) */
     float *sig_lb;        /* n x AMSCR__SIG_LB_DIM: their lower-bound vectors */
     int nf;               /* channel frames whose features are kept (0: no channel) */
-    amscr__hf *hf;        /* n x nf: each shape's channel features, ready for matching */
+    amscr__hf *hf;        /* n x nf: each shape's channel features, ready for matching (an entry
+                           * with no sequences, after a lazy load: built where a pair needs it) */
+    int lazy;             /* loaded with AMSCR_INDEX_LAZY: features of loaded shapes not built */
     uint32_t *nb_idx;     /* n x k: itself first, then by (base distance, index) */
     double *nb_dist;      /* n x k */
     char **names;         /* n entries (NULL: unnamed) */

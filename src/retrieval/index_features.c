@@ -22,8 +22,8 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
     if (!j->have_sig)
         amscr__shape_signature(d, sig);
     amscr__sig_bound_vector(sig, x->sig_lb + i * AMSCR__SIG_LB_DIM);
-    if (x->nf == 0)
-        return AMSCR_OK;
+    if (x->nf == 0 || (x->lazy && j->have_sig))
+        return AMSCR_OK; /* a lazy load: built by the pairs that need them (index_pairs.c) */
     amscr__hf *hf = x->hf + i * (size_t)x->nf;
     for (int f = 0; f < x->nf; f++)
         amscr__hf_free(&hf[f]);

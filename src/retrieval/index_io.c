@@ -172,11 +172,15 @@ static amscr_status read_names(amscr__rbuf *r, amscr_index *x)
     return AMSCR_OK;
 }
 
-amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out)
+static amscr_status check_flags(unsigned flags, const char *what)
 {
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(buf);
-    AMSCR_CHECK_NULL(out);
+    if (flags & ~(unsigned)AMSCR_INDEX_LAZY)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: unknown flags 0x%x", what, flags & ~(unsigned)AMSCR_INDEX_LAZY);
+    return AMSCR_OK;
+}
+
+static amscr_status load_memory(const void *buf, size_t len, unsigned flags, amscr_index **out)
+{
     amscr_db *db = NULL;
     size_t pos = 0;
     uint32_t version = 0;
@@ -191,6 +195,7 @@ amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **
     x->db = db;
     x->sig_dim = AMSCR__SIG_DIM;
     x->nf = amscr__index_frames(amscr_db_params(db));
+    x->lazy = (flags & AMSCR_INDEX_LAZY) != 0;
     amscr__rbuf r = {buf, len - 8, pos, 0};
     uint64_t sec = version >= AMSCR__DB_VERSION_INDEX ? amscr__r_u64(&r) : 0;
     if (version < AMSCR__DB_VERSION_INDEX)
@@ -216,17 +221,34 @@ amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **
     return AMSCR_OK;
 }
 
-amscr_status amscr_index_load(const char *path, amscr_index **out)
+amscr_status amscr_index_load_memory_with(const void *buf, size_t len, unsigned flags, amscr_index **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(buf);
+    AMSCR_CHECK_NULL(out);
+    amscr_status st = check_flags(flags, "amscr_index_load_memory_with");
+    return st == AMSCR_OK ? load_memory(buf, len, flags, out) : st;
+}
+
+amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out)
+{
+    return amscr_index_load_memory_with(buf, len, 0, out);
+}
+
+amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index **out)
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(path);
     AMSCR_CHECK_NULL(out);
-    unsigned char *buf = NULL;
-    size_t len = 0;
-    amscr_status st = amscr__file_read(path, &buf, &len);
+    amscr_status st = check_flags(flags, "amscr_index_load_with");
     if (st != AMSCR_OK)
         return st;
-    st = amscr_index_load_memory(buf, len, out);
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    st = amscr__file_read(path, &buf, &len);
+    if (st != AMSCR_OK)
+        return st;
+    st = load_memory(buf, len, flags, out);
     if (st != AMSCR_OK) {
         char d[400];
         snprintf(d, sizeof d, "%s", amscr_last_error_detail());
@@ -234,4 +256,9 @@ amscr_status amscr_index_load(const char *path, amscr_index **out)
     }
     free(buf);
     return st;
+}
+
+amscr_status amscr_index_load(const char *path, amscr_index **out)
+{
+    return amscr_index_load_with(path, 0, out);
 }

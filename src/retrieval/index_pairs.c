@@ -90,8 +90,11 @@ amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const a
     for (size_t t = 0; t < m && st == AMSCR_OK; t++) {
         const amscr_descriptor *d = amscr_db_descriptor(db, cand[t]);
         amscr__hf built[2];
-        const amscr__hf *hd = hfs ? hfs + cand[t] * (size_t)b->nf : built;
-        if (!hfs)
+        const amscr__hf *stored = hfs ? hfs + cand[t] * (size_t)b->nf : NULL;
+        /* not kept, or not built yet (an index loaded with AMSCR_INDEX_LAZY): built here */
+        int build = !stored || (b->nf > 0 && stored[0].seq[0] == NULL);
+        const amscr__hf *hd = build ? built : stored;
+        if (build)
             st = amscr__base_hf(b, d, built);
         if (st != AMSCR_OK)
             break;
@@ -99,7 +102,7 @@ amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const a
             st = base_pair(b, d, hd, q, hq, pw, &out[t]);
         else
             st = base_pair(b, q, hq, d, hd, pw, &out[t]);
-        if (!hfs)
+        if (build)
             amscr__base_hf_free(b, built);
     }
     return st;

@@ -50,7 +50,7 @@ int cmd_index(opts *o)
     collection c;
     memset(&c, 0, sizeof c);
     int r = TOOL_EXIT_FAIL;
-    if (o->add && index_open(o->out, &x) != 0)
+    if (o->add && index_open(o->out, 0, &x) != 0)
         return TOOL_EXIT_FAIL;
     if (collection_open(o->pos[0], &c) == 0)
         r = o->add ? index_add(o, x, &c) : build(o, &c, &x);

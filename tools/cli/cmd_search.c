@@ -203,7 +203,7 @@ static int open_target(const opts *o, amscr_index **x, amscr_params **p, collect
             return r;
         return collection_open(cpath, c) == 0 && load_db(*p, c, o->threshold, db) == 0 ? 0 : TOOL_EXIT_FAIL;
     }
-    if (index_open(cpath, x) != 0)
+    if (index_open(cpath, 1, x) != 0)
         return TOOL_EXIT_FAIL;
     if ((r = index_params(o, cpath, amscr_db_params(amscr_index_db(*x)), p)) != 0)
         return r;

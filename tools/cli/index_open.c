@@ -101,9 +101,9 @@ int index_file_is(const char *path)
     return got == sizeof m && (memcmp(m, "AMSCRIDX", 8) == 0 || memcmp(m, "AMSCRDB", 7) == 0);
 }
 
-int index_open(const char *path, amscr_index **out)
+int index_open(const char *path, int lazy, amscr_index **out)
 {
-    amscr_status st = amscr_index_load(path, out);
+    amscr_status st = amscr_index_load_with(path, lazy ? AMSCR_INDEX_LAZY : 0u, out);
     if (st != AMSCR_OK) {
         tool_lib_error(path, st);
         return -1;
@@ -203,7 +203,7 @@ int open_collection_db(const opts *o, const char *path, int (*check)(const opts 
     int r;
     if (index_file_is(path)) {
         amscr_index *x = NULL;
-        if (index_open(path, &x) != 0)
+        if (index_open(path, 1, &x) != 0)
             return TOOL_EXIT_FAIL;
         r = index_params(o, path, amscr_db_params(amscr_index_db(x)), p);
         if (r == 0 && index_collection(x, c) != 0)

@@ -13,9 +13,10 @@
 /* Non-zero when the file at path is an amscr binary file (an index, a collection file, or an
  * index of the tool before 0.4), not a folder or a manifest. */
 int index_file_is(const char *path);
-/* Reads an index file; 0, or -1 after printing one error line (the library's: a collection
- * file without an index or an old tool index says to rebuild it). */
-int index_open(const char *path, amscr_index **out);
+/* Reads an index file (lazy != 0: AMSCR_INDEX_LAZY, for a command that queries it once or
+ * only reads its collection); 0, or -1 after printing one error line (the library's: a
+ * collection file without an index or an old tool index says to rebuild it). */
+int index_open(const char *path, int lazy, amscr_index **out);
 /* The index's file names, classes and groups as a collection (item paths are the names). */
 int index_collection(const amscr_index *x, collection *out);
 /* Stores the file names and groups of collection c into shapes from..from+c->n-1 of the

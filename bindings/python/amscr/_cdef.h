@@ -13,6 +13,7 @@
 #define AMSCR_THRESHOLD_AUTO -1
 #define AMSCR_TRACE_PIXEL_CHAIN 1
 #define AMSCR_INDEX_CANDIDATES 256
+#define AMSCR_INDEX_LAZY 1
 
 typedef enum amscr_status {
     AMSCR_OK = 0,
@@ -258,6 +259,8 @@ amscr_status amscr_index_save(const amscr_index *x, const char *path);
 amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_t *out_len);
 amscr_status amscr_index_load(const char *path, amscr_index **out);
 amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out);
+amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index **out);
+amscr_status amscr_index_load_memory_with(const void *buf, size_t len, unsigned flags, amscr_index **out);
 void amscr_index_free(amscr_index *x);
 amscr_status amscr_channel_distance(const amscr_params *p, const amscr_descriptor *a, const amscr_descriptor *b, double *out_dist);
 amscr_status amscr_topk(const double *dist, size_t n, size_t k, size_t exclude, size_t *out_indices);
