@@ -30,8 +30,11 @@ import time
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, '..', 'bindings', 'python'))
-import amscr  # noqa: E402
+try:  # the installed package (scripts/setup.sh puts it into .venv)
+    import amscr  # noqa: E402
+except ImportError:  # else this checkout's, with AMSCR_LIBRARY naming build/libamscr.so.0
+    sys.path.insert(0, os.path.join(HERE, '..', 'bindings', 'python'))
+    import amscr  # noqa: E402
 
 CONDITIONS = [
     ('clean', 'clean', 0.0, 99.5),

@@ -20,9 +20,7 @@ static double iso_sample(const amscr__iso *f, size_t x, size_t y)
     return f->p8 ? (double)f->p8[i] : (double)f->p16[i];
 }
 
-/* Otsu's split t (class 0: v <= t) on nb bins: the middle of the plateau of maxima of the
- * between-class variance; -1 when the image has one value. */
-static long iso_otsu(const uint64_t *hist, size_t nb)
+long amscr__otsu(const uint64_t *hist, size_t nb)
 {
     double total = 0.0, sum_all = 0.0;
     for (size_t v = 0; v < nb; v++) {
@@ -74,7 +72,7 @@ static amscr_status iso_auto_level(const amscr__iso *f, double *out)
     for (size_t y = 0; y < f->h; y++)
         for (size_t x = 0; x < f->w; x++)
             hist[(size_t)iso_sample(f, x, y)]++;
-    long t = iso_otsu(hist, nb);
+    long t = amscr__otsu(hist, nb);
     uint64_t n0 = 0, n = (uint64_t)f->w * f->h;
     for (long v = 0; v <= t; v++)
         n0 += hist[v];

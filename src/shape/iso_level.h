@@ -20,6 +20,10 @@ typedef struct amscr__iso {
     double pad;          /* the frame's field value: the background's mean level, < 0 */
 } amscr__iso;
 
+/* Otsu's split t (class 0: v <= t) on nb bins: the middle of the plateau of maxima of the
+ * between-class variance; -1 when the image has one value (used by trace.c too). */
+long amscr__otsu(const uint64_t *hist, size_t nb);
+
 /* The level (given, or automatic when level < 0: halfway between the medians of the two
  * classes of Otsu's split), the polarity and the frame value. Arguments are validated by the caller. */
 amscr_status amscr__iso_setup(const void *pixels, size_t w, size_t h, size_t stride, int bits, double level,

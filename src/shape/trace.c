@@ -8,6 +8,7 @@
  * Memory: (width+2)*(height+2) bytes for the padded mask plus 4 bytes per foreground
  * pixel for the queue, plus the boundary itself. */
 #include "internal.h"
+#include "iso_level.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -31,35 +32,14 @@ static const int tr_newback[8] = {6, 6, 0, 0, 2, 2, 4, 4};
  * all on (value 255) or all off. */
 static int tr_otsu(const uint64_t hist[256])
 {
-    double total = 0.0, sum_all = 0.0;
-    for (int v = 0; v < 256; v++) {
-        total += (double)hist[v];
-        sum_all += (double)v * (double)hist[v];
-    }
-    double n0 = 0.0, s0 = 0.0, best = -1.0;
-    int t_first = -1, t_last = -1;
-    for (int t = 0; t < 255; t++) {
-        n0 += (double)hist[t];
-        s0 += (double)t * (double)hist[t];
-        double n1 = total - n0;
-        if (n0 <= 0.0 || n1 <= 0.0)
-            continue;
-        double d = s0 / n0 - (sum_all - s0) / n1;
-        double vb = n0 * n1 * d * d;
-        if (vb > best) {
-            best = vb;
-            t_first = t_last = t;
-        } else if (vb == best && t_last == t - 1) {
-            t_last = t;
-        }
-    }
-    if (t_first < 0) { /* one value only */
+    long t = amscr__otsu(hist, 256);
+    if (t < 0) { /* one value only */
         for (int v = 0; v < 256; v++)
             if (hist[v])
                 return v >= 255 ? 254 : v;
         return 0;
     }
-    return (t_first + t_last) / 2;
+    return (int)t;
 }
 
 /* Step 0: the arguments. */

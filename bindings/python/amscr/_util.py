@@ -138,6 +138,17 @@ def dbuf(a: np.ndarray):
     return ffi.from_buffer('double[]', a)
 
 
+def saved_bytes(save_memory, obj) -> bytes:
+    """The bytes of save_memory(obj, void **, size_t *) (a buffer the library allocated)."""
+    buf = ffi.new('void **')
+    n = ffi.new('size_t *')
+    _check(save_memory(obj, buf, n))
+    try:
+        return bytes(ffi.buffer(buf[0], n[0]))
+    finally:
+        lib.amscr_free(buf[0])
+
+
 def copy_doubles(p, count: int) -> np.ndarray:
     """Copies `count` doubles from a borrowed C pointer into a new numpy array."""
     if p == ffi.NULL:

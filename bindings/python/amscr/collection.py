@@ -8,7 +8,7 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ProgressArg, RWLock, as_points, bad, dbuf, new_object, progress_call
+from ._util import ProgressArg, RWLock, as_points, bad, dbuf, new_object, progress_call, saved_bytes
 from .contour import contour_new
 from .errors import _check
 from .params import Params, make_params
@@ -347,13 +347,7 @@ class Collection:
             bytes (give them to :meth:`from_bytes`).
         """
         with self._lock.read():
-            buf = ffi.new('void **')
-            n = ffi.new('size_t *')
-            _check(lib.amscr_db_save_memory(self._db, buf, n))
-            try:
-                return bytes(ffi.buffer(buf[0], n[0]))
-            finally:
-                lib.amscr_free(buf[0])
+            return saved_bytes(lib.amscr_db_save_memory, self._db)
 
     @classmethod
     def from_bytes(cls, data: Union[bytes, bytearray, memoryview],

@@ -7,7 +7,7 @@ from typing import Any, List, Optional, Tuple, Union
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ProgressArg, RWLock, bad, dbuf, new_object, progress_call
+from ._util import ProgressArg, RWLock, bad, dbuf, new_object, progress_call, saved_bytes
 from .collection import Collection, _new_db
 from .errors import _check
 from .shape import PointsLike, as_shape
@@ -99,13 +99,7 @@ class Index:
             bytes (give them to :meth:`from_bytes`).
         """
         with self._lock.read():
-            buf = ffi.new('void **')
-            n = ffi.new('size_t *')
-            _check(lib.amscr_index_save_memory(self._x, buf, n))
-            try:
-                return bytes(ffi.buffer(buf[0], n[0]))
-            finally:
-                lib.amscr_free(buf[0])
+            return saved_bytes(lib.amscr_index_save_memory, self._x)
 
     @classmethod
     def from_bytes(cls, data: Union[bytes, bytearray, memoryview]) -> 'Index':
