@@ -27,7 +27,8 @@ ms/pair: wall time per pair (the tool's includes process start and PNG decoding)
 Usage: nice .venv/bin/python bench/registration_traced.py [--data DIR] [--tool PATH] [--draws 2]
        [--no-ecc] [--no-chain] [--conditions clean,lowres,...] [--fold A|B] [--json OUT]
 --conditions (alias --only) and --fold restrict the run (the tables then show what ran);
---no-chain skips the --pixel-chain column. "lib ms": the library alone in this process (the
+--no-chain skips the --pixel-chain column; --breakdown splits the library's time (the traces,
+the registration, without the polish, without the polish and the refinement). "lib ms": the library alone in this process (the
 Python binding: both images traced by amscr.contour_from_mask, then amscr.register), the
 median over the condition's pairs; skipped when the amscr package is not importable.
 Deterministic: every draw is seeded by (class index, condition, draw).
@@ -175,15 +176,27 @@ def map_error(M, T, f):
     return 100 * float(np.sqrt((d * d).sum(axis=1)).max() / shape_size(apply(T, f)))
 
 
-def lib_register_ms(src, tgt):
-    """Wall time (ms) of the library alone on the pair: both traces and the registration."""
+def lib_register_ms(src, tgt, breakdown=None):
+    """Wall time (ms) of the library alone on the pair: both traces and the registration.
+    breakdown: a list that receives the ms of (the two traces, the registration, the
+    registration without the polish, without the polish and the refinement)."""
     try:
         import amscr
     except ImportError:
         return math.nan
     t0 = time.perf_counter()
-    amscr.register(amscr.contour_from_mask(src), amscr.contour_from_mask(tgt))
-    return 1000 * (time.perf_counter() - t0)
+    ps, pt = amscr.contour_from_mask(src), amscr.contour_from_mask(tgt)
+    t1 = time.perf_counter()
+    amscr.register(ps, pt)
+    t2 = time.perf_counter()
+    if breakdown is not None:
+        times = [t1 - t0, t2 - t1]
+        for opts in ({'polish': False}, {'polish': False, 'refine': 0}):
+            t3 = time.perf_counter()
+            amscr.register(ps, pt, **opts)
+            times.append(time.perf_counter() - t3)
+        breakdown.extend(1000 * t for t in times)
+    return 1000 * (t2 - t0)
 
 
 def tool_register(tool, sp, tp, extra):
@@ -241,7 +254,7 @@ METHODS = [('sub', 'amscr sub-pixel'), ('chain', 'amscr --pixel-chain'), ('ecc',
 EXTRA = [('lib', 'library alone')]  # timing only
 
 
-def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True):
+def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=None):
     if key in ('lowres', 'grey'):
         src, tgt = reduce(src, key == 'lowres'), reduce(tgt, key == 'lowres')
         T = compose(S_LOW, compose(T, inv_affine(S_LOW)))
@@ -255,7 +268,7 @@ def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True):
             continue
         M, conf, ms = tool_register(tool, sp, tp, extra)
         out[m] = (map_error(M, T, f), conf, ms)
-    out['lib'] = (0.0, 0.0, lib_register_ms(src, tgt))
+    out['lib'] = (0.0, 0.0, lib_register_ms(src, tgt, breakdown))
     if use_ecc:
         t0 = time.perf_counter()
         W = ecc_register(src, tgt)
@@ -306,6 +319,8 @@ def main():
     ap.add_argument('--conditions', '--only', dest='only', default='',
                     help='comma-separated condition keys: ' + ','.join(c[0] for c in CONDITIONS))
     ap.add_argument('--fold', default='', choices=['', 'A', 'B'], help='one fold of folds.tsv only')
+    ap.add_argument('--breakdown', action='store_true',
+                    help="the library's time split: traces, registration, without polish, without polish and refinement")
     ap.add_argument('--classes', type=int, default=0, help='the first N classes only (0: all)')
     ap.add_argument('--json', default=None)
     a = ap.parse_args()
@@ -324,6 +339,7 @@ def main():
     keys = [c[0] for c in conds]
     res = {fold: {k: {m: [] for m, _ in METHODS + EXTRA} for k, _, _ in CONDITIONS} for fold in ('A', 'B', 'all')}
     rows = []
+    split = {}  # condition -> [ms of the traces, register, no polish, no polish + no refine]
     with tempfile.TemporaryDirectory() as tmp:
         for ci, (cls, path, fold) in enumerate(classes):
             src = load_source(path)
@@ -333,7 +349,10 @@ def main():
                     rng = np.random.default_rng([class_index[cls], [c[0] for c in CONDITIONS].index(key), d, 2024])
                     tgt, T = make_target(src, f, rng)
                     tgt = damage(key, tgt, apply(T, f), rng)
-                    out = run_pair(a.tool, tmp, key, src, tgt, f, T, use_ecc)
+                    bd = [] if a.breakdown else None
+                    out = run_pair(a.tool, tmp, key, src, tgt, f, T, use_ecc, use_chain, bd)
+                    if bd:
+                        split.setdefault(key, []).append(bd)
                     rows.append({'class': cls, 'fold': fold, 'condition': key, 'draw': d,
                                  **{m: list(v) for m, v in out.items()}})
                     for m, v in out.items():
@@ -345,6 +364,11 @@ def main():
     for fold, title in (('A', 'fold 1 (folds.tsv A)'), ('B', 'fold 2 (folds.tsv B)'), ('all', 'both folds')):
         if any(res[fold][k]['sub'] for k in keys):
             print_table(title, res[fold], conds, use_ecc, use_chain)
+    if split:
+        print('\nlibrary ms, medians over the run: traces | register | no polish | no polish, no refine')
+        for key in keys:
+            if key in split:
+                print('%-10s' % key + ' | '.join('%7.2f' % v for v in np.median(np.array(split[key]), axis=0)))
     if a.json:
         with open(a.json, 'w') as fp:
             json.dump(rows, fp)
