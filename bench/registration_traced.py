@@ -25,7 +25,12 @@ lowres and grey). Wrong + confident: a failure the tool reports with confidence 
 ms/pair: wall time per pair (the tool's includes process start and PNG decoding).
 
 Usage: nice .venv/bin/python bench/registration_traced.py [--data DIR] [--tool PATH] [--draws 2]
-       [--no-ecc] [--json OUT]
+       [--no-ecc] [--no-chain] [--conditions clean,lowres,...] [--fold A|B] [--json OUT]
+--conditions (alias --only) and --fold restrict the run (the tables then show what ran);
+--no-chain skips the --pixel-chain column; --breakdown splits the library's time (the traces,
+the registration, without the polish, without the polish and the refinement). "lib ms": the library alone in this process (the
+Python binding: both images traced by amscr.contour_from_mask, then amscr.register), the
+median over the condition's pairs; skipped when the amscr package is not importable.
 Deterministic: every draw is seeded by (class index, condition, draw).
 """
 import argparse
@@ -171,6 +176,29 @@ def map_error(M, T, f):
     return 100 * float(np.sqrt((d * d).sum(axis=1)).max() / shape_size(apply(T, f)))
 
 
+def lib_register_ms(src, tgt, breakdown=None):
+    """Wall time (ms) of the library alone on the pair: both traces and the registration.
+    breakdown: a list that receives the ms of (the two traces, the registration, the
+    registration without the polish, without the polish and the refinement)."""
+    try:
+        import amscr
+    except ImportError:
+        return math.nan
+    t0 = time.perf_counter()
+    ps, pt = amscr.contour_from_mask(src), amscr.contour_from_mask(tgt)
+    t1 = time.perf_counter()
+    amscr.register(ps, pt)
+    t2 = time.perf_counter()
+    if breakdown is not None:
+        times = [t1 - t0, t2 - t1]
+        for opts in ({'polish': False}, {'polish': False, 'refine': 0}):
+            t3 = time.perf_counter()
+            amscr.register(ps, pt, **opts)
+            times.append(time.perf_counter() - t3)
+        breakdown.extend(1000 * t for t in times)
+    return 1000 * (t2 - t0)
+
+
 def tool_register(tool, sp, tp, extra):
     t0 = time.perf_counter()
     r = subprocess.run([tool, 'register', sp, tp, '--json'] + extra, capture_output=True, text=True)
@@ -223,9 +251,10 @@ def load_classes(data):
 
 
 METHODS = [('sub', 'amscr sub-pixel'), ('chain', 'amscr --pixel-chain'), ('ecc', 'OpenCV ECC')]
+EXTRA = [('lib', 'library alone')]  # timing only
 
 
-def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc):
+def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=None):
     if key in ('lowres', 'grey'):
         src, tgt = reduce(src, key == 'lowres'), reduce(tgt, key == 'lowres')
         T = compose(S_LOW, compose(T, inv_affine(S_LOW)))
@@ -235,8 +264,11 @@ def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc):
     cv2.imwrite(tp, tgt)
     out = {}
     for m, extra in (('sub', []), ('chain', ['--pixel-chain'])):
+        if m == 'chain' and not use_chain:
+            continue
         M, conf, ms = tool_register(tool, sp, tp, extra)
         out[m] = (map_error(M, T, f), conf, ms)
+    out['lib'] = (0.0, 0.0, lib_register_ms(src, tgt, breakdown))
     if use_ecc:
         t0 = time.perf_counter()
         W = ecc_register(src, tgt)
@@ -255,10 +287,10 @@ def summary(recs, thr):
             len(recs))
 
 
-def print_table(title, res, conds, use_ecc):
+def print_table(title, res, conds, use_ecc, use_chain=True):
     print('\n%s' % title)
     head = '%-34s' % 'condition'
-    methods = [m for m in METHODS if use_ecc or m[0] != 'ecc']
+    methods = [m for m in METHODS if (use_ecc or m[0] != 'ecc') and (use_chain or m[0] != 'chain')]
     for _, lab in methods:
         head += ' | %-30s' % lab
     print(head)
@@ -271,6 +303,9 @@ def print_table(title, res, conds, use_ecc):
                 line += ' | %5.1f      -  %9.3f %5.0f' % (s[0], s[2], s[3])
             else:
                 line += ' | %5.1f  %5.1f  %9.3f %5.0f' % (s[0], s[1], s[2], s[3])
+        lib = [r[2] for r in res[key]['lib']]
+        if lib and np.all(np.isfinite(lib)):
+            line += ' | lib ms median %.1f' % float(np.median(lib))
         print(line)
 
 
@@ -280,7 +315,12 @@ def main():
     ap.add_argument('--tool', default=os.path.join(ROOT, 'build', 'tools', 'amscr'))
     ap.add_argument('--draws', type=int, default=2)
     ap.add_argument('--no-ecc', action='store_true')
-    ap.add_argument('--only', default='', help='comma-separated condition keys')
+    ap.add_argument('--no-chain', action='store_true', help='skip the --pixel-chain column')
+    ap.add_argument('--conditions', '--only', dest='only', default='',
+                    help='comma-separated condition keys: ' + ','.join(c[0] for c in CONDITIONS))
+    ap.add_argument('--fold', default='', choices=['', 'A', 'B'], help='one fold of folds.tsv only')
+    ap.add_argument('--breakdown', action='store_true',
+                    help="the library's time split: traces, registration, without polish, without polish and refinement")
     ap.add_argument('--classes', type=int, default=0, help='the first N classes only (0: all)')
     ap.add_argument('--json', default=None)
     a = ap.parse_args()
@@ -289,22 +329,30 @@ def main():
         return 0
     use_ecc = not a.no_ecc
     classes = load_classes(a.data)
+    class_index = {c[0]: i for i, c in enumerate(classes)}  # the seeds do not depend on --fold
     if a.classes:
         classes = classes[:a.classes]
+    if a.fold:
+        classes = [c for c in classes if c[2] == a.fold]
+    use_chain = not a.no_chain
     conds = [c for c in CONDITIONS if not a.only or c[0] in a.only.split(',')]
     keys = [c[0] for c in conds]
-    res = {fold: {k: {m: [] for m, _ in METHODS} for k, _, _ in CONDITIONS} for fold in ('A', 'B', 'all')}
+    res = {fold: {k: {m: [] for m, _ in METHODS + EXTRA} for k, _, _ in CONDITIONS} for fold in ('A', 'B', 'all')}
     rows = []
+    split = {}  # condition -> [ms of the traces, register, no polish, no polish + no refine]
     with tempfile.TemporaryDirectory() as tmp:
         for ci, (cls, path, fold) in enumerate(classes):
             src = load_source(path)
             f = subpixel_contour(src)
             for key in keys:
                 for d in range(a.draws):
-                    rng = np.random.default_rng([ci, [c[0] for c in CONDITIONS].index(key), d, 2024])
+                    rng = np.random.default_rng([class_index[cls], [c[0] for c in CONDITIONS].index(key), d, 2024])
                     tgt, T = make_target(src, f, rng)
                     tgt = damage(key, tgt, apply(T, f), rng)
-                    out = run_pair(a.tool, tmp, key, src, tgt, f, T, use_ecc)
+                    bd = [] if a.breakdown else None
+                    out = run_pair(a.tool, tmp, key, src, tgt, f, T, use_ecc, use_chain, bd)
+                    if bd:
+                        split.setdefault(key, []).append(bd)
                     rows.append({'class': cls, 'fold': fold, 'condition': key, 'draw': d,
                                  **{m: list(v) for m, v in out.items()}})
                     for m, v in out.items():
@@ -314,7 +362,13 @@ def main():
             print('.', end='', file=sys.stderr, flush=True)
     print(file=sys.stderr)
     for fold, title in (('A', 'fold 1 (folds.tsv A)'), ('B', 'fold 2 (folds.tsv B)'), ('all', 'both folds')):
-        print_table(title, res[fold], conds, use_ecc)
+        if any(res[fold][k]['sub'] for k in keys):
+            print_table(title, res[fold], conds, use_ecc, use_chain)
+    if split:
+        print('\nlibrary ms, medians over the run: traces | register | no polish | no polish, no refine')
+        for key in keys:
+            if key in split:
+                print('%-10s' % key + ' | '.join('%7.2f' % v for v in np.median(np.array(split[key]), axis=0)))
     if a.json:
         with open(a.json, 'w') as fp:
             json.dump(rows, fp)

@@ -169,6 +169,72 @@ START_TEST(missing_run_inliers_and_correspondences)
 }
 END_TEST
 
+/* Whether (x, y) lies in the test's asymmetric shape: an ellipse with a smaller one on its side. */
+static int touching_shape_at(double x, double y)
+{
+    double u = x / 45.0, v = y / 25.0, a = (x - 30.0) / 18.0, b = (y - 24.0) / 14.0;
+    return u * u + v * v <= 1.0 || a * a + b * b <= 1.0;
+}
+
+/* A 200 x 200 8-bit image of the shape under x -> T x (centred), plus a disk of radius rd at
+ * (dx, dy) when rd > 0, traced sub-pixel at level 127.5. */
+static amscr_contour *touching_trace(const double T[6], double dx, double dy, double rd)
+{
+    enum { W = 200 };
+    static unsigned char img[W * W];
+    double det = T[0] * T[4] - T[1] * T[3];
+    for (size_t y = 0; y < W; y++)
+        for (size_t x = 0; x < W; x++) {
+            double px = (double)x - T[2], py = (double)y - T[5];
+            double sx = (T[4] * px - T[1] * py) / det, sy = (-T[3] * px + T[0] * py) / det;
+            int on = touching_shape_at(sx, sy) || (rd > 0.0 && hypot((double)x - dx, (double)y - dy) <= rd);
+            img[y * W + x] = on ? 255 : 0;
+        }
+    amscr_contour *c = NULL;
+    ck_assert_int_eq(amscr_contour_from_image(img, W, W, W, 8, 127.5, 0, &c), AMSCR_OK);
+    return c;
+}
+
+/* A touching object: the target traced with a disk (a third of the shape's radius) attached
+ * outside. The map is right, and so are the inliers: the correspondences' windowed search must
+ * not follow the disk's outline and lose the shape's boundary (it did: inliers 0.4, confidence
+ * below 0.25 for a map within 0.5 %). */
+START_TEST(touching_object_inliers)
+{
+    static const double I[6] = {1.0, 0.0, 100.0, 0.0, 1.0, 100.0};
+    static const double T[6] = {0.9, -0.7, 100.0, 0.5, 1.1, 100.0};
+    amscr_contour *cs = touching_trace(I, 0.0, 0.0, 0.0);
+    double e[2] = {45.0, 0.0}, q[2]; /* the ellipse's tip, mapped: the disk touches it */
+    amscr_test_apply_affine(T, e, 1, q);
+    double ux = q[0] - 100.0, uy = q[1] - 100.0, l = hypot(ux, uy), rd = 16.0;
+    amscr_contour *ct = touching_trace(T, q[0] + 0.95 * rd * ux / l, q[1] + 0.95 * rd * uy / l, rd);
+    amscr_result *r = NULL;
+    ck_assert_int_eq(amscr_register_contours(NULL, cs, ct, &r), AMSCR_OK);
+    double M[6], Tc[6];
+    ck_assert_int_eq(amscr_result_affine(r, M), AMSCR_OK);
+    /* the source image's frame is the shape's shifted by (100, 100) */
+    memcpy(Tc, T, sizeof Tc);
+    Tc[2] = T[2] - 100.0 * (T[0] + T[1]);
+    Tc[5] = T[5] - 100.0 * (T[3] + T[4]);
+    size_t n = amscr_contour_size(cs);
+    const double *xy = amscr_contour_xy(cs);
+    double *m = malloc(2 * n * sizeof *m);
+    ck_assert_ptr_nonnull(m);
+    amscr_test_apply_affine(Tc, xy, n, m);
+    double err = amscr_test_max_map_error(M, Tc, xy, n) / amscr_test_shape_size(m, n);
+    double inl = amscr_result_inlier_fraction(r), conf = amscr_result_confidence(r);
+    printf("robust: touching object: error %.3f %%, inliers %.3f, confidence %.3f\n", 100.0 * err, inl, conf);
+    fflush(stdout);
+    ck_assert_msg(err < 0.02, "touching object: error %.3f %%", 100.0 * err);
+    ck_assert_msg(inl > 0.85, "touching object: inlier fraction %.3f of a right map", inl);
+    ck_assert_msg(conf > 0.5, "touching object: confidence %.3f of a right map", conf);
+    free(m);
+    amscr_result_free(r);
+    amscr_contour_free(cs);
+    amscr_contour_free(ct);
+}
+END_TEST
+
 /* Bad input: partial needs an open source and a closed target; the flag is 0 or 1. */
 START_TEST(partial_errors)
 {
@@ -272,6 +338,7 @@ Suite *amscr_suite_robust(void)
     tcase_add_test(tc, symmetric_shapes_ambiguous);
     tcase_add_test(tc, missing_run_inliers_and_correspondences);
     tcase_add_test(tc, partial_errors);
+    tcase_add_test(tc, touching_object_inliers);
     tcase_add_test(tc, kimia_fragments);
     tcase_add_test(tc, kimia_missing_10);
     tcase_add_test(tc, kimia_missing_20);

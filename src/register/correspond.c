@@ -13,7 +13,9 @@
  * the normalized frame) of the target's boundary: 2.5 standard deviations of 2 % noise. */
 #define AMSCR__INLIER_DIST (0.05 * 1.4142135623730951)
 /* Partners after the first are searched within ±N/32 samples of the previous sample's (the
- * next sample's partner lies a sample or so further; ±N/8 gave the same results, 4x slower). */
+ * next sample's partner lies a sample or so further; ±N/8 gave the same results, 4x slower);
+ * a partner found there beyond the inlier distance is searched again on the whole boundary (a
+ * window that followed an extra object's outline would lose the shape's boundary for good). */
 #define AMSCR__CORR_WINDOW_DIV 32
 
 double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6])
@@ -50,6 +52,8 @@ amscr_status amscr__correspond(const amscr_descriptor *f, const amscr_descriptor
         size_t seg = 0;
         double d2 = amscr__closest_on_polygon(Hd, nd, closed, a == 0 ? 0 : prev, a == 0 ? nd : w, px, py, &qx, &qy,
                                               &seg);
+        if (a > 0 && !(sqrt(d2) <= AMSCR__INLIER_DIST)) /* the window lost the boundary: search it all */
+            d2 = amscr__closest_on_polygon(Hd, nd, closed, 0, nd, px, py, &qx, &qy, &seg);
         prev = seg;
         size_t nx = seg + 1 == nd ? 0 : seg + 1;
         double ex = Hd[2 * nx] - Hd[2 * seg], ey = Hd[2 * nx + 1] - Hd[2 * seg + 1], l2 = ex * ex + ey * ey;
