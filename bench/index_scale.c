@@ -22,7 +22,8 @@
  * and the build's shortlist search per row: exact (every bound) against the coarse quantizer
  * (signature.h), with the quantizer's recall of the exact shortlist. Times are wall clock
  * with the process's CPU seconds (all threads) in parentheses: on a busy machine CPU / threads
- * is what idle cores would give. Exit 77 without the datasets. */
+ * is what idle cores would give. Environment: INDEX_BENCH_NO_MIXED skips part 1,
+ * INDEX_BENCH_NO_LOAD part 2's load. Exit 77 without the datasets. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -315,7 +316,9 @@ static void part_scale(const amscr_params *p, const shape_set *s, size_t n)
     amscr_index *x = build(db, M, tb);
     double per_shape = (rss_mb() - before) * 1e3 / (double)n, peak = max_rss_mb();
     index_bytes(x, ib);
-    load_time(x, &tl, &mb);
+    tl = mb = NAN;
+    if (!getenv("INDEX_BENCH_NO_LOAD")) /* a load rebuilds every shape's features */
+        load_time(x, &tl, &mb);
     for (size_t q = 0; q < NQ_SCALE; q++) {
         amscr_descriptor *d = warped(p, s->c[(size_t)(urand(&qseed) * (double)s->n) % s->n], &qseed);
         size_t a[TOP];
