@@ -37,7 +37,7 @@
 #include "index.h"
 #include "mcd_set.h"
 
-enum { TOP = 10, NQ = 50, NQ_SCALE = 50, SEARCH_ROWS = 200, BUILD_M = 64 };
+enum { TOP = 10, NQ = 50, NQ_SCALE = 50, SEARCH_ROWS = 200, BUILD_M = 256 };
 
 static void die(const char *what)
 {
