@@ -389,7 +389,8 @@ END_TEST
 START_TEST(quantizer_shortlist)
 {
     enum { N = 3000, M = 32, ROWS = 20, CLUSTERS = 60 };
-    float *sig = malloc((size_t)N * AMSCR__SIG_DIM * sizeof *sig), *lb = malloc((size_t)N * AMSCR__SIG_LB_DIM * sizeof *lb);
+    float *sig = malloc((size_t)N * AMSCR__SIG_DIM * sizeof *sig);
+    float *lb = malloc((size_t)N * AMSCR__SIG_LB_DIM * sizeof *lb);
     amscr_test_rng r;
     amscr_test_rng_seed(&r, 77);
     for (size_t i = 0; i < N; i++)

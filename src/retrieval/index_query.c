@@ -282,8 +282,16 @@ static amscr_status diffusion_row(graph *g, size_t start, unsigned iters, double
             }
         }
     }
-    free(a.v), free(a.sup), free(v.v), free(v.sup), free(b.v), free(b.sup);
-    free(s.tmp), free(s.mark), free(s.list), free(rmark);
+    free(a.v);
+    free(a.sup);
+    free(v.v);
+    free(v.sup);
+    free(b.v);
+    free(b.sup);
+    free(s.tmp);
+    free(s.mark);
+    free(s.list);
+    free(rmark);
     return st;
 }
 
@@ -363,8 +371,9 @@ static amscr_status diffuse(const amscr_index *x, size_t self, const size_t *can
     uint32_t *rv = x->rev_start ? NULL : amscr__malloc_array(n ? n : 1, x->k * sizeof *rv);
     double *r = amscr__calloc_array(rows, sizeof *r);
     rsup = amscr__malloc_array(rows, sizeof *rsup);
-    amscr_status st = r && rsup && (x->rev_start || (rs && rv)) ? graph_alloc(&g, rows, k)
-                                                                 : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    int have_rev = x->rev_start || (rs && rv);
+    amscr_status st = r && rsup && have_rev ? graph_alloc(&g, rows, k)
+                                            : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     if (st == AMSCR_OK && !x->rev_start)
         reverse_lists(x, n, rs, rv);
     g.x = x;
