@@ -11,11 +11,19 @@
  * time of one query at the default shortlist, and its recall against the exact query (the full
  * index, candidates 0): % of the exact top 10 in the shortlist query's top 10, % of queries
  * with the same first hit.
+ * Then the neighbour lists (K = 8) of builds with candidates 32, 64, 128, 256 against the exact
+ * lists: % of the exact neighbours kept (the build seeks them among min(candidates, its build
+ * shortlist) shapes).
  * Part 2: collections of SIZES shapes, each an affine-warped, noisy copy of an mpeg7-dev shape
- * (shape i % 700, its own seed): build time at the default shortlist, the process's resident
- * memory per shape after the build, load time, median of 20 queries. Times are wall clock
+ * (shape i % 700, its own seed): build time at the default shortlist, the process's peak
+ * resident memory (max RSS) and its growth per shape over the collection, the bytes a shape
+ * of the index (channel features, signature and bound vector, neighbour lists and their
+ * reverse) and of the collection (the prepared shape) holds, load time, median of 50 queries;
+ * and the build's shortlist search per row: exact (every bound) against the coarse quantizer
+ * (signature.h), with the quantizer's recall of the exact shortlist. Times are wall clock
  * with the process's CPU seconds (all threads) in parentheses: on a busy machine CPU / threads
- * is what idle cores would give. Exit 77 without the datasets. */
+ * is what idle cores would give. Environment: INDEX_BENCH_NO_MIXED skips part 1,
+ * INDEX_BENCH_NO_LOAD part 2's load. Exit 77 without the datasets. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,10 +31,13 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <sys/resource.h>
+
 #include "amscr.h"
+#include "index.h"
 #include "mcd_set.h"
 
-enum { TOP = 10, NQ = 50, NQ_SCALE = 20 };
+enum { TOP = 10, NQ = 50, NQ_SCALE = 50, SEARCH_ROWS = 200, BUILD_M = 256 };
 
 static void die(const char *what)
 {
@@ -58,6 +69,13 @@ static double rss_mb(void)
         fclose(f);
     }
     return (double)res * (double)sysconf(_SC_PAGESIZE) / 1e6;
+}
+
+static double max_rss_mb(void)
+{
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return (double)u.ru_maxrss / 1e3;
 }
 
 static double urand(unsigned long long *s)
@@ -170,6 +188,77 @@ static void load_time(const amscr_index *x, double *secs, double *mb)
     amscr_free(buf);
 }
 
+/* The K - 1 neighbours (itself left out) of the lists of builds with candidates c kept
+ * against the exact lists of full. */
+static void list_recall(const amscr_db *db, const amscr_index *full)
+{
+    static const size_t cs[] = {32, 64, 128, 256};
+    size_t n = amscr_db_size(db), k = full->k;
+    printf("\n| candidates | build (M) | exact neighbours kept | rows with all kept |\n|---|---|---|---|\n");
+    for (size_t u = 0; u < sizeof cs / sizeof *cs; u++) {
+        double tb[2];
+        amscr_index *x = build(db, cs[u], tb);
+        size_t kept = 0, rows = 0;
+        for (size_t i = 0; i < n; i++) {
+            size_t here = 0;
+            for (size_t a = 1; a < k; a++)
+                for (size_t b = 1; b < k; b++)
+                    here += x->nb_idx[i * k + a] == full->nb_idx[i * k + b];
+            kept += here;
+            rows += here == k - 1;
+        }
+        printf("| %zu | %.1f s (%.1f) | %.2f %% | %.1f %% |\n", cs[u], tb[0], tb[1],
+               100.0 * (double)kept / (double)(n * (k - 1)), 100.0 * (double)rows / (double)n);
+        fflush(stdout);
+        amscr_index_free(x);
+    }
+}
+
+/* Bytes a shape of x holds: channel features, signature with its bound vector, lists and reverse. */
+static void index_bytes(const amscr_index *x, double b[3])
+{
+    size_t n = amscr_db_size(x->db), hf = 0;
+    for (size_t i = 0; i < n * (size_t)x->nf; i++)
+        hf += 2 * (x->hf[i].n * AMSCR__HF_BINS + AMSCR__HF_BINS * 2 * x->hf[i].nfreq * sizeof(double));
+    b[0] = (double)hf / (double)n;
+    b[1] = (double)(x->sig_dim + AMSCR__SIG_LB_DIM) * sizeof(float);
+    b[2] = (double)x->k * (sizeof(uint32_t) + sizeof(double)) + (x->rev ? (double)x->k * 4 + 8 : 0.0);
+}
+
+/* The build's shortlist search of SEARCH_ROWS rows: exact against the quantizer, ms a row, and
+ * the % of the exact shortlist the quantizer finds. */
+static void search_cost(const amscr_index *x, size_t m, double out[3])
+{
+    size_t n = amscr_db_size(x->db), *a = malloc(m * sizeof *a), *b = malloc(m * sizeof *b), same = 0;
+    amscr__sig_ivf v;
+    if (!a || !b || amscr__sig_ivf_build(x->sig_lb, n, &v) != AMSCR_OK)
+        die("out of memory");
+    double te = 0.0, ti = 0.0;
+    for (size_t r = 0; r < SEARCH_ROWS; r++) {
+        size_t i = r * n / SEARCH_ROWS;
+        const float *sig = x->sig + i * x->sig_dim, *lb = x->sig_lb + i * AMSCR__SIG_LB_DIM;
+        double t = now();
+        if (amscr__sig_nearest(x->sig, x->sig_lb, n, sig, lb, m, i, a) != m)
+            die("search");
+        te += now() - t;
+        t = now();
+        if (amscr__sig_ivf_nearest(&v, x->sig, x->sig_lb, n, sig, lb, m, i, b) != m)
+            die("search");
+        ti += now() - t;
+        for (size_t u = 0, w = 0; u < m; u++) { /* both ascending */
+            while (w < m && b[w] < a[u])
+                w++;
+            same += w < m && b[w] == a[u];
+        }
+    }
+    out[0] = 1e3 * te / SEARCH_ROWS;
+    out[1] = 1e3 * ti / SEARCH_ROWS;
+    out[2] = 100.0 * (double)same / (double)(m * SEARCH_ROWS);
+    amscr__sig_ivf_free(&v);
+    free(a);
+    free(b);
+}
+
 /* Part 1: the 1400-shape collection. */
 static void part_mixed(const amscr_params *p, const shape_set *s)
 {
@@ -205,6 +294,7 @@ static void part_mixed(const amscr_params *p, const shape_set *s)
            1e3 * median(ctimes, NQ), 100.0 * (double)top_in / (double)(TOP * NQ),
            100.0 * (double)same_first / (double)NQ);
     fflush(stdout);
+    list_recall(db, full);
     amscr_index_free(x);
     amscr_index_free(full);
     amscr_db_free(db);
@@ -217,13 +307,18 @@ static void part_scale(const amscr_params *p, const shape_set *s, size_t n)
     unsigned long long seed = 0xABCDEF12345ull + n, qseed = 0x1234ull;
     if (amscr_db_new(p, &db) != AMSCR_OK)
         die("db");
+    double empty = rss_mb();
     for (size_t i = 0; i < n; i++)
         add(db, warped(p, s->c[i % s->n], &seed), s->labels[i % s->n]);
     size_t M = AMSCR_INDEX_CANDIDATES;
-    double before = rss_mb(), tb[2], tl, mb, times[NQ_SCALE], ctimes[NQ_SCALE];
+    double before = rss_mb(), tb[2], tl, mb, times[NQ_SCALE], ctimes[NQ_SCALE], ib[3], sc[3];
+    double prepared = (before - empty) * 1e6 / (double)n;
     amscr_index *x = build(db, M, tb);
-    double per_shape = (rss_mb() - before) * 1e3 / (double)n;
-    load_time(x, &tl, &mb);
+    double per_shape = (rss_mb() - before) * 1e3 / (double)n, peak = max_rss_mb();
+    index_bytes(x, ib);
+    tl = mb = NAN;
+    if (!getenv("INDEX_BENCH_NO_LOAD")) /* a load rebuilds every shape's features */
+        load_time(x, &tl, &mb);
     for (size_t q = 0; q < NQ_SCALE; q++) {
         amscr_descriptor *d = warped(p, s->c[(size_t)(urand(&qseed) * (double)s->n) % s->n], &qseed);
         size_t a[TOP];
@@ -231,8 +326,11 @@ static void part_scale(const amscr_params *p, const shape_set *s, size_t n)
         timed_query(x, d, M, a, sa, &times[q], &ctimes[q]);
         amscr_descriptor_free(d);
     }
-    printf("| warped copies | %zu | %zu | %.1f s (%.1f) | %.0f KB | %.2f s, %.0f MB | %.1f ms (%.1f) |\n", n, M, tb[0],
-           tb[1], per_shape, tl, mb, 1e3 * median(times, NQ_SCALE), 1e3 * median(ctimes, NQ_SCALE));
+    search_cost(x, BUILD_M, sc);
+    printf("| warped copies | %zu | %zu | %.1f s (%.1f) | %.0f MB | %.1f KB | %.0f + %.0f + %.0f B | %.0f B | "
+           "%.2f s, %.0f MB | %.1f ms (%.1f) | %.3f / %.3f ms, %.1f %% |\n", n, M, tb[0], tb[1], peak, per_shape,
+           ib[0], ib[1], ib[2], prepared, tl, mb, 1e3 * median(times, NQ_SCALE), 1e3 * median(ctimes, NQ_SCALE), sc[0],
+           sc[1], sc[2]);
     fflush(stdout);
     amscr_index_free(x);
     amscr_db_free(db);
@@ -258,8 +356,9 @@ int main(int argc, char **argv)
         part_mixed(p, &s);
         printf("\n");
     }
-    printf("| collection | shapes | M | build | memory a shape | load, file | query (median of %d) |\n"
-           "|---|---|---|---|---|---|---|\n", NQ_SCALE);
+    printf("| collection | shapes | M | build | max RSS | RSS growth a shape | index a shape: features + signature + "
+           "lists | prepared shape | load, file | query (median of %d) | build shortlist (%d) a row: exact / "
+           "quantizer, recall |\n|---|---|---|---|---|---|---|---|---|---|---|\n", NQ_SCALE, BUILD_M);
     for (int a = 2; a < argc || a == 2; a++) {
         size_t sizes[2] = {1000, 10000};
         if (argc > 2)

@@ -2219,9 +2219,11 @@ typedef struct amscr_index amscr_index;
  *        amscr_db_retrieval_matrix (the fused distance before re-ranking), with the fusion's
  *        medians and the largest distance. candidates 0 computes the whole base matrix (the
  *        lists are exact: a query then gives exactly amscr_db_query_retrieval's scores);
- *        candidates M > 0 seeks each shape's neighbours among its M signature-nearest shapes
- *        only (O(n M) distances, for large collections; at least K - 1; fused medians
- *        estimated on 256 shapes). Runs on the params' threads; the result does not depend
+ *        candidates M > 0 seeks each shape's neighbours among its min(M, 256)
+ *        signature-nearest shapes only (O(n M) distances, for large collections; at least
+ *        K - 1; fused medians estimated on 256 shapes; from 20,000 shapes each shortlist is
+ *        sought among the shapes of the signature clusters nearest it, so it may miss a few
+ *        of the nearest). Runs on the params' threads; the result does not depend
  *        on the thread count.
  * @param[in]  db  the collection (copied; may be freed afterwards).
  * @param[in]  candidates  0, or the shortlist size M.

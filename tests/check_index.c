@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "index.h"
 #include "suites.h"
 #include "testutil.h"
 
@@ -420,6 +421,66 @@ START_TEST(default_shortlist_first_hit)
 }
 END_TEST
 
+/* A query reads the lists' reverse kept by the build, or builds its own (after an add): the
+ * same scores. */
+START_TEST(kept_and_own_reverse)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_index *x = named_index(p, 10);
+    amscr_descriptor *q = shape(p, 3000);
+    double a[NSHAPES], b[NSHAPES], ma[NSHAPES], mb[NSHAPES];
+    ck_assert_ptr_nonnull(x->rev);
+    ck_assert_int_eq(amscr_index_query_scores(x, q, 12, a, NSHAPES), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_member_scores(x, 5, 12, ma, NSHAPES), AMSCR_OK);
+    amscr__index_reverse_free(x);
+    ck_assert_int_eq(amscr_index_query_scores(x, q, 12, b, NSHAPES), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_member_scores(x, 5, 12, mb, NSHAPES), AMSCR_OK);
+    for (size_t j = 0; j < NSHAPES; j++) {
+        ck_assert(a[j] == b[j] || (isinf(a[j]) && isinf(b[j])));
+        ck_assert(ma[j] == mb[j] || (isinf(ma[j]) && isinf(mb[j])));
+    }
+    amscr_descriptor_free(q);
+    amscr_index_free(x);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* The coarse quantizer's shortlist: m distinct shapes, ascending, without the excluded one, and
+ * most of the exact shortlist. */
+START_TEST(quantizer_shortlist)
+{
+    enum { N = 3000, M = 32, ROWS = 20, CLUSTERS = 60 };
+    float *sig = malloc((size_t)N * AMSCR__SIG_DIM * sizeof *sig);
+    float *lb = malloc((size_t)N * AMSCR__SIG_LB_DIM * sizeof *lb);
+    amscr_test_rng r;
+    amscr_test_rng_seed(&r, 77);
+    for (size_t i = 0; i < N; i++)
+        for (size_t t = 0; t < AMSCR__SIG_DIM; t++) /* clustered: a centre per class plus noise */
+            sig[i * AMSCR__SIG_DIM + t] = (float)(sin((double)((i % CLUSTERS) * 131 + t)) +
+                                                  0.2 * amscr_test_uniform(&r));
+    for (size_t i = 0; i < N; i++)
+        amscr__sig_bound_vector(sig + i * AMSCR__SIG_DIM, lb + i * AMSCR__SIG_LB_DIM);
+    amscr__sig_ivf v;
+    ck_assert_int_eq(amscr__sig_ivf_build(lb, N, &v), AMSCR_OK);
+    size_t a[M], b[M], same = 0;
+    for (size_t q = 0; q < ROWS; q++) {
+        size_t i = q * 149;
+        const float *s = sig + i * AMSCR__SIG_DIM, *l = lb + i * AMSCR__SIG_LB_DIM;
+        ck_assert_uint_eq(amscr__sig_nearest(sig, lb, N, s, l, M, i, a), M);
+        ck_assert_uint_eq(amscr__sig_ivf_nearest(&v, sig, lb, N, s, l, M, i, b), M);
+        for (size_t u = 0; u < M; u++) {
+            ck_assert(b[u] != i && b[u] < N && (u == 0 || b[u] > b[u - 1]));
+            for (size_t w = 0; w < M; w++)
+                same += a[w] == b[u];
+        }
+    }
+    ck_assert_msg(same >= 9 * M * ROWS / 10, "%zu of %d", same, M * ROWS);
+    amscr__sig_ivf_free(&v);
+    free(sig);
+    free(lb);
+}
+END_TEST
+
 Suite *amscr_suite_index(void)
 {
     Suite *s = suite_create("index");
@@ -439,6 +500,8 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, top_and_shortlist);
     tcase_add_test(tc, default_shortlist_first_hit);
     tcase_add_test(tc, groups);
+    tcase_add_test(tc, kept_and_own_reverse);
+    tcase_add_test(tc, quantizer_shortlist);
     suite_add_tcase(s, tc);
     return s;
 }

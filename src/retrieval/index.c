@@ -99,6 +99,7 @@ void amscr_index_free(amscr_index *x)
     free(x->sig_lb);
     free(x->nb_idx);
     free(x->nb_dist);
+    amscr__index_reverse_free(x);
     amscr_db_free(x->db);
     free(x);
 }

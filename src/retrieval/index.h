@@ -28,6 +28,8 @@ struct amscr_index {
     char **classes;       /* class name of label L (0 <= L < nclasses; NULL: unnamed) */
     size_t nclasses;
     size_t cap;           /* allocated rows of sig, nb_*, names */
+    size_t *rev_start;    /* n + 1 offsets into rev (NULL: not built; a query builds its own) */
+    uint32_t *rev;        /* rows i holding shape j in their lists: rev[rev_start[j]..rev_start[j+1]) */
 };
 
 /* How the base distance of the retrieval matrix (fuse.c) is computed pair by pair. */
@@ -51,6 +53,9 @@ typedef struct {
 void amscr__base_init(amscr__base *b, const amscr_params *p, double med_a, double med_h);
 amscr_status amscr__pair_ws_init(const amscr__base *b, amscr__pair_ws *pw);
 void amscr__pair_ws_free(amscr__pair_ws *pw);
+/* A workspace on the heap (*out, for the threads' scratch of index_threads.c) and its release. */
+amscr_status amscr__pair_ws_new(const amscr__base *b, void **out);
+void amscr__pair_ws_delete(void *pw);
 /* The channel sequences of d in b's frames (hf[0..nf-1]); free with amscr__base_hf_free. */
 amscr_status amscr__base_hf(const amscr__base *b, const amscr_descriptor *d, amscr__hf hf[2]);
 void amscr__base_hf_free(const amscr__base *b, amscr__hf hf[2]);
@@ -78,7 +83,8 @@ typedef struct {
 amscr_status amscr__run_rows(const amscr__rows_fn *f, size_t first, size_t n, unsigned threads,
                              amscr_progress_fn progress, void *user);
 /* Signatures, lower-bound vectors (unless have_sig: then the signatures are there) and channel
- * features of shapes first..n-1 (index_features.c), on the params' threads. */
+ * features of shapes first..n-1 (index_features.c), on the params' threads; drops the lists'
+ * reverse, and rebuilds it when have_sig and first == 0 (a load: the lists are in place). */
 amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig);
 
 /* Row i's k nearest (itself first, then by (distance, index)) among m candidates cj[t] with
@@ -105,6 +111,9 @@ amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t
                                  double *out);
 /* Rows first..n-1 from their M signature-nearest shapes (index_build.c); x->dmax grows. */
 amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_progress_fn progress, void *user);
+/* The lists' reverse (x->rev_start, x->rev) from x's lists (index_query.c); frees the old. */
+amscr_status amscr__index_reverse(amscr_index *x);
+void amscr__index_reverse_free(amscr_index *x);
 /* db can be indexed (closed curves for the channel, at most 2^32 - 1 shapes). */
 amscr_status amscr__index_check_db(const amscr_db *db, const char *what);
 

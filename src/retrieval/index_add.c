@@ -56,22 +56,7 @@ typedef struct {
 
 static amscr_status add_pw_init(void *ctx, void **scratch)
 {
-    add_ctx *c = ctx;
-    amscr__pair_ws *pw = malloc(sizeof *pw);
-    if (!pw)
-        return AMSCR_E_NOMEM;
-    amscr_status st = amscr__pair_ws_init(&c->b, pw);
-    if (st != AMSCR_OK)
-        free(pw);
-    else
-        *scratch = pw;
-    return st;
-}
-
-static void add_pw_fini(void *scratch)
-{
-    amscr__pair_ws_free(scratch);
-    free(scratch);
+    return amscr__pair_ws_new(&((add_ctx *)ctx)->b, scratch);
 }
 
 static amscr_status add_distances(void *ctx, size_t j, void *scratch)
@@ -94,7 +79,7 @@ static amscr_status add_distances(void *ctx, size_t j, void *scratch)
 static amscr_status add_rows(add_ctx *c, size_t j1, size_t n0)
 {
     amscr_index *x = c->x;
-    amscr__rows_fn f = {add_pw_init, add_pw_fini, add_distances, c};
+    amscr__rows_fn f = {add_pw_init, amscr__pair_ws_delete, add_distances, c};
     amscr_status st = amscr__run_rows(&f, c->j0, j1, c->b.threads, NULL, NULL);
     for (size_t j = c->j0; st == AMSCR_OK && j < j1; j++) {
         size_t r = j - c->j0, m = c->m[r], *cand = c->cand + r * c->n;
@@ -151,6 +136,8 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
     }
     if (st == AMSCR_OK && progress && progress(user, add, add) != 0)
         st = amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback");
+    if (st == AMSCR_OK)
+        st = amscr__index_reverse(x); /* the lists changed: their reverse for the queries */
     free(c.cand);
     free(c.cd);
     free(c.m);

@@ -10,6 +10,13 @@
 
 /* Shapes on which a shortlist build estimates the medians of a fused distance. */
 enum { MEDIAN_SAMPLE = 256 };
+/* A shortlist build seeks each shape's K neighbours among at most this many signature-nearest
+ * shapes (the query's shortlist may be longer): the smallest shortlist that keeps 99 % of the
+ * exact neighbour lists (docs/measurements.md, "The index: build, query, recall"). */
+enum { BUILD_SHORTLIST = 256 };
+/* From this many shapes a build finds the shortlists among the lists of a coarse quantizer
+ * (signature.h) instead of scanning every shape's lower bound. */
+enum { IVF_MIN_SHAPES = 20000 };
 
 typedef struct {
     double d;
@@ -118,26 +125,12 @@ typedef struct {
     size_t first, m;
     uint32_t *S;
     double *D;
+    const amscr__sig_ivf *ivf; /* NULL: exact shortlists */
 } rows_ctx;
 
 static amscr_status pw_init(void *ctx, void **scratch)
 {
-    rows_ctx *c = ctx;
-    amscr__pair_ws *pw = malloc(sizeof *pw);
-    if (!pw)
-        return AMSCR_E_NOMEM;
-    amscr_status st = amscr__pair_ws_init(&c->b, pw);
-    if (st != AMSCR_OK)
-        free(pw);
-    else
-        *scratch = pw;
-    return st;
-}
-
-static void pw_fini(void *scratch)
-{
-    amscr__pair_ws_free(scratch);
-    free(scratch);
+    return amscr__pair_ws_new(&((rows_ctx *)ctx)->b, scratch);
 }
 
 static amscr_status shortlist_row(void *ctx, size_t i, void *scratch)
@@ -146,9 +139,11 @@ static amscr_status shortlist_row(void *ctx, size_t i, void *scratch)
     rows_ctx *c = ctx;
     amscr_index *x = c->x;
     size_t *cand = amscr__malloc_array(c->m, sizeof *cand);
-    size_t got = cand ? amscr__index_shortlist(x, x->sig + i * x->sig_dim, x->sig_lb + i * AMSCR__SIG_LB_DIM, c->m,
-                                               i, cand)
-                      : 0;
+    const float *sig = x->sig + i * x->sig_dim, *lb = x->sig_lb + i * AMSCR__SIG_LB_DIM;
+    size_t got = !cand ? 0
+                 : c->ivf ? amscr__sig_ivf_nearest(c->ivf, x->sig, x->sig_lb, amscr_db_size(x->db), sig, lb, c->m, i,
+                                                   cand)
+                          : amscr__index_shortlist(x, sig, lb, c->m, i, cand);
     for (size_t t = 0; t < got; t++)
         c->S[(i - c->first) * c->m + t] = (uint32_t)cand[t];
     free(cand);
@@ -232,12 +227,17 @@ static amscr_status list_row(void *ctx, size_t i, void *scratch)
 amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_progress_fn progress, void *user)
 {
     size_t n = amscr_db_size(x->db), rows = n - first;
-    rows_ctx c = {x, {0}, first, m, NULL, NULL};
+    rows_ctx c = {x, {0}, first, m, NULL, NULL, NULL};
+    amscr__sig_ivf ivf = {0, NULL, NULL, NULL};
     amscr__base_init(&c.b, amscr_db_params(x->db), x->med_a, x->med_h);
     c.S = amscr__malloc_array(rows, m * sizeof *c.S);
     c.D = amscr__malloc_array(rows, m * sizeof *c.D);
     amscr_status st = c.S && c.D ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
-    amscr__rows_fn f1 = {NULL, NULL, shortlist_row, &c}, f2 = {pw_init, pw_fini, distance_row, &c};
+    if (st == AMSCR_OK && n >= IVF_MIN_SHAPES) {
+        st = amscr__sig_ivf_build(x->sig_lb, n, &ivf);
+        c.ivf = &ivf;
+    }
+    amscr__rows_fn f1 = {NULL, NULL, shortlist_row, &c}, f2 = {pw_init, amscr__pair_ws_delete, distance_row, &c};
     amscr__rows_fn f3 = {NULL, NULL, list_row, &c};
     if (st == AMSCR_OK)
         st = amscr__run_rows(&f1, first, n, c.b.threads, NULL, NULL);
@@ -249,6 +249,7 @@ amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_pro
         x->dmax = c.D[t] > x->dmax ? c.D[t] : x->dmax;
     free(c.S);
     free(c.D);
+    amscr__sig_ivf_free(&ivf);
     return st;
 }
 
@@ -288,10 +289,13 @@ amscr_status amscr_index_build(const amscr_db *db, size_t candidates, amscr_prog
     if (x->candidates == 0) {
         st = build_full(x, progress, user);
     } else {
+        size_t mb = x->candidates < BUILD_SHORTLIST ? x->candidates : BUILD_SHORTLIST;
         st = sampled_medians(x);
         if (st == AMSCR_OK)
-            st = amscr__index_rows(x, 0, x->candidates, progress, user);
+            st = amscr__index_rows(x, 0, mb + 1 < x->k ? x->k - 1 : mb, progress, user);
     }
+    if (st == AMSCR_OK)
+        st = amscr__index_reverse(x);
     if (st != AMSCR_OK) {
         amscr_index_free(x);
         return st;

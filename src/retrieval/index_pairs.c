@@ -42,6 +42,25 @@ void amscr__pair_ws_free(amscr__pair_ws *pw)
     memset(pw, 0, sizeof *pw);
 }
 
+amscr_status amscr__pair_ws_new(const amscr__base *b, void **out)
+{
+    amscr__pair_ws *pw = malloc(sizeof *pw);
+    if (!pw)
+        return AMSCR_E_NOMEM;
+    amscr_status st = amscr__pair_ws_init(b, pw);
+    if (st != AMSCR_OK)
+        free(pw);
+    else
+        *out = pw;
+    return st;
+}
+
+void amscr__pair_ws_delete(void *pw)
+{
+    amscr__pair_ws_free(pw);
+    free(pw);
+}
+
 amscr_status amscr__base_hf(const amscr__base *b, const amscr_descriptor *d, amscr__hf hf[2])
 {
     memset(hf, 0, (size_t)b->nf * sizeof *hf);

@@ -16,11 +16,22 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The graph of the n + 1 (or n) shapes, its rows built on demand: a query touches only the
+ * shapes its diffusion reaches, never the whole collection. */
 typedef struct {
-    size_t n, k;   /* rows (the query last, when there is one), k entries each */
-    uint32_t *j;   /* neighbours */
-    double *d, *w; /* base distances, then the row-normalized affinities */
-    double *s;     /* scales: each row's k-th distance */
+    size_t n, k;           /* rows (the query last, when there is one), k entries each */
+    uint32_t *j;           /* neighbours */
+    double *d, *w;         /* base distances, then the row-normalized affinities */
+    unsigned char *state;  /* per row: 0 not built, 1 list built, 2 affinities too */
+    const amscr_index *x;
+    const double *dfull;   /* the query's distances (dfull[i] where have[i]) */
+    const unsigned char *have;
+    int query;             /* row n - 1 is the query */
+    double tiny;
+    const size_t *rs;      /* the stored lists' reverse (x's or built for this query) */
+    const uint32_t *rv;
+    const size_t *cand;    /* the query's candidates (the rows it may enter) */
+    size_t m;
 } graph;
 
 static amscr_status graph_alloc(graph *g, size_t n, size_t k)
@@ -30,8 +41,8 @@ static amscr_status graph_alloc(graph *g, size_t n, size_t k)
     g->j = amscr__malloc_array(n, k * sizeof *g->j);
     g->d = amscr__malloc_array(n, k * sizeof *g->d);
     g->w = amscr__malloc_array(n, k * sizeof *g->w);
-    g->s = amscr__malloc_array(n, sizeof *g->s);
-    return g->j && g->d && g->w && g->s ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    g->state = amscr__calloc_array(n, 1);
+    return g->j && g->d && g->w && g->state ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
 }
 
 static void graph_free(graph *g)
@@ -39,7 +50,7 @@ static void graph_free(graph *g)
     free(g->j);
     free(g->d);
     free(g->w);
-    free(g->s);
+    free(g->state);
 }
 
 /* Row i of the graph: its stored list (x->k entries) with the query (index g->n - 1, distance
@@ -77,90 +88,222 @@ static amscr_status query_row(const size_t *cand, const double *dq, size_t m, gr
             g->j[q * k + t] = (uint32_t)cand[order[t - 1]];
             g->d[q * k + t] = dq[order[t - 1]];
         }
+        g->state[q] = 1;
     }
     free(order);
     return st;
 }
 
-/* Affinities exp(-D / sqrt(s_i s_j)), row-normalized (as amscr_rerank_diffusion). */
-static void weights(graph *g, double dmax)
+static void need_row(graph *g, size_t i)
+{
+    if (g->state[i] == 0) {
+        collection_row(g->x, i, g->dfull[i], g->query && g->have[i], g);
+        g->state[i] = 1;
+    }
+}
+
+/* Row i's affinities exp(-D / sqrt(s_i s_j)), row-normalized (as amscr_rerank_diffusion), with
+ * s the rows' k-th distances. */
+static void need_weights(graph *g, size_t i)
 {
     size_t k = g->k;
-    double tiny = dmax > 0.0 ? 1e-12 * dmax : 1e-300;
-    for (size_t i = 0; i < g->n; i++)
-        g->s[i] = g->d[i * k + k - 1];
-    for (size_t i = 0; i < g->n; i++) {
-        double sum = 0.0;
+    if (g->state[i] == 2)
+        return;
+    need_row(g, i);
+    for (size_t t = 0; t < k; t++)
+        need_row(g, g->j[i * k + t]);
+    double sum = 0.0, si = g->d[i * k + k - 1];
+    for (size_t t = 0; t < k; t++) {
+        double s = sqrt((si + g->tiny) * (g->d[(size_t)g->j[i * k + t] * k + k - 1] + g->tiny));
+        g->w[i * k + t] = exp(-g->d[i * k + t] / s);
+        sum += g->w[i * k + t];
+    }
+    for (size_t t = 0; t < k; t++)
+        g->w[i * k + t] /= sum;
+    g->state[i] = 2;
+}
+
+/* A sparse vector: dense values (zero outside sup) and its support, ascending. */
+typedef struct {
+    double *v;
+    size_t *sup, len;
+} svec;
+
+static int cmp_size(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Scratch of the products: a marked set and a value vector (zero, unmarked between calls). */
+typedef struct {
+    double *tmp;
+    unsigned char *mark;
+    size_t *list;
+} sscratch;
+
+/* out <- in P (in's rows pushed to their neighbours, rows in ascending order as the dense sum). */
+static void apply_rows(graph *g, const svec *in, svec *out, sscratch *s)
+{
+    size_t k = g->k, c = 0;
+    for (size_t u = 0; u < in->len; u++) {
+        size_t i = in->sup[u];
+        if (in->v[i] == 0.0)
+            continue;
+        need_weights(g, i);
         for (size_t t = 0; t < k; t++) {
-            double s = sqrt((g->s[i] + tiny) * (g->s[g->j[i * k + t]] + tiny));
-            g->w[i * k + t] = exp(-g->d[i * k + t] / s);
-            sum += g->w[i * k + t];
+            size_t j = g->j[i * k + t];
+            if (!s->mark[j]) {
+                s->mark[j] = 1;
+                s->list[c++] = j;
+            }
+            s->tmp[j] += in->v[i] * g->w[i * k + t];
         }
+    }
+    qsort(s->list, c, sizeof *s->list, cmp_size);
+    for (size_t u = 0; u < out->len; u++)
+        out->v[out->sup[u]] = 0.0;
+    for (size_t u = 0; u < c; u++) {
+        size_t j = s->list[u];
+        out->v[j] = s->tmp[j];
+        out->sup[u] = j;
+        s->tmp[j] = 0.0;
+        s->mark[j] = 0;
+    }
+    out->len = c;
+}
+
+/* Marks row i as a row P in may reach. */
+static void reach(sscratch *s, size_t i, size_t *c)
+{
+    if (!s->mark[i]) {
+        s->mark[i] = 1;
+        s->list[(*c)++] = i;
+    }
+}
+
+/* v <- P v: only the rows holding a shape of v's support (the stored lists' reverse, plus the
+ * query and the rows it may enter) can be nonzero. */
+static void apply_cols(graph *g, svec *v, sscratch *s)
+{
+    size_t k = g->k, c = 0, n = g->query ? g->n - 1 : g->n;
+    int to_query = 0;
+    for (size_t u = 0; u < v->len; u++) {
+        size_t j = v->sup[u];
+        if (j >= n) {
+            to_query = 1;
+            continue;
+        }
+        for (size_t r = g->rs[j]; r < g->rs[j + 1]; r++)
+            reach(s, g->rv[r], &c);
+        reach(s, j, &c);
+    }
+    if (g->query && v->len > 0)
+        reach(s, n, &c);
+    for (size_t t = 0; to_query && t < g->m; t++)
+        reach(s, g->cand[t], &c);
+    qsort(s->list, c, sizeof *s->list, cmp_size);
+    for (size_t u = 0; u < c; u++) {
+        size_t i = s->list[u];
+        need_weights(g, i);
+        double sum = 0.0;
         for (size_t t = 0; t < k; t++)
-            g->w[i * k + t] /= sum;
+            sum += g->w[i * k + t] * v->v[g->j[i * k + t]];
+        s->tmp[i] = sum;
+    }
+    for (size_t u = 0; u < v->len; u++)
+        v->v[v->sup[u]] = 0.0;
+    size_t len = 0;
+    for (size_t u = 0; u < c; u++) {
+        size_t i = s->list[u];
+        s->mark[i] = 0;
+        if (s->tmp[i] != 0.0) {
+            v->v[i] = s->tmp[i];
+            v->sup[len++] = i;
+        }
+        s->tmp[i] = 0.0;
+    }
+    v->len = len;
+}
+
+static void svec_copy(svec *dst, const svec *src)
+{
+    for (size_t u = 0; u < dst->len; u++)
+        dst->v[dst->sup[u]] = 0.0;
+    for (size_t u = 0; u < src->len; u++) {
+        dst->v[src->sup[u]] = src->v[src->sup[u]];
+        dst->sup[u] = src->sup[u];
+    }
+    dst->len = src->len;
+}
+
+/* r += v (r's support marked in rmark, listed in rsup). */
+static void accumulate(double *r, unsigned char *rmark, size_t *rsup, size_t *rlen, const svec *v)
+{
+    for (size_t u = 0; u < v->len; u++) {
+        size_t i = v->sup[u];
+        r[i] += v->v[i];
+        if (!rmark[i]) {
+            rmark[i] = 1;
+            rsup[(*rlen)++] = i;
+        }
     }
 }
 
-/* v <- P v. */
-static void apply_cols(const graph *g, double *v, double *tmp)
-{
-    for (size_t i = 0; i < g->n; i++) {
-        double s = 0.0;
-        for (size_t t = 0; t < g->k; t++)
-            s += g->w[i * g->k + t] * v[g->j[i * g->k + t]];
-        tmp[i] = s;
-    }
-    memcpy(v, tmp, g->n * sizeof *v);
-}
-
-/* a <- a P. */
-static void apply_rows(const graph *g, double *a, double *tmp)
-{
-    memset(tmp, 0, g->n * sizeof *tmp);
-    for (size_t i = 0; i < g->n; i++)
-        if (a[i] != 0.0)
-            for (size_t t = 0; t < g->k; t++)
-                tmp[g->j[i * g->k + t]] += a[i] * g->w[i * g->k + t];
-    memcpy(a, tmp, g->n * sizeof *a);
-}
-
-/* Row `start` of Q_T into r (g->n entries). */
-static amscr_status diffusion_row(const graph *g, size_t start, unsigned iters, double *r)
+/* Row `start` of Q_T into r (g->n entries, zero on entry); its support into rsup / rlen. */
+static amscr_status diffusion_row(graph *g, size_t start, unsigned iters, double *r, size_t *rsup, size_t *rlen)
 {
     size_t n = g->n;
-    double *a = amscr__calloc_array(n, sizeof *a), *v = amscr__malloc_array(n, sizeof *v);
-    double *tmp = amscr__malloc_array(n, sizeof *tmp);
-    amscr_status st = a && v && tmp ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    svec a = {amscr__calloc_array(n, sizeof(double)), amscr__malloc_array(n, sizeof(size_t)), 0};
+    svec v = {amscr__calloc_array(n, sizeof(double)), amscr__malloc_array(n, sizeof(size_t)), 0};
+    svec b = {amscr__calloc_array(n, sizeof(double)), amscr__malloc_array(n, sizeof(size_t)), 0};
+    sscratch s = {amscr__calloc_array(n, sizeof(double)), amscr__calloc_array(n, 1),
+                  amscr__malloc_array(n, sizeof(size_t))};
+    unsigned char *rmark = amscr__calloc_array(n, 1);
+    amscr_status st = a.v && a.sup && v.v && v.sup && b.v && b.sup && s.tmp && s.mark && s.list && rmark
+                          ? AMSCR_OK
+                          : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    *rlen = 0;
     if (st == AMSCR_OK) {
-        memset(r, 0, n * sizeof *r);
-        a[start] = 1.0;
+        a.v[start] = 1.0;
+        a.sup[0] = start;
+        a.len = 1;
         for (unsigned t = 0; t <= iters; t++) {
-            memcpy(v, a, n * sizeof *v);
             if (t == iters)
-                apply_rows(g, v, tmp); /* the last term: e_q P^T P */
+                apply_rows(g, &a, &v, &s); /* the last term: e_q P^T P */
+            else
+                svec_copy(&v, &a);
             for (unsigned u = 0; u < t; u++)
-                apply_cols(g, v, tmp);
-            for (size_t i = 0; i < n; i++)
-                r[i] += v[i];
-            if (t < iters)
-                apply_rows(g, a, tmp);
+                apply_cols(g, &v, &s);
+            accumulate(r, rmark, rsup, rlen, &v);
+            if (t < iters) {
+                apply_rows(g, &a, &b, &s);
+                svec_copy(&a, &b);
+            }
         }
     }
-    free(a);
-    free(v);
-    free(tmp);
+    free(a.v);
+    free(a.sup);
+    free(v.v);
+    free(v.sup);
+    free(b.v);
+    free(b.sup);
+    free(s.tmp);
+    free(s.mark);
+    free(s.list);
+    free(rmark);
     return st;
 }
 
-/* out[j] (j < n) from the diffused row r (len entries): halved 1 - r / max r where reached,
+/* out[j] (j < n) from the diffused row r (support rsup): halved 1 - r / max r where reached,
  * 0.5 + half the base distance / dmax for the matched shapes it does not reach, +inf for the
  * others; 0 for `self` (the library's normalization of the retrieval matrix). */
-static void scores(const double *r, size_t len, size_t n, size_t self, const double *dfull, const unsigned char *have,
-                   double dmax, double *out)
+static void scores(const double *r, const size_t *rsup, size_t rlen, size_t n, size_t self, const double *dfull,
+                   const unsigned char *have, double dmax, double *out)
 {
     double rmax = 0.0;
-    for (size_t i = 0; i < len; i++)
-        rmax = r[i] > rmax ? r[i] : rmax;
+    for (size_t u = 0; u < rlen; u++)
+        rmax = r[rsup[u]] > rmax ? r[rsup[u]] : rmax;
     for (size_t j = 0; j < n; j++) {
         if (j == self)
             out[j] = 0.0;
@@ -171,32 +314,88 @@ static void scores(const double *r, size_t len, size_t n, size_t self, const dou
     }
 }
 
+/* The stored lists' reverse of x (n shapes, k each) into rs (n + 1) and rv (n k). */
+static void reverse_lists(const amscr_index *x, size_t n, size_t *rs, uint32_t *rv)
+{
+    size_t k = x->k;
+    memset(rs, 0, (n + 1) * sizeof *rs);
+    for (size_t e = 0; e < n * k; e++)
+        rs[x->nb_idx[e] + 1]++;
+    for (size_t j = 0; j < n; j++)
+        rs[j + 1] += rs[j];
+    for (size_t i = 0; i < n; i++) /* rs[j] runs ahead while filling, then shifts back */
+        for (size_t t = 0; t < k; t++)
+            rv[rs[x->nb_idx[i * k + t]]++] = (uint32_t)i;
+    for (size_t j = n; j > 0; j--)
+        rs[j] = rs[j - 1];
+    rs[0] = 0;
+}
+
+void amscr__index_reverse_free(amscr_index *x)
+{
+    free(x->rev_start);
+    free(x->rev);
+    x->rev_start = NULL;
+    x->rev = NULL;
+}
+
+amscr_status amscr__index_reverse(amscr_index *x)
+{
+    size_t n = amscr_db_size(x->db);
+    amscr__index_reverse_free(x);
+    if (x->k == 0)
+        return AMSCR_OK;
+    x->rev_start = amscr__malloc_array(n + 1, sizeof *x->rev_start);
+    x->rev = amscr__malloc_array(n ? n : 1, x->k * sizeof *x->rev);
+    if (!x->rev_start || !x->rev) {
+        amscr__index_reverse_free(x);
+        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    }
+    reverse_lists(x, n, x->rev_start, x->rev);
+    return AMSCR_OK;
+}
+
 /* The diffusion's scores of row `self` (< n: a shape of the index; n: the query, with
  * distances dfull[j] where have[j]). */
 static amscr_status diffuse(const amscr_index *x, size_t self, const size_t *cand, const double *dq, size_t m,
                             const double *dfull, const unsigned char *have, double *out)
 {
     const amscr_params *p = amscr_db_params(x->db);
-    size_t n = amscr_db_size(x->db), rows = self == n ? n + 1 : n;
+    size_t n = amscr_db_size(x->db), rows = self == n ? n + 1 : n, rlen = 0;
     size_t k = p->rerank_k < rows ? p->rerank_k : rows;
     double dmax = x->dmax;
     for (size_t t = 0; self == n && t < m; t++)
         dmax = dq[t] > dmax ? dq[t] : dmax;
-    graph g = {0, 0, NULL, NULL, NULL, NULL};
-    double *r = amscr__malloc_array(rows, sizeof *r);
-    amscr_status st = r ? graph_alloc(&g, rows, k) : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
-    for (size_t i = 0; st == AMSCR_OK && i < n; i++)
-        collection_row(x, i, dfull[i], self == n && have[i], &g);
+    graph g = {0};
+    size_t *rs = x->rev_start ? NULL : amscr__malloc_array(n + 1, sizeof *rs), *rsup = NULL;
+    uint32_t *rv = x->rev_start ? NULL : amscr__malloc_array(n ? n : 1, x->k * sizeof *rv);
+    double *r = amscr__calloc_array(rows, sizeof *r);
+    rsup = amscr__malloc_array(rows, sizeof *rsup);
+    int have_rev = x->rev_start || (rs && rv);
+    amscr_status st = r && rsup && have_rev ? graph_alloc(&g, rows, k)
+                                            : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    if (st == AMSCR_OK && !x->rev_start)
+        reverse_lists(x, n, rs, rv);
+    g.x = x;
+    g.dfull = dfull;
+    g.have = have;
+    g.query = self == n;
+    g.tiny = dmax > 0.0 ? 1e-12 * dmax : 1e-300;
+    g.rs = x->rev_start ? x->rev_start : rs;
+    g.rv = x->rev_start ? x->rev : rv;
+    g.cand = cand;
+    g.m = self == n ? m : 0;
     if (st == AMSCR_OK && self == n)
         st = query_row(cand, dq, m, &g);
-    if (st == AMSCR_OK) {
-        weights(&g, dmax);
-        st = diffusion_row(&g, self, p->rerank_iterations, r);
-    }
     if (st == AMSCR_OK)
-        scores(r, rows, n, self, dfull, have, dmax, out);
+        st = diffusion_row(&g, self, p->rerank_iterations, r, rsup, &rlen);
+    if (st == AMSCR_OK)
+        scores(r, rsup, rlen, n, self, dfull, have, dmax, out);
     graph_free(&g);
     free(r);
+    free(rsup);
+    free(rs);
+    free(rv);
     return st;
 }
 

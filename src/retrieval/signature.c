@@ -92,32 +92,39 @@ static void sort_indices(size_t *c, size_t m)
     }
 }
 
-size_t amscr__sig_nearest(const float *sigs, const float *lbs, size_t n, const float *sig, const float *lb, size_t m,
-                          size_t exclude, size_t *cand)
+/* The exact search among ids[0..nids-1] (ascending; NULL: the n shapes 0..n-1). */
+static size_t nearest_among(const float *sigs, const float *lbs, const size_t *ids, size_t nids, const float *sig,
+                            const float *lb, size_t m, size_t exclude, size_t *cand)
 {
-    size_t avail = exclude < n ? n - 1 : n, first = 2 * m < avail ? 2 * m : avail;
-    double *bound = amscr__malloc_array(n, sizeof *bound), *full = amscr__malloc_array(n, sizeof *full);
+    size_t ex = SIZE_MAX;
+    for (size_t t = 0; t < nids && exclude != SIZE_MAX; t++)
+        if ((ids ? ids[t] : t) == exclude)
+            ex = t;
+    size_t avail = ex < nids ? nids - 1 : nids, first = 2 * m < avail ? 2 * m : avail;
+    double *bound = amscr__malloc_array(nids, sizeof *bound), *full = amscr__malloc_array(nids, sizeof *full);
     size_t *order = amscr__malloc_array(first ? first : 1, sizeof *order);
     int ok = bound && full && order && m <= avail;
-    for (size_t j = 0; ok && j < n; j++) {
-        bound[j] = j == exclude ? INFINITY : amscr__sig_bound(lbs + j * AMSCR__SIG_LB_DIM, lb);
-        full[j] = INFINITY;
+    for (size_t t = 0; ok && t < nids; t++) {
+        bound[t] = t == ex ? INFINITY : amscr__sig_bound(lbs + (ids ? ids[t] : t) * AMSCR__SIG_LB_DIM, lb);
+        full[t] = INFINITY;
     }
-    ok = ok && amscr_topk(bound, n, first, exclude, order) == AMSCR_OK;
+    ok = ok && amscr_topk(bound, nids, first, ex, order) == AMSCR_OK;
     for (size_t t = 0; ok && t < first; t++)
-        full[order[t]] = amscr__sig_distance(sigs + order[t] * AMSCR__SIG_DIM, sig);
-    ok = ok && amscr_topk(full, n, m, exclude, cand) == AMSCR_OK;
+        full[order[t]] = amscr__sig_distance(sigs + (ids ? ids[order[t]] : order[t]) * AMSCR__SIG_DIM, sig);
+    ok = ok && amscr_topk(full, nids, m, ex, cand) == AMSCR_OK;
     if (ok && m > 0) {
         double tau = full[cand[m - 1]];
         int more = 0;
-        for (size_t j = 0; j < n; j++)
-            if (j != exclude && isinf(full[j]) && bound[j] <= tau) {
-                full[j] = amscr__sig_distance(sigs + j * AMSCR__SIG_DIM, sig);
+        for (size_t t = 0; t < nids; t++)
+            if (t != ex && isinf(full[t]) && bound[t] <= tau) {
+                full[t] = amscr__sig_distance(sigs + (ids ? ids[t] : t) * AMSCR__SIG_DIM, sig);
                 more = 1;
             }
         if (more)
-            ok = amscr_topk(full, n, m, exclude, cand) == AMSCR_OK;
+            ok = amscr_topk(full, nids, m, ex, cand) == AMSCR_OK;
     }
+    for (size_t t = 0; ok && ids && t < m; t++)
+        cand[t] = ids[cand[t]];
     free(bound);
     free(full);
     free(order);
@@ -125,4 +132,135 @@ size_t amscr__sig_nearest(const float *sigs, const float *lbs, size_t n, const f
         return 0;
     sort_indices(cand, m);
     return m;
+}
+
+size_t amscr__sig_nearest(const float *sigs, const float *lbs, size_t n, const float *sig, const float *lb, size_t m,
+                          size_t exclude, size_t *cand)
+{
+    return nearest_among(sigs, lbs, NULL, n, sig, lb, m, exclude, cand);
+}
+
+/* ------------------------------------------------ the coarse quantizer of a large build */
+
+enum { IVF_ITERS = 6, IVF_TRAIN_PER_LIST = 48, IVF_PROBE_LISTS = 8, IVF_PROBE_PER_M = 16 };
+
+static float sq_dist(const float *a, const float *b)
+{
+    float s = 0.0f;
+    for (size_t t = 0; t < AMSCR__SIG_LB_DIM; t++) {
+        float e = a[t] - b[t];
+        s += e * e;
+    }
+    return s;
+}
+
+static size_t nearest_centroid(const amscr__sig_ivf *v, const float *x)
+{
+    size_t best = 0;
+    float bd = INFINITY;
+    for (size_t c = 0; c < v->nc; c++) {
+        float d = sq_dist(v->cent + c * AMSCR__SIG_LB_DIM, x);
+        if (d < bd) {
+            bd = d;
+            best = c;
+        }
+    }
+    return best;
+}
+
+/* Lloyd iterations on the shapes t * n / ntrain (evenly spread), from nc of them. */
+static int ivf_train(amscr__sig_ivf *v, const float *lbs, size_t n)
+{
+    size_t ntrain = v->nc * IVF_TRAIN_PER_LIST < n ? v->nc * IVF_TRAIN_PER_LIST : n, D = AMSCR__SIG_LB_DIM;
+    double *sum = amscr__malloc_array(v->nc, D * sizeof *sum);
+    size_t *cnt = amscr__malloc_array(v->nc, sizeof *cnt);
+    if (!sum || !cnt) {
+        free(sum);
+        free(cnt);
+        return 0;
+    }
+    for (size_t c = 0; c < v->nc; c++)
+        memcpy(v->cent + c * D, lbs + (size_t)((double)c * (double)n / (double)v->nc) * D, D * sizeof *v->cent);
+    for (int it = 0; it < IVF_ITERS; it++) {
+        memset(sum, 0, v->nc * D * sizeof *sum);
+        memset(cnt, 0, v->nc * sizeof *cnt);
+        for (size_t t = 0; t < ntrain; t++) {
+            const float *x = lbs + (size_t)((double)t * (double)n / (double)ntrain) * D;
+            size_t c = nearest_centroid(v, x);
+            cnt[c]++;
+            for (size_t u = 0; u < D; u++)
+                sum[c * D + u] += x[u];
+        }
+        for (size_t c = 0; c < v->nc; c++)
+            for (size_t u = 0; cnt[c] > 0 && u < D; u++) /* an empty list keeps its centroid */
+                v->cent[c * D + u] = (float)(sum[c * D + u] / (double)cnt[c]);
+    }
+    free(sum);
+    free(cnt);
+    return 1;
+}
+
+amscr_status amscr__sig_ivf_build(const float *lbs, size_t n, amscr__sig_ivf *v)
+{
+    memset(v, 0, sizeof *v);
+    v->nc = (size_t)ceil(sqrt((double)n));
+    v->cent = amscr__malloc_array(v->nc, AMSCR__SIG_LB_DIM * sizeof *v->cent);
+    v->start = amscr__calloc_array(v->nc + 1, sizeof *v->start);
+    v->ids = amscr__malloc_array(n ? n : 1, sizeof *v->ids);
+    size_t *of = amscr__malloc_array(n ? n : 1, sizeof *of), *fill = amscr__calloc_array(v->nc, sizeof *fill);
+    int ok = v->cent && v->start && v->ids && of && fill && ivf_train(v, lbs, n);
+    for (size_t i = 0; ok && i < n; i++) {
+        of[i] = nearest_centroid(v, lbs + i * AMSCR__SIG_LB_DIM);
+        v->start[of[i] + 1]++;
+    }
+    for (size_t c = 0; ok && c < v->nc; c++)
+        v->start[c + 1] += v->start[c];
+    for (size_t i = 0; ok && i < n; i++) /* ascending within a list */
+        v->ids[v->start[of[i]] + fill[of[i]]++] = i;
+    free(of);
+    free(fill);
+    if (!ok) {
+        amscr__sig_ivf_free(v);
+        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    }
+    return AMSCR_OK;
+}
+
+void amscr__sig_ivf_free(amscr__sig_ivf *v)
+{
+    free(v->cent);
+    free(v->start);
+    free(v->ids);
+    memset(v, 0, sizeof *v);
+}
+
+static int cmp_size(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return (x > y) - (x < y);
+}
+
+size_t amscr__sig_ivf_nearest(const amscr__sig_ivf *v, const float *sigs, const float *lbs, size_t n, const float *sig,
+                              const float *lb, size_t m, size_t exclude, size_t *cand)
+{
+    double *cd = amscr__malloc_array(v->nc, sizeof *cd);
+    size_t *order = amscr__malloc_array(v->nc, sizeof *order), *ids = amscr__malloc_array(n, sizeof *ids), got = 0;
+    int ok = cd && order && ids;
+    for (size_t c = 0; ok && c < v->nc; c++)
+        cd[c] = sq_dist(v->cent + c * AMSCR__SIG_LB_DIM, lb);
+    ok = ok && amscr_topk(cd, v->nc, v->nc, SIZE_MAX, order) == AMSCR_OK;
+    for (size_t r = 0; ok && r < v->nc && (r < IVF_PROBE_LISTS || got < IVF_PROBE_PER_M * m + 1); r++)
+        for (size_t t = v->start[order[r]]; t < v->start[order[r] + 1]; t++)
+            ids[got++] = v->ids[t];
+    if (ok)
+        qsort(ids, got, sizeof *ids, cmp_size);
+    size_t res = 0;
+    if (ok && got > m + 1)
+        res = nearest_among(sigs, lbs, ids, got, sig, lb, m, exclude, cand);
+    else if (ok)
+        res = nearest_among(sigs, lbs, NULL, n, sig, lb, m, exclude, cand);
+    free(cd);
+    free(order);
+    free(ids);
+    return res;
 }

@@ -32,4 +32,20 @@ double amscr__sig_distance(const float *a, const float *b);
 size_t amscr__sig_nearest(const float *sigs, const float *lbs, size_t n, const float *sig, const float *lb, size_t m,
                           size_t exclude, size_t *cand);
 
+/* A coarse quantizer of the lower-bound vectors (a large build's shortlists): ceil(sqrt(n))
+ * K-means lists, each holding its shapes in ascending order. */
+typedef struct {
+    size_t nc;     /* lists */
+    float *cent;   /* nc x AMSCR__SIG_LB_DIM centroids */
+    size_t *start; /* nc + 1 offsets into ids */
+    size_t *ids;   /* the n shapes, list by list */
+} amscr__sig_ivf;
+
+amscr_status amscr__sig_ivf_build(const float *lbs, size_t n, amscr__sig_ivf *v);
+void amscr__sig_ivf_free(amscr__sig_ivf *v);
+/* amscr__sig_nearest among the shapes of the lists nearest lb (at least 8 lists and 16 m + 1
+ * shapes): the m nearest of those, not necessarily the m nearest of all. */
+size_t amscr__sig_ivf_nearest(const amscr__sig_ivf *v, const float *sigs, const float *lbs, size_t n, const float *sig,
+                              const float *lb, size_t m, size_t exclude, size_t *cand);
+
 #endif
