@@ -17,6 +17,16 @@ def _new_index(make: Any, *args: Any):
     return new_object('amscr_index', make, lib.amscr_index_free, *args)
 
 
+def _candidates(candidates: Optional[int]) -> int:
+    """The shortlist size the C calls take: None is the library's default."""
+    if candidates is None:
+        return int(lib.AMSCR_INDEX_CANDIDATES)
+    c = int(candidates)
+    if c < 0:
+        raise bad('candidates: %d is negative' % c)
+    return c
+
+
 def _text(p) -> Optional[str]:
     return None if p == ffi.NULL else ffi.string(p).decode('utf-8', 'surrogateescape')
 
@@ -238,9 +248,10 @@ class Index:
 
         Args:
             points: the query: points or a :class:`Shape`.
-            candidates: None or 0: match the query with every shape; M: its M
-                signature-nearest only (the others score inf unless the re-ranking reaches
-                them).
+            candidates: None: the library's default shortlist (``AMSCR_INDEX_CANDIDATES``,
+                256 shapes; the tool's ``amscr search`` default); 0: match the query with every
+                shape (exact: its row of the retrieval matrix); M: its M signature-nearest only
+                (the others score inf unless the re-ranking reaches them).
             order: 'xy' (default) or 'rc'.
         Returns:
             (len(self),) float array.
@@ -250,7 +261,7 @@ class Index:
         with self._lock.read():
             q = as_shape(points, self.collection_params(), 'points', order)
             out = np.zeros(len(self), dtype=np.float64)
-            _check(lib.amscr_index_query_scores(self._x, q._d, int(candidates or 0), dbuf(out), len(out)))
+            _check(lib.amscr_index_query_scores(self._x, q._d, _candidates(candidates), dbuf(out), len(out)))
             return out
 
     def query(self, points: PointsLike, top: int = 10, candidates: Optional[int] = None, *,
@@ -275,7 +286,7 @@ class Index:
             idx = np.zeros(max(top, 1), dtype=np.uintp)
             sc = np.zeros(max(top, 1), dtype=np.float64)
             cnt = ffi.new('size_t *')
-            _check(lib.amscr_index_query(self._x, q._d, int(candidates or 0), top,
+            _check(lib.amscr_index_query(self._x, q._d, _candidates(candidates), top,
                                          ffi.from_buffer('size_t[]', idx), dbuf(sc), cnt))
             k = int(cnt[0])
             return idx[:k].astype(np.int64), sc[:k].copy()
