@@ -7,7 +7,13 @@
  *   hf_matrix.c     the shape channel over a whole collection
  *   fuse.c          the fused, re-ranked retrieval matrix
  *   rerank.c        contextual re-ranking by affinity diffusion
- *   scores.c        retrieval scores (this file)
+ *   scores.c        retrieval scores (this file); protocols.c the evaluation protocols
+ *   db_io.c, bytes.c  the collection file format (little-endian readers and writers)
+ *   index.c         the index object (amscr_index); index_build.c, index_add.c build it on
+ *                   threads (index_threads.c), index_pairs.c the base distance pair by pair,
+ *                   index_features.c each shape's kept features, index_query.c one query's
+ *                   exact re-ranked row, index_io.c its file section
+ *   signature.c, affine_signature.c  the shortlist signature and its search
  *
  * scores.c — retrieval scores on a distance matrix (docs/method.md §4): top-k selection,
  * bull's eye, the Kimia top-k table and 1-NN accuracies. Ranking is by distance

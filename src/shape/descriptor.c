@@ -3,6 +3,9 @@
  *   contour_text.c  text point lists: reading, parsing, writing
  *   trace.c         the outer boundary of the largest component of a mask
  *   trace_all.c     every contour of a mask with its hierarchy
+ *   iso_level.c     the grey level a sub-pixel contour follows (and Otsu's split)
+ *   march.c         marching squares along that level
+ *   trace_image.c   sub-pixel contours of 8- and 16-bit images (amscr_contour(s)_from_image)
  *   resample.c      Euclidean and affine arc-length resampling, whitening normalization
  *   despike.c       isolated stray points dropped from a point list
  *   descriptor.c    the prepared shape (this file), built from the others
