@@ -60,7 +60,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (st == AMSCR_OK)
             check_contour(c, w, h, !flags, 0);
         else
-            FUZZ_CHECK(c == NULL && (st == AMSCR_E_NOT_FOUND || st == AMSCR_E_DEGENERATE));
+            FUZZ_CHECK(c == NULL && (st == AMSCR_E_NOT_FOUND || st == AMSCR_E_DEGENERATE ||
+                                     (w == 0 && st == AMSCR_E_INVALID_ARG)));
         amscr_contour_free(c);
     } else {
         amscr_contour_set *s = NULL;
@@ -73,7 +74,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 check_contour(amscr_contour_set_contour(s, i), w, h, !flags, amscr_contour_set_is_hole(s, i));
             }
         } else {
-            FUZZ_CHECK(s == NULL && st == AMSCR_E_NOT_FOUND);
+            FUZZ_CHECK(s == NULL && (st == AMSCR_E_NOT_FOUND || (w == 0 && st == AMSCR_E_INVALID_ARG)));
         }
         amscr_contour_set_free(s);
     }
