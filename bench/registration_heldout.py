@@ -173,9 +173,9 @@ def compose(P, Q):  # P after Q
     return np.hstack([P[:, :2] @ Q[:, :2], P[:, :2] @ Q[:, 2:] + P[:, 2:]])
 
 
-def ecc_register(src, tgt, cv2):
-    a, Ps = render(src, cv2)
-    b, Pt = render(tgt, cv2)
+def ecc_multistart(a, b, cv2):
+    """OpenCV's ECC (MOTION_AFFINE) between float images a and b from 8 starting rotations, the
+    centroids and areas matched: the W (2 x 3, b(W x) ~ a(x)) of the best correlation, or None."""
     ma, mb = cv2.moments(a), cv2.moments(b)
     if ma['m00'] <= 0 or mb['m00'] <= 0:
         return None
@@ -194,6 +194,13 @@ def ecc_register(src, tgt, cv2):
             continue
         if rho > best_rho:
             best, best_rho = W.astype(np.float64), rho
+    return best
+
+
+def ecc_register(src, tgt, cv2):
+    a, Ps = render(src, cv2)
+    b, Pt = render(tgt, cv2)
+    best = ecc_multistart(a, b, cv2)
     if best is None:
         return None
     # a(x) ~ b(W x): W maps source pixels to target pixels
