@@ -68,6 +68,8 @@ void base_free(base_t *b);
 /* Score of the sub-collection idx (m shapes; NULL = all) under pc. */
 extern size_t last_k; /* the k of the last eval_sub */
 double eval_sub(const base_t *b, const coll_t *c, const size_t *idx, size_t m, const post_cfg *pc);
+/* The sub-collection's final matrix (m x m, caller frees; NULL on failure) under pc. */
+double *eval_matrix(const base_t *b, const size_t *idx, size_t m, const post_cfg *pc);
 
 /* One row: fold A, fold B, mpeg7-dev, Kimia-99, Kimia-216 under (r, pc). */
 typedef struct {
@@ -82,6 +84,7 @@ int folds_fourier(const folds_data *fd);
 int folds_fuse(const folds_data *fd, const char *datasets);
 int folds_local(const folds_data *fd, const char *datasets);
 int folds_halves(const folds_data *fd);
+int folds_classes(const folds_data *fd, const char *datasets);
 /* Local scale of each row of the m x m matrix M: its k-th smallest off-diagonal entry. */
 void folds_local_scale(const double *M, size_t m, size_t k, double *sigma);
 int folds_mcd(const char *datasets);

@@ -235,7 +235,7 @@ static size_t mutual_k(const double *F, size_t m, size_t K)
 
 size_t last_k;
 
-double eval_sub(const base_t *b, const coll_t *c, const size_t *idx, size_t m, const post_cfg *pc)
+double *eval_matrix(const base_t *b, const size_t *idx, size_t m, const post_cfg *pc)
 {
     size_t n = b->n, *all = NULL;
     if (!idx) {
@@ -246,9 +246,6 @@ double eval_sub(const base_t *b, const coll_t *c, const size_t *idx, size_t m, c
         m = n;
     }
     double *F = malloc(m * m * sizeof *F), *X = malloc(m * m * sizeof *X);
-    int32_t *lab = malloc(m * sizeof *lab);
-    for (size_t i = 0; i < m; i++)
-        lab[i] = c->s.labels[idx[i]];
     sub(b->hs, n, idx, m, F);
     sub(b->ha, n, idx, m, X);
     for (size_t i = 0; i < m * m; i++)
@@ -280,13 +277,27 @@ double eval_sub(const base_t *b, const coll_t *c, const size_t *idx, size_t m, c
     last_k = k;
     if (k > m)
         k = m;
-    double s = -1;
-    if (k == 0 || amscr__rerank_normalized(F, m, k, pc->iters, F) == AMSCR_OK)
+    if (k != 0 && amscr__rerank_normalized(F, m, k, pc->iters, F) != AMSCR_OK) {
+        free(F);
+        F = NULL;
+    }
+    free(X);
+    free(all);
+    return F;
+}
+
+double eval_sub(const base_t *b, const coll_t *c, const size_t *idx, size_t m, const post_cfg *pc)
+{
+    if (!idx)
+        m = b->n;
+    double *F = eval_matrix(b, idx, m, pc), s = -1;
+    int32_t *lab = malloc(m * sizeof *lab);
+    for (size_t i = 0; i < m; i++)
+        lab[i] = c->s.labels[idx ? idx[i] : i];
+    if (F)
         s = score_of(F, m, lab, c->kind);
     free(F);
-    free(X);
     free(lab);
-    free(all);
     return s;
 }
 

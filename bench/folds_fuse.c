@@ -10,6 +10,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "../tools/cli/collection.h"
+
 static int fold_idx(const folds_data *fd, int which, size_t *idx)
 {
     int m = 0;
@@ -254,5 +256,110 @@ int folds_halves(const folds_data *fd)
     free(idx);
     free(in);
     free(perm);
+    return 0;
+}
+
+/* Where the candidates win and lose (`... classes`): 1-NN accuracy (the leaf and ETH-80 protocol)
+ * and bull's eye per part of the 916-shape collection (the mpeg7-dev and the Kimia-216 classes),
+ * and the mpeg7-dev classes whose bull's eye moves most. */
+static void part_scores(const double *F, const coll_t *c, double out[4])
+{
+    size_t n = c->s.n, nc = 0;
+    int32_t maxl = 0;
+    for (size_t i = 0; i < n; i++)
+        maxl = c->s.labels[i] > maxl ? c->s.labels[i] : maxl;
+    if (amscr_score_classes(c->s.labels, n, NULL, NULL, &nc) != AMSCR_OK)
+        return;
+    double *be = malloc(nc * sizeof *be), *nn = malloc(nc * sizeof *nn);
+    int32_t *cls = malloc(nc * sizeof *cls);
+    size_t *sz = malloc(nc * sizeof *sz);
+    double w[2] = {0}, sb[2] = {0}, sn[2] = {0};
+    if (amscr_score_classes(c->s.labels, n, cls, sz, &nc) == AMSCR_OK &&
+        amscr_score_per_class(F, n, c->s.labels, nc, be, nn) == AMSCR_OK)
+        for (size_t k = 0; k < nc; k++) {
+            int part = cls[k] >= 1000;
+            sb[part] += be[k] * (double)sz[k];
+            sn[part] += nn[k] * (double)sz[k];
+            w[part] += (double)sz[k];
+        }
+    for (int part = 0; part < 2; part++) {
+        out[2 * part] = w[part] > 0 ? 100.0 * sb[part] / w[part] : 0.0;
+        out[2 * part + 1] = w[part] > 0 ? 100.0 * sn[part] / w[part] : 0.0;
+    }
+    free(be);
+    free(nn);
+    free(cls);
+    free(sz);
+}
+
+int folds_classes(const folds_data *fd, const char *datasets)
+{
+    static const struct {
+        int prop, fmode;
+        double w;
+        const char *name;
+    } cand[] = {{0, 0, 0.0, "the preset"},
+                {0, 1, 0.0, "channel in local scales"},
+                {3, 1, 0.02, "moments (both frames), local scales, 0.02"},
+                {3, 1, 0.1, "moments (both frames), local scales, 0.1"},
+                {2, 1, 0.02, "moments (affine frame), local scales, 0.02"}};
+    enum { NC = sizeof cand / sizeof cand[0] };
+    const coll_t *cs[4] = {&fd->dev, &fd->k99, &fd->k216, &fd->devk216};
+    base_t b[4];
+    for (int t = 0; t < 4; t++)
+        if (base_get(cs[t], &RAW_DEFAULT, 0, 2, &b[t]) != 0)
+            return 1;
+    size_t n = fd->dev.s.n, nc = 0;
+    if (amscr_score_classes(fd->dev.s.labels, n, NULL, NULL, &nc) != AMSCR_OK)
+        return 1;
+    double *be[NC];
+    printf("| candidate | 1-NN mpeg7-dev | 1-NN Kimia-99 | 1-NN Kimia-216 | 916: bull's eye mpeg7 part | 916: Kimia part "
+           "| 916: 1-NN mpeg7 part | 916: 1-NN Kimia part |\n|---|---|---|---|---|---|---|---|\n");
+    for (int c = 0; c < NC; c++) {
+        post_cfg p = POST_DEFAULT;
+        p.prop = cand[c].prop;
+        p.fmode = cand[c].fmode;
+        p.wfd = cand[c].w;
+        double v[4][4] = {{0}};
+        be[c] = malloc(nc * sizeof *be[c]);
+        for (int t = 0; t < 4; t++) {
+            double *F = eval_matrix(&b[t], NULL, 0, &p);
+            if (!F)
+                return 1;
+            part_scores(F, cs[t], v[t]);
+            if (t == 0 && amscr_score_per_class(F, n, fd->dev.s.labels, nc, be[c], NULL) != AMSCR_OK)
+                return 1;
+            free(F);
+        }
+        printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", cand[c].name, v[0][1], v[1][1], v[2][1], v[3][0],
+               v[3][2], v[3][1], v[3][3]);
+    }
+    char path[1024];
+    collection col;
+    snprintf(path, sizeof path, "%s/mpeg7-dev/manifest.tsv", datasets);
+    if (collection_open(path, &col) != 0)
+        return 1;
+    printf("\nmpeg7-dev classes, bull's eye %% (fold in brackets): the preset, then each candidate\n\n| class |");
+    for (int c = 0; c < NC; c++)
+        printf(" %s |", cand[c].name);
+    printf("\n|---|");
+    for (int c = 0; c < NC; c++)
+        printf("---|");
+    printf("\n");
+    for (size_t k = 0; k < nc && k < col.nclasses; k++) {
+        int fold = 0;
+        for (size_t i = 0; i < n; i++)
+            if (fd->dev.s.labels[i] == (int32_t)k)
+                fold = fd->fold[i];
+        printf("| %s (%c) |", col.classes[k], fold ? 'B' : 'A');
+        for (int c = 0; c < NC; c++)
+            printf(" %.1f |", 100.0 * be[c][k]);
+        printf("\n");
+    }
+    collection_free(&col);
+    for (int c = 0; c < NC; c++)
+        free(be[c]);
+    for (int t = 0; t < 4; t++)
+        base_free(&b[t]);
     return 0;
 }

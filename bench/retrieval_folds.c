@@ -20,6 +20,7 @@
  *   amscr-retrieval-folds DATASETS local   the channel rescaled before re-ranking: local scaling, NICDM,
  *                                          mutual proximity (folds_fuse.c; LOCAL_K=k the re-ranking's k)
  *   amscr-retrieval-folds DATASETS halves  candidates on 24 random class halves of mpeg7-dev (folds_fuse.c)
+ *   amscr-retrieval-folds DATASETS classes 1-NN, the 916-shape collection's parts, mpeg7-dev per class
  *   amscr-retrieval-folds DATASETS mcd     the MCD-style affine views by band and affine share
  *   amscr-retrieval-folds DATASETS row N BAND SKIP LOC SHARE K ITERS [STRIDE]   one combination, all splits
  *                                          and the MCD-style views
@@ -62,6 +63,8 @@ int main(int argc, char **argv)
         r = folds_local(&fd, argv[1]);
     else if (strcmp(what, "halves") == 0)
         r = folds_halves(&fd);
+    else if (strcmp(what, "classes") == 0)
+        r = folds_classes(&fd, argv[1]);
     else
         fprintf(stderr, "unknown sweep %s\n", what);
     folds_free(&fd);
