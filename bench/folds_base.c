@@ -185,7 +185,8 @@ static void fourier_matrix(const amscr_db *db, double *out)
  * The key's "sp" marks contours traced at sub-pixel accuracy (the tool's tracer since 0.4). */
 static double *one(const coll_t *c, const raw_cfg *r, int what, amscr_db **db)
 {
-    static const char *names[] = {"channel similarity", "channel affine", "AMSCR", "Fourier", "moments", "moments, affine frame"};
+    static const char *names[] = {"channel similarity", "channel affine", "AMSCR",
+                                  "Fourier",            "moments",        "moments, affine frame"};
     size_t n = c->s.n;
     char key[300];
     char tag[32] = "";
