@@ -192,8 +192,8 @@ static double *one(const coll_t *c, const raw_cfg *r, int what, amscr_db **db)
     char tag[32] = "";
     if (r->stride > 1)
         snprintf(tag, sizeof tag, " t%zu", r->stride);
-    snprintf(key, sizeof key, "%s sp n%zu N%zu b%g s%g l%g r%d m%d%s", c->name, n, r->N, r->band, r->skip, r->loc, r->refl,
-             what, tag);
+    snprintf(key, sizeof key, "%s sp n%zu N%zu b%g s%g l%g r%d m%d%s", c->name, n, r->N, r->band, r->skip, r->loc,
+             r->refl, what, tag);
     double *M = malloc(n * n * sizeof *M);
     if (!M || cache_io(key, M, n, 0) == 0)
         return M;

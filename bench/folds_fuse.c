@@ -35,8 +35,8 @@ static int row(const folds_data *fd, const base_t *bd, const base_t *b99, const 
     double dev = eval_sub(bd, &fd->dev, NULL, 0, p), k99 = eval_sub(b99, &fd->k99, NULL, 0, p);
     double k216 = eval_sub(b216, &fd->k216, NULL, 0, p), mc = eval_sub(bm, mcd, NULL, 0, p);
     double dk = eval_sub(g_bdk, &fd->devk216, NULL, 0, p), dw = eval_sub(g_bdw, &fd->devwarp, NULL, 0, p);
-    printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %.0f | %.2f | %.2f | %.2f | %.1f |\n", label, a, b, a0, b0, dev,
-           k99, k216, mc, dk, dw, folds_now() - t0);
+    printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %.0f | %.2f | %.2f | %.2f | %.1f |\n", label, a, b, a0, b0,
+           dev, k99, k216, mc, dk, dw, folds_now() - t0);
     fflush(stdout);
     return 0;
 }
@@ -181,7 +181,8 @@ static void shuffle(int *perm, int L, unsigned long long *seed)
 
 /* Candidates against the preset on many random class halves of mpeg7-dev (`... halves`): each half
  * (17 or 18 of the 35 classes, seeded; HALVES_CLASSES=C: C and 35 - C) is its own collection; per
- * candidate the mean gain over the preset and the share of halves it helps (re-ranked and before re-ranking). One fixed fold pair
+ * candidate the mean gain over the preset and the share of halves it helps (re-ranked and before
+ * re-ranking). One fixed fold pair
  * can be lucky; a rule that generalizes helps on most class subsets. */
 int folds_halves(const folds_data *fd)
 {
@@ -245,8 +246,8 @@ int folds_halves(const folds_data *fd)
     }
     int C = getenv("HALVES_CLASSES") ? atoi(getenv("HALVES_CLASSES")) : (maxl + 1) / 2;
     for (int half = 0; half < 2; half++) {
-        printf("\n%d random collections of %d of mpeg7-dev's %d classes (seeded); the preset's mean: %.2f %% re-ranked, "
-               "%.2f %% before\n\n| candidate | mean gain re-ranked | better / worse (of %d) | mean gain before "
+        printf("\n%d random collections of %d of mpeg7-dev's %d classes (seeded); the preset's mean: %.2f %% "
+               "re-ranked, %.2f %% before\n\n| candidate | mean gain re-ranked | better / worse (of %d) | mean gain before "
                "re-ranking | better / worse |\n|---|---|---|---|---|\n",
                NH, half ? maxl + 1 - C : C, maxl + 1, base[half][0], base[half][1], NH);
         for (int c = 1; c < NC; c++)
@@ -323,7 +324,8 @@ int folds_classes(const folds_data *fd, const char *datasets)
                 return 1;
             free(F);
         }
-        printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f |\n", cand[c].name, v[0][1], v[1][1], v[2][1], v[3][1], v[3][0]);
+        printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f |\n", cand[c].name, v[0][1], v[1][1], v[2][1], v[3][1],
+               v[3][0]);
     }
     char path[1024];
     collection col;
