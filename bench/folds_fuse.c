@@ -182,8 +182,8 @@ static void shuffle(int *perm, int L, unsigned long long *seed)
 /* Candidates against the preset on many random class halves of mpeg7-dev (`... halves`): each half
  * (17 or 18 of the 35 classes, seeded; HALVES_CLASSES=C: C and 35 - C) is its own collection; per
  * candidate the mean gain over the preset and the share of halves it helps (re-ranked and before
- * re-ranking). One fixed fold pair
- * can be lucky; a rule that generalizes helps on most class subsets. */
+ * re-ranking). One fixed fold pair can be lucky; a rule that generalizes helps on most class
+ * subsets. */
 int folds_halves(const folds_data *fd)
 {
     static const struct {
