@@ -19,6 +19,7 @@
  * The winner's closest-point pairs are left in ws->rbuf for the reported QR solve. */
 #include "dense.h"
 #include "match.h"
+#include "nearest.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -43,6 +44,11 @@
 #define RECOVER_ITERS 30
 /* Partners after the first step are searched within ±RECOVER_HINT samples of the last. */
 #define RECOVER_HINT 3
+/* When the first fragment tried (the one the reported map's outliers touch least) lands, after
+ * refinement, within this RMS displacement of the refined reported map (2 % of the RMS radius,
+ * sqrt 2 in the normalized frame), the two independent estimates agree and the other fragments
+ * are not tried. */
+#define RECOVER_AGREE (0.02 * 1.4142135623730951)
 /* Share of the samples each direction of the ranking cost keeps. */
 #define RECOVER_RANK_KEEP 0.7
 
@@ -50,6 +56,7 @@
 typedef struct {
     double *q, *r2, *sorted, *seg, *Hd, *P;
     size_t nd;
+    amscr__grid grid; /* over Hd's vertices: the global search's first guess */
 } scratch_t;
 
 /* Closest target points of X f (global search when `global`, else around seg), the adaptive
@@ -60,8 +67,13 @@ static double pairs(const amscr_descriptor *f, scratch_t *s, const double X[6], 
     for (size_t a = 0; a < n; a++) {
         double fx = f->base[2 * a], fy = f->base[2 * a + 1], qx, qy;
         double px = X[0] * fx + X[1] * fy + X[2], py = X[3] * fx + X[4] * fy + X[5];
-        size_t b0 = global ? 0 : (size_t)s->seg[a], w = global ? s->nd : RECOVER_HINT * AMSCR__DENSE, seg = 0;
-        s->r2[a] = amscr__closest_on_polygon(s->Hd, s->nd, 1, b0, w, px, py, &qx, &qy, &seg);
+        size_t b0 = (size_t)s->seg[a], seg = 0;
+        if (global) { /* the nearest dense vertex, then its neighbouring edges (as the local step) */
+            double d2;
+            b0 = amscr__grid_nearest(&s->grid, s->Hd, px, py, &d2);
+        }
+        s->r2[a] = amscr__closest_on_polygon(s->Hd, s->nd, 1, b0, RECOVER_HINT * AMSCR__DENSE, px, py, &qx, &qy,
+                                             &seg);
         s->q[2 * a] = qx;
         s->q[2 * a + 1] = qy;
         s->seg[a] = (double)seg;
@@ -144,6 +156,27 @@ static double inlier_share(const double *r2, size_t n)
     return (double)in / (double)n;
 }
 
+/* The fragments in the order they are tried: fewest samples without a target boundary near
+ * them under the reported map (r2: its squared residuals) first, so the first one tried is the
+ * one most likely to avoid the missing run. */
+static void fragment_order(const double *r2, size_t n, size_t order[RECOVER_FRAGS])
+{
+    size_t len = (size_t)(RECOVER_SHARE * (double)n), out[RECOVER_FRAGS];
+    for (size_t k = 0; k < RECOVER_FRAGS; k++) {
+        size_t start = k * n / RECOVER_FRAGS;
+        out[k] = 0;
+        for (size_t j = 0; j < len; j++)
+            out[k] += r2[(start + j) % n] > RECOVER_INLIER_DIST * RECOVER_INLIER_DIST;
+        order[k] = k;
+    }
+    for (size_t k = 1; k < RECOVER_FRAGS; k++) /* insertion sort, stable: ties keep k's order */
+        for (size_t j = k; j > 0 && out[order[j]] < out[order[j - 1]]; j--) {
+            size_t t = order[j];
+            order[j] = order[j - 1];
+            order[j - 1] = t;
+        }
+}
+
 /* The map of fragment k of f placed on h by partial matching, in f's normalized frame.
  * Returns 0 when the fragment cannot be placed. */
 static int fragment_start(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h, size_t k,
@@ -194,15 +227,26 @@ static amscr_status finish(const amscr_params *prm, const amscr_descriptor *f, s
     return AMSCR_OK;
 }
 
+static void scratch_free(scratch_t *s)
+{
+    free(s->q);
+    amscr__grid_free(&s->grid);
+    s->q = NULL;
+}
+
 static amscr_status scratch_new(const amscr_descriptor *f, const amscr_descriptor *h, scratch_t *s)
 {
     size_t n = f->n;
     double *buf = amscr__malloc_array(2 * AMSCR__DENSE * n + 10 * n, sizeof *buf);
     if (!buf)
         return amscr__fail(AMSCR_E_NOMEM, "registration: out of memory");
-    scratch_t t = {buf, buf + 2 * n, buf + 3 * n, buf + 4 * n, buf + 5 * n, buf + 5 * n + 2 * AMSCR__DENSE * n, 0};
+    scratch_t t = {buf, buf + 2 * n, buf + 3 * n, buf + 4 * n, buf + 5 * n, buf + 5 * n + 2 * AMSCR__DENSE * n, 0, {0}};
     *s = t;
     s->nd = amscr__densify(h->base, n, 1, s->Hd);
+    if (!amscr__grid_build(&s->grid, s->Hd, s->nd)) {
+        scratch_free(s);
+        return amscr__fail(AMSCR_E_NOMEM, "registration: out of memory (or a non-finite target)");
+    }
     return AMSCR_OK;
 }
 
@@ -218,7 +262,7 @@ amscr_status amscr__refine_adaptive(const amscr_params *prm, const amscr_descrip
     double best[6];
     memcpy(best, m->X, sizeof best);
     st = finish(prm, f, &s, ws, best, m);
-    free(s.q);
+    scratch_free(&s);
     return st;
 }
 
@@ -232,23 +276,29 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
     amscr_status st = scratch_new(f, h, &s);
     if (st != AMSCR_OK)
         return st;
-    double *buf = s.q, *pts = s.P + 2 * n;
-    double best[6], X[6], best_cost;
+    double *pts = s.P + 2 * n;
+    double best[6], X[6], reported[6], best_cost;
+    size_t order[RECOVER_FRAGS];
+    fragment_order(ws->rbuf + 2 * n, n, order);
     memcpy(best, m->X, sizeof best);
     refine_adaptive(prm, f, &s, best);
+    memcpy(reported, best, sizeof best);
     best_cost = two_way_cost(f, h, &s, best);
-    for (size_t k = 0; k < RECOVER_FRAGS; k++) {
-        if (!fragment_start(prm, f, h, k, ws, pts, X))
+    for (size_t i = 0; i < RECOVER_FRAGS; i++) {
+        if (!fragment_start(prm, f, h, order[i], ws, pts, X))
             continue;
         refine_adaptive(prm, f, &s, X);
         double c = two_way_cost(f, h, &s, X);
+        int agree = i == 0 && amscr__map_gap2(f, X, reported) <= RECOVER_AGREE * RECOVER_AGREE;
         if (c < best_cost) {
             best_cost = c;
             memcpy(best, X, sizeof best);
         }
+        if (agree)
+            break;
     }
     amscr__clear_error();
     st = finish(prm, f, &s, ws, best, m);
-    free(buf);
+    scratch_free(&s);
     return st;
 }
