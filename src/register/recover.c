@@ -240,8 +240,13 @@ static amscr_status scratch_new(const amscr_descriptor *f, const amscr_descripto
     double *buf = amscr__malloc_array(2 * AMSCR__DENSE * n + 10 * n, sizeof *buf);
     if (!buf)
         return amscr__fail(AMSCR_E_NOMEM, "registration: out of memory");
-    scratch_t t = {buf, buf + 2 * n, buf + 3 * n, buf + 4 * n, buf + 5 * n, buf + 5 * n + 2 * AMSCR__DENSE * n, 0, {0}};
-    *s = t;
+    memset(s, 0, sizeof *s);
+    s->q = buf;
+    s->r2 = buf + 2 * n;
+    s->sorted = buf + 3 * n;
+    s->seg = buf + 4 * n;
+    s->Hd = buf + 5 * n;
+    s->P = buf + 5 * n + 2 * AMSCR__DENSE * n;
     s->nd = amscr__densify(h->base, n, 1, s->Hd);
     if (!amscr__grid_build(&s->grid, s->Hd, s->nd)) {
         scratch_free(s);
