@@ -30,7 +30,8 @@ Usage: nice .venv/bin/python bench/registration_traced.py [--data DIR] [--tool P
 --no-chain skips the --pixel-chain column; --breakdown splits the library's time (the traces,
 the registration, without the polish, without the polish and the refinement); --cpu-time reports
 the library's time as this process's CPU time (with OPENBLAS_NUM_THREADS=1). "lib ms": the library alone in this process (the
-Python binding: both images traced by amscr.contour_from_mask, then amscr.register), the
+Python binding: both images traced by amscr.contour_from_mask(join=True) as the tool traces them,
+then amscr.register), the
 median over the condition's pairs; skipped when the amscr package is not importable.
 Deterministic: every draw is seeded by (class index, condition, draw).
 """
@@ -191,7 +192,7 @@ def lib_register_ms(src, tgt, breakdown=None):
     except ImportError:
         return math.nan
     t0 = CLOCK()
-    ps, pt = amscr.contour_from_mask(src), amscr.contour_from_mask(tgt)
+    ps, pt = amscr.contour_from_mask(src, join=True), amscr.contour_from_mask(tgt, join=True)  # as the tool
     t1 = CLOCK()
     amscr.register(ps, pt)
     t2 = CLOCK()
