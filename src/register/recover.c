@@ -16,8 +16,8 @@
  *      a fixed share would keep part of a missing run); the first partners come from a grid
  *      over the target's dense vertices;
  *   2b. as soon as two of these refined maps agree (RECOVER_AGREE), one of them the best so far
- *      by the cost of 3., no further fragment is placed (placements: ~60 % of the stage's time),
- *      unless the whole-curve search was ambiguous (RECOVER_AMBIGUOUS);
+ *      by the cost of 3., no further fragment is placed (placements: ~60 % of the stage's time);
+ *      after an ambiguous whole-curve search (RECOVER_AMBIGUOUS) two fragments must agree;
  *   3. the candidates are ranked by a two-way trimmed cost — source samples to the target and
  *      target samples to the mapped source — so a map that collapses the source onto a piece
  *      of the target (low one-way cost) loses to one that covers the target.
@@ -54,9 +54,10 @@
  * independent estimates agree and the remaining fragments are not tried (the fragments are
  * tried fewest-outliers first, so the first is the likeliest to avoid the missing run). */
 #define RECOVER_AGREE (0.02 * 1.4142135623730951)
-/* ... unless the whole-curve search found another map nearly as good (ambiguity at least this:
- * a symmetric shape, whose fragments may agree on a wrong turn): then every fragment is tried
- * (measured: a 12-fold star with 10 % missing stopped on a wrong turn that a later fragment beats). */
+/* ... but the reported map counts only when the whole-curve search was not ambiguous (ambiguity
+ * below this): on a symmetric shape it may be a wrong turn that the first fragment, fitting
+ * equally well, agrees with (measured: a 12-fold star with 10 % missing stopped on one that a
+ * later fragment beats); two fragments must then agree. */
 #define RECOVER_AMBIGUOUS 0.5
 /* Share of the samples each direction of the ranking cost keeps. */
 #define RECOVER_RANK_KEEP 0.7
@@ -308,8 +309,8 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
             best_cost = c;
             memcpy(best, X, sizeof best);
         }
-        int agree = 0; /* with an earlier map, one of the two being the best so far */
-        for (size_t j = 0; j < nt && !agree && m->ambiguity < RECOVER_AMBIGUOUS; j++)
+        int agree = 0; /* with an earlier map (tried[0]: the reported one), one of the two the best so far */
+        for (size_t j = m->ambiguity < RECOVER_AMBIGUOUS ? 0 : 1; j < nt && !agree; j++)
             agree = (c <= best_cost || cost[j] <= best_cost) &&
                     amscr__map_gap2(f, X, tried[j]) <= RECOVER_AGREE * RECOVER_AGREE;
         nt++;
