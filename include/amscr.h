@@ -457,6 +457,12 @@ AMSCR_API double amscr_contour_set_area(const amscr_contour_set *s, size_t i);
 #define AMSCR_LEVEL_AUTO (-1.0)
 /** Flag of amscr_contour_from_image: the pixel-centre chain of amscr_contour_from_mask. @since 0.4 */
 #define AMSCR_TRACE_PIXEL_CHAIN 1
+/** Flag of amscr_contour_from_image (sub-pixel tracing; no effect with AMSCR_TRACE_PIXEL_CHAIN):
+ *  the other large components near the largest (at least 5 % of its pixels, within its RMS
+ *  radius, not inside its holes; up to 8) joined to its outline by zero-width bridges between
+ *  closest vertices — a shape an occluder cut in pieces keeps all its boundary for registration
+ *  (docs/method.md §5). @since 0.5 */
+#define AMSCR_TRACE_JOIN 2
 
 /**
  * @brief Traces the outer boundary of the largest foreground component of an 8- or 16-bit
@@ -471,7 +477,8 @@ AMSCR_API double amscr_contour_set_area(const amscr_contour_set *s, size_t i);
  * coverage is one half), with positive signed area (counter-clockwise in a y-up frame), no
  * repeated point. Saddle cells join foreground corners. With AMSCR_TRACE_PIXEL_CHAIN the
  * pixels are classified the same way and the result is amscr_contour_from_mask's chain of
- * boundary pixel centres.
+ * boundary pixel centres. With AMSCR_TRACE_JOIN (sub-pixel only) the outline also takes in the
+ * other large pieces near the largest component (see the flag).
  *
  * @param[in] pixels  height rows of width samples (uint8_t for bits 8, native-endian uint16_t
  *                    for bits 16), rows `stride` samples apart.
@@ -482,7 +489,7 @@ AMSCR_API double amscr_contour_set_area(const amscr_contour_set *s, size_t i);
  *                   pixels as amscr_contour_from_mask's threshold T); negative
  *                   (AMSCR_LEVEL_AUTO): halfway between the medians of the two classes
  *                   of Otsu's split.
- * @param[in] flags  0 (sub-pixel) or AMSCR_TRACE_PIXEL_CHAIN.
+ * @param[in] flags  0 (sub-pixel), AMSCR_TRACE_PIXEL_CHAIN, and/or AMSCR_TRACE_JOIN (since 0.5).
  * @param[out] out  new contour.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, empty image, bad stride, bits, level or
  *         flags); AMSCR_E_LIMIT; AMSCR_E_NOT_FOUND (no foreground, or foreground
@@ -504,7 +511,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_from_image(const void *pixe
  * its region and the region around it: outer contours counter-clockwise, holes clockwise.
  * Areas are those of the sub-pixel polygons (a single binary pixel has area 0.5).
  *
- * @param[in] pixels, width, height, stride, bits, level, flags  as amscr_contour_from_image.
+ * @param[in] pixels, width, height, stride, bits, level  as amscr_contour_from_image.
+ * @param[in] flags  0 or AMSCR_TRACE_PIXEL_CHAIN (AMSCR_TRACE_JOIN: AMSCR_E_INVALID_ARG).
  * @param[in] min_area  pixels^2, >= 0 and finite.
  * @param[out] out  new set with at least one contour.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_LIMIT; AMSCR_E_NOT_FOUND (no foreground,

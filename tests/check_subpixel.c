@@ -231,6 +231,57 @@ START_TEST(old_calls_unchanged)
 }
 END_TEST
 
+/* AMSCR_TRACE_JOIN: a bar cut in two by a gap (the halves 24 and 16 px long) is one outline
+ * holding both halves' areas and reaching both ends; a speck (below 5 % of the largest) and a
+ * piece beyond the largest's RMS radius stay out; without the flag the largest half alone;
+ * amscr_contours_from_image refuses the flag. */
+START_TEST(join_pieces)
+{
+    const size_t w = 80, h = 40;
+    uint8_t *img = calloc(w * h, 1);
+    for (size_t y = 10; y < 16; y++) {
+        for (size_t x = 10; x < 34; x++)
+            img[y * w + x] = 255; /* left half: 24 x 6 */
+        for (size_t x = 38; x < 54; x++)
+            img[y * w + x] = 255; /* right half: 16 x 6, 4 px away */
+    }
+    img[30 * w + 20] = 255; /* a speck */
+    amscr_contour *a = trace_ok(img, w, h, 8, 127.5, 0), *b = trace_ok(img, w, h, 8, 127.5, AMSCR_TRACE_JOIN);
+    double area_a = 0.0, area_b = 0.0;
+    ck_assert_int_eq(amscr_contour_signed_area(a, &area_a), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_signed_area(b, &area_b), AMSCR_OK);
+    ck_assert_msg(fabs(area_a - (24 * 6 - 0.5)) < 1e-9, "largest alone: area %g", area_a);
+    ck_assert_msg(fabs(area_b - (24 * 6 - 0.5) - (16 * 6 - 0.5)) < 1e-9, "joined: area %g", area_b);
+    const double *xy = amscr_contour_xy(b);
+    double xmin = 1e9, xmax = -1e9, ymax = -1e9;
+    for (size_t i = 0; i < amscr_contour_size(b); i++) {
+        xmin = fmin(xmin, xy[2 * i]);
+        xmax = fmax(xmax, xy[2 * i]);
+        ymax = fmax(ymax, xy[2 * i + 1]);
+    }
+    ck_assert(xmin == 9.5 && xmax == 53.5 && ymax == 15.5); /* both ends, not the speck (row 30) */
+    amscr_contour_free(a);
+    amscr_contour_free(b);
+    /* a second piece far away (beyond the RMS radius, about 7 px): not joined */
+    memset(img, 0, w * h);
+    for (size_t y = 10; y < 16; y++)
+        for (size_t x = 10; x < 34; x++)
+            img[y * w + x] = 255;
+    for (size_t y = 30; y < 36; y++)
+        for (size_t x = 60; x < 76; x++)
+            img[y * w + x] = 255;
+    b = trace_ok(img, w, h, 8, 127.5, AMSCR_TRACE_JOIN);
+    ck_assert_int_eq(amscr_contour_signed_area(b, &area_b), AMSCR_OK);
+    ck_assert_msg(fabs(area_b - (24 * 6 - 0.5)) < 1e-9, "far piece joined: area %g", area_b);
+    amscr_contour_free(b);
+    amscr_contour_set *s = NULL;
+    ck_assert_int_eq(amscr_contours_from_image(img, w, h, w, 8, 127.5, AMSCR_TRACE_JOIN, 0.0, &s),
+                     AMSCR_E_INVALID_ARG);
+    ck_assert_ptr_null(s);
+    free(img);
+}
+END_TEST
+
 Suite *amscr_suite_subpixel(void)
 {
     Suite *s = suite_create("subpixel");
@@ -240,6 +291,7 @@ Suite *amscr_suite_subpixel(void)
     tcase_add_test(tc, holes_and_hierarchy);
     tcase_add_test(tc, bad_input);
     tcase_add_test(tc, old_calls_unchanged);
+    tcase_add_test(tc, join_pieces);
     suite_add_tcase(s, tc);
     return s;
 }

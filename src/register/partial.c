@@ -286,11 +286,15 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
             if (ratio > m->ambiguity)
                 m->ambiguity = ratio > 1.0 ? 1.0 : ratio;
         }
-    /* the winner again, so that ws->rbuf holds its pairs for the reported QR solve */
-    double X[6];
-    memcpy(X, best[win].X0, sizeof X);
-    initial_partners(&best[win], cumF, LF, Hp, n, nd, b);
-    double cost = refine_placement(prm, f, Hd, nd, X, b, q, r2, sorted, &cut);
+    /* the winner again, so that ws->rbuf holds its pairs for the reported QR solve (they are
+     * there already when it was the last refined: the refinement is deterministic) */
+    double X[6], cost = best[win].tcost;
+    memcpy(X, best[win].X, sizeof X);
+    if (win + 1 != nb) {
+        memcpy(X, best[win].X0, sizeof X);
+        initial_partners(&best[win], cumF, LF, Hp, n, nd, b);
+        cost = refine_placement(prm, f, Hd, nd, X, b, q, r2, sorted, &cut);
+    }
     double all = 0.0;
     for (size_t a = 0; a < n; a++)
         all += r2[a];

@@ -6,6 +6,7 @@
  *   iso_level.c     the grey level a sub-pixel contour follows (and Otsu's split)
  *   march.c         marching squares along that level
  *   trace_image.c   sub-pixel contours of 8- and 16-bit images (amscr_contour(s)_from_image)
+ *   join.c          AMSCR_TRACE_JOIN: a shape cut in pieces as one outline
  *   resample.c      Euclidean and affine arc-length resampling, whitening normalization
  *   despike.c       isolated stray points dropped from a point list
  *   descriptor.c    the prepared shape (this file), built from the others

@@ -54,4 +54,11 @@ amscr_status amscr__iso_mask(const amscr__iso *f, uint8_t **out_on, size_t *out_
 amscr_status amscr__march(const amscr__iso *f, size_t cx, size_t cy, int entry, const char *fn, double **out_xy,
                           size_t *out_n);
 
+struct amscr__regions;
+/* AMSCR_TRACE_JOIN (join.c): joins to the outline xy (n points, counter-clockwise) of component
+ * `largest` of R (count: pixels per label) the outlines of the other large components near it;
+ * xy and n are replaced. */
+amscr_status amscr__join_pieces(const amscr__iso *f, const struct amscr__regions *R, const size_t *count,
+                                size_t largest, double **xy, size_t *n);
+
 #endif

@@ -16,7 +16,7 @@
 #include <stdlib.h>
 
 static amscr_status ti_check(const void *pixels, size_t width, size_t height, size_t stride, int bits, double level,
-                             int flags, const char *fn)
+                             int flags, int allowed, const char *fn)
 {
     if (pixels == NULL)
         return amscr__fail(AMSCR_E_INVALID_ARG, "%s: pixels is NULL", fn);
@@ -33,7 +33,7 @@ static amscr_status ti_check(const void *pixels, size_t width, size_t height, si
     if (isnan(level) || level >= maxval)
         return amscr__fail(AMSCR_E_INVALID_ARG, "%s: level %g not in [0, %g) nor negative (automatic)", fn, level,
                            maxval);
-    if (flags & ~AMSCR_TRACE_PIXEL_CHAIN)
+    if (flags & ~allowed)
         return amscr__fail(AMSCR_E_INVALID_ARG, "%s: unknown flags 0x%x", fn, (unsigned)flags);
     return AMSCR_OK;
 }
@@ -91,10 +91,12 @@ static amscr_status ti_region(void *ctx, const amscr__regions *R, size_t r, doub
     return amscr__contour_wrap(xy, n, out);
 }
 
-/* The largest foreground region of R (pixel count; ties: the first in raster order). */
-static size_t ti_largest(const amscr__regions *R, size_t npix, size_t *out_label)
+/* Pixels per label of R (R->n + 1 counts) into *out_count, and the largest foreground region
+ * (ties: the first in raster order) into *out_label; returns its size, 0 when out of memory. */
+static size_t ti_largest(const amscr__regions *R, size_t npix, size_t **out_count, size_t *out_label)
 {
     size_t *count = amscr__calloc_array(R->n + 1, sizeof *count);
+    *out_count = count;
     if (!count)
         return 0;
     for (size_t i = 0; i < npix; i++)
@@ -105,13 +107,13 @@ static size_t ti_largest(const amscr__regions *R, size_t npix, size_t *out_label
             best = r;
             best_size = count[r];
         }
-    free(count);
     *out_label = best;
     return best_size;
 }
 
-/* The outer iso-line of the largest component of the padded mask `on`, counter-clockwise. */
-static amscr_status ti_outer(const amscr__iso *f, const uint8_t *on, double **out_xy, size_t *out_n)
+/* The outer iso-line of the largest component of the padded mask `on`, counter-clockwise;
+ * with AMSCR_TRACE_JOIN in flags the other large pieces joined to it (join.c). */
+static amscr_status ti_outer(const amscr__iso *f, const uint8_t *on, int flags, double **out_xy, size_t *out_n)
 {
     static const char fn[] = "amscr_contour_from_image";
     const size_t W = f->w + 2, H = f->h + 2;
@@ -119,25 +121,29 @@ static amscr_status ti_outer(const amscr__iso *f, const uint8_t *on, double **ou
     amscr_status st = amscr__regions_label(on, W, H, &R);
     if (st != AMSCR_OK)
         return st;
-    size_t label = 0, size = ti_largest(&R, W * H, &label);
+    size_t label = 0, *count = NULL, size = ti_largest(&R, W * H, &count, &label);
     if (size == 0) {
+        free(count);
         amscr__regions_free(&R);
         return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory (%zu regions)", fn, R.n);
     }
     size_t p = R.first[label];
-    amscr__regions_free(&R);
     double *xy = NULL;
     size_t n = 0;
     st = amscr__march(f, p % W - 1, p / W - 1, 2, fn, &xy, &n);
-    if (st != AMSCR_OK)
-        return st;
-    double a = n >= 3 ? amscr__signed_area(xy, n) : 0.0;
-    if (a == 0.0) {
-        free(xy);
-        return amscr__fail(AMSCR_E_DEGENERATE, "%s: largest component (%zu pixels) has no area", fn, size);
-    }
-    if (a < 0.0)
+    double a = st == AMSCR_OK && n >= 3 ? amscr__signed_area(xy, n) : 0.0;
+    if (st == AMSCR_OK && a == 0.0)
+        st = amscr__fail(AMSCR_E_DEGENERATE, "%s: largest component (%zu pixels) has no area", fn, size);
+    if (st == AMSCR_OK && a < 0.0)
         amscr__reverse_points(xy, n);
+    if (st == AMSCR_OK && (flags & AMSCR_TRACE_JOIN))
+        st = amscr__join_pieces(f, &R, count, label, &xy, &n);
+    free(count);
+    amscr__regions_free(&R);
+    if (st != AMSCR_OK) {
+        free(xy);
+        return st;
+    }
     *out_xy = xy;
     *out_n = n;
     return AMSCR_OK;
@@ -149,7 +155,8 @@ amscr_status amscr_contour_from_image(const void *pixels, size_t width, size_t h
     static const char fn[] = "amscr_contour_from_image";
     amscr__clear_error();
     AMSCR_CHECK_NULL(out);
-    amscr_status st = ti_check(pixels, width, height, stride, bits, level, flags, fn);
+    amscr_status st =
+        ti_check(pixels, width, height, stride, bits, level, flags, AMSCR_TRACE_PIXEL_CHAIN | AMSCR_TRACE_JOIN, fn);
     amscr__iso f;
     if (st == AMSCR_OK)
         st = amscr__iso_setup(pixels, width, height, stride, bits, level, &f);
@@ -169,7 +176,7 @@ amscr_status amscr_contour_from_image(const void *pixels, size_t width, size_t h
         return st;
     double *xy = NULL;
     size_t n = 0;
-    st = ti_outer(&f, on, &xy, &n);
+    st = ti_outer(&f, on, flags, &xy, &n);
     free(on);
     if (st != AMSCR_OK)
         return st;
@@ -182,7 +189,7 @@ amscr_status amscr_contours_from_image(const void *pixels, size_t width, size_t 
     static const char fn[] = "amscr_contours_from_image";
     amscr__clear_error();
     AMSCR_CHECK_NULL(out);
-    amscr_status st = ti_check(pixels, width, height, stride, bits, level, flags, fn);
+    amscr_status st = ti_check(pixels, width, height, stride, bits, level, flags, AMSCR_TRACE_PIXEL_CHAIN, fn);
     if (st == AMSCR_OK && (!(min_area >= 0.0) || min_area > 1e300))
         st = amscr__fail(AMSCR_E_INVALID_ARG, "%s: min_area must be finite and >= 0", fn);
     amscr__iso f;

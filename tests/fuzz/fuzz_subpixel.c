@@ -2,7 +2,8 @@
  * iso-lines) on arbitrary 8- and 16-bit images.
  * Input: byte 0 = width - 1, byte 1 = height - 1, byte 2 = stride - width (mod 16) with bit 0x80
  * for 16-bit samples, byte 3 = level byte L (255: automatic; else L + 0.5, times 257 for 16
- * bits), byte 4 = mode (bit 0: every contour, bit 1: AMSCR_TRACE_PIXEL_CHAIN), then the samples
+ * bits), byte 4 = mode (bit 0: every contour, bit 1: AMSCR_TRACE_PIXEL_CHAIN, bit 2:
+ * AMSCR_TRACE_JOIN, which every contour refuses), then the samples
  * (16-bit: two bytes each, native order). The height (and if needed the width) shrinks to what
  * the input holds; the samples are copied into a buffer of exactly the size the image needs.
  * Properties on success: >= 3 finite points inside the padded image, each on a pixel-grid line
@@ -41,7 +42,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t bps = (size_t)bits / 8;
     size_t w = (size_t)data[0] + 1, h = (size_t)data[1] + 1, pad = (size_t)(data[2] & 0x7f) % 16;
     double level = data[3] == 255 ? AMSCR_LEVEL_AUTO : (data[3] + 0.5) * (bits == 16 ? 257.0 : 1.0);
-    int all = data[4] & 1, flags = data[4] & 2 ? AMSCR_TRACE_PIXEL_CHAIN : 0;
+    int all = data[4] & 1, chain = data[4] & 2 ? AMSCR_TRACE_PIXEL_CHAIN : 0;
+    int flags = chain | (data[4] & 4 ? AMSCR_TRACE_JOIN : 0);
     size_t avail = (size - 5) / bps;
     if (avail < w) {
         w = avail;
@@ -58,7 +60,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         amscr_contour *c = NULL;
         amscr_status st = amscr_contour_from_image(buf, w, h, stride, bits, level, flags, &c);
         if (st == AMSCR_OK)
-            check_contour(c, w, h, !flags, 0);
+            check_contour(c, w, h, !chain, 0);
         else
             FUZZ_CHECK(c == NULL && (st == AMSCR_E_NOT_FOUND || st == AMSCR_E_DEGENERATE ||
                                      (w == 0 && st == AMSCR_E_INVALID_ARG)));
@@ -71,10 +73,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             for (size_t i = 0; i < amscr_contour_set_size(s); i++) {
                 size_t p = amscr_contour_set_parent(s, i);
                 FUZZ_CHECK(p == AMSCR_NO_PARENT || p < i);
-                check_contour(amscr_contour_set_contour(s, i), w, h, !flags, amscr_contour_set_is_hole(s, i));
+                check_contour(amscr_contour_set_contour(s, i), w, h, !chain, amscr_contour_set_is_hole(s, i));
             }
+            FUZZ_CHECK(!(flags & AMSCR_TRACE_JOIN));
         } else {
-            FUZZ_CHECK(s == NULL && (st == AMSCR_E_NOT_FOUND || (w == 0 && st == AMSCR_E_INVALID_ARG)));
+            FUZZ_CHECK(s == NULL && (st == AMSCR_E_NOT_FOUND ||
+                                     ((w == 0 || (flags & AMSCR_TRACE_JOIN)) && st == AMSCR_E_INVALID_ARG)));
         }
         amscr_contour_set_free(s);
     }

@@ -109,6 +109,12 @@ grey = [[min(255, max(0, 128 + 40 * (6 - abs(x - 8)) - 30 * abs(y - 6))) for x i
 put('subpixel', 'grey-auto', subpixel_input(grey))
 put('subpixel', 'grey16-all', subpixel_input([[v * 257 for v in row] for row in grey], 1, 127, 1, 16))
 put('subpixel', 'ring-all', subpixel_input(ring, 1, 100, 1))
+pieces = blank(20, 12, 0)
+fill_rect(pieces, 2, 3, 9, 6, 255)
+fill_rect(pieces, 12, 3, 16, 6, 255)
+fill_rect(pieces, 18, 10, 18, 10, 255)
+put('subpixel', 'pieces-join', subpixel_input(pieces, 0, 127, 4))
+put('subpixel', 'pieces-join-chain', subpixel_input(pieces, 2, 255, 6))
 put('subpixel', 'checker-all', subpixel_input([[255 * ((x + y) % 2) for x in range(6)] for y in range(5)], 0, 127, 1))
 
 # ------------------------------------------------------------------ contours (every component)

@@ -208,3 +208,24 @@ def test_odd_file_names(tmp_path):
     assert j["source"] == str(s) and j["target"] == str(t)
     ET.fromstring(ov.read_bytes())
     ET.fromstring(pl.read_bytes())
+
+
+def test_register_joins_the_pieces_of_a_cut_target(tmp_path):
+    """A target an occluder cut in two (a T whose bar is severed): register joins the pieces to
+    the largest one's outline and recovers the shift; `contour` still traces the largest only."""
+    from imgutil import blank, fill_rect
+    whole = fill_rect(fill_rect(blank(100, 60), 10, 20, 79, 31, 255), 70, 14, 79, 37, 255)
+    cut = fill_rect(fill_rect(blank(100, 60), 15, 23, 84, 34, 255), 75, 17, 84, 40, 255)
+    fill_rect(cut, 43, 0, 48, 59, 0)
+    src, tgt = tmp_path / ("whole" + img_ext()), tmp_path / ("cut" + img_ext())
+    src.write_bytes(image_bytes(whole, src.name))
+    tgt.write_bytes(image_bytes(cut, tgt.name))
+    r = run("register", src, tgt, "--json")
+    assert r.returncode == 0, r.stderr
+    j = json.loads(r.stdout)
+    assert rel_err_A(j["A"], ((1, 0, 5), (0, 1, 3))) < 0.02
+    assert abs(j["B"][0] - 5) < 0.3 and abs(j["B"][1] - 3) < 0.3
+    out = tmp_path / "c.txt"
+    assert run("contour", tgt, "-o", out).returncode == 0
+    xs = [float(l.split()[0]) for l in out.read_text().splitlines() if l and not l.startswith("#")]
+    assert min(xs) > 45  # the largest piece alone

@@ -70,6 +70,9 @@ static int register_pair(const opts *o, const amscr_params *p, amscr_contour **s
     const char *spath = o->pos[0], *tpath = o->pos[1];
     amscr_descriptor *ds = NULL, *dt = NULL;
     int ret = -1;
+    /* an image's other large pieces near its largest component are part of the shape (an
+     * occluder cut it): joined to the outline (sub-pixel tracing) */
+    image_set_trace_flags(image_trace_flags() | AMSCR_TRACE_JOIN);
     if (shape_load_opts(o, spath, src) != 0 || shape_load_opts(o, tpath, tgt) != 0)
         goto done;
     if (prepare_pair(p, o, *src, *tgt, &ds, &dt) != 0)

@@ -19,7 +19,7 @@ int shape_contours(const char *path, int threshold, double min_area, amscr_conto
     const void *pixels;
     double level = image_level(&img, threshold, &bits, &pixels);
     amscr_status st = amscr_contours_from_image(pixels, img.width, img.height, img.width, bits, level,
-                                                image_trace_flags(), min_area, out);
+                                                image_trace_flags() & AMSCR_TRACE_PIXEL_CHAIN, min_area, out);
     image_free(&img);
     if (st != AMSCR_OK) {
         const char *d = lib_detail();

@@ -103,7 +103,7 @@ def _image_and_level(mask: ArrayLike, threshold: Union[int, float, str, None],
 
 
 def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] = None,
-                      subpixel: bool = True) -> np.ndarray:
+                      subpixel: bool = True, join: bool = False) -> np.ndarray:
     """Outer boundary of the largest 8-connected foreground component of a 2-D image.
 
     Args:
@@ -119,6 +119,10 @@ def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] =
             images) by marching squares, to sub-pixel accuracy on grey and antialiased edges
             (a binary edge lies halfway between pixel centres); False: the chain of boundary
             pixel centres.
+        join: True: the other large components near the largest (at least 5 % of its pixels,
+            within its RMS radius, not in its holes) are joined to its outline by zero-width
+            bridges — a shape an occluder cut in pieces keeps all its boundary (as ``amscr
+            register`` traces images; sub-pixel only, ignored with subpixel=False).
     Returns:
         (n, 2) float array (x = column, y = row; pixel centres at integers), with positive
         signed area (counter-clockwise in a y-up frame), no repeated end point.
@@ -127,6 +131,8 @@ def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] =
         LimitError: image too large; InvalidArgumentError: a bad mask or threshold.
     """
     a, bits, level, flags = _image_and_level(mask, threshold, subpixel)
+    if as_bool(join, 'join'):
+        flags |= lib.AMSCR_TRACE_JOIN
     h, w = a.shape
     return _take(_new_contour(lib.amscr_contour_from_image, ffi.from_buffer(a), w, h, w, bits, level, flags))
 

@@ -55,3 +55,24 @@ def test_bad_float_and_threshold():
         amscr.contour_from_mask(np.zeros((8, 8)) + np.eye(8), threshold=5.0)
     with pytest.raises(amscr.InvalidArgumentError):
         amscr.contour_from_mask(np.zeros((8, 8), np.uint16), threshold=65535)
+
+
+def test_join_registers_a_shape_cut_in_two():
+    """join=True: a bar cut in two by an occluder is one outline holding both pieces; registered
+    against the whole bar (shifted) it gives the map back, where the largest piece alone
+    cannot (it lacks a third of the boundary)."""
+    whole = np.zeros((60, 100), np.uint8)
+    whole[20:32, 10:80] = 255
+    whole[14:38, 70:80] = 255  # a T, so the map is determined
+    cut = np.roll(whole, (3, 5), axis=(0, 1)).copy()
+    cut[:, 38:44] = 0  # the occluder severs the bar
+    alone, joined = amscr.contour_from_mask(cut), amscr.contour_from_mask(cut, join=True)
+    assert amscr.signed_area(joined) == pytest.approx(
+        amscr.signed_area(alone) + amscr.signed_area(amscr.contour_from_mask(cut[:, :40])))
+    assert joined[:, 0].min() == pytest.approx(14.5) and alone[:, 0].min() > 40
+    src = amscr.contour_from_mask(whole)
+    r = amscr.register(src, joined)
+    assert np.allclose(r.A, np.eye(2), atol=0.02) and np.allclose(r.B, [5, 3], atol=0.3)
+    # pixel chain: the flag has no effect
+    assert np.array_equal(amscr.contour_from_mask(cut, subpixel=False, join=True),
+                          amscr.contour_from_mask(cut, subpixel=False))

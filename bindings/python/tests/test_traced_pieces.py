@@ -1,0 +1,38 @@
+"""Traced image pairs whose target a bite cut in two (bench/registration_traced.py, condition
+"bite"): with join=True, as `amscr register` traces images, the map is within 2 % of the size;
+the largest piece alone gave maps 80-330 % off. Skipped without mpeg7-dev or OpenCV."""
+import numpy as np
+import pytest
+
+import amscr
+from test_polish import heldout_data
+
+# (class, draw): the bite failures of the benchmark before the pieces were joined
+CUT_IN_TWO = [('Bone', 1), ('Glas', 1), ('guitar', 0), ('guitar', 1), ('ray', 1), ('spoon', 0), ('spoon', 1)]
+
+
+@pytest.fixture(scope='module')
+def bench():
+    pytest.importorskip('cv2')
+    data = heldout_data()
+    import registration_traced
+    classes = registration_traced.load_classes(data)
+    return registration_traced, classes
+
+
+@pytest.mark.parametrize('cls,draw', CUT_IN_TWO)
+def test_bite_through_a_thin_part(bench, cls, draw):
+    B, classes = bench
+    i = [c[0] for c in classes].index(cls)
+    src = B.load_source(classes[i][1])
+    f = B.subpixel_contour(src)
+    rng = np.random.default_rng([i, [c[0] for c in B.CONDITIONS].index('bite'), draw, 2024])
+    tgt, T = B.make_target(src, f, rng)
+    tgt = B.damage('bite', tgt, B.apply(T, f), rng)
+    errors = []
+    for join in (False, True):
+        r = amscr.register(amscr.contour_from_mask(src, join=join), amscr.contour_from_mask(tgt, join=join))
+        errors.append(B.map_error(np.hstack([np.asarray(r.A), np.asarray(r.B)[:, None]]), T, f))
+    assert errors[0] > 2.0, 'the largest piece alone: %.2f %% (no longer a cut case?)' % errors[0]
+    assert errors[1] < 2.0, 'joined: %.2f %% of the size' % errors[1]
+    assert r.confidence >= 0.25
