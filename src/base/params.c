@@ -203,3 +203,29 @@ amscr_status amscr_params_get_scales(const amscr_params *p, double *out_sigmas, 
     *inout_n = p->num_scales;
     return AMSCR_OK;
 }
+
+/* ---- switchable stages of amscr_register (register/stages.c) ---- */
+amscr_status amscr_params_set_stage(amscr_params *p, const char *name, int on)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(p);
+    AMSCR_CHECK_NULL(name);
+    int i = amscr__stage_switch(name);
+    if (i < 0)
+        return amscr__fail(AMSCR_E_INVALID_ARG,
+                           "amscr_params_set_stage: '%s' is not a switchable stage (despike, recovery, polish, "
+                           "order, even_spacing)", name);
+    if (on != 0 && on != 1)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_params_set_stage: %d is not 0 or 1", on);
+    if (on)
+        p->stages_off &= ~AMSCR__STAGE_BIT(i);
+    else
+        p->stages_off |= AMSCR__STAGE_BIT(i);
+    return AMSCR_OK;
+}
+
+int amscr_params_get_stage(const amscr_params *p, const char *name)
+{
+    int i = p ? amscr__stage_switch(name) : -1;
+    return i < 0 ? -1 : AMSCR__STAGE_ON(p, i);
+}
