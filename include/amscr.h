@@ -1409,8 +1409,9 @@ AMSCR_API int amscr_params_get_partial(const amscr_params *p);
  *        It applies when both descriptors keep their input points (amscr_descriptor_new keeps
  *        up to 4096 of them, 64 KiB, under affine invariance; descriptors in or loaded from a
  *        collection keep none), the target is closed and the invariance is affine. With the
- *        polish on, amscr_descriptor_new also drops isolated stray points of contours of 32
- *        or more points. The distance is not changed by the polish.
+ *        polish and the "despike" stage on (amscr_params_set_stage; opt-in since 0.5),
+ *        amscr_descriptor_new also drops isolated stray points of contours of 32 or more
+ *        points. The distance is not changed by the polish.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -1431,9 +1432,11 @@ AMSCR_API int amscr_params_get_polish(const amscr_params *p);
  * @brief Switches an optional stage of amscr_register on or off by name: "despike" (stray
  *        points dropped when a shape is prepared with the polish on), "recovery" (fragments
  *        placed as further starts when part of the target is missing), "polish" (as
- *        amscr_params_set_polish), "order" and "even_spacing" (the polish's steps on markedly
- *        noisy points). Default: all on except even_spacing (off: measured not to help traced
- *        contours, docs/results-registration.md). A stage switched on still runs only when its
+ *        amscr_params_set_polish; both must be on), "order" and "even_spacing" (the polish's
+ *        steps on markedly noisy points). Default in every preset: recovery and polish on;
+ *        despike, order and even_spacing off (opt-in since 0.5: they changed no map of the
+ *        traced-image benchmark; they help point lists with stray points or synthetic noise,
+ *        docs/results-registration.md). A stage switched on still runs only when its
  *        condition holds (amscr_result_stage).
  * @param on  1 on, 0 off.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, unknown or mandatory stage, on not 0 or 1).

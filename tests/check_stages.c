@@ -84,9 +84,9 @@ START_TEST(stage_list_in_pipeline_order)
     ck_assert_int_eq(amscr_result_stage(NULL, 0, NULL, NULL), AMSCR_E_INVALID_ARG);
     ck_assert_uint_eq(amscr_result_num_stages(NULL), 0);
     /* a clean pair under the preset: the always-stages and the polish; nothing to recover, no
-     * noise for the order and even-spacing steps, no symmetric distance */
-    const char *yes[] = {"despike", "search", "method", "final_solve", "polish", "alternatives", "correspondences"};
-    const char *no[] = {"recovery", "symmetric", "order", "even_spacing"};
+     * symmetric distance; the opt-in stages off */
+    const char *yes[] = {"search", "method", "final_solve", "polish", "alternatives", "correspondences"};
+    const char *no[] = {"despike", "recovery", "symmetric", "order", "even_spacing"};
     for (size_t i = 0; i < sizeof yes / sizeof *yes; i++)
         ck_assert_msg(ran(r, yes[i]) == 1, "%s did not run", yes[i]);
     for (size_t i = 0; i < sizeof no / sizeof *no; i++)
@@ -117,6 +117,56 @@ START_TEST(paper_method_runs_no_optional_stage)
 }
 END_TEST
 
+/* Opt-in (default off in every preset): despike, order, even_spacing; on: recovery, polish. */
+START_TEST(default_switches)
+{
+    amscr_params *p[3] = {NULL, NULL, NULL};
+    ck_assert_int_eq(amscr_params_new(&p[0]), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new_registration(&p[1]), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new_retrieval(&p[2]), AMSCR_OK);
+    for (int i = 0; i < 3; i++) {
+        ck_assert_int_eq(amscr_params_get_stage(p[i], "despike"), 0);
+        ck_assert_int_eq(amscr_params_get_stage(p[i], "order"), 0);
+        ck_assert_int_eq(amscr_params_get_stage(p[i], "even_spacing"), 0);
+        ck_assert_int_eq(amscr_params_get_stage(p[i], "recovery"), 1);
+        ck_assert_int_eq(amscr_params_get_stage(p[i], "polish"), 1);
+        amscr_params_free(p[i]);
+    }
+}
+END_TEST
+
+/* A noisy target densely sampled (2 % noise, 4x the source's points): the order and
+ * even-spacing steps run when switched on, never by default. */
+START_TEST(opt_in_steps_run_when_switched_on)
+{
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, 11);
+    size_t ns = 400, nt = 1600;
+    double *a = malloc(2 * ns * sizeof *a), *b = malloc(2 * nt * sizeof *b);
+    ck_assert(a && b);
+    amscr_test_ellipse(ns, 1.0, 0.5, 0.0, a);
+    amscr_test_ellipse(nt, 1.0, 0.5, 0.3, b);
+    amscr_test_apply_affine(MAP, b, nt, b);
+    amscr_test_add_noise(&rng, b, nt, 0.02 * amscr_test_shape_size(b, nt));
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+    amscr_result *off = reg(p, a, ns, b, nt);
+    ck_assert_int_eq(amscr_params_set_stage(p, "order", 1), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_stage(p, "even_spacing", 1), AMSCR_OK);
+    amscr_result *on = reg(p, a, ns, b, nt);
+    ck_assert_int_eq(ran(off, "polish"), 1);
+    ck_assert_int_eq(ran(off, "order"), 0);
+    ck_assert_int_eq(ran(off, "even_spacing"), 0);
+    ck_assert_int_eq(ran(on, "order"), 1);
+    ck_assert_int_eq(ran(on, "even_spacing"), 1);
+    amscr_result_free(on);
+    amscr_result_free(off);
+    amscr_params_free(p);
+    free(a);
+    free(b);
+}
+END_TEST
+
 START_TEST(switches)
 {
     amscr_params *p = NULL;
@@ -142,6 +192,7 @@ START_TEST(switches)
     ck_assert_int_eq(amscr_params_set_stage(p, "despike", 0), AMSCR_OK);
     amscr_result *off = self_pair(p, ELL, 6, 300);
     ck_assert_int_eq(ran(on, "polish"), 1);
+    ck_assert_int_eq(ran(on, "despike"), 1);
     ck_assert_int_eq(ran(off, "polish"), 0);
     ck_assert_int_eq(ran(off, "despike"), 0);
     double a[6], b[6];
@@ -226,6 +277,8 @@ Suite *amscr_suite_stages(void)
     tcase_set_timeout(t, 120);
     tcase_add_test(t, stage_list_in_pipeline_order);
     tcase_add_test(t, paper_method_runs_no_optional_stage);
+    tcase_add_test(t, default_switches);
+    tcase_add_test(t, opt_in_steps_run_when_switched_on);
     tcase_add_test(t, switches);
     tcase_add_test(t, symmetric_shapes_list_alternatives);
     tcase_add_test(t, asymmetric_shape_lists_the_chosen_map_only);

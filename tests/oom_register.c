@@ -109,6 +109,9 @@ static amscr_status run(const scenario *s, amscr_result **out)
         st = amscr_params_set_partial(p, 1);
     if (st == AMSCR_OK && s->symmetric)
         st = amscr_params_set_symmetric(p, 1);
+    const char *opt_in[] = {"despike", "order", "even_spacing"}; /* every stage on */
+    for (size_t i = 0; i < 3 && st == AMSCR_OK; i++)
+        st = amscr_params_set_stage(p, opt_in[i], 1);
     if (st == AMSCR_OK)
         st = amscr_contour_new(a, ns, &src);
     if (st == AMSCR_OK)

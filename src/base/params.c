@@ -42,6 +42,12 @@ void amscr__params_defaults(amscr_params *p)
     p->num_threads = 0;
     p->invariance = AMSCR_INVARIANCE_AFFINE;
     p->penalty = 0.5;
+    /* Opt-in stages (amscr_params_set_stage): despike, order and even_spacing changed no map of
+     * the 216 traced pairs of fold A of bench/registration_traced.py (either tracer; fold B
+     * confirmed it), which chose this; they help point lists with stray points or synthetic
+     * noise (docs/results-registration.md, "0.5: the pipeline as stages"). */
+    p->stages_off = AMSCR__STAGE_BIT(AMSCR__STAGE_DESPIKE) | AMSCR__STAGE_BIT(AMSCR__STAGE_ORDER) |
+                    AMSCR__STAGE_BIT(AMSCR__STAGE_EVEN);
     retrieval_defaults(p);
 }
 

@@ -129,11 +129,12 @@ class Params:
     penalty = _Option('penalty', _FLOAT, "weight of the 'penalized' invariance")
     partial = _Option('partial', _BOOL, "the source is an open fragment of the target's closed boundary (register)")
     polish = _Option('polish', _BOOL, 'polish the map on the input points, fitting the noisier curve onto the '
-                     'cleaner and, for markedly noisy points, using their order and even spacing (register; on in the '
-                     'registration preset)')
+                     'cleaner (register; on in the registration preset; its order and even-spacing steps for '
+                     'markedly noisy point lists are opt-in: stages)')
     stages = _StagesOption("the optional stages of register on or off, a dict {name: bool} over "
                            "'despike', 'recovery', 'polish', 'order', 'even_spacing' (setting one leaves the others; "
-                           "Registration.stages says which ran)")
+                           "default: despike, order and even_spacing off, for point lists with stray points or "
+                           "synthetic noise; Registration.stages says which ran)")
     channel_weight = _Option('channel_weight', _FLOAT,
                              'share of the shape channel in Collection.retrieval_matrix, 0..1 (0 = the AMSCR '
                              'distance alone, the default; 1 = the channel alone, the retrieval preset)')
