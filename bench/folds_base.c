@@ -102,6 +102,68 @@ static void fourier_features(const amscr_descriptor *d, double *f)
         f[t] /= sqrt(e);
 }
 
+/* Low-order moments of the samples (centroid at the origin, RMS radius 1; rotation-, reflection-
+ * and start-invariant): the elongation |mu20 - mu02 + 2i mu11|, the two third-order magnitudes of
+ * Hu's phi3 and phi4 (asymmetry: a pear against an apple), and the enclosed area over pi (how
+ * round the outline is). */
+enum { GM_K = 4 };
+static void moment_features_of(const double *P, size_t n, double *f)
+{
+    double cx = 0, cy = 0, r2 = 0, area = 0;
+    for (size_t i = 0; i < n; i++) {
+        cx += P[2 * i] / (double)n;
+        cy += P[2 * i + 1] / (double)n;
+    }
+    for (size_t i = 0; i < n; i++)
+        r2 += ((P[2 * i] - cx) * (P[2 * i] - cx) + (P[2 * i + 1] - cy) * (P[2 * i + 1] - cy)) / (double)n;
+    double s = 1.0 / sqrt(r2), m[4][4] = {{0}};
+    for (size_t i = 0; i < n; i++) {
+        size_t j = (i + 1) % n;
+        double x = s * (P[2 * i] - cx), y = s * (P[2 * i + 1] - cy);
+        double x2 = s * (P[2 * j] - cx), y2 = s * (P[2 * j + 1] - cy);
+        area += 0.5 * (x * y2 - x2 * y);
+        for (int p = 0; p <= 3; p++)
+            for (int q = 0; p + q <= 3; q++)
+                m[p][q] += pow(x, p) * pow(y, q) / (double)n;
+    }
+    f[0] = hypot(m[2][0] - m[0][2], 2.0 * m[1][1]);
+    f[1] = hypot(m[3][0] - 3.0 * m[1][2], 3.0 * m[2][1] - m[0][3]);
+    f[2] = hypot(m[3][0] + m[1][2], m[2][1] + m[0][3]);
+    f[3] = fabs(area) / 3.141592653589793;
+}
+
+/* The moments of the samples as they are (the similarity frame) or whitened (the affine frame:
+ * the elongation is then 0 and the other three are affine invariants). */
+static void moment_features(const amscr_descriptor *d, int affine, double *f)
+{
+    if (!affine) {
+        moment_features_of(d->input, d->n, f);
+        return;
+    }
+    double *w = malloc(2 * d->n * sizeof *w), fwd[6], inv[6];
+    if (w && amscr__whiten(d->input, d->n, w, fwd, inv) == AMSCR_OK)
+        moment_features_of(w, d->n, f);
+    else
+        f[0] = f[1] = f[2] = f[3] = 0.0;
+    free(w);
+}
+
+static void moment_matrix(const amscr_db *db, int affine, double *out)
+{
+    size_t n = amscr_db_size(db);
+    double *F = malloc(n * GM_K * sizeof *F);
+    for (size_t i = 0; i < n; i++)
+        moment_features(amscr_db_descriptor(db, i), affine, F + i * GM_K);
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < n; j++) {
+            double t = 0;
+            for (int u = 0; u < GM_K; u++)
+                t += (F[i * GM_K + u] - F[j * GM_K + u]) * (F[i * GM_K + u] - F[j * GM_K + u]);
+            out[i * n + j] = sqrt(t);
+        }
+    free(F);
+}
+
 static void fourier_matrix(const amscr_db *db, double *out)
 {
     size_t n = amscr_db_size(db);
@@ -118,17 +180,20 @@ static void fourier_matrix(const amscr_db *db, double *out)
     free(F);
 }
 
-/* One base matrix: from the cache or computed (what: 0 sim, 1 aff, 2 AMSCR, 3 Fourier). */
+/* One base matrix: from the cache or computed (what: 0 sim, 1 aff, 2 AMSCR, 3 Fourier, 4 moments, 5 moments
+ * in the affine frame).
+ * The key's "sp" marks contours traced at sub-pixel accuracy (the tool's tracer since 0.4). */
 static double *one(const coll_t *c, const raw_cfg *r, int what, amscr_db **db)
 {
-    static const char *names[] = {"channel similarity", "channel affine", "AMSCR", "Fourier"};
+    static const char *names[] = {"channel similarity", "channel affine", "AMSCR",
+                                  "Fourier",            "moments",        "moments, affine frame"};
     size_t n = c->s.n;
     char key[300];
     char tag[32] = "";
     if (r->stride > 1)
         snprintf(tag, sizeof tag, " t%zu", r->stride);
-    snprintf(key, sizeof key, "%s n%zu N%zu b%g s%g l%g r%d m%d%s", c->name, n, r->N, r->band, r->skip, r->loc, r->refl,
-             what, tag);
+    snprintf(key, sizeof key, "%s sp n%zu N%zu b%g s%g l%g r%d m%d%s", c->name, n, r->N, r->band, r->skip, r->loc,
+             r->refl, what, tag);
     double *M = malloc(n * n * sizeof *M);
     if (!M || cache_io(key, M, n, 0) == 0)
         return M;
@@ -144,8 +209,10 @@ static double *one(const coll_t *c, const raw_cfg *r, int what, amscr_db **db)
         st = channel_in_frame(*db, what ? AMSCR_INVARIANCE_AFFINE : AMSCR_INVARIANCE_SIMILARITY, r->stride, M);
     else if (what == 2)
         st = amscr_db_distance_matrix(*db, NULL, NULL, M) == AMSCR_OK ? 0 : -1;
-    else
+    else if (what == 3)
         fourier_matrix(*db, M);
+    else
+        moment_matrix(*db, what == 5, M);
     double t = folds_now() - t0, pairs = 0.5 * (double)n * (double)(n - 1);
     fprintf(stderr, "[%s: %s, %zu shapes (prepare %.1f s): %.1f s, %.0f pairs/s]\n", key, names[what], n, tp, t,
             pairs / t);
@@ -184,6 +251,10 @@ int base_get(const coll_t *c, const raw_cfg *r, int amscr, int fourier, base_t *
         b->am = one(c, r, 2, &db);
     if (fourier)
         b->fd = one(c, r, 3, &db);
+    if (fourier > 1)
+        b->gm = one(c, r, 4, &db);
+    if (fourier > 1)
+        b->ga = one(c, r, 5, &db);
     amscr_db_free(db);
-    return b->hs && b->ha && (!amscr || b->am) && (!fourier || b->fd) ? 0 : -1;
+    return b->hs && b->ha && (!amscr || b->am) && (!fourier || b->fd) && (fourier < 2 || (b->gm && b->ga)) ? 0 : -1;
 }

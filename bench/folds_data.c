@@ -13,7 +13,7 @@
 #include "../tools/cli/collection.h"
 
 const raw_cfg RAW_DEFAULT = {128, 0.08, 1.0, 4.0, 1, 1};
-const post_cfg POST_DEFAULT = {0.2, 1.0, 8, 10, 0.0, 0, 0.0};
+const post_cfg POST_DEFAULT = {0.2, 1.0, 8, 10, 0.0, 0, 0.0, 0, 0, 0, 0};
 
 double folds_now(void)
 {
@@ -107,6 +107,32 @@ static int read_folds(const char *dir, const shape_set *s, int *fold)
     return 0;
 }
 
+/* Kimia-216's 18 classes are MPEG-7 classes (its images are MPEG-7 shapes redrawn): in
+ * mpeg7-dev + Kimia-216 a Kimia shape of a class mpeg7-dev has takes that class's label, so the
+ * same object is never counted as two classes (a bird's nearest shape is an mpeg7-dev bird). */
+static int same_class_names(const char *dir, shape_set *s, size_t ndev)
+{
+    char path[1024];
+    collection cd, ck;
+    snprintf(path, sizeof path, "%s/mpeg7-dev/manifest.tsv", dir);
+    if (collection_open(path, &cd) != 0)
+        return -1;
+    snprintf(path, sizeof path, "%s/kimia216/manifest.tsv", dir);
+    if (collection_open(path, &ck) != 0) {
+        collection_free(&cd);
+        return -1;
+    }
+    for (size_t i = ndev; i < s->n; i++) {
+        const char *name = ck.classes[s->labels[i] - 1000];
+        for (size_t k = 0; k < cd.nclasses; k++)
+            if (strcmp(cd.classes[k], name) == 0)
+                s->labels[i] = (int32_t)k;
+    }
+    collection_free(&cd);
+    collection_free(&ck);
+    return 0;
+}
+
 int folds_load(const char *dir, folds_data *fd)
 {
     char path[1024];
@@ -127,7 +153,7 @@ int folds_load(const char *dir, folds_data *fd)
     fd->devk216.name = "mpeg7-dev+kimia216";
     if (concat(&fd->dev.s, NULL, 0, &fd->devwarp.s) != 0 || concat(&fd->dev.s, &fd->k216.s, 1000, &fd->devk216.s) != 0)
         return -1;
-    return 0;
+    return same_class_names(dir, &fd->devk216.s, fd->dev.s.n);
 }
 
 void folds_free(folds_data *fd)
@@ -144,5 +170,7 @@ void base_free(base_t *b)
     free(b->ha);
     free(b->am);
     free(b->fd);
+    free(b->gm);
+    free(b->ga);
     memset(b, 0, sizeof *b);
 }

@@ -49,6 +49,138 @@ static void add_normalized(double *F, const double *X, size_t m, double wf, doub
         F[i] = wf * F[i] / mf + wx * X[i] / mx;
 }
 
+void folds_local_scale(const double *M, size_t m, size_t k, double *sigma)
+{
+    double *v = malloc(m * sizeof *v);
+    if (k + 1 > m)
+        k = m - 1;
+    for (size_t i = 0; i < m; i++) {
+        size_t t = 0;
+        for (size_t j = 0; j < m; j++)
+            if (j != i)
+                v[t++] = M[i * m + j];
+        qsort(v, t, sizeof *v, cmp_d);
+        sigma[i] = v[k - 1] > 0.0 ? v[k - 1] : 1e-12;
+    }
+    free(v);
+}
+
+/* Median of each row's off-diagonal entries. */
+static void row_medians(const double *M, size_t m, double *med)
+{
+    double *v = malloc(m * sizeof *v);
+    for (size_t i = 0; i < m; i++) {
+        size_t t = 0;
+        for (size_t j = 0; j < m; j++)
+            if (j != i)
+                v[t++] = M[i * m + j];
+        qsort(v, t, sizeof *v, cmp_d);
+        med[i] = v[t / 2];
+    }
+    free(v);
+}
+
+/* F = F / sqrt(sF_i sF_j) + w_ij X / sqrt(sX_i sX_j): each distance in units of its own
+ * neighbourhood scale (the distance of a shape to its k-th neighbour in that channel). conf: w_ij =
+ * w sqrt(q_i q_j), q = 2 cX / (cX + cF) with c = 1 - sigma / row median (how much nearer a
+ * channel's k nearest are than its typical shape: the channel's confidence for that query). X NULL:
+ * F alone, locally scaled. */
+static void fuse_local(double *F, const double *X, size_t m, size_t k, double w, int conf)
+{
+    double *sf = malloc(m * sizeof *sf), *sx = malloc(m * sizeof *sx), *q = malloc(m * sizeof *q);
+    folds_local_scale(F, m, k, sf);
+    for (size_t i = 0; i < m; i++)
+        q[i] = 1.0;
+    if (X) {
+        folds_local_scale(X, m, k, sx);
+        if (conf) {
+            double *mf = malloc(m * sizeof *mf), *mx = malloc(m * sizeof *mx);
+            row_medians(F, m, mf);
+            row_medians(X, m, mx);
+            for (size_t i = 0; i < m; i++) {
+                double cf = fmax(0.0, 1.0 - sf[i] / mf[i]), cx = fmax(0.0, 1.0 - sx[i] / mx[i]);
+                q[i] = cf + cx > 0.0 ? 2.0 * cx / (cf + cx) : 1.0;
+            }
+            free(mf);
+            free(mx);
+        }
+    }
+    for (size_t i = 0; i < m; i++)
+        for (size_t j = 0; j < m; j++) {
+            double v = F[i * m + j] / sqrt(sf[i] * sf[j]);
+            if (X)
+                v += w * sqrt(q[i] * q[j]) * X[i * m + j] / sqrt(sx[i] * sx[j]);
+            F[i * m + j] = i == j ? 0.0 : v;
+        }
+    free(sf);
+    free(sx);
+    free(q);
+}
+
+/* The rescalings of the channel matrix F (m x m, symmetric) before re-ranking (post_cfg.scale). */
+static void rescale(double *F, size_t m, int how, size_t k)
+{
+    double *s = malloc(m * sizeof *s), *sd = malloc(m * sizeof *sd), *v = malloc(m * sizeof *v);
+    double *R = malloc(m * m * sizeof *R);
+    if (k + 1 > m)
+        k = m - 1;
+    for (size_t i = 0; i < m; i++) {
+        size_t t = 0;
+        for (size_t j = 0; j < m; j++)
+            if (j != i)
+                v[t++] = F[i * m + j];
+        qsort(v, t, sizeof *v, cmp_d);
+        double mean = 0, var = 0;
+        for (size_t u = 0; u < t; u++)
+            mean += v[u] / (double)t;
+        for (size_t u = 0; u < t; u++)
+            var += (v[u] - mean) * (v[u] - mean) / (double)t;
+        if (how == 1)
+            s[i] = v[k - 1];
+        else if (how == 2) {
+            s[i] = 0;
+            for (size_t u = 0; u < k; u++)
+                s[i] += v[u] / (double)k;
+        } else {
+            s[i] = mean;
+            sd[i] = sqrt(var) > 0 ? sqrt(var) : 1e-12;
+        }
+        if (!(s[i] > 0))
+            s[i] = 1e-12;
+        if (how == 3) /* empirical: the share of the others farther from i than j is */
+            for (size_t j = 0; j < m; j++) {
+                double d = F[i * m + j];
+                size_t lo = 0, hi = t; /* first index with v > d */
+                while (lo < hi) {
+                    size_t mid = (lo + hi) / 2;
+                    if (v[mid] > d)
+                        hi = mid;
+                    else
+                        lo = mid + 1;
+                }
+                R[i * m + j] = (double)(t - lo) / (double)t;
+            }
+    }
+    for (size_t i = 0; i < m; i++)
+        for (size_t j = 0; j < m; j++) {
+            double d = F[i * m + j], x;
+            if (i == j)
+                x = 0.0;
+            else if (how <= 2)
+                x = d / sqrt(s[i] * s[j]);
+            else if (how == 3)
+                x = 1.0 - R[i * m + j] * R[j * m + i];
+            else
+                x = 1.0 - 0.25 * erfc((d - s[i]) / (sd[i] * 1.4142135623730951)) *
+                              erfc((d - s[j]) / (sd[j] * 1.4142135623730951));
+            F[i * m + j] = x; /* F is read only through v, s and sd here */
+        }
+    free(s);
+    free(sd);
+    free(v);
+    free(R);
+}
+
 static double score_of(const double *F, size_t m, const int32_t *labels, int kind)
 {
     if (kind == 1) {
@@ -103,7 +235,7 @@ static size_t mutual_k(const double *F, size_t m, size_t K)
 
 size_t last_k;
 
-double eval_sub(const base_t *b, const coll_t *c, const size_t *idx, size_t m, const post_cfg *pc)
+double *eval_matrix(const base_t *b, const size_t *idx, size_t m, const post_cfg *pc)
 {
     size_t n = b->n, *all = NULL;
     if (!idx) {
@@ -114,9 +246,6 @@ double eval_sub(const base_t *b, const coll_t *c, const size_t *idx, size_t m, c
         m = n;
     }
     double *F = malloc(m * m * sizeof *F), *X = malloc(m * m * sizeof *X);
-    int32_t *lab = malloc(m * sizeof *lab);
-    for (size_t i = 0; i < m; i++)
-        lab[i] = c->s.labels[idx[i]];
     sub(b->hs, n, idx, m, F);
     sub(b->ha, n, idx, m, X);
     for (size_t i = 0; i < m * m; i++)
@@ -125,22 +254,50 @@ double eval_sub(const base_t *b, const coll_t *c, const size_t *idx, size_t m, c
         sub(b->am, n, idx, m, X);
         add_normalized(F, X, m, pc->weight, 1.0 - pc->weight);
     }
+    size_t ks = pc->k ? pc->k : POST_DEFAULT.k; /* the local scales' neighbour: the re-ranking's k */
     if (pc->wfd > 0.0) {
-        sub(b->fd, n, idx, m, X);
-        add_normalized(F, X, m, 1.0, pc->wfd);
-    }
+        sub(pc->prop == 0 ? b->fd : pc->prop == 1 ? b->gm : b->ga, n, idx, m, X);
+        if (pc->prop == 3) {
+            double *Y = malloc(m * m * sizeof *Y);
+            sub(b->gm, n, idx, m, Y);
+            for (size_t i = 0; i < m * m; i++)
+                X[i] = (1.0 - pc->share) * Y[i] + pc->share * X[i];
+            free(Y);
+        }
+        if (pc->fmode == 0)
+            add_normalized(F, X, m, 1.0, pc->wfd);
+        else
+            fuse_local(F, X, m, ks, pc->wfd, pc->fmode == 2);
+    } else if (pc->fmode > 0)
+        fuse_local(F, NULL, m, ks, 0.0, 0);
+    if (pc->scale > 0)
+        rescale(F, m, pc->scale, pc->lsk ? pc->lsk : ks);
     size_t k = pc->kmode == 1 ? (size_t)floor(pc->kfrac * sqrt((double)m) + 0.5)
                : pc->kmode == 2 ? mutual_k(F, m, (size_t)pc->kfrac) : pc->k;
     last_k = k;
     if (k > m)
         k = m;
-    double s = -1;
-    if (k == 0 || amscr__rerank_normalized(F, m, k, pc->iters, F) == AMSCR_OK)
+    if (k != 0 && amscr__rerank_normalized(F, m, k, pc->iters, F) != AMSCR_OK) {
+        free(F);
+        F = NULL;
+    }
+    free(X);
+    free(all);
+    return F;
+}
+
+double eval_sub(const base_t *b, const coll_t *c, const size_t *idx, size_t m, const post_cfg *pc)
+{
+    if (!idx)
+        m = b->n;
+    double *F = eval_matrix(b, idx, m, pc), s = -1;
+    int32_t *lab = malloc(m * sizeof *lab);
+    for (size_t i = 0; i < m; i++)
+        lab[i] = c->s.labels[idx ? idx[i] : i];
+    if (F)
         s = score_of(F, m, lab, c->kind);
     free(F);
-    free(X);
     free(lab);
-    free(all);
     return s;
 }
 
@@ -155,7 +312,7 @@ int score_row(const folds_data *fd, const raw_cfg *r, const post_cfg *pc, row_sc
             ia[na++] = i;
     }
     base_t b;
-    int am = pc->weight < 1.0, fo = pc->wfd > 0.0, st = -1;
+    int am = pc->weight < 1.0, fo = pc->wfd > 0.0 ? 1 + pc->prop : 0, st = -1;
     if (base_get(&fd->dev, r, am, fo, &b) == 0) {
         out->a = eval_sub(&b, &fd->dev, ia, na, pc);
         out->b = eval_sub(&b, &fd->dev, ib, nb, pc);

@@ -1,8 +1,9 @@
 /* folds_scale.c — re-ranking k against the collection's size and class size: bull's eye of the
  * default channel at every k on fold A (360 shapes), fold B (340), mpeg7-dev (700),
- * mpeg7-dev + Kimia-216 (916: more shapes, same class sizes) and mpeg7-dev + a mild affine copy
- * of every shape (1400: twice the class size); then k = c sqrt(n), and k = 1 + the median count
- * of mutual neighbours among each shape's K nearest (the mutual-kNN graph: a class-size estimate). */
+ * mpeg7-dev + Kimia-216 (916: Kimia-216 labelled by class name, classes of 20 and 32) and
+ * mpeg7-dev + a mild affine copy of every shape (1400: twice the class size); then k = c sqrt(n),
+ * and k = 1 + the median count of mutual neighbours among each shape's K nearest (the mutual-kNN
+ * graph: a class-size estimate). */
 #include "folds.h"
 
 #include <math.h>

@@ -15,6 +15,12 @@
  *   amscr-retrieval-folds DATASETS raw     N samples, band, skip, locality, reflections
  *   amscr-retrieval-folds DATASETS scale   re-ranking k at 350 / 700 / 916 / 1400 shapes
  *   amscr-retrieval-folds DATASETS fd      the global proportion channel (Fourier magnitudes)
+ *   amscr-retrieval-folds DATASETS fuse    a proportion channel (Fourier / moments) fused over medians or
+ *                                          local scales (folds_fuse.c)
+ *   amscr-retrieval-folds DATASETS local   the channel rescaled before re-ranking: local scaling, NICDM,
+ *                                          mutual proximity (folds_fuse.c; LOCAL_K=k the re-ranking's k)
+ *   amscr-retrieval-folds DATASETS halves  candidates on 24 random class halves of mpeg7-dev (folds_fuse.c)
+ *   amscr-retrieval-folds DATASETS classes 1-NN, the 916-shape collection's parts, mpeg7-dev per class
  *   amscr-retrieval-folds DATASETS mcd     the MCD-style affine views by band and affine share
  *   amscr-retrieval-folds DATASETS row N BAND SKIP LOC SHARE K ITERS [STRIDE]   one combination, all splits
  *                                          and the MCD-style views
@@ -29,7 +35,7 @@
 int main(int argc, char **argv)
 {
     if (argc < 3) {
-        fprintf(stderr, "usage: %s DATASETS post|raw|scale|fd|mcd\n", argv[0]);
+        fprintf(stderr, "usage: %s DATASETS post|raw|scale|fd|fuse|mcd|cost|row ...\n", argv[0]);
         return 2;
     }
     if (strcmp(argv[2], "mcd") == 0)
@@ -51,6 +57,14 @@ int main(int argc, char **argv)
         r = folds_cost(&fd);
     else if (strcmp(what, "fd") == 0)
         r = folds_fourier(&fd);
+    else if (strcmp(what, "fuse") == 0)
+        r = folds_fuse(&fd, argv[1]);
+    else if (strcmp(what, "local") == 0)
+        r = folds_local(&fd, argv[1]);
+    else if (strcmp(what, "halves") == 0)
+        r = folds_halves(&fd);
+    else if (strcmp(what, "classes") == 0)
+        r = folds_classes(&fd, argv[1]);
     else
         fprintf(stderr, "unknown sweep %s\n", what);
     folds_free(&fd);

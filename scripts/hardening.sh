@@ -4,7 +4,7 @@
 #                the fuzz-corpus replays and the tool tests, with leak detection
 #   2. abi       tests/abi/check-abi.sh: abidiff against tests/abi/amscr-<version>.abi
 #   3. tsan      build-tsan/ (ThreadSanitizer): the threads and db suites
-#   4. valgrind  build/ with `--setup valgrind`: the unit suites but accuracy/db/threads, and the
+#   4. valgrind  build/ with `--setup valgrind`: the unit suites but the slow ones below, and the
 #                fuzz-corpus replays
 #   5. fuzz      tests/fuzz/run.sh: every libFuzzer target for AMSCR_FUZZ_SECONDS (default 30) each
 # Prints one line per step and a summary; exits non-zero when any step fails (its log is shown).
@@ -28,8 +28,10 @@ want() { case " ${STEPS[*]} " in *" $1 "*) return 0 ;; esac; return 1; }
 
 # Valgrind runs every unit suite except these slow ones (20-50x slower than native there):
 # accuracy (datasets: minutes), db and threads (about 70 s each: they run under ASan and
-# ThreadSanitizer instead). New areas are included automatically.
-VALGRIND_SKIP=(accuracy db threads)
+# ThreadSanitizer instead), robust, polish and index (100-175 s each: many registrations;
+# they run under ASan+UBSan, and the index loader's corpus replays under valgrind below).
+# New areas are included automatically.
+VALGRIND_SKIP=(accuracy db threads robust polish index)
 
 T0=$(date +%s)
 summary=()
