@@ -2006,8 +2006,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_stage(const amscr_result *r,
  *        cost c satisfies (c0 + f) / (c + f) >= 0.75 (c0 the chosen map's cost, f the
  *        ambiguity's floor): then amscr_result_ambiguity >= 0.75 and the confidence is at
  *        most 0.25. The maps come from the registration's ranking of its start points (with
- *        refinement; the polish's re-ranking when it re-ranked): without refinement, or for a
- *        partial match, only the chosen map is listed.
+ *        refinement; the polish's re-ranking when it re-ranked): without refinement, for a
+ *        partial match, or when the recovery replaced the ranked winner, only the chosen map
+ *        is listed.
  * @return the count; 0 for NULL.
  * Ownership: none.
  * Thread-safety: const.
@@ -2020,7 +2021,7 @@ AMSCR_API size_t amscr_result_num_alternatives(const amscr_result *r);
  *        chosen map): the map in input coordinates, like amscr_result_affine, and its ranking
  *        cost (the trimmed closest-point cost in the normalized frames after a few refinement
  *        or polish steps; costs compare within one result only; NaN for alternative 0 when
- *        the registration ranked no starts).
+ *        no ranking describes the reported map).
  * @param[out] out_m6    {a11, a12, b1, a21, a22, b2} (may be NULL).
  * @param[out] out_cost  the ranking cost (may be NULL).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL r, i out of range).

@@ -6,7 +6,8 @@
  * or, when the polish re-ranked the starts (the search was ambiguous), the polish's (each start
  * polished a few steps, scored by the two-way trimmed cost). Within one ranking the costs
  * compare. Entry 0 is always the reported map (amscr_result_affine) with its ranking cost (NaN
- * when the registration ranked no starts: no refinement, partial matching). Another ranked map
+ * when the registration ranked no starts — no refinement, partial matching — or when the
+ * recovery moved the map away from the ranked winner: the ranking no longer describes it). Another ranked map
  * is listed when it is distinct — it differs from the chosen start and from every map listed
  * before by more than the ambiguity's AMSCR__DISTINCT_GAP2 (an RMS displacement of 10 % of the
  * normalized frame's RMS radius) — and about as good: (chosen cost + floor) / (its cost +
@@ -63,10 +64,13 @@ void amscr__alternatives(const amscr_descriptor *f, const amscr_descriptor *h, a
     const match_t *m = &r->m;
     double norm[AMSCR__MAX_ALTERNATIVES][6];
     size_t idx[AMSCR__MAX_ALTERNATIVES];
+    /* a later stage (the recovery) that moved the map off the ranked start leaves a ranking that
+     * no longer describes it */
+    int ranked = m->nrank && amscr__map_gap2(f, m->X, m->rank_X[m->rank_best]) <= AMSCR__DISTINCT_GAP2;
     to_input(f, h, m->X, r->alt[0]);
-    r->alt_cost[0] = m->nrank ? m->rank_cost[m->rank_best] : NAN;
+    r->alt_cost[0] = ranked ? m->rank_cost[m->rank_best] : NAN;
     r->nalt = 1;
-    if (!m->nrank)
+    if (!ranked)
         return;
     by_cost(m, idx);
     double best = r->alt_cost[0] + AMSCR__AMBIGUITY_FLOOR;
