@@ -261,7 +261,7 @@ static amscr_status scratch_new(const amscr_descriptor *f, const amscr_descripto
     s->Hd = buf + 5 * n;
     s->P = buf + 5 * n + 2 * AMSCR__DENSE * n;
     s->nd = amscr__densify(h->base, n, 1, s->Hd);
-    if (!amscr__grid_build(&s->grid, s->Hd, s->nd)) {
+    if (amscr__grid_build(&s->grid, s->Hd, s->nd) != 1) {
         scratch_free(s);
         return amscr__fail(AMSCR_E_NOMEM, "registration: out of memory (or a non-finite target)");
     }
