@@ -2,8 +2,9 @@
  * Header: "AMSCRDB\0", u32 version, u32 reserved, params, (version >= 2) the retrieval
  * settings (retrieval_io.c), u64 count, u64 N, u64 p; per shape: i32 label, f64 fwd[6],
  * f64 inv[6], f64 input[2N], base[2N], scaled[2Np]; (version 3) u64 length and the index
- * section (index_io.c); trailer: u64 FNV-1a of everything before it. The shape channel is
- * derived from the prepared shapes on demand and is not stored. */
+ * section (index_io.c); trailer: u64 checksum of everything before it (FNV-1a; version 4:
+ * amscr__sum64). A collection file does not store the shape channel (derived from the
+ * prepared shapes on demand); an index file of version 4 does, in its section. */
 #include "db_io.h"
 
 #include <errno.h>
@@ -11,6 +12,15 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+
+uint64_t amscr__db_checksum(uint32_t version, const unsigned char *p, size_t n)
+{
+    return version >= AMSCR__DB_VERSION_FEATURES ? amscr__sum64(p, n) : amscr__fnv1a(p, n);
+}
 
 static void w_params(amscr__wbuf *w, const amscr_params *p)
 {
@@ -203,12 +213,12 @@ static amscr_status check_envelope(const unsigned char *buf, size_t len, uint32_
         return amscr__fail(AMSCR_E_FORMAT, "not an amscr collection (bad magic)");
     amscr__rbuf r = {buf, len, 8, 0}, t = {buf, len, len - 8, 0};
     *version = amscr__r_u32(&r);
-    if (*version > AMSCR__DB_VERSION_INDEX)
+    if (*version > AMSCR__DB_VERSION_FEATURES)
         return amscr__fail(AMSCR_E_FORMAT, "collection format version %u is newer than this library's (%u)",
-                           (unsigned)*version, AMSCR__DB_VERSION_INDEX);
+                           (unsigned)*version, AMSCR__DB_VERSION_FEATURES);
     if (*version == 0)
         return amscr__fail(AMSCR_E_FORMAT, "collection format version 0 is invalid");
-    if (amscr__fnv1a(buf, len - 8) != amscr__r_u64(&t))
+    if (amscr__db_checksum(*version, buf, len - 8) != amscr__r_u64(&t))
         return amscr__fail(AMSCR_E_FORMAT, "collection checksum mismatch (corrupt or truncated file)");
     return AMSCR_OK;
 }
@@ -275,12 +285,22 @@ amscr_status amscr_db_load_memory(const void *buf, size_t len, amscr_db **out)
     return AMSCR_OK;
 }
 
+/* The size of the open file f, or 0 when unknown (then read in growing chunks). */
+static size_t file_size(FILE *f)
+{
+    struct stat sb;
+    return fstat(fileno(f), &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0 && (uintmax_t)sb.st_size < SIZE_MAX / 2
+               ? (size_t)sb.st_size
+               : 0;
+}
+
 amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out_len)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
         return amscr__fail(AMSCR_E_IO, "%s: %s", path, strerror(errno));
-    size_t cap = 1 << 16, len = 0;
+    size_t cap = file_size(f), len = 0;
+    cap = cap ? cap + 1 : (size_t)1 << 16; /* one more byte: the end is seen without a second buffer */
     unsigned char *buf = malloc(cap);
     amscr_status st = AMSCR_OK;
     while (buf) {
@@ -316,6 +336,40 @@ amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out
     *out = buf;
     *out_len = len;
     return AMSCR_OK;
+}
+
+amscr_status amscr__file_map(const char *path, unsigned char **out, size_t *out_len, int *mapped)
+{
+    *mapped = 0;
+    int fd = open(path, O_RDONLY);
+    struct stat sb;
+    if (fd >= 0 && fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0 &&
+        (uintmax_t)sb.st_size < SIZE_MAX / 2) {
+#ifdef MAP_POPULATE
+        int flags = MAP_PRIVATE | MAP_POPULATE; /* every page mapped at once: the load reads them all */
+#else
+        int flags = MAP_PRIVATE;
+#endif
+        void *p = mmap(NULL, (size_t)sb.st_size, PROT_READ, flags, fd, 0);
+        if (p != MAP_FAILED) {
+            close(fd);
+            *out = p;
+            *out_len = (size_t)sb.st_size;
+            *mapped = 1;
+            return AMSCR_OK;
+        }
+    }
+    if (fd >= 0)
+        close(fd);
+    return amscr__file_read(path, out, out_len); /* not mappable: read (and its errors) */
+}
+
+void amscr__file_unmap(unsigned char *buf, size_t len, int mapped)
+{
+    if (mapped)
+        munmap(buf, len);
+    else
+        free(buf);
 }
 
 amscr_status amscr_db_load(const char *path, amscr_db **out)

@@ -111,6 +111,9 @@ amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t
                                  double *out);
 /* Rows first..n-1 from their M signature-nearest shapes (index_build.c); x->dmax grows. */
 amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_progress_fn progress, void *user);
+/* Rows first..n-1's lists (their K nearest among their shortlists S, m each, ascending) refined
+ * from the neighbours' lists (index_refine.c); x->dmax grows. */
+amscr_status amscr__index_refine(amscr_index *x, const amscr__base *b, size_t first, const uint32_t *S, size_t m);
 /* The lists' reverse (x->rev_start, x->rev) from x's lists (index_query.c); frees the old. */
 amscr_status amscr__index_reverse(amscr_index *x);
 void amscr__index_reverse_free(amscr_index *x);
