@@ -5,6 +5,7 @@
  * section (index_io.c); trailer: u64 checksum of everything before it (FNV-1a; version 4:
  * amscr__sum64). A collection file does not store the shape channel (derived from the
  * prepared shapes on demand); an index file of version 4 does, in its section. */
+#define _DEFAULT_SOURCE /* MAP_POPULATE, where the system has it */
 #include "db_io.h"
 
 #include <errno.h>
