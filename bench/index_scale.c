@@ -38,7 +38,7 @@
 #include "index.h"
 #include "mcd_set.h"
 
-enum { TOP = 10, NQ = 50, NQ_SCALE = 50, SEARCH_ROWS = 200, BUILD_M = 160 };
+enum { TOP = 10, NQ = 50, NQ_SCALE = 50, SEARCH_ROWS = 200, BUILD_M = 192 };
 
 static void die(const char *what)
 {
