@@ -244,6 +244,20 @@ START_TEST(stored_features)
     ck_assert(memcmp(b2, buf, len) == 0);
     amscr_index_free(y);
     y = NULL;
+    /* a lazy load of a file reads the heights in place from the mapped file: the same scores,
+     * the same bytes saved */
+    const char *path = "check_index_features.idx";
+    ck_assert_int_eq(amscr_index_save(x, path), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_load_with(path, AMSCR_INDEX_LAZY, &y), AMSCR_OK);
+    same_query(x, y, q, 0);
+    same_query(x, y, q, 6);
+    amscr_free(b2);
+    ck_assert_int_eq(amscr_index_save_memory(y, &b2, &len2), AMSCR_OK);
+    ck_assert_uint_eq(len2, len);
+    ck_assert(memcmp(b2, buf, len) == 0);
+    amscr_index_free(y);
+    y = NULL;
+    remove(path);
     /* two frames announced as one: refused */
     unsigned char *b = buf;
     size_t at = len - 8 - (12 + NSHAPES * 2 * 2 * 64 * AMSCR__HF_BINS);

@@ -231,10 +231,11 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
         h->n = N;
         h->nfreq = AMSCR__HF_FREQS(N) + 1;
         for (int o = 0; o < 2; o++) {
-            h->seq[o] = malloc(bytes);
+            h->seq[o] = x->map ? (uint8_t *)(x->map + r->pos) : malloc(bytes); /* mapped: read in place */
             if (!h->seq[o])
                 return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
-            memcpy(h->seq[o], r->p + r->pos, bytes);
+            if (!x->map)
+                memcpy(h->seq[o], r->p + r->pos, bytes);
             r->pos += bytes;
         }
     }
@@ -258,7 +259,9 @@ static amscr_status check_flags(unsigned flags, const char *what)
     return AMSCR_OK;
 }
 
-static amscr_status load_memory(const void *buf, size_t len, unsigned flags, amscr_index **out)
+/* The index in buf; map: buf is the file mapped for this load, which a lazy load keeps (the
+ * index unmaps it) and reads the heights from in place. */
+static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int map, amscr_index **out)
 {
     amscr_db *db = NULL;
     size_t pos = 0;
@@ -275,6 +278,10 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, ams
     x->sig_dim = AMSCR__SIG_DIM;
     x->nf = amscr__index_frames(amscr_db_params(db));
     x->lazy = (flags & AMSCR_INDEX_LAZY) != 0;
+    if (map && x->lazy) {
+        x->map = (unsigned char *)(uintptr_t)buf;
+        x->map_len = len;
+    }
     amscr__rbuf r = {buf, len - 8, pos, 0};
     uint64_t sec = version >= AMSCR__DB_VERSION_INDEX ? amscr__r_u64(&r) : 0;
     if (version < AMSCR__DB_VERSION_INDEX)
@@ -295,6 +302,7 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, ams
     if (st == AMSCR_OK)
         st = amscr__index_features(x, 0, 1);
     if (st != AMSCR_OK) {
+        amscr__index_detach_map(x); /* the caller unmaps */
         amscr_index_free(x);
         return st;
     }
@@ -308,7 +316,7 @@ amscr_status amscr_index_load_memory_with(const void *buf, size_t len, unsigned 
     AMSCR_CHECK_NULL(buf);
     AMSCR_CHECK_NULL(out);
     amscr_status st = check_flags(flags, "amscr_index_load_memory_with");
-    return st == AMSCR_OK ? load_memory(buf, len, flags, out) : st;
+    return st == AMSCR_OK ? load_memory(buf, len, flags, 0, out) : st;
 }
 
 amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out)
@@ -330,13 +338,14 @@ amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index
     st = amscr__file_map(path, &buf, &len, &mapped);
     if (st != AMSCR_OK)
         return st;
-    st = load_memory(buf, len, flags, out);
+    st = load_memory(buf, len, flags, mapped, out);
     if (st != AMSCR_OK) {
         char d[400];
         snprintf(d, sizeof d, "%s", amscr_last_error_detail());
         amscr__fail(st, "%s: %s", path, d);
     }
-    amscr__file_unmap(buf, len, mapped);
+    if (st != AMSCR_OK || !(*out)->map) /* else the index keeps the mapping */
+        amscr__file_unmap(buf, len, mapped);
     return st;
 }
 
