@@ -2483,8 +2483,10 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_set_group(amscr_index *x, siz
 AMSCR_API const char *amscr_index_group(const amscr_index *x, size_t i);
 
 /**
- * @brief Writes the index (the collection file format, version 3: amscr_db_load of it gives the
- *        collection) to a temporary name in the same folder and renames it.
+ * @brief Writes the index (the collection file format, version 4 since 0.5, 3 in 0.4:
+ *        amscr_db_load of it gives the collection; version 4 also stores each shape's channel
+ *        features, so a load does not rebuild them) to a temporary name in the same folder and
+ *        renames it.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none. Thread-safety: const.
  * @since 0.4
@@ -2502,9 +2504,11 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_save_memory(const amscr_index
                                                                size_t *out_len);
 
 /**
- * @brief Reads an index file. A collection file without an index (amscr_db_save) and the
- *        index files of the tool before 0.4 are AMSCR_E_FORMAT with a detail saying to build
- *        the index again.
+ * @brief Reads an index file (mapped read-only while it is read, where the system can map
+ *        it: replace an index file by renaming, as amscr_index_save does, not by rewriting it
+ *        in place). Index files of format 3 (0.4) load too, their channel features built from
+ *        the shapes. A collection file without an index (amscr_db_save) and the index files of
+ *        the tool before 0.4 are AMSCR_E_FORMAT with a detail saying to build the index again.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_LIMIT; AMSCR_E_FORMAT (wrong
  *         magic, version, checksum, truncated or inconsistent content); AMSCR_E_NOMEM.
  * Ownership: caller frees *out with amscr_index_free.
@@ -2522,10 +2526,11 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load(const char *path, amscr_
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out);
 
-/** Load flag: the shapes' channel features are not computed at load; each query computes those
- *  of the candidates it matches (for one or a few queries a load, e.g. a command-line search);
- *  without it a load computes every shape's once, on the params' threads (for many queries).
- *  Scores are the same either way. @since 0.4 */
+/** Load flag: the shapes' channel features are not made ready at load (format 4: their
+ *  spectra, from the stored heights; format 3: the features); each query computes those of the
+ *  candidates it matches (for one or a few queries a load, e.g. a command-line search); without
+ *  it a load computes every shape's once, on the params' threads (for many queries). Scores are
+ *  the same either way. @since 0.4 */
 #define AMSCR_INDEX_LAZY 1u
 
 /**
