@@ -18,6 +18,12 @@ struct amscr_db {
     size_t n, cap;
     amscr_descriptor **d;
     int32_t *labels;
+    /* A lazy load (amscr__db_set_source): shapes below nsrc are decoded from src (the file,
+     * kept by the index that owns the collection) when first asked for; d[i] NULL until then,
+     * under lock (a const collection stays safe for concurrent readers). */
+    const unsigned char *src;
+    size_t src_pos0, src_per, nsrc;
+    pthread_mutex_t lock;
 };
 
 amscr_status amscr_db_new(const amscr_params *p, amscr_db **out)
@@ -41,6 +47,8 @@ void amscr_db_free(amscr_db *db)
         return;
     for (size_t i = 0; i < db->n; i++)
         amscr_descriptor_free(db->d[i]);
+    if (db->src)
+        pthread_mutex_destroy(&db->lock);
     free(db->d);
     free(db->labels);
     free(db);
@@ -129,7 +137,54 @@ amscr_status amscr_db_add_descriptor(amscr_db *db, const amscr_descriptor *d, in
 
 size_t amscr_db_size(const amscr_db *db) { return db ? db->n : 0; }
 int32_t amscr_db_label(const amscr_db *db, size_t i) { return (db && i < db->n) ? db->labels[i] : 0; }
-const amscr_descriptor *amscr_db_descriptor(const amscr_db *db, size_t i) { return (db && i < db->n) ? db->d[i] : NULL; }
+void amscr__db_set_source(amscr_db *db, const unsigned char *src, size_t pos0, size_t per, size_t count)
+{
+    pthread_mutex_init(&db->lock, NULL);
+    db->src = src;
+    db->src_pos0 = pos0;
+    db->src_per = per;
+    db->nsrc = count;
+}
+
+/* Shape i, decoded from the source when it is not yet (NULL: out of memory). */
+static amscr_descriptor *db_get(const amscr_db *db, size_t i)
+{
+    if (i >= db->nsrc)
+        return db->d[i];
+    amscr_db *m = (amscr_db *)(uintptr_t)db; /* the cache of a const collection, under its lock */
+    pthread_mutex_lock(&m->lock);
+    if (!m->d[i] && amscr__db_decode(db->src, db->src_pos0 + i * db->src_per, db->src_per, &db->params, NULL,
+                                     &m->d[i]) != AMSCR_OK)
+        m->d[i] = NULL;
+    amscr_descriptor *d = m->d[i];
+    pthread_mutex_unlock(&m->lock);
+    return d;
+}
+
+amscr_status amscr__db_decode_all(const amscr_db *db)
+{
+    for (size_t i = 0; i < db->nsrc; i++)
+        if (!db_get(db, i))
+            return amscr__fail(AMSCR_E_NOMEM, "collection: out of memory");
+    return AMSCR_OK;
+}
+
+const amscr_descriptor *amscr_db_descriptor(const amscr_db *db, size_t i)
+{
+    return (db && i < db->n) ? db_get(db, i) : NULL;
+}
+
+size_t amscr__db_find_input(const amscr_db *db, const double *input, size_t n)
+{
+    size_t N = db->params.num_samples;
+    if (n != N)
+        return SIZE_MAX;
+    for (size_t i = 0; i < db->n; i++) /* a shape of the source: its bytes (never decoded here) */
+        if (i < db->nsrc ? amscr__db_input_is(db->src, db->src_pos0 + i * db->src_per, input, N)
+                         : memcmp(db->d[i]->input, input, 2 * N * sizeof *input) == 0)
+            return i;
+    return SIZE_MAX;
+}
 const amscr_params *amscr_db_params(const amscr_db *db) { return db ? &db->params : NULL; }
 
 /* ------------------------------------------------------------ batch engine */
@@ -320,6 +375,9 @@ amscr_status amscr_db_query(const amscr_db *db, const amscr_descriptor *q, amscr
     AMSCR_CHECK_NULL(out_dist);
     if (!amscr__params_compatible(&db->params, &q->params, "amscr_db_query"))
         return AMSCR_E_INVALID_ARG;
+    amscr_status st = amscr__db_decode_all(db);
+    if (st != AMSCR_OK)
+        return st;
     batch_t b;
     memset(&b, 0, sizeof b);
     b.prm = &db->params;
@@ -336,6 +394,9 @@ amscr_status amscr_db_distance_matrix(const amscr_db *db, amscr_progress_fn prog
     amscr__clear_error();
     AMSCR_CHECK_NULL(db);
     AMSCR_CHECK_NULL(out_dist);
+    amscr_status st = amscr__db_decode_all(db);
+    if (st != AMSCR_OK)
+        return st;
     batch_t b;
     memset(&b, 0, sizeof b);
     b.prm = &db->params;
@@ -365,6 +426,11 @@ amscr_status amscr_db_cross_distances(const amscr_db *queries, const amscr_db *t
     AMSCR_CHECK_NULL(out_dist);
     if (!amscr__params_compatible(&queries->params, &targets->params, "amscr_db_cross_distances"))
         return AMSCR_E_INVALID_ARG;
+    amscr_status st = amscr__db_decode_all(queries);
+    if (st == AMSCR_OK)
+        st = amscr__db_decode_all(targets);
+    if (st != AMSCR_OK)
+        return st;
     batch_t b;
     memset(&b, 0, sizeof b);
     b.prm = &queries->params;

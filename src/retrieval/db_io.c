@@ -7,6 +7,7 @@
  * prepared shapes on demand); an index file of version 4 does, in its section. */
 #define _DEFAULT_SOURCE /* MAP_POPULATE, where the system has it */
 #include "db_io.h"
+#include "dense.h"
 
 #include <errno.h>
 #include <pthread.h>
@@ -75,6 +76,9 @@ amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *ou
     AMSCR_CHECK_NULL(db);
     AMSCR_CHECK_NULL(out_buf);
     AMSCR_CHECK_NULL(out_len);
+    amscr_status st = amscr__db_decode_all(db); /* a lazy load's shapes */
+    if (st != AMSCR_OK)
+        return st;
     amscr__wbuf w = {NULL, 0, 0, 0};
     amscr__db_write(db, AMSCR__DB_VERSION_PLAIN, &w);
     if (!w.oom)
@@ -179,8 +183,64 @@ static amscr_status r_params(amscr__rbuf *r, uint32_t version, amscr_params *prm
     return AMSCR_OK;
 }
 
+/* Shape bytes at `at` decoded: 0, or 1 truncated / not finite, 2 degenerate, 3 out of memory. */
+static int decode_shape(const unsigned char *p, size_t at, size_t per, const amscr_params *prm, int32_t *label,
+                        amscr_descriptor **out)
+{
+    size_t N = prm->num_samples, np = prm->num_scales;
+    amscr__rbuf r = {p, at + per, at, 0};
+    *label = (int32_t)amscr__r_u32(&r);
+    amscr_descriptor *d = NULL;
+    if (amscr__descriptor_alloc(N, np, &d) != AMSCR_OK)
+        return 3;
+    d->params = *prm;
+    int bad = 0;
+    if (!amscr__r_f64s(&r, d->fwd, 6) || !amscr__r_f64s(&r, d->inv, 6) || !amscr__r_f64s(&r, d->input, 2 * N) ||
+        !amscr__r_f64s(&r, d->base, 2 * N) || !amscr__r_f64s(&r, d->scaled, 2 * N * np))
+        bad = 1;
+    else {
+        amscr_status st = amscr__descriptor_finish(d);
+        bad = st == AMSCR_OK ? 0 : st == AMSCR_E_DEGENERATE ? 2 : 3;
+    }
+    if (bad) {
+        amscr_descriptor_free(d);
+        return bad;
+    }
+    *out = d;
+    return 0;
+}
+
+amscr_status amscr__db_decode(const unsigned char *p, size_t at, size_t per, const amscr_params *prm, int32_t *label,
+                              amscr_descriptor **out)
+{
+    int32_t lab = 0;
+    int bad = decode_shape(p, at, per, prm, &lab, out);
+    if (bad == 1)
+        return amscr__fail(AMSCR_E_FORMAT, "collection: a shape is truncated or has non-finite values");
+    if (bad == 2)
+        return amscr__fail(AMSCR_E_FORMAT, "collection: a shape is degenerate");
+    if (bad == 3)
+        return amscr__fail(AMSCR_E_NOMEM, "collection: out of memory");
+    if (label)
+        *label = lab;
+    return AMSCR_OK;
+}
+
+int amscr__db_input_is(const unsigned char *p, size_t at, const double *input, size_t N)
+{
+    amscr__rbuf r = {p, at + 4 + 8 * (12 + 2 * N), at + 4 + 8 * 12, 0};
+    for (size_t a = 0; a < 2 * N; a++) {
+        double v = amscr__r_f64(&r);
+        if (r.bad || memcmp(&v, &input[a], sizeof v) != 0)
+            return 0;
+    }
+    return 1;
+}
+
 /* The shapes of a file, decoded on threads: shape i's bytes start at pos0 + i * per (a fixed
- * size), each thread takes every nt-th shape. */
+ * size), each thread takes every nt-th shape. A lazy load (check_only) decodes none: it checks
+ * what a decode would (finite values, no degenerate level), the shapes decoded when asked for
+ * (db.c). */
 typedef struct {
     const unsigned char *p;
     size_t pos0, per;
@@ -189,33 +249,58 @@ typedef struct {
     amscr_descriptor **d; /* count entries, NULL until decoded */
     int32_t *label;
     unsigned char *bad; /* per shape: 0, or 1 truncated / not finite, 2 degenerate, 3 out of memory */
+    int check_only;
     unsigned t, nt;
 } shapes_job;
 
-static void read_shape(const shapes_job *j, uint64_t i)
+/* Whether the curve xy (n points) has an invertible moment matrix (amscr__descriptor_finish's
+ * test). */
+static int level_ok(const double *xy, size_t n)
+{
+    double mom[6], M9[9], inv[9];
+    amscr__moments(xy, n, mom);
+    amscr__moment_matrix(mom, M9);
+    return amscr__inv3(M9, inv);
+}
+
+/* Shape i checked as a decode would, in scratch (2N doubles). */
+static void check_shape(const shapes_job *j, uint64_t i, double *scratch)
 {
     size_t N = j->prm->num_samples, p = j->prm->num_scales, at = j->pos0 + (size_t)i * j->per;
     amscr__rbuf r = {j->p, at + j->per, at, 0};
     j->label[i] = (int32_t)amscr__r_u32(&r);
-    amscr_descriptor *d = NULL;
-    if (amscr__descriptor_alloc(N, p, &d) != AMSCR_OK) {
-        j->bad[i] = 3;
+    if (!amscr__r_f64s(&r, scratch, 12) || !amscr__r_f64s(&r, scratch, 2 * N)) {
+        j->bad[i] = 1;
         return;
     }
-    d->params = *j->prm;
-    if (!amscr__r_f64s(&r, d->fwd, 6) || !amscr__r_f64s(&r, d->inv, 6) || !amscr__r_f64s(&r, d->input, 2 * N) ||
-        !amscr__r_f64s(&r, d->base, 2 * N) || !amscr__r_f64s(&r, d->scaled, 2 * N * p))
-        j->bad[i] = 1;
-    else if (amscr__descriptor_finish(d) != AMSCR_OK)
-        j->bad[i] = 2;
-    j->d[i] = d;
+    for (size_t k = 0; k <= p; k++) {
+        if (!amscr__r_f64s(&r, scratch, 2 * N)) {
+            j->bad[i] = 1;
+            return;
+        }
+        if (!level_ok(scratch, N))
+            j->bad[i] = 2;
+    }
+}
+
+static void read_shape(const shapes_job *j, uint64_t i)
+{
+    j->bad[i] = (unsigned char)decode_shape(j->p, j->pos0 + (size_t)i * j->per, j->per, j->prm, &j->label[i],
+                                            &j->d[i]);
 }
 
 static void *shapes_worker(void *arg)
 {
     const shapes_job *j = arg;
+    double *scratch = j->check_only ? amscr__malloc_array(2 * j->prm->num_samples, sizeof *scratch) : NULL;
     for (uint64_t i = j->t; i < j->count; i += j->nt)
-        read_shape(j, i);
+        if (!j->check_only)
+            read_shape(j, i);
+        else if (scratch)
+            check_shape(j, i, scratch);
+        else
+            j->bad[i] = 3;
+    free(scratch);
     return NULL;
 }
 
@@ -247,11 +332,12 @@ static void run_shapes(shapes_job *j)
         pthread_join(tid[t], NULL);
 }
 
-/* The count shapes into db (params prm), decoded on the params' threads, entered in order. */
-static amscr_status r_shapes(amscr__rbuf *r, const amscr_params *prm, uint64_t count, amscr_db *db)
+/* The count shapes into db (params prm), decoded on the params' threads, entered in order
+ * (lazy: checked, and left to decode from r's buffer when asked for). */
+static amscr_status r_shapes(amscr__rbuf *r, const amscr_params *prm, uint64_t count, int lazy, amscr_db *db)
 {
     size_t N = prm->num_samples, p = prm->num_scales;
-    shapes_job j = {r->p, r->pos, 4 + 8 * (12 + 4 * N + 2 * N * p), prm, count, NULL, NULL, NULL, 0, 1};
+    shapes_job j = {r->p, r->pos, 4 + 8 * (12 + 4 * N + 2 * N * p), prm, count, NULL, NULL, NULL, lazy, 0, 1};
     j.d = amscr__calloc_array(count ? count : 1, sizeof *j.d);
     j.label = amscr__malloc_array(count ? count : 1, sizeof *j.label);
     j.bad = amscr__calloc_array(count ? count : 1, 1);
@@ -271,6 +357,8 @@ static amscr_status r_shapes(amscr__rbuf *r, const amscr_params *prm, uint64_t c
         if (st == AMSCR_OK)
             j.d[i] = NULL; /* the collection's now */
     }
+    if (st == AMSCR_OK && lazy)
+        amscr__db_set_source(db, r->p, r->pos, j.per, (size_t)count);
     for (uint64_t i = 0; j.d && i < count; i++)
         amscr_descriptor_free(j.d[i]);
     r->pos += st == AMSCR_OK ? (size_t)count * j.per : 0;
@@ -300,7 +388,7 @@ static amscr_status check_envelope(const unsigned char *buf, size_t len, uint32_
     return AMSCR_OK;
 }
 
-amscr_status amscr__db_parse(const unsigned char *buf, size_t len, amscr_db **out, size_t *out_pos,
+amscr_status amscr__db_parse(const unsigned char *buf, size_t len, int lazy, amscr_db **out, size_t *out_pos,
                              uint32_t *out_version)
 {
     uint32_t version = 0;
@@ -322,7 +410,7 @@ amscr_status amscr__db_parse(const unsigned char *buf, size_t len, amscr_db **ou
     amscr_db *db = NULL;
     st = amscr_db_new(&prm, &db);
     if (st == AMSCR_OK)
-        st = r_shapes(&r, &prm, count, db);
+        st = r_shapes(&r, &prm, count, lazy, db);
     if (st != AMSCR_OK) {
         amscr_db_free(db);
         return st;
@@ -341,7 +429,7 @@ amscr_status amscr_db_load_memory(const void *buf, size_t len, amscr_db **out)
     amscr_db *db = NULL;
     size_t pos = 0;
     uint32_t version = 0;
-    amscr_status st = amscr__db_parse(buf, len, &db, &pos, &version);
+    amscr_status st = amscr__db_parse(buf, len, 0, &db, &pos, &version);
     if (st != AMSCR_OK)
         return st;
     if (version >= AMSCR__DB_VERSION_INDEX) { /* an index file: its collection, the section skipped */

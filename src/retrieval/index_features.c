@@ -19,10 +19,13 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
     (void)scratch;
     feat_job *j = ctx;
     amscr_index *x = j->x;
-    const amscr_descriptor *d = amscr_db_descriptor(x->db, i);
     float *sig = x->sig + i * x->sig_dim;
-    if (!j->have_sig)
+    if (!j->have_sig) {
+        const amscr_descriptor *d = amscr_db_descriptor(x->db, i);
+        if (!d)
+            return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
         amscr__shape_signature(d, sig);
+    }
     amscr__sig_bound_vector(sig, x->sig_lb + i * AMSCR__SIG_LB_DIM);
     amscr__hf *hf = x->hf + i * (size_t)x->nf;
     if (x->nf == 0 || (x->lazy && j->have_sig))
@@ -33,6 +36,9 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
             st = hf[f].spec[0] ? AMSCR_OK : amscr__hf_spectra(&hf[f], NULL);
         return st;
     }
+    const amscr_descriptor *d = amscr_db_descriptor(x->db, i); /* a lazy load's: decoded here */
+    if (!d)
+        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
     for (int f = 0; f < x->nf; f++)
         amscr__hf_free(&hf[f]);
     return amscr__base_hf(&j->b, d, hf);

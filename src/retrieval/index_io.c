@@ -89,12 +89,15 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
     AMSCR_CHECK_NULL(x);
     AMSCR_CHECK_NULL(out_buf);
     AMSCR_CHECK_NULL(out_len);
+    amscr_status st = amscr__db_decode_all(x->db); /* a lazy load's shapes */
+    if (st != AMSCR_OK)
+        return st;
     amscr__wbuf w = {NULL, 0, 0, 0};
     amscr__db_write(x->db, AMSCR__DB_VERSION_FEATURES, &w);
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
     write_section(x, &w);
-    amscr_status st = write_features(x, &w);
+    st = write_features(x, &w);
     if (st != AMSCR_OK) {
         free(w.buf);
         return st;
@@ -266,7 +269,8 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int
     amscr_db *db = NULL;
     size_t pos = 0;
     uint32_t version = 0;
-    amscr_status st = amscr__db_parse(buf, len, &db, &pos, &version);
+    int lazy = map && (flags & AMSCR_INDEX_LAZY); /* the shapes decoded from the kept mapping when needed */
+    amscr_status st = amscr__db_parse(buf, len, lazy, &db, &pos, &version);
     if (st != AMSCR_OK)
         return st;
     amscr_index *x = calloc(1, sizeof *x);

@@ -131,13 +131,18 @@ amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const a
 {
     amscr_status st = AMSCR_OK;
     for (size_t t = 0; t < m && st == AMSCR_OK; t++) {
-        const amscr_descriptor *d = amscr_db_descriptor(db, cand[t]);
         amscr__hf built[2];
         const amscr__hf *stored = hfs ? hfs + cand[t] * (size_t)b->nf : NULL;
         /* not kept, or not built yet (an index loaded with AMSCR_INDEX_LAZY): built here */
         int build = !stored || (b->nf > 0 && stored[0].seq[0] == NULL);
         int spectra = !build && b->nf > 0 && stored[0].spec[0] == NULL; /* the file's heights */
         const amscr__hf *hd = build || spectra ? built : stored;
+        /* the prepared shape, when the pair reads it (a lazy load decodes it here) */
+        const amscr_descriptor *d = build || b->w < 1.0 ? amscr_db_descriptor(db, cand[t]) : NULL;
+        if ((build || b->w < 1.0) && !d) {
+            st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+            break;
+        }
         if (build)
             st = amscr__base_hf(b, d, built);
         else if (spectra)

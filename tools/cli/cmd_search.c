@@ -30,17 +30,37 @@ static size_t member_index(const collection *c, const char *qpath)
     return SIZE_MAX;
 }
 
+/* Whether shape j of db has the query's prepared samples, bit for bit. */
+static int same_samples(const amscr_db *db, size_t j, const amscr_descriptor *dq)
+{
+    const amscr_descriptor *d = amscr_db_descriptor(db, j);
+    size_t ns = amscr_descriptor_num_samples(dq);
+    return d && amscr_descriptor_num_samples(d) == ns &&
+           memcmp(amscr_descriptor_input_points(d), amscr_descriptor_input_points(dq), 2 * ns * sizeof(double)) == 0;
+}
+
 /* The shape of db whose prepared samples are the query's, bit for bit, or SIZE_MAX: an index
  * keeps no paths, so a member query is known by its samples. */
 static size_t member_of(const amscr_db *db, const amscr_descriptor *dq)
 {
-    size_t ns = amscr_descriptor_num_samples(dq);
-    const double *q = amscr_descriptor_input_points(dq);
-    for (size_t j = 0; j < amscr_db_size(db); j++) {
-        const amscr_descriptor *d = amscr_db_descriptor(db, j);
-        if (amscr_descriptor_num_samples(d) == ns && memcmp(amscr_descriptor_input_points(d), q, 2 * ns * sizeof *q) == 0)
+    for (size_t j = 0; j < amscr_db_size(db); j++)
+        if (same_samples(db, j, dq))
             return j;
-    }
+    return SIZE_MAX;
+}
+
+/* member_of among the shapes that the query's own scores (dist, n of them) rank first: a
+ * member's copy is its own nearest shape (base distance 0, the same neighbours), so it ranks
+ * there, and only those few shapes are read (a lazily loaded index decodes no other). */
+static size_t member_among_first(const amscr_db *db, const amscr_descriptor *dq, const double *dist, size_t n)
+{
+    enum { FIRST = 32 };
+    size_t idx[FIRST], k = n < FIRST ? n : FIRST;
+    if (k == 0 || amscr_topk(dist, n, k, SIZE_MAX, idx) != AMSCR_OK)
+        return member_of(db, dq);
+    for (size_t t = 0; t < k; t++)
+        if (same_samples(db, idx[t], dq))
+            return idx[t];
     return SIZE_MAX;
 }
 
@@ -81,20 +101,23 @@ static int index_distances(const amscr_index *x, const amscr_params *p, const am
 {
     const amscr_db *idb = amscr_index_db(x);
     const amscr_params *b = amscr_db_params(idb);
-    size_t n = amscr_index_size(x), member = member_of(idb, dq);
-    if (amscr_params_get_channel_weight(p) >= 1.0 && amscr_params_get_rerank_k(p) == 0)
-        member = SIZE_MAX; /* the channel alone: the query's own distances, as a folder search */
+    size_t n = amscr_index_size(x);
+    /* the channel alone: the query's own distances, as a folder search */
+    int own = amscr_params_get_channel_weight(p) >= 1.0 && amscr_params_get_rerank_k(p) == 0;
     if (retrieval_is_plain(p))
         return query_distances(idb, dq, SIZE_MAX, qpath, cpath, dist);
     if (amscr_params_get_rerank_k(p) != amscr_params_get_rerank_k(b) ||
         amscr_params_get_rerank_iterations(p) != amscr_params_get_rerank_iterations(b)) {
         amscr_db *db = NULL;
+        size_t member = own ? SIZE_MAX : member_of(idb, dq);
         int r = index_db_with_params(x, p, cpath, &db) == 0 ? query_distances(db, dq, member, qpath, cpath, dist) : -1;
         amscr_db_free(db);
         return r;
     }
-    amscr_status st = member != SIZE_MAX ? amscr_index_member_scores(x, member, cand, dist, n)
-                                         : amscr_index_query_scores(x, dq, cand, dist, n);
+    amscr_status st = amscr_index_query_scores(x, dq, cand, dist, n);
+    size_t member = st == AMSCR_OK && !own ? member_among_first(idb, dq, dist, n) : SIZE_MAX;
+    if (member != SIZE_MAX) /* a member: its row of the collection's matrix */
+        st = amscr_index_member_scores(x, member, cand, dist, n);
     if (st != AMSCR_OK) {
         tool_lib_error(qpath, st);
         return -1;
