@@ -181,6 +181,57 @@ START_TEST(lazy_load)
 }
 END_TEST
 
+/* A lazy load of a file decodes each prepared shape when first needed: with a fused weight
+ * (the AMSCR distance read for the candidates) the scores, member rows, the collection's
+ * shapes and batch calls, a save (the same bytes) and an add are an eager load's. */
+START_TEST(lazy_file_shapes)
+{
+    amscr_params *p = params_of(0.5, 8, 2);
+    amscr_index *x = named_index(p, 6), *y = NULL, *e = NULL;
+    amscr_descriptor *q = shape(p, 2000);
+    const char *path = "check_index_lazy_shapes.idx";
+    ck_assert_int_eq(amscr_index_save(x, path), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_load_with(path, AMSCR_INDEX_LAZY, &y), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_load_with(path, 0u, &e), AMSCR_OK);
+    same_query(e, y, q, 0);
+    same_query(e, y, q, 6);
+    double a[NSHAPES], b[NSHAPES];
+    ck_assert_int_eq(amscr_index_member_scores(e, 5, 6, a, NSHAPES), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_member_scores(y, 5, 6, b, NSHAPES), AMSCR_OK);
+    for (size_t j = 0; j < NSHAPES; j++)
+        ck_assert(a[j] == b[j] || (isinf(a[j]) && isinf(b[j])));
+    const amscr_db *dy = amscr_index_db(y), *de = amscr_index_db(e);
+    ck_assert_int_eq(amscr_db_query(dy, q, NULL, NULL, a), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_query(de, q, NULL, NULL, b), AMSCR_OK);
+    ck_assert(memcmp(a, b, sizeof a) == 0);
+    const amscr_descriptor *s = amscr_db_descriptor(dy, 7), *t = amscr_db_descriptor(de, 7);
+    ck_assert_ptr_nonnull(s);
+    ck_assert(memcmp(amscr_descriptor_input_points(s), amscr_descriptor_input_points(t), 2 * 64 * sizeof(double)) == 0);
+    void *b1 = NULL, *b2 = NULL;
+    size_t l1 = 0, l2 = 0;
+    ck_assert_int_eq(amscr_index_save_memory(e, &b1, &l1), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_save_memory(y, &b2, &l2), AMSCR_OK);
+    ck_assert_uint_eq(l1, l2);
+    ck_assert(memcmp(b1, b2, l1) == 0);
+    amscr_db *more = db_of(p, 2);
+    ck_assert_int_eq(amscr_index_add(y, more, NULL, NULL), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_add(e, more, NULL, NULL), AMSCR_OK);
+    double c[NSHAPES + 2], d[NSHAPES + 2];
+    ck_assert_int_eq(amscr_index_query_scores(e, q, 0, c, NSHAPES + 2), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_query_scores(y, q, 0, d, NSHAPES + 2), AMSCR_OK);
+    ck_assert(memcmp(c, d, sizeof c) == 0);
+    amscr_db_free(more);
+    amscr_free(b1);
+    amscr_free(b2);
+    remove(path);
+    amscr_index_free(x);
+    amscr_index_free(y);
+    amscr_index_free(e);
+    amscr_descriptor_free(q);
+    amscr_params_free(p);
+}
+END_TEST
+
 /* The version 3 file of index x (no stored channel features, FNV-1a checksum) from its version 4
  * bytes b (len): the groups flag (no groups) and the features dropped. *out_len set. */
 static unsigned char *as_version3(const amscr_index *x, const unsigned char *b, size_t len, size_t *out_len)
@@ -592,6 +643,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, member_rows);
     tcase_add_test(tc, round_trips);
     tcase_add_test(tc, lazy_load);
+    tcase_add_test(tc, lazy_file_shapes);
     tcase_add_test(tc, stored_features);
     tcase_add_test(tc, bad_files);
     tcase_add_test(tc, add_shapes);
