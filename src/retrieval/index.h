@@ -122,6 +122,10 @@ amscr_status amscr__index_reverse(amscr_index *x);
 void amscr__index_reverse_free(amscr_index *x);
 /* Drops x's hold on its mapped file: the heights that point into it forgotten, x->map NULL. */
 void amscr__index_detach_map(amscr_index *x);
+/* An index file's bytes buf (len) mapped with mmap: loaded as amscr_index_load_with loads a
+ * file (AMSCR_INDEX_LAZY: the index keeps the mapping, its shapes decoded from it when needed);
+ * the mapping is the callee's either way (unmapped when not kept). */
+amscr_status amscr__index_load_mapped(unsigned char *buf, size_t len, unsigned flags, amscr_index **out);
 /* db can be indexed (closed curves for the channel, at most 2^32 - 1 shapes). */
 amscr_status amscr__index_check_db(const amscr_db *db, const char *what);
 

@@ -328,6 +328,14 @@ amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **
     return amscr_index_load_memory_with(buf, len, 0, out);
 }
 
+amscr_status amscr__index_load_mapped(unsigned char *buf, size_t len, unsigned flags, amscr_index **out)
+{
+    amscr_status st = load_memory(buf, len, flags, 1, out);
+    if (st != AMSCR_OK || !(*out)->map) /* else the index keeps the mapping */
+        amscr__file_unmap(buf, len, 1);
+    return st;
+}
+
 amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index **out)
 {
     amscr__clear_error();
@@ -342,14 +350,14 @@ amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index
     st = amscr__file_map(path, &buf, &len, &mapped);
     if (st != AMSCR_OK)
         return st;
-    st = load_memory(buf, len, flags, mapped, out);
+    st = mapped ? amscr__index_load_mapped(buf, len, flags, out) : load_memory(buf, len, flags, 0, out);
     if (st != AMSCR_OK) {
         char d[400];
         snprintf(d, sizeof d, "%s", amscr_last_error_detail());
         amscr__fail(st, "%s: %s", path, d);
     }
-    if (st != AMSCR_OK || !(*out)->map) /* else the index keeps the mapping */
-        amscr__file_unmap(buf, len, mapped);
+    if (!mapped)
+        free(buf);
     return st;
 }
 

@@ -3,13 +3,47 @@
  * features of a version 4 file too). Properties
  * on success: neighbour lists start with the shape itself and stay in range, the collection
  * loader reads the same bytes to the same collection, and the index serializes into bytes
- * that load again to the same counts. On failure: a detail. */
+ * that load again to the same counts; a lazy load of the bytes mapped (as a file's: the shapes
+ * checked, decoded when needed) succeeds or fails with the eager load, to the same collection
+ * bytes. On failure: a detail. */
+#define _DEFAULT_SOURCE /* MAP_ANONYMOUS */
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 
 #include "amscr.h"
 #include "db_io.h"
 #include "fuzz_common.h"
+#include "index.h"
+
+/* The collection file bytes of index x's collection (*len; caller frees), NULL when not saved. */
+static void *collection_bytes(const amscr_index *x, size_t *len)
+{
+    void *buf = NULL;
+    return amscr_db_save_memory(amscr_index_db(x), &buf, len) == AMSCR_OK ? buf : NULL;
+}
+
+/* data loaded lazily from a private mapping: as the eager load x (NULL: it failed). */
+static void lazy_mapped(const uint8_t *data, size_t size, const amscr_index *x)
+{
+    if (size == 0)
+        return;
+    unsigned char *m = mmap(NULL, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (m == MAP_FAILED)
+        return;
+    memcpy(m, data, size);
+    amscr_index *y = NULL;
+    amscr_status st = amscr__index_load_mapped(m, size, AMSCR_INDEX_LAZY, &y); /* the mapping is its */
+    FUZZ_CHECK((st == AMSCR_OK) == (x != NULL));
+    if (st != AMSCR_OK || !x)
+        return;
+    size_t la = 0, lb = 0;
+    void *a = collection_bytes(x, &la), *b = collection_bytes(y, &lb);
+    FUZZ_CHECK((a == NULL) == (b == NULL) && la == lb && (a == NULL || memcmp(a, b, la) == 0));
+    amscr_free(a);
+    amscr_free(b);
+    amscr_index_free(y);
+}
 
 static void one(const uint8_t *data, size_t size)
 {
@@ -17,8 +51,10 @@ static void one(const uint8_t *data, size_t size)
     amscr_status st = amscr_index_load_memory(data, size, &x);
     if (st != AMSCR_OK) {
         FUZZ_CHECK(amscr_last_error_detail()[0] != '\0');
+        lazy_mapped(data, size, NULL);
         return;
     }
+    lazy_mapped(data, size, x);
     size_t n = amscr_index_size(x);
     FUZZ_CHECK(amscr_index_neighbours(x) <= n);
     amscr_db *db = NULL;
