@@ -21,8 +21,9 @@ struct amscr_index {
     amscr__hf *hf;        /* n x nf: each shape's channel features, ready for matching (an entry
                            * with no sequences, after a lazy load: built where a pair needs it) */
     int lazy;             /* loaded with AMSCR_INDEX_LAZY: features of loaded shapes not built */
-    unsigned char *map;   /* the index file, mapped, while loaded shapes' heights point into it (a
-                           * lazy load of a file; index_io.c), else NULL */
+    unsigned char *map;   /* the index file, mapped, while loaded shapes' heights point into it and
+                           * db decodes its prepared shapes from it (a lazy load of a file;
+                           * index_io.c, db.c), else NULL */
     size_t map_len;
     uint32_t *nb_idx;     /* n x k: itself first, then by (base distance, index) */
     double *nb_dist;      /* n x k */

@@ -15,7 +15,10 @@
  * Every count is bounded by the bytes left before anything is allocated; F, N and B must be the
  * params' (any byte is a valid height). The features' spectra are not stored: a load computes
  * them from the heights (an FFT, a fifth of building the features), or, with AMSCR_INDEX_LAZY,
- * a query computes those of its candidates. A version 3 file has no features: they are
+ * a query computes those of its candidates. A lazy load of a file also leaves the prepared
+ * shapes in the mapped file (checked as a decode would, db_io.c): each is decoded when first
+ * read (a fused query's candidates, a member query, a save, an add, the collection's calls), so a
+ * channel-only query decodes none. A version 3 file has no features: they are
  * rebuilt from the shapes (index_features.c). */
 #include "db_io.h"
 #include "index.h"
