@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Runs the speed benchmark, then single registrations per stage (amscr-registration-bench), then
-(when the tool is built) the query time against a synthetic
-10,000-shape index (bench/index_bench.py; the index is built once and cached in
+(when the tool is built) the query time against synthetic
+1400- and 10,000-shape indexes (bench/index_bench.py; each index is built once and cached in
 --index-work), then (when ../shared/datasets exists) `amscr eval` on Kimia-99 and Kimia-216,
 printing the top-k tables beside the paper's rows."""
 import argparse
@@ -21,7 +21,7 @@ ap.add_argument('--registration-bench')
 ap.add_argument('--tool')
 ap.add_argument('--datasets')
 ap.add_argument('--shapes', default='1400')
-ap.add_argument('--index-shapes', default='10000', help='shapes of the synthetic index (0: skip)')
+ap.add_argument('--index-shapes', default='1400,10000', help='shapes of the synthetic indexes, comma-separated (0: skip)')
 ap.add_argument('--index-work', default=os.path.join('build', 'bench-index'))
 args, rest = ap.parse_known_args()
 

@@ -33,6 +33,7 @@
 #include <time.h>
 
 #include "affine_signature.h"
+#include "affine_warp.h"
 #include "channel.h"
 #include "mcd_set.h"
 #include "../tools/cli/collection.h"
@@ -159,42 +160,12 @@ static void set_medians(const double *sig, size_t n)
 
 /* ------------------------------------------------------------ affine copies */
 
-static double urand(unsigned long long *s)
-{
-    *s ^= *s >> 12;
-    *s ^= *s << 25;
-    *s ^= *s >> 27;
-    return (double)((*s * 2685821657736338717ull) >> 11) / 9007199254740992.0;
-}
-
-/* A random affine copy of c (mcd_set.h's distortion: any rotation, axis scales x0.5-2
- * log-uniform, shear +-0.5, Gaussian noise 0.5 % of the RMS radius). */
+/* A random affine copy of c (affine_warp.h). */
 static amscr_contour *warp(const amscr_contour *c, unsigned long long *seed)
 {
-    size_t n = amscr_contour_size(c);
-    const double *xy = amscr_contour_xy(c);
-    double th = 6.283185307179586 * urand(seed);
-    double sx = exp(log(0.5) + log(4.0) * urand(seed)), sy = exp(log(0.5) + log(4.0) * urand(seed));
-    double sh = -0.5 + urand(seed), cs = cos(th), sn = sin(th);
-    double A[4] = {cs * sx, cs * sx * sh - sn * sy, sn * sx, sn * sx * sh + cs * sy};
-    double *out = xmalloc(2 * n * sizeof *out), cx = 0, cy = 0, r = 0;
-    for (size_t i = 0; i < n; i++) {
-        out[2 * i] = A[0] * xy[2 * i] + A[1] * xy[2 * i + 1];
-        out[2 * i + 1] = A[2] * xy[2 * i] + A[3] * xy[2 * i + 1];
-        cx += out[2 * i] / (double)n;
-        cy += out[2 * i + 1] / (double)n;
-    }
-    for (size_t i = 0; i < n; i++)
-        r += ((out[2 * i] - cx) * (out[2 * i] - cx) + (out[2 * i + 1] - cy) * (out[2 * i + 1] - cy)) / (double)n;
-    r = sqrt(r);
-    for (size_t i = 0; i < 2 * n; i++) {
-        double u = urand(seed), w = urand(seed);
-        out[i] += 0.005 * r * sqrt(-2.0 * log(u > 1e-300 ? u : 1e-300)) * cos(6.283185307179586 * w);
-    }
-    amscr_contour *ct = NULL;
-    if (amscr_contour_new(out, n, &ct) != AMSCR_OK)
+    amscr_contour *ct = warp_affine(c, seed);
+    if (!ct)
         die("affine copy");
-    free(out);
     return ct;
 }
 
@@ -442,7 +413,7 @@ static void make_queries(const shape_set *s, const char *fold, char which, size_
     q->c = xmalloc(nq * sizeof *q->c);
     q->labels = xmalloc(nq * sizeof *q->labels);
     for (size_t k = 0; k < nq; k++) {
-        size_t i = pool[(size_t)(urand(&seed) * (double)np) % np];
+        size_t i = pool[(size_t)(warp_urand(&seed) * (double)np) % np];
         q->c[k] = warp(s->c[i], &seed);
         q->labels[k] = s->labels[i];
     }

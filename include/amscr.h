@@ -1417,8 +1417,9 @@ AMSCR_API int amscr_params_get_partial(const amscr_params *p);
  *        It applies when both descriptors keep their input points (amscr_descriptor_new keeps
  *        up to 4096 of them, 64 KiB, under affine invariance; descriptors in or loaded from a
  *        collection keep none), the target is closed and the invariance is affine. With the
- *        polish on, amscr_descriptor_new also drops isolated stray points of contours of 32
- *        or more points. The distance is not changed by the polish.
+ *        polish and the "despike" stage on (amscr_params_set_stage; opt-in since 0.5),
+ *        amscr_descriptor_new also drops isolated stray points of contours of 32 or more
+ *        points. The distance is not changed by the polish.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -1434,6 +1435,33 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_polish(amscr_params *p, 
  * @since 0.3
  */
 AMSCR_API int amscr_params_get_polish(const amscr_params *p);
+
+/**
+ * @brief Switches an optional stage of amscr_register on or off by name: "despike" (stray
+ *        points dropped when a shape is prepared with the polish on), "recovery" (fragments
+ *        placed as further starts when part of the target is missing), "polish" (as
+ *        amscr_params_set_polish; both must be on), "order" and "even_spacing" (the polish's
+ *        steps on markedly noisy points). Default in every preset: recovery and polish on;
+ *        despike, order and even_spacing off (opt-in since 0.5: they changed no map of the
+ *        traced-image benchmark; they help point lists with stray points or synthetic noise,
+ *        docs/results-registration.md). A stage switched on still runs only when its
+ *        condition holds (amscr_result_stage).
+ * @param on  1 on, 0 off.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, unknown or mandatory stage, on not 0 or 1).
+ * Ownership: none.
+ * Thread-safety: exclusive on p.
+ * @since 0.5
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_stage(amscr_params *p, const char *name, int on);
+
+/**
+ * @brief Whether the optional stage `name` is on (see amscr_params_set_stage).
+ * @return 1 on, 0 off; -1 for NULL or a name that is not a switchable stage.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.5
+ */
+AMSCR_API int amscr_params_get_stage(const amscr_params *p, const char *name);
 
 /* ------------------------------------------------------------- batch calls */
 
@@ -1949,6 +1977,69 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_correspondences(const amscr_
                                                                     double *out_param, double *out_tgt_xy,
                                                                     size_t *inout_n);
 
+/**
+ * @brief The number of stages of amscr_register's pipeline (the same for every result): in
+ *        order despike, search, method, recovery, final_solve, symmetric, polish, order,
+ *        even_spacing, alternatives, correspondences (docs/method.md §12). New stages may be
+ *        added in later versions; read them by index with amscr_result_stage.
+ * @return the count; 0 for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.5
+ */
+AMSCR_API size_t amscr_result_num_stages(const amscr_result *r);
+
+/**
+ * @brief Stage i of the pipeline (0 .. amscr_result_num_stages - 1, in pipeline order): its
+ *        name and whether it ran for this result (its condition held: e.g. the recovery only
+ *        when many source samples found no target boundary near them, the order and
+ *        even-spacing steps only on markedly noisy points, a switched-off stage never;
+ *        amscr_params_set_stage). despike ran when either shape was prepared with it.
+ * @param[out] out_name  the stage's name, a static string owned by the library (may be NULL).
+ * @param[out] out_ran   1 when it ran, else 0 (may be NULL).
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL r, i out of range).
+ * Ownership: *out_name is the library's, valid for the process's lifetime.
+ * Thread-safety: const.
+ * @since 0.5
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_stage(const amscr_result *r, size_t i, const char **out_name,
+                                                          int *out_ran);
+
+/**
+ * @brief How many distinct maps fit about as well as the chosen one, the chosen one included
+ *        (at least 1). Symmetric shapes have several: a square's quarter turns, a triangle's
+ *        thirds. Alternative 0 is always the reported map (amscr_result_affine). Another map
+ *        is listed when it moves the source samples by more than 10 % of the shape's RMS
+ *        radius (RMS) from the chosen one and from every map listed before, and its ranking
+ *        cost c satisfies (c0 + f) / (c + f) >= 0.75 (c0 the chosen map's cost, f the
+ *        ambiguity's floor): then amscr_result_ambiguity >= 0.75 and the confidence is at
+ *        most 0.25. The maps come from the registration's ranking of its start points (with
+ *        refinement; the polish's re-ranking when it re-ranked): without refinement, for a
+ *        partial match, or when the recovery replaced the ranked winner, only the chosen map
+ *        is listed.
+ * @return the count; 0 for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.5
+ */
+AMSCR_API size_t amscr_result_num_alternatives(const amscr_result *r);
+
+/**
+ * @brief Alternative i (0 .. amscr_result_num_alternatives - 1, by ascending cost after the
+ *        chosen map): the map in input coordinates, like amscr_result_affine, and its ranking
+ *        cost (the trimmed closest-point cost in the normalized frames after a few refinement
+ *        or polish steps; costs compare within one result only; NaN for alternative 0 when
+ *        no ranking describes the reported map).
+ * @param[out] out_m6    {a11, a12, b1, a21, a22, b2} (may be NULL).
+ * @param[out] out_cost  the ranking cost (may be NULL).
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL r, i out of range).
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.5
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_alternative(const amscr_result *r, size_t i, double out_m6[6],
+                                                                double *out_cost);
+
 /* ============================================================================
  * Registration
  * ============================================================================ */
@@ -2392,8 +2483,10 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_set_group(amscr_index *x, siz
 AMSCR_API const char *amscr_index_group(const amscr_index *x, size_t i);
 
 /**
- * @brief Writes the index (the collection file format, version 3: amscr_db_load of it gives the
- *        collection) to a temporary name in the same folder and renames it.
+ * @brief Writes the index (the collection file format, version 4 since 0.5, 3 in 0.4:
+ *        amscr_db_load of it gives the collection; version 4 also stores each shape's channel
+ *        features, so a load does not rebuild them) to a temporary name in the same folder and
+ *        renames it.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none. Thread-safety: const.
  * @since 0.4
@@ -2411,9 +2504,11 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_save_memory(const amscr_index
                                                                size_t *out_len);
 
 /**
- * @brief Reads an index file. A collection file without an index (amscr_db_save) and the
- *        index files of the tool before 0.4 are AMSCR_E_FORMAT with a detail saying to build
- *        the index again.
+ * @brief Reads an index file (mapped read-only while it is read, where the system can map
+ *        it: replace an index file by renaming, as amscr_index_save does, not by rewriting it
+ *        in place). Index files of format 3 (0.4) load too, their channel features built from
+ *        the shapes. A collection file without an index (amscr_db_save) and the index files of
+ *        the tool before 0.4 are AMSCR_E_FORMAT with a detail saying to build the index again.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_LIMIT; AMSCR_E_FORMAT (wrong
  *         magic, version, checksum, truncated or inconsistent content); AMSCR_E_NOMEM.
  * Ownership: caller frees *out with amscr_index_free.
@@ -2431,10 +2526,11 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load(const char *path, amscr_
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out);
 
-/** Load flag: the shapes' channel features are not computed at load; each query computes those
- *  of the candidates it matches (for one or a few queries a load, e.g. a command-line search);
- *  without it a load computes every shape's once, on the params' threads (for many queries).
- *  Scores are the same either way. @since 0.4 */
+/** Load flag: the shapes' channel features are not made ready at load (format 4: their
+ *  spectra, from the stored heights; format 3: the features); each query computes those of the
+ *  candidates it matches (for one or a few queries a load, e.g. a command-line search); without
+ *  it a load computes every shape's once, on the params' threads (for many queries). Scores are
+ *  the same either way. @since 0.4 */
 #define AMSCR_INDEX_LAZY 1u
 
 /**

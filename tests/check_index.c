@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "db_io.h"
 #include "index.h"
 #include "suites.h"
 #include "testutil.h"
@@ -175,6 +176,103 @@ START_TEST(lazy_load)
     amscr_free(buf);
     amscr_index_free(x);
     amscr_index_free(y);
+    amscr_descriptor_free(q);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* The version 3 file of index x (no stored channel features, FNV-1a checksum) from its version 4
+ * bytes b (len): the groups flag (no groups) and the features dropped. *out_len set. */
+static unsigned char *as_version3(const amscr_index *x, const unsigned char *b, size_t len, size_t *out_len)
+{
+    void *dbuf = NULL;
+    size_t dlen = 0, n = amscr_index_size(x);
+    ck_assert_int_eq(amscr_db_save_memory(amscr_index_db(x), &dbuf, &dlen), AMSCR_OK);
+    amscr_free(dbuf);
+    size_t feat = 12 + n * (size_t)x->nf * 2 * 64 * AMSCR__HF_BINS, keep = len - 8 - feat - 4, at = dlen - 8;
+    unsigned char *o = malloc(keep + 8);
+    memcpy(o, b, keep);
+    o[8] = 3;
+    uint64_t sec = 0;
+    for (int i = 0; i < 8; i++)
+        sec |= (uint64_t)o[at + (size_t)i] << (8 * i);
+    sec -= feat + 4;
+    for (int i = 0; i < 8; i++)
+        o[at + (size_t)i] = (unsigned char)(sec >> (8 * i));
+    uint64_t h = amscr__db_checksum(3, o, keep);
+    for (int i = 0; i < 8; i++)
+        o[keep + (size_t)i] = (unsigned char)(h >> (8 * i));
+    *out_len = keep + 8;
+    return o;
+}
+
+/* Format 4 stores the channel features' heights; a version 3 file (without them, rebuilt at
+ * load) still loads, eagerly and lazily, to the same scores; features of other dimensions are
+ * refused with a detail. */
+START_TEST(stored_features)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_index *x = named_index(p, 0), *y = NULL;
+    amscr_descriptor *q = shape(p, 2000);
+    void *buf = NULL;
+    size_t len = 0, l3 = 0;
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    ck_assert_int_eq(((unsigned char *)buf)[8], 4);
+    ck_assert_int_eq(x->nf, 2);
+    unsigned char *v3 = as_version3(x, buf, len, &l3);
+    for (unsigned lazy = 0; lazy < 2; lazy++) {
+        ck_assert_int_eq(amscr_index_load_memory_with(v3, l3, lazy ? AMSCR_INDEX_LAZY : 0u, &y), AMSCR_OK);
+        same_query(x, y, q, 0);
+        same_query(x, y, q, 6);
+        ck_assert_str_eq(amscr_index_name(y, 3), "three.png");
+        amscr_index_free(y);
+        y = NULL;
+        ck_assert_int_eq(amscr_index_load_memory_with(buf, len, lazy ? AMSCR_INDEX_LAZY : 0u, &y), AMSCR_OK);
+        ck_assert_ptr_nonnull(y->hf[0].seq[0]);
+        ck_assert(lazy ? y->hf[0].spec[0] == NULL : y->hf[0].spec[0] != NULL);
+        same_query(x, y, q, 0);
+        same_query(x, y, q, 6);
+        amscr_index_free(y);
+        y = NULL;
+    }
+    /* a lazily loaded index saves the heights it did not build: the same bytes */
+    void *b2 = NULL;
+    size_t len2 = 0;
+    ck_assert_int_eq(amscr_index_load_memory_with(v3, l3, AMSCR_INDEX_LAZY, &y), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_save_memory(y, &b2, &len2), AMSCR_OK);
+    ck_assert_uint_eq(len2, len);
+    ck_assert(memcmp(b2, buf, len) == 0);
+    amscr_index_free(y);
+    y = NULL;
+    /* a lazy load of a file reads the heights in place from the mapped file: the same scores,
+     * the same bytes saved */
+    const char *path = "check_index_features.idx";
+    ck_assert_int_eq(amscr_index_save(x, path), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_load_with(path, AMSCR_INDEX_LAZY, &y), AMSCR_OK);
+    same_query(x, y, q, 0);
+    same_query(x, y, q, 6);
+    amscr_free(b2);
+    ck_assert_int_eq(amscr_index_save_memory(y, &b2, &len2), AMSCR_OK);
+    ck_assert_uint_eq(len2, len);
+    ck_assert(memcmp(b2, buf, len) == 0);
+    amscr_index_free(y);
+    y = NULL;
+    remove(path);
+    /* two frames announced as one: refused */
+    unsigned char *b = buf;
+    size_t at = len - 8 - (12 + NSHAPES * 2 * 2 * 64 * AMSCR__HF_BINS);
+    ck_assert_int_eq(b[at], 2);
+    b[at] = 1;
+    uint64_t h = amscr__db_checksum(4, b, len - 8);
+    for (int i = 0; i < 8; i++)
+        b[len - 8 + (size_t)i] = (unsigned char)(h >> (8 * i));
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "channel features") != NULL);
+    ck_assert_ptr_null(y);
+    free(v3);
+    amscr_free(b2);
+    amscr_free(buf);
+    amscr_index_free(x);
     amscr_descriptor_free(q);
     amscr_params_free(p);
 }
@@ -494,6 +592,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, member_rows);
     tcase_add_test(tc, round_trips);
     tcase_add_test(tc, lazy_load);
+    tcase_add_test(tc, stored_features);
     tcase_add_test(tc, bad_files);
     tcase_add_test(tc, add_shapes);
     tcase_add_test(tc, thread_independence);

@@ -33,5 +33,6 @@ Suite *amscr_suite_index(void);
 Suite *amscr_suite_signature(void);
 Suite *amscr_suite_protocols(void);
 Suite *amscr_suite_subpixel(void);
+Suite *amscr_suite_stages(void);
 
 #endif

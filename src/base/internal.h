@@ -67,6 +67,8 @@ struct amscr_params {
     int partial;
     /* polish the reported map on the input points (polish.c) */
     int polish;
+    /* switchable stages of amscr_register turned off (AMSCR__STAGE_BIT; register/stages.c) */
+    unsigned stages_off;
     /* retrieval (0.2, channel.c / fuse.c) */
     double channel_weight;             /* share of the shape channel in the fused distance, 0..1 */
     amscr_invariance channel_invariance; /* frame of the shape channel (affine or similarity) */
@@ -78,6 +80,27 @@ struct amscr_params {
     unsigned rerank_iterations;
 };
 
+/* The stages of amscr_register in pipeline order (register/stages.c holds the table). */
+enum {
+    AMSCR__STAGE_DESPIKE,
+    AMSCR__STAGE_SEARCH,
+    AMSCR__STAGE_METHOD,
+    AMSCR__STAGE_RECOVERY,
+    AMSCR__STAGE_FINAL_SOLVE,
+    AMSCR__STAGE_SYMMETRIC,
+    AMSCR__STAGE_POLISH,
+    AMSCR__STAGE_ORDER,
+    AMSCR__STAGE_EVEN,
+    AMSCR__STAGE_ALTERNATIVES,
+    AMSCR__STAGE_CORRESPOND,
+    AMSCR__NUM_STAGES
+};
+/* The bit of stage i in params->stages_off. */
+#define AMSCR__STAGE_BIT(i) (1u << (unsigned)(i))
+/* Whether params p leave switchable stage i on. */
+#define AMSCR__STAGE_ON(p, i) (!((p)->stages_off & AMSCR__STAGE_BIT(i)))
+/* Index of the switchable stage called name, or -1 (register/stages.c). */
+int amscr__stage_switch(const char *name);
 
 /* ---- geometry internals (contour.c, smooth.c, resample.c, affine.c) ---- */
 double amscr__signed_area(const double *xy, size_t n);

@@ -42,6 +42,12 @@ void amscr__params_defaults(amscr_params *p)
     p->num_threads = 0;
     p->invariance = AMSCR_INVARIANCE_AFFINE;
     p->penalty = 0.5;
+    /* Opt-in stages (amscr_params_set_stage): despike, order and even_spacing changed no map of
+     * the 216 traced pairs of fold A of bench/registration_traced.py (either tracer; fold B
+     * confirmed it), which chose this; they help point lists with stray points or synthetic
+     * noise (docs/results-registration.md, "0.5: the pipeline as stages"). */
+    p->stages_off = AMSCR__STAGE_BIT(AMSCR__STAGE_DESPIKE) | AMSCR__STAGE_BIT(AMSCR__STAGE_ORDER) |
+                    AMSCR__STAGE_BIT(AMSCR__STAGE_EVEN);
     retrieval_defaults(p);
 }
 
@@ -202,4 +208,30 @@ amscr_status amscr_params_get_scales(const amscr_params *p, double *out_sigmas, 
     }
     *inout_n = p->num_scales;
     return AMSCR_OK;
+}
+
+/* ---- switchable stages of amscr_register (register/stages.c) ---- */
+amscr_status amscr_params_set_stage(amscr_params *p, const char *name, int on)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(p);
+    AMSCR_CHECK_NULL(name);
+    int i = amscr__stage_switch(name);
+    if (i < 0)
+        return amscr__fail(AMSCR_E_INVALID_ARG,
+                           "amscr_params_set_stage: '%s' is not a switchable stage (despike, recovery, polish, "
+                           "order, even_spacing)", name);
+    if (on != 0 && on != 1)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_params_set_stage: %d is not 0 or 1", on);
+    if (on)
+        p->stages_off &= ~AMSCR__STAGE_BIT(i);
+    else
+        p->stages_off |= AMSCR__STAGE_BIT(i);
+    return AMSCR_OK;
+}
+
+int amscr_params_get_stage(const amscr_params *p, const char *name)
+{
+    int i = p ? amscr__stage_switch(name) : -1;
+    return i < 0 ? -1 : AMSCR__STAGE_ON(p, i);
 }

@@ -72,6 +72,7 @@ typedef struct {
     double dir;   /* +1: b runs with a's order, -1 against */
     double *cum;  /* na + 1 arc lengths of the moved a */
     double *grad; /* 4 (na + 1): their derivatives by the map's linear part (Y0 Y1 Y3 Y4) */
+    int nomem;    /* an allocation failed */
 } even_t;
 
 /* The moved length of a's edge k under the linear part of x; into d (when not NULL) its
@@ -314,13 +315,16 @@ static double start_places(even_t *e, const double Y[6], double x[EVEN_NP])
     amscr__grid g = {0};
     memcpy(x, Y, 6 * sizeof *x);
     double L = moved_cum(e, x, 0);
+    e->nomem = !p || !k;
     int ok = p && k && L > 0.0;
     for (size_t j = 0, s = 0; ok && j < K; j++) {
         s = locate(e, L, (double)j / (double)K, s, &f);
         edge_point(e, s, f, q);
         p[2 * j] = Y[0] * q[0] + Y[1] * q[1] + Y[2], p[2 * j + 1] = Y[3] * q[0] + Y[4] * q[1] + Y[5];
     }
-    ok = ok && amscr__grid_build(&g, p, K);
+    int built = ok ? amscr__grid_build(&g, p, K) : 0;
+    e->nomem = e->nomem || built < 0;
+    ok = built > 0;
     for (size_t i = 0; ok && i < nb; i++) {
         k[i] = (long)amscr__grid_nearest(&g, p, e->b[2 * i], e->b[2 * i + 1], &one);
         d2 += one / (double)nb;
@@ -332,12 +336,13 @@ static double start_places(even_t *e, const double Y[6], double x[EVEN_NP])
     return ok && isfinite(d2) ? d2 : INFINITY;
 }
 
-/* Whether b's points scatter across the curve by EVEN_MIN_SCATTER of their spacing. */
+/* Whether b's points scatter across the curve by EVEN_MIN_SCATTER of their spacing (-1: out of
+ * memory). */
 static int scattered(const double *b, size_t nb, double rough_b)
 {
     double *scratch = amscr__malloc_array(nb, sizeof *scratch);
     if (!scratch)
-        return 0;
+        return -1;
     double spacing = amscr__median_edge(b, nb, 1, scratch);
     free(scratch);
     return sqrt(rough_b) >= EVEN_MIN_SCATTER * spacing;
@@ -385,14 +390,21 @@ static double fit_from_starts(const even_t *e, double x[EVEN_NP], double best[EV
 
 int amscr__even_fit(const double *a, size_t na, const double *b, size_t nb, double rough_b, double Y[6])
 {
-    if (na < 3 || nb < EVEN_MIN_POINTS || !(rough_b > 0.0) || !scattered(b, nb, rough_b))
+    if (na < 3 || nb < EVEN_MIN_POINTS || !(rough_b > 0.0))
         return 0;
+    int sc = scattered(b, nb, rough_b);
+    if (sc <= 0)
+        return sc;
     even_t e = {.a = a, .b = b, .na = na, .nb = nb};
     double *block = amscr__malloc_array(5 * (na + 1) + nb, sizeof *block), x[EVEN_NP], best[EVEN_NP];
     if (!block)
-        return 0;
+        return -1;
     e.cum = block, e.grad = block + na + 1;
     double d2 = start_places(&e, Y, x);
+    if (e.nomem) {
+        free(block);
+        return -1;
+    }
     double low = d2 <= EVEN_MAX_FIT * rough_b ? fit_from_starts(&e, x, best) : INFINITY;
     int white = low < INFINITY && along_kuiper(&e, best, block + 5 * (na + 1)) <= EVEN_MAX_KUIPER;
     free(block);

@@ -15,7 +15,7 @@
  * curve (even sampling leaves twice that: the noise's along-curve half joins its across-curve
  * half; uneven sampling many times more), and their residuals along the curve white (Kuiper's
  * test). Returns 1 when Y was refined, 0 when it was left as given (outside that regime, too few
- * points, out of memory, a degenerate or area-changing result). */
+ * points, a degenerate or area-changing result), -1 when out of memory (Y as given). */
 int amscr__even_fit(const double *a, size_t na, const double *b, size_t nb, double rough_b, double Y[6]);
 
 #endif

@@ -3,6 +3,8 @@
  *   shape/descriptor.c  (per shape, once) validate, orient, parametrize, sample, whiten, smooth
  *   shape/despike.c     (per shape, once) isolated stray points dropped before parametrizing
  *   register.c          the public entry points: check the pair, run the stages below, top-down
+ *   stages.c            the stage table of amscr_register: each stage's name, function and
+ *                       when it runs, in pipeline order (the list below and amscr_result_stage)
  *   shift_search.c      spectral start-point search: candidates and their one ranking rule
  *   method.c            the method at one start point: per-scale solves, residuals, stacked solve
  *   scale_select.c      which scales enter the stacked solve (all, finest, EM + Bayes threshold)
@@ -15,6 +17,7 @@
  *   nearest.c           closest points on the input polylines, for the polish (nearest.h)
  *   ordered.c           the polish's order stage: a noisy curve's point order (ordered.h)
  *   even.c              the polish's even-spacing stage: points taken evenly along it (even.h)
+ *   alternatives.c      the distinct maps that fit about as well as the chosen one
  *   correspond.c        confidence, inliers, the part covered, dense correspondences
  *   result.c            the result object and its getters
  * and base/workspace.c, the caller-owned scratch of all of the above. */
@@ -95,7 +98,15 @@ typedef struct {
     /* the search's scored start candidates (registration with refinement; else ncand 0) */
     double cand[2 * AMSCR__CANDIDATES][6];
     size_t ncand;
+    /* the last ranking of distinct starts (the search's, or the polish's when it re-ranked):
+     * their maps (normalized frames), their ranking costs and the winner (nrank 0: none) */
+    double rank_X[1 + 2 * AMSCR__CANDIDATES][6];
+    double rank_cost[1 + 2 * AMSCR__CANDIDATES];
+    size_t nrank, rank_best;
 } match_t;
+
+/* Most maps a result lists as alternatives: the chosen one and every distinct ranked start. */
+#define AMSCR__MAX_ALTERNATIVES (1 + 2 * AMSCR__CANDIDATES)
 
 struct amscr_result {
     amscr_method method;
@@ -107,6 +118,11 @@ struct amscr_result {
     double *corr;  /* 5n: source xy (input), target parameter, target xy (input) */
     double inlier; /* inlier fraction */
     double part[2];
+    unsigned char ran[AMSCR__NUM_STAGES]; /* which stages ran (stages.c) */
+    /* the distinct maps that fit about as well (alternatives.c), input coordinates; 0 the chosen */
+    double alt[AMSCR__MAX_ALTERNATIVES][6];
+    double alt_cost[AMSCR__MAX_ALTERNATIVES];
+    size_t nalt;
 };
 
 /* ---- workspace.c ---- */
@@ -151,6 +167,22 @@ void amscr__spectral_prepare(const amscr_descriptor *f, const amscr_descriptor *
 /* Cross sums R_0 (unsmoothed) .. R_p (scale k) at the continuous shift s from ws->P. */
 void amscr__spectral_cross_sums(const amscr_descriptor *f, const amscr_descriptor *h, double s, amscr_workspace *ws,
                                 double R[][6]);
+/* The start-point search's outcome: the candidates, their scores and the winner. */
+typedef struct {
+    double s[2 * AMSCR__CANDIDATES]; /* continuous shift */
+    int o[2 * AMSCR__CANDIDATES];    /* orientation */
+    double X[2 * AMSCR__CANDIDATES][6], score[2 * AMSCR__CANDIDATES];
+    size_t count, best;
+    int kind;       /* how the candidates were scored (shift_search.c) */
+    int prepared_o; /* the orientation whose spectra ws->P holds */
+} amscr__search;
+/* The start-point search of f -> h: every candidate scored by one ranking rule into *s. */
+amscr_status amscr__search_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                  amscr_workspace *ws, amscr__search *s);
+/* The method and its whole refinement at the search's winner into m (with the ambiguity and
+ * the ranked candidates). */
+amscr_status amscr__method_at(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                              amscr_workspace *ws, amscr__search *s, match_t *m);
 /* The best start point of f -> h (one ranking rule), run through the method and refined. */
 amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                               amscr_workspace *ws, match_t *m);
@@ -188,6 +220,10 @@ int amscr__plane_solve(const amscr_params *prm, const double *f, const double *q
  * target boundary near them (part of the target missing): fragments of the source placed by
  * partial matching as further starts, ranked by a two-way trimmed cost; ws->rbuf keeps the
  * winner's pairs. */
+/* recover.c: whether m leaves enough source samples without a target boundary near them for
+ * amscr__recover_missing to look further. */
+int amscr__recover_applies(const amscr_descriptor *f, const amscr_descriptor *h, const amscr_workspace *ws,
+                           const match_t *m);
 amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                     amscr_workspace *ws, match_t *m);
 /* recover.c: the adaptive trimmed closest-point refinement of m (global partners first) on a
@@ -215,9 +251,35 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
 /* polish.c: m's map polished on the input points the descriptors kept (f->raw, h->raw; a closed
  * target, affine invariance): the chosen map and the search's other distinct candidates,
  * point-to-line both ways weighted by each curve's measured noise (partial: f an open fragment,
- * its points alone), ranked by a two-way trimmed cost; m->X and m->ambiguity updated when a
- * polished map wins. */
-amscr_status amscr__polish(const amscr_descriptor *f, const amscr_descriptor *h, int partial, match_t *m);
+ * its points alone), ranked by a two-way trimmed cost; m->X, m->ambiguity and the ranking
+ * (m->rank_*) updated when a polished map wins. *out: the polish's state for its order and
+ * even-spacing steps (NULL when the fit did not finish; amscr__polish_end frees it). */
+typedef struct amscr__polish_state amscr__polish_state;
+amscr_status amscr__polish_fit(const amscr_descriptor *f, const amscr_descriptor *h, int partial, match_t *m,
+                               amscr__polish_state **out);
+/* Whether the order and even-spacing steps apply to the polished map (markedly noisier points,
+ * no gap, not partial). */
+int amscr__polish_steps_apply(const amscr__polish_state *w);
+/* The polished map refined by the order of the noisier curve's points (ordered.c), into m->X. */
+amscr_status amscr__polish_order(amscr__polish_state *w, match_t *m);
+/* The polished map refined by the even spacing of those points (even.c), into m->X. */
+amscr_status amscr__polish_even(amscr__polish_state *w, match_t *m);
+void amscr__polish_end(amscr__polish_state *w);
+
+/* stages.c: the stages of amscr_register on the checked pair, in pipeline order, into r (r->m,
+ * r->ran). The caller fills the result's maps afterwards. */
+amscr_status amscr__run_stages(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                               amscr_workspace *ws, amscr_result *r);
+/* The name of stage i (< AMSCR__NUM_STAGES). */
+const char *amscr__stage_name(size_t i);
+
+/* alternatives.c: the result's alternatives (r->alt*, input coordinates) from the last ranking
+ * of r->m: the chosen map first, then each distinct ranked map about as good, best first. */
+void amscr__alternatives(const amscr_descriptor *f, const amscr_descriptor *h, amscr_result *r);
+/* A ranked map whose (cost + floor) is within this factor of the chosen one's is "about as
+ * good": listing one means an ambiguity of at least AMSCR__ALT_RATIO, so the confidence is at
+ * most 1 - AMSCR__ALT_RATIO = 0.25, the benchmarks' limit of a confident answer. */
+#define AMSCR__ALT_RATIO 0.75
 
 /* correspond.c: the dense correspondences, inlier fraction and part of a finished result r of
  * f -> h (fills r->corr, r->ncorr, r->inlier, r->part). */

@@ -22,7 +22,8 @@ void amscr__grid_free(amscr__grid *g)
 }
 
 /* Cells about as wide as sqrt(area / n), and never so narrow that a thin set spreads over more
- * than about 3n cells: a few points per occupied cell of a curve. Returns 0 for non-finite points. */
+ * than about 3n cells: a few points per occupied cell of a curve. Returns 0 for non-finite points,
+ * -1 when out of memory. */
 int amscr__grid_build(amscr__grid *g, const double *p, size_t n)
 {
     double lo[2] = {p[0], p[1]}, hi[2] = {p[0], p[1]};
@@ -46,7 +47,7 @@ int amscr__grid_build(amscr__grid *g, const double *p, size_t n)
     g->start = amscr__malloc_array((size_t)(g->nx * g->ny) + 1, sizeof *g->start);
     g->item = amscr__malloc_array(n, sizeof *g->item);
     if (!g->start || !g->item)
-        return 0;
+        return -1;
     memset(g->start, 0, ((size_t)(g->nx * g->ny) + 1) * sizeof *g->start);
     for (size_t i = 0; i < n; i++) {
         long cx = (long)((p[2 * i] - g->x0) * g->inv), cy = (long)((p[2 * i + 1] - g->y0) * g->inv);

@@ -13,8 +13,8 @@ typedef struct {
     size_t *start, *item; /* nx*ny + 1 offsets, n point indices */
 } amscr__grid;
 
-/* (Re)builds g over the n points p (2n), cells about sqrt(area / n) wide. Returns 0 when out of
- * memory or a point is not finite. amscr__grid_free releases; a zeroed grid is empty. */
+/* (Re)builds g over the n points p (2n), cells about sqrt(area / n) wide. Returns 1; 0 when a
+ * point is not finite; -1 when out of memory. amscr__grid_free releases; a zeroed grid is empty. */
 int amscr__grid_build(amscr__grid *g, const double *p, size_t n);
 void amscr__grid_free(amscr__grid *g);
 /* Index of the point of g's set p nearest to (qx, qy) (finite); *d2 its squared distance. */

@@ -84,6 +84,7 @@ typedef struct {
     int reversed;     /* the states run against a's order */
     amscr__grid g;
     double *block;
+    int nomem; /* an allocation failed */
 } order_t;
 
 static void order_free(order_t *o)
@@ -174,7 +175,9 @@ static int first_bands(order_t *o)
 {
     long K = (long)o->K;
     double s2 = 0.0, d2;
-    if (!amscr__grid_build(&o->g, o->sp, o->K))
+    int g = amscr__grid_build(&o->g, o->sp, o->K);
+    o->nomem = g < 0;
+    if (g <= 0)
         return 0;
     for (size_t i = 0; i < o->nb; i++) {
         o->c[i] = (long)amscr__grid_nearest(&o->g, o->sp, o->b[2 * i], o->b[2 * i + 1], &d2);
@@ -495,7 +498,7 @@ int amscr__ordered_fit(const double *a, size_t na, const double *b, size_t nb, d
     order_t o = {.a = a, .b = b, .na = na, .nb = nb, .K = ORDER_STATES * nb};
     double *scratch = amscr__malloc_array(nb, sizeof *scratch), sigma = sqrt(rough_b), Z[6];
     if (!scratch)
-        return 0;
+        return -1;
     double spacing = amscr__median_edge(b, nb, 1, scratch), speed = measured_speed(b, nb, scratch);
     free(scratch);
     o.S = (size_t)ceil(speed * ORDER_STATES);
@@ -504,12 +507,16 @@ int amscr__ordered_fit(const double *a, size_t na, const double *b, size_t nb, d
     memcpy(Z, Y, sizeof Z);
     double L = moved_length(a, na, Z);
     o.W = L > 0.0 && isfinite(L) ? band_width(sigma, L / (double)o.K, o.S) : 0;
-    if (o.W == 0 || o.W > o.K || !order_alloc(&o)) {
-        order_free(&o);
+    if (o.W == 0 || o.W > o.K)
         return 0;
+    if (!order_alloc(&o)) {
+        order_free(&o);
+        return -1;
     }
     int ok = accelerated_em(&o, Z);
     order_free(&o);
+    if (o.nomem)
+        return -1;
     if (!ok || rms_move(a, na, Y, Z) > ORDER_MAX_MOVE * sigma)
         return 0;
     memcpy(Y, Z, sizeof Z);

@@ -10,7 +10,7 @@
  * coordinate. Runs only where it helps: the points scatter across the curve by at least
  * ORDER_MIN_SCATTER of their spacing (else their closest points already say where along the
  * curve each was taken). Returns 1 when Y was refined, 0 when it was left as given (outside that
- * regime, out of memory, or a result that moved too far to trust). */
+ * regime, or a result that moved too far to trust), -1 when out of memory (Y as given). */
 int amscr__ordered_fit(const double *a, size_t na, const double *b, size_t nb, double rough_b, double Y[6]);
 
 #endif

@@ -95,6 +95,7 @@ typedef struct {
     double wb, wa;   /* weights: b's points onto the moved a, and the moved a's points onto b */
     int partial;     /* a is an open fragment of the closed b: only its points are paired */
     amscr__grid gb, gm; /* grids over b and over the moved a */
+    int nomem;          /* an allocation failed (the registration reports it) */
     double *block;
     size_t *iblock;
 } polish_t;
@@ -254,7 +255,9 @@ static int pair_all(polish_t *w, const double Y[6], int global)
     }
     if (!w->partial) { /* b's points onto the moved a */
         amscr__edge_normals(w->moved, a->n, w->a->en);
-        if (global && !amscr__grid_build(&w->gm, w->moved, a->n))
+        int g = global ? amscr__grid_build(&w->gm, w->moved, a->n) : 1;
+        w->nomem = w->nomem || g < 0;
+        if (g <= 0)
             return 0;
         pair_side(w->b->p, w->b->n, w->moved, w->a, &w->gm, global, w->b);
     }
@@ -381,7 +384,8 @@ static double polish_one(polish_t *w, double Y[6], int iters)
 }
 
 /* Loads both curves, measures their noise, picks the moved curve (the smoother, in the target's
- * units under X) and the weights; builds the grid of the other. Returns 0 when it cannot. */
+ * units under X) and the weights; builds the grid of the other. Returns 1, 0 when it cannot,
+ * -1 when out of memory. */
 static int polish_prepare(polish_t *w, const amscr_descriptor *f, const amscr_descriptor *h, const double X[6],
                           int partial)
 {
@@ -417,16 +421,6 @@ static int has_gap(const curve_t *c)
     return 0;
 }
 
-/* The polished Y refined by the order of b's points, where that applies (ORDER_NOISIER), then
- * by their even spacing where the points bear that out (even.c). */
-static void order_refine(const polish_t *w, double Y[6])
-{
-    if (w->partial || w->wb < ORDER_NOISIER * w->wa || has_gap(w->a) || has_gap(w->b))
-        return;
-    amscr__ordered_fit(w->a->p, w->a->n, w->b->p, w->b->n, w->b->rough, Y);
-    amscr__even_fit(w->a->p, w->a->n, w->b->p, w->b->n, w->b->rough, Y);
-}
-
 /* The start maps: the chosen one first, then — when the search could not tell its candidates
  * apart (ambiguity at least AMBIGUOUS_SEARCH) — each candidate that differs from all before. */
 static size_t polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6])
@@ -459,32 +453,116 @@ static double polished_ambiguity(const amscr_descriptor *f, double S[][6], const
     return amb;
 }
 
-amscr_status amscr__polish(const amscr_descriptor *f, const amscr_descriptor *h, int partial, match_t *m)
-{
+/* The polish between its fit and its order and even-spacing steps. */
+struct amscr__polish_state {
     polish_t w;
-    amscr_status st = polish_alloc(f->nraw, h->nraw, &w);
-    if (st != AMSCR_OK)
+    const amscr_descriptor *f, *h;
+    double Y[6]; /* the polished map, a -> b in the curves' frames */
+};
+
+/* The re-ranked starts as the match's ranking (the alternatives read it). */
+static void keep_ranking(double S[][6], const double *cost, size_t count, size_t best, match_t *m)
+{
+    m->nrank = count;
+    m->rank_best = best;
+    memcpy(m->rank_X, S, count * sizeof S[0]);
+    memcpy(m->rank_cost, cost, count * sizeof *cost);
+}
+
+/* Every start a few steps, ranked; the index of the best (count when none finished). */
+static size_t rank_starts(amscr__polish_state *ps, double S[][6], double Y[][6], double *cost, size_t count)
+{
+    size_t best = count;
+    for (size_t k = 0; k < count; k++) {
+        to_frames(&ps->w, ps->f, ps->h, S[k], Y[k]);
+        cost[k] = polish_one(&ps->w, Y[k], SCORE_ITERS);
+        from_frames(&ps->w, ps->f, ps->h, Y[k], S[k]);
+        if (cost[k] < (best < count ? cost[best] : INFINITY))
+            best = k;
+    }
+    return best;
+}
+
+/* Polishes the winner on; returns whether it finished (ps->Y then holds it). */
+static int polish_winner(amscr__polish_state *ps, double S[][6], double Y[][6], const double *cost, size_t count,
+                         size_t best, match_t *m)
+{
+    if (count > 1) {
+        m->ambiguity = polished_ambiguity(ps->f, S, cost, count, best);
+        keep_ranking(S, cost, count, best, m);
+    }
+    int done = polish_one(&ps->w, Y[best], POLISH_ITERS - SCORE_ITERS) < INFINITY;
+    if (done) {
+        memcpy(ps->Y, Y[best], sizeof ps->Y);
+        from_frames(&ps->w, ps->f, ps->h, Y[best], S[best]);
+    }
+    memcpy(m->X, S[best], sizeof m->X);
+    return done;
+}
+
+void amscr__polish_end(amscr__polish_state *ps)
+{
+    if (!ps)
+        return;
+    polish_free(&ps->w);
+    free(ps);
+}
+
+amscr_status amscr__polish_fit(const amscr_descriptor *f, const amscr_descriptor *h, int partial, match_t *m,
+                               amscr__polish_state **out)
+{
+    *out = NULL;
+    amscr__polish_state *ps = calloc(1, sizeof *ps);
+    if (!ps)
+        return amscr__fail(AMSCR_E_NOMEM, "registration polish: out of memory");
+    amscr_status st = polish_alloc(f->nraw, h->nraw, &ps->w);
+    if (st != AMSCR_OK) {
+        free(ps);
         return st;
+    }
+    ps->f = f;
+    ps->h = h;
     double S[1 + 2 * AMSCR__CANDIDATES][6], Y[1 + 2 * AMSCR__CANDIDATES][6], cost[1 + 2 * AMSCR__CANDIDATES];
     size_t count = polish_starts(f, m, S), best = count;
-    if (polish_prepare(&w, f, h, m->X, partial)) {
-        for (size_t k = 0; k < count; k++) { /* every start a few steps, ranked */
-            to_frames(&w, f, h, S[k], Y[k]);
-            cost[k] = polish_one(&w, Y[k], SCORE_ITERS);
-            from_frames(&w, f, h, Y[k], S[k]);
-            if (cost[k] < (best < count ? cost[best] : INFINITY))
-                best = k;
-        }
+    int ready = polish_prepare(&ps->w, f, h, m->X, partial);
+    if (ready > 0)
+        best = rank_starts(ps, S, Y, cost, count);
+    if (ready < 0 || ps->w.nomem) {
+        amscr__polish_end(ps);
+        return amscr__fail(AMSCR_E_NOMEM, "registration polish: out of memory");
     }
-    if (best < count) { /* the winner polished on */
-        if (count > 1)
-            m->ambiguity = polished_ambiguity(f, S, cost, count, best);
-        if (polish_one(&w, Y[best], POLISH_ITERS - SCORE_ITERS) < INFINITY) {
-            order_refine(&w, Y[best]);
-            from_frames(&w, f, h, Y[best], S[best]);
-        }
-        memcpy(m->X, S[best], sizeof m->X);
+    int done = best < count && polish_winner(ps, S, Y, cost, count, best, m);
+    if (ps->w.nomem) {
+        amscr__polish_end(ps);
+        return amscr__fail(AMSCR_E_NOMEM, "registration polish: out of memory");
     }
-    polish_free(&w);
+    if (done)
+        *out = ps;
+    else
+        amscr__polish_end(ps);
+    return AMSCR_OK;
+}
+
+int amscr__polish_steps_apply(const amscr__polish_state *ps)
+{
+    const polish_t *w = &ps->w;
+    return !w->partial && w->wb >= ORDER_NOISIER * w->wa && !has_gap(w->a) && !has_gap(w->b);
+}
+
+amscr_status amscr__polish_order(amscr__polish_state *ps, match_t *m)
+{
+    const polish_t *w = &ps->w;
+    if (amscr__ordered_fit(w->a->p, w->a->n, w->b->p, w->b->n, w->b->rough, ps->Y) < 0)
+        return amscr__fail(AMSCR_E_NOMEM, "registration polish (order): out of memory");
+    from_frames(w, ps->f, ps->h, ps->Y, m->X);
+    return AMSCR_OK;
+}
+
+amscr_status amscr__polish_even(amscr__polish_state *ps, match_t *m)
+{
+    const polish_t *w = &ps->w;
+    if (amscr__even_fit(w->a->p, w->a->n, w->b->p, w->b->n, w->b->rough, ps->Y) < 0)
+        return amscr__fail(AMSCR_E_NOMEM, "registration polish (even spacing): out of memory");
+    from_frames(w, ps->f, ps->h, ps->Y, m->X);
     return AMSCR_OK;
 }

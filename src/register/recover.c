@@ -188,9 +188,9 @@ static void fragment_order(const double *r2, size_t n, size_t order[RECOVER_FRAG
 }
 
 /* The map of fragment k of f placed on h by partial matching, in f's normalized frame.
- * Returns 0 when the fragment cannot be placed. */
-static int fragment_start(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h, size_t k,
-                          amscr_workspace *ws, double *pts, double X[6])
+ * Returns a failure status when the fragment cannot be placed. */
+static amscr_status fragment_start(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                   size_t k, amscr_workspace *ws, double *pts, double X[6])
 {
     size_t n = f->n, len = (size_t)(RECOVER_SHARE * (double)n), start = k * n / RECOVER_FRAGS;
     for (size_t j = 0; j < len; j++)
@@ -201,14 +201,17 @@ static int fragment_start(const amscr_params *prm, const amscr_descriptor *f, co
     amscr_contour *c = NULL;
     amscr_descriptor *d = NULL;
     match_t mf;
-    int ok = amscr_contour_new(pts, len, &c) == AMSCR_OK && amscr_descriptor_new(&pp, c, &d) == AMSCR_OK;
+    amscr_status st = amscr_contour_new(pts, len, &c);
+    if (st == AMSCR_OK)
+        st = amscr_descriptor_new(&pp, c, &d);
     pp.closed = 1;
-    ok = ok && amscr__match_partial_min(&pp, d, h, RECOVER_PHI_MIN, ws, &mf) == AMSCR_OK;
-    if (ok) /* d's input frame is f's normalized frame */
+    if (st == AMSCR_OK)
+        st = amscr__match_partial_min(&pp, d, h, RECOVER_PHI_MIN, ws, &mf);
+    if (st == AMSCR_OK) /* d's input frame is f's normalized frame */
         amscr__affine_compose(mf.X, d->fwd, X);
     amscr_descriptor_free(d);
     amscr_contour_free(c);
-    return ok;
+    return st; /* a fragment that cannot be placed is skipped; out of memory is not */
 }
 
 /* Refines `best` once more, stores the map in m and its pairs in ws->rbuf (the reported
@@ -258,7 +261,7 @@ static amscr_status scratch_new(const amscr_descriptor *f, const amscr_descripto
     s->Hd = buf + 5 * n;
     s->P = buf + 5 * n + 2 * AMSCR__DENSE * n;
     s->nd = amscr__densify(h->base, n, 1, s->Hd);
-    if (!amscr__grid_build(&s->grid, s->Hd, s->nd)) {
+    if (amscr__grid_build(&s->grid, s->Hd, s->nd) != 1) {
         scratch_free(s);
         return amscr__fail(AMSCR_E_NOMEM, "registration: out of memory (or a non-finite target)");
     }
@@ -281,11 +284,17 @@ amscr_status amscr__refine_adaptive(const amscr_params *prm, const amscr_descrip
     return st;
 }
 
+int amscr__recover_applies(const amscr_descriptor *f, const amscr_descriptor *h, const amscr_workspace *ws,
+                           const match_t *m)
+{
+    return m->refined && f->n == h->n && inlier_share(ws->rbuf + 2 * f->n, f->n) < RECOVER_INLIERS;
+}
+
 amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                     amscr_workspace *ws, match_t *m)
 {
     size_t n = f->n;
-    if (!m->refined || n != h->n || inlier_share(ws->rbuf + 2 * n, n) >= RECOVER_INLIERS)
+    if (!amscr__recover_applies(f, h, ws, m))
         return AMSCR_OK;
     scratch_t s = {0};
     amscr_status st = scratch_new(f, h, &s);
@@ -301,7 +310,10 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
     best_cost = cost[0] = two_way_cost(f, h, &s, best);
     for (size_t i = 0, nt = 1; i < RECOVER_FRAGS; i++) {
         double *X = tried[nt];
-        if (!fragment_start(prm, f, h, order[i], ws, pts, X))
+        st = fragment_start(prm, f, h, order[i], ws, pts, X);
+        if (st == AMSCR_E_NOMEM)
+            break;
+        if (st != AMSCR_OK)
             continue;
         refine_adaptive(prm, f, &s, X);
         double c = cost[nt] = two_way_cost(f, h, &s, X);
@@ -316,6 +328,10 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
         nt++;
         if (agree)
             break;
+    }
+    if (st == AMSCR_E_NOMEM) {
+        scratch_free(&s);
+        return st;
     }
     amscr__clear_error();
     st = finish(prm, f, &s, ws, best, m);

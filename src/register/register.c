@@ -3,12 +3,13 @@
  * (docs/method.md §12); this file holds the public entry points.
  *
  * register.c — matching a prepared source onto a prepared target (docs/method.md §3, §9), top-down:
- *   amscr_register / amscr_distance  check the pair, then match_pair:
- *   match_pair        one direction f -> h, the reported solve, and (symmetric) h -> f;
- *   amscr__match_dir  (shift_search.c) candidate start points ranked by one rule, the winner
- *                     through the method (method.c: per-scale solves, scale_select.c, stacked
- *                     solve) and the trimmed closest-point refinement (refine.c);
- *   amscr__final_solve (final_solve.c) the reported stacked solve by LAPACKE QR.
+ *   amscr_register    checks the pair, runs the stage table (stages.c: despike, search, method,
+ *                     recovery, final solve, symmetric, polish, order, even spacing,
+ *                     alternatives, correspondences) and fills the result's maps;
+ *   amscr_distance    checks the pair, then match_pair: one direction f -> h by
+ *                     amscr__match_dir (shift_search.c: candidate start points ranked by one
+ *                     rule, the winner through the method and the refinement) and, symmetric,
+ *                     h -> f.
  * The distance of the batch path (amscr_distance) is the method's closed form; amscr_register
  * reports the QR solve; tests check they agree. */
 #include "match.h"
@@ -20,7 +21,7 @@
 static amscr_status check_partial(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt);
 static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor *src, const amscr_descriptor *tgt);
 static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
-                               int report, amscr_workspace *ws, match_t *m);
+                               amscr_workspace *ws, match_t *m);
 
 amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
                             amscr_workspace *ws, amscr_result **out_result)
@@ -38,16 +39,11 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
     if (!r)
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_register: out of memory");
     if (st == AMSCR_OK)
-        st = match_pair(p, src, tgt, 1, w, &r->m);
+        st = amscr__run_stages(p, src, tgt, w, r);
     if (!ws)
         amscr__ws_release(&local);
-    if (st == AMSCR_OK && p->polish && src->raw && tgt->raw && tgt->params.closed &&
-        (p->partial || src->params.closed) && p->invariance == AMSCR_INVARIANCE_AFFINE) /* on the input points */
-        st = amscr__polish(src, tgt, p->partial, &r->m);
-    if (st == AMSCR_OK)
-        st = amscr__correspond(src, tgt, r);
     if (st != AMSCR_OK) {
-        free(r);
+        amscr_result_free(r);
         return st;
     }
     r->method = p->method;
@@ -82,7 +78,7 @@ amscr_status amscr__distance_ws(const amscr_params *prm, const amscr_descriptor 
                                 amscr_workspace *ws, double *out)
 {
     match_t m;
-    amscr_status st = match_pair(prm, src, tgt, 0, ws, &m);
+    amscr_status st = match_pair(prm, src, tgt, ws, &m);
     if (st == AMSCR_OK)
         *out = m.dist;
     return st;
@@ -117,23 +113,15 @@ static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor 
     return AMSCR_OK;
 }
 
-/* The match src -> tgt; `report`: replaced by the reported QR solve (affine invariance; the
- * constrained groups keep their closed form). Symmetric: the distance is the mean of both
- * directions' (the reported solve comes first: the way back reuses the workspace). */
+/* The distance of src -> tgt (the batch path): the search and the method (partial: the
+ * fragment's placement); symmetric: the mean of both directions'. amscr_register runs the whole
+ * stage table instead (stages.c). */
 static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
-                               int report, amscr_workspace *ws, match_t *m)
+                               amscr_workspace *ws, match_t *m)
 {
-    if (prm->partial) { /* partial matching: the fragment's place, then the reported QR of its pairs */
-        amscr_status st = amscr__match_partial(prm, src, tgt, ws, m);
-        if (st == AMSCR_OK && report) /* the place is known: refine on with an adaptive trim */
-            st = amscr__refine_adaptive(prm, src, tgt, ws, m);
-        return st == AMSCR_OK && report ? amscr__final_solve(prm, src, tgt, ws, m) : st;
-    }
+    if (prm->partial)
+        return amscr__match_partial(prm, src, tgt, ws, m);
     amscr_status st = amscr__match_dir(prm, src, tgt, ws, m);
-    if (st == AMSCR_OK && report && prm->invariance == AMSCR_INVARIANCE_AFFINE && src->params.closed)
-        st = amscr__recover_missing(prm, src, tgt, ws, m); /* part of the target missing */
-    if (st == AMSCR_OK && report && prm->invariance == AMSCR_INVARIANCE_AFFINE)
-        st = amscr__final_solve(prm, src, tgt, ws, m);
     if (st == AMSCR_OK && prm->symmetric) {
         match_t back;
         st = amscr__match_dir(prm, tgt, src, ws, &back);

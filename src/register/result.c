@@ -147,3 +147,34 @@ amscr_status amscr_result_correspondences(const amscr_result *r, double *out_src
     *inout_n = n;
     return AMSCR_OK;
 }
+
+/* ---- the stages that ran (stages.c) and the alternatives (alternatives.c) ---- */
+size_t amscr_result_num_stages(const amscr_result *r) { return r ? (size_t)AMSCR__NUM_STAGES : 0; }
+
+amscr_status amscr_result_stage(const amscr_result *r, size_t i, const char **out_name, int *out_ran)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    if (i >= AMSCR__NUM_STAGES)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_result_stage: stage %zu of %d", i, (int)AMSCR__NUM_STAGES);
+    if (out_name)
+        *out_name = amscr__stage_name(i);
+    if (out_ran)
+        *out_ran = r->ran[i];
+    return AMSCR_OK;
+}
+
+size_t amscr_result_num_alternatives(const amscr_result *r) { return r ? r->nalt : 0; }
+
+amscr_status amscr_result_alternative(const amscr_result *r, size_t i, double out_m6[6], double *out_cost)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(r);
+    if (i >= r->nalt)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_result_alternative: alternative %zu of %zu", i, r->nalt);
+    if (out_m6)
+        memcpy(out_m6, r->alt[i], sizeof r->alt[i]);
+    if (out_cost)
+        *out_cost = r->alt_cost[i];
+    return AMSCR_OK;
+}

@@ -395,7 +395,7 @@ static amscr_status run_start(const amscr_params *prm, const amscr_descriptor *f
 
 /* Ambiguity: the chosen candidate's score over the best score of a clearly different candidate
  * map (1: as good; 0: none, or far worse). */
-static double ambiguity_of(const amscr_descriptor *f, double X[][6], const double *score, size_t count, size_t best)
+static double ambiguity_of(const amscr_descriptor *f, const double X[][6], const double *score, size_t count, size_t best)
 {
     double amb = 0.0;
     for (size_t i = 0; i < count; i++) {
@@ -408,49 +408,90 @@ static double ambiguity_of(const amscr_descriptor *f, double X[][6], const doubl
     return amb;
 }
 
-amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                              amscr_workspace *ws, match_t *m)
+/* Each candidate scored (the cheap kinds need no run of the method) into s. */
+static amscr_status score_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                 const double *crit, amscr_workspace *ws, amscr__search *s)
 {
-    amscr_status st = amscr__ws_reserve(ws, f->n, f->p);
-    if (st != AMSCR_OK)
-        return st;
-    score_kind kind = !f->params.closed ? SCORE_METHOD : prm->refine > 0 ? SCORE_GEOMETRY : SCORE_CRITERION;
-    start_t starts[2 * AMSCR__CANDIDATES];
-    double crit[2 * AMSCR__CANDIDATES];
-    STAGE_T0;
-    size_t count = collect_starts(prm, f, h, kind == SCORE_CRITERION, ws, starts, crit);
-    int prepared_o = (prm->reflections ? 2 : 1) - 1;
-    size_t best = 0;
     double best_score = INFINITY, best_dist = INFINITY;
-    double cand_X[2 * AMSCR__CANDIDATES][6], cand_score[2 * AMSCR__CANDIDATES]; /* for the ambiguity */
-    for (size_t i = 0; i < count; i++) {
+    for (size_t i = 0; i < s->count; i++) {
         double score = crit[i], dist = crit[i];
-        if (kind != SCORE_CRITERION) {
+        if (s->kind != SCORE_CRITERION) {
             match_t cur;
             unsigned iters = prm->refine < AMSCR__SCORE_REFINE ? prm->refine : AMSCR__SCORE_REFINE;
-            st = run_start(prm, f, h, &starts[i], &prepared_o, kind == SCORE_GEOMETRY ? iters : 0, ws, &cur);
+            start_t st0 = {s->o[i], s->s[i]};
+            amscr_status st = run_start(prm, f, h, &st0, &s->prepared_o, s->kind == SCORE_GEOMETRY ? iters : 0, ws,
+                                        &cur);
             if (st != AMSCR_OK)
                 return st;
-            score = kind == SCORE_GEOMETRY ? cur.rcost : cur.dist;
+            score = s->kind == SCORE_GEOMETRY ? cur.rcost : cur.dist;
             dist = cur.dist;
-            memcpy(cand_X[i], cur.X, sizeof cand_X[i]);
+            memcpy(s->X[i], cur.X, sizeof s->X[i]);
         }
-        cand_score[i] = score;
+        s->score[i] = score;
         /* the one ranking rule: lower score, then lower distance, then the earlier candidate */
         if (i == 0 || score < best_score || (score == best_score && dist < best_dist)) {
-            best = i;
+            s->best = i;
             best_score = score;
             best_dist = dist;
         }
     }
+    return AMSCR_OK;
+}
+
+amscr_status amscr__search_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                  amscr_workspace *ws, amscr__search *s)
+{
+    amscr_status st = amscr__ws_reserve(ws, f->n, f->p);
+    if (st != AMSCR_OK)
+        return st;
+    s->kind = !f->params.closed ? SCORE_METHOD : prm->refine > 0 ? SCORE_GEOMETRY : SCORE_CRITERION;
+    start_t starts[2 * AMSCR__CANDIDATES];
+    double crit[2 * AMSCR__CANDIDATES];
+    STAGE_T0;
+    s->count = collect_starts(prm, f, h, s->kind == SCORE_CRITERION, ws, starts, crit);
+    for (size_t i = 0; i < s->count; i++) {
+        s->s[i] = starts[i].s;
+        s->o[i] = starts[i].o;
+    }
+    s->prepared_o = (prm->reflections ? 2 : 1) - 1;
+    s->best = 0;
+    st = score_starts(prm, f, h, crit, ws, s);
     STAGE_MARK(ws, 0);
-    st = run_start(prm, f, h, &starts[best], &prepared_o, prm->refine, ws, m);
-    if (st == AMSCR_OK)
-        m->ambiguity = kind == SCORE_CRITERION ? 0.0 : ambiguity_of(f, cand_X, cand_score, count, best);
-    m->ncand = kind == SCORE_CRITERION ? 0 : count; /* further starts for polish.c */
-    if (m->ncand)
-        memcpy(m->cand, cand_X, count * sizeof cand_X[0]);
-    if (st == AMSCR_OK && !isfinite(m->dist))
-        st = amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
     return st;
+}
+
+/* The search's ranking into m: its distinct maps for the polish and the alternatives. */
+static void keep_ranking(const amscr_descriptor *f, const amscr__search *s, match_t *m)
+{
+    int ranked = s->kind != SCORE_CRITERION;
+    m->ambiguity = ranked ? ambiguity_of(f, s->X, s->score, s->count, s->best) : 0.0;
+    m->ncand = ranked ? s->count : 0; /* further starts for polish.c */
+    m->nrank = m->ncand;
+    m->rank_best = s->best;
+    if (!m->ncand)
+        return;
+    memcpy(m->cand, s->X, s->count * sizeof s->X[0]);
+    memcpy(m->rank_X, s->X, s->count * sizeof s->X[0]);
+    memcpy(m->rank_cost, s->score, s->count * sizeof s->score[0]);
+}
+
+amscr_status amscr__method_at(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                              amscr_workspace *ws, amscr__search *s, match_t *m)
+{
+    start_t win = {s->o[s->best], s->s[s->best]};
+    amscr_status st = run_start(prm, f, h, &win, &s->prepared_o, prm->refine, ws, m);
+    if (st != AMSCR_OK)
+        return st;
+    keep_ranking(f, s, m);
+    if (!isfinite(m->dist))
+        return amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
+    return AMSCR_OK;
+}
+
+amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                              amscr_workspace *ws, match_t *m)
+{
+    amscr__search s;
+    amscr_status st = amscr__search_starts(prm, f, h, ws, &s);
+    return st == AMSCR_OK ? amscr__method_at(prm, f, h, ws, &s, m) : st;
 }

@@ -106,13 +106,39 @@ double amscr__r_f64(amscr__rbuf *r)
     return d;
 }
 
+static uint64_t le64(const unsigned char *p)
+{
+    uint64_t v = 0;
+    for (int i = 0; i < 8; i++)
+        v |= (uint64_t)p[i] << (8 * i);
+    return v;
+}
+
 int amscr__r_f64s(amscr__rbuf *r, double *d, size_t n)
 {
-    for (size_t i = 0; i < n && !r->bad; i++) {
-        d[i] = amscr__r_f64(r);
-        if (d[i] != d[i] || d[i] - d[i] != 0.0) /* NaN or infinite */
-            r->bad = 1;
+    if (r->bad || (r->len - r->pos) / 8 < n) {
+        r->bad = 1;
+        return 0;
     }
+    const unsigned char *p = r->p + r->pos;
+    uint64_t inf = 0; /* any value with every exponent bit set: NaN or infinite */
+    const uint64_t one = 1;
+    if (*(const unsigned char *)&one == 1) { /* a little-endian host: the bytes as they are */
+        memcpy(d, p, 8 * n);
+        for (size_t i = 0; i < n; i++) {
+            uint64_t v;
+            memcpy(&v, &d[i], 8);
+            inf |= (uint64_t)((v >> 52 & 0x7ff) == 0x7ff);
+        }
+    } else {
+        for (size_t i = 0; i < n; i++) {
+            uint64_t v = le64(p + 8 * i);
+            inf |= (uint64_t)((v >> 52 & 0x7ff) == 0x7ff);
+            memcpy(&d[i], &v, 8);
+        }
+    }
+    r->pos += 8 * n;
+    r->bad = inf != 0;
     return !r->bad;
 }
 
@@ -148,4 +174,27 @@ uint64_t amscr__fnv1a(const unsigned char *p, size_t n)
         h *= 1099511628211ull;
     }
     return h;
+}
+
+uint64_t amscr__sum64(const unsigned char *p, size_t n)
+{
+    const uint64_t K = 0x9E3779B97F4A7C15ull;
+    uint64_t h[4] = {1469598103934665603ull, 1469598103934665603ull ^ 1u, 1469598103934665603ull ^ 2u,
+                     1469598103934665603ull ^ 3u};
+    size_t i = 0;
+    for (; n - i >= 32; i += 32)
+        for (int l = 0; l < 4; l++) { /* both steps are one-to-one: a changed word changes its lane */
+            h[l] = (h[l] ^ le64(p + i + 8 * (size_t)l)) * K;
+            h[l] ^= h[l] >> 29;
+        }
+    uint64_t r = (uint64_t)n * K;
+    for (int l = 0; l < 4; l++) {
+        r = (r ^ h[l]) * K;
+        r ^= r >> 32;
+    }
+    for (; i < n; i++) {
+        r ^= p[i];
+        r *= 1099511628211ull;
+    }
+    return r ^ (r >> 31);
 }

@@ -35,7 +35,14 @@ int amscr__r_f64s(amscr__rbuf *r, double *d, size_t n);
  * 0 when short, not NUL-free or out of memory (*oom set). */
 int amscr__r_str(amscr__rbuf *r, char **out, int *oom);
 
-/* FNV-1a 64 of n bytes: the files' trailing checksum. */
+/* FNV-1a 64 of n bytes: the trailing checksum of collection files and of index files before
+ * format version 4. */
 uint64_t amscr__fnv1a(const unsigned char *p, size_t n);
+/* The trailing checksum of index files from format version 4: four lanes of 64-bit
+ * little-endian words, each lane h = (h ^ word) * 0x9E3779B97F4A7C15, h ^= h >> 29 (one-to-one:
+ * a changed word always changes its lane), the lanes folded into one value with the length,
+ * the last n mod 32 bytes as FNV-1a. Several bytes a cycle where FNV-1a takes several cycles a
+ * byte (a 50 MB index file: ~5 ms instead of ~70 ms). */
+uint64_t amscr__sum64(const unsigned char *p, size_t n);
 
 #endif

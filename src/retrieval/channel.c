@@ -135,6 +135,27 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
     return st;
 }
 
+amscr_status amscr__hf_spectra(amscr__hf *h, amscr__hf_ws *ws)
+{
+    amscr__fft_plan plan;
+    int own = !ws || ws->n != h->n || !ws->have_plan;
+    double *z = own ? amscr__malloc_array(2 * h->n, sizeof *z) : ws->z;
+    int have_plan = own && amscr__fft_plan_init(&plan, h->n) == 0;
+    amscr_status st = z && (have_plan || !own) ? AMSCR_OK : AMSCR_E_NOMEM;
+    for (int o = 0; o < 2 && st == AMSCR_OK; o++) {
+        h->spec[o] = amscr__malloc_array(AMSCR__HF_BINS * 2 * h->nfreq, sizeof(double));
+        if (h->spec[o])
+            spectra(h->seq[o], h->n, h->nfreq, h->spec[o], own ? &plan : &ws->plan, z);
+        else
+            st = AMSCR_E_NOMEM;
+    }
+    if (have_plan)
+        amscr__fft_plan_free(&plan);
+    if (own)
+        free(z);
+    return st == AMSCR_OK ? st : amscr__fail(st, "shape channel: out of memory");
+}
+
 amscr_status amscr__hf_ws_init(amscr__hf_ws *ws, size_t n, size_t band)
 {
     memset(ws, 0, sizeof *ws);

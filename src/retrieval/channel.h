@@ -33,17 +33,22 @@ typedef struct {
 } amscr__hf_cfg;
 
 /* Per-thread scratch of the pair distance. */
-typedef struct {
+struct amscr__hf_ws {
     size_t n;
     amscr__fft_plan plan;
     int have_plan;
     double *z;
     int32_t *row;
     int *start;
-} amscr__hf_ws;
+};
 
 amscr_status amscr__hf_build(const double *base, size_t n, double locality, amscr__hf *out);
 void amscr__hf_free(amscr__hf *h);
+typedef struct amscr__hf_ws amscr__hf_ws;
+/* The spectra of h (spec[0..1], allocated here; free with amscr__hf_free or free()) from its
+ * height sequences, n and nfreq: bit for bit amscr__hf_build's (an index file keeps the heights
+ * only, index_io.c). ws (may be NULL): a pair scratch whose FFT plan is used when it fits. */
+amscr_status amscr__hf_spectra(amscr__hf *h, amscr__hf_ws *ws);
 amscr_status amscr__hf_ws_init(amscr__hf_ws *ws, size_t n, size_t band);
 void amscr__hf_ws_free(amscr__hf_ws *ws);
 /* The channel distance of two shapes built with the same n (>= 0, 0 for identical ones). */

@@ -2,15 +2,27 @@
  * Header: "AMSCRDB\0", u32 version, u32 reserved, params, (version >= 2) the retrieval
  * settings (retrieval_io.c), u64 count, u64 N, u64 p; per shape: i32 label, f64 fwd[6],
  * f64 inv[6], f64 input[2N], base[2N], scaled[2Np]; (version 3) u64 length and the index
- * section (index_io.c); trailer: u64 FNV-1a of everything before it. The shape channel is
- * derived from the prepared shapes on demand and is not stored. */
+ * section (index_io.c); trailer: u64 checksum of everything before it (FNV-1a; version 4:
+ * amscr__sum64). A collection file does not store the shape channel (derived from the
+ * prepared shapes on demand); an index file of version 4 does, in its section. */
+#define _DEFAULT_SOURCE /* MAP_POPULATE, where the system has it */
 #include "db_io.h"
 
 #include <errno.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+
+uint64_t amscr__db_checksum(uint32_t version, const unsigned char *p, size_t n)
+{
+    return version >= AMSCR__DB_VERSION_FEATURES ? amscr__sum64(p, n) : amscr__fnv1a(p, n);
+}
 
 static void w_params(amscr__wbuf *w, const amscr_params *p)
 {
@@ -167,29 +179,104 @@ static amscr_status r_params(amscr__rbuf *r, uint32_t version, amscr_params *prm
     return AMSCR_OK;
 }
 
-/* The count shapes into db (params prm). */
+/* The shapes of a file, decoded on threads: shape i's bytes start at pos0 + i * per (a fixed
+ * size), each thread takes every nt-th shape. */
+typedef struct {
+    const unsigned char *p;
+    size_t pos0, per;
+    const amscr_params *prm;
+    uint64_t count;
+    amscr_descriptor **d; /* count entries, NULL until decoded */
+    int32_t *label;
+    unsigned char *bad; /* per shape: 0, or 1 truncated / not finite, 2 degenerate, 3 out of memory */
+    unsigned t, nt;
+} shapes_job;
+
+static void read_shape(const shapes_job *j, uint64_t i)
+{
+    size_t N = j->prm->num_samples, p = j->prm->num_scales, at = j->pos0 + (size_t)i * j->per;
+    amscr__rbuf r = {j->p, at + j->per, at, 0};
+    j->label[i] = (int32_t)amscr__r_u32(&r);
+    amscr_descriptor *d = NULL;
+    if (amscr__descriptor_alloc(N, p, &d) != AMSCR_OK) {
+        j->bad[i] = 3;
+        return;
+    }
+    d->params = *j->prm;
+    if (!amscr__r_f64s(&r, d->fwd, 6) || !amscr__r_f64s(&r, d->inv, 6) || !amscr__r_f64s(&r, d->input, 2 * N) ||
+        !amscr__r_f64s(&r, d->base, 2 * N) || !amscr__r_f64s(&r, d->scaled, 2 * N * p))
+        j->bad[i] = 1;
+    else if (amscr__descriptor_finish(d) != AMSCR_OK)
+        j->bad[i] = 2;
+    j->d[i] = d;
+}
+
+static void *shapes_worker(void *arg)
+{
+    const shapes_job *j = arg;
+    for (uint64_t i = j->t; i < j->count; i += j->nt)
+        read_shape(j, i);
+    return NULL;
+}
+
+/* Runs job j (t, nt unset) on up to the params' threads (the calling thread too). */
+static void run_shapes(shapes_job *j)
+{
+    enum { MAX_THREADS = 64, MIN_SHAPES = 32 }; /* a thread for at least MIN_SHAPES shapes */
+    unsigned nt = amscr__resolve_threads(j->prm->num_threads), started = 0;
+    if (nt > MAX_THREADS)
+        nt = MAX_THREADS;
+    if ((uint64_t)nt * MIN_SHAPES > j->count)
+        nt = j->count / MIN_SHAPES > 0 ? (unsigned)(j->count / MIN_SHAPES) : 1u;
+    shapes_job part[MAX_THREADS];
+    pthread_t tid[MAX_THREADS];
+    for (unsigned t = 0; t < nt; t++) {
+        part[t] = *j;
+        part[t].t = t;
+        part[t].nt = nt;
+    }
+    for (unsigned t = 1; t < nt; t++)
+        if (pthread_create(&tid[t], NULL, shapes_worker, &part[t]) == 0)
+            started = t;
+        else
+            break;
+    for (unsigned t = started + 1; t < nt; t++) /* threads that did not start: done here */
+        shapes_worker(&part[t]);
+    shapes_worker(&part[0]);
+    for (unsigned t = 1; t <= started; t++)
+        pthread_join(tid[t], NULL);
+}
+
+/* The count shapes into db (params prm), decoded on the params' threads, entered in order. */
 static amscr_status r_shapes(amscr__rbuf *r, const amscr_params *prm, uint64_t count, amscr_db *db)
 {
     size_t N = prm->num_samples, p = prm->num_scales;
-    amscr_status st = AMSCR_OK;
+    shapes_job j = {r->p, r->pos, 4 + 8 * (12 + 4 * N + 2 * N * p), prm, count, NULL, NULL, NULL, 0, 1};
+    j.d = amscr__calloc_array(count ? count : 1, sizeof *j.d);
+    j.label = amscr__malloc_array(count ? count : 1, sizeof *j.label);
+    j.bad = amscr__calloc_array(count ? count : 1, 1);
+    amscr_status st = j.d && j.label && j.bad ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "collection: out of memory");
+    if (st == AMSCR_OK)
+        run_shapes(&j); /* count * per bytes are there: amscr__db_parse checked */
     for (uint64_t i = 0; i < count && st == AMSCR_OK; i++) {
-        int32_t label = (int32_t)amscr__r_u32(r);
-        amscr_descriptor *d = NULL;
-        st = amscr__descriptor_alloc(N, p, &d);
-        if (st != AMSCR_OK)
-            break;
-        d->params = *prm;
-        if (!amscr__r_f64s(r, d->fwd, 6) || !amscr__r_f64s(r, d->inv, 6) || !amscr__r_f64s(r, d->input, 2 * N) ||
-            !amscr__r_f64s(r, d->base, 2 * N) || !amscr__r_f64s(r, d->scaled, 2 * N * p))
+        if (j.bad[i] == 1)
             st = amscr__fail(AMSCR_E_FORMAT, "collection: shape %llu is truncated or has non-finite values",
                              (unsigned long long)i);
-        if (st == AMSCR_OK && amscr__descriptor_finish(d) != AMSCR_OK)
+        else if (j.bad[i] == 2)
             st = amscr__fail(AMSCR_E_FORMAT, "collection: shape %llu is degenerate", (unsigned long long)i);
+        else if (j.bad[i] == 3)
+            st = amscr__fail(AMSCR_E_NOMEM, "collection: out of memory");
+        else
+            st = amscr__db_push(db, j.d[i], j.label[i], NULL);
         if (st == AMSCR_OK)
-            st = amscr__db_push(db, d, label, NULL);
-        if (st != AMSCR_OK)
-            amscr_descriptor_free(d);
+            j.d[i] = NULL; /* the collection's now */
     }
+    for (uint64_t i = 0; j.d && i < count; i++)
+        amscr_descriptor_free(j.d[i]);
+    r->pos += st == AMSCR_OK ? (size_t)count * j.per : 0;
+    free(j.d);
+    free(j.label);
+    free(j.bad);
     return st;
 }
 
@@ -203,12 +290,12 @@ static amscr_status check_envelope(const unsigned char *buf, size_t len, uint32_
         return amscr__fail(AMSCR_E_FORMAT, "not an amscr collection (bad magic)");
     amscr__rbuf r = {buf, len, 8, 0}, t = {buf, len, len - 8, 0};
     *version = amscr__r_u32(&r);
-    if (*version > AMSCR__DB_VERSION_INDEX)
+    if (*version > AMSCR__DB_VERSION_FEATURES)
         return amscr__fail(AMSCR_E_FORMAT, "collection format version %u is newer than this library's (%u)",
-                           (unsigned)*version, AMSCR__DB_VERSION_INDEX);
+                           (unsigned)*version, AMSCR__DB_VERSION_FEATURES);
     if (*version == 0)
         return amscr__fail(AMSCR_E_FORMAT, "collection format version 0 is invalid");
-    if (amscr__fnv1a(buf, len - 8) != amscr__r_u64(&t))
+    if (amscr__db_checksum(*version, buf, len - 8) != amscr__r_u64(&t))
         return amscr__fail(AMSCR_E_FORMAT, "collection checksum mismatch (corrupt or truncated file)");
     return AMSCR_OK;
 }
@@ -275,12 +362,22 @@ amscr_status amscr_db_load_memory(const void *buf, size_t len, amscr_db **out)
     return AMSCR_OK;
 }
 
+/* The size of the open file f, or 0 when unknown (then read in growing chunks). */
+static size_t file_size(FILE *f)
+{
+    struct stat sb;
+    return fstat(fileno(f), &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0 && (uintmax_t)sb.st_size < SIZE_MAX / 2
+               ? (size_t)sb.st_size
+               : 0;
+}
+
 amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out_len)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
         return amscr__fail(AMSCR_E_IO, "%s: %s", path, strerror(errno));
-    size_t cap = 1 << 16, len = 0;
+    size_t cap = file_size(f), len = 0;
+    cap = cap ? cap + 1 : (size_t)1 << 16; /* one more byte: the end is seen without a second buffer */
     unsigned char *buf = malloc(cap);
     amscr_status st = AMSCR_OK;
     while (buf) {
@@ -316,6 +413,40 @@ amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out
     *out = buf;
     *out_len = len;
     return AMSCR_OK;
+}
+
+amscr_status amscr__file_map(const char *path, unsigned char **out, size_t *out_len, int *mapped)
+{
+    *mapped = 0;
+    int fd = open(path, O_RDONLY);
+    struct stat sb;
+    if (fd >= 0 && fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0 &&
+        (uintmax_t)sb.st_size < SIZE_MAX / 2) {
+#ifdef MAP_POPULATE
+        int flags = MAP_PRIVATE | MAP_POPULATE; /* every page mapped at once: the load reads them all */
+#else
+        int flags = MAP_PRIVATE;
+#endif
+        void *p = mmap(NULL, (size_t)sb.st_size, PROT_READ, flags, fd, 0);
+        if (p != MAP_FAILED) {
+            close(fd);
+            *out = p;
+            *out_len = (size_t)sb.st_size;
+            *mapped = 1;
+            return AMSCR_OK;
+        }
+    }
+    if (fd >= 0)
+        close(fd);
+    return amscr__file_read(path, out, out_len); /* not mappable: read (and its errors) */
+}
+
+void amscr__file_unmap(unsigned char *buf, size_t len, int mapped)
+{
+    if (mapped)
+        munmap(buf, len);
+    else
+        free(buf);
 }
 
 amscr_status amscr_db_load(const char *path, amscr_db **out)

@@ -9,9 +9,15 @@
 
 #define AMSCR__DB_MAGIC "AMSCRDB"
 /* 1 (0.1); 2 (0.2): the retrieval settings follow the params; 3 (0.4): an index section
- * (u64 length, then index_io.c's bytes) follows the shapes. Every version loads. */
+ * (u64 length, then index_io.c's bytes) follows the shapes; 4 (0.5): the index section holds
+ * the shapes' channel features too, and the trailing checksum is amscr__sum64 instead of
+ * FNV-1a. Every version loads. */
 #define AMSCR__DB_VERSION_PLAIN 2u
 #define AMSCR__DB_VERSION_INDEX 3u
+#define AMSCR__DB_VERSION_FEATURES 4u
+
+/* The trailing checksum of a file of `version` over its first n bytes. */
+uint64_t amscr__db_checksum(uint32_t version, const unsigned char *p, size_t n);
 
 /* Appends db.c's row (db_push) to a collection. */
 amscr_status amscr__db_push(amscr_db *db, amscr_descriptor *d, int32_t label, size_t *out_index);
@@ -27,5 +33,9 @@ amscr_status amscr__db_parse(const unsigned char *buf, size_t len, amscr_db **ou
 amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t len);
 /* The whole file at path (caller frees *out). */
 amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out_len);
+/* The whole file at path mapped read-only (*mapped = 1; no copy, the page cache's pages), or
+ * read as amscr__file_read where it cannot be mapped; release with amscr__file_unmap. */
+amscr_status amscr__file_map(const char *path, unsigned char **out, size_t *out_len, int *mapped);
+void amscr__file_unmap(unsigned char *buf, size_t len, int mapped);
 
 #endif

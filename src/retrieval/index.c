@@ -1,4 +1,5 @@
 /* index.c — the retrieval index object: allocation, the per-shape arrays, names, getters. */
+#include "db_io.h"
 #include "index.h"
 
 #include <stdlib.h>
@@ -79,10 +80,26 @@ amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
     return AMSCR_OK;
 }
 
+void amscr__index_detach_map(amscr_index *x)
+{
+    for (size_t e = 0; x->map && x->hf && e < x->cap * (size_t)x->nf; e++)
+        for (int o = 0; o < 2; o++)
+            if ((uintptr_t)x->hf[e].seq[o] - (uintptr_t)x->map < x->map_len) /* points into the map */
+                x->hf[e].seq[o] = NULL;
+    x->map = NULL;
+    x->map_len = 0;
+}
+
 void amscr_index_free(amscr_index *x)
 {
     if (!x)
         return;
+    if (x->map) {
+        unsigned char *map = x->map;
+        size_t len = x->map_len;
+        amscr__index_detach_map(x);
+        amscr__file_unmap(map, len, 1);
+    }
     for (size_t i = 0; x->names && i < x->cap; i++)
         free(x->names[i]);
     for (size_t i = 0; x->groups && i < x->cap; i++)

@@ -21,6 +21,9 @@ struct amscr_index {
     amscr__hf *hf;        /* n x nf: each shape's channel features, ready for matching (an entry
                            * with no sequences, after a lazy load: built where a pair needs it) */
     int lazy;             /* loaded with AMSCR_INDEX_LAZY: features of loaded shapes not built */
+    unsigned char *map;   /* the index file, mapped, while loaded shapes' heights point into it (a
+                           * lazy load of a file; index_io.c), else NULL */
+    size_t map_len;
     uint32_t *nb_idx;     /* n x k: itself first, then by (base distance, index) */
     double *nb_dist;      /* n x k */
     char **names;         /* n entries (NULL: unnamed) */
@@ -111,9 +114,14 @@ amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t
                                  double *out);
 /* Rows first..n-1 from their M signature-nearest shapes (index_build.c); x->dmax grows. */
 amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_progress_fn progress, void *user);
+/* Rows first..n-1's lists (their K nearest among their shortlists S, m each, ascending) refined
+ * from the neighbours' lists (index_refine.c); x->dmax grows. */
+amscr_status amscr__index_refine(amscr_index *x, const amscr__base *b, size_t first, const uint32_t *S, size_t m);
 /* The lists' reverse (x->rev_start, x->rev) from x's lists (index_query.c); frees the old. */
 amscr_status amscr__index_reverse(amscr_index *x);
 void amscr__index_reverse_free(amscr_index *x);
+/* Drops x's hold on its mapped file: the heights that point into it forgotten, x->map NULL. */
+void amscr__index_detach_map(amscr_index *x);
 /* db can be indexed (closed curves for the channel, at most 2^32 - 1 shapes). */
 amscr_status amscr__index_check_db(const amscr_db *db, const char *what);
 

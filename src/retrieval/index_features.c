@@ -1,7 +1,9 @@
 /* index_features.c — what an index keeps of each shape for matching, computed once per shape
  * (after a build, an add or a load) on the params' threads: its shortlist signature with the
  * signature's lower-bound vector (signature.h) and its channel features in every frame of the
- * channel (channel.h), so a query or a row matches a shape without rebuilding anything. */
+ * channel (channel.h), so a query or a row matches a shape without rebuilding anything. A
+ * load from a file that holds the features' heights computes only their spectra; a lazy load
+ * nothing (index_pairs.c computes what a pair needs). */
 #include "index.h"
 
 #include <stdlib.h>
@@ -22,9 +24,15 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
     if (!j->have_sig)
         amscr__shape_signature(d, sig);
     amscr__sig_bound_vector(sig, x->sig_lb + i * AMSCR__SIG_LB_DIM);
+    amscr__hf *hf = x->hf + i * (size_t)x->nf;
     if (x->nf == 0 || (x->lazy && j->have_sig))
         return AMSCR_OK; /* a lazy load: built by the pairs that need them (index_pairs.c) */
-    amscr__hf *hf = x->hf + i * (size_t)x->nf;
+    if (j->have_sig && hf[0].seq[0] != NULL) { /* the heights came with the file: their spectra */
+        amscr_status st = AMSCR_OK;
+        for (int f = 0; f < x->nf && st == AMSCR_OK; f++)
+            st = hf[f].spec[0] ? AMSCR_OK : amscr__hf_spectra(&hf[f], NULL);
+        return st;
+    }
     for (int f = 0; f < x->nf; f++)
         amscr__hf_free(&hf[f]);
     return amscr__base_hf(&j->b, d, hf);

@@ -1,14 +1,22 @@
-/* index_io.c — the index file: a collection file (db_io.c) of version 3 whose index section
- * follows the shapes, so amscr_db_load of an index file gives its collection. Little-endian:
+/* index_io.c — the index file: a collection file (db_io.c) of version 4 (3 before 0.5) whose
+ * index section follows the shapes, so amscr_db_load of an index file gives its collection.
+ * Little-endian:
  *   u64 section length (the bytes up to the trailing checksum), then
  *   u32 sig_dim, u32 4 (bytes of a signature value), u64 k, u64 candidates (0: full lists),
  *   f64 dmax, f64 median AMSCR, f64 median channel, n x sig_dim f32 signatures (signature.h),
  *   n x k x (u32 neighbour, f64 distance)
  *   (each row: itself first, then by distance), n names, u64 nclasses, nclasses class names
- *   (string: u32 length and bytes, 0xffffffff for none), then, when a shape has a group,
- *   n group names (absent: no shape has one).
- * Every count is bounded by the bytes left before anything is allocated. The shapes' channel
- * features are not stored: they are rebuilt at load (index_features.c). */
+ *   (string: u32 length and bytes, 0xffffffff for none), then
+ *   version 3: when a shape has a group, n group names (absent: no shape has one);
+ *   version 4: u32 1 and n group names, or u32 0 (no shape has one); then the channel
+ *     features: u32 frames F (0: no channel), u32 samples N, u32 bins B (AMSCR__HF_BINS), and
+ *     per shape, per frame, its quantized height sequences (channel.h), forward then mirrored:
+ *     2 N B bytes (F = 2, N = 128: 8 KB a shape).
+ * Every count is bounded by the bytes left before anything is allocated; F, N and B must be the
+ * params' (any byte is a valid height). The features' spectra are not stored: a load computes
+ * them from the heights (an FFT, a fifth of building the features), or, with AMSCR_INDEX_LAZY,
+ * a query computes those of its candidates. A version 3 file has no features: they are
+ * rebuilt from the shapes (index_features.c). */
 #include "db_io.h"
 #include "index.h"
 
@@ -44,8 +52,35 @@ static void write_section(const amscr_index *x, amscr__wbuf *w)
     int groups = 0;
     for (size_t i = 0; i < n && !groups; i++)
         groups = x->groups[i] != NULL;
+    amscr__w_u32(w, (uint32_t)groups);
     for (size_t i = 0; groups && i < n; i++)
         amscr__w_str(w, x->groups[i]);
+}
+
+/* The channel features: every shape's height sequences (built here where a lazy load left
+ * them unbuilt). */
+static amscr_status write_features(const amscr_index *x, amscr__wbuf *w)
+{
+    size_t n = amscr_db_size(x->db), N = amscr_db_params(x->db)->num_samples, bytes = N * AMSCR__HF_BINS;
+    amscr__w_u32(w, (uint32_t)x->nf);
+    amscr__w_u32(w, (uint32_t)N);
+    amscr__w_u32(w, AMSCR__HF_BINS);
+    amscr__base b;
+    amscr__base_init(&b, amscr_db_params(x->db), x->med_a, x->med_h);
+    amscr_status st = AMSCR_OK;
+    for (size_t i = 0; i < n && x->nf > 0 && st == AMSCR_OK; i++) {
+        const amscr__hf *hf = x->hf + i * (size_t)x->nf;
+        amscr__hf built[2];
+        int build = hf[0].seq[0] == NULL;
+        if (build && (st = amscr__base_hf(&b, amscr_db_descriptor(x->db, i), built)) != AMSCR_OK)
+            break;
+        for (int f = 0; f < x->nf; f++)
+            for (int o = 0; o < 2; o++)
+                amscr__w_bytes(w, (build ? built : hf)[f].seq[o], bytes);
+        if (build)
+            amscr__base_hf_free(&b, built);
+    }
+    return st;
 }
 
 amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_t *out_len)
@@ -55,15 +90,20 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
     AMSCR_CHECK_NULL(out_buf);
     AMSCR_CHECK_NULL(out_len);
     amscr__wbuf w = {NULL, 0, 0, 0};
-    amscr__db_write(x->db, AMSCR__DB_VERSION_INDEX, &w);
+    amscr__db_write(x->db, AMSCR__DB_VERSION_FEATURES, &w);
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
     write_section(x, &w);
+    amscr_status st = write_features(x, &w);
+    if (st != AMSCR_OK) {
+        free(w.buf);
+        return st;
+    }
     if (!w.oom) {
         uint64_t sec = (uint64_t)(w.len - at - 8);
         for (int i = 0; i < 8; i++)
             w.buf[at + (size_t)i] = (unsigned char)(sec >> (8 * i));
-        amscr__w_u64(&w, amscr__fnv1a(w.buf, w.len));
+        amscr__w_u64(&w, amscr__db_checksum(AMSCR__DB_VERSION_FEATURES, w.buf, w.len));
     }
     if (w.oom) {
         free(w.buf);
@@ -142,8 +182,8 @@ static amscr_status read_lists(amscr__rbuf *r, amscr_index *x)
     return AMSCR_OK;
 }
 
-/* Shape names and class names. */
-static amscr_status read_names(amscr__rbuf *r, amscr_index *x)
+/* Shape names and class names, then the groups (version 3: when bytes are left). */
+static amscr_status read_names(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
     size_t n = amscr_db_size(x->db);
     int oom = 0;
@@ -162,14 +202,54 @@ static amscr_status read_names(amscr__rbuf *r, amscr_index *x)
         if (!amscr__r_str(r, &x->classes[c], &oom))
             return oom ? amscr__fail(AMSCR_E_NOMEM, "index file: out of memory")
                        : amscr__fail(AMSCR_E_FORMAT, "index file: class name %zu is truncated or invalid", c);
-    for (size_t i = 0; r->pos < r->len && i < n; i++) /* the groups, when a shape has one */
+    uint32_t groups = version >= AMSCR__DB_VERSION_FEATURES ? amscr__r_u32(r) : r->pos < r->len;
+    if (r->bad || groups > 1)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: bad groups flag");
+    for (size_t i = 0; groups && i < n; i++) /* the groups, when a shape has one */
         if (!amscr__r_str(r, &x->groups[i], &oom))
             return oom ? amscr__fail(AMSCR_E_NOMEM, "index file: out of memory")
                        : amscr__fail(AMSCR_E_FORMAT, "index file: shape %zu's group is truncated or invalid", i);
-    if (r->pos != r->len)
-        return amscr__fail(AMSCR_E_FORMAT, "index file: %zu unexpected bytes after the index section",
-                           r->len - r->pos);
     return AMSCR_OK;
+}
+
+/* The channel features of a version 4 file: each shape's height sequences (index.h's x->hf,
+ * their spectra not yet computed). */
+static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
+{
+    size_t n = amscr_db_size(x->db), N = amscr_db_params(x->db)->num_samples;
+    uint32_t nf = amscr__r_u32(r), ns = amscr__r_u32(r), bins = amscr__r_u32(r);
+    if (r->bad || nf != (uint32_t)x->nf || ns != N || bins != AMSCR__HF_BINS)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: channel features of %u frames, %u samples, %u bins; the "
+                                           "params give %d, %zu, %d", (unsigned)nf, (unsigned)ns, (unsigned)bins,
+                           x->nf, N, AMSCR__HF_BINS);
+    size_t bytes = N * AMSCR__HF_BINS, per = 2 * (size_t)nf * bytes;
+    if (per > 0 && (r->len - r->pos) / per < n)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: the channel features are truncated");
+    for (size_t e = 0; e < n * nf; e++) {
+        amscr__hf *h = &x->hf[e];
+        amscr__hf_free(h);
+        h->n = N;
+        h->nfreq = AMSCR__HF_FREQS(N) + 1;
+        for (int o = 0; o < 2; o++) {
+            h->seq[o] = x->map ? (uint8_t *)(x->map + r->pos) : malloc(bytes); /* mapped: read in place */
+            if (!h->seq[o])
+                return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
+            if (!x->map)
+                memcpy(h->seq[o], r->p + r->pos, bytes);
+            r->pos += bytes;
+        }
+    }
+    return AMSCR_OK;
+}
+
+/* What follows the names: the features (version 4), then nothing. */
+static amscr_status read_rest(amscr__rbuf *r, amscr_index *x, uint32_t version)
+{
+    amscr_status st = version >= AMSCR__DB_VERSION_FEATURES ? read_features(r, x) : AMSCR_OK;
+    if (st == AMSCR_OK && r->pos != r->len)
+        st = amscr__fail(AMSCR_E_FORMAT, "index file: %zu unexpected bytes after the index section",
+                         r->len - r->pos);
+    return st;
 }
 
 static amscr_status check_flags(unsigned flags, const char *what)
@@ -179,7 +259,9 @@ static amscr_status check_flags(unsigned flags, const char *what)
     return AMSCR_OK;
 }
 
-static amscr_status load_memory(const void *buf, size_t len, unsigned flags, amscr_index **out)
+/* The index in buf; map: buf is the file mapped for this load, which a lazy load keeps (the
+ * index unmaps it) and reads the heights from in place. */
+static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int map, amscr_index **out)
 {
     amscr_db *db = NULL;
     size_t pos = 0;
@@ -196,6 +278,10 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, ams
     x->sig_dim = AMSCR__SIG_DIM;
     x->nf = amscr__index_frames(amscr_db_params(db));
     x->lazy = (flags & AMSCR_INDEX_LAZY) != 0;
+    if (map && x->lazy) {
+        x->map = (unsigned char *)(uintptr_t)buf;
+        x->map_len = len;
+    }
     amscr__rbuf r = {buf, len - 8, pos, 0};
     uint64_t sec = version >= AMSCR__DB_VERSION_INDEX ? amscr__r_u64(&r) : 0;
     if (version < AMSCR__DB_VERSION_INDEX)
@@ -210,10 +296,13 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, ams
     if (st == AMSCR_OK)
         st = read_lists(&r, x);
     if (st == AMSCR_OK)
-        st = read_names(&r, x);
+        st = read_names(&r, x, version);
+    if (st == AMSCR_OK)
+        st = read_rest(&r, x, version);
     if (st == AMSCR_OK)
         st = amscr__index_features(x, 0, 1);
     if (st != AMSCR_OK) {
+        amscr__index_detach_map(x); /* the caller unmaps */
         amscr_index_free(x);
         return st;
     }
@@ -227,7 +316,7 @@ amscr_status amscr_index_load_memory_with(const void *buf, size_t len, unsigned 
     AMSCR_CHECK_NULL(buf);
     AMSCR_CHECK_NULL(out);
     amscr_status st = check_flags(flags, "amscr_index_load_memory_with");
-    return st == AMSCR_OK ? load_memory(buf, len, flags, out) : st;
+    return st == AMSCR_OK ? load_memory(buf, len, flags, 0, out) : st;
 }
 
 amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out)
@@ -245,16 +334,18 @@ amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index
         return st;
     unsigned char *buf = NULL;
     size_t len = 0;
-    st = amscr__file_read(path, &buf, &len);
+    int mapped = 0;
+    st = amscr__file_map(path, &buf, &len, &mapped);
     if (st != AMSCR_OK)
         return st;
-    st = load_memory(buf, len, flags, out);
+    st = load_memory(buf, len, flags, mapped, out);
     if (st != AMSCR_OK) {
         char d[400];
         snprintf(d, sizeof d, "%s", amscr_last_error_detail());
         amscr__fail(st, "%s: %s", path, d);
     }
-    free(buf);
+    if (st != AMSCR_OK || !(*out)->map) /* else the index keeps the mapping */
+        amscr__file_unmap(buf, len, mapped);
     return st;
 }
 

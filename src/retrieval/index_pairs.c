@@ -101,6 +101,30 @@ static amscr_status base_pair(const amscr__base *b, const amscr_descriptor *lo, 
     return AMSCR_OK;
 }
 
+static void spectra_free(const amscr__base *b, amscr__hf out[2])
+{
+    for (int f = 0; f < b->nf; f++) {
+        free(out[f].spec[0]);
+        free(out[f].spec[1]);
+    }
+}
+
+/* out[f]: the heights of stored[f] (shared, not copied) with their spectra computed here (with
+ * ws's FFT plan when it has one). */
+static amscr_status with_spectra(const amscr__base *b, const amscr__hf *stored, amscr__hf_ws *ws, amscr__hf out[2])
+{
+    amscr_status st = AMSCR_OK;
+    for (int f = 0; f < b->nf; f++) {
+        out[f] = stored[f];
+        out[f].spec[0] = out[f].spec[1] = NULL;
+    }
+    for (int f = 0; f < b->nf && st == AMSCR_OK; f++)
+        st = amscr__hf_spectra(&out[f], ws);
+    if (st != AMSCR_OK)
+        spectra_free(b, out);
+    return st;
+}
+
 amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const amscr__hf *hfs,
                                const amscr_descriptor *q, const amscr__hf hq[2], size_t qpos, const size_t *cand,
                                size_t m, amscr__pair_ws *pw, double *out)
@@ -112,9 +136,12 @@ amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const a
         const amscr__hf *stored = hfs ? hfs + cand[t] * (size_t)b->nf : NULL;
         /* not kept, or not built yet (an index loaded with AMSCR_INDEX_LAZY): built here */
         int build = !stored || (b->nf > 0 && stored[0].seq[0] == NULL);
-        const amscr__hf *hd = build ? built : stored;
+        int spectra = !build && b->nf > 0 && stored[0].spec[0] == NULL; /* the file's heights */
+        const amscr__hf *hd = build || spectra ? built : stored;
         if (build)
             st = amscr__base_hf(b, d, built);
+        else if (spectra)
+            st = with_spectra(b, stored, pw->have_hws ? &pw->hws : NULL, built);
         if (st != AMSCR_OK)
             break;
         if (cand[t] < qpos)
@@ -123,6 +150,8 @@ amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const a
             st = base_pair(b, q, hq, d, hd, pw, &out[t]);
         if (build)
             amscr__base_hf_free(b, built);
+        if (spectra)
+            spectra_free(b, built);
     }
     return st;
 }

@@ -220,7 +220,7 @@ amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c,
     if (!pts)
         return amscr__fail(AMSCR_E_NOMEM, "descriptor: out of memory");
     size_t m = amscr__dedupe_points(c->xy, c->n, closed, pts);
-    if (p->polish) { /* registration: isolated stray points dropped (despike.c) */
+    if (p->polish && AMSCR__STAGE_ON(p, AMSCR__STAGE_DESPIKE)) { /* registration: stray points dropped (despike.c) */
         double *scratch = amscr__malloc_array(m, sizeof *scratch);
         if (!scratch) {
             free(pts);

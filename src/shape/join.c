@@ -106,7 +106,7 @@ static amscr_status join_piece(const amscr__iso *f, const amscr__regions *R, siz
     if (a < 0.0)
         amscr__reverse_points(P, m);
     amscr__grid g = {0};
-    if (!amscr__grid_build(&g, *J, *n)) {
+    if (amscr__grid_build(&g, *J, *n) != 1) {
         free(P);
         amscr__grid_free(&g);
         return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_from_image: out of memory (joining)");

@@ -7,8 +7,9 @@
  *           bits 4-5 oversampling 1/2/4/8; bits 6-7 arc-length passes 1..4
  * Scales {0, 1, 2, 3}. Properties on success: finite distance >= 0, equal (to rounding) to
  * amscr_distance on the same descriptors, finite maps, shift < N, kept <= scales. Curves under
- * affine invariance are registered again with the polish on (stray points dropped, the
- * fit on the input points, the order of noisy points): a finite map or a clean error. */
+ * affine invariance are registered again with the polish and every optional stage on (stray
+ * points dropped, the fit on the input points, the order and even spacing of noisy points): a
+ * finite map or a clean error; finite alternatives, the chosen map first. */
 #include <math.h>
 #include <string.h>
 
@@ -24,12 +25,23 @@ static void polished(const amscr_params *p, const amscr_contour *a, const amscr_
     amscr_result *r = NULL;
     set_ok(amscr_params_copy(p, &q));
     set_ok(amscr_params_set_polish(q, 1));
+    set_ok(amscr_params_set_stage(q, "despike", 1)); /* the opt-in stages too */
+    set_ok(amscr_params_set_stage(q, "order", 1));
+    set_ok(amscr_params_set_stage(q, "even_spacing", 1));
     amscr_status st = amscr_register_contours(q, a, tgt, &r);
     if (st == AMSCR_OK) {
-        double m[6];
+        double m[6], c = 0.0;
         FUZZ_CHECK(amscr_result_affine(r, m) == AMSCR_OK);
         for (int i = 0; i < 6; i++)
             FUZZ_CHECK(isfinite(m[i]));
+        size_t na = amscr_result_num_alternatives(r); /* the chosen map first, finite maps */
+        FUZZ_CHECK(na >= 1);
+        for (size_t k = 0; k < na; k++) {
+            double ak[6];
+            FUZZ_CHECK(amscr_result_alternative(r, k, ak, &c) == AMSCR_OK);
+            for (int i = 0; i < 6; i++)
+                FUZZ_CHECK(isfinite(ak[i]) && (k > 0 || ak[i] == m[i]));
+        }
         amscr_result_free(r);
     } else {
         FUZZ_CHECK(r == NULL);

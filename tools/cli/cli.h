@@ -40,6 +40,7 @@ enum {
     TOOL_RERANK_ITERS_MAX = 1000, /* --rerank ITER: diffusion converges long before */
     TOOL_POINTS_MIN = 16,         /* the library's range of samples: 16..AMSCR_MAX_SAMPLES */
     TOOL_REFINE_MAX = 50,         /* the library's range of refinement iterations */
+    TOOL_STAGES_MAX = 8,          /* register --stage: more than the switchable stages */
     TOOL_KMAX_MAX = 16,           /* the library's range of the elbow's Kmax */
     TOOL_THREADS_MAX = 1024,      /* the library's range of threads */
     TOOL_SPLITS_DEFAULT = 10,     /* eval --protocol split: random splits averaged */
@@ -92,6 +93,9 @@ typedef struct opts {
     int open;
     int partial; /* register --partial */
     int no_polish; /* register --no-polish (0.3) */
+    char stage_name[TOOL_STAGES_MAX][32]; /* register --stage NAME=on|off (0.5), in order given */
+    int stage_on[TOOL_STAGES_MAX];
+    size_t nstages;
     int refine_set;
     unsigned refine;
     int threads_set;

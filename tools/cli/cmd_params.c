@@ -39,6 +39,8 @@ int make_params(const opts *o, int registration, amscr_params **out)
     SET(o->partial, "--partial", amscr_params_set_partial(p, 1));
     SET(o->no_polish, "--no-polish", amscr_params_set_polish(p, 0));
     SET(o->refine_set, "--refine", amscr_params_set_refine(p, o->refine));
+    for (size_t i = 0; i < o->nstages; i++)
+        SET(1, "--stage", amscr_params_set_stage(p, o->stage_name[i], o->stage_on[i]));
     SET(o->threads_set, "--threads", amscr_params_set_num_threads(p, o->threads));
     SET(o->kmax_set, "--kmax", amscr_params_set_kmax(p, o->kmax));
     SET(o->symmetric, "--symmetric", amscr_params_set_symmetric(p, 1));

@@ -31,6 +31,11 @@ typedef struct reg_report {
     double conf, amb, inl, part[2];
     size_t ncorr;
     double *corr_param, *corr_xy; /* ncorr and 2 ncorr */
+    /* the pipeline's stages and whether each ran; the maps that fit about as well (0.5) */
+    size_t nstages, nalt;
+    const char **stage_name; /* nstages, the library's strings */
+    int *stage_ran;          /* nstages */
+    double *alt, *alt_cost;  /* 6 nalt and nalt: maps in input coordinates, ranking costs */
 } reg_report;
 
 static void report_free(reg_report *r)
@@ -41,6 +46,10 @@ static void report_free(reg_report *r)
     free(r->sse);
     free(r->corr_param);
     free(r->corr_xy);
+    free(r->stage_name);
+    free(r->stage_ran);
+    free(r->alt);
+    free(r->alt_cost);
 }
 
 /* Prepares both shapes; --partial: the source open, the target closed. */
@@ -127,9 +136,32 @@ static int read_arrays(const amscr_result *res, const amscr_params *p, reg_repor
     return 0;
 }
 
+/* The stages and the alternatives of the report. */
+static int read_stages(const amscr_result *res, reg_report *r)
+{
+    r->nstages = amscr_result_num_stages(res);
+    r->nalt = amscr_result_num_alternatives(res);
+    r->stage_name = xmalloc_array(r->nstages ? r->nstages : 1, sizeof *r->stage_name);
+    r->stage_ran = xmalloc_array(r->nstages ? r->nstages : 1, sizeof *r->stage_ran);
+    r->alt = xmalloc_array(r->nalt ? 6 * r->nalt : 1, sizeof *r->alt);
+    r->alt_cost = xmalloc_array(r->nalt ? r->nalt : 1, sizeof *r->alt_cost);
+    if (!r->stage_name || !r->stage_ran || !r->alt || !r->alt_cost)
+        return -1;
+    amscr_status st = AMSCR_OK;
+    for (size_t i = 0; i < r->nstages && st == AMSCR_OK; i++)
+        st = amscr_result_stage(res, i, &r->stage_name[i], &r->stage_ran[i]);
+    for (size_t i = 0; i < r->nalt && st == AMSCR_OK; i++)
+        st = amscr_result_alternative(res, i, r->alt + 6 * i, &r->alt_cost[i]);
+    if (st != AMSCR_OK) {
+        tool_lib_error("register", st);
+        return -1;
+    }
+    return 0;
+}
+
 static int read_report(const amscr_result *res, const amscr_params *p, reg_report *r)
 {
-    if (read_arrays(res, p, r) != 0)
+    if (read_arrays(res, p, r) != 0 || read_stages(res, r) != 0)
         return -1;
     r->dist = amscr_result_distance(res);
     r->thr = amscr_result_threshold(res);
@@ -219,6 +251,38 @@ static void json_confidence(sbuf *b, const opts *o, const reg_report *r)
     sb_puts(b, "]}");
 }
 
+/* A map m6 as "A": [[a11, a12], [a21, a22]], "B": [b1, b2] (after `lead`). */
+static void json_map(sbuf *b, const char *lead, const double *m)
+{
+    double a0[2] = {m[0], m[1]}, a1[2] = {m[3], m[4]}, t[2] = {m[2], m[5]};
+    sb_puts(b, lead);
+    sb_puts(b, "\"A\": [");
+    sb_json_nums(b, a0, NULL, 2);
+    sb_puts(b, ", ");
+    sb_json_nums(b, a1, NULL, 2);
+    sb_puts(b, "], \"B\": ");
+    sb_json_nums(b, t, NULL, 2);
+}
+
+/* "stages": {name: ran, ...} in pipeline order; "alternatives": [{"A", "B", "cost"}, ...]. */
+static void json_stages(sbuf *b, const reg_report *r)
+{
+    sb_puts(b, ", \"stages\": {");
+    for (size_t i = 0; i < r->nstages; i++) {
+        sb_puts(b, i ? ", " : "");
+        sb_json_str(b, r->stage_name[i]);
+        sb_puts(b, r->stage_ran[i] ? ": true" : ": false");
+    }
+    sb_puts(b, "}, \"alternatives\": [");
+    for (size_t i = 0; i < r->nalt; i++) {
+        json_map(b, i ? ", {" : "{", r->alt + 6 * i);
+        sb_puts(b, ", \"cost\": ");
+        sb_json_num(b, r->alt_cost[i]);
+        sb_puts(b, "}");
+    }
+    sb_puts(b, "]");
+}
+
 static void format_json(sbuf *b, const opts *o, const amscr_contour *src, const amscr_contour *tgt,
                         const reg_report *r)
 {
@@ -227,13 +291,7 @@ static void format_json(sbuf *b, const opts *o, const amscr_contour *src, const 
     sb_json_str(b, o->pos[0]);
     sb_puts(b, ", \"target\": ");
     sb_json_str(b, o->pos[1]);
-    double a0[2] = {m[0], m[1]}, a1[2] = {m[3], m[4]}, t[2] = {m[2], m[5]};
-    sb_puts(b, ", \"A\": [");
-    sb_json_nums(b, a0, NULL, 2);
-    sb_puts(b, ", ");
-    sb_json_nums(b, a1, NULL, 2);
-    sb_puts(b, "], \"B\": ");
-    sb_json_nums(b, t, NULL, 2);
+    json_map(b, ", ", m);
     sb_puts(b, ", \"distance\": ");
     sb_json_num(b, r->dist);
     sb_puts(b, ", \"method\": ");
@@ -258,6 +316,7 @@ static void format_json(sbuf *b, const opts *o, const amscr_contour *src, const 
     sb_printf(b, "}, \"samples\": %zu, \"closed\": %s, \"source_points\": %zu, \"target_points\": %zu", r->N,
               o->open ? "false" : "true", amscr_contour_size(src), amscr_contour_size(tgt));
     json_confidence(b, o, r);
+    json_stages(b, r);
     sb_puts(b, "}\n");
 }
 
@@ -294,6 +353,13 @@ static void format_text(sbuf *b, const opts *o, const amscr_contour *src, const 
               r->conf < 0.25 ? "  LOW: the map may be wrong" : "");
     if (o->partial)
         sb_printf(b, "part        %.4f .. %.4f of the target's boundary\n", r->part[0], r->part[1]);
+    if (r->nalt > 1)
+        sb_printf(b, "alternatives %zu distinct maps fit about as well (--json: \"alternatives\")\n", r->nalt - 1);
+    sb_puts(b, "stages     ");
+    for (size_t i = 0; i < r->nstages; i++)
+        if (r->stage_ran[i])
+            sb_printf(b, " %s", r->stage_name[i]);
+    sb_puts(b, "   (the stages that ran)\n");
     if (o->overlay)
         sb_printf(b, "overlay     %s\n", o->overlay);
     if (o->plot)

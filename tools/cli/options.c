@@ -46,6 +46,7 @@ typedef enum opt_id {
     O_INVARIANCE,
     O_PARTIAL,
     O_NO_POLISH,
+    O_STAGE,
     O_RERANK,
     O_NO_RERANK,
     O_CHANNEL_WEIGHT,
@@ -98,6 +99,7 @@ static const optdef OPTS[] = {
     {"--invariance", O_INVARIANCE, 1, C_SHAPES, "NAME"},
     {"--partial", O_PARTIAL, 0, C_REGISTER, NULL},
     {"--no-polish", O_NO_POLISH, 0, C_REGISTER, NULL},
+    {"--stage", O_STAGE, 1, C_REGISTER, "NAME=on|off"},
     {"--rerank", O_RERANK, 1, C_RETRIEVAL, "K[,ITER]"},
     {"--no-rerank", O_NO_RERANK, 0, C_RETRIEVAL, NULL},
     {"--channel-weight", O_CHANNEL_WEIGHT, 1, C_RETRIEVAL, "W"},
@@ -148,6 +150,21 @@ static int parse_size(const char *opt, const char *s, size_t lo, size_t hi, size
 }
 
 /* parse_size into an unsigned field, setting *set. */
+/* --stage NAME=on|off (repeatable): the name is checked by the library (amscr_params_set_stage). */
+static int parse_stage(const char *opt, const char *s, opts *o)
+{
+    const char *eq = strchr(s, '=');
+    size_t len = eq ? (size_t)(eq - s) : 0;
+    if (!eq || len == 0 || len >= sizeof o->stage_name[0] || (strcmp(eq + 1, "on") != 0 && strcmp(eq + 1, "off") != 0))
+        return usage_error(opt, "expected NAME=on or NAME=off, got '%s'", s);
+    if (o->nstages == TOOL_STAGES_MAX)
+        return usage_error(opt, "at most %d stages", TOOL_STAGES_MAX);
+    memcpy(o->stage_name[o->nstages], s, len);
+    o->stage_name[o->nstages][len] = '\0';
+    o->stage_on[o->nstages++] = strcmp(eq + 1, "on") == 0;
+    return 0;
+}
+
 static int parse_unsigned(const char *opt, const char *s, size_t lo, size_t hi, int *set, unsigned *out)
 {
     size_t t;
@@ -332,6 +349,7 @@ static int set_option(opts *o, const optdef *d, const char *v)
     case O_OPEN: o->open = 1; return 0;
     case O_PARTIAL: o->partial = 1; return 0;
     case O_NO_POLISH: o->no_polish = 1; return 0;
+    case O_STAGE: return parse_stage(n, v, o);
     case O_REFINE: return parse_unsigned(n, v, 0, TOOL_REFINE_MAX, &o->refine_set, &o->refine);
     case O_THREADS: return parse_unsigned(n, v, 0, TOOL_THREADS_MAX, &o->threads_set, &o->threads);
     case O_KMAX: return parse_unsigned(n, v, 1, TOOL_KMAX_MAX, &o->kmax_set, &o->kmax);

@@ -35,7 +35,7 @@ from .params import Params
 from .contour import (ImageContour, as_points, contour_from_mask, contours_from_mask, orient_ccw, parse_points,
                       read_points, signed_area, validate_contour, write_points)
 from .shape import PointsLike, Shape
-from .result import Mixture, Registration, channel_distance, distance, register
+from .result import Alternative, Mixture, Registration, channel_distance, distance, register
 from .collection import Collection, distance_matrix
 from .scores import bullseye, nn_accuracy, nn_split, topk, topk_table
 from .scores import (ClassScores, GroupScores, PrecisionRecall, SplitScores, nn_groups, nn_random_split,
@@ -58,7 +58,7 @@ __all__ = [
     'UnsupportedError', 'DegenerateError', 'NumericError', 'NumericalError', 'NotConvergedError',
     'NotFoundError', 'StateError', 'InternalError', 'CancelledError', 'LimitError',
     # registration and retrieval
-    'Params', 'Shape', 'Registration', 'Mixture', 'register', 'distance', 'channel_distance', 'Collection',
+    'Params', 'Shape', 'Registration', 'Mixture', 'Alternative', 'register', 'distance', 'channel_distance', 'Collection',
     'distance_matrix',
     'bullseye', 'topk_table', 'nn_accuracy', 'nn_split', 'topk', 'rerank_diffusion',
     # contours

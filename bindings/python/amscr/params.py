@@ -73,6 +73,30 @@ class _Option(Generic[T]):
         _check(self.c_set(obj._p, *self.conv.write(value, self.name)))
 
 
+#: The stages of ``amscr_register`` a Params can switch (C ``amscr_params_set_stage``).
+SWITCHABLE_STAGES: Tuple[str, ...] = ('despike', 'recovery', 'polish', 'order', 'even_spacing')
+
+
+class _StagesOption(_Option[Dict[str, bool]]):
+    """The switchable stages as a dict {name: on}; setting one changes the names it holds only."""
+
+    def __init__(self, doc: str):
+        super().__init__('stage', _BOOL, doc)  # type: ignore[arg-type]
+
+    def __get__(self, obj, owner=None):
+        if obj is None:
+            return self
+        return {k: bool(self.c_get(obj._p, k.encode())) for k in SWITCHABLE_STAGES}
+
+    def __set__(self, obj: 'Params', value: Any) -> None:
+        if not isinstance(value, dict):
+            raise TypeError('stages: expected a dict {stage name: bool}, got %s' % type(value).__name__)
+        for k, on in value.items():
+            if not isinstance(k, str):
+                raise TypeError('stages: stage names are str, got %s' % type(k).__name__)
+            _check(self.c_set(obj._p, k.encode(), as_bool(on, 'stages[%r]' % k)))
+
+
 def _new_params(make: Callable[..., int], *args: Any):
     return new_object('amscr_params', make, lib.amscr_params_free, *args)
 
@@ -105,8 +129,12 @@ class Params:
     penalty = _Option('penalty', _FLOAT, "weight of the 'penalized' invariance")
     partial = _Option('partial', _BOOL, "the source is an open fragment of the target's closed boundary (register)")
     polish = _Option('polish', _BOOL, 'polish the map on the input points, fitting the noisier curve onto the '
-                     'cleaner and, for markedly noisy points, using their order and even spacing (register; on in the '
-                     'registration preset)')
+                     'cleaner (register; on in the registration preset; its order and even-spacing steps for '
+                     'markedly noisy point lists are opt-in: stages)')
+    stages = _StagesOption("the optional stages of register on or off, a dict {name: bool} over "
+                           "'despike', 'recovery', 'polish', 'order', 'even_spacing' (setting one leaves the others; "
+                           "default: despike, order and even_spacing off, for point lists with stray points or "
+                           "synthetic noise; Registration.stages says which ran)")
     channel_weight = _Option('channel_weight', _FLOAT,
                              'share of the shape channel in Collection.retrieval_matrix, 0..1 (0 = the AMSCR '
                              'distance alone, the default; 1 = the channel alone, the retrieval preset)')

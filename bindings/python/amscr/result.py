@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import threading
-from typing import Any, Dict, NamedTuple, Optional, Tuple
+from typing import Any, Dict, List, NamedTuple, Optional, Tuple
 
 import numpy as np
 
@@ -30,6 +30,13 @@ class Mixture(NamedTuple):
     weights: np.ndarray
     means: np.ndarray
     variances: np.ndarray
+
+
+class Alternative(NamedTuple):
+    """A map that fits about as well as the chosen one (see :attr:`Registration.alternatives`)."""
+    A: np.ndarray
+    B: np.ndarray
+    cost: float
 
 
 class Registration:
@@ -66,6 +73,15 @@ class Registration:
         inlier_fraction: share of source samples within 5 % of the target's size of its boundary.
         part: (start, end) fractions of the target's boundary the source's first and last samples
             fall on (where a fragment lies, with partial=True).
+        stages: dict {stage name: whether it ran}, in pipeline order (despike, search, method,
+            recovery, final_solve, symmetric, polish, order, even_spacing, alternatives,
+            correspondences; C ``amscr_result_stage``).
+        alternatives: list of :class:`Alternative` (A, B, cost): the distinct maps that fit
+            about as well, the chosen map first (always there; its cost NaN when the
+            registration ranked no starts), then each map that moves the source samples by more
+            than 10 % of the shape's RMS radius from those before and whose ranking cost is
+            within a factor 4/3 of the chosen one's (ambiguity >= 0.75): a square gives its
+            quarter turns, an asymmetric shape the chosen map alone.
         correspondences: (N,) target boundary parameter (fraction) matched to each source sample.
         source_samples: (N, 2) the source samples (input coordinates).
         target_points: (N, 2) the matched target boundary points (input coordinates).
@@ -100,6 +116,8 @@ class Registration:
         _check(lib.amscr_result_part(r, part, part + 1))
         self.part = (float(part[0]), float(part[1]))
         self.source_samples, self.correspondences, self.target_points = _correspondences(r)
+        self.stages = _stages(r)
+        self.alternatives = _alternatives(r)
 
     def apply(self, points: ArrayLike, order: str = 'xy') -> np.ndarray:
         """Maps points of the source onto the target: ``points @ A.T + B``.
@@ -131,6 +149,26 @@ def _correspondences(r) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
         _check(lib.amscr_result_correspondences(r, ffi.from_buffer('double[]', src), ffi.from_buffer('double[]', par),
                                                 ffi.from_buffer('double[]', tgt), n))
     return src, par, tgt
+
+
+def _stages(r) -> Dict[str, bool]:
+    """{stage name: ran} of a result, in pipeline order."""
+    name, ran = ffi.new('const char **'), ffi.new('int *')
+    out: Dict[str, bool] = {}
+    for i in range(int(lib.amscr_result_num_stages(r))):
+        _check(lib.amscr_result_stage(r, i, name, ran))
+        out[ffi.string(name[0]).decode()] = bool(ran[0])
+    return out
+
+
+def _alternatives(r) -> List[Alternative]:
+    """The alternatives of a result, the chosen map first."""
+    m, cost = ffi.new('double[6]'), ffi.new('double *')
+    out = []
+    for i in range(int(lib.amscr_result_num_alternatives(r))):
+        _check(lib.amscr_result_alternative(r, i, m, cost))
+        out.append(Alternative(np.array([[m[0], m[1]], [m[3], m[4]]]), np.array([m[2], m[5]]), float(cost[0])))
+    return out
 
 
 def _pair(src: PointsLike, tgt: PointsLike, params: Optional[Params], options: Dict[str, Any], order: str
@@ -172,8 +210,10 @@ def register(src: PointsLike, tgt: PointsLike, *, method: Optional[str] = None, 
             points such as scikit-image's ``measure.find_contours`` gives. Either way the
             result is in the (x, y) frame: 'rc' points are swapped on the way in.
         **options: other options of :class:`Params`, e.g. ``partial=True`` (the source an open
-            fragment of the target) or ``polish=False`` (skip the final fit on the input points,
-            on in the preset: it fits the noisier curve onto the cleaner one).
+            fragment of the target), ``polish=False`` (skip the final fit on the input points,
+            on in the preset: it fits the noisier curve onto the cleaner one) or
+            ``stages={'even_spacing': True}`` (switch an optional stage; see
+            :attr:`Params.stages`).
 
     Returns:
         a :class:`Registration`: the affine map (``A``, ``B``, ``matrix``), the distance and the

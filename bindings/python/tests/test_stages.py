@@ -1,0 +1,103 @@
+"""Registration.stages (which stages of the pipeline ran, in order), Params.stages (the optional
+stages' switches) and Registration.alternatives (the distinct maps that fit about as well)."""
+import pickle
+
+import numpy as np
+import pytest
+
+import amscr
+
+PIPELINE = ['despike', 'search', 'method', 'recovery', 'final_solve', 'symmetric', 'polish', 'order',
+            'even_spacing', 'alternatives', 'correspondences']
+A = np.array([[1.3, 0.4], [-0.2, 0.9]])
+B = np.array([3.0, 1.0])
+
+
+def outline(vertices, n):
+    v = np.asarray(vertices, float)
+    per = n // len(v)
+    t = np.arange(per)[:, None] / per
+    return np.vstack([v[i] + t * (v[(i + 1) % len(v)] - v[i]) for i in range(len(v))])
+
+
+SQUARE = [[0, 0], [1, 0], [1, 1], [0, 1]]
+CROSS = [[1, 0], [2, 0], [2, 1], [3, 1], [3, 2], [2, 2], [2, 3], [1, 3], [1, 2], [0, 2], [0, 1], [1, 1]]
+TRIANGLE = [[0, 0], [1, 0], [0.5, np.sqrt(3) / 2]]
+ELL = [[0, 0], [3, 0], [3, 1], [1, 1], [1, 2.5], [0, 2.5]]
+
+
+def pair(vertices, n=480):
+    src = outline(vertices, n)
+    return src, src @ A.T + B
+
+
+def test_stages_dict_in_pipeline_order():
+    r = amscr.register(*pair(ELL))
+    assert list(r.stages) == PIPELINE
+    assert all(isinstance(v, bool) for v in r.stages.values())
+    assert r.stages['search'] and r.stages['polish'] and r.stages['correspondences']
+    assert not r.stages['symmetric'] and not r.stages['recovery']
+    assert amscr.register(*pair(ELL), symmetric=True).stages['symmetric']
+
+
+def test_params_stages_switch():
+    p = amscr.Params.registration()
+    assert set(p.stages) == set(amscr.params.SWITCHABLE_STAGES)
+    p.stages = {'polish': False}
+    assert p.stages['polish'] is False and p.stages['recovery'] is True  # the others unchanged
+    assert p.polish  # the polish option is its own switch
+    q = pickle.loads(pickle.dumps(p))
+    assert q == p and q.stages == p.stages
+    assert p != amscr.Params.registration()
+    r = amscr.register(*pair(ELL), params=p)
+    assert not r.stages['polish']
+    on = amscr.register(*pair(ELL), stages={'polish': True})
+    assert on.stages['polish'] and not np.array_equal(on.A, r.A)
+
+
+@pytest.mark.parametrize('bad', [{'search': False}, {'nonsense': True}])
+def test_params_stages_refused(bad):
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.Params(stages=bad)
+
+
+def test_params_stages_type():
+    with pytest.raises(TypeError):
+        amscr.Params(stages=['polish'])
+
+
+def check_alternatives(r, vertices, at_least):
+    """At least `at_least` distinct maps, each a symmetry of the polygon, about equal costs."""
+    alts = r.alternatives
+    assert len(alts) >= at_least
+    assert np.array_equal(alts[0].A, r.A) and np.array_equal(alts[0].B, r.B)
+    assert r.confidence <= 0.25 and r.ambiguity >= 0.75
+    v = np.asarray(vertices, float)
+    tv = v @ A.T + B
+    for alt in alts:
+        assert isinstance(alt, amscr.Alternative) and alt.A.shape == (2, 2) and alt.B.shape == (2,)
+        w = v @ alt.A.T + alt.B
+        gap = np.min(np.linalg.norm(w[:, None] - tv[None], axis=2), axis=1).max()
+        assert gap < 0.02  # every vertex onto a target vertex: a symmetry
+        assert (alts[0].cost + 1e-9) / (alt.cost + 1e-9) >= 0.75
+    images = [v @ a.A.T + a.B for a in alts]
+    for i in range(len(images)):
+        for j in range(i):
+            assert np.abs(images[i] - images[j]).max() > 0.1  # distinct
+
+
+@pytest.mark.parametrize('name,vertices', [('square', SQUARE), ('cross', CROSS), ('triangle', TRIANGLE)])
+def test_symmetric_shapes_list_alternatives(name, vertices):
+    check_alternatives(amscr.register(*pair(vertices)), vertices, 3)
+
+
+def test_asymmetric_shape_lists_the_chosen_map_only():
+    r = amscr.register(*pair(ELL))
+    assert len(r.alternatives) == 1
+    assert np.array_equal(r.alternatives[0].A, r.A)
+    assert np.isfinite(r.alternatives[0].cost) and r.confidence > 0.9
+
+
+def test_no_ranking_without_refinement():
+    r = amscr.register(*pair(SQUARE), refine=0)
+    assert len(r.alternatives) == 1 and np.isnan(r.alternatives[0].cost)

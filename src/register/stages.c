@@ -1,0 +1,144 @@
+/* stages.c — the stage table of amscr_register (docs/method.md §12): every stage's name, its
+ * function and when it runs, in pipeline order. The runner calls each stage whose condition
+ * holds, records that it ran (amscr_result_stage) and stops at the first status that is not
+ * AMSCR_OK, which it returns unchanged (an allocation failure anywhere reaches the caller as
+ * AMSCR_E_NOMEM). The batch path (amscr_distance, register.c) runs search, method and the
+ * symmetric way back only.
+ *
+ * Switchable stages (amscr_params_set_stage) are the optional ones: despike, recovery, polish,
+ * order, even_spacing. The despike runs when a shape is prepared (amscr_descriptor_new); its
+ * entry records that it did for either shape. */
+#include "match.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* What the stages share: the pair, the result they fill and the state passed on between them. */
+typedef struct {
+    const amscr_params *prm;
+    const amscr_descriptor *f, *h;
+    amscr_workspace *ws;
+    amscr_result *r;
+    amscr__search search;     /* the search's candidates, for the method */
+    amscr__polish_state *pol; /* the polish's state, for its order and even-spacing steps */
+} stage_ctx;
+
+typedef struct {
+    const char *name;
+    amscr_status (*run)(stage_ctx *c); /* NULL: runs when a shape is prepared */
+    int (*when)(const stage_ctx *c);
+    int optional; /* switchable by amscr_params_set_stage */
+} stage_t;
+
+static int affine(const stage_ctx *c) { return c->prm->invariance == AMSCR_INVARIANCE_AFFINE; }
+static int is_on(const stage_ctx *c, int i) { return AMSCR__STAGE_ON(c->prm, i); }
+
+/* ---- conditions ---- */
+static int despiked(const amscr_descriptor *d)
+{
+    return d->params.polish && AMSCR__STAGE_ON(&d->params, AMSCR__STAGE_DESPIKE);
+}
+static int when_despike(const stage_ctx *c) { return despiked(c->f) || despiked(c->h); }
+static int always(const stage_ctx *c) { return c != NULL; }
+static int when_recovery(const stage_ctx *c)
+{
+    return !c->prm->partial && affine(c) && c->f->params.closed && is_on(c, AMSCR__STAGE_RECOVERY) &&
+           amscr__recover_applies(c->f, c->h, c->ws, &c->r->m);
+}
+/* The reported QR solve: affine invariance, and every partial match (its pairs' affine fit). */
+static int when_final(const stage_ctx *c) { return affine(c) || c->prm->partial; }
+static int when_symmetric(const stage_ctx *c) { return c->prm->symmetric && !c->prm->partial; }
+static int when_polish(const stage_ctx *c)
+{
+    const amscr_descriptor *f = c->f, *h = c->h;
+    return c->prm->polish && is_on(c, AMSCR__STAGE_POLISH) && f->raw && h->raw && h->params.closed &&
+           (c->prm->partial || f->params.closed) && affine(c);
+}
+static int when_order(const stage_ctx *c)
+{
+    return c->pol && is_on(c, AMSCR__STAGE_ORDER) && amscr__polish_steps_apply(c->pol);
+}
+static int when_even(const stage_ctx *c)
+{
+    return c->pol && is_on(c, AMSCR__STAGE_EVEN) && amscr__polish_steps_apply(c->pol);
+}
+
+/* ---- stages ---- */
+/* The start-point search (partial: the fragment's placement, refined). */
+static amscr_status run_search(stage_ctx *c)
+{
+    if (c->prm->partial)
+        return amscr__match_partial(c->prm, c->f, c->h, c->ws, &c->r->m);
+    return amscr__search_starts(c->prm, c->f, c->h, c->ws, &c->search);
+}
+/* The method and its refinement at the chosen start (partial: the adaptive refinement). */
+static amscr_status run_method(stage_ctx *c)
+{
+    if (c->prm->partial)
+        return amscr__refine_adaptive(c->prm, c->f, c->h, c->ws, &c->r->m);
+    return amscr__method_at(c->prm, c->f, c->h, c->ws, &c->search, &c->r->m);
+}
+static amscr_status run_recovery(stage_ctx *c) { return amscr__recover_missing(c->prm, c->f, c->h, c->ws, &c->r->m); }
+static amscr_status run_final(stage_ctx *c) { return amscr__final_solve(c->prm, c->f, c->h, c->ws, &c->r->m); }
+/* The distance of a symmetric match: the mean of both directions' (the reported map stays). */
+static amscr_status run_symmetric(stage_ctx *c)
+{
+    match_t back;
+    amscr_status st = amscr__match_dir(c->prm, c->h, c->f, c->ws, &back);
+    if (st == AMSCR_OK)
+        c->r->m.dist = 0.5 * (c->r->m.dist + back.dist);
+    return st;
+}
+static amscr_status run_polish(stage_ctx *c) { return amscr__polish_fit(c->f, c->h, c->prm->partial, &c->r->m, &c->pol); }
+static amscr_status run_order(stage_ctx *c) { return amscr__polish_order(c->pol, &c->r->m); }
+static amscr_status run_even(stage_ctx *c) { return amscr__polish_even(c->pol, &c->r->m); }
+static amscr_status run_alternatives(stage_ctx *c)
+{
+    amscr__alternatives(c->f, c->h, c->r);
+    return AMSCR_OK;
+}
+static amscr_status run_correspond(stage_ctx *c) { return amscr__correspond(c->f, c->h, c->r); }
+
+/* The pipeline, in order (indexed by AMSCR__STAGE_*). */
+static const stage_t STAGES[AMSCR__NUM_STAGES] = {
+    [AMSCR__STAGE_DESPIKE] = {"despike", NULL, when_despike, 1},
+    [AMSCR__STAGE_SEARCH] = {"search", run_search, always, 0},
+    [AMSCR__STAGE_METHOD] = {"method", run_method, always, 0},
+    [AMSCR__STAGE_RECOVERY] = {"recovery", run_recovery, when_recovery, 1},
+    [AMSCR__STAGE_FINAL_SOLVE] = {"final_solve", run_final, when_final, 0},
+    [AMSCR__STAGE_SYMMETRIC] = {"symmetric", run_symmetric, when_symmetric, 0},
+    [AMSCR__STAGE_POLISH] = {"polish", run_polish, when_polish, 1},
+    [AMSCR__STAGE_ORDER] = {"order", run_order, when_order, 1},
+    [AMSCR__STAGE_EVEN] = {"even_spacing", run_even, when_even, 1},
+    [AMSCR__STAGE_ALTERNATIVES] = {"alternatives", run_alternatives, always, 0},
+    [AMSCR__STAGE_CORRESPOND] = {"correspondences", run_correspond, always, 0},
+};
+
+const char *amscr__stage_name(size_t i) { return i < AMSCR__NUM_STAGES ? STAGES[i].name : NULL; }
+
+int amscr__stage_switch(const char *name)
+{
+    for (int i = 0; name && i < AMSCR__NUM_STAGES; i++)
+        if (STAGES[i].optional && strcmp(STAGES[i].name, name) == 0)
+            return i;
+    return -1;
+}
+
+amscr_status amscr__run_stages(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                               amscr_workspace *ws, amscr_result *r)
+{
+    stage_ctx c;
+    memset(&c, 0, sizeof c);
+    c.prm = prm, c.f = src, c.h = tgt, c.ws = ws, c.r = r;
+    amscr_status st = AMSCR_OK;
+    for (size_t i = 0; i < AMSCR__NUM_STAGES && st == AMSCR_OK; i++) {
+        if (!STAGES[i].when(&c))
+            continue;
+        r->ran[i] = 1;
+        if (STAGES[i].run)
+            st = STAGES[i].run(&c);
+    }
+    amscr__polish_end(c.pol);
+    return st;
+}

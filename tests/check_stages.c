@@ -1,0 +1,287 @@
+/* check_stages.c — the registration pipeline as named stages (src/register/stages.c) and the
+ * distinct maps that fit about as well (src/register/alternatives.c): the stage list in pipeline
+ * order, which stages run for which pair, the switches of the optional stages, and the
+ * alternatives of symmetric shapes (a square, a 4-armed cross, an equilateral triangle) against
+ * an asymmetric one. Out of memory in every stage: tests/oom_register.c. */
+#include <amscr.h>
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "suites.h"
+#include "testutil.h"
+
+static const char *const PIPELINE[] = {"despike", "search", "method", "recovery", "final_solve", "symmetric",
+                                       "polish", "order", "even_spacing", "alternatives", "correspondences"};
+enum { NSTAGES = sizeof PIPELINE / sizeof PIPELINE[0] };
+
+/* A polygon's outline (nv vertices) with m points (m / nv per edge); a test map applied. */
+static double *outline(const double *v, size_t nv, size_t m, const double M[6])
+{
+    double *p = malloc(2 * m * sizeof *p), *q = malloc(2 * m * sizeof *q);
+    ck_assert(p && q && m % nv == 0);
+    ck_assert_uint_eq(amscr_test_polygon(v, nv, m / nv, p), m);
+    amscr_test_apply_affine(M, p, m, q);
+    free(p);
+    return q;
+}
+
+static const double ID[6] = {1, 0, 0, 0, 1, 0}, MAP[6] = {1.3, 0.4, 3.0, -0.2, 0.9, 1.0};
+
+/* src -> tgt with params p (NULL: the registration preset). */
+static amscr_result *reg(const amscr_params *p, const double *a, size_t na, const double *b, size_t nb)
+{
+    amscr_contour *s = NULL, *t = NULL;
+    amscr_result *r = NULL;
+    ck_assert_int_eq(amscr_contour_new(a, na, &s), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_new(b, nb, &t), AMSCR_OK);
+    ck_assert_int_eq(amscr_register_contours(p, s, t, &r), AMSCR_OK);
+    amscr_contour_free(s);
+    amscr_contour_free(t);
+    return r;
+}
+
+static int ran(const amscr_result *r, const char *name)
+{
+    for (size_t i = 0; i < amscr_result_num_stages(r); i++) {
+        const char *n = NULL;
+        int on = -1;
+        ck_assert_int_eq(amscr_result_stage(r, i, &n, &on), AMSCR_OK);
+        if (strcmp(n, name) == 0)
+            return on;
+    }
+    ck_abort_msg("no stage %s", name);
+    return -1;
+}
+
+/* Registers the polygon v (nv) onto its image under MAP. */
+static amscr_result *self_pair(const amscr_params *p, const double *v, size_t nv, size_t m)
+{
+    double *a = outline(v, nv, m, ID), *b = outline(v, nv, m, MAP);
+    amscr_result *r = reg(p, a, m, b, m);
+    free(a);
+    free(b);
+    return r;
+}
+
+static const double SQUARE[] = {0, 0, 1, 0, 1, 1, 0, 1};
+static const double CROSS[] = {1, 0, 2, 0, 2, 1, 3, 1, 3, 2, 2, 2, 2, 3, 1, 3, 1, 2, 0, 2, 0, 1, 1, 1};
+static const double TRIANGLE[] = {0, 0, 1, 0, 0.5, 0.8660254037844386};
+static const double ELL[] = {0, 0, 3, 0, 3, 1, 1, 1, 1, 2.5, 0, 2.5};
+
+START_TEST(stage_list_in_pipeline_order)
+{
+    amscr_result *r = self_pair(NULL, ELL, 6, 300);
+    ck_assert_uint_eq(amscr_result_num_stages(r), NSTAGES);
+    for (size_t i = 0; i < NSTAGES; i++) {
+        const char *n = NULL;
+        ck_assert_int_eq(amscr_result_stage(r, i, &n, NULL), AMSCR_OK);
+        ck_assert_str_eq(n, PIPELINE[i]);
+    }
+    ck_assert_int_eq(amscr_result_stage(r, NSTAGES, NULL, NULL), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_result_stage(NULL, 0, NULL, NULL), AMSCR_E_INVALID_ARG);
+    ck_assert_uint_eq(amscr_result_num_stages(NULL), 0);
+    /* a clean pair under the preset: the always-stages and the polish; nothing to recover, no
+     * symmetric distance; the opt-in stages off */
+    const char *yes[] = {"search", "method", "final_solve", "polish", "alternatives", "correspondences"};
+    const char *no[] = {"despike", "recovery", "symmetric", "order", "even_spacing"};
+    for (size_t i = 0; i < sizeof yes / sizeof *yes; i++)
+        ck_assert_msg(ran(r, yes[i]) == 1, "%s did not run", yes[i]);
+    for (size_t i = 0; i < sizeof no / sizeof *no; i++)
+        ck_assert_msg(ran(r, no[i]) == 0, "%s ran", no[i]);
+    amscr_result_free(r);
+}
+END_TEST
+
+START_TEST(paper_method_runs_no_optional_stage)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new(&p), AMSCR_OK); /* the defaults: no refinement, no polish */
+    amscr_result *r = self_pair(p, ELL, 6, 300);
+    ck_assert_int_eq(ran(r, "search"), 1);
+    ck_assert_int_eq(ran(r, "method"), 1);
+    ck_assert_int_eq(ran(r, "despike"), 0);
+    ck_assert_int_eq(ran(r, "polish"), 0);
+    ck_assert_int_eq(ran(r, "recovery"), 0); /* needs the refinement */
+    /* no ranked starts without refinement: the chosen map alone, cost NaN */
+    ck_assert_uint_eq(amscr_result_num_alternatives(r), 1);
+    double m[6], a[6], c = 0.0;
+    ck_assert_int_eq(amscr_result_alternative(r, 0, a, &c), AMSCR_OK);
+    ck_assert_int_eq(amscr_result_affine(r, m), AMSCR_OK);
+    ck_assert_mem_eq(a, m, sizeof m);
+    ck_assert(isnan(c));
+    amscr_result_free(r);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* Opt-in (default off in every preset): despike, order, even_spacing; on: recovery, polish. */
+START_TEST(default_switches)
+{
+    amscr_params *p[3] = {NULL, NULL, NULL};
+    ck_assert_int_eq(amscr_params_new(&p[0]), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new_registration(&p[1]), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new_retrieval(&p[2]), AMSCR_OK);
+    for (int i = 0; i < 3; i++) {
+        ck_assert_int_eq(amscr_params_get_stage(p[i], "despike"), 0);
+        ck_assert_int_eq(amscr_params_get_stage(p[i], "order"), 0);
+        ck_assert_int_eq(amscr_params_get_stage(p[i], "even_spacing"), 0);
+        ck_assert_int_eq(amscr_params_get_stage(p[i], "recovery"), 1);
+        ck_assert_int_eq(amscr_params_get_stage(p[i], "polish"), 1);
+        amscr_params_free(p[i]);
+    }
+}
+END_TEST
+
+/* A noisy target densely sampled (2 % noise, 4x the source's points): the order and
+ * even-spacing steps run when switched on, never by default. */
+START_TEST(opt_in_steps_run_when_switched_on)
+{
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, 11);
+    size_t ns = 400, nt = 1600;
+    double *a = malloc(2 * ns * sizeof *a), *b = malloc(2 * nt * sizeof *b);
+    ck_assert(a && b);
+    amscr_test_ellipse(ns, 1.0, 0.5, 0.0, a);
+    amscr_test_ellipse(nt, 1.0, 0.5, 0.3, b);
+    amscr_test_apply_affine(MAP, b, nt, b);
+    amscr_test_add_noise(&rng, b, nt, 0.02 * amscr_test_shape_size(b, nt));
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+    amscr_result *off = reg(p, a, ns, b, nt);
+    ck_assert_int_eq(amscr_params_set_stage(p, "order", 1), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_stage(p, "even_spacing", 1), AMSCR_OK);
+    amscr_result *on = reg(p, a, ns, b, nt);
+    ck_assert_int_eq(ran(off, "polish"), 1);
+    ck_assert_int_eq(ran(off, "order"), 0);
+    ck_assert_int_eq(ran(off, "even_spacing"), 0);
+    ck_assert_int_eq(ran(on, "order"), 1);
+    ck_assert_int_eq(ran(on, "even_spacing"), 1);
+    amscr_result_free(on);
+    amscr_result_free(off);
+    amscr_params_free(p);
+    free(a);
+    free(b);
+}
+END_TEST
+
+START_TEST(switches)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+    const char *opt[] = {"despike", "recovery", "polish", "order", "even_spacing"};
+    for (size_t i = 0; i < sizeof opt / sizeof *opt; i++) {
+        ck_assert_int_eq(amscr_params_set_stage(p, opt[i], 0), AMSCR_OK);
+        ck_assert_int_eq(amscr_params_get_stage(p, opt[i]), 0);
+        ck_assert_int_eq(amscr_params_set_stage(p, opt[i], 1), AMSCR_OK);
+        ck_assert_int_eq(amscr_params_get_stage(p, opt[i]), 1);
+    }
+    /* mandatory or unknown stages, bad values */
+    ck_assert_int_eq(amscr_params_set_stage(p, "search", 0), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_stage(p, "nonsense", 1), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_stage(p, "polish", 2), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_stage(p, NULL, 1), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_stage(NULL, "polish", 1), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_get_stage(p, "method"), -1);
+    ck_assert_int_eq(amscr_params_get_stage(NULL, "polish"), -1);
+    /* switched off: never runs, and the map differs (the polish moves a clean pair's map a little) */
+    amscr_result *on = self_pair(p, ELL, 6, 300);
+    ck_assert_int_eq(amscr_params_set_stage(p, "polish", 0), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_stage(p, "despike", 0), AMSCR_OK);
+    amscr_result *off = self_pair(p, ELL, 6, 300);
+    ck_assert_int_eq(ran(on, "polish"), 1);
+    ck_assert_int_eq(ran(on, "despike"), 1);
+    ck_assert_int_eq(ran(off, "polish"), 0);
+    ck_assert_int_eq(ran(off, "despike"), 0);
+    double a[6], b[6];
+    ck_assert_int_eq(amscr_result_affine(on, a), AMSCR_OK);
+    ck_assert_int_eq(amscr_result_affine(off, b), AMSCR_OK);
+    ck_assert(memcmp(a, b, sizeof a) != 0);
+    amscr_result_free(on);
+    amscr_result_free(off);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* Checks that r lists at least `want` distinct alternatives: the chosen map first, each a
+ * symmetry of the polygon v (it maps the source's vertices onto the target's vertex set), about
+ * equal costs, and a low confidence. */
+static void check_symmetric(const char *what, const double *v, size_t nv, size_t m, size_t want)
+{
+    amscr_result *r = self_pair(NULL, v, nv, m);
+    size_t k = amscr_result_num_alternatives(r);
+    ck_assert_msg(k >= want, "%s: %zu alternatives, %zu wanted", what, k, want);
+    ck_assert_msg(amscr_result_confidence(r) <= 0.25, "%s: confidence %g", what, amscr_result_confidence(r));
+    ck_assert(amscr_result_ambiguity(r) >= 0.75);
+    double m0[6], c0 = 0.0, chosen[6];
+    ck_assert_int_eq(amscr_result_affine(r, chosen), AMSCR_OK);
+    ck_assert_int_eq(amscr_result_alternative(r, 0, m0, &c0), AMSCR_OK);
+    ck_assert_mem_eq(m0, chosen, sizeof m0);
+    double tv[2 * 12], w[2 * 12], u[2 * 12];
+    ck_assert(nv <= 12);
+    amscr_test_apply_affine(MAP, v, nv, tv);
+    for (size_t i = 0; i < k; i++) {
+        double mi[6], ci = 0.0;
+        ck_assert_int_eq(amscr_result_alternative(r, i, mi, &ci), AMSCR_OK);
+        ck_assert_msg((c0 + 1e-9) / (ci + 1e-9) >= 0.75 || i == 0, "%s: cost %g vs %g", what, ci, c0);
+        amscr_test_apply_affine(mi, v, nv, w);
+        for (size_t a = 0; a < nv; a++) { /* each vertex lands on some target vertex */
+            double best = INFINITY;
+            for (size_t b = 0; b < nv; b++)
+                best = fmin(best, hypot(w[2 * a] - tv[2 * b], w[2 * a + 1] - tv[2 * b + 1]));
+            ck_assert_msg(best < 0.02, "%s: alternative %zu moves vertex %zu %g off", what, i, a, best);
+        }
+        for (size_t j = 0; j < i; j++) { /* distinct: some vertex goes elsewhere */
+            double mj[6], gap = 0.0;
+            ck_assert_int_eq(amscr_result_alternative(r, j, mj, NULL), AMSCR_OK);
+            amscr_test_apply_affine(mj, v, nv, u);
+            for (size_t a = 0; a < nv; a++)
+                gap = fmax(gap, hypot(w[2 * a] - u[2 * a], w[2 * a + 1] - u[2 * a + 1]));
+            ck_assert_msg(gap > 0.1, "%s: alternatives %zu and %zu are the same map", what, j, i);
+        }
+    }
+    ck_assert_int_eq(amscr_result_alternative(r, k, NULL, NULL), AMSCR_E_INVALID_ARG);
+    amscr_result_free(r);
+}
+
+START_TEST(symmetric_shapes_list_alternatives)
+{
+    check_symmetric("square", SQUARE, 4, 400, 3);
+    check_symmetric("cross", CROSS, 12, 480, 3);
+    check_symmetric("triangle", TRIANGLE, 3, 300, 3);
+}
+END_TEST
+
+START_TEST(asymmetric_shape_lists_the_chosen_map_only)
+{
+    amscr_result *r = self_pair(NULL, ELL, 6, 300);
+    ck_assert_uint_eq(amscr_result_num_alternatives(r), 1);
+    ck_assert(amscr_result_confidence(r) > 0.9);
+    double m0[6], c0 = NAN, chosen[6];
+    ck_assert_int_eq(amscr_result_alternative(r, 0, m0, &c0), AMSCR_OK);
+    ck_assert_int_eq(amscr_result_affine(r, chosen), AMSCR_OK);
+    ck_assert_mem_eq(m0, chosen, sizeof m0);
+    ck_assert(isfinite(c0) && c0 >= 0.0);
+    ck_assert_uint_eq(amscr_result_num_alternatives(NULL), 0);
+    ck_assert_int_eq(amscr_result_alternative(NULL, 0, m0, &c0), AMSCR_E_INVALID_ARG);
+    amscr_result_free(r);
+}
+END_TEST
+
+Suite *amscr_suite_stages(void)
+{
+    Suite *s = suite_create("stages");
+    TCase *t = tcase_create("core");
+    tcase_set_timeout(t, 120);
+    tcase_add_test(t, stage_list_in_pipeline_order);
+    tcase_add_test(t, paper_method_runs_no_optional_stage);
+    tcase_add_test(t, default_switches);
+    tcase_add_test(t, opt_in_steps_run_when_switched_on);
+    tcase_add_test(t, switches);
+    tcase_add_test(t, symmetric_shapes_list_alternatives);
+    tcase_add_test(t, asymmetric_shape_lists_the_chosen_map_only);
+    suite_add_tcase(s, t);
+    return s;
+}

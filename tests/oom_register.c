@@ -1,0 +1,186 @@
+/* oom_register.c — every allocation failure in a registration reaches the caller.
+ *
+ * Linked with -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free against the static
+ * library, so every allocation the library makes passes through the wrappers below. For each
+ * scenario (a noisy target, which runs the polish with its order and even-spacing steps; a target
+ * with a missing run, which runs the recovery; a partial match; a symmetric match) the test
+ * counts the allocations of one amscr_register_contours call, then fails each of them in turn
+ * and checks that the call returns AMSCR_E_NOMEM (nothing swallowed: no stage falls back
+ * silently) and frees everything it allocated (no leak on any error path). The allocations of
+ * the shared libraries (LAPACK, BLAS) are not wrapped. Not thread-safe: a single thread. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amscr.h"
+
+void *__real_malloc(size_t n);
+void *__real_calloc(size_t n, size_t s);
+void *__real_realloc(void *p, size_t n);
+void __real_free(void *p);
+
+static long counted, fail_at, live; /* allocations since arming; the one to fail (0: none); balance */
+static int armed;
+
+static int should_fail(void)
+{
+    if (!armed)
+        return 0;
+    return ++counted == fail_at;
+}
+void *__wrap_malloc(size_t n);
+void *__wrap_calloc(size_t n, size_t s);
+void *__wrap_realloc(void *q, size_t n);
+void __wrap_free(void *p);
+
+void *__wrap_malloc(size_t n)
+{
+    if (should_fail())
+        return NULL;
+    void *p = __real_malloc(n);
+    live += armed && p;
+    return p;
+}
+void *__wrap_calloc(size_t n, size_t s)
+{
+    if (should_fail())
+        return NULL;
+    void *p = __real_calloc(n, s);
+    live += armed && p;
+    return p;
+}
+void *__wrap_realloc(void *q, size_t n)
+{
+    if (should_fail())
+        return NULL;
+    void *p = __real_realloc(q, n);
+    live += armed && p && !q;
+    return p;
+}
+void __wrap_free(void *p)
+{
+    live -= armed && p;
+    __real_free(p);
+}
+
+/* A closed star-like curve of n points: r(t) = 1 + a cos(k t) + b sin(3 t), mapped by M and
+ * with Gaussian noise sigma (a fixed LCG), starting at point `start`. */
+static double *curve(size_t n, double sigma, const double M[6], size_t start, unsigned *seed)
+{
+    double *xy = __real_malloc(2 * n * sizeof *xy);
+    for (size_t i = 0; i < n; i++) {
+        double t = 2.0 * 3.141592653589793 * (double)((i + start) % n) / (double)n;
+        double r = 1.0 + 0.3 * cos(5.0 * t) + 0.1 * sin(3.0 * t), x = r * cos(t), y = r * sin(t);
+        double g[2];
+        for (int k = 0; k < 2; k++) { /* Box-Muller from two LCG draws */
+            *seed = *seed * 1103515245u + 12345u;
+            double u1 = ((*seed >> 8) + 1.0) / 16777217.0;
+            *seed = *seed * 1103515245u + 12345u;
+            double u2 = (*seed >> 8) / 16777216.0;
+            g[k] = sqrt(-2.0 * log(u1)) * cos(2.0 * 3.141592653589793 * u2);
+        }
+        xy[2 * i] = M[0] * x + M[1] * y + M[2] + sigma * g[0];
+        xy[2 * i + 1] = M[3] * x + M[4] * y + M[5] + sigma * g[1];
+    }
+    return xy;
+}
+
+typedef struct {
+    const char *name;
+    size_t ns, nt, drop; /* source points, target points, target points dropped (a missing run) */
+    double sigma;
+    int partial, symmetric;
+    const char *must_run; /* a stage the scenario exists for */
+} scenario;
+
+static amscr_status run(const scenario *s, amscr_result **out)
+{
+    static const double I[6] = {1, 0, 0, 0, 1, 0}, M[6] = {1.4, 0.3, 2.0, -0.2, 0.8, -1.0};
+    unsigned seed = 7;
+    size_t ns = s->partial ? s->ns * 6 / 10 : s->ns, nt = s->nt - s->drop;
+    double *a = curve(s->ns, 0.0, I, 0, &seed), *b = curve(s->nt, s->sigma, M, 0, &seed);
+    amscr_contour *src = NULL, *tgt = NULL;
+    amscr_params *p = NULL;
+    amscr_status st = amscr_params_new_registration(&p);
+    if (st == AMSCR_OK)
+        st = amscr_params_set_num_samples(p, 128);
+    if (st == AMSCR_OK && s->partial)
+        st = amscr_params_set_partial(p, 1);
+    if (st == AMSCR_OK && s->symmetric)
+        st = amscr_params_set_symmetric(p, 1);
+    const char *opt_in[] = {"despike", "order", "even_spacing"}; /* every stage on */
+    for (size_t i = 0; i < 3 && st == AMSCR_OK; i++)
+        st = amscr_params_set_stage(p, opt_in[i], 1);
+    if (st == AMSCR_OK)
+        st = amscr_contour_new(a, ns, &src);
+    if (st == AMSCR_OK)
+        st = amscr_contour_new(b + 2 * s->drop, nt, &tgt);
+    if (st == AMSCR_OK)
+        st = amscr_register_contours(p, src, tgt, out);
+    amscr_contour_free(src);
+    amscr_contour_free(tgt);
+    amscr_params_free(p);
+    __real_free(a);
+    __real_free(b);
+    return st;
+}
+
+static int stage_ran(const amscr_result *r, const char *name)
+{
+    for (size_t i = 0; i < amscr_result_num_stages(r); i++) {
+        const char *n;
+        int ran;
+        if (amscr_result_stage(r, i, &n, &ran) == AMSCR_OK && strcmp(n, name) == 0)
+            return ran;
+    }
+    return 0;
+}
+
+/* The scenario's allocations counted, then each failed in turn. Returns the failures found. */
+static int check_scenario(const scenario *s)
+{
+    amscr_result *r = NULL;
+    counted = fail_at = live = 0;
+    armed = 1;
+    amscr_status st = run(s, &r);
+    int ran = st == AMSCR_OK && stage_ran(r, s->must_run);
+    amscr_result_free(r);
+    armed = 0;
+    long total = counted;
+    if (st != AMSCR_OK || !ran || live != 0) {
+        printf("FAIL %s: status %d, stage %s ran %d, %ld blocks left\n", s->name, (int)st, s->must_run, ran, live);
+        return 1;
+    }
+    int bad = 0;
+    for (long k = 1; k <= total; k++) {
+        r = NULL;
+        counted = live = 0;
+        fail_at = k;
+        armed = 1;
+        st = run(s, &r);
+        amscr_result_free(r);
+        armed = 0;
+        if (st != AMSCR_E_NOMEM || live != 0) {
+            printf("FAIL %s: allocation %ld of %ld failed: status %d (%s), %ld blocks left\n", s->name, k, total,
+                   (int)st, amscr_last_error_detail(), live);
+            bad++;
+        }
+    }
+    printf("%s: %ld allocations, each failure reported as out of memory%s\n", s->name, total, bad ? " NOT" : "");
+    return bad;
+}
+
+int main(void)
+{
+    static const scenario scenarios[] = {
+        {"noisy target (polish, order, even spacing)", 400, 1600, 0, 0.01, 0, 0, "even_spacing"},
+        {"missing run (recovery)", 300, 300, 75, 0.0, 0, 0, "recovery"},
+        {"partial fragment", 300, 300, 0, 0.0, 1, 0, "polish"},
+        {"symmetric distance", 300, 300, 0, 0.0, 0, 1, "symmetric"},
+    };
+    int bad = 0;
+    for (size_t i = 0; i < sizeof scenarios / sizeof scenarios[0]; i++)
+        bad += check_scenario(&scenarios[i]);
+    return bad ? 1 : 0;
+}
