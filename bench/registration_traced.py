@@ -18,18 +18,18 @@ then the target damaged in the image:
 Both PNGs are registered by the tool, `amscr register SRC TGT --json` (the default sub-pixel
 tracer, and with --pixel-chain), and by cv2.findTransformECC (MOTION_AFFINE, 8 starting
 rotations with centroid and area matched, the best correlation kept) on the same images.
---reference adds the issue's calibration column: scikit-image find_contours point lists of
+--reference adds the reference evaluation's calibration column: scikit-image find_contours point lists of
 both images through `amscr register` (no image decoding in the tool).
 
 Error, two measures over the clean source's sub-pixel contour f (in the source image's pixels),
 both as % of size(T(f)), the RMS radius about the centroid:
-  RMS  sqrt(mean_i |M(f_i) - T(f_i)|^2) -- the primary table, "as the issue measures": the issue
+  RMS  sqrt(mean_i |M(f_i) - T(f_i)|^2) -- the primary table, "as the reference evaluation measures": the evaluation
        states "map error below 2 % of the shape's size; 4 % at low resolution" without saying
        max or RMS, and gives a calibration (binary / grey 35-px images traced by scikit-image's
        find_contours at half level, handed to the tool as point lists: 94.3 % / 92.9 %).
        `--reference` (those point lists, 70 pairs each) gives 95.7 / 98.6 % under RMS and
        80.0 / 97.1 % under max: on binary images, which tell the measures apart, RMS is one pair
-       from the issue's figure and max ten pairs short -- so the issue's figures are taken to be
+       from the reference figure and max ten pairs short -- so the reference figures are taken to be
        RMS ones (docs/measurements.md);
   max  max_i |M(f_i) - T(f_i)| -- the stricter second table, the measure of the figures before
        0.5 (kept so they stay comparable).
@@ -205,7 +205,7 @@ def map_error(M, T, f):
 
 
 def rms_error(M, T, f):
-    """The measure as the issue states its figures: the RMS of |M f_i - T f_i| over the
+    """The measure as the reference evaluation states its figures: the RMS of |M f_i - T f_i| over the
     contour, % of the size."""
     if M is None:
         return math.inf
@@ -283,7 +283,7 @@ MEASURES = [(0, 'RMS'), (1, 'max')]  # index into a record (rms %, max %, confid
 
 
 def reference_register(tool, tmp, src, tgt):
-    """The issue's calibration: both images traced by scikit-image's find_contours at half level
+    """The reference evaluation's calibration: both images traced by scikit-image's find_contours at half level
     and handed to the tool as point lists."""
     sp, tp = os.path.join(tmp, 'src.txt'), os.path.join(tmp, 'tgt.txt')
     np.savetxt(sp, subpixel_contour(src))
@@ -368,7 +368,7 @@ def main():
                     help="lib ms as the process's CPU time, not wall time (steadier on a shared machine; "
                          "run with OPENBLAS_NUM_THREADS=1, or BLAS threads that spin are counted)")
     ap.add_argument('--reference', action='store_true',
-                    help="add the issue's calibration: scikit-image find_contours point lists through the tool")
+                    help="add the reference evaluation's calibration: scikit-image find_contours point lists through the tool")
     ap.add_argument('--classes', type=int, default=0, help='the first N classes only (0: all)')
     ap.add_argument('--json', default=None)
     a = ap.parse_args()
@@ -414,7 +414,7 @@ def main():
     print(file=sys.stderr)
     methods = [m for m in METHODS if (use_ecc or m[0] != 'ecc') and (use_chain or m[0] != 'chain')
                and (a.reference or m[0] != 'ref')]
-    for measure, what in ((0, 'RMS error (as the issue measures)'), (1, 'max error (stricter; the figures before 0.5)')):
+    for measure, what in ((0, 'RMS error (as the reference evaluation measures)'), (1, 'max error (stricter; the figures before 0.5)')):
         print('\n=== %s: success < 2 %% of the size (4 %% at low resolution) ===' % what)
         for fold, title in (('A', 'fold 1 (folds.tsv A)'), ('B', 'fold 2 (folds.tsv B)'), ('all', 'both folds')):
             if any(res[fold][k]['sub'] for k in keys):
