@@ -18,14 +18,29 @@ then the target damaged in the image:
 Both PNGs are registered by the tool, `amscr register SRC TGT --json` (the default sub-pixel
 tracer, and with --pixel-chain), and by cv2.findTransformECC (MOTION_AFFINE, 8 starting
 rotations with centroid and area matched, the best correlation kept) on the same images.
+--reference adds the reference evaluation's calibration column: scikit-image find_contours point lists of
+both images through `amscr register` (no image decoding in the tool).
 
-Error: max_i |M(f_i) - T(f_i)| / size(T(f)) over the clean source's sub-pixel contour f (in the
-source image's pixels), size = RMS radius about the centroid. Success: error < 2 % (4 % for
-lowres and grey). Wrong + confident: a failure the tool reports with confidence >= 0.25.
+Error, two measures over the clean source's sub-pixel contour f (in the source image's pixels),
+both as % of size(T(f)), the RMS radius about the centroid:
+  RMS  sqrt(mean_i |M(f_i) - T(f_i)|^2) -- the primary table, "as the reference evaluation measures": the evaluation
+       states "map error below 2 % of the shape's size; 4 % at low resolution" without saying
+       max or RMS, and gives a calibration (binary / grey 35-px images traced by scikit-image's
+       find_contours at half level, handed to the tool as point lists: 94.3 % / 92.9 %).
+       `--reference` (those point lists, 70 pairs each) gives 95.7 / 98.6 % under RMS and
+       80.0 / 97.1 % under max: on binary images, which tell the measures apart, RMS is one pair
+       from the reference figure and max ten pairs short -- so the reference figures are taken to be
+       RMS ones (docs/measurements.md);
+  max  max_i |M(f_i) - T(f_i)| -- the stricter second table, the measure of the figures before
+       0.5 (kept so they stay comparable).
+Success: error < 2 % (4 % for lowres and grey), under each measure. Wrong + confident (w+c): a
+failure the tool reports with confidence >= 0.25; ok+c: the share of the successes reported with
+confidence >= 0.25. ECC is scored by the same two measures (it reports no confidence).
 ms/pair: wall time per pair (the tool's includes process start and PNG decoding).
 
 Usage: nice .venv/bin/python bench/registration_traced.py [--data DIR] [--tool PATH] [--draws 2]
-       [--no-ecc] [--no-chain] [--conditions clean,lowres,...] [--fold A|B] [--json OUT]
+       [--no-ecc] [--no-chain] [--reference] [--conditions clean,lowres,...] [--fold A|B] [--json OUT]
+--json OUT writes one row per pair, each method as [RMS %, max %, confidence, ms].
 --conditions (alias --only) and --fold restrict the run (the tables then show what ran);
 --no-chain skips the --pixel-chain column; --breakdown splits the library's time (the traces,
 the registration, without the polish, without the polish and the refinement); --cpu-time reports
@@ -85,11 +100,19 @@ def inv_affine(P):
     return np.hstack([A, -(A @ P[:, 2:])])
 
 
+def enclosed_area(xy):
+    x, y = xy[:, 0], xy[:, 1]
+    return 0.5 * abs(float(np.dot(x, np.roll(y, 1)) - np.dot(y, np.roll(x, 1))))
+
+
 def subpixel_contour(img):
-    """The largest iso-line at half level of an 8-bit image, (x, y) rows (skimage)."""
+    """The iso-line at half level of an 8-bit image enclosing the largest area -- the outer
+    boundary -- as (x, y) rows (skimage). (Before 0.5 the line with the most points was taken,
+    which for the pocket watch is a hole's jagged boundary: its targets were fitted to that hole
+    and overflowed the canvas, and its errors were measured on the hole.)"""
     from skimage import measure
     cs = measure.find_contours(np.pad(img.astype(float), 1), 127.5)
-    c = max(cs, key=len)[:, ::-1] - 1.0
+    c = max(cs, key=enclosed_area)[:, ::-1] - 1.0
     return c[:-1] if np.all(c[0] == c[-1]) else c
 
 
@@ -174,10 +197,24 @@ S_LOW = np.array([[1.0 / REDUCE, 0, -(REDUCE - 1) / 2 / REDUCE], [0, 1.0 / REDUC
 
 
 def map_error(M, T, f):
+    """The stricter measure: the largest |M f_i - T f_i| over the contour, % of the size."""
     if M is None:
         return math.inf
     d = apply(M, f) - apply(T, f)
     return 100 * float(np.sqrt((d * d).sum(axis=1)).max() / shape_size(apply(T, f)))
+
+
+def rms_error(M, T, f):
+    """The measure as the reference evaluation states its figures: the RMS of |M f_i - T f_i| over the
+    contour, % of the size."""
+    if M is None:
+        return math.inf
+    d = apply(M, f) - apply(T, f)
+    return 100 * float(np.sqrt((d * d).sum(axis=1).mean()) / shape_size(apply(T, f)))
+
+
+def errors(M, T, f):
+    return rms_error(M, T, f), map_error(M, T, f)
 
 
 CLOCK = time.perf_counter  # --cpu-time: time.process_time
@@ -239,11 +276,23 @@ def load_classes(data):
     return [(c, os.path.join(data, f), folds.get(c, '?')) for c, f in first.items()]
 
 
-METHODS = [('sub', 'amscr sub-pixel'), ('chain', 'amscr --pixel-chain'), ('ecc', 'OpenCV ECC')]
+METHODS = [('sub', 'amscr sub-pixel'), ('chain', 'amscr --pixel-chain'), ('ref', 'skimage lists (reference)'),
+           ('ecc', 'OpenCV ECC')]
 EXTRA = [('lib', 'library alone')]  # timing only
+MEASURES = [(0, 'RMS'), (1, 'max')]  # index into a record (rms %, max %, confidence, ms)
 
 
-def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=None):
+def reference_register(tool, tmp, src, tgt):
+    """The reference evaluation's calibration: both images traced by scikit-image's find_contours at half level
+    and handed to the tool as point lists."""
+    sp, tp = os.path.join(tmp, 'src.txt'), os.path.join(tmp, 'tgt.txt')
+    np.savetxt(sp, subpixel_contour(src))
+    np.savetxt(tp, subpixel_contour(tgt))
+    return tool_register(tool, sp, tp, [])
+
+
+def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=None, use_ref=False):
+    """{method: (rms error %, max error %, confidence, ms)}."""
     if key in ('lowres', 'grey'):
         src, tgt = reduce(src, key == 'lowres'), reduce(tgt, key == 'lowres')
         T = compose(S_LOW, compose(T, inv_affine(S_LOW)))
@@ -256,43 +305,48 @@ def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=
         if m == 'chain' and not use_chain:
             continue
         M, conf, ms = tool_register(tool, sp, tp, extra)
-        out[m] = (map_error(M, T, f), conf, ms)
-    out['lib'] = (0.0, 0.0, lib_register_ms(src, tgt, breakdown))
+        out[m] = (*errors(M, T, f), conf, ms)
+    if use_ref:
+        M, conf, ms = reference_register(tool, tmp, src, tgt)
+        out['ref'] = (*errors(M, T, f), conf, ms)
+    out['lib'] = (0.0, 0.0, 0.0, lib_register_ms(src, tgt, breakdown))
     if use_ecc:
         t0 = time.perf_counter()
         W = ecc_register(src, tgt)
-        out['ecc'] = (map_error(W, T, f), math.nan, 1000 * (time.perf_counter() - t0))
+        out['ecc'] = (*errors(W, T, f), math.nan, 1000 * (time.perf_counter() - t0))
     return out
 
 
-def summary(recs, thr):
+def summary(recs, thr, measure=0):
+    """(ok %, wrong + confident %, median error %, mean ms, pairs, successes with confidence
+    >= CONFIDENT %) under the measure (0: RMS, 1: max)."""
     if not recs:
         return None
-    err = np.array([r[0] for r in recs])
-    conf = np.array([r[1] for r in recs])
+    err = np.array([r[measure] for r in recs])
+    conf = np.array([r[2] for r in recs])
     ok = err < thr
     wrong_conf = (~ok) & (conf >= CONFIDENT)
-    return (100 * ok.mean(), 100 * wrong_conf.mean(), float(np.median(err)), float(np.mean([r[2] for r in recs])),
-            len(recs))
+    good_conf = 100 * float(np.mean(conf[ok] >= CONFIDENT)) if ok.any() else math.nan
+    return (100 * ok.mean(), 100 * wrong_conf.mean(), float(np.median(err)), float(np.mean([r[3] for r in recs])),
+            len(recs), good_conf)
 
 
-def print_table(title, res, conds, use_ecc, use_chain=True):
+def print_table(title, res, conds, methods, measure=0):
     print('\n%s' % title)
-    head = '%-34s' % 'condition'
-    methods = [m for m in METHODS if (use_ecc or m[0] != 'ecc') and (use_chain or m[0] != 'chain')]
+    head = '%-44s' % 'condition'
     for _, lab in methods:
-        head += ' | %-30s' % lab
+        head += ' | %-38s' % lab
     print(head)
-    print('%-34s' % '' + ''.join(' | %-30s' % 'ok %   w+c %  med err %  ms' for _ in methods))
+    print('%-44s' % '' + ''.join(' | %-38s' % 'ok %   w+c %  ok+c %  med err %  ms' for _ in methods))
     for key, lab, thr in conds:
-        line = '%-34s' % ('%s (%d pairs)' % (lab, len(res[key]['sub'])))
+        line = '%-44s' % ('%s (%d pairs)' % (lab, len(res[key]['sub'])))
         for m, _ in methods:
-            s = summary(res[key][m], thr)
+            s = summary(res[key][m], thr, measure)
             if m == 'ecc':
-                line += ' | %5.1f      -  %9.3f %5.0f' % (s[0], s[2], s[3])
+                line += ' | %5.1f      -       -  %9.3f %5.0f' % (s[0], s[2], s[3])
             else:
-                line += ' | %5.1f  %5.1f  %9.3f %5.0f' % (s[0], s[1], s[2], s[3])
-        lib = [r[2] for r in res[key]['lib']]
+                line += ' | %5.1f  %5.1f   %5.1f  %9.3f %5.0f' % (s[0], s[1], s[5], s[2], s[3])
+        lib = [r[3] for r in res[key]['lib']]
         if lib and np.all(np.isfinite(lib)):
             line += ' | lib ms median %.1f' % float(np.median(lib))
         print(line)
@@ -313,6 +367,8 @@ def main():
     ap.add_argument('--cpu-time', action='store_true',
                     help="lib ms as the process's CPU time, not wall time (steadier on a shared machine; "
                          "run with OPENBLAS_NUM_THREADS=1, or BLAS threads that spin are counted)")
+    ap.add_argument('--reference', action='store_true',
+                    help="add the reference evaluation's calibration: scikit-image find_contours point lists through the tool")
     ap.add_argument('--classes', type=int, default=0, help='the first N classes only (0: all)')
     ap.add_argument('--json', default=None)
     a = ap.parse_args()
@@ -345,7 +401,7 @@ def main():
                     tgt, T = make_target(src, f, rng)
                     tgt = damage(key, tgt, apply(T, f), rng)
                     bd = [] if a.breakdown else None
-                    out = run_pair(a.tool, tmp, key, src, tgt, f, T, use_ecc, use_chain, bd)
+                    out = run_pair(a.tool, tmp, key, src, tgt, f, T, use_ecc, use_chain, bd, a.reference)
                     if bd:
                         split.setdefault(key, []).append(bd)
                     rows.append({'class': cls, 'fold': fold, 'condition': key, 'draw': d,
@@ -356,9 +412,13 @@ def main():
                             res[fold][key][m].append(v)
             print('.', end='', file=sys.stderr, flush=True)
     print(file=sys.stderr)
-    for fold, title in (('A', 'fold 1 (folds.tsv A)'), ('B', 'fold 2 (folds.tsv B)'), ('all', 'both folds')):
-        if any(res[fold][k]['sub'] for k in keys):
-            print_table(title, res[fold], conds, use_ecc, use_chain)
+    methods = [m for m in METHODS if (use_ecc or m[0] != 'ecc') and (use_chain or m[0] != 'chain')
+               and (a.reference or m[0] != 'ref')]
+    for measure, what in ((0, 'RMS error (as the reference evaluation measures)'), (1, 'max error (stricter; the figures before 0.5)')):
+        print('\n=== %s: success < 2 %% of the size (4 %% at low resolution) ===' % what)
+        for fold, title in (('A', 'fold 1 (folds.tsv A)'), ('B', 'fold 2 (folds.tsv B)'), ('all', 'both folds')):
+            if any(res[fold][k]['sub'] for k in keys):
+                print_table('%s, %s' % (title, what.split(' (')[0]), res[fold], conds, methods, measure)
     if split:
         print('\nlibrary ms, medians over the run: traces | register | no polish | no polish, no refine')
         for key in keys:
