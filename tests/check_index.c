@@ -5,6 +5,7 @@
 #include <amscr.h>
 #include <check.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -181,9 +182,45 @@ START_TEST(lazy_load)
 }
 END_TEST
 
+/* A thread's member rows of a lazily loaded index: rows 0..NSHAPES-1 into out (NSHAPES^2). */
+typedef struct {
+    const amscr_index *x;
+    double *out;
+    int ok;
+} rows_arg;
+
+static void *member_rows_thread(void *arg)
+{
+    rows_arg *a = arg;
+    a->ok = 1;
+    for (size_t i = 0; i < NSHAPES; i++)
+        a->ok &= amscr_index_member_scores(a->x, i, 6, a->out + i * NSHAPES, NSHAPES) == AMSCR_OK;
+    return NULL;
+}
+
+/* Two threads reading the same lazily loaded index at once (each decoding shapes as it goes)
+ * get the eager load's rows. */
+static void concurrent_rows(const char *path, const amscr_index *e)
+{
+    amscr_index *y = NULL;
+    ck_assert_int_eq(amscr_index_load_with(path, AMSCR_INDEX_LAZY, &y), AMSCR_OK);
+    static double want[NSHAPES * NSHAPES], got[2][NSHAPES * NSHAPES];
+    for (size_t i = 0; i < NSHAPES; i++)
+        ck_assert_int_eq(amscr_index_member_scores(e, i, 6, want + i * NSHAPES, NSHAPES), AMSCR_OK);
+    rows_arg a[2] = {{y, got[0], 0}, {y, got[1], 0}};
+    pthread_t t;
+    ck_assert_int_eq(pthread_create(&t, NULL, member_rows_thread, &a[1]), 0);
+    member_rows_thread(&a[0]);
+    pthread_join(t, NULL);
+    ck_assert(a[0].ok && a[1].ok);
+    ck_assert(memcmp(got[0], want, sizeof want) == 0 && memcmp(got[1], want, sizeof want) == 0);
+    amscr_index_free(y);
+}
+
 /* A lazy load of a file decodes each prepared shape when first needed: with a fused weight
- * (the AMSCR distance read for the candidates) the scores, member rows, the collection's
- * shapes and batch calls, a save (the same bytes) and an add are an eager load's. */
+ * (the AMSCR distance read for the candidates) the scores, member rows (two threads at once
+ * too), the collection's shapes and batch calls, a save (the same bytes) and an add are an
+ * eager load's. */
 START_TEST(lazy_file_shapes)
 {
     amscr_params *p = params_of(0.5, 8, 2);
@@ -193,6 +230,7 @@ START_TEST(lazy_file_shapes)
     ck_assert_int_eq(amscr_index_save(x, path), AMSCR_OK);
     ck_assert_int_eq(amscr_index_load_with(path, AMSCR_INDEX_LAZY, &y), AMSCR_OK);
     ck_assert_int_eq(amscr_index_load_with(path, 0u, &e), AMSCR_OK);
+    concurrent_rows(path, e);
     same_query(e, y, q, 0);
     same_query(e, y, q, 6);
     double a[NSHAPES], b[NSHAPES];

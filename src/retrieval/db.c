@@ -146,17 +146,28 @@ void amscr__db_set_source(amscr_db *db, const unsigned char *src, size_t pos0, s
     db->nsrc = count;
 }
 
-/* Shape i, decoded from the source when it is not yet (NULL: out of memory). */
+/* Shape i, decoded from the source when it is not yet (NULL: out of memory). Decoded outside
+ * the lock (threads decode different shapes at once); the first decode of a shape is kept. */
 static amscr_descriptor *db_get(const amscr_db *db, size_t i)
 {
     if (i >= db->nsrc)
         return db->d[i];
     amscr_db *m = (amscr_db *)(uintptr_t)db; /* the cache of a const collection, under its lock */
     pthread_mutex_lock(&m->lock);
-    if (!m->d[i] && amscr__db_decode(db->src, db->src_pos0 + i * db->src_per, db->src_per, &db->params, NULL,
-                                     &m->d[i]) != AMSCR_OK)
-        m->d[i] = NULL;
     amscr_descriptor *d = m->d[i];
+    pthread_mutex_unlock(&m->lock);
+    if (d)
+        return d;
+    amscr_descriptor *mine = NULL;
+    if (amscr__db_decode(db->src, db->src_pos0 + i * db->src_per, db->src_per, &db->params, NULL, &mine) !=
+        AMSCR_OK)
+        return NULL;
+    pthread_mutex_lock(&m->lock);
+    if (!m->d[i])
+        m->d[i] = mine;
+    else
+        amscr_descriptor_free(mine); /* another thread's came first */
+    d = m->d[i];
     pthread_mutex_unlock(&m->lock);
     return d;
 }
@@ -174,17 +185,6 @@ const amscr_descriptor *amscr_db_descriptor(const amscr_db *db, size_t i)
     return (db && i < db->n) ? db_get(db, i) : NULL;
 }
 
-size_t amscr__db_find_input(const amscr_db *db, const double *input, size_t n)
-{
-    size_t N = db->params.num_samples;
-    if (n != N)
-        return SIZE_MAX;
-    for (size_t i = 0; i < db->n; i++) /* a shape of the source: its bytes (never decoded here) */
-        if (i < db->nsrc ? amscr__db_input_is(db->src, db->src_pos0 + i * db->src_per, input, N)
-                         : memcmp(db->d[i]->input, input, 2 * N * sizeof *input) == 0)
-            return i;
-    return SIZE_MAX;
-}
 const amscr_params *amscr_db_params(const amscr_db *db) { return db ? &db->params : NULL; }
 
 /* ------------------------------------------------------------ batch engine */

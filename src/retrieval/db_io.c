@@ -226,17 +226,6 @@ amscr_status amscr__db_decode(const unsigned char *p, size_t at, size_t per, con
     return AMSCR_OK;
 }
 
-int amscr__db_input_is(const unsigned char *p, size_t at, const double *input, size_t N)
-{
-    amscr__rbuf r = {p, at + 4 + 8 * (12 + 2 * N), at + 4 + 8 * 12, 0};
-    for (size_t a = 0; a < 2 * N; a++) {
-        double v = amscr__r_f64(&r);
-        if (r.bad || memcmp(&v, &input[a], sizeof v) != 0)
-            return 0;
-    }
-    return 1;
-}
-
 /* The shapes of a file, decoded on threads: shape i's bytes start at pos0 + i * per (a fixed
  * size), each thread takes every nt-th shape. A lazy load (check_only) decodes none: it checks
  * what a decode would (finite values, no degenerate level), the shapes decoded when asked for

@@ -26,16 +26,11 @@ amscr_status amscr__db_push(amscr_db *db, amscr_descriptor *d, int32_t label, si
  * *label when label is not NULL. AMSCR_E_FORMAT when truncated, not finite or degenerate. */
 amscr_status amscr__db_decode(const unsigned char *p, size_t at, size_t per, const amscr_params *prm, int32_t *label,
                               amscr_descriptor **out);
-/* Whether the shape bytes at `at` hold input points equal to input (2N doubles), bit for bit. */
-int amscr__db_input_is(const unsigned char *p, size_t at, const double *input, size_t N);
 /* A lazy collection (db.c): its count shapes, at pos0 + i * per of src (which outlives it),
  * are decoded when first asked for; amscr__db_decode_all decodes every one (the batch calls'
  * and a save's). */
 void amscr__db_set_source(amscr_db *db, const unsigned char *src, size_t pos0, size_t per, size_t count);
 amscr_status amscr__db_decode_all(const amscr_db *db);
-/* The shape of db whose input points are input's (n samples), bit for bit, or SIZE_MAX; a
- * lazy collection's shapes are compared in their bytes, not decoded. */
-size_t amscr__db_find_input(const amscr_db *db, const double *input, size_t n);
 
 /* Writes the collection part of a file of `version`: magic, version, params, retrieval
  * settings, the shapes (no section, no checksum). */
