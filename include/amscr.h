@@ -2151,7 +2151,9 @@ AMSCR_API int32_t amscr_db_label(const amscr_db *db, size_t i);
 
 /**
  * @brief Descriptor of shape i.
- * @return the descriptor; NULL for NULL or i out of range.
+ * @return the descriptor; NULL for NULL or i out of range, or (the collection of an index
+ *         loaded with AMSCR_INDEX_LAZY from a file, whose shapes are decoded when first read)
+ *         when decoding it ran out of memory.
  * Ownership: borrowed from db.
  * Thread-safety: const.
  * @since 0.1
@@ -2529,8 +2531,10 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory(const void *buf, 
 /** Load flag: the shapes' channel features are not made ready at load (format 4: their
  *  spectra, from the stored heights; format 3: the features); each query computes those of the
  *  candidates it matches (for one or a few queries a load, e.g. a command-line search); without
- *  it a load computes every shape's once, on the params' threads (for many queries). Scores are
- *  the same either way. @since 0.4 */
+ *  it a load computes every shape's once, on the params' threads (for many queries). A lazy load
+ *  of a file (amscr_index_load_with) also maps the file and decodes each prepared shape when it
+ *  is first read (every shape is still checked at load, so the same files are refused). Scores
+ *  are the same either way. @since 0.4 */
 #define AMSCR_INDEX_LAZY 1u
 
 /**
