@@ -10,6 +10,7 @@
  * their closest vertices: the outline walks to the piece, around it (counter-clockwise, as
  * itself) and back along the same bridge. The bridge is a zero-width slit, so the area is the
  * pieces' sum; the registration sees the gap as it sees a bite (method.md §11.3). */
+#include "dense.h"
 #include "internal.h"
 #include "iso_level.h"
 #include "nearest.h"
@@ -30,16 +31,10 @@
 /* RMS distance of the n vertices xy from their centroid. */
 static double join_radius(const double *xy, size_t n)
 {
-    double cx = 0.0, cy = 0.0, s = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        cx += xy[2 * i];
-        cy += xy[2 * i + 1];
-    }
-    cx /= (double)n;
-    cy /= (double)n;
-    for (size_t i = 0; i < n; i++)
-        s += (xy[2 * i] - cx) * (xy[2 * i] - cx) + (xy[2 * i + 1] - cy) * (xy[2 * i + 1] - cy);
-    return sqrt(s / (double)n);
+    double cx, cy, cov[3];
+    amscr__centroid(xy, n, &cx, &cy);
+    amscr__scatter(xy, n, cx, cy, 1.0, cov);
+    return sqrt((cov[0] + cov[2]) / (double)n);
 }
 
 /* The pieces to join: foreground labels other than `largest`, outside any hole (the pixel left
