@@ -118,7 +118,9 @@ static amscr_status join_piece(const amscr__iso *f, const amscr__regions *R, siz
         }
     }
     amscr__grid_free(&g);
-    if (sqrt(best) <= reach)
+    /* a piece touching the outline at a vertex (a saddle of the iso-line) is left out: its
+     * bridge would repeat that vertex */
+    if (best > 0.0 && sqrt(best) <= reach)
         st = join_splice(J, n, P, m, bi, bj);
     free(P);
     return st;
