@@ -183,32 +183,50 @@ void amscr__hf_ws_free(amscr__hf_ws *ws)
     memset(ws, 0, sizeof *ws);
 }
 
-/* Best cyclic shift of b's orientation o against a (max correlation), and that correlation. */
-static size_t best_shift(const amscr__hf *a, const amscr__hf *b, int o, amscr__hf_ws *ws, double *out_corr)
+/* The low-passed cross-spectrum conj(A) B of every bin, orientation o of b, added into z with
+ * weight i^q (q 0: real part, q 1: imaginary part), its Hermitian half as well. */
+static void cross_spectrum(const amscr__hf *a, const amscr__hf *b, int o, int q, double *z)
 {
-    const size_t D = AMSCR__HF_BINS, n = a->n;
-    double *z = ws->z;
-    memset(z, 0, 2 * n * sizeof *z);
-    size_t half = n / 2, fmax = AMSCR__HF_FREQS(n), F = a->nfreq;
-    for (size_t bin = 0; bin < D; bin++) {
-        const double *fa = a->spec[0] + bin * 2 * F, *fb = b->spec[o] + bin * 2 * F;
-        for (size_t f = 0; f <= fmax; f++) {
-            double ar = fa[2 * f], ai = fa[2 * f + 1], br = fb[2 * f], bi = fb[2 * f + 1];
-            z[2 * f] += ar * br + ai * bi; /* conj(A) B */
-            z[2 * f + 1] += ar * bi - ai * br;
+    const size_t D = AMSCR__HF_BINS, n = a->n, half = n / 2, fmax = AMSCR__HF_FREQS(n), F = a->nfreq;
+    for (size_t f = 0; f <= fmax; f++) {
+        double re = 0.0, im = 0.0;
+        for (size_t bin = 0; bin < D; bin++) {
+            const double *fa = a->spec[0] + bin * 2 * F + 2 * f, *fb = b->spec[o] + bin * 2 * F + 2 * f;
+            re += fa[0] * fb[0] + fa[1] * fb[1];
+            im += fa[0] * fb[1] - fa[1] * fb[0];
+        }
+        /* X = re + i im enters as X (q 0) or i X (q 1); its mirror n - f as conj(X) or i conj(X) */
+        double xr = q ? -im : re, xi = q ? re : im;
+        z[2 * f] += xr;
+        z[2 * f + 1] += xi;
+        if (f > 0 && n - f > half) {
+            z[2 * (n - f)] += q ? im : re;
+            z[2 * (n - f) + 1] += q ? re : -im;
         }
     }
-    for (size_t f = n - fmax; f < n && f > half; f++) { /* Hermitian: the inputs are real */
-        z[2 * f] = z[2 * (n - f)];
-        z[2 * f + 1] = -z[2 * (n - f) + 1];
-    }
+}
+
+/* The cyclic shift of b that maximizes its correlation with a, for orientation 0 and, when
+ * `both`, orientation 1 — one inverse FFT for the two: both correlations are real, so
+ * orientation 1 rides in the imaginary part. shift[o] and corr[o] receive them. */
+static void best_shifts(const amscr__hf *a, const amscr__hf *b, int both, amscr__hf_ws *ws, size_t shift[2],
+                        double corr[2])
+{
+    const size_t n = a->n;
+    double *z = ws->z;
+    memset(z, 0, 2 * n * sizeof *z);
+    cross_spectrum(a, b, 0, 0, z);
+    if (both)
+        cross_spectrum(a, b, 1, 1, z);
     amscr__fft(&ws->plan, z, 1);
-    size_t best = 0;
-    for (size_t s = 1; s < n; s++)
-        if (z[2 * s] > z[2 * best])
-            best = s;
-    *out_corr = z[2 * best];
-    return best;
+    for (int o = 0; o < (both ? 2 : 1); o++) {
+        size_t best = 0;
+        for (size_t s = 1; s < n; s++)
+            if (z[2 * s + o] > z[2 * best + o])
+                best = s;
+        shift[o] = best;
+        corr[o] = z[2 * best + o];
+    }
 }
 
 /* L1 distance of two quantized height vectors (integer: the same on every platform). */
@@ -230,6 +248,33 @@ static inline int32_t l1(const uint8_t *x, const uint8_t *y)
 #endif
 }
 
+/* One row of the banded DTW (see band_dp): cur[kk] = cost[kk] + the cheapest of prev[kk] (a
+ * match), prev[kk + 1] + skip (this row's sample matched twice) and cur[kk - 1] + skip (the
+ * other's), ties kept in that order; cs[kk] the start offset its path came from. Two passes: the
+ * first two moves are independent across the row (branch-free selects the compiler vectorizes),
+ * only the third chains along it — the same values and ties as one pass over the three. */
+static void band_row(const int32_t *restrict prev, const int *restrict ps, const int32_t *restrict cost, long W,
+                     int32_t skip, int32_t *restrict cur, int *restrict cs)
+{
+    for (long kk = 0; kk + 1 < W; kk++) { /* masks, not branches: the choice is data-dependent */
+        int32_t b = prev[kk], v = prev[kk + 1] + skip, m = -(int32_t)(v < b);
+        cur[kk] = (v & m) | (b & ~m);
+        cs[kk] = (ps[kk + 1] & m) | (ps[kk] & ~m);
+    }
+    cur[W - 1] = prev[W - 1];
+    cs[W - 1] = ps[W - 1];
+    int32_t c = cost[0] + cur[0];
+    int st = cs[0];
+    cur[0] = c;
+    for (long kk = 1; kk < W; kk++) {
+        int32_t h = c + skip, b = cur[kk], m = -(int32_t)(h < b);
+        st = (st & m) | (cs[kk] & ~m);
+        cs[kk] = st;
+        c = cost[kk] + ((h & m) | (b & ~m));
+        cur[kk] = c;
+    }
+}
+
 /* Banded DTW of a against b (orientation o) cyclically shifted by s; see the file comment. */
 static double band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, size_t band, size_t stride,
                       int32_t skip, amscr__hf_ws *ws)
@@ -239,6 +284,10 @@ static double band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, si
     int32_t *prev = ws->row, *cur = ws->row + W;
     int *ps = ws->start, *cs = ws->start + W;
     int32_t *cost = ws->row + 2 * W;
+    for (long kk = 0; kk < W; kk++) { /* before the first row: every start free, paths cost 0 */
+        prev[kk] = 0;
+        ps[kk] = (int)(kk - w);
+    }
     for (size_t i = 0; i < m; i++) {
         const uint8_t *ai = A + i * stride * D;
         size_t jb = (s + i * stride + n * stride - (size_t)w * stride) % n;
@@ -248,29 +297,7 @@ static double band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, si
             if (jb >= n)
                 jb -= n;
         }
-        for (long kk = 0; kk < W; kk++) {
-            int32_t best;
-            int st;
-            if (i == 0) {
-                best = 0;
-                st = (int)(kk - w);
-            } else {
-                best = prev[kk];
-                st = ps[kk];
-                int32_t v = kk + 1 < W ? prev[kk + 1] + skip : INT32_MAX;
-                if (v < best) {
-                    best = v;
-                    st = ps[kk + 1];
-                }
-            }
-            int32_t h = kk > 0 ? cur[kk - 1] + skip : INT32_MAX;
-            if (h < best) {
-                best = h;
-                st = cs[kk - 1];
-            }
-            cur[kk] = cost[kk] + best;
-            cs[kk] = st;
-        }
+        band_row(prev, ps, cost, W, skip, cur, cs);
         int32_t *t = prev;
         prev = cur;
         cur = t;
@@ -291,10 +318,11 @@ double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__h
 {
     const size_t n = a->n;
     size_t band = cfg->band < n / 2 ? cfg->band : n / 2;
-    double c0 = 0.0, c1 = -DBL_MAX;
-    size_t s0 = best_shift(a, b, 0, ws, &c0), s1 = 0;
-    if (cfg->reflections)
-        s1 = best_shift(a, b, 1, ws, &c1);
+    size_t sh[2] = {0, 0};
+    double corr[2] = {0.0, -DBL_MAX};
+    best_shifts(a, b, cfg->reflections, ws, sh, corr);
+    size_t s0 = sh[0], s1 = sh[1];
+    double c0 = corr[0], c1 = corr[1];
     int32_t skip = (int32_t)lround(cfg->skip * AMSCR__HF_QUANT);
     if (cfg->reflections && cfg->both_orientations) {
         double d0 = band_dp(a->seq[0], b->seq[0], n, s0, band, cfg->stride, skip, ws);
