@@ -84,6 +84,10 @@ int folds_fourier(const folds_data *fd);
 int folds_fuse(const folds_data *fd, const char *datasets);
 int folds_local(const folds_data *fd, const char *datasets);
 int folds_halves(const folds_data *fd);
+/* perm = a seeded random permutation of 0..L-1 (xorshift64*, Fisher-Yates). */
+void folds_shuffle(int *perm, int L, unsigned long long *seed);
+/* The channel's band on random class subsets of mpeg7-dev and on the larger collections. */
+int folds_band(const folds_data *fd);
 int folds_classes(const folds_data *fd, const char *datasets);
 /* Local scale of each row of the m x m matrix M: its k-th smallest off-diagonal entry. */
 void folds_local_scale(const double *M, size_t m, size_t k, double *sigma);

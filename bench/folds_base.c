@@ -64,7 +64,7 @@ static int channel_in_frame(const amscr_db *db, amscr_invariance frame, size_t s
         st = amscr__hf_of_descriptor(p, frame, amscr_db_descriptor(db, i), &hf[i]);
     if (st == AMSCR_OK) {
         amscr__hf_cfg cfg;
-        amscr__hf_cfg_from(p, hf[0].n, &cfg);
+        amscr__hf_cfg_from(p, hf[0].n, 0, &cfg); /* the audit's band: the same in both frames */
         cfg.stride = stride;
         st = amscr__hf_matrix(hf, n, &cfg, 2, NULL, NULL, out);
     }

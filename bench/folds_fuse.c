@@ -164,8 +164,7 @@ int folds_local(const folds_data *fd, const char *datasets)
     return 0;
 }
 
-/* perm = a seeded random permutation of 0..L-1 (xorshift64*, Fisher-Yates). */
-static void shuffle(int *perm, int L, unsigned long long *seed)
+void folds_shuffle(int *perm, int L, unsigned long long *seed)
 {
     for (int c = 0; c < L; c++)
         perm[c] = c;
@@ -214,7 +213,7 @@ int folds_halves(const folds_data *fd)
     unsigned long long seed = 0x2545F4914F6CDD1Dull;
     for (int h = 0; h < NH; h++) {
         int L = maxl + 1;
-        shuffle(perm, L, &seed);
+        folds_shuffle(perm, L, &seed);
         int C = getenv("HALVES_CLASSES") ? atoi(getenv("HALVES_CLASSES")) : L / 2; /* classes of the first */
         for (int half = 0; half < 2; half++) {
             for (int c = 0; c < L; c++)

@@ -20,6 +20,8 @@
  *   amscr-retrieval-folds DATASETS local   the channel rescaled before re-ranking: local scaling, NICDM,
  *                                          mutual proximity (folds_fuse.c; LOCAL_K=k the re-ranking's k)
  *   amscr-retrieval-folds DATASETS halves  candidates on 24 random class halves of mpeg7-dev (folds_fuse.c)
+ *   amscr-retrieval-folds DATASETS band    the channel's band on random class subsets of mpeg7-dev and on
+ *                                          the 916- and 1400-shape collections (folds_band.c)
  *   amscr-retrieval-folds DATASETS classes 1-NN, the 916-shape collection's parts, mpeg7-dev per class
  *   amscr-retrieval-folds DATASETS mcd     the MCD-style affine views by band and affine share
  *   amscr-retrieval-folds DATASETS row N BAND SKIP LOC SHARE K ITERS [STRIDE]   one combination, all splits
@@ -63,6 +65,8 @@ int main(int argc, char **argv)
         r = folds_local(&fd, argv[1]);
     else if (strcmp(what, "halves") == 0)
         r = folds_halves(&fd);
+    else if (strcmp(what, "band") == 0)
+        r = folds_band(&fd);
     else if (strcmp(what, "classes") == 0)
         r = folds_classes(&fd, argv[1]);
     else

@@ -227,13 +227,29 @@ static void prepared_free(prepared *s)
 
 /* The channel distance of collection shape i and query q (shape i first), as
  * amscr_channel_distance with the retrieval preset. */
+static double two_frames(const amscr_params *p, const amscr__hf *a0, const amscr__hf *a1, const amscr__hf *b0,
+                         const amscr__hf *b1, amscr__hf_ws *ws)
+{
+    amscr__hf_cfg cfg[2];
+    amscr__hf_cfg_from(p, a0->n, 0, &cfg[0]);
+    amscr__hf_cfg_from(p, a0->n, 1, &cfg[1]);
+    double s = amscr_params_get_channel_affine_share(p);
+    return (1.0 - s) * amscr__hf_distance(a0, b0, &cfg[0], ws) + s * amscr__hf_distance(a1, b1, &cfg[1], ws);
+}
+
 static double exact(const amscr_params *p, const prepared *c, size_t i, const prepared *q, size_t k, amscr__hf_ws *ws)
 {
-    amscr__hf_cfg cfg;
-    amscr__hf_cfg_from(p, c->d[i]->n, &cfg);
-    double s = amscr_params_get_channel_affine_share(p);
-    return (1.0 - s) * amscr__hf_distance(&c->hf[0][i], &q->hf[0][k], &cfg, ws) +
-           s * amscr__hf_distance(&c->hf[1][i], &q->hf[1][k], &cfg, ws);
+    return two_frames(p, &c->hf[0][i], &c->hf[1][i], &q->hf[0][k], &q->hf[1][k], ws);
+}
+
+/* A channel workspace with room for both frames' bands. */
+static void ws_init(const amscr_params *p, size_t n, amscr__hf_ws *ws)
+{
+    amscr__hf_cfg c0, c1;
+    amscr__hf_cfg_from(p, n, 0, &c0);
+    amscr__hf_cfg_from(p, n, 1, &c1);
+    if (amscr__hf_ws_init(ws, n, c0.band > c1.band ? c0.band : c1.band) != AMSCR_OK)
+        die("workspace");
 }
 
 typedef struct {
@@ -272,10 +288,7 @@ static void recall(const amscr_params *p, const prepared *c, const prepared *q, 
     double *e = xmalloc(n * sizeof *e), *sd = xmalloc(n * sizeof *sd);
     size_t *rank = xmalloc(n * sizeof *rank);
     amscr__hf_ws ws;
-    amscr__hf_cfg cfg;
-    amscr__hf_cfg_from(p, c->d[0]->n, &cfg);
-    if (amscr__hf_ws_init(&ws, c->d[0]->n, cfg.band) != AMSCR_OK)
-        die("workspace");
+    ws_init(p, c->d[0]->n, &ws);
     memset(t, 0, sizeof *t);
     for (size_t k = 0; k < q->n; k++) {
         for (size_t i = 0; i < n; i++)
@@ -309,11 +322,8 @@ static void query_parts(const amscr_params *p, const prepared *c, amscr_contour 
 {
     size_t n = c->n, dim = VARS[v].dim, *cand = xmalloc(n * sizeof *cand), m = n < 256 ? n : 256;
     double *sd = xmalloc(n * sizeof *sd), *qs = xmalloc(dim * sizeof *qs), ms[3][TIMED];
-    amscr__hf_cfg cfg;
     amscr__hf_ws ws;
-    amscr__hf_cfg_from(p, c->d[0]->n, &cfg);
-    if (amscr__hf_ws_init(&ws, c->d[0]->n, cfg.band) != AMSCR_OK)
-        die("workspace");
+    ws_init(p, c->d[0]->n, &ws);
     nq = nq < TIMED ? nq : TIMED;
     for (size_t k = 0; k < nq; k++) {
         amscr__hf h[2], b[2];
@@ -329,8 +339,7 @@ static void query_parts(const amscr_params *p, const prepared *c, amscr_contour 
             die("top-k");
         double t1 = cpu();
         for (size_t j = 0; j < m; j++)
-            for (int f = 0; f < 2; f++)
-                acc += amscr__hf_distance(&c->hf[f][cand[j]], &h[f], &cfg, &ws);
+            acc += two_frames(p, &c->hf[0][cand[j]], &c->hf[1][cand[j]], &h[0], &h[1], &ws);
         double t2 = cpu();
         for (size_t j = 0; j < 16; j++)
             for (int f = 0; f < 2; f++) {

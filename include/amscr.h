@@ -1548,7 +1548,11 @@ AMSCR_API double amscr_params_get_channel_affine_share(const amscr_params *p);
 
 /**
  * @brief Sets the half width of the channel's dynamic-programming band, as a fraction of N
- *        in (0, 0.5] (default 0.08: 10 samples at N = 128).
+ *        in (0, 0.5] (default 0.15: 19 samples at N = 128; 0.08 before 0.6): how far the
+ *        correspondence may stray from the best cyclic shift, i.e. how much articulation
+ *        (a part bent or stretched along the curve) the channel forgives. With the
+ *        similarity frame and an affine share, the whitened frame has its own band
+ *        (amscr_params_set_channel_affine_band).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -1564,6 +1568,30 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_band(amscr_param
  * @since 0.2
  */
 AMSCR_API double amscr_params_get_channel_band(const amscr_params *p);
+
+/**
+ * @brief Sets the band of the channel's whitened frame when it is the second frame (the
+ *        similarity frame with an affine share > 0), as a fraction of N in (0, 0.5]
+ *        (default 0.08). That frame is there for affine views, not articulation: a band
+ *        as wide as the similarity frame's changes no measured score there and costs
+ *        time (docs/results-retrieval.md). Set it equal to amscr_params_set_channel_band's
+ *        value for the settings before 0.6 (0.08 both). A collection file saved before 0.6
+ *        loads with the two bands equal, as it was computed.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
+ * Ownership: none.
+ * Thread-safety: exclusive on p.
+ * @since 0.6
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_affine_band(amscr_params *p, double fraction);
+
+/**
+ * @brief The band of the channel's whitened second frame.
+ * @return the value; 0 for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.6
+ */
+AMSCR_API double amscr_params_get_channel_affine_band(const amscr_params *p);
 
 /**
  * @brief Sets the cost of a sample matched twice (a skipped stretch on the other curve), in

@@ -225,6 +225,8 @@ START_TEST(test_bad_input)
     ck_assert_int_eq(amscr_params_set_channel_weight(p, NAN), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_params_set_channel_band(p, 0.0), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_params_set_channel_band(p, 0.6), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_channel_affine_band(p, 0.0), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_channel_affine_band(p, NAN), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_params_set_channel_skip(p, -0.1), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_params_set_channel_locality(p, INFINITY), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_params_set_channel_invariance(p, AMSCR_INVARIANCE_PENALIZED), AMSCR_E_INVALID_ARG);

@@ -1169,7 +1169,7 @@ START_TEST(blob_layout_sanity)
     unsigned char *b = small_blob(&len);
     ck_assert(len > 100);
     ck_assert(memcmp(b, "AMSCRDB", 8) == 0);
-    ck_assert(b[8] == 2 && b[9] == 0 && b[10] == 0 && b[11] == 0); /* version 2, little-endian */
+    ck_assert(b[8] == 5 && b[9] == 0 && b[10] == 0 && b[11] == 0); /* version 5, little-endian */
     uint64_t h = 0;
     for (int i = 0; i < 8; i++)
         h |= (uint64_t)b[len - 8 + i] << (8 * i);
@@ -1182,16 +1182,16 @@ START_TEST(blob_layout_sanity)
 }
 END_TEST
 
-/* Format version 2 puts the retrieval settings (52 bytes) right after the params, which end
- * 60 bytes after the scales; version 1 files (the same without that block) still load, with
- * the retrieval settings at their defaults. */
+/* Format version 5 puts the retrieval settings (60 bytes; 52 in version 2) right after the
+ * params, which end 60 bytes after the scales; version 1 files (the same without that block)
+ * still load, with the retrieval settings at their defaults. */
 #define BLOB_RETRIEVAL_OFFSET (BLOB_SCALE_OFFSET + 8 + 60)
 START_TEST(format_v1_still_loads)
 {
     size_t len = 0;
     unsigned char *b = small_blob(&len);
-    memmove(b + BLOB_RETRIEVAL_OFFSET, b + BLOB_RETRIEVAL_OFFSET + 52, len - BLOB_RETRIEVAL_OFFSET - 52);
-    len -= 52;
+    memmove(b + BLOB_RETRIEVAL_OFFSET, b + BLOB_RETRIEVAL_OFFSET + 60, len - BLOB_RETRIEVAL_OFFSET - 60);
+    len -= 60;
     b[8] = 1;
     fix_checksum(b, len);
     amscr_db *db = NULL;
@@ -1204,11 +1204,49 @@ START_TEST(format_v1_still_loads)
 }
 END_TEST
 
+/* A version 2 file (before 0.6: a 52-byte block, one band for both frames) loads with the
+ * whitened frame's band equal to the band, as it was computed; a bad band there is refused. */
+START_TEST(format_v2_one_band)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_channel_band(p, 0.125), AMSCR_OK);
+    ck_assert(amscr_params_get_channel_affine_band(p) != 0.125);
+    amscr_db *db = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
+    void *buf = NULL;
+    size_t len = 0;
+    ck_assert_int_eq(amscr_db_save_memory(db, &buf, &len), AMSCR_OK);
+    unsigned char *b = buf;
+    size_t nscales = 0, at = 0;
+    ck_assert_int_eq(amscr_params_get_scales(p, NULL, &nscales), AMSCR_OK);
+    at = BLOB_SCALE_OFFSET + 8 * nscales + 60 + 52; /* the affine band, after the 52 bytes of version 2 */
+    memmove(b + at, b + at + 8, len - at - 8);
+    len -= 8;
+    b[8] = 2;
+    fix_checksum(b, len);
+    amscr_db *back = NULL;
+    ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_OK);
+    ck_assert(amscr_params_get_channel_band(amscr_db_params(back)) == 0.125);
+    ck_assert(amscr_params_get_channel_affine_band(amscr_db_params(back)) == 0.125);
+    amscr_db_free(back);
+    back = NULL;
+    b[8] = 5; /* read as version 5, the block runs 8 bytes into the counts: refused or inconsistent */
+    fix_checksum(b, len);
+    ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_E_FORMAT);
+    ck_assert_ptr_null(back);
+    amscr_free(buf);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+END_TEST
+
 START_TEST(retrieval_settings_roundtrip)
 {
     amscr_params *p = NULL;
     ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
     ck_assert_int_eq(amscr_params_set_channel_band(p, 0.125), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_channel_affine_band(p, 0.0625), AMSCR_OK);
     ck_assert_int_eq(amscr_params_set_channel_affine_share(p, 0.3), AMSCR_OK);
     amscr_db *db = NULL;
     ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
@@ -1220,6 +1258,7 @@ START_TEST(retrieval_settings_roundtrip)
     const amscr_params *q = amscr_db_params(back);
     ck_assert(amscr_params_get_channel_weight(q) == amscr_params_get_channel_weight(p));
     ck_assert(amscr_params_get_channel_band(q) == 0.125);
+    ck_assert(amscr_params_get_channel_affine_band(q) == 0.0625);
     ck_assert(amscr_params_get_channel_affine_share(q) == 0.3);
     ck_assert(amscr_params_get_channel_skip(q) == amscr_params_get_channel_skip(p));
     ck_assert(amscr_params_get_channel_locality(q) == amscr_params_get_channel_locality(p));
@@ -1593,6 +1632,7 @@ Suite *amscr_suite_db(void)
     tcase_add_test(tc, corrupt_magic_and_version);
     tcase_add_test(tc, format_v1_still_loads);
     tcase_add_test(tc, retrieval_settings_roundtrip);
+    tcase_add_test(tc, format_v2_one_band);
     tcase_add_test(tc, corrupt_truncated);
     tcase_add_test(tc, corrupt_flipped_bytes);
     tcase_add_test(tc, crafted_files_valid_checksum);

@@ -74,6 +74,7 @@ struct amscr_params {
     amscr_invariance channel_invariance; /* frame of the shape channel (affine or similarity) */
     double channel_affine_share;       /* similarity frame: share of the whitened frame's channel */
     double channel_band;               /* DP band half-width, fraction of N */
+    double channel_affine_band;        /* the same in the whitened second frame (0.6) */
     double channel_skip;               /* DP cost of a sample matched twice */
     double channel_locality;           /* height bins weighted 1 / (1 + locality * distance along the curve) */
     unsigned rerank_k;                 /* re-ranking neighbours, 0 = no re-ranking */
@@ -205,13 +206,27 @@ size_t amscr__elbow_choose(const double *sse, size_t m, size_t k_min);
  * the diffusion) and a zero diagonal (rerank.c). */
 amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);
 
-/* The retrieval settings in the saved collection (format version 2, retrieval_io.c):
+/* The retrieval settings in the saved collection (format versions 2-4, retrieval_io.c):
  * little-endian f64 channel_weight, u32 channel_invariance, f64 channel_affine_share,
  * f64 channel_band, f64 channel_skip, f64 channel_locality, u32 rerank_k,
- * u32 rerank_iterations. read validates through the setters' rules (AMSCR_E_FORMAT). */
+ * u32 rerank_iterations; versions 5 and 6 (0.6) then f64 channel_affine_band (_V2). A shorter
+ * block reads with channel_affine_band = channel_band (one band for both frames before 0.6).
+ * read validates through the setters' rules (AMSCR_E_FORMAT). */
 #define AMSCR__RETRIEVAL_BLOCK 52
-void amscr__retrieval_block_write(const amscr_params *p, unsigned char out[AMSCR__RETRIEVAL_BLOCK]);
-amscr_status amscr__retrieval_block_read(const unsigned char in[AMSCR__RETRIEVAL_BLOCK], amscr_params *p);
+#define AMSCR__RETRIEVAL_BLOCK_V2 60
+/* size: AMSCR__RETRIEVAL_BLOCK or AMSCR__RETRIEVAL_BLOCK_V2. */
+void amscr__retrieval_block_write(const amscr_params *p, unsigned char *out, size_t size);
+amscr_status amscr__retrieval_block_read(const unsigned char *in, size_t size, amscr_params *p);
+
+/* The re-ranking's neighbours in a collection of n shapes (n >= 1): rerank_k, but at most half
+ * the collection and at least 1; 0 without re-ranking. Neighbourhoods that cover the collection
+ * carry no context: the diffusion then flattens every score, and a 9-shape folder ranked by
+ * noise (0.6; min(rerank_k, n) before, which index files of 0.5 hold). */
+static inline size_t amscr__rerank_k(const amscr_params *p, size_t n)
+{
+    size_t half = n / 2 > 0 ? n / 2 : 1;
+    return p->rerank_k < half ? p->rerank_k : half;
+}
 
 /* Thread count helper: 0 -> online cores. */
 unsigned amscr__resolve_threads(unsigned requested);

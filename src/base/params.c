@@ -16,7 +16,8 @@ static void retrieval_defaults(amscr_params *p)
     p->channel_weight = 0.0;
     p->channel_invariance = AMSCR_INVARIANCE_SIMILARITY;
     p->channel_affine_share = 0.2;
-    p->channel_band = 0.08;
+    p->channel_band = 0.15;
+    p->channel_affine_band = 0.08;
     p->channel_skip = 1.0;
     p->channel_locality = 4.0;
     p->rerank_k = 0;
@@ -162,6 +163,8 @@ SETTER(channel_affine_share, double, channel_affine_share, v >= 0.0 && v <= 1.0,
 GETTER(channel_affine_share, double, channel_affine_share)
 SETTER(channel_band, double, channel_band, v > 0.0 && v <= 0.5, "%g is not in (0, 0.5]")
 GETTER(channel_band, double, channel_band)
+SETTER(channel_affine_band, double, channel_affine_band, v > 0.0 && v <= 0.5, "%g is not in (0, 0.5]")
+GETTER(channel_affine_band, double, channel_affine_band)
 SETTER(channel_skip, double, channel_skip, v >= 0.0 && v <= 1e3, "%g is not in 0..1000")
 GETTER(channel_skip, double, channel_skip)
 SETTER(channel_locality, double, channel_locality, v >= 0.0 && v <= 1e3, "%g is not in 0..1000")

@@ -266,12 +266,13 @@ static void band_row(const int32_t *restrict prev, const int *restrict ps, const
     int32_t c = cost[0] + cur[0];
     int st = cs[0];
     cur[0] = c;
-    for (long kk = 1; kk < W; kk++) {
-        int32_t h = c + skip, b = cur[kk], m = -(int32_t)(h < b);
-        st = (st & m) | (cs[kk] & ~m);
-        cs[kk] = st;
-        c = cost[kk] + ((h & m) | (b & ~m));
+    for (long kk = 1; kk < W; kk++) { /* plain selects: conditional moves, the shortest chain */
+        int32_t h = c + skip, b = cur[kk];
+        int sb = cs[kk], lt = h < b;
+        c = (lt ? h : b) + cost[kk];
+        st = lt ? st : sb;
         cur[kk] = c;
+        cs[kk] = st;
     }
 }
 

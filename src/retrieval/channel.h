@@ -61,7 +61,7 @@ amscr_status amscr__hf_matrix(const amscr__hf *hf, size_t n, const amscr__hf_cfg
 amscr_status amscr__hf_of_descriptor(const amscr_params *p, amscr_invariance frame, const amscr_descriptor *d,
                                      amscr__hf *out);
 /* The channel's pair settings from p for N samples. */
-void amscr__hf_cfg_from(const amscr_params *p, size_t n, amscr__hf_cfg *cfg);
+void amscr__hf_cfg_from(const amscr_params *p, size_t n, int second, amscr__hf_cfg *cfg);
 
 /* The frames of the channel and their shares (fuse.c): the primary frame, plus the whitened
  * frame with channel_affine_share when the primary one is the similarity frame. Returns the

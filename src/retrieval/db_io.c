@@ -22,7 +22,7 @@
 
 uint64_t amscr__db_checksum(uint32_t version, const unsigned char *p, size_t n)
 {
-    return version >= AMSCR__DB_VERSION_FEATURES ? amscr__sum64(p, n) : amscr__fnv1a(p, n);
+    return amscr__db_has_features(version) ? amscr__sum64(p, n) : amscr__fnv1a(p, n);
 }
 
 static void w_params(amscr__wbuf *w, const amscr_params *p)
@@ -52,9 +52,10 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
     amscr__w_u32(w, version);
     amscr__w_u32(w, 0);
     w_params(w, prm);
-    unsigned char rblock[AMSCR__RETRIEVAL_BLOCK];
-    amscr__retrieval_block_write(prm, rblock);
-    amscr__w_bytes(w, rblock, sizeof rblock);
+    unsigned char rblock[AMSCR__RETRIEVAL_BLOCK_V2];
+    size_t rsize = amscr__db_retrieval_block(version);
+    amscr__retrieval_block_write(prm, rblock, rsize);
+    amscr__w_bytes(w, rblock, rsize);
     size_t N = prm->num_samples, p = prm->num_scales, n = amscr_db_size(db);
     amscr__w_u64(w, n);
     amscr__w_u64(w, N);
@@ -80,7 +81,7 @@ amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *ou
     if (st != AMSCR_OK)
         return st;
     amscr__wbuf w = {NULL, 0, 0, 0};
-    amscr__db_write(db, AMSCR__DB_VERSION_PLAIN, &w);
+    amscr__db_write(db, AMSCR__DB_VERSION_PLAIN_BANDS, &w);
     if (!w.oom)
         amscr__w_u64(&w, amscr__fnv1a(w.buf, w.len));
     if (w.oom) {
@@ -173,11 +174,11 @@ static amscr_status r_params(amscr__rbuf *r, uint32_t version, amscr_params *prm
         amscr_params_set_penalty(&chk, q.penalty))
         return amscr__fail(AMSCR_E_FORMAT, "collection header: invalid parameters");
     amscr__clear_error();
-    if (version >= 2) {
-        if (r->bad || r->len - r->pos < AMSCR__RETRIEVAL_BLOCK ||
-            amscr__retrieval_block_read(r->p + r->pos, &q) != AMSCR_OK)
+    size_t rsize = amscr__db_retrieval_block(version);
+    if (rsize > 0) {
+        if (r->bad || r->len - r->pos < rsize || amscr__retrieval_block_read(r->p + r->pos, rsize, &q) != AMSCR_OK)
             return amscr__fail(AMSCR_E_FORMAT, "collection header: invalid retrieval settings");
-        r->pos += AMSCR__RETRIEVAL_BLOCK;
+        r->pos += rsize;
     }
     *prm = q;
     return AMSCR_OK;
@@ -367,9 +368,9 @@ static amscr_status check_envelope(const unsigned char *buf, size_t len, uint32_
         return amscr__fail(AMSCR_E_FORMAT, "not an amscr collection (bad magic)");
     amscr__rbuf r = {buf, len, 8, 0}, t = {buf, len, len - 8, 0};
     *version = amscr__r_u32(&r);
-    if (*version > AMSCR__DB_VERSION_FEATURES)
+    if (*version > AMSCR__DB_VERSION_NEWEST)
         return amscr__fail(AMSCR_E_FORMAT, "collection format version %u is newer than this library's (%u)",
-                           (unsigned)*version, AMSCR__DB_VERSION_FEATURES);
+                           (unsigned)*version, AMSCR__DB_VERSION_NEWEST);
     if (*version == 0)
         return amscr__fail(AMSCR_E_FORMAT, "collection format version 0 is invalid");
     if (amscr__db_checksum(*version, buf, len - 8) != amscr__r_u64(&t))
@@ -421,7 +422,7 @@ amscr_status amscr_db_load_memory(const void *buf, size_t len, amscr_db **out)
     amscr_status st = amscr__db_parse(buf, len, 0, &db, &pos, &version);
     if (st != AMSCR_OK)
         return st;
-    if (version >= AMSCR__DB_VERSION_INDEX) { /* an index file: its collection, the section skipped */
+    if (amscr__db_is_index(version)) { /* an index file: its collection, the section skipped */
         amscr__rbuf r = {buf, len - 8, pos, 0};
         uint64_t sec = amscr__r_u64(&r);
         if (r.bad || sec != r.len - r.pos)

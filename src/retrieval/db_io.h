@@ -11,10 +11,35 @@
 /* 1 (0.1); 2 (0.2): the retrieval settings follow the params; 3 (0.4): an index section
  * (u64 length, then index_io.c's bytes) follows the shapes; 4 (0.5): the index section holds
  * the shapes' channel features too, and the trailing checksum is amscr__sum64 instead of
- * FNV-1a. Every version loads. */
+ * FNV-1a; 5 and 6 (0.6): 2 and 4 (FNV-1a and amscr__sum64) with the longer retrieval block (the whitened frame's band
+ * after the others; AMSCR__RETRIEVAL_BLOCK_V2). Every version loads. */
 #define AMSCR__DB_VERSION_PLAIN 2u
 #define AMSCR__DB_VERSION_INDEX 3u
 #define AMSCR__DB_VERSION_FEATURES 4u
+#define AMSCR__DB_VERSION_PLAIN_BANDS 5u
+#define AMSCR__DB_VERSION_INDEX_BANDS 6u
+#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_BANDS
+
+/* Whether a file of `version` is an index file (an index section after the shapes). */
+static inline int amscr__db_is_index(uint32_t version)
+{
+    return version == AMSCR__DB_VERSION_INDEX || version == AMSCR__DB_VERSION_FEATURES ||
+           version == AMSCR__DB_VERSION_INDEX_BANDS;
+}
+
+/* Whether an index file of `version` stores the shapes' channel features. */
+static inline int amscr__db_has_features(uint32_t version)
+{
+    return version == AMSCR__DB_VERSION_FEATURES || version == AMSCR__DB_VERSION_INDEX_BANDS;
+}
+
+/* The bytes of the retrieval block in a file of `version` (0: none). */
+static inline size_t amscr__db_retrieval_block(uint32_t version)
+{
+    return version >= AMSCR__DB_VERSION_PLAIN_BANDS ? AMSCR__RETRIEVAL_BLOCK_V2
+           : version >= AMSCR__DB_VERSION_PLAIN     ? AMSCR__RETRIEVAL_BLOCK
+                                                    : 0;
+}
 
 /* The trailing checksum of a file of `version` over its first n bytes. */
 uint64_t amscr__db_checksum(uint32_t version, const unsigned char *p, size_t n);

@@ -7,9 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-void amscr__hf_cfg_from(const amscr_params *p, size_t n, amscr__hf_cfg *cfg)
+void amscr__hf_cfg_from(const amscr_params *p, size_t n, int second, amscr__hf_cfg *cfg)
 {
-    size_t band = (size_t)floor(p->channel_band * (double)n + 0.5);
+    size_t band = (size_t)floor((second ? p->channel_affine_band : p->channel_band) * (double)n + 0.5);
     cfg->band = band < 1 ? 1 : band;
     cfg->skip = p->channel_skip;
     cfg->reflections = p->reflections;
@@ -81,13 +81,14 @@ int amscr__channel_frames(const amscr_params *p, amscr_invariance frames[2], dou
     return 2;
 }
 
-static amscr_status pair_in_frame(const amscr_params *p, amscr_invariance frame, const amscr_descriptor *a,
-                                  const amscr_descriptor *b, double *out)
+/* The channel of a and b in frame `frame`, the second of amscr__channel_frames when `second`. */
+static amscr_status pair_in_frame(const amscr_params *p, amscr_invariance frame, int second,
+                                  const amscr_descriptor *a, const amscr_descriptor *b, double *out)
 {
     amscr__hf ha, hb;
     amscr__hf_ws ws;
     amscr__hf_cfg cfg;
-    amscr__hf_cfg_from(p, a->n, &cfg);
+    amscr__hf_cfg_from(p, a->n, second, &cfg);
     amscr_status st = amscr__hf_of_descriptor(p, frame, a, &ha);
     if (st != AMSCR_OK)
         return st;
@@ -122,7 +123,7 @@ amscr_status amscr_channel_distance(const amscr_params *p, const amscr_descripto
     int nf = amscr__channel_frames(p, frames, share);
     for (int f = 0; f < nf; f++) {
         double d = 0.0;
-        amscr_status st = pair_in_frame(p, frames[f], a, b, &d);
+        amscr_status st = pair_in_frame(p, frames[f], f, a, b, &d);
         if (st != AMSCR_OK)
             return st;
         sum += share[f] * d;
@@ -154,9 +155,9 @@ static int stage_cb(void *user, size_t done, size_t total)
     return sp->fn(sp->user, sp->stage * total + done, whole);
 }
 
-/* The channel matrix in one frame into out. */
-static amscr_status matrix_in_frame(const amscr_db *db, amscr_invariance frame, amscr_progress_fn progress,
-                                    void *user, double *out)
+/* The channel matrix in one frame (the second of amscr__channel_frames when `second`) into out. */
+static amscr_status matrix_in_frame(const amscr_db *db, amscr_invariance frame, int second,
+                                    amscr_progress_fn progress, void *user, double *out)
 {
     const amscr_params *p = amscr_db_params(db);
     size_t n = amscr_db_size(db);
@@ -168,7 +169,7 @@ static amscr_status matrix_in_frame(const amscr_db *db, amscr_invariance frame, 
         st = amscr__hf_of_descriptor(p, frame, amscr_db_descriptor(db, i), &hf[i]);
     if (st == AMSCR_OK) {
         amscr__hf_cfg cfg;
-        amscr__hf_cfg_from(p, hf[0].n, &cfg);
+        amscr__hf_cfg_from(p, hf[0].n, second, &cfg);
         st = amscr__hf_matrix(hf, n, &cfg, amscr__resolve_threads(p->num_threads), progress, user, out);
     }
     free_hfs(hf, n);
@@ -187,7 +188,7 @@ static amscr_status channel_matrix(const amscr_db *db, amscr_progress_fn progres
     double share[2];
     int nf = amscr__channel_frames(p, frames, share);
     stage_progress sp = {progress, user, 0, (size_t)nf};
-    amscr_status st = matrix_in_frame(db, frames[0], progress ? stage_cb : NULL, &sp, out);
+    amscr_status st = matrix_in_frame(db, frames[0], 0, progress ? stage_cb : NULL, &sp, out);
     if (st != AMSCR_OK || nf == 1)
         return st;
     double *second = amscr__malloc_array(n * n, sizeof *second);
@@ -195,7 +196,7 @@ static amscr_status channel_matrix(const amscr_db *db, amscr_progress_fn progres
         st = amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
     sp.stage = 1;
     if (st == AMSCR_OK)
-        st = matrix_in_frame(db, frames[1], progress ? stage_cb : NULL, &sp, second);
+        st = matrix_in_frame(db, frames[1], 1, progress ? stage_cb : NULL, &sp, second);
     for (size_t i = 0; st == AMSCR_OK && i < n * n; i++)
         out[i] = share[0] * out[i] + share[1] * second[i];
     if (st != AMSCR_OK)
@@ -324,7 +325,7 @@ amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn pro
     double med[2];
     amscr_status st = amscr__base_matrix(db, progress, user, out_dist, med);
     if (st == AMSCR_OK && n > 0 && p->rerank_k > 0)
-        st = amscr__rerank_normalized(out_dist, n, p->rerank_k < n ? p->rerank_k : n, p->rerank_iterations, out_dist);
+        st = amscr__rerank_normalized(out_dist, n, amscr__rerank_k(p, n), p->rerank_iterations, out_dist);
     if (st != AMSCR_OK)
         for (size_t i = 0; i < n * n; i++)
             out_dist[i] = NAN;

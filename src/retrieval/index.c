@@ -66,7 +66,7 @@ amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
     size_t n = amscr_db_size(db);
     x->sig_dim = AMSCR__SIG_DIM;
     x->nf = amscr__index_frames(p);
-    x->k = p->rerank_k < n ? p->rerank_k : n;
+    x->k = n > 0 ? amscr__rerank_k(p, n) : 0;
     amscr_status st = amscr_db_new(p, &x->db);
     for (size_t i = 0; st == AMSCR_OK && i < n; i++)
         st = amscr_db_add_descriptor(x->db, amscr_db_descriptor(db, i), amscr_db_label(db, i), NULL);

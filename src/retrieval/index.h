@@ -10,7 +10,7 @@
 
 struct amscr_index {
     amscr_db *db;         /* the collection (owned) */
-    size_t k;             /* neighbours a shape: min(rerank_k, n); 0 without re-ranking */
+    size_t k;             /* neighbours a shape: amscr__rerank_k (a 0.5 file: min(rerank_k, n)) */
     size_t candidates;    /* the build's shortlist M (0: every shape, exact lists) */
     double dmax;          /* largest base distance of the collection */
     double med_a, med_h;  /* the fusion's medians (0 < channel weight < 1; else 0) */
@@ -49,7 +49,7 @@ typedef struct {
 /* Per-thread scratch of the pair distance. */
 typedef struct {
     amscr_workspace *ws;
-    amscr__hf_cfg cfg;
+    amscr__hf_cfg cfg[2]; /* per frame of amscr__channel_frames */
     amscr__hf_ws hws;
     int have_hws;
 } amscr__pair_ws;

@@ -19,8 +19,8 @@ static const char *differing_option(const amscr_params *a, const amscr_params *b
         return #f;
     CMP(method) CMP(closed) CMP(reflections) CMP(parametrization) CMP(presmooth) CMP(arclength_passes)
     CMP(oversampling) CMP(kmax) CMP(symmetric) CMP(refine) CMP(invariance) CMP(penalty) CMP(channel_weight)
-    CMP(channel_invariance) CMP(channel_affine_share) CMP(channel_band) CMP(channel_skip) CMP(channel_locality)
-    CMP(rerank_k) CMP(rerank_iterations)
+    CMP(channel_invariance) CMP(channel_affine_share) CMP(channel_band) CMP(channel_affine_band) CMP(channel_skip)
+    CMP(channel_locality) CMP(rerank_k) CMP(rerank_iterations)
 #undef CMP
     return NULL;
 }
@@ -107,7 +107,7 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
                                                 "index (rebuild the index to change it)", diff);
     size_t n0 = amscr_db_size(x->db), add = amscr_db_size(shapes), n = n0 + add;
     amscr_status st = amscr__index_check_db(shapes, "amscr_index_add");
-    size_t kp = p->rerank_k < n ? p->rerank_k : n;
+    size_t kp = amscr__rerank_k(p, n);
     if (st == AMSCR_OK && kp != x->k && n0 > 0) /* a list grows with the collection: rebuild */
         return amscr__fail(AMSCR_E_STATE, "amscr_index_add: the index holds %zu neighbours a shape and needs %zu "
                                           "with %zu shapes; rebuild it", x->k, kp, n);

@@ -1,4 +1,4 @@
-/* index_io.c — the index file: a collection file (db_io.c) of version 4 (3 before 0.5) whose
+/* index_io.c — the index file: a collection file (db_io.c) of version 6 (4 in 0.5, 3 in 0.4) whose
  * index section follows the shapes, so amscr_db_load of an index file gives its collection.
  * Little-endian:
  *   u64 section length (the bytes up to the trailing checksum), then
@@ -8,7 +8,7 @@
  *   (each row: itself first, then by distance), n names, u64 nclasses, nclasses class names
  *   (string: u32 length and bytes, 0xffffffff for none), then
  *   version 3: when a shape has a group, n group names (absent: no shape has one);
- *   version 4: u32 1 and n group names, or u32 0 (no shape has one); then the channel
+ *   versions 4 and 6: u32 1 and n group names, or u32 0 (no shape has one); then the channel
  *     features: u32 frames F (0: no channel), u32 samples N, u32 bins B (AMSCR__HF_BINS), and
  *     per shape, per frame, its quantized height sequences (channel.h), forward then mirrored:
  *     2 N B bytes (F = 2, N = 128: 8 KB a shape).
@@ -96,7 +96,7 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
     if (st != AMSCR_OK)
         return st;
     amscr__wbuf w = {NULL, 0, 0, 0};
-    amscr__db_write(x->db, AMSCR__DB_VERSION_FEATURES, &w);
+    amscr__db_write(x->db, AMSCR__DB_VERSION_INDEX_BANDS, &w);
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
     write_section(x, &w);
@@ -109,7 +109,7 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
         uint64_t sec = (uint64_t)(w.len - at - 8);
         for (int i = 0; i < 8; i++)
             w.buf[at + (size_t)i] = (unsigned char)(sec >> (8 * i));
-        amscr__w_u64(&w, amscr__db_checksum(AMSCR__DB_VERSION_FEATURES, w.buf, w.len));
+        amscr__w_u64(&w, amscr__db_checksum(AMSCR__DB_VERSION_INDEX_BANDS, w.buf, w.len));
     }
     if (w.oom) {
         free(w.buf);
@@ -150,7 +150,8 @@ static amscr_status read_header(amscr__rbuf *r, amscr_index *x)
         return amscr__fail(AMSCR_E_FORMAT, "index file: signatures of dimension %u (%u bytes a value), this "
                                            "library's have %u (%u); rebuild the index", (unsigned)sig_dim,
                            (unsigned)sig_bytes, (unsigned)AMSCR__SIG_DIM, (unsigned)sizeof(float));
-    if (k != (p->rerank_k < n ? p->rerank_k : n) || (m != 0 && m + 1 >= n))
+    size_t k05 = p->rerank_k < n ? p->rerank_k : n; /* the rule of 0.5's files */
+    if ((k != amscr__rerank_k(p, n) && k != k05) || (m != 0 && m + 1 >= n))
         return amscr__fail(AMSCR_E_FORMAT, "index file: %llu neighbours or %llu candidates do not fit %zu shapes "
                                            "with re-ranking k %u", (unsigned long long)k, (unsigned long long)m, n,
                            p->rerank_k);
@@ -208,7 +209,7 @@ static amscr_status read_names(amscr__rbuf *r, amscr_index *x, uint32_t version)
         if (!amscr__r_str(r, &x->classes[c], &oom))
             return oom ? amscr__fail(AMSCR_E_NOMEM, "index file: out of memory")
                        : amscr__fail(AMSCR_E_FORMAT, "index file: class name %zu is truncated or invalid", c);
-    uint32_t groups = version >= AMSCR__DB_VERSION_FEATURES ? amscr__r_u32(r) : r->pos < r->len;
+    uint32_t groups = amscr__db_has_features(version) ? amscr__r_u32(r) : r->pos < r->len;
     if (r->bad || groups > 1)
         return amscr__fail(AMSCR_E_FORMAT, "index file: bad groups flag");
     for (size_t i = 0; groups && i < n; i++) /* the groups, when a shape has one */
@@ -218,7 +219,7 @@ static amscr_status read_names(amscr__rbuf *r, amscr_index *x, uint32_t version)
     return AMSCR_OK;
 }
 
-/* The channel features of a version 4 file: each shape's height sequences (index.h's x->hf,
+/* The channel features of a version 4 or 6 file: each shape's height sequences (index.h's x->hf,
  * their spectra not yet computed). */
 static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
 {
@@ -248,10 +249,10 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
     return AMSCR_OK;
 }
 
-/* What follows the names: the features (version 4), then nothing. */
+/* What follows the names: the features (versions 4 and 6), then nothing. */
 static amscr_status read_rest(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
-    amscr_status st = version >= AMSCR__DB_VERSION_FEATURES ? read_features(r, x) : AMSCR_OK;
+    amscr_status st = amscr__db_has_features(version) ? read_features(r, x) : AMSCR_OK;
     if (st == AMSCR_OK && r->pos != r->len)
         st = amscr__fail(AMSCR_E_FORMAT, "index file: %zu unexpected bytes after the index section",
                          r->len - r->pos);
@@ -290,8 +291,8 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int
         x->map_len = len;
     }
     amscr__rbuf r = {buf, len - 8, pos, 0};
-    uint64_t sec = version >= AMSCR__DB_VERSION_INDEX ? amscr__r_u64(&r) : 0;
-    if (version < AMSCR__DB_VERSION_INDEX)
+    uint64_t sec = amscr__db_is_index(version) ? amscr__r_u64(&r) : 0;
+    if (!amscr__db_is_index(version))
         st = amscr__fail(AMSCR_E_FORMAT, "a collection file without an index (format version %u): build one with "
                                          "amscr_index_build", (unsigned)version);
     else if (r.bad || sec != r.len - r.pos)

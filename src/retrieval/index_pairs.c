@@ -25,8 +25,10 @@ amscr_status amscr__pair_ws_init(const amscr__base *b, amscr__pair_ws *pw)
     memset(pw, 0, sizeof *pw);
     amscr_status st = b->w < 1.0 ? amscr_workspace_new(&pw->ws) : AMSCR_OK;
     if (st == AMSCR_OK && b->nf > 0) {
-        amscr__hf_cfg_from(b->p, b->p->num_samples, &pw->cfg);
-        st = amscr__hf_ws_init(&pw->hws, b->p->num_samples, pw->cfg.band);
+        amscr__hf_cfg_from(b->p, b->p->num_samples, 0, &pw->cfg[0]);
+        amscr__hf_cfg_from(b->p, b->p->num_samples, 1, &pw->cfg[1]);
+        size_t band = pw->cfg[0].band > pw->cfg[1].band ? pw->cfg[0].band : pw->cfg[1].band;
+        st = amscr__hf_ws_init(&pw->hws, b->p->num_samples, band); /* room for the wider band */
         pw->have_hws = st == AMSCR_OK;
     }
     if (st != AMSCR_OK)
@@ -93,10 +95,10 @@ static amscr_status base_pair(const amscr__base *b, const amscr_descriptor *lo, 
         sym = 0.5 * (f + r);
     }
     if (b->nf == 1)
-        ch = amscr__hf_distance(&hlo[0], &hhi[0], &pw->cfg, &pw->hws);
+        ch = amscr__hf_distance(&hlo[0], &hhi[0], &pw->cfg[0], &pw->hws);
     else if (b->nf == 2)
-        ch = b->share[0] * amscr__hf_distance(&hlo[0], &hhi[0], &pw->cfg, &pw->hws) +
-             b->share[1] * amscr__hf_distance(&hlo[1], &hhi[1], &pw->cfg, &pw->hws);
+        ch = b->share[0] * amscr__hf_distance(&hlo[0], &hhi[0], &pw->cfg[0], &pw->hws) +
+             b->share[1] * amscr__hf_distance(&hlo[1], &hhi[1], &pw->cfg[1], &pw->hws);
     *out = amscr__fuse_pair(b->w, b->sa, b->sh, sym, ch);
     return AMSCR_OK;
 }

@@ -362,7 +362,7 @@ static amscr_status diffuse(const amscr_index *x, size_t self, const size_t *can
 {
     const amscr_params *p = amscr_db_params(x->db);
     size_t n = amscr_db_size(x->db), rows = self == n ? n + 1 : n, rlen = 0;
-    size_t k = p->rerank_k < rows ? p->rerank_k : rows;
+    size_t k = amscr__rerank_k(p, rows);
     double dmax = x->dmax;
     for (size_t t = 0; self == n && t < m; t++)
         dmax = dq[t] > dmax ? dq[t] : dmax;

@@ -1,4 +1,4 @@
-/* retrieval_io.c — the retrieval settings block of the saved collection (format version 2;
+/* retrieval_io.c — the retrieval settings block of the saved collection (format versions 2-6;
  * layout in internal.h). Little-endian whatever the host. */
 #include "internal.h"
 
@@ -36,7 +36,7 @@ static double get_f64(const unsigned char *b)
     return d;
 }
 
-void amscr__retrieval_block_write(const amscr_params *p, unsigned char out[AMSCR__RETRIEVAL_BLOCK])
+void amscr__retrieval_block_write(const amscr_params *p, unsigned char *out, size_t size)
 {
     put_f64(out, p->channel_weight);
     put_u32(out + 8, (uint32_t)p->channel_invariance);
@@ -46,16 +46,20 @@ void amscr__retrieval_block_write(const amscr_params *p, unsigned char out[AMSCR
     put_f64(out + 36, p->channel_locality);
     put_u32(out + 44, p->rerank_k);
     put_u32(out + 48, p->rerank_iterations);
+    if (size >= AMSCR__RETRIEVAL_BLOCK_V2)
+        put_f64(out + 52, p->channel_affine_band);
 }
 
-amscr_status amscr__retrieval_block_read(const unsigned char in[AMSCR__RETRIEVAL_BLOCK], amscr_params *p)
+amscr_status amscr__retrieval_block_read(const unsigned char *in, size_t size, amscr_params *p)
 {
     amscr_params q = *p;
     uint32_t inv = get_u32(in + 8);
+    double affine_band = size >= AMSCR__RETRIEVAL_BLOCK_V2 ? get_f64(in + 52) : get_f64(in + 20);
     if (inv > 1u || amscr_params_set_channel_weight(&q, get_f64(in)) != AMSCR_OK ||
         amscr_params_set_channel_invariance(&q, (amscr_invariance)inv) != AMSCR_OK ||
         amscr_params_set_channel_affine_share(&q, get_f64(in + 12)) != AMSCR_OK ||
         amscr_params_set_channel_band(&q, get_f64(in + 20)) != AMSCR_OK ||
+        amscr_params_set_channel_affine_band(&q, affine_band) != AMSCR_OK ||
         amscr_params_set_channel_skip(&q, get_f64(in + 28)) != AMSCR_OK ||
         amscr_params_set_channel_locality(&q, get_f64(in + 36)) != AMSCR_OK ||
         amscr_params_set_rerank_k(&q, get_u32(in + 44)) != AMSCR_OK ||

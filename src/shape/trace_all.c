@@ -62,35 +62,62 @@ static int regions_push(regions *R, uint32_t first, unsigned char fg)
     return 0;
 }
 
-/* Labels every pixel of the padded mask `on` (W x H) by BFS; queue has W*H entries. */
+/* Breadth-first from queue[0..tail): each pixel's neighbours of the same kind (8 for the
+ * foreground, W N E S for the background) that have no label get `label`. Every queued pixel
+ * lies inside the ring, so all its neighbours exist. Returns the queue's length. */
+static size_t flood(const uint8_t *on, const ptrdiff_t off[8], uint8_t kind, uint32_t label, uint32_t *queue,
+                    size_t tail, uint32_t *lab)
+{
+    int step = kind ? 1 : 2;
+    for (size_t head = 0; head < tail; head++) {
+        size_t p = queue[head];
+        for (int d = 0; d < 8; d += step) {
+            size_t q = (size_t)((ptrdiff_t)p + off[d]);
+            if (lab[q] == 0 && on[q] == kind) {
+                lab[q] = label;
+                queue[tail++] = (uint32_t)q;
+            }
+        }
+    }
+    return tail;
+}
+
+/* Labels every pixel of the padded mask `on` (W x H >= 3 x 3; its one-pixel ring is background)
+ * by BFS; queue has W*H entries. The ring is labelled first as the outer background's (label
+ * 1, first pixel 0), with the background 4-adjacent to it queued; after that every region lies
+ * inside the ring and needs no bounds tests. Labels follow the raster order of each region's
+ * first pixel. */
 static amscr_status label_regions(const uint8_t *on, size_t W, size_t H, uint32_t *queue, regions *R)
 {
     ptrdiff_t off[8];
     for (int d = 0; d < 8; d++)
         off[d] = (ptrdiff_t)ta_dy[d] * (ptrdiff_t)W + ta_dx[d];
-    for (size_t idx = 0; idx < W * H; idx++) {
+    if (regions_push(R, 0, 0) != 0)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_contours_from_mask: out of memory (%zu regions)", R->n);
+    for (size_t x = 0; x < W; x++)
+        R->lab[x] = R->lab[(H - 1) * W + x] = 1;
+    for (size_t y = 0; y < H; y++)
+        R->lab[y * W] = R->lab[y * W + W - 1] = 1;
+    size_t tail = 0;
+    for (size_t y = 1; y + 1 < H; y++) /* the inner pixels 4-adjacent to the ring */
+        for (size_t x = 1; x + 1 < W; x += (y == 1 || y + 2 == H || x + 2 == W) ? 1 : W - 3) {
+            size_t q = y * W + x;
+            if (R->lab[q] == 0 && on[q] == 0) {
+                R->lab[q] = 1;
+                queue[tail++] = (uint32_t)q;
+            }
+        }
+    flood(on, off, 0, 1, queue, tail, R->lab);
+    for (size_t idx = W + 1; idx + W + 1 < W * H; idx++) {
         if (R->lab[idx] != 0)
             continue;
         uint8_t kind = on[idx];
         if (regions_push(R, (uint32_t)idx, kind) != 0)
             return amscr__fail(AMSCR_E_NOMEM, "amscr_contours_from_mask: out of memory (%zu regions)", R->n);
         uint32_t label = (uint32_t)R->n;
-        size_t head = 0, tail = 0;
-        queue[tail++] = (uint32_t)idx;
         R->lab[idx] = label;
-        while (head < tail) {
-            size_t p = queue[head++], x = p % W, y = p / W;
-            for (int d = 0; d < 8; d += kind ? 1 : 2) { /* background: W, N, E, S only */
-                int dx = ta_dx[d], dy = ta_dy[d];
-                if ((dx < 0 && x == 0) || (dx > 0 && x + 1 == W) || (dy < 0 && y == 0) || (dy > 0 && y + 1 == H))
-                    continue;
-                size_t q = (size_t)((ptrdiff_t)p + off[d]);
-                if (R->lab[q] == 0 && on[q] == kind) {
-                    R->lab[q] = label;
-                    queue[tail++] = (uint32_t)q;
-                }
-            }
-        }
+        queue[0] = (uint32_t)idx;
+        flood(on, off, kind, label, queue, 1, R->lab);
     }
     return AMSCR_OK;
 }

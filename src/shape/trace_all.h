@@ -24,7 +24,8 @@ typedef struct amscr__regions {
     size_t n, cap; /* labels 1..n are used; index 0 unused */
 } amscr__regions;
 
-/* Labels the padded mask `on` (1 = foreground). On failure R holds nothing to free. */
+/* Labels the padded mask `on` (W x H; 1 = foreground; its one-pixel ring must be background,
+ * as every caller pads). On failure R holds nothing to free. */
 amscr_status amscr__regions_label(const uint8_t *on, size_t W, size_t H, amscr__regions *R);
 void amscr__regions_free(amscr__regions *R);
 

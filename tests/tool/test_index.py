@@ -60,8 +60,9 @@ def test_add_equals_a_rebuild(tmp_path):
     equal to rounding (every shape a candidate, channel weight 1)."""
     m = make_manifest(tmp_path)
     rows = m.read_text().splitlines()
-    (tmp_path / "a.tsv").write_text("\n".join(rows[:5]) + "\n")
-    (tmp_path / "b.tsv").write_text("\n".join([rows[0]] + rows[5:]) + "\n")
+    # 6 shapes first: their lists already hold the re-ranking's 3 (at most half a collection)
+    (tmp_path / "a.tsv").write_text("\n".join(rows[:7]) + "\n")
+    (tmp_path / "b.tsv").write_text("\n".join([rows[0]] + rows[7:]) + "\n")
     opts = ("--refine", "0", "--rerank", "3")
     whole = build(tmp_path, m, *opts, name="whole.idx")
     part = build(tmp_path, tmp_path / "a.tsv", *opts, name="part.idx")
@@ -84,7 +85,8 @@ def test_add_equals_a_rebuild(tmp_path):
 
 
 def test_add_to_an_index_smaller_than_its_lists_is_refused(tmp_path):
-    """An index of fewer shapes than its re-ranking K holds shorter lists: --add says to rebuild."""
+    """An index of fewer than twice its re-ranking K holds shorter lists (at most half the
+    collection): --add says to rebuild."""
     m = make_manifest(tmp_path)
     rows = m.read_text().splitlines()
     (tmp_path / "a.tsv").write_text("\n".join(rows[:3]) + "\n")

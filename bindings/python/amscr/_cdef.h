@@ -182,6 +182,8 @@ amscr_status amscr_params_set_channel_affine_share(amscr_params *p, double share
 double amscr_params_get_channel_affine_share(const amscr_params *p);
 amscr_status amscr_params_set_channel_band(amscr_params *p, double fraction);
 double amscr_params_get_channel_band(const amscr_params *p);
+amscr_status amscr_params_set_channel_affine_band(amscr_params *p, double fraction);
+double amscr_params_get_channel_affine_band(const amscr_params *p);
 amscr_status amscr_params_set_channel_skip(amscr_params *p, double cost);
 double amscr_params_get_channel_skip(const amscr_params *p);
 amscr_status amscr_params_set_channel_locality(amscr_params *p, double locality);

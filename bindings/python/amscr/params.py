@@ -144,7 +144,11 @@ class Params:
                                    'with the similarity frame: the share, 0..1, of the channel computed in the '
                                    'affine frame (default 0.2; 0 = one frame, half the time)')
     channel_band = _Option('channel_band', _FLOAT,
-                           "half width of the channel's dynamic-programming band, fraction of N in (0, 0.5]")
+                           "half width of the channel's dynamic-programming band, fraction of N in (0, 0.5] "
+                           '(default 0.15; 0.08 before 0.6)')
+    channel_affine_band = _Option('channel_affine_band', _FLOAT,
+                                  "the band of the whitened frame mixed in by channel_affine_share, fraction of N "
+                                  'in (0, 0.5] (default 0.08; equal to channel_band for the settings before 0.6)')
     channel_skip = _Option('channel_skip', _FLOAT, "the channel's cost of a skipped sample (>= 0)")
     channel_locality = _Option('channel_locality', _FLOAT, "the channel's locality of the height functions (>= 0)")
     rerank_k = _Option('rerank_k', _UINT, 'neighbours of the re-ranking of retrieval_matrix (0 = none; preset 8)')

@@ -159,14 +159,15 @@ def channel_in_frame(pa, pb, kind, band, skip, locality, reflections, exact):
     return match(A, B, s, w, int(round(skip * QUANT))) / (n * QUANT)
 
 
-def channel_distance(pa, pb, *, invariance='similarity', affine_share=0.2, band=0.08, skip=1.0, locality=4.0,
-                     reflections=True, exact=False):
+def channel_distance(pa, pb, *, invariance='similarity', affine_share=0.2, band=0.15, affine_band=0.08, skip=1.0,
+                     locality=4.0, reflections=True, exact=False):
     """The channel distance of two shapes given their prepared samples (N x 2 each); exact=True
-    minimizes step 5 over every start instead of following the library's rule."""
-    opts = dict(band=band, skip=skip, locality=locality, reflections=reflections, exact=exact)
+    minimizes step 5 over every start instead of following the library's rule. The whitened
+    frame mixed in with affine_share uses affine_band; a frame alone uses band."""
+    opts = dict(skip=skip, locality=locality, reflections=reflections, exact=exact)
     if invariance == 'affine' or affine_share >= 1.0:
-        return channel_in_frame(pa, pb, 'affine', **opts)
-    d = channel_in_frame(pa, pb, invariance, **opts)
+        return channel_in_frame(pa, pb, 'affine', band=band, **opts)
+    d = channel_in_frame(pa, pb, invariance, band=band, **opts)
     if affine_share <= 0.0:
         return d
-    return (1.0 - affine_share) * d + affine_share * channel_in_frame(pa, pb, 'affine', **opts)
+    return (1.0 - affine_share) * d + affine_share * channel_in_frame(pa, pb, 'affine', band=affine_band, **opts)

@@ -50,7 +50,7 @@ def lib(S, a, b, **opts):
 
 
 def ref(S, a, b, exact=False, **opts):
-    names = {'channel_band': 'band', 'channel_skip': 'skip', 'channel_locality': 'locality',
+    names = {'channel_band': 'band', 'channel_affine_band': 'affine_band', 'channel_skip': 'skip', 'channel_locality': 'locality',
              'channel_affine_share': 'affine_share', 'channel_invariance': 'invariance',
              'reflections': 'reflections'}
     return ref_channel.channel_distance(S[a].input_points, S[b].input_points,
@@ -64,7 +64,8 @@ CASES = [
     ('blob1', 'body', {'channel_affine_share': 0.0}),
     ('body', 'bent', {'channel_band': 0.03, 'channel_skip': 2.5}),
     ('blob2', 'bent', {'channel_locality': 0.0, 'channel_invariance': 'affine'}),
-    ('body', 'rolled', {'channel_affine_share': 0.5, 'channel_band': 0.15}),
+    ('body', 'rolled', {'channel_affine_share': 0.5, 'channel_band': 0.08}),
+    ('body', 'bent', {'channel_affine_share': 0.5, 'channel_affine_band': 0.2}),
     ('blob1', 'mirrored', {'reflections': False}),
 ]
 
