@@ -70,6 +70,11 @@ static const double SQUARE[] = {0, 0, 1, 0, 1, 1, 0, 1};
 static const double CROSS[] = {1, 0, 2, 0, 2, 1, 3, 1, 3, 2, 2, 2, 2, 3, 1, 3, 1, 2, 0, 2, 0, 1, 1, 1};
 static const double TRIANGLE[] = {0, 0, 1, 0, 0.5, 0.8660254037844386};
 static const double ELL[] = {0, 0, 3, 0, 3, 1, 1, 1, 1, 2.5, 0, 2.5};
+/* A regular 5-pointed star: points at radius 1, notches at 0.4. */
+static const double STAR5[] = {0.0,        1.0,         -0.23511410, 0.32360680,  -0.95105652, 0.30901699,
+                               -0.38042261, -0.12360680, -0.58778525, -0.80901699, 0.0,         -0.4,
+                               0.58778525, -0.80901699, 0.38042261,  -0.12360680, 0.95105652,  0.30901699,
+                               0.23511410, 0.32360680};
 
 START_TEST(stage_list_in_pipeline_order)
 {
@@ -205,14 +210,16 @@ START_TEST(switches)
 }
 END_TEST
 
-/* Checks that r lists at least `want` distinct alternatives: the chosen map first, each a
- * symmetry of the polygon v (it maps the source's vertices onto the target's vertex set), about
- * equal costs, and a low confidence. */
-static void check_symmetric(const char *what, const double *v, size_t nv, size_t m, size_t want)
+/* Checks that r (params p, NULL: the registration preset) lists exactly `want` distinct
+ * alternatives — each of the shape's symmetries once: the chosen map first, each a symmetry of the
+ * polygon v (it maps the source's vertices onto the target's vertex set), about equal costs,
+ * and a low confidence. */
+static void check_symmetric(const amscr_params *p, const char *what, const double *v, size_t nv, size_t m,
+                            size_t want)
 {
-    amscr_result *r = self_pair(NULL, v, nv, m);
+    amscr_result *r = self_pair(p, v, nv, m);
     size_t k = amscr_result_num_alternatives(r);
-    ck_assert_msg(k >= want, "%s: %zu alternatives, %zu wanted", what, k, want);
+    ck_assert_msg(k == want, "%s: %zu alternatives, %zu wanted", what, k, want);
     ck_assert_msg(amscr_result_confidence(r) <= 0.25, "%s: confidence %g", what, amscr_result_confidence(r));
     ck_assert(amscr_result_ambiguity(r) >= 0.75);
     double m0[6], c0 = 0.0, chosen[6];
@@ -246,11 +253,21 @@ static void check_symmetric(const char *what, const double *v, size_t nv, size_t
     amscr_result_free(r);
 }
 
+/* Every symmetry: more than the search's lowest three minima per orientation where the shape has
+ * more (a square's and a cross's quarter turns, a star's fifths), the mirror maps too with
+ * reflections on. */
 START_TEST(symmetric_shapes_list_alternatives)
 {
-    check_symmetric("square", SQUARE, 4, 400, 3);
-    check_symmetric("cross", CROSS, 12, 480, 3);
-    check_symmetric("triangle", TRIANGLE, 3, 300, 3);
+    check_symmetric(NULL, "square", SQUARE, 4, 400, 4);
+    check_symmetric(NULL, "cross", CROSS, 12, 480, 4);
+    check_symmetric(NULL, "triangle", TRIANGLE, 3, 300, 3);
+    check_symmetric(NULL, "star", STAR5, 10, 500, 5);
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_reflections(p, 1), AMSCR_OK);
+    check_symmetric(p, "square, reflections", SQUARE, 4, 400, 8);
+    check_symmetric(p, "triangle, reflections", TRIANGLE, 3, 300, 6);
+    amscr_params_free(p);
 }
 END_TEST
 

@@ -33,8 +33,14 @@
 #define AMSCR__DENSE 4
 
 /* Candidate start shifts per orientation: a shape's criterion rarely has more than a few deep
- * minima (symmetries); three keeps the right one among them at a small cost. */
+ * minima (symmetries); the lowest three, which keep the right one among them at a small cost, are
+ * the reported map's pool. With refinement on (the ranked search), when those three are distinct
+ * maps that score alike, further minima about as low are ranked too (shift_search.c), so that a
+ * shape with more symmetries than three (a square's four quarter turns, a regular star's fifths)
+ * lists each as an alternative — up to AMSCR__CANDIDATES_MAX per orientation (a 12-fold
+ * symmetry); they never become the reported map. */
 #define AMSCR__CANDIDATES 3
+#define AMSCR__CANDIDATES_MAX 12
 
 /* Per-stage timing, compiled only into the benchmark's copy of the library
  * (-DAMSCR_STAGE_TIMING): the product's hot path has no clock calls. */
@@ -96,17 +102,18 @@ typedef struct {
     /* confidence of the match (see amscr_result_ambiguity / _inlier_fraction) */
     double ambiguity;
     /* the search's scored start candidates (registration with refinement; else ncand 0) */
-    double cand[2 * AMSCR__CANDIDATES][6];
+    double cand[2 * AMSCR__CANDIDATES_MAX][6];
     size_t ncand;
+    size_t ncand_base; /* the first ncand_base of cand may win (the rest: further minima, listed only) */
     /* the last ranking of distinct starts (the search's, or the polish's when it re-ranked):
      * their maps (normalized frames), their ranking costs and the winner (nrank 0: none) */
-    double rank_X[1 + 2 * AMSCR__CANDIDATES][6];
-    double rank_cost[1 + 2 * AMSCR__CANDIDATES];
+    double rank_X[1 + 2 * AMSCR__CANDIDATES_MAX][6];
+    double rank_cost[1 + 2 * AMSCR__CANDIDATES_MAX];
     size_t nrank, rank_best;
 } match_t;
 
 /* Most maps a result lists as alternatives: the chosen one and every distinct ranked start. */
-#define AMSCR__MAX_ALTERNATIVES (1 + 2 * AMSCR__CANDIDATES)
+#define AMSCR__MAX_ALTERNATIVES (1 + 2 * AMSCR__CANDIDATES_MAX)
 
 struct amscr_result {
     amscr_method method;
@@ -169,10 +176,12 @@ void amscr__spectral_cross_sums(const amscr_descriptor *f, const amscr_descripto
                                 double R[][6]);
 /* The start-point search's outcome: the candidates, their scores and the winner. */
 typedef struct {
-    double s[2 * AMSCR__CANDIDATES]; /* continuous shift */
-    int o[2 * AMSCR__CANDIDATES];    /* orientation */
-    double X[2 * AMSCR__CANDIDATES][6], score[2 * AMSCR__CANDIDATES];
+    double s[2 * AMSCR__CANDIDATES_MAX]; /* continuous shift */
+    int o[2 * AMSCR__CANDIDATES_MAX];    /* orientation */
+    double X[2 * AMSCR__CANDIDATES_MAX][6], score[2 * AMSCR__CANDIDATES_MAX];
+    double dist[2 * AMSCR__CANDIDATES_MAX]; /* the distance: the ranking's tie-break */
     size_t count, best;
+    size_t nbase; /* the first nbase: the lowest minima, the winner's pool; then the further ones */
     int kind;       /* how the candidates were scored (shift_search.c) */
     int prepared_o; /* the orientation whose spectra ws->P holds */
 } amscr__search;

@@ -20,7 +20,9 @@
  *
  * When the start-point search could not tell its candidates apart, the other distinct
  * candidates are polished alike and ranked by a two-way trimmed cost, so a noisy
- * symmetric-looking shape gets the start the points favour. When the rougher curve is markedly
+ * symmetric-looking shape gets the start the points favour (the search's further minima of a
+ * shape with more than three symmetries are polished and ranked too, for the alternatives, but
+ * never become the reported map). When the rougher curve is markedly
  * the noisier, the winner is refined by the order of its points (ordered.c), then by their even
  * spacing where the points bear that out (even.c). Runs on closed
  * curves under affine invariance when the params ask for it (the registration preset does);
@@ -422,19 +424,24 @@ static int has_gap(const curve_t *c)
 }
 
 /* The start maps: the chosen one first, then — when the search could not tell its candidates
- * apart (ambiguity at least AMBIGUOUS_SEARCH) — each candidate that differs from all before. */
-static size_t polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6])
+ * apart (ambiguity at least AMBIGUOUS_SEARCH) — each candidate that differs from all before.
+ * may_win[k]: start k may become the reported map (the search's further minima are polished and
+ * ranked for the alternatives only). */
+static size_t polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6], unsigned char *may_win)
 {
     size_t count = 1;
     memcpy(S[0], m->X, sizeof S[0]);
+    may_win[0] = 1;
     for (size_t c = 0; m->ambiguity >= AMBIGUOUS_SEARCH && c < m->ncand; c++) {
         int fresh = 1;
         for (int k = 0; k < 6; k++)
             fresh = fresh && isfinite(m->cand[c][k]);
         for (size_t k = 0; k < count && fresh; k++)
             fresh = amscr__map_gap2(f, m->cand[c], S[k]) > AMSCR__DISTINCT_GAP2;
-        if (fresh)
+        if (fresh) {
+            may_win[count] = c < m->ncand_base;
             memcpy(S[count++], m->cand[c], sizeof S[0]);
+        }
     }
     return count;
 }
@@ -469,15 +476,16 @@ static void keep_ranking(double S[][6], const double *cost, size_t count, size_t
     memcpy(m->rank_cost, cost, count * sizeof *cost);
 }
 
-/* Every start a few steps, ranked; the index of the best (count when none finished). */
-static size_t rank_starts(amscr__polish_state *ps, double S[][6], double Y[][6], double *cost, size_t count)
+/* Every start a few steps, ranked; the index of the best that may win (count when none finished). */
+static size_t rank_starts(amscr__polish_state *ps, double S[][6], double Y[][6], double *cost,
+                          const unsigned char *may_win, size_t count)
 {
     size_t best = count;
     for (size_t k = 0; k < count; k++) {
         to_frames(&ps->w, ps->f, ps->h, S[k], Y[k]);
         cost[k] = polish_one(&ps->w, Y[k], SCORE_ITERS);
         from_frames(&ps->w, ps->f, ps->h, Y[k], S[k]);
-        if (cost[k] < (best < count ? cost[best] : INFINITY))
+        if (may_win[k] && cost[k] < (best < count ? cost[best] : INFINITY))
             best = k;
     }
     return best;
@@ -522,11 +530,13 @@ amscr_status amscr__polish_fit(const amscr_descriptor *f, const amscr_descriptor
     }
     ps->f = f;
     ps->h = h;
-    double S[1 + 2 * AMSCR__CANDIDATES][6], Y[1 + 2 * AMSCR__CANDIDATES][6], cost[1 + 2 * AMSCR__CANDIDATES];
-    size_t count = polish_starts(f, m, S), best = count;
+    double S[1 + 2 * AMSCR__CANDIDATES_MAX][6], Y[1 + 2 * AMSCR__CANDIDATES_MAX][6],
+        cost[1 + 2 * AMSCR__CANDIDATES_MAX];
+    unsigned char may_win[1 + 2 * AMSCR__CANDIDATES_MAX];
+    size_t count = polish_starts(f, m, S, may_win), best = count;
     int ready = polish_prepare(&ps->w, f, h, m->X, partial);
     if (ready > 0)
-        best = rank_starts(ps, S, Y, cost, count);
+        best = rank_starts(ps, S, Y, cost, may_win, count);
     if (ready < 0 || ps->w.nomem) {
         amscr__polish_end(ps);
         return amscr__fail(AMSCR_E_NOMEM, "registration polish: out of memory");

@@ -6,10 +6,15 @@
  * smoothing of both curves at σ_k multiplies its spectrum by |G_k|^2, so the stacked
  * least-squares residual of every shift costs O(N log N) per pair (the search criterion). The
  * lowest few local minima of that criterion per orientation are the candidates, each refined to
- * a continuous shift. Open curves have one candidate per orientation (no shift).
+ * a continuous shift: the lowest AMSCR__CANDIDATES and, in the ranked search (refinement on),
+ * when those are distinct maps that all score about as well as the winner (a shape with three
+ * or more symmetries), every further one about as low, up to AMSCR__CANDIDATES_MAX — so that each
+ * symmetry of a square or a regular star is ranked and listed as an alternative. Open curves have
+ * one candidate per orientation (no shift).
  *
  * One ranking rule picks the winner: the lowest score, ties broken by the lower distance, then
- * by the earlier candidate (orientations in order, each one's candidates best criterion first).
+ * by the earlier candidate (orientations in order, each one's candidates best criterion first);
+ * the further minima are scored and ranked alike (the alternatives, the ambiguity) but never win.
  * The score is the cheapest quantity that judges the start point (see score_start). The winner
  * gets the whole method and the refinement.
  */
@@ -28,6 +33,12 @@
 /* With refinement on, each candidate is scored after at most this many closest-point steps
  * (the winner then gets all of them). */
 #define AMSCR__SCORE_REFINE 2
+/* The ranked search takes a minimum beyond the lowest AMSCR__CANDIDATES when its residual is within
+ * AMSCR__PRUNE_RATIO of the best one's plus this share of the smoothed target's energy (an RMS
+ * misfit of 2 % of the RMS radius). The criterion sees a fractional shift through band-limited
+ * interpolation, which blurs sharp corners: at the twelve equal minima of a clean 12-pointed star
+ * it reads residuals up to 1.4e-4 of the energy where the best reads 0. */
+#define AMSCR__EXTRA_FLOOR (0.02 * 0.02)
 
 /* ---------------------------------------------------- spectral cross sums
  * For closed curves every cross sum R_k(s) = Σ_a h_k(a+s) [f_k(a), 1]^T is a trigonometric
@@ -299,8 +310,8 @@ static void shift_criterion(const amscr_descriptor *f, const amscr_descriptor *h
     }
 }
 
-/* The lowest (at most AMSCR__CANDIDATES) circular local minima of ws->crit, ascending. */
-static size_t integer_candidates(const amscr_workspace *ws, size_t n, size_t *cand)
+/* The lowest (at most cap) circular local minima of ws->crit, ascending (ties: lower shift first). */
+static size_t integer_candidates(const amscr_workspace *ws, size_t n, size_t cap, size_t *cand)
 {
     size_t nc = 0;
     for (size_t s = 0; s < n; s++) {
@@ -311,13 +322,13 @@ static size_t integer_candidates(const amscr_workspace *ws, size_t n, size_t *ca
         size_t pos = nc;
         while (pos > 0 && ws->crit[cand[pos - 1]] > v)
             pos--;
-        if (pos >= AMSCR__CANDIDATES)
+        if (pos >= cap)
             continue;
-        size_t last = nc < AMSCR__CANDIDATES ? nc : AMSCR__CANDIDATES - 1;
+        size_t last = nc < cap ? nc : cap - 1;
         for (size_t j = last; j > pos; j--)
             cand[j] = cand[j - 1];
         cand[pos] = s;
-        if (nc < AMSCR__CANDIDATES)
+        if (nc < cap)
             nc++;
     }
     if (nc == 0) { /* flat criterion: take shift 0 */
@@ -327,19 +338,46 @@ static size_t integer_candidates(const amscr_workspace *ws, size_t n, size_t *ca
     return nc;
 }
 
-
 /* One start point: orientation, continuous shift (closed curves) and the shift criterion. */
 typedef struct {
     int o;
     double s;
 } start_t;
 
+/* The smoothed target's energy Σ_k |h_k|^2 without its mean (Parseval, the criterion's gains):
+ * the residual at a shift is this plus the criterion (f is centred: its mean explains nothing). */
+static double smoothed_energy(const amscr_descriptor *f, const amscr_descriptor *h, int use_finest)
+{
+    size_t n = f->n;
+    const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
+    const double *Hx = h->spec, *Hy = h->spec + 2 * n;
+    double e = 0.0;
+    for (size_t w = 1; w < n; w++)
+        e += gain[w] * (Hx[2 * w] * Hx[2 * w] + Hx[2 * w + 1] * Hx[2 * w + 1] + Hy[2 * w] * Hy[2 * w] +
+                        Hy[2 * w + 1] * Hy[2 * w + 1]);
+    return e / (double)n;
+}
+
+/* Whether a further minimum (beyond the lowest AMSCR__CANDIDATES of its orientation) of criterion
+ * `crit` is about as low as the lowest criterion `best`: its residual (energy e plus the
+ * criterion) within AMSCR__PRUNE_RATIO of the best residual, plus AMSCR__EXTRA_FLOOR of e. */
+static int about_as_good(double crit, double best, double e)
+{
+    double r = e + crit, r0 = e + best;
+    return r <= AMSCR__PRUNE_RATIO * (r0 > 0.0 ? r0 : 0.0) + AMSCR__EXTRA_FLOOR * e;
+}
+
 /* The candidates of f -> h, in ranking order of ties (orientation, then criterion). Closed
  * curves: per orientation the lowest local minima of the criterion refined to a continuous
- * shift; `prune` drops those far above the orientation's best (criterion ranking). On return
- * ws->P holds orientation `norient - 1`'s spectra; crit[i] is candidate i's criterion. */
+ * shift; `prune` drops those far above the orientation's best (criterion ranking). Those are
+ * the first *nbase; without `prune` (the ranked search) further ones follow (orientation, then
+ * criterion): where an orientation's lowest AMSCR__CANDIDATES minima are alike (each
+ * about_as_good as the lowest of all), every further minimum of it that is about_as_good too, up
+ * to AMSCR__CANDIDATES_MAX per orientation — the symmetries of a shape with more than three, which
+ * the ranking takes when their base candidates score alike (further_alike). On return ws->P
+ * holds orientation `norient - 1`'s spectra; crit[i] is candidate i's criterion. */
 static size_t collect_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                             int prune, amscr_workspace *ws, start_t *out, double *crit)
+                             int prune, amscr_workspace *ws, start_t *out, double *crit, size_t *nbase)
 {
     int norient = prm->reflections ? 2 : 1, use_finest = prm->method == AMSCR_METHOD_ACMA;
     size_t n = f->n, count = 0;
@@ -349,6 +387,7 @@ static size_t collect_starts(const amscr_params *prm, const amscr_descriptor *f,
             out[count].s = 0.0;
             crit[count++] = 0.0;
         }
+        *nbase = count;
         return count;
     }
     double Si[4];
@@ -356,19 +395,37 @@ static size_t collect_starts(const amscr_params *prm, const amscr_descriptor *f,
     /* The residual is Σ_k |h_k|^2 + criterion; Σ_k |h_k|^2 is bounded by p |h|^2. The pruning
      * test allows a rounding-sized 1e-12 of it so that equal residuals always stay in. */
     double hk2 = (use_finest ? 1.0 : (double)f->p) * h->norm2;
+    size_t cap = prune ? AMSCR__CANDIDATES : AMSCR__CANDIDATES_MAX, nfur = 0;
+    start_t fur[2 * (AMSCR__CANDIDATES_MAX - AMSCR__CANDIDATES)];
+    double fur_crit[2 * (AMSCR__CANDIDATES_MAX - AMSCR__CANDIDATES)];
+    double best = INFINITY, e = prune ? 0.0 : smoothed_energy(f, h, use_finest);
     for (int o = 0; o < norient; o++) {
         shift_criterion(f, h, o, use_finest, Si, ws);
-        size_t cand[AMSCR__CANDIDATES];
-        size_t nc = integer_candidates(ws, n, cand);
+        size_t cand[AMSCR__CANDIDATES_MAX];
+        size_t nc = integer_candidates(ws, n, cap, cand), first = count;
         double r0 = ws->crit[cand[0]] + hk2;
-        for (size_t c = 0; c < nc; c++) {
+        for (size_t c = 0; c < nc && c < AMSCR__CANDIDATES; c++) {
             if (prune && c > 0 && ws->crit[cand[c]] + hk2 > AMSCR__PRUNE_RATIO * r0 + 1e-12 * hk2)
                 break;
             out[count].o = o;
             out[count].s = refine_shift(f, use_finest, Si, ws, cand[c], &crit[count]);
-            count++;
+            best = fmin(best, crit[count++]);
+        }
+        int alike = nc > AMSCR__CANDIDATES;
+        for (size_t i = first; alike && i < count; i++)
+            alike = about_as_good(crit[i], best, e);
+        for (size_t c = AMSCR__CANDIDATES; alike && c < nc; c++) {
+            fur[nfur].o = o;
+            fur[nfur].s = refine_shift(f, use_finest, Si, ws, cand[c], &fur_crit[nfur]);
+            nfur += about_as_good(fur_crit[nfur], best, e);
         }
     }
+    *nbase = count;
+    for (size_t i = 0; i < nfur; i++) /* the first orientation's against the best of both */
+        if (about_as_good(fur_crit[i], best, e)) {
+            out[count] = fur[i];
+            crit[count++] = fur_crit[i];
+        }
     return count;
 }
 
@@ -408,12 +465,13 @@ static double ambiguity_of(const amscr_descriptor *f, const double X[][6], const
     return amb;
 }
 
-/* Each candidate scored (the cheap kinds need no run of the method) into s. */
+/* Candidates from..s->count-1 scored (the cheap kinds need no run of the method) into s; the
+ * winner by the one ranking rule among the first s->nbase (the further minima are ranked for the
+ * alternatives and the ambiguity only: the reported map is the best of the lowest minima). */
 static amscr_status score_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                 const double *crit, amscr_workspace *ws, amscr__search *s)
+                                 const double *crit, size_t from, amscr_workspace *ws, amscr__search *s)
 {
-    double best_score = INFINITY, best_dist = INFINITY;
-    for (size_t i = 0; i < s->count; i++) {
+    for (size_t i = from; i < s->count; i++) {
         double score = crit[i], dist = crit[i];
         if (s->kind != SCORE_CRITERION) {
             match_t cur;
@@ -428,14 +486,34 @@ static amscr_status score_starts(const amscr_params *prm, const amscr_descriptor
             memcpy(s->X[i], cur.X, sizeof s->X[i]);
         }
         s->score[i] = score;
+        s->dist[i] = dist;
         /* the one ranking rule: lower score, then lower distance, then the earlier candidate */
-        if (i == 0 || score < best_score || (score == best_score && dist < best_dist)) {
+        double bs = s->score[s->best], bd = s->dist[s->best];
+        if (i == 0 || (i < s->nbase && (score < bs || (score == bs && dist < bd))))
             s->best = i;
-            best_score = score;
-            best_dist = dist;
-        }
     }
     return AMSCR_OK;
+}
+
+/* Whether the ranked search also scores orientation o's further minima: its lowest
+ * AMSCR__CANDIDATES (among the first s->nbase) are distinct maps that all scored about as well as
+ * the winner, by the alternatives' tests — a shape with three or more symmetries, which may have
+ * more (the search's ambiguity is then at least AMSCR__ALT_RATIO already). */
+static int further_alike(const amscr_descriptor *f, const amscr__search *s, int o)
+{
+    double best = s->score[s->best] + AMSCR__AMBIGUITY_FLOOR;
+    size_t k = 0;
+    for (size_t i = 0; i < s->nbase; i++) {
+        if (s->o[i] != o)
+            continue;
+        if (!(best / (s->score[i] + AMSCR__AMBIGUITY_FLOOR) >= AMSCR__ALT_RATIO))
+            return 0;
+        for (size_t j = 0; j < i; j++)
+            if (s->o[j] == o && !(amscr__map_gap2(f, s->X[i], s->X[j]) > AMSCR__DISTINCT_GAP2))
+                return 0;
+        k++;
+    }
+    return k == AMSCR__CANDIDATES;
 }
 
 amscr_status amscr__search_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
@@ -445,17 +523,29 @@ amscr_status amscr__search_starts(const amscr_params *prm, const amscr_descripto
     if (st != AMSCR_OK)
         return st;
     s->kind = !f->params.closed ? SCORE_METHOD : prm->refine > 0 ? SCORE_GEOMETRY : SCORE_CRITERION;
-    start_t starts[2 * AMSCR__CANDIDATES];
-    double crit[2 * AMSCR__CANDIDATES];
+    start_t starts[2 * AMSCR__CANDIDATES_MAX];
+    double crit[2 * AMSCR__CANDIDATES_MAX];
+    size_t nbase, total;
     STAGE_T0;
-    s->count = collect_starts(prm, f, h, s->kind == SCORE_CRITERION, ws, starts, crit);
-    for (size_t i = 0; i < s->count; i++) {
+    total = collect_starts(prm, f, h, s->kind == SCORE_CRITERION, ws, starts, crit, &nbase);
+    for (size_t i = 0; i < total; i++) {
         s->s[i] = starts[i].s;
         s->o[i] = starts[i].o;
     }
+    s->count = s->nbase = nbase;
     s->prepared_o = (prm->reflections ? 2 : 1) - 1;
     s->best = 0;
-    st = score_starts(prm, f, h, crit, ws, s);
+    st = score_starts(prm, f, h, crit, 0, ws, s);
+    if (st == AMSCR_OK && total > nbase) { /* the further minima of the orientations that need them */
+        int want[2] = {further_alike(f, s, 0), further_alike(f, s, 1)};
+        for (size_t i = nbase; i < total; i++)
+            if (want[starts[i].o]) {
+                s->s[s->count] = starts[i].s;
+                s->o[s->count] = starts[i].o;
+                crit[s->count++] = crit[i];
+            }
+        st = score_starts(prm, f, h, crit, nbase, ws, s);
+    }
     STAGE_MARK(ws, 0);
     return st;
 }
@@ -466,6 +556,7 @@ static void keep_ranking(const amscr_descriptor *f, const amscr__search *s, matc
     int ranked = s->kind != SCORE_CRITERION;
     m->ambiguity = ranked ? ambiguity_of(f, s->X, s->score, s->count, s->best) : 0.0;
     m->ncand = ranked ? s->count : 0; /* further starts for polish.c */
+    m->ncand_base = ranked ? s->nbase : 0;
     m->nrank = m->ncand;
     m->rank_best = s->best;
     if (!m->ncand)

@@ -80,8 +80,11 @@ class Registration:
             about as well, the chosen map first (always there; its cost NaN when the
             registration ranked no starts), then each map that moves the source samples by more
             than 10 % of the shape's RMS radius from those before and whose ranking cost is
-            within a factor 4/3 of the chosen one's (ambiguity >= 0.75): a square gives its
-            quarter turns, an asymmetric shape the chosen map alone.
+            within a factor 4/3 of the chosen one's (ambiguity >= 0.75). Each symmetry once: a
+            square or a 4-armed cross gives 4 maps (its quarter turns), an equilateral triangle
+            3, a regular 5-pointed star 5 — with ``reflections=True`` their mirror maps too (8,
+            6, 10) — and an asymmetric shape the chosen map alone. At most 12 per orientation
+            (the start-point search's cap): a circle or an ellipse lists 12 (24 with reflections).
         correspondences: (N,) target boundary parameter (fraction) matched to each source sample.
         source_samples: (N, 2) the source samples (input coordinates).
         target_points: (N, 2) the matched target boundary points (input coordinates).

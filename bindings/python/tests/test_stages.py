@@ -24,6 +24,9 @@ SQUARE = [[0, 0], [1, 0], [1, 1], [0, 1]]
 CROSS = [[1, 0], [2, 0], [2, 1], [3, 1], [3, 2], [2, 2], [2, 3], [1, 3], [1, 2], [0, 2], [0, 1], [1, 1]]
 TRIANGLE = [[0, 0], [1, 0], [0.5, np.sqrt(3) / 2]]
 ELL = [[0, 0], [3, 0], [3, 1], [1, 1], [1, 2.5], [0, 2.5]]
+# a regular 5-pointed star: points at radius 1, notches at 0.4
+STAR5 = [[(1.0 if i % 2 == 0 else 0.4) * np.cos(np.pi / 2 + np.pi * i / 5),
+          (1.0 if i % 2 == 0 else 0.4) * np.sin(np.pi / 2 + np.pi * i / 5)] for i in range(10)]
 
 
 def pair(vertices, n=480):
@@ -66,10 +69,10 @@ def test_params_stages_type():
         amscr.Params(stages=['polish'])
 
 
-def check_alternatives(r, vertices, at_least):
-    """At least `at_least` distinct maps, each a symmetry of the polygon, about equal costs."""
+def check_alternatives(r, vertices, count):
+    """Exactly `count` distinct maps (each symmetry of the polygon once), about equal costs."""
     alts = r.alternatives
-    assert len(alts) >= at_least
+    assert len(alts) == count
     assert np.array_equal(alts[0].A, r.A) and np.array_equal(alts[0].B, r.B)
     assert r.confidence <= 0.25 and r.ambiguity >= 0.75
     v = np.asarray(vertices, float)
@@ -86,9 +89,15 @@ def check_alternatives(r, vertices, at_least):
             assert np.abs(images[i] - images[j]).max() > 0.1  # distinct
 
 
-@pytest.mark.parametrize('name,vertices', [('square', SQUARE), ('cross', CROSS), ('triangle', TRIANGLE)])
-def test_symmetric_shapes_list_alternatives(name, vertices):
-    check_alternatives(amscr.register(*pair(vertices)), vertices, 3)
+@pytest.mark.parametrize('name,vertices,count', [('square', SQUARE, 4), ('cross', CROSS, 4), ('triangle', TRIANGLE, 3),
+                                                  ('star', STAR5, 5)])
+def test_symmetric_shapes_list_alternatives(name, vertices, count):
+    check_alternatives(amscr.register(*pair(vertices, n=480 if name != 'star' else 500)), vertices, count)
+
+
+@pytest.mark.parametrize('name,vertices,count', [('square', SQUARE, 8), ('triangle', TRIANGLE, 6)])
+def test_symmetric_shapes_list_mirror_maps_with_reflections(name, vertices, count):
+    check_alternatives(amscr.register(*pair(vertices), reflections=True), vertices, count)
 
 
 def test_asymmetric_shape_lists_the_chosen_map_only():
