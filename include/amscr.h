@@ -1634,7 +1634,9 @@ AMSCR_API double amscr_params_get_channel_locality(const amscr_params *p);
 
 /**
  * @brief Sets the neighbours of the context re-ranking in amscr_db_retrieval_matrix,
- *        0..1000; 0 = no re-ranking (default 0; 8 in the retrieval preset).
+ *        0..1000; 0 = no re-ranking (default 0; 8 in the retrieval preset). A collection of
+ *        n shapes uses K = min(k, max(1, n / 2)): neighbourhoods that cover the collection
+ *        carry no context and flatten every score (since 0.6; min(k, n) before).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -2273,8 +2275,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_retrieval_matrix(const amscr_db 
 
 /**
  * @brief Writes the prepared collection (versioned little-endian binary format with a
- *        checksum, 4 + 8 * (12 + 4N + 2Np) bytes per shape) to a temporary name in the same
- *        folder and renames it.
+ *        checksum, 4 + 8 * (12 + 4N + 2Np) bytes per shape; version 5 since 0.6, 2 before,
+ *        and every earlier version loads) to a temporary name in the same folder and renames
+ *        it.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: const.
@@ -2350,7 +2353,8 @@ typedef struct amscr_index amscr_index;
 /**
  * @brief Builds the index of a collection (its params say the retrieval: channel weight,
  *        re-ranking k and iterations): a copy of the shapes, a signature per shape, and each
- *        shape's K = min(rerank_k, n) nearest shapes under the base distance of
+ *        shape's K (amscr_params_set_rerank_k: min(rerank_k, max(1, n / 2)); an index file of
+ *        0.5 holds min(rerank_k, n)) nearest shapes under the base distance of
  *        amscr_db_retrieval_matrix (the fused distance before re-ranking), with the fusion's
  *        medians and the largest distance. candidates 0 computes the whole base matrix (the
  *        lists are exact: a query then gives exactly amscr_db_query_retrieval's scores);
@@ -2382,8 +2386,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_build(const amscr_db *db, siz
  *        the medians of the build.
  * @param[in] shapes  prepared with exactly the index's params (threads aside).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL; params that differ: the detail names the
- *         option); AMSCR_E_STATE (the index holds fewer than min(rerank_k, n) neighbours a
- *         shape: rebuild it); AMSCR_E_LIMIT; AMSCR_E_CANCELLED; AMSCR_E_NOMEM. After
+ *         option); AMSCR_E_STATE (the index holds fewer neighbours a shape than its K at the
+ *         new size: rebuild it); AMSCR_E_LIMIT; AMSCR_E_CANCELLED; AMSCR_E_NOMEM. After
  *         AMSCR_E_CANCELLED or AMSCR_E_NOMEM the index holds the shapes but not all their
  *         lists: free it.
  * Ownership: none (shapes is copied).
@@ -2462,7 +2466,7 @@ AMSCR_API const amscr_db *amscr_index_db(const amscr_index *x);
 AMSCR_API int32_t amscr_index_label(const amscr_index *x, size_t i);
 
 /**
- * @brief Neighbours stored a shape: min(rerank_k, n) at the build (0 for NULL).
+ * @brief Neighbours stored a shape: K at the build (amscr_index_build; 0 for NULL).
  * Ownership: none. Thread-safety: const.
  * @since 0.4
  */
@@ -2519,10 +2523,11 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_set_group(amscr_index *x, siz
 AMSCR_API const char *amscr_index_group(const amscr_index *x, size_t i);
 
 /**
- * @brief Writes the index (the collection file format, version 4 since 0.5, 3 in 0.4:
- *        amscr_db_load of it gives the collection; version 4 also stores each shape's channel
- *        features, so a load does not rebuild them) to a temporary name in the same folder and
- *        renames it.
+ * @brief Writes the index (the collection file format, version 6 since 0.6, 4 in 0.5, 3 in
+ *        0.4: amscr_db_load of it gives the collection; versions 4 and 6 also store each
+ *        shape's channel features, so a load does not rebuild them; 6 adds the whitened
+ *        frame's band to the settings) to a temporary name in the same folder and renames it.
+ *        Every earlier version loads.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none. Thread-safety: const.
  * @since 0.4

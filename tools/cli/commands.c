@@ -233,7 +233,7 @@ static void print_retrieval_options(const amscr_params *ret)
            "                          0 with --open)\n"
            "  --affine-share S        share of the channel computed in the affine (whitened)\n"
            "                          frame, the rest in the similarity frame (default %g)\n"
-           "  --fast                  --affine-share 0: the channel in one frame, half the time\n"
+           "  --fast                  --affine-share 0: the channel in one frame, less time\n"
            "  --rerank K[,ITER]       contextual re-ranking: diffusion on the K-nearest-neighbour\n"
            "                          graph, ITER iterations (default %u,%u; ITER default %d)\n"
            "  --no-rerank             the fused pairwise distances\n"
