@@ -16,7 +16,7 @@
  *
  * Per pair: the cyclic shift (and orientation) that maximizes the correlation of the two
  * sequences, low-passed to the first N/8 frequencies (the band absorbs the coarser shift;
- * one inverse FFT per orientation), then a banded DTW with a cost `skip` for
+ * one inverse FFT for both orientations), then a banded DTW with a cost `skip` for
  * every sample matched twice (a skipped stretch on the other side) and free start/end
  * within the band (the difference of the end and start offsets pays `skip` per sample, so
  * a path that does not close costs what its missing samples would). Heights are quantized
