@@ -1186,14 +1186,22 @@ END_TEST
  * params, which end 60 bytes after the scales; version 1 files (the same without that block)
  * still load, with the retrieval settings at their defaults. */
 #define BLOB_RETRIEVAL_OFFSET (BLOB_SCALE_OFFSET + 8 + 60)
+
+/* The file b (*len bytes) as an older version writes it: the `drop` bytes at `at` removed, the
+ * version byte set and the checksum fixed. */
+static void as_older_version(unsigned char *b, size_t *len, size_t at, size_t drop, unsigned char version)
+{
+    memmove(b + at, b + at + drop, *len - at - drop);
+    *len -= drop;
+    b[8] = version;
+    fix_checksum(b, *len);
+}
+
 START_TEST(format_v1_still_loads)
 {
     size_t len = 0;
     unsigned char *b = small_blob(&len);
-    memmove(b + BLOB_RETRIEVAL_OFFSET, b + BLOB_RETRIEVAL_OFFSET + 60, len - BLOB_RETRIEVAL_OFFSET - 60);
-    len -= 60;
-    b[8] = 1;
-    fix_checksum(b, len);
+    as_older_version(b, &len, BLOB_RETRIEVAL_OFFSET, 60, 1);
     amscr_db *db = NULL;
     ck_assert_int_eq(load_exact(b, len, &db), AMSCR_OK);
     ck_assert_uint_eq(amscr_db_size(db), 2);
@@ -1218,13 +1226,10 @@ START_TEST(format_v2_one_band)
     size_t len = 0;
     ck_assert_int_eq(amscr_db_save_memory(db, &buf, &len), AMSCR_OK);
     unsigned char *b = buf;
-    size_t nscales = 0, at = 0;
+    size_t nscales = 0;
     ck_assert_int_eq(amscr_params_get_scales(p, NULL, &nscales), AMSCR_OK);
-    at = BLOB_SCALE_OFFSET + 8 * nscales + 60 + 52; /* the affine band, after the 52 bytes of version 2 */
-    memmove(b + at, b + at + 8, len - at - 8);
-    len -= 8;
-    b[8] = 2;
-    fix_checksum(b, len);
+    /* the affine band, after the 52 bytes of version 2 */
+    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 52, 8, 2);
     amscr_db *back = NULL;
     ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_OK);
     ck_assert(amscr_params_get_channel_band(amscr_db_params(back)) == 0.125);
