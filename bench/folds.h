@@ -33,6 +33,7 @@ typedef struct {
                        distance to the lsk-th neighbour; 2 the same with s = the mean distance to the lsk
                        nearest; 3 mutual proximity (empirical, no parameter); 4 mutual proximity (Gaussian) */
     size_t lsk;
+    double inner;   /* share of the inner-distance graph in the re-ranking (0: one graph) */
 } post_cfg;
 
 /* A labelled collection. */
@@ -47,6 +48,7 @@ typedef struct {
     size_t n;
     double *hs, *ha, *am, *fd, *gm, *ga; /* channel similarity / affine frame, AMSCR, Fourier, moments
                                          (similarity / affine frame) */
+    double *in;                          /* the inner distance (the re-ranking's second graph) */
 } base_t;
 
 typedef struct {
@@ -88,6 +90,8 @@ int folds_halves(const folds_data *fd);
 void folds_shuffle(int *perm, int L, unsigned long long *seed);
 /* The channel's band on random class subsets of mpeg7-dev and on the larger collections. */
 int folds_band(const folds_data *fd);
+/* The inner-distance graph's share in the re-ranking, the same way (folds_inner.c). */
+int folds_inner(const folds_data *fd);
 int folds_classes(const folds_data *fd, const char *datasets);
 /* Local scale of each row of the m x m matrix M: its k-th smallest off-diagonal entry. */
 void folds_local_scale(const double *M, size_t m, size_t k, double *sigma);

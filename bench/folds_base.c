@@ -11,6 +11,7 @@
 #include <time.h>
 
 #include "channel.h"
+#include "inner.h"
 
 /* Low-order Fourier magnitudes |c_k|, |c_-k| (k = 1..FD_K) of the similarity-normalized curve. */
 enum { FD_K = 8 };
@@ -185,8 +186,8 @@ static void fourier_matrix(const amscr_db *db, double *out)
  * The key's "sp" marks contours traced at sub-pixel accuracy (the tool's tracer since 0.4). */
 static double *one(const coll_t *c, const raw_cfg *r, int what, amscr_db **db)
 {
-    static const char *names[] = {"channel similarity", "channel affine", "AMSCR",
-                                  "Fourier",            "moments",        "moments, affine frame"};
+    static const char *names[] = {"channel similarity", "channel affine", "AMSCR", "Fourier", "moments",
+                                  "moments, affine frame", "inner distance"};
     size_t n = c->s.n;
     char key[300];
     char tag[32] = "";
@@ -211,6 +212,8 @@ static double *one(const coll_t *c, const raw_cfg *r, int what, amscr_db **db)
         st = amscr_db_distance_matrix(*db, NULL, NULL, M) == AMSCR_OK ? 0 : -1;
     else if (what == 3)
         fourier_matrix(*db, M);
+    else if (what == 6)
+        st = amscr__inner_matrix(*db, 2, NULL, NULL, M) == AMSCR_OK ? 0 : -1;
     else
         moment_matrix(*db, what == 5, M);
     double t = folds_now() - t0, pairs = 0.5 * (double)n * (double)(n - 1);
@@ -247,6 +250,7 @@ int base_get(const coll_t *c, const raw_cfg *r, int amscr, int fourier, base_t *
     b->n = c->s.n;
     b->hs = one(c, r, 0, &db);
     b->ha = one(c, r, 1, &db);
+    b->in = one(c, r, 6, &db);
     if (amscr)
         b->am = one(c, r, 2, &db);
     if (fourier)
@@ -256,5 +260,5 @@ int base_get(const coll_t *c, const raw_cfg *r, int amscr, int fourier, base_t *
     if (fourier > 1)
         b->ga = one(c, r, 5, &db);
     amscr_db_free(db);
-    return b->hs && b->ha && (!amscr || b->am) && (!fourier || b->fd) && (fourier < 2 || (b->gm && b->ga)) ? 0 : -1;
+    return b->hs && b->ha && b->in && (!amscr || b->am) && (!fourier || b->fd) && (fourier < 2 || (b->gm && b->ga)) ? 0 : -1;
 }

@@ -13,7 +13,7 @@
 #include "../tools/cli/collection.h"
 
 const raw_cfg RAW_DEFAULT = {128, 0.08, 1.0, 4.0, 1, 1};
-const post_cfg POST_DEFAULT = {0.2, 1.0, 8, 10, 0.0, 0, 0.0, 0, 0, 0, 0};
+const post_cfg POST_DEFAULT = {0.2, 1.0, 8, 10, 0.0, 0, 0.0, 0, 0, 0, 0, 0.05};
 
 double folds_now(void)
 {
@@ -172,5 +172,6 @@ void base_free(base_t *b)
     free(b->fd);
     free(b->gm);
     free(b->ga);
+    free(b->in);
     memset(b, 0, sizeof *b);
 }

@@ -1,6 +1,7 @@
 /* folds_eval.c — a sub-collection's retrieval matrix composed from the base matrices exactly as
  * amscr_db_retrieval_matrix composes them (channel frames mixed by the affine share; fusion with
- * AMSCR = each matrix over its median off-diagonal value; re-ranking), plus the optional Fourier
+ * AMSCR = each matrix over its median off-diagonal value; re-ranking, on the inner distance's
+ * graph too when pc->inner > 0), plus the optional Fourier
  * proportion channel, and its score. */
 #include "folds.h"
 
@@ -277,7 +278,13 @@ double *eval_matrix(const base_t *b, const size_t *idx, size_t m, const post_cfg
     last_k = k;
     if (k > m)
         k = m;
-    if (k != 0 && amscr__rerank_normalized(F, m, k, pc->iters, F) != AMSCR_OK) {
+    amscr_status st = AMSCR_OK;
+    if (k != 0 && pc->inner > 0.0) { /* the inner-distance graph beside the fused distance's */
+        sub(b->in, n, idx, m, X);
+        st = amscr__rerank_normalized2(F, X, pc->inner, m, k, pc->iters, F);
+    } else if (k != 0)
+        st = amscr__rerank_normalized(F, m, k, pc->iters, F);
+    if (st != AMSCR_OK) {
         free(F);
         F = NULL;
     }

@@ -152,7 +152,7 @@ static int run_timing(const char *dir)
     printf("retrieval pipeline, %s x%s, %ld cores online, load average %.2f %.2f %.2f\n\n",
            have ? "mpeg7-dev" : "MCD-style kimia216", have ? "2" : " (seeds)", sysconf(_SC_NPROCESSORS_ONLN),
            la[0], la[1], la[2]);
-    printf("| setting | shapes | decode+trace s | prepare s | channel matrix s | fusion+re-ranking s | total s | "
+    printf("| setting | shapes | decode+trace s | prepare s | channel matrix s | inner distance + re-ranking s | total s | "
            "channel pairs/s |\n|---|---|---|---|---|---|---|---|\n");
     time_setting("default (retrieval preset)", &a, t_load, 0.2);
     time_setting("fast (--fast: affine share 0)", &a, t_load, 0.0);

@@ -22,6 +22,8 @@
  *   amscr-retrieval-folds DATASETS halves  candidates on 24 random class halves of mpeg7-dev (folds_fuse.c)
  *   amscr-retrieval-folds DATASETS band    the channel's band on random class subsets of mpeg7-dev and on
  *                                          the 916- and 1400-shape collections (folds_band.c)
+ *   amscr-retrieval-folds DATASETS inner   the inner-distance graph's share in the re-ranking on the same
+ *                                          subsets, the folds and the whole collections (folds_inner.c)
  *   amscr-retrieval-folds DATASETS classes 1-NN, the 916-shape collection's parts, mpeg7-dev per class
  *   amscr-retrieval-folds DATASETS mcd     the MCD-style affine views by band and affine share
  *   amscr-retrieval-folds DATASETS row N BAND SKIP LOC SHARE K ITERS [STRIDE]   one combination, all splits
@@ -67,6 +69,8 @@ int main(int argc, char **argv)
         r = folds_halves(&fd);
     else if (strcmp(what, "band") == 0)
         r = folds_band(&fd);
+    else if (strcmp(what, "inner") == 0)
+        r = folds_inner(&fd);
     else if (strcmp(what, "classes") == 0)
         r = folds_classes(&fd, argv[1]);
     else

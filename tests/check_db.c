@@ -1169,7 +1169,7 @@ START_TEST(blob_layout_sanity)
     unsigned char *b = small_blob(&len);
     ck_assert(len > 100);
     ck_assert(memcmp(b, "AMSCRDB", 8) == 0);
-    ck_assert(b[8] == 5 && b[9] == 0 && b[10] == 0 && b[11] == 0); /* version 5, little-endian */
+    ck_assert(b[8] == 7 && b[9] == 0 && b[10] == 0 && b[11] == 0); /* version 7, little-endian */
     uint64_t h = 0;
     for (int i = 0; i < 8; i++)
         h |= (uint64_t)b[len - 8 + i] << (8 * i);
@@ -1182,9 +1182,9 @@ START_TEST(blob_layout_sanity)
 }
 END_TEST
 
-/* Format version 5 puts the retrieval settings (60 bytes; 52 in version 2) right after the
- * params, which end 60 bytes after the scales; version 1 files (the same without that block)
- * still load, with the retrieval settings at their defaults. */
+/* Format version 7 puts the retrieval settings (68 bytes; 60 in version 5, 52 in version 2)
+ * right after the params, which end 60 bytes after the scales; version 1 files (the same
+ * without that block) still load, with the retrieval settings at their defaults. */
 #define BLOB_RETRIEVAL_OFFSET (BLOB_SCALE_OFFSET + 8 + 60)
 
 /* The file b (*len bytes) as an older version writes it: the `drop` bytes at `at` removed, the
@@ -1201,7 +1201,7 @@ START_TEST(format_v1_still_loads)
 {
     size_t len = 0;
     unsigned char *b = small_blob(&len);
-    as_older_version(b, &len, BLOB_RETRIEVAL_OFFSET, 60, 1);
+    as_older_version(b, &len, BLOB_RETRIEVAL_OFFSET, 68, 1);
     amscr_db *db = NULL;
     ck_assert_int_eq(load_exact(b, len, &db), AMSCR_OK);
     ck_assert_uint_eq(amscr_db_size(db), 2);
@@ -1228,18 +1228,47 @@ START_TEST(format_v2_one_band)
     unsigned char *b = buf;
     size_t nscales = 0;
     ck_assert_int_eq(amscr_params_get_scales(p, NULL, &nscales), AMSCR_OK);
-    /* the affine band, after the 52 bytes of version 2 */
-    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 52, 8, 2);
+    /* the affine band and the inner share, after the 52 bytes of version 2 */
+    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 52, 16, 2);
     amscr_db *back = NULL;
     ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_OK);
     ck_assert(amscr_params_get_channel_band(amscr_db_params(back)) == 0.125);
     ck_assert(amscr_params_get_channel_affine_band(amscr_db_params(back)) == 0.125);
+    ck_assert(amscr_params_get_rerank_inner_share(amscr_db_params(back)) == 0.0);
     amscr_db_free(back);
     back = NULL;
-    b[8] = 5; /* read as version 5, the block runs 8 bytes into the counts: refused or inconsistent */
+    b[8] = 7; /* read as version 7, the block runs 16 bytes into the counts: refused or inconsistent */
     fix_checksum(b, len);
     ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_E_FORMAT);
     ck_assert_ptr_null(back);
+    amscr_free(buf);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* A version 5 file (0.6: a 60-byte block, one graph in the re-ranking) loads with the inner
+ * share 0, as it was computed, and its bands kept. */
+START_TEST(format_v5_one_graph)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.05), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_channel_affine_band(p, 0.0625), AMSCR_OK);
+    amscr_db *db = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
+    void *buf = NULL;
+    size_t len = 0;
+    ck_assert_int_eq(amscr_db_save_memory(db, &buf, &len), AMSCR_OK);
+    size_t nscales = 0;
+    ck_assert_int_eq(amscr_params_get_scales(p, NULL, &nscales), AMSCR_OK);
+    unsigned char *b = buf;
+    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 60, 8, 5);
+    amscr_db *back = NULL;
+    ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_OK);
+    ck_assert(amscr_params_get_rerank_inner_share(amscr_db_params(back)) == 0.0);
+    ck_assert(amscr_params_get_channel_affine_band(amscr_db_params(back)) == 0.0625);
+    amscr_db_free(back);
     amscr_free(buf);
     amscr_db_free(db);
     amscr_params_free(p);
@@ -1253,6 +1282,7 @@ START_TEST(retrieval_settings_roundtrip)
     ck_assert_int_eq(amscr_params_set_channel_band(p, 0.125), AMSCR_OK);
     ck_assert_int_eq(amscr_params_set_channel_affine_band(p, 0.0625), AMSCR_OK);
     ck_assert_int_eq(amscr_params_set_channel_affine_share(p, 0.3), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.125), AMSCR_OK);
     amscr_db *db = NULL;
     ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
     void *buf = NULL;
@@ -1270,6 +1300,7 @@ START_TEST(retrieval_settings_roundtrip)
     ck_assert_int_eq(amscr_params_get_channel_invariance(q), amscr_params_get_channel_invariance(p));
     ck_assert_uint_eq(amscr_params_get_rerank_k(q), amscr_params_get_rerank_k(p));
     ck_assert_uint_eq(amscr_params_get_rerank_iterations(q), amscr_params_get_rerank_iterations(p));
+    ck_assert(amscr_params_get_rerank_inner_share(q) == 0.125);
     /* an out-of-range weight in the block is a format error, not a silent value */
     unsigned char *b = buf;
     double bad = 2.0;
@@ -1638,6 +1669,7 @@ Suite *amscr_suite_db(void)
     tcase_add_test(tc, format_v1_still_loads);
     tcase_add_test(tc, retrieval_settings_roundtrip);
     tcase_add_test(tc, format_v2_one_band);
+    tcase_add_test(tc, format_v5_one_graph);
     tcase_add_test(tc, corrupt_truncated);
     tcase_add_test(tc, corrupt_flipped_bytes);
     tcase_add_test(tc, crafted_files_valid_checksum);

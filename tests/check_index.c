@@ -93,9 +93,11 @@ static void exact_case(double w, unsigned k)
     reference_row(db, q, ref);
     ck_assert_int_eq(amscr_db_query_retrieval(db, q, NULL, NULL, got, NSHAPES), AMSCR_OK);
     assert_close(ref, got, NSHAPES, 1e-12);
-    if (w <= 0.0 || w >= 1.0) {
+    if (w <= 0.0 || w >= 1.0) { /* an index: one graph (its collection's share is 0) */
         amscr_index *x = NULL;
         ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
+        ck_assert(amscr_params_get_rerank_inner_share(amscr_db_params(amscr_index_db(x))) == 0.0);
+        reference_row(amscr_index_db(x), q, ref);
         ck_assert_int_eq(amscr_index_query_scores(x, q, 0, viax, NSHAPES), AMSCR_OK);
         assert_close(ref, viax, NSHAPES, 1e-12);
         amscr_index_free(x);
@@ -122,9 +124,9 @@ START_TEST(member_rows)
     amscr_params *p = params_of(1.0, 8, 2);
     amscr_db *db = db_of(p, NSHAPES);
     double *M = malloc(NSHAPES * NSHAPES * sizeof *M), got[NSHAPES];
-    ck_assert_int_eq(amscr_db_retrieval_matrix(db, NULL, NULL, M), AMSCR_OK);
     amscr_index *x = NULL;
     ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_retrieval_matrix(amscr_index_db(x), NULL, NULL, M), AMSCR_OK);
     for (size_t i = 0; i < NSHAPES; i += 5) {
         ck_assert_int_eq(amscr_index_member_scores(x, i, 0, got, NSHAPES), AMSCR_OK);
         assert_close(M + i * NSHAPES, got, NSHAPES, 1e-12);
@@ -292,8 +294,8 @@ static unsigned char *as_version3(const amscr_index *x, const unsigned char *b, 
     size_t ns = 0;
     ck_assert_int_eq(amscr_params_get_scales(amscr_db_params(amscr_index_db(x)), NULL, &ns), AMSCR_OK);
     size_t band_at = 32 + 8 * ns + 60 + 52; /* magic .. scales, the params, the version 2 block */
-    memmove(o + band_at, o + band_at + 8, keep - band_at - 8);
-    keep -= 8;
+    memmove(o + band_at, o + band_at + 16, keep - band_at - 16); /* the band and the inner share */
+    keep -= 16;
     uint64_t h = amscr__db_checksum(3, o, keep);
     for (int i = 0; i < 8; i++)
         o[keep + (size_t)i] = (unsigned char)(h >> (8 * i));
@@ -314,7 +316,7 @@ START_TEST(stored_features)
     void *buf = NULL;
     size_t len = 0, l3 = 0;
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    ck_assert_int_eq(((unsigned char *)buf)[8], 6);
+    ck_assert_int_eq(((unsigned char *)buf)[8], 8);
     ck_assert_int_eq(x->nf, 2);
     unsigned char *v3 = as_version3(x, buf, len, &l3);
     for (unsigned lazy = 0; lazy < 2; lazy++) {

@@ -34,5 +34,6 @@ Suite *amscr_suite_signature(void);
 Suite *amscr_suite_protocols(void);
 Suite *amscr_suite_subpixel(void);
 Suite *amscr_suite_stages(void);
+Suite *amscr_suite_inner(void);
 
 #endif

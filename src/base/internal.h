@@ -79,6 +79,7 @@ struct amscr_params {
     double channel_locality;           /* height bins weighted 1 / (1 + locality * distance along the curve) */
     unsigned rerank_k;                 /* re-ranking neighbours, 0 = no re-ranking */
     unsigned rerank_iterations;
+    double rerank_inner_share;         /* share of the inner-distance graph in the re-ranking (0.7) */
 };
 
 /* The stages of amscr_register in pipeline order (register/stages.c holds the table). */
@@ -205,16 +206,23 @@ size_t amscr__elbow_choose(const double *sse, size_t m, size_t k_min);
 /* Re-ranking as amscr_rerank_diffusion with the output halved into [0, 1] (< 0.5: reached by
  * the diffusion) and a zero diagonal (rerank.c). */
 amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);
+/* The same on two graphs: the kNN graphs of dist and of dist2 (n x n, symmetric) mixed as
+ * (1 - share) P + share P2 before the diffusion; unreached pairs ordered by dist. */
+amscr_status amscr__rerank_normalized2(const double *dist, const double *dist2, double share, size_t n, size_t k,
+                                       unsigned iterations, double *out_dist);
 
 /* The retrieval settings in the saved collection (format versions 2-4, retrieval_io.c):
  * little-endian f64 channel_weight, u32 channel_invariance, f64 channel_affine_share,
  * f64 channel_band, f64 channel_skip, f64 channel_locality, u32 rerank_k,
- * u32 rerank_iterations; versions 5 and 6 (0.6) then f64 channel_affine_band (_V2). A shorter
- * block reads with channel_affine_band = channel_band (one band for both frames before 0.6).
+ * u32 rerank_iterations; versions 5 and 6 (0.6) then f64 channel_affine_band (_V2); versions 7
+ * and 8 (0.7) then f64 rerank_inner_share (_V3). A shorter block reads with
+ * channel_affine_band = channel_band (one band for both frames before 0.6) and
+ * rerank_inner_share = 0 (one graph before 0.7).
  * read validates through the setters' rules (AMSCR_E_FORMAT). */
 #define AMSCR__RETRIEVAL_BLOCK 52
 #define AMSCR__RETRIEVAL_BLOCK_V2 60
-/* size: AMSCR__RETRIEVAL_BLOCK or AMSCR__RETRIEVAL_BLOCK_V2. */
+#define AMSCR__RETRIEVAL_BLOCK_V3 68
+/* size: AMSCR__RETRIEVAL_BLOCK, _V2 or _V3. */
 void amscr__retrieval_block_write(const amscr_params *p, unsigned char *out, size_t size);
 amscr_status amscr__retrieval_block_read(const unsigned char *in, size_t size, amscr_params *p);
 

@@ -22,6 +22,7 @@ static void retrieval_defaults(amscr_params *p)
     p->channel_locality = 4.0;
     p->rerank_k = 0;
     p->rerank_iterations = 10;
+    p->rerank_inner_share = 0.0;
 }
 
 void amscr__params_defaults(amscr_params *p)
@@ -90,6 +91,7 @@ void amscr__params_retrieval(amscr_params *p)
     p->reflections = 1;
     p->channel_weight = 1.0;
     p->rerank_k = 8;
+    p->rerank_inner_share = 0.0;
 }
 
 amscr_status amscr_params_new_retrieval(amscr_params **out)
@@ -173,6 +175,8 @@ SETTER(rerank_k, unsigned, rerank_k, v <= 1000, "%u is outside 0..1000")
 GETTER(rerank_k, unsigned, rerank_k)
 SETTER(rerank_iterations, unsigned, rerank_iterations, v >= 1 && v <= 1000, "%u is outside 1..1000")
 GETTER(rerank_iterations, unsigned, rerank_iterations)
+SETTER(rerank_inner_share, double, rerank_inner_share, v >= 0.0 && v < 1.0, "%g is not in [0, 1)")
+GETTER(rerank_inner_share, double, rerank_inner_share)
 
 /* ---- robust registration: partial matching, polish ---- */
 SETTER(partial, int, partial, v == 0 || v == 1, "%d is not 0 or 1")

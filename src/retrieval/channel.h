@@ -57,6 +57,8 @@ double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__h
 /* Symmetric n x n matrix of channel distances (zero diagonal), on `threads` threads. */
 amscr_status amscr__hf_matrix(const amscr__hf *hf, size_t n, const amscr__hf_cfg *cfg, unsigned threads,
                               amscr_progress_fn progress, void *user, double *out);
+/* out (n x n) from its upper triangle: mirrored below, a zero diagonal. */
+void amscr__mirror_upper(double *out, size_t n);
 /* The channel's sequences of a prepared shape in `frame`, with the settings of p. */
 amscr_status amscr__hf_of_descriptor(const amscr_params *p, amscr_invariance frame, const amscr_descriptor *d,
                                      amscr__hf *out);

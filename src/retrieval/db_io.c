@@ -2,9 +2,9 @@
  * Header: "AMSCRDB\0", u32 version, u32 reserved, params, (version >= 2) the retrieval
  * settings (retrieval_io.c), u64 count, u64 N, u64 p; per shape: i32 label, f64 fwd[6],
  * f64 inv[6], f64 input[2N], base[2N], scaled[2Np]; (version 3) u64 length and the index
- * section (index_io.c); trailer: u64 checksum of everything before it (FNV-1a; version 4:
- * amscr__sum64). A collection file does not store the shape channel (derived from the
- * prepared shapes on demand); an index file of version 4 does, in its section. */
+ * section (index_io.c); trailer: u64 checksum of everything before it (FNV-1a; versions 4, 6
+ * and 8: amscr__sum64). A collection file does not store the shape channel (derived from the
+ * prepared shapes on demand); an index file of version 4, 6 or 8 does, in its section. */
 #define _DEFAULT_SOURCE /* MAP_POPULATE, where the system has it */
 #include "db_io.h"
 #include "dense.h"
@@ -52,7 +52,7 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
     amscr__w_u32(w, version);
     amscr__w_u32(w, 0);
     w_params(w, prm);
-    unsigned char rblock[AMSCR__RETRIEVAL_BLOCK_V2];
+    unsigned char rblock[AMSCR__RETRIEVAL_BLOCK_V3];
     size_t rsize = amscr__db_retrieval_block(version);
     amscr__retrieval_block_write(prm, rblock, rsize);
     amscr__w_bytes(w, rblock, rsize);
@@ -81,7 +81,7 @@ amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *ou
     if (st != AMSCR_OK)
         return st;
     amscr__wbuf w = {NULL, 0, 0, 0};
-    amscr__db_write(db, AMSCR__DB_VERSION_PLAIN_BANDS, &w);
+    amscr__db_write(db, AMSCR__DB_VERSION_PLAIN_INNER, &w);
     if (!w.oom)
         amscr__w_u64(&w, amscr__fnv1a(w.buf, w.len));
     if (w.oom) {

@@ -2,6 +2,7 @@
  * prepared shape in its own frame, the channel alone (pair and collection), and the fused,
  * re-ranked retrieval matrix. */
 #include "channel.h"
+#include "inner.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -315,6 +316,24 @@ amscr_status amscr__base_matrix(const amscr_db *db, amscr_progress_fn progress, 
     return st;
 }
 
+/* The re-ranking of the base matrix D (n x n, in place): on its kNN graph, and on the inner
+ * distance's too when the params give it a share. */
+static amscr_status rerank_base(const amscr_db *db, size_t n, double *D)
+{
+    const amscr_params *p = amscr_db_params(db);
+    size_t k = amscr__rerank_k(p, n);
+    if (!(p->rerank_inner_share > 0.0))
+        return amscr__rerank_normalized(D, n, k, p->rerank_iterations, D);
+    double *I = amscr__malloc_array(n * n, sizeof *I);
+    if (!I)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_db_retrieval_matrix: out of memory");
+    amscr_status st = amscr__inner_matrix(db, amscr__resolve_threads(p->num_threads), NULL, NULL, I);
+    if (st == AMSCR_OK)
+        st = amscr__rerank_normalized2(D, I, p->rerank_inner_share, n, k, p->rerank_iterations, D);
+    free(I);
+    return st;
+}
+
 amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out_dist)
 {
     amscr__clear_error();
@@ -325,7 +344,7 @@ amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn pro
     double med[2];
     amscr_status st = amscr__base_matrix(db, progress, user, out_dist, med);
     if (st == AMSCR_OK && n > 0 && p->rerank_k > 0)
-        st = amscr__rerank_normalized(out_dist, n, amscr__rerank_k(p, n), p->rerank_iterations, out_dist);
+        st = rerank_base(db, n, out_dist);
     if (st != AMSCR_OK)
         for (size_t i = 0; i < n * n; i++)
             out_dist[i] = NAN;

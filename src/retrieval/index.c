@@ -67,7 +67,9 @@ amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
     x->sig_dim = AMSCR__SIG_DIM;
     x->nf = amscr__index_frames(p);
     x->k = n > 0 ? amscr__rerank_k(p, n) : 0;
-    amscr_status st = amscr_db_new(p, &x->db);
+    amscr_params q = *p; /* an index re-ranks on the retrieval distance's graph alone */
+    q.rerank_inner_share = 0.0;
+    amscr_status st = amscr_db_new(&q, &x->db);
     for (size_t i = 0; st == AMSCR_OK && i < n; i++)
         st = amscr_db_add_descriptor(x->db, amscr_db_descriptor(db, i), amscr_db_label(db, i), NULL);
     if (st == AMSCR_OK)

@@ -1,4 +1,4 @@
-/* index_io.c — the index file: a collection file (db_io.c) of version 6 (4 in 0.5, 3 in 0.4) whose
+/* index_io.c — the index file: a collection file (db_io.c) of version 8 (6 in 0.6, 4 in 0.5, 3 in 0.4) whose
  * index section follows the shapes, so amscr_db_load of an index file gives its collection.
  * Little-endian:
  *   u64 section length (the bytes up to the trailing checksum), then
@@ -8,7 +8,7 @@
  *   (each row: itself first, then by distance), n names, u64 nclasses, nclasses class names
  *   (string: u32 length and bytes, 0xffffffff for none), then
  *   version 3: when a shape has a group, n group names (absent: no shape has one);
- *   versions 4 and 6: u32 1 and n group names, or u32 0 (no shape has one); then the channel
+ *   versions 4, 6 and 8: u32 1 and n group names, or u32 0 (no shape has one); then the channel
  *     features: u32 frames F (0: no channel), u32 samples N, u32 bins B (AMSCR__HF_BINS), and
  *     per shape, per frame, its quantized height sequences (channel.h), forward then mirrored:
  *     2 N B bytes (F = 2, N = 128: 8 KB a shape).
@@ -96,7 +96,7 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
     if (st != AMSCR_OK)
         return st;
     amscr__wbuf w = {NULL, 0, 0, 0};
-    amscr__db_write(x->db, AMSCR__DB_VERSION_INDEX_BANDS, &w);
+    amscr__db_write(x->db, AMSCR__DB_VERSION_INDEX_INNER, &w);
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
     write_section(x, &w);
@@ -109,7 +109,7 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
         uint64_t sec = (uint64_t)(w.len - at - 8);
         for (int i = 0; i < 8; i++)
             w.buf[at + (size_t)i] = (unsigned char)(sec >> (8 * i));
-        amscr__w_u64(&w, amscr__db_checksum(AMSCR__DB_VERSION_INDEX_BANDS, w.buf, w.len));
+        amscr__w_u64(&w, amscr__db_checksum(AMSCR__DB_VERSION_INDEX_INNER, w.buf, w.len));
     }
     if (w.oom) {
         free(w.buf);
@@ -219,7 +219,7 @@ static amscr_status read_names(amscr__rbuf *r, amscr_index *x, uint32_t version)
     return AMSCR_OK;
 }
 
-/* The channel features of a version 4 or 6 file: each shape's height sequences (index.h's x->hf,
+/* The channel features of a version 4, 6 or 8 file: each shape's height sequences (index.h's x->hf,
  * their spectra not yet computed). */
 static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
 {
@@ -249,7 +249,7 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
     return AMSCR_OK;
 }
 
-/* What follows the names: the features (versions 4 and 6), then nothing. */
+/* What follows the names: the features (versions 4, 6 and 8), then nothing. */
 static amscr_status read_rest(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
     amscr_status st = amscr__db_has_features(version) ? read_features(r, x) : AMSCR_OK;

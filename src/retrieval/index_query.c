@@ -577,7 +577,9 @@ amscr_status amscr_db_query_retrieval(const amscr_db *db, const amscr_descriptor
         return AMSCR_E_INVALID_ARG;
     const amscr_params *p = amscr_db_params(db);
     double w = p->channel_weight;
-    if (w > 0.0 && w < 1.0) /* fused weights: the medians move with the query, so the whole matrix */
+    /* fused weights: the medians move with the query; the inner-distance graph: an index holds
+     * one graph. Both: the whole matrix. */
+    if ((w > 0.0 && w < 1.0) || (p->rerank_k > 0 && p->rerank_inner_share > 0.0))
         return query_by_matrix(db, q, progress, user, out_scores);
     if (p->rerank_k == 0) /* the base distances alone: nothing of the collection's is needed */
         return plain_row(db, q, progress, user, out_scores);

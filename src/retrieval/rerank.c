@@ -27,18 +27,20 @@ static amscr_status check_args(const double *dist, size_t n, size_t k, unsigned 
     return AMSCR_OK;
 }
 
-/* The working buffers: D the symmetrized distances, Q the diffused affinity, T a product,
- * sc the self-tuning scales, (pj, pw) the kNN graph P (k neighbours and weights a row); row
- * (0..n-1) and nb (k) the neighbour selection's scratch. */
+/* The working buffers: D the symmetrized distances (D2 the second graph's), Q the diffused
+ * affinity, T a product, sc the self-tuning scales, (pj, pw) the kNN graph P (kk entries a
+ * row: k neighbours of each graph); row (0..n-1) and nb (k) the neighbour selection's scratch. */
 typedef struct {
-    double *D, *Q, *T, *sc, *pw;
+    double *D, *D2, *Q, *T, *sc, *pw;
     size_t *pj, *row;
     uint32_t *nb;
+    size_t kk;
 } rerank_buf;
 
 static void buf_free(rerank_buf *b)
 {
     free(b->D);
+    free(b->D2);
     free(b->Q);
     free(b->T);
     free(b->sc);
@@ -48,17 +50,20 @@ static void buf_free(rerank_buf *b)
     free(b->nb);
 }
 
-static int buf_alloc(rerank_buf *b, size_t n, size_t k)
+static int buf_alloc(rerank_buf *b, size_t n, size_t k, int graphs)
 {
+    memset(b, 0, sizeof *b);
+    b->kk = k * (size_t)graphs;
     b->D = amscr__malloc_array(n * n, sizeof *b->D);
+    b->D2 = graphs > 1 ? amscr__malloc_array(n * n, sizeof *b->D2) : NULL;
     b->Q = amscr__malloc_array(n * n, sizeof *b->Q);
     b->T = amscr__malloc_array(n * n, sizeof *b->T);
     b->sc = amscr__malloc_array(n, sizeof *b->sc);
-    b->pw = amscr__malloc_array(n * k, sizeof *b->pw);
-    b->pj = amscr__malloc_array(n * k, sizeof *b->pj);
+    b->pw = amscr__malloc_array(n * b->kk, sizeof *b->pw);
+    b->pj = amscr__malloc_array(n * b->kk, sizeof *b->pj);
     b->row = amscr__malloc_array(n, sizeof *b->row);
     b->nb = amscr__malloc_array(k, sizeof *b->nb);
-    if (b->D && b->Q && b->T && b->sc && b->pw && b->pj && b->row && b->nb)
+    if (b->D && (graphs < 2 || b->D2) && b->Q && b->T && b->sc && b->pw && b->pj && b->row && b->nb)
         return 1;
     buf_free(b);
     return 0;
@@ -77,39 +82,42 @@ static double symmetrize(const double *dist, size_t n, double *D)
     return dmax;
 }
 
-/* The kNN graph P: each row's k neighbours (itself first: distance 0, ties by index), weighted
- * by exp(-d / s) with self-tuning scales s and normalized to sum 1. */
-static amscr_status knn_graph(rerank_buf *b, size_t n, size_t k, double dmax)
+/* One kNN graph of D into the entries [off, off + k) of P's rows: each row's k neighbours
+ * (itself first: distance 0, ties by index), weighted by exp(-d / s) with self-tuning scales s
+ * and normalized to sum `mass`. */
+static amscr_status knn_graph(rerank_buf *b, const double *D, size_t n, size_t k, size_t off, double mass,
+                              double dmax)
 {
-    const double *D = b->D;
+    size_t kk = b->kk;
     for (size_t j = 0; j < n; j++)
         b->row[j] = j;
     for (size_t i = 0; i < n; i++) {
-        amscr_status st = amscr__knn_select(i, b->row, D + i * n, n, k, b->nb, b->pw + i * k);
+        amscr_status st = amscr__knn_select(i, b->row, D + i * n, n, k, b->nb, b->pw + i * kk + off);
         if (st != AMSCR_OK)
             return st;
         for (size_t t = 0; t < k; t++)
-            b->pj[i * k + t] = b->nb[t];
-        b->sc[i] = D[i * n + b->pj[i * k + k - 1]];
+            b->pj[i * kk + off + t] = b->nb[t];
+        b->sc[i] = D[i * n + b->pj[i * kk + off + k - 1]];
     }
     double tiny = dmax > 0.0 ? 1e-12 * dmax : 1e-300;
     for (size_t i = 0; i < n; i++) {
-        double sum = 0.0;
+        double sum = 0.0, *w = b->pw + i * kk + off;
+        const size_t *pj = b->pj + i * kk + off;
         for (size_t t = 0; t < k; t++) {
-            size_t j = b->pj[i * k + t];
-            double s = sqrt((b->sc[i] + tiny) * (b->sc[j] + tiny));
-            b->pw[i * k + t] = exp(-D[i * n + j] / s);
-            sum += b->pw[i * k + t];
+            double s = sqrt((b->sc[i] + tiny) * (b->sc[pj[t]] + tiny));
+            w[t] = exp(-D[i * n + pj[t]] / s);
+            sum += w[t];
         }
         for (size_t t = 0; t < k; t++)
-            b->pw[i * k + t] /= sum;
+            w[t] = mass * (w[t] / sum); /* exactly w / sum for one graph */
     }
     return AMSCR_OK;
 }
 
 /* Q = P, then `iterations` times Q <- P Q P^T + I (P sparse: k entries a row). */
-static void diffuse(rerank_buf *b, size_t n, size_t k, unsigned iterations)
+static void diffuse(rerank_buf *b, size_t n, unsigned iterations)
 {
+    size_t k = b->kk;
     double *Q = b->Q, *T = b->T;
     const double *pw = b->pw;
     const size_t *pj = b->pj;
@@ -165,34 +173,43 @@ static void to_distances(const double *Q, const double *D, size_t n, double dmax
     }
 }
 
-static amscr_status rerank(const double *dist, size_t n, size_t k, unsigned iterations, int norm, double *out_dist,
-                           const char *what)
+/* dist2 (NULL: one graph) enters with `share` of every row's mass. */
+static amscr_status rerank(const double *dist, const double *dist2, double share, size_t n, size_t k,
+                           unsigned iterations, int norm, double *out_dist, const char *what)
 {
     amscr__clear_error();
     amscr_status st = check_args(dist, n, k, iterations, out_dist, what);
+    if (st == AMSCR_OK && dist2)
+        st = check_args(dist2, n, k, iterations, out_dist, what);
     if (st != AMSCR_OK)
         return st;
     rerank_buf b;
-    if (!buf_alloc(&b, n, k))
-        return amscr__fail(AMSCR_E_NOMEM, "amscr_rerank_diffusion: out of memory");
+    if (!buf_alloc(&b, n, k, dist2 ? 2 : 1))
+        return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", what);
     double dmax = symmetrize(dist, n, b.D);
-    st = knn_graph(&b, n, k, dmax);
-    if (st != AMSCR_OK) {
-        buf_free(&b);
-        return st;
+    st = knn_graph(&b, b.D, n, k, 0, dist2 ? 1.0 - share : 1.0, dmax);
+    if (st == AMSCR_OK && dist2)
+        st = knn_graph(&b, b.D2, n, k, k, share, symmetrize(dist2, n, b.D2));
+    if (st == AMSCR_OK) {
+        diffuse(&b, n, iterations);
+        to_distances(b.Q, b.D, n, dmax, norm, out_dist);
     }
-    diffuse(&b, n, k, iterations);
-    to_distances(b.Q, b.D, n, dmax, norm, out_dist);
     buf_free(&b);
-    return AMSCR_OK;
+    return st;
 }
 
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
 {
-    return rerank(dist, n, k, iterations, NORM_ROW_MAX, out_dist, "amscr_rerank_diffusion");
+    return rerank(dist, NULL, 0.0, n, k, iterations, NORM_ROW_MAX, out_dist, "amscr_rerank_diffusion");
 }
 
 amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
 {
-    return rerank(dist, n, k, iterations, NORM_UNIT, out_dist, "re-ranking");
+    return rerank(dist, NULL, 0.0, n, k, iterations, NORM_UNIT, out_dist, "re-ranking");
+}
+
+amscr_status amscr__rerank_normalized2(const double *dist, const double *dist2, double share, size_t n, size_t k,
+                                       unsigned iterations, double *out_dist)
+{
+    return rerank(dist, dist2, share, n, k, iterations, NORM_UNIT, out_dist, "re-ranking");
 }

@@ -115,6 +115,8 @@ typedef struct opts {
     double channel_weight;
     int affine_share_set;
     double affine_share;
+    int inner_share_set;
+    double inner_share;
 } opts;
 
 typedef struct tool_command {

@@ -237,11 +237,14 @@ static void print_retrieval_options(const amscr_params *ret)
            "  --rerank K[,ITER]       contextual re-ranking: diffusion on the K-nearest-neighbour\n"
            "                          graph, ITER iterations (default %u,%u; ITER default %d)\n"
            "  --no-rerank             the fused pairwise distances\n"
+           "  --inner-share S         share of the inner-distance graph in the re-ranking, 0..1\n"
+           "                          exclusive (default %g; 0 = one graph; an index uses 0)\n"
            "  --paper                 the paper's method: the AMSCR distance alone, affine group,\n"
            "                          no refinement, no re-ranking (= --channel-weight 0\n"
            "                          --no-rerank --invariance affine --refine 0)\n",
            amscr_params_get_channel_weight(ret), amscr_params_get_channel_affine_share(ret),
-           amscr_params_get_rerank_k(ret), amscr_params_get_rerank_iterations(ret), TOOL_RERANK_ITERS);
+           amscr_params_get_rerank_k(ret), amscr_params_get_rerank_iterations(ret), TOOL_RERANK_ITERS,
+           amscr_params_get_rerank_inner_share(ret));
 }
 
 /* The image and shape options, their defaults read from reg (register's params) and ret

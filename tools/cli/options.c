@@ -51,6 +51,7 @@ typedef enum opt_id {
     O_NO_RERANK,
     O_CHANNEL_WEIGHT,
     O_AFFINE_SHARE,
+    O_INNER_SHARE,
     O_FAST,
     O_PAPER,
     O_PIXEL_CHAIN
@@ -104,6 +105,7 @@ static const optdef OPTS[] = {
     {"--no-rerank", O_NO_RERANK, 0, C_RETRIEVAL, NULL},
     {"--channel-weight", O_CHANNEL_WEIGHT, 1, C_RETRIEVAL, "W"},
     {"--affine-share", O_AFFINE_SHARE, 1, C_RETRIEVAL, "S"},
+    {"--inner-share", O_INNER_SHARE, 1, C_RETRIEVAL, "S"},
     {"--fast", O_FAST, 0, C_RETRIEVAL, NULL},
     {"--paper", O_PAPER, 0, C_RETRIEVAL, NULL},
     {"--pixel-chain", O_PIXEL_CHAIN, 0, C_ALL, NULL},
@@ -231,7 +233,7 @@ static int parse_rerank(const char *opt, const char *v, opts *o)
     return 0;
 }
 
-/* A fraction 0..1 (--channel-weight, --affine-share) into *out, setting *set. */
+/* A fraction 0..1 (--channel-weight, --affine-share, --inner-share) into *out, setting *set. */
 static int parse_fraction(const char *opt, const char *v, int *set, double *out)
 {
     char *end = NULL;
@@ -369,6 +371,7 @@ static int set_option(opts *o, const optdef *d, const char *v)
         return 0;
     case O_CHANNEL_WEIGHT: return parse_fraction(n, v, &o->channel_weight_set, &o->channel_weight);
     case O_AFFINE_SHARE: return parse_fraction(n, v, &o->affine_share_set, &o->affine_share);
+    case O_INNER_SHARE: return parse_fraction(n, v, &o->inner_share_set, &o->inner_share);
     case O_FAST:
         o->affine_share_set = 1;
         o->affine_share = 0.0;

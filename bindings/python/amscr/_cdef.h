@@ -192,6 +192,8 @@ amscr_status amscr_params_set_rerank_k(amscr_params *p, unsigned k);
 unsigned amscr_params_get_rerank_k(const amscr_params *p);
 amscr_status amscr_params_set_rerank_iterations(amscr_params *p, unsigned iterations);
 unsigned amscr_params_get_rerank_iterations(const amscr_params *p);
+amscr_status amscr_params_set_rerank_inner_share(amscr_params *p, double share);
+double amscr_params_get_rerank_inner_share(const amscr_params *p);
 amscr_status amscr_workspace_new(amscr_workspace **out);
 void amscr_workspace_free(amscr_workspace *ws);
 amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out);

@@ -153,6 +153,9 @@ class Params:
     channel_locality = _Option('channel_locality', _FLOAT, "the channel's locality of the height functions (>= 0)")
     rerank_k = _Option('rerank_k', _UINT, 'neighbours of the re-ranking of retrieval_matrix (0 = none; preset 8)')
     rerank_iterations = _Option('rerank_iterations', _UINT, 'diffusion iterations of that re-ranking (1..1000)')
+    rerank_inner_share = _Option('rerank_inner_share', _FLOAT,
+                                 'share, in [0, 1), of the inner-distance graph in that re-ranking (0 = one graph, '
+                                 'the default; 0.05 in the retrieval preset; an Index uses 0)')
 
     #: The option names, in the order of the table above.
     OPTIONS: Tuple[str, ...] = ()

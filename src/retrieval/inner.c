@@ -1,0 +1,279 @@
+/* inner.c — the inner-distance graph of the re-ranking (docs/method.md §10.4): the inner
+ * distance of Ling and Jacobs ("Shape classification using the inner-distance", IEEE PAMI
+ * 2007), the length of the shortest path between two boundary points that stays inside the
+ * shape. Bending a part at a joint leaves it almost unchanged, so it sees articulated shapes
+ * alike where the height functions of the shape channel see them differ.
+ *
+ * Per shape (once): the closed curve resampled to AMSCR__INNER_N points evenly along its
+ * length; the visibility graph of that polygon (a chord joins two vertices when it crosses
+ * no edge and its midpoint lies inside) and its shortest paths (Floyd-Warshall); the matrix
+ * divided by its mean (scale-free; chords that no path joins, possible only on a degenerate
+ * polygon, keep their straight length). Per pair: the matrices compared at every cyclic
+ * shift of the vertices and both orientations at once, by one inverse FFT over the columns
+ * of the offset form (i -> ID(i, i + k)); O(N^2 / 2) complex products a pair. */
+#include "inner.h"
+
+#include "channel.h" /* amscr__mirror_upper */
+#include "dense.h"   /* AMSCR__PI */
+#include "rows.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define N AMSCR__INNER_N
+
+amscr_status amscr__inner_ws_init(amscr__inner_ws *ws)
+{
+    if (amscr__fft_plan_init(&ws->plan, N) != 0)
+        return amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
+    for (size_t m = 0; m < N; m++) {
+        double a = -2.0 * AMSCR__PI * (double)m / (double)N;
+        ws->cs[2 * m] = cos(a);
+        ws->cs[2 * m + 1] = sin(a);
+    }
+    return AMSCR_OK;
+}
+
+void amscr__inner_ws_free(amscr__inner_ws *ws) { amscr__fft_plan_free(&ws->plan); }
+
+/* out: N points evenly spaced along the closed polygon xy (n points). 0 if it has no length. */
+static int resample(const double *xy, size_t n, double *out)
+{
+    double len = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        size_t j = (i + 1) % n;
+        len += hypot(xy[2 * j] - xy[2 * i], xy[2 * j + 1] - xy[2 * i + 1]);
+    }
+    if (!(len > 0.0) || !isfinite(len))
+        return 0;
+    double at = 0.0;
+    size_t seg = 0;
+    for (size_t t = 0; t < N; t++) {
+        double want = len * (double)t / (double)N;
+        for (;;) {
+            size_t j = (seg + 1) % n;
+            double l = hypot(xy[2 * j] - xy[2 * seg], xy[2 * j + 1] - xy[2 * seg + 1]);
+            if (at + l >= want || seg + 1 >= n) {
+                double u = l > 0.0 ? (want - at) / l : 0.0;
+                u = u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
+                out[2 * t] = xy[2 * seg] + u * (xy[2 * j] - xy[2 * seg]);
+                out[2 * t + 1] = xy[2 * seg + 1] + u * (xy[2 * j + 1] - xy[2 * seg + 1]);
+                break;
+            }
+            at += l;
+            seg++;
+        }
+    }
+    return 1;
+}
+
+static double cross(const double *o, const double *a, const double *b)
+{
+    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
+/* Whether the point (x, y) lies inside the polygon V (even-odd rule). */
+static int inside(const double *V, double x, double y)
+{
+    int in = 0;
+    for (size_t e = 0; e < N; e++) {
+        const double *a = V + 2 * e, *b = V + 2 * ((e + 1) % N);
+        if ((a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0])
+            in = !in;
+    }
+    return in;
+}
+
+/* Whether the chord from vertex i to vertex j stays inside the polygon V. */
+static int visible(const double *V, size_t i, size_t j)
+{
+    const double *p = V + 2 * i, *q = V + 2 * j;
+    for (size_t e = 0; e < N; e++) {
+        size_t f = (e + 1) % N;
+        if (e == i || e == j || f == i || f == j)
+            continue;
+        const double *a = V + 2 * e, *b = V + 2 * f;
+        if (cross(p, q, a) * cross(p, q, b) < 0.0 && cross(a, b, p) * cross(a, b, q) < 0.0)
+            return 0;
+    }
+    return inside(V, 0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]));
+}
+
+/* D (N x N): the inner distances of the polygon V, divided by their mean. 0 if degenerate. */
+static int inner_matrix_of(const double *V, double *D)
+{
+    for (size_t i = 0; i < N; i++) {
+        D[i * N + i] = 0.0;
+        for (size_t j = i + 1; j < N; j++) {
+            int adjacent = j == i + 1 || (i == 0 && j == N - 1);
+            double l = hypot(V[2 * j] - V[2 * i], V[2 * j + 1] - V[2 * i + 1]);
+            D[i * N + j] = D[j * N + i] = adjacent || visible(V, i, j) ? l : INFINITY;
+        }
+    }
+    for (size_t k = 0; k < N; k++)
+        for (size_t i = 0; i < N; i++) {
+            double dik = D[i * N + k];
+            for (size_t j = 0; j < N; j++)
+                if (dik + D[k * N + j] < D[i * N + j])
+                    D[i * N + j] = dik + D[k * N + j];
+        }
+    double sum = 0.0;
+    for (size_t i = 0; i < N; i++)
+        for (size_t j = 0; j < N; j++) {
+            if (!isfinite(D[i * N + j]))
+                D[i * N + j] = hypot(V[2 * j] - V[2 * i], V[2 * j + 1] - V[2 * i + 1]);
+            sum += D[i * N + j];
+        }
+    if (!(sum > 0.0) || !isfinite(sum))
+        return 0;
+    double s = (double)(N * N) / sum;
+    for (size_t i = 0; i < N * N; i++)
+        D[i] *= s;
+    return 1;
+}
+
+amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, amscr__inner_ws *ws)
+{
+    if (n < 3 || !resample(xy, n, ws->xy) || !inner_matrix_of(ws->xy, ws->id))
+        return amscr__fail(AMSCR_E_DEGENERATE, "inner distance: the curve has no extent");
+    out->norm2 = 0.0;
+    for (size_t k = 0; k < AMSCR__INNER_K; k++) {
+        size_t off = k + 1;
+        double w = sqrt(off < N / 2 ? 2.0 : 1.0);
+        for (size_t i = 0; i < N; i++) {
+            double v = w * ws->id[i * N + (i + off) % N];
+            ws->z[2 * i] = v;
+            ws->z[2 * i + 1] = 0.0;
+            out->norm2 += v * v;
+        }
+        amscr__fft(&ws->plan, ws->z, 0);
+        memcpy(out->spec[k], ws->z, sizeof out->spec[k]);
+    }
+    return AMSCR_OK;
+}
+
+/* Z(f), f = 0..N/2, into ws->z with its Hermitian rest: the correlation of a and b over the
+ * shifts (real part) and, when `refl`, of a and b reversed (imaginary part). */
+static void spectrum(const amscr__inner *a, const amscr__inner *b, int refl, amscr__inner_ws *ws)
+{
+    double *z = ws->z;
+    for (size_t f = 0; f < AMSCR__INNER_F; f++) {
+        double xr = 0.0, xi = 0.0, yr = 0.0, yi = 0.0;
+        for (size_t k = 0; k < AMSCR__INNER_K; k++) {
+            double ar = a->spec[k][2 * f], ai = a->spec[k][2 * f + 1];
+            double br = b->spec[k][2 * f], bi = b->spec[k][2 * f + 1];
+            xr += ar * br + ai * bi; /* conj(A) B: sum_i a[i] b[i + s] */
+            xi += ar * bi - ai * br;
+            if (refl) { /* A B e^{-2 pi i f (k + 1) / N}: sum_i a[i] b[-i - s - (k + 1)] */
+                double pr = ar * br - ai * bi, pi = ar * bi + ai * br;
+                const double *c = ws->cs + 2 * ((f * (k + 1)) % N);
+                yr += pr * c[0] - pi * c[1];
+                yi += pr * c[1] + pi * c[0];
+            }
+        }
+        z[2 * f] = xr - yi; /* X + i Y */
+        z[2 * f + 1] = xi + yr;
+        if (f > 0 && f < N / 2) { /* conj(X) + i conj(Y) at N - f */
+            z[2 * (N - f)] = xr + yi;
+            z[2 * (N - f) + 1] = -xi + yr;
+        }
+    }
+}
+
+double amscr__inner_distance(const amscr__inner *a, const amscr__inner *b, int reflections, amscr__inner_ws *ws)
+{
+    spectrum(a, b, reflections, ws);
+    amscr__fft(&ws->plan, ws->z, 1);
+    double best = -INFINITY;
+    for (size_t s = 0; s < N; s++) {
+        if (ws->z[2 * s] > best)
+            best = ws->z[2 * s];
+        if (reflections && ws->z[2 * s + 1] > best)
+            best = ws->z[2 * s + 1];
+    }
+    double d2 = a->norm2 + b->norm2 - 2.0 * best / (double)N;
+    /* below the sums' rounding (a shape against itself): 0 */
+    return d2 > 1e-12 * (a->norm2 + b->norm2) ? sqrt(d2 / (double)(N * N)) : 0.0;
+}
+
+/* ------------------------------------------------------------ the collection */
+
+typedef struct {
+    const amscr_descriptor **d;
+    amscr__inner *f;
+    amscr_status *st;
+    size_t n;
+    int reflections;
+    double *out;
+} inner_job;
+
+static amscr_status job_ws_init(const void *ctx, void **ws)
+{
+    (void)ctx;
+    amscr__inner_ws *w = malloc(sizeof *w);
+    if (!w || amscr__inner_ws_init(w) != AMSCR_OK) {
+        free(w);
+        return AMSCR_E_NOMEM;
+    }
+    *ws = w;
+    return AMSCR_OK;
+}
+
+static void job_ws_free(void *ws)
+{
+    if (ws)
+        amscr__inner_ws_free(ws);
+    free(ws);
+}
+
+static void feature_row(const void *ctx, size_t i, void *ws)
+{
+    const inner_job *m = ctx;
+    m->st[i] = amscr__inner_build(m->d[i]->input, m->d[i]->n, &m->f[i], ws);
+}
+
+static void pair_row(const void *ctx, size_t i, void *ws)
+{
+    const inner_job *m = ctx;
+    for (size_t j = i + 1; j < m->n; j++)
+        m->out[i * m->n + j] = amscr__inner_distance(&m->f[i], &m->f[j], m->reflections, ws);
+}
+
+static amscr_status run(inner_job *m, unsigned threads, amscr_progress_fn progress, void *user)
+{
+    static const amscr__rows_ops features = {job_ws_init, job_ws_free, feature_row, "inner distance"};
+    static const amscr__rows_ops pairs = {job_ws_init, job_ws_free, pair_row, "inner distance"};
+    amscr_status st = amscr__rows_run(m->n, &features, m, threads, 0, NULL, NULL);
+    for (size_t i = 0; st == AMSCR_OK && i < m->n; i++)
+        if (m->st[i] != AMSCR_OK)
+            st = amscr__fail(AMSCR_E_DEGENERATE, "inner distance: shape %zu has no extent", i);
+    if (st == AMSCR_OK)
+        st = amscr__rows_run(m->n, &pairs, m, threads, m->n, progress, user);
+    if (st == AMSCR_OK)
+        amscr__mirror_upper(m->out, m->n);
+    return st;
+}
+
+amscr_status amscr__inner_matrix(const amscr_db *db, unsigned threads, amscr_progress_fn progress, void *user,
+                                 double *out)
+{
+    size_t n = amscr_db_size(db);
+    inner_job m = {NULL, NULL, NULL, n, amscr_db_params(db)->reflections, out};
+    m.d = amscr__malloc_array(n, sizeof *m.d);
+    m.f = amscr__malloc_array(n, sizeof *m.f);
+    m.st = amscr__malloc_array(n, sizeof *m.st);
+    amscr_status st = m.d && m.f && m.st ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
+    for (size_t i = 0; st == AMSCR_OK && i < n; i++)
+        if (!(m.d[i] = amscr_db_descriptor(db, i)))
+            st = amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
+    if (st == AMSCR_OK)
+        st = run(&m, threads, progress, user);
+    if (st != AMSCR_OK)
+        for (size_t i = 0; i < n * n; i++)
+            out[i] = NAN;
+    free(m.d);
+    free(m.f);
+    free(m.st);
+    return st;
+}

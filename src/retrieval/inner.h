@@ -1,0 +1,45 @@
+/* inner.h — the inner-distance graph of the re-ranking (inner.c). Never installed. */
+#ifndef AMSCR_INNER_H
+#define AMSCR_INNER_H
+
+#include "fft.h"
+#include "internal.h"
+
+/* Vertices of the polygon whose inner distances are taken, and the offsets kept (the others
+ * repeat them: ID(i, i + N - k) = ID(i - k, i)). */
+#define AMSCR__INNER_N 64
+#define AMSCR__INNER_K (AMSCR__INNER_N / 2)
+#define AMSCR__INNER_F (AMSCR__INNER_N / 2 + 1)
+
+/* A shape's inner distances in offset form, column k (offset k + 1) the sequence
+ * i -> ID(i, i + k + 1) over the N vertices, scaled by the square root of its share of the
+ * whole matrix (2 for offsets below N/2, 1 for N/2): the DFT of every column (frequencies
+ * 0..N/2, complex interleaved) and the columns' sum of squares. */
+typedef struct {
+    double spec[AMSCR__INNER_K][2 * AMSCR__INNER_F];
+    double norm2;
+} amscr__inner;
+
+/* Per-thread scratch of the features and the pair distance. */
+typedef struct {
+    amscr__fft_plan plan;
+    double z[2 * AMSCR__INNER_N];
+    double cs[2 * AMSCR__INNER_N]; /* e^{-2 pi i m / N}, m = 0..N-1 */
+    double xy[2 * AMSCR__INNER_N];
+    double id[AMSCR__INNER_N * AMSCR__INNER_N];
+} amscr__inner_ws;
+
+amscr_status amscr__inner_ws_init(amscr__inner_ws *ws);
+void amscr__inner_ws_free(amscr__inner_ws *ws);
+/* The features of the closed curve of n points xy (the descriptor's samples). */
+amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, amscr__inner_ws *ws);
+/* The distance of two shapes: the RMS difference of their inner-distance matrices (each
+ * divided by its mean) at the best cyclic shift, and orientation when `reflections`; 0 for
+ * a shape against itself, symmetric. */
+double amscr__inner_distance(const amscr__inner *a, const amscr__inner *b, int reflections, amscr__inner_ws *ws);
+/* The symmetric n x n matrix of the collection's inner distances (zero diagonal), on
+ * `threads` threads; independent of the thread count. */
+amscr_status amscr__inner_matrix(const amscr_db *db, unsigned threads, amscr_progress_fn progress, void *user,
+                                 double *out);
+
+#endif

@@ -1,0 +1,216 @@
+/* check_inner.c — the inner-distance graph of the re-ranking (src/retrieval/inner.c): the pair
+ * distance against a brute-force search over shifts and orientations, invariance under
+ * similarity maps and mirror images, tolerance to a bent part, degenerate curves, the
+ * collection matrix for any thread count, and the retrieval matrix with the graph's share. */
+#include <amscr.h>
+#include <check.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "inner.h"
+#include "suites.h"
+#include "testutil.h"
+
+#define NPTS 400
+
+/* A body (4 x 2) with one arm of width 0.4 and length 4: straight, bent up at its middle, or
+ * (kind 2) two short arms on opposite sides instead. */
+static size_t body(int kind, const double m[6], double *xy)
+{
+    static const double straight[] = {0, 0, 4, 0, 4, 0.8, 8, 0.8, 8, 1.2, 4, 1.2, 4, 2, 0, 2};
+    static const double bent[] = {0, 0, 4, 0, 4, 0.8, 6.2, 0.8, 6.2, 3.0, 5.8, 3.0, 5.8, 1.2, 4, 1.2, 4, 2, 0, 2};
+    static const double two[] = {0, 0, 4, 0, 4, 0.8, 6, 0.8, 6, 1.2, 4, 1.2, 4, 2, 0, 2, 0, 1.2, -2, 1.2, -2, 0.8, 0, 0.8};
+    const double *v = kind == 0 ? straight : kind == 1 ? bent : two;
+    size_t nv = kind == 0 ? 8 : kind == 1 ? 10 : 12;
+    double tmp[2 * NPTS];
+    size_t n = amscr_test_polygon(v, nv, 30, tmp); /* at most 12 x 30 < NPTS points */
+    amscr_test_apply_affine(m, tmp, n, xy);
+    return n;
+}
+
+static const double ident[6] = {1, 0, 0, 0, 1, 0};
+
+typedef struct {
+    amscr__inner f;
+    double id[AMSCR__INNER_N * AMSCR__INNER_N];
+} feat;
+
+static void build(const double *xy, size_t n, feat *out, amscr__inner_ws *ws)
+{
+    ck_assert_int_eq(amscr__inner_build(xy, n, &out->f, ws), AMSCR_OK);
+    memcpy(out->id, ws->id, sizeof out->id);
+}
+
+/* min over shifts s (and orientations) of the RMS of A[i][j] - B[s+i][s+j] (B[s-i][s-j]). */
+static double brute(const double *A, const double *B, int reflections)
+{
+    const size_t n = AMSCR__INNER_N;
+    double best = INFINITY;
+    for (int o = 0; o < (reflections ? 2 : 1); o++)
+        for (size_t s = 0; s < n; s++) {
+            double sum = 0.0;
+            for (size_t i = 0; i < n; i++)
+                for (size_t j = 0; j < n; j++) {
+                    size_t bi = o ? (s + n - i) % n : (s + i) % n, bj = o ? (s + n - j) % n : (s + j) % n;
+                    double d = A[i * n + j] - B[bi * n + bj];
+                    sum += d * d;
+                }
+            if (sum < best)
+                best = sum;
+        }
+    return sqrt(best / (double)(n * n));
+}
+
+START_TEST(test_against_brute_force)
+{
+    amscr__inner_ws ws;
+    ck_assert_int_eq(amscr__inner_ws_init(&ws), AMSCR_OK);
+    double xy[2 * NPTS];
+    feat *f = malloc(3 * sizeof *f);
+    for (int k = 0; k < 3; k++)
+        build(xy, body(k, ident, xy), &f[k], &ws);
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            for (int refl = 0; refl < 2; refl++) {
+                double fast = amscr__inner_distance(&f[a].f, &f[b].f, refl, &ws);
+                double slow = brute(f[a].id, f[b].id, refl);
+                ck_assert_msg(fabs(fast - slow) <= 1e-9 * (1.0 + slow), "%d-%d refl %d: %.12g vs %.12g", a, b, refl,
+                              fast, slow);
+                if (a == b)
+                    ck_assert(fast == 0.0);
+            }
+    free(f);
+    amscr__inner_ws_free(&ws);
+}
+END_TEST
+
+/* A similarity copy (rotated, scaled, moved, started elsewhere) and a mirror image are near 0
+ * (the resampling differs only by where it starts); the bent arm is much nearer than the
+ * other shape; a curve with no extent is refused. */
+START_TEST(test_invariance_and_articulation)
+{
+    amscr__inner_ws ws;
+    ck_assert_int_eq(amscr__inner_ws_init(&ws), AMSCR_OK);
+    double c = cos(2.2), s = sin(2.2);
+    const double sim[6] = {3 * c, -3 * s, 10, 3 * s, 3 * c, -4}, mir[6] = {-1.5, 0, 2, 0, 1.5, 1};
+    double xy[2 * NPTS], sh[2 * NPTS];
+    feat *f = malloc(5 * sizeof *f);
+    build(xy, body(0, ident, xy), &f[0], &ws);
+    size_t n = body(0, sim, xy);
+    amscr_test_cyclic_shift(xy, n, n / 3, sh);
+    build(sh, n, &f[1], &ws);
+    build(xy, body(0, mir, xy), &f[2], &ws);
+    build(xy, body(1, ident, xy), &f[3], &ws);
+    build(xy, body(2, ident, xy), &f[4], &ws);
+    double copy = amscr__inner_distance(&f[0].f, &f[1].f, 0, &ws);
+    double mirror = amscr__inner_distance(&f[0].f, &f[2].f, 1, &ws);
+    double bent = amscr__inner_distance(&f[0].f, &f[3].f, 1, &ws);
+    double other = amscr__inner_distance(&f[0].f, &f[4].f, 1, &ws);
+    ck_assert(amscr__inner_distance(&f[4].f, &f[4].f, 1, &ws) == 0.0);
+    ck_assert_msg(copy < 0.1 * other && mirror < 0.1 * other, "copy %g mirror %g other %g", copy, mirror, other);
+    ck_assert_msg(bent < 0.5 * other, "bent arm %g vs other shape %g", bent, other);
+    ck_assert(fabs(amscr__inner_distance(&f[3].f, &f[4].f, 1, &ws) - amscr__inner_distance(&f[4].f, &f[3].f, 1, &ws)) <
+              1e-9);
+    double dot[8] = {1, 1, 1, 1, 1, 1, 1, 1};
+    ck_assert_int_eq(amscr__inner_build(dot, 4, &f[0].f, &ws), AMSCR_E_DEGENERATE);
+    free(f);
+    amscr__inner_ws_free(&ws);
+}
+END_TEST
+
+static amscr_db *collection(const amscr_params *p, unsigned threads)
+{
+    amscr_params *q = NULL;
+    ck_assert_int_eq(amscr_params_copy(p, &q), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_num_threads(q, threads), AMSCR_OK);
+    amscr_db *db = NULL;
+    ck_assert_int_eq(amscr_db_new(q, &db), AMSCR_OK);
+    amscr_params_free(q);
+    amscr_test_rng r;
+    double xy[2 * NPTS], w[2 * NPTS], m[6];
+    for (int i = 0; i < 12; i++) {
+        size_t n = body(i % 3, ident, xy);
+        amscr_test_rng_seed(&r, 100u + (unsigned)i);
+        amscr_test_random_affine(&r, 1.5, 0.0, 3.0, 0, m);
+        amscr_test_apply_affine(m, xy, n, w);
+        amscr_test_add_noise(&r, w, n, 0.005);
+        amscr_contour *c = NULL;
+        ck_assert_int_eq(amscr_contour_new(w, n, &c), AMSCR_OK);
+        ck_assert_int_eq(amscr_db_add_contour(db, c, i % 3, NULL), AMSCR_OK);
+        amscr_contour_free(c);
+    }
+    return db;
+}
+
+/* The collection's inner matrix: symmetric, zero diagonal, bit for bit the same on 1 and 3
+ * threads; the retrieval matrix with the graph's share: the same on 1 and 3 threads, a zero
+ * diagonal, values in [0, 1], and different from the one-graph matrix. */
+START_TEST(test_matrices)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_rerank_k(p, 3), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.3), AMSCR_OK);
+    enum { n = 12 };
+    double I1[n * n], I3[n * n], R1[n * n], R3[n * n], R0[n * n];
+    amscr_db *d1 = collection(p, 1), *d3 = collection(p, 3);
+    ck_assert_int_eq(amscr__inner_matrix(d1, 1, NULL, NULL, I1), AMSCR_OK);
+    ck_assert_int_eq(amscr__inner_matrix(d3, 3, NULL, NULL, I3), AMSCR_OK);
+    ck_assert(memcmp(I1, I3, sizeof I1) == 0);
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            ck_assert(i == j ? I1[i * n + j] == 0.0 : I1[i * n + j] == I1[j * n + i] && I1[i * n + j] >= 0.0);
+    ck_assert_int_eq(amscr_db_retrieval_matrix(d1, NULL, NULL, R1), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_retrieval_matrix(d3, NULL, NULL, R3), AMSCR_OK);
+    ck_assert(memcmp(R1, R3, sizeof R1) == 0);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.0), AMSCR_OK);
+    amscr_db *d0 = collection(p, 2);
+    ck_assert_int_eq(amscr_db_retrieval_matrix(d0, NULL, NULL, R0), AMSCR_OK);
+    int differ = 0;
+    for (int i = 0; i < n * n; i++) {
+        ck_assert(R1[i] >= 0.0 && R1[i] <= 1.0);
+        differ |= R1[i] != R0[i];
+    }
+    for (int i = 0; i < n; i++)
+        ck_assert(R1[i * n + i] == 0.0);
+    ck_assert(differ);
+    amscr_db_free(d0);
+    amscr_db_free(d1);
+    amscr_db_free(d3);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* The setter: [0, 1) only; the presets: 0, and 0.05 for retrieval. */
+START_TEST(test_params)
+{
+    amscr_params *p = NULL, *r = NULL;
+    ck_assert_int_eq(amscr_params_new(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new_retrieval(&r), AMSCR_OK);
+    ck_assert(amscr_params_get_rerank_inner_share(p) == 0.0);
+    ck_assert(amscr_params_get_rerank_inner_share(r) == 0.0);
+    ck_assert(amscr_params_get_rerank_inner_share(NULL) == 0.0);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, -0.1), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 1.0), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, NAN), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(NULL, 0.1), AMSCR_E_INVALID_ARG);
+    ck_assert(amscr_params_get_rerank_inner_share(p) == 0.0);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.5), AMSCR_OK);
+    ck_assert(amscr_params_get_rerank_inner_share(p) == 0.5);
+    amscr_params_free(p);
+    amscr_params_free(r);
+}
+END_TEST
+
+Suite *amscr_suite_inner(void)
+{
+    Suite *s = suite_create("inner");
+    TCase *tc = tcase_create("core");
+    tcase_add_test(tc, test_against_brute_force);
+    tcase_add_test(tc, test_invariance_and_articulation);
+    tcase_add_test(tc, test_matrices);
+    tcase_add_test(tc, test_params);
+    suite_add_tcase(s, tc);
+    return s;
+}
