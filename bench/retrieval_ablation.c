@@ -40,6 +40,7 @@ static const row_t ROWS[] = {
     {"channel, affine frame (band 0.08)", {0, 0, 1, 0}, 1, 1, 0},
     {"channel, both frames (0.8 / 0.2)", {0, 1, 1, 0}, 1, 0.2, 0},
     {"AMSCR + channel fused (w 0.5)", {1, 1, 1, 0}, 0.5, 0.2, 0},
+    {"inner distance alone", {0, 0, 0, 1}, 1, 0, 0},
     {"channel, similarity frame + re-ranking", {0, 1, 0, 0}, 1, 0, 1},
     {"channel, affine frame (band 0.08) + re-ranking", {0, 0, 1, 0}, 1, 1, 1},
     {"AMSCR + channel fused (w 0.5) + re-ranking", {1, 1, 1, 0}, 0.5, 0.2, 1},
@@ -137,6 +138,11 @@ static void compose(const set_run *r, const row_t *w, double *out)
     if (!H)
         die("memory");
     int ch = w->use[M_SIM] || w->use[M_AFF];
+    if (!ch && !w->use[M_AMSCR]) { /* the inner distance alone */
+        memcpy(out, r->base[M_INNER], nn * sizeof *out);
+        free(H);
+        return;
+    }
     for (size_t i = 0; ch && i < nn; i++)
         H[i] = !w->use[M_AFF] ? r->base[M_SIM][i]
              : !w->use[M_SIM] ? r->base[M_AFF][i]

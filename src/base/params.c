@@ -91,7 +91,7 @@ void amscr__params_retrieval(amscr_params *p)
     p->reflections = 1;
     p->channel_weight = 1.0;
     p->rerank_k = 8;
-    p->rerank_inner_share = 0.0;
+    p->rerank_inner_share = 0.05;
 }
 
 amscr_status amscr_params_new_retrieval(amscr_params **out)

@@ -95,7 +95,8 @@ static int query_distances(const amscr_db *db, const amscr_descriptor *dq, size_
 
 /* The query's scores against an index: its stored lists (amscr_index_query_scores, or the
  * member's row) when the user's params are the index's; the collection's matrix (as a folder)
- * when --rerank/--no-rerank differs from the build's; the plain distance without the channel. */
+ * when --rerank/--no-rerank/--inner-share differs from the build's (an index holds one graph:
+ * share 0); the plain distance without the channel. */
 static int index_distances(const amscr_index *x, const amscr_params *p, const amscr_descriptor *dq, size_t cand,
                            const char *qpath, const char *cpath, double *dist)
 {
@@ -107,7 +108,8 @@ static int index_distances(const amscr_index *x, const amscr_params *p, const am
     if (retrieval_is_plain(p))
         return query_distances(idb, dq, SIZE_MAX, qpath, cpath, dist);
     if (amscr_params_get_rerank_k(p) != amscr_params_get_rerank_k(b) ||
-        amscr_params_get_rerank_iterations(p) != amscr_params_get_rerank_iterations(b)) {
+        amscr_params_get_rerank_iterations(p) != amscr_params_get_rerank_iterations(b) ||
+        amscr_params_get_rerank_inner_share(p) != amscr_params_get_rerank_inner_share(b)) {
         amscr_db *db = NULL;
         size_t member = own ? SIZE_MAX : member_of(idb, dq);
         int r = index_db_with_params(x, p, cpath, &db) == 0 ? query_distances(db, dq, member, qpath, cpath, dist) : -1;

@@ -46,13 +46,15 @@ def test_query_equals_collection_query(weight):
     coll = synthetic(params)
     index = amscr.Index(coll)
     q = warp(blob(300, seed=2), np.random.default_rng(9))
-    full = coll.query(q)
-    # Collection.query with retrieval params is the row of the matrix of collection + query
+    # Collection.query with retrieval params (two graphs) is the row of the matrix of collection + query
     plus = amscr.Collection(params)
     for i in range(len(coll)):
         plus.add(coll.shape(i))
     plus.add(q)
-    np.testing.assert_allclose(full, plus.retrieval_matrix()[-1, :-1], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(coll.query(q), plus.retrieval_matrix()[-1, :-1], rtol=0, atol=1e-12)
+    # an Index re-ranks on one graph: the collection's query with the inner share 0
+    assert index.collection_params().rerank_inner_share == 0.0
+    full = synthetic(amscr.Params.retrieval(points=64, channel_weight=weight, rerank_inner_share=0)).query(q)
     idx, sc = index.query(q, top=10, candidates=0)
     same_ranking(idx, sc, full)
     np.testing.assert_allclose(index.scores(q), full, rtol=0, atol=1e-12)
@@ -118,7 +120,7 @@ def dataset_shapes(name, count):
 @pytest.mark.parametrize('name', ['kimia216', 'mpeg7-dev'])
 def test_datasets_affine_queries(name):
     shapes = dataset_shapes(name, 60)
-    params = amscr.Params.retrieval()
+    params = amscr.Params.retrieval(rerank_inner_share=0)  # an Index re-ranks on one graph
     coll = amscr.Collection(params)
     for pts, cls in shapes:
         coll.add(pts, label=cls)
