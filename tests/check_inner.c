@@ -1,5 +1,6 @@
 /* check_inner.c — the inner-distance graph of the re-ranking (src/retrieval/inner.c): the pair
- * distance against a brute-force search over shifts and orientations, invariance under
+ * distance against a brute-force search over shifts and orientations (direct DFTs for the
+ * low-pass along the curve), invariance under
  * similarity maps and mirror images, tolerance to a bent part, degenerate curves, the
  * collection matrix for any thread count, and the retrieval matrix with the graph's share. */
 #include <amscr.h>
@@ -20,7 +21,8 @@ static size_t body(int kind, const double m[6], double *xy)
 {
     static const double straight[] = {0, 0, 4, 0, 4, 0.8, 8, 0.8, 8, 1.2, 4, 1.2, 4, 2, 0, 2};
     static const double bent[] = {0, 0, 4, 0, 4, 0.8, 6.2, 0.8, 6.2, 3.0, 5.8, 3.0, 5.8, 1.2, 4, 1.2, 4, 2, 0, 2};
-    static const double two[] = {0, 0, 4, 0, 4, 0.8, 6, 0.8, 6, 1.2, 4, 1.2, 4, 2, 0, 2, 0, 1.2, -2, 1.2, -2, 0.8, 0, 0.8};
+    static const double two[] = {0, 0, 4, 0, 4, 0.8, 6, 0.8, 6, 1.2, 4, 1.2,
+                                 4, 2, 0, 2, 0, 1.2, -2, 1.2, -2, 0.8, 0, 0.8};
     const double *v = kind == 0 ? straight : kind == 1 ? bent : two;
     size_t nv = kind == 0 ? 8 : kind == 1 ? 10 : 12;
     double tmp[2 * NPTS];
@@ -42,23 +44,58 @@ static void build(const double *xy, size_t n, feat *out, amscr__inner_ws *ws)
     memcpy(out->id, ws->id, sizeof out->id);
 }
 
-/* min over shifts s (and orientations) of the RMS of A[i][j] - B[s+i][s+j] (B[s-i][s-j]). */
+/* The offset form of M (N x N): J[k][i] = M[i][i + k], each column low-passed to the
+ * frequencies |f| < AMSCR__INNER_F by a direct DFT. */
+static void lowpassed_offsets(const double *M, double *J)
+{
+    const size_t n = AMSCR__INNER_N;
+    double c[AMSCR__INNER_N];
+    for (size_t m = 0; m < n; m++)
+        c[m] = cos(2.0 * 3.14159265358979323846 * (double)m / (double)n);
+    for (size_t k = 0; k < n; k++) {
+        double col[AMSCR__INNER_N];
+        for (size_t i = 0; i < n; i++)
+            col[i] = M[i * n + (i + k) % n];
+        for (size_t t = 0; t < n; t++) {
+            double v = 0.0;
+            for (size_t f = 0; f < n; f++) {
+                if (f >= AMSCR__INNER_F && n - f >= AMSCR__INNER_F)
+                    continue;
+                for (size_t i = 0; i < n; i++)
+                    v += col[i] * c[(f * ((t + n - i) % n)) % n];
+            }
+            J[k * n + t] = v / (double)n;
+        }
+    }
+}
+
+/* min over shifts s (and orientations: B's vertices reversed) of the RMS difference of the
+ * low-passed offset forms of A and B. */
 static double brute(const double *A, const double *B, int reflections)
 {
     const size_t n = AMSCR__INNER_N;
+    double *ja = malloc(n * n * sizeof *ja), *jb = malloc(n * n * sizeof *jb), *rb = malloc(n * n * sizeof *rb);
     double best = INFINITY;
-    for (int o = 0; o < (reflections ? 2 : 1); o++)
+    lowpassed_offsets(A, ja);
+    for (int o = 0; o < (reflections ? 2 : 1); o++) {
+        for (size_t i = 0; i < n; i++)
+            for (size_t j = 0; j < n; j++)
+                rb[i * n + j] = o ? B[((n - i) % n) * n + (n - j) % n] : B[i * n + j];
+        lowpassed_offsets(rb, jb);
         for (size_t s = 0; s < n; s++) {
             double sum = 0.0;
-            for (size_t i = 0; i < n; i++)
-                for (size_t j = 0; j < n; j++) {
-                    size_t bi = o ? (s + n - i) % n : (s + i) % n, bj = o ? (s + n - j) % n : (s + j) % n;
-                    double d = A[i * n + j] - B[bi * n + bj];
+            for (size_t k = 1; k < n; k++)
+                for (size_t i = 0; i < n; i++) {
+                    double d = ja[k * n + i] - jb[k * n + (i + s) % n];
                     sum += d * d;
                 }
             if (sum < best)
                 best = sum;
         }
+    }
+    free(ja);
+    free(jb);
+    free(rb);
     return sqrt(best / (double)(n * n));
 }
 

@@ -15,13 +15,11 @@ typedef struct {
     double *out;
 } hfm_t;
 
-static amscr_status hfm_ws_init(const void *ctx, void **ws)
+static amscr_status hfm_init(void *ctx, void **ws)
 {
     const hfm_t *m = ctx;
     amscr__hf_ws *w = malloc(sizeof *w);
-    if (!w)
-        return AMSCR_E_NOMEM;
-    if (amscr__hf_ws_init(w, m->hf[0].n, m->cfg->band) != AMSCR_OK) {
+    if (!w || amscr__hf_ws_init(w, m->hf[0].n, m->cfg->band) != AMSCR_OK) {
         free(w);
         return AMSCR_E_NOMEM;
     }
@@ -29,18 +27,18 @@ static amscr_status hfm_ws_init(const void *ctx, void **ws)
     return AMSCR_OK;
 }
 
-static void hfm_ws_free(void *ws)
+static void hfm_fini(void *ws)
 {
-    if (ws)
-        amscr__hf_ws_free(ws);
+    amscr__hf_ws_free(ws);
     free(ws);
 }
 
-static void hfm_row(const void *ctx, size_t i, void *ws)
+static amscr_status hfm_row(void *ctx, size_t i, void *ws)
 {
     const hfm_t *m = ctx;
     for (size_t j = i + 1; j < m->n; j++)
         m->out[i * m->n + j] = amscr__hf_distance(&m->hf[i], &m->hf[j], m->cfg, ws);
+    return AMSCR_OK;
 }
 
 void amscr__mirror_upper(double *out, size_t n)
@@ -58,8 +56,8 @@ amscr_status amscr__hf_matrix(const amscr__hf *hf, size_t n, const amscr__hf_cfg
     if (n == 0)
         return AMSCR_OK;
     hfm_t m = {hf, n, cfg, out};
-    static const amscr__rows_ops ops = {hfm_ws_init, hfm_ws_free, hfm_row, "shape channel"};
-    amscr_status st = amscr__rows_run(n, &ops, &m, threads, n, progress, user);
+    amscr__rows_fn f = {hfm_init, hfm_fini, hfm_row, &m, "shape channel"};
+    amscr_status st = amscr__run_rows(&f, 0, n, threads, progress, user);
     if (st != AMSCR_OK) {
         for (size_t i = 0; i < n * n; i++)
             out[i] = NAN;

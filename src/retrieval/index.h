@@ -6,6 +6,7 @@
 
 #include "channel.h"
 #include "internal.h"
+#include "rows.h"
 #include "signature.h"
 
 struct amscr_index {
@@ -57,7 +58,7 @@ typedef struct {
 void amscr__base_init(amscr__base *b, const amscr_params *p, double med_a, double med_h);
 amscr_status amscr__pair_ws_init(const amscr__base *b, amscr__pair_ws *pw);
 void amscr__pair_ws_free(amscr__pair_ws *pw);
-/* A workspace on the heap (*out, for the threads' scratch of index_threads.c) and its release. */
+/* A workspace on the heap (*out, for the threads' scratch of rows.c) and its release. */
 amscr_status amscr__pair_ws_new(const amscr__base *b, void **out);
 void amscr__pair_ws_delete(void *pw);
 /* The channel sequences of d in b's frames (hf[0..nf-1]); free with amscr__base_hf_free. */
@@ -76,16 +77,6 @@ amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const ams
                              const amscr_descriptor *q, size_t qpos, const size_t *cand, size_t m,
                              amscr_progress_fn progress, void *user, double *out);
 
-/* Work on rows first..n-1 on threads (index_threads.c): row(ctx, i, scratch) with a scratch
- * per thread from init (may be NULL) freed by fini. */
-typedef struct {
-    amscr_status (*init)(void *ctx, void **scratch);
-    void (*fini)(void *scratch);
-    amscr_status (*row)(void *ctx, size_t i, void *scratch);
-    void *ctx;
-} amscr__rows_fn;
-amscr_status amscr__run_rows(const amscr__rows_fn *f, size_t first, size_t n, unsigned threads,
-                             amscr_progress_fn progress, void *user);
 /* Signatures, lower-bound vectors (unless have_sig: then the signatures are there) and channel
  * features of shapes first..n-1 (index_features.c), on the params' threads; drops the lists'
  * reverse, and rebuilds it when have_sig and first == 0 (a load: the lists are in place). */

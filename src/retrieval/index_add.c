@@ -79,7 +79,7 @@ static amscr_status add_distances(void *ctx, size_t j, void *scratch)
 static amscr_status add_rows(add_ctx *c, size_t j1, size_t n0)
 {
     amscr_index *x = c->x;
-    amscr__rows_fn f = {add_pw_init, amscr__pair_ws_delete, add_distances, c};
+    amscr__rows_fn f = {add_pw_init, amscr__pair_ws_delete, add_distances, c, NULL};
     amscr_status st = amscr__run_rows(&f, c->j0, j1, c->b.threads, NULL, NULL);
     for (size_t j = c->j0; st == AMSCR_OK && j < j1; j++) {
         size_t r = j - c->j0, m = c->m[r], *cand = c->cand + r * c->n;

@@ -241,8 +241,9 @@ amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_pro
         st = amscr__sig_ivf_build(x->sig_lb, n, &ivf);
         c.ivf = &ivf;
     }
-    amscr__rows_fn f1 = {NULL, NULL, shortlist_row, &c}, f2 = {pw_init, amscr__pair_ws_delete, distance_row, &c};
-    amscr__rows_fn f3 = {NULL, NULL, list_row, &c};
+    amscr__rows_fn f1 = {NULL, NULL, shortlist_row, &c, NULL};
+    amscr__rows_fn f2 = {pw_init, amscr__pair_ws_delete, distance_row, &c, NULL};
+    amscr__rows_fn f3 = {NULL, NULL, list_row, &c, NULL};
     if (st == AMSCR_OK)
         st = amscr__run_rows(&f1, first, n, c.b.threads, NULL, NULL);
     if (st == AMSCR_OK)

@@ -50,7 +50,7 @@ amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig)
     j.x = x;
     j.have_sig = have_sig;
     amscr__base_init(&j.b, amscr_db_params(x->db), x->med_a, x->med_h);
-    amscr__rows_fn f = {NULL, NULL, feat_row, &j};
+    amscr__rows_fn f = {NULL, NULL, feat_row, &j, NULL};
     amscr__index_reverse_free(x);
     amscr_status st = amscr__run_rows(&f, first, amscr_db_size(x->db), j.b.threads, NULL, NULL);
     return st == AMSCR_OK && have_sig && first == 0 ? amscr__index_reverse(x) : st;

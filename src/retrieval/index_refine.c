@@ -108,7 +108,8 @@ amscr_status amscr__index_refine(amscr_index *x, const amscr__base *b, size_t fi
     c.nb_dist = amscr__malloc_array(x->cap, k * sizeof *c.nb_dist);
     amscr_status st = c.R && c.D && c.nr && c.nb_idx && c.nb_dist ? AMSCR_OK
                                                                    : amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
-    amscr__rows_fn f1 = {refine_init, amscr__pair_ws_delete, refine_row, &c}, f2 = {NULL, NULL, merge_row, &c};
+    amscr__rows_fn f1 = {refine_init, amscr__pair_ws_delete, refine_row, &c, NULL};
+    amscr__rows_fn f2 = {NULL, NULL, merge_row, &c, NULL};
     if (st == AMSCR_OK)
         st = amscr__run_rows(&f1, first, n, b->threads, NULL, NULL);
     if (st == AMSCR_OK)

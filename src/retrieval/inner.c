@@ -8,9 +8,10 @@
  * length; the visibility graph of that polygon (a chord joins two vertices when it crosses
  * no edge and its midpoint lies inside) and its shortest paths (Floyd-Warshall); the matrix
  * divided by its mean (scale-free; chords that no path joins, possible only on a degenerate
- * polygon, keep their straight length). Per pair: the matrices compared at every cyclic
- * shift of the vertices and both orientations at once, by one inverse FFT over the columns
- * of the offset form (i -> ID(i, i + k)); O(N^2 / 2) complex products a pair. */
+ * polygon, keep their straight length). Per pair: the matrices, low-passed along the curve,
+ * compared at every cyclic shift of the vertices and both orientations at once, by one inverse
+ * FFT over the columns of the offset form (i -> ID(i, i + k)); N/2 x (N/4 + 1) complex products
+ * a pair and orientation. */
 #include "inner.h"
 
 #include "channel.h" /* amscr__mirror_upper */
@@ -142,35 +143,40 @@ amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, a
         size_t off = k + 1;
         double w = sqrt(off < N / 2 ? 2.0 : 1.0);
         for (size_t i = 0; i < N; i++) {
-            double v = w * ws->id[i * N + (i + off) % N];
-            ws->z[2 * i] = v;
+            ws->z[2 * i] = w * ws->id[i * N + (i + off) % N];
             ws->z[2 * i + 1] = 0.0;
-            out->norm2 += v * v;
         }
         amscr__fft(&ws->plan, ws->z, 0);
-        memcpy(out->spec[k], ws->z, sizeof out->spec[k]);
+        for (size_t f = 0; f < AMSCR__INNER_F; f++) {
+            double br = ws->z[2 * f], bi = ws->z[2 * f + 1];
+            out->norm2 += (f == 0 || 2 * f == N ? 1.0 : 2.0) * (br * br + bi * bi) / (double)N;
+            const double *c = ws->cs + 2 * ((f * off) % N);
+            out->re[f][k] = br;
+            out->im[f][k] = bi;
+            out->tre[f][k] = br * c[0] - bi * c[1];
+            out->tim[f][k] = br * c[1] + bi * c[0];
+        }
     }
     return AMSCR_OK;
 }
 
 /* Z(f), f = 0..N/2, into ws->z with its Hermitian rest: the correlation of a and b over the
- * shifts (real part) and, when `refl`, of a and b reversed (imaginary part). */
+ * shifts (real part: sum_k conj(A) B, sum_i a[i] b[i + s]) and, when `refl`, of a and b
+ * reversed (imaginary part: sum_k A B e^{-2 pi i f (k + 1) / N}, sum_i a[i] b[-i - s - k - 1]). */
 static void spectrum(const amscr__inner *a, const amscr__inner *b, int refl, amscr__inner_ws *ws)
 {
     double *z = ws->z;
     for (size_t f = 0; f < AMSCR__INNER_F; f++) {
+        const double *ar = a->re[f], *ai = a->im[f], *br = b->re[f], *bi = b->im[f];
+        const double *tr = b->tre[f], *ti = b->tim[f];
         double xr = 0.0, xi = 0.0, yr = 0.0, yi = 0.0;
         for (size_t k = 0; k < AMSCR__INNER_K; k++) {
-            double ar = a->spec[k][2 * f], ai = a->spec[k][2 * f + 1];
-            double br = b->spec[k][2 * f], bi = b->spec[k][2 * f + 1];
-            xr += ar * br + ai * bi; /* conj(A) B: sum_i a[i] b[i + s] */
-            xi += ar * bi - ai * br;
-            if (refl) { /* A B e^{-2 pi i f (k + 1) / N}: sum_i a[i] b[-i - s - (k + 1)] */
-                double pr = ar * br - ai * bi, pi = ar * bi + ai * br;
-                const double *c = ws->cs + 2 * ((f * (k + 1)) % N);
-                yr += pr * c[0] - pi * c[1];
-                yi += pr * c[1] + pi * c[0];
-            }
+            xr += ar[k] * br[k] + ai[k] * bi[k];
+            xi += ar[k] * bi[k] - ai[k] * br[k];
+        }
+        for (size_t k = 0; refl && k < AMSCR__INNER_K; k++) {
+            yr += ar[k] * tr[k] - ai[k] * ti[k];
+            yi += ar[k] * ti[k] + ai[k] * tr[k];
         }
         z[2 * f] = xr - yi; /* X + i Y */
         z[2 * f + 1] = xi + yr;
@@ -179,6 +185,8 @@ static void spectrum(const amscr__inner *a, const amscr__inner *b, int refl, ams
             z[2 * (N - f) + 1] = -xi + yr;
         }
     }
+    for (size_t f = AMSCR__INNER_F; f + AMSCR__INNER_F <= N; f++) /* the frequencies left out */
+        z[2 * f] = z[2 * f + 1] = 0.0;
 }
 
 double amscr__inner_distance(const amscr__inner *a, const amscr__inner *b, int reflections, amscr__inner_ws *ws)
@@ -202,13 +210,12 @@ double amscr__inner_distance(const amscr__inner *a, const amscr__inner *b, int r
 typedef struct {
     const amscr_descriptor **d;
     amscr__inner *f;
-    amscr_status *st;
     size_t n;
     int reflections;
     double *out;
 } inner_job;
 
-static amscr_status job_ws_init(const void *ctx, void **ws)
+static amscr_status job_init(void *ctx, void **ws)
 {
     (void)ctx;
     amscr__inner_ws *w = malloc(sizeof *w);
@@ -220,36 +227,33 @@ static amscr_status job_ws_init(const void *ctx, void **ws)
     return AMSCR_OK;
 }
 
-static void job_ws_free(void *ws)
+static void job_fini(void *ws)
 {
-    if (ws)
-        amscr__inner_ws_free(ws);
+    amscr__inner_ws_free(ws);
     free(ws);
 }
 
-static void feature_row(const void *ctx, size_t i, void *ws)
+static amscr_status feature_row(void *ctx, size_t i, void *ws)
 {
     const inner_job *m = ctx;
-    m->st[i] = amscr__inner_build(m->d[i]->input, m->d[i]->n, &m->f[i], ws);
+    return amscr__inner_build(m->d[i]->input, m->d[i]->n, &m->f[i], ws);
 }
 
-static void pair_row(const void *ctx, size_t i, void *ws)
+static amscr_status pair_row(void *ctx, size_t i, void *ws)
 {
     const inner_job *m = ctx;
     for (size_t j = i + 1; j < m->n; j++)
         m->out[i * m->n + j] = amscr__inner_distance(&m->f[i], &m->f[j], m->reflections, ws);
+    return AMSCR_OK;
 }
 
 static amscr_status run(inner_job *m, unsigned threads, amscr_progress_fn progress, void *user)
 {
-    static const amscr__rows_ops features = {job_ws_init, job_ws_free, feature_row, "inner distance"};
-    static const amscr__rows_ops pairs = {job_ws_init, job_ws_free, pair_row, "inner distance"};
-    amscr_status st = amscr__rows_run(m->n, &features, m, threads, 0, NULL, NULL);
-    for (size_t i = 0; st == AMSCR_OK && i < m->n; i++)
-        if (m->st[i] != AMSCR_OK)
-            st = amscr__fail(AMSCR_E_DEGENERATE, "inner distance: shape %zu has no extent", i);
+    amscr__rows_fn features = {job_init, job_fini, feature_row, m, "inner distance"};
+    amscr__rows_fn pairs = {job_init, job_fini, pair_row, m, "inner distance"};
+    amscr_status st = amscr__run_rows(&features, 0, m->n, threads, NULL, NULL);
     if (st == AMSCR_OK)
-        st = amscr__rows_run(m->n, &pairs, m, threads, m->n, progress, user);
+        st = amscr__run_rows(&pairs, 0, m->n, threads, progress, user);
     if (st == AMSCR_OK)
         amscr__mirror_upper(m->out, m->n);
     return st;
@@ -259,11 +263,10 @@ amscr_status amscr__inner_matrix(const amscr_db *db, unsigned threads, amscr_pro
                                  double *out)
 {
     size_t n = amscr_db_size(db);
-    inner_job m = {NULL, NULL, NULL, n, amscr_db_params(db)->reflections, out};
+    inner_job m = {NULL, NULL, n, amscr_db_params(db)->reflections, out};
     m.d = amscr__malloc_array(n, sizeof *m.d);
     m.f = amscr__malloc_array(n, sizeof *m.f);
-    m.st = amscr__malloc_array(n, sizeof *m.st);
-    amscr_status st = m.d && m.f && m.st ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
+    amscr_status st = m.d && m.f ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
     for (size_t i = 0; st == AMSCR_OK && i < n; i++)
         if (!(m.d[i] = amscr_db_descriptor(db, i)))
             st = amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
@@ -274,6 +277,5 @@ amscr_status amscr__inner_matrix(const amscr_db *db, unsigned threads, amscr_pro
             out[i] = NAN;
     free(m.d);
     free(m.f);
-    free(m.st);
     return st;
 }

@@ -5,18 +5,23 @@
 #include "fft.h"
 #include "internal.h"
 
-/* Vertices of the polygon whose inner distances are taken, and the offsets kept (the others
- * repeat them: ID(i, i + N - k) = ID(i - k, i)). */
+/* Vertices of the polygon whose inner distances are taken, the offsets kept (the others
+ * repeat them: ID(i, i + N - k) = ID(i - k, i)), and the frequencies kept along the contour
+ * (0..N/4: the matrices are compared smoothed along the curve; the full spectrum scores the
+ * same, at twice the cost: docs/results-retrieval.md). */
 #define AMSCR__INNER_N 64
 #define AMSCR__INNER_K (AMSCR__INNER_N / 2)
-#define AMSCR__INNER_F (AMSCR__INNER_N / 2 + 1)
+#define AMSCR__INNER_F (AMSCR__INNER_N / 4 + 1)
 
 /* A shape's inner distances in offset form, column k (offset k + 1) the sequence
  * i -> ID(i, i + k + 1) over the N vertices, scaled by the square root of its share of the
- * whole matrix (2 for offsets below N/2, 1 for N/2): the DFT of every column (frequencies
- * 0..N/2, complex interleaved) and the columns' sum of squares. */
+ * whole matrix (2 for offsets below N/2, 1 for N/2): the DFT of every column at the kept
+ * frequencies, as re[f][k] + i im[f][k] (columns contiguous: the pair loop runs along k), the
+ * same turned by e^{-2 pi i f (k + 1) / N} (tre, tim: the reversed orientation's shift of
+ * column k), and the sum of squares of the columns so low-passed. */
 typedef struct {
-    double spec[AMSCR__INNER_K][2 * AMSCR__INNER_F];
+    double re[AMSCR__INNER_F][AMSCR__INNER_K], im[AMSCR__INNER_F][AMSCR__INNER_K];
+    double tre[AMSCR__INNER_F][AMSCR__INNER_K], tim[AMSCR__INNER_F][AMSCR__INNER_K];
     double norm2;
 } amscr__inner;
 

@@ -1,127 +1,92 @@
-/* rows.c — a collection's rows on POSIX threads (see rows.h). */
+/* rows.c — a collection's rows on POSIX threads (the index's lists, the shape channel's and the
+ * inner distance's matrices): rows handed out one at a time, each computed by the same code
+ * whatever thread runs it (so results do not depend on the thread count); the calling thread
+ * works too and is the only one that reports progress. */
 #include "rows.h"
 
 #include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
 typedef struct {
-    const amscr__rows_ops *ops;
-    const void *ctx;
-    size_t n;
+    const amscr__rows_fn *f;
+    size_t first, n;
     pthread_mutex_t lock;
     size_t next, done;
-    int failed, cancel;
-} rows_t;
+    int cancel;
+    amscr_status st;
+    char detail[256];
+} rows_job;
 
-static int take(rows_t *m, size_t *row)
+static void record(rows_job *j, amscr_status st)
 {
-    int ok = 0;
-    pthread_mutex_lock(&m->lock);
-    if (!m->failed && !m->cancel && m->next < m->n) {
-        *row = m->next++;
-        ok = 1;
+    if (st != AMSCR_OK && j->st == AMSCR_OK) {
+        j->st = st;
+        const char *what = j->f->what ? j->f->what : "index";
+        if (st == AMSCR_E_NOMEM)
+            snprintf(j->detail, sizeof j->detail, "%s: out of memory", what);
+        else
+            snprintf(j->detail, sizeof j->detail, "%s", amscr_last_error_detail());
     }
-    pthread_mutex_unlock(&m->lock);
-    return ok;
 }
 
-static void run_row(rows_t *m, size_t i, void *ws)
+static void rows_work(rows_job *j, amscr_progress_fn progress, void *user)
 {
-    m->ops->row(m->ctx, i, ws);
-    pthread_mutex_lock(&m->lock);
-    m->done++;
-    pthread_mutex_unlock(&m->lock);
+    void *scratch = NULL;
+    amscr_status st = j->f->init ? j->f->init(j->f->ctx, &scratch) : AMSCR_OK;
+    int have = st == AMSCR_OK;
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        record(j, st);
+        size_t i = j->next, done = j->done;
+        int go = j->st == AMSCR_OK && !j->cancel && i < j->n;
+        if (go)
+            j->next++;
+        pthread_mutex_unlock(&j->lock);
+        if (progress && progress(user, done - j->first, j->n - j->first) != 0) {
+            pthread_mutex_lock(&j->lock);
+            j->cancel = 1;
+            pthread_mutex_unlock(&j->lock);
+        }
+        if (!go)
+            break;
+        st = j->f->row(j->f->ctx, i, scratch);
+        pthread_mutex_lock(&j->lock);
+        j->done++;
+        pthread_mutex_unlock(&j->lock);
+    }
+    if (have && j->f->fini)
+        j->f->fini(scratch);
 }
 
-static int scratch(rows_t *m, void **ws)
+static void *rows_worker(void *arg)
 {
-    *ws = NULL;
-    if (!m->ops->ws_init || m->ops->ws_init(m->ctx, ws) == AMSCR_OK)
-        return 1;
-    pthread_mutex_lock(&m->lock);
-    m->failed = 1;
-    pthread_mutex_unlock(&m->lock);
-    return 0;
-}
-
-static void scratch_free(rows_t *m, void *ws)
-{
-    if (m->ops->ws_free)
-        m->ops->ws_free(ws);
-}
-
-static void *worker(void *arg)
-{
-    rows_t *m = arg;
-    void *ws;
-    size_t i;
-    if (!scratch(m, &ws))
-        return NULL;
-    while (take(m, &i))
-        run_row(m, i, ws);
-    scratch_free(m, ws);
+    rows_work(arg, NULL, NULL);
     return NULL;
 }
 
-/* The calling thread: works like the others and is the only one that reports progress. */
-static void main_thread(rows_t *m, size_t cells, amscr_progress_fn progress, void *user)
-{
-    void *ws;
-    size_t i;
-    if (!scratch(m, &ws))
-        return;
-    for (;;) {
-        if (progress) {
-            pthread_mutex_lock(&m->lock);
-            size_t done = m->done;
-            pthread_mutex_unlock(&m->lock);
-            if (progress(user, done * cells, m->n * cells) != 0) {
-                pthread_mutex_lock(&m->lock);
-                m->cancel = 1;
-                pthread_mutex_unlock(&m->lock);
-            }
-        }
-        if (!take(m, &i))
-            break;
-        run_row(m, i, ws);
-    }
-    scratch_free(m, ws);
-}
-
-amscr_status amscr__rows_run(size_t n, const amscr__rows_ops *ops, const void *ctx, unsigned threads, size_t cells,
+amscr_status amscr__run_rows(const amscr__rows_fn *f, size_t first, size_t n, unsigned threads,
                              amscr_progress_fn progress, void *user)
 {
-    if (n == 0)
+    if (first >= n)
         return AMSCR_OK;
-    rows_t m;
-    memset(&m, 0, sizeof m);
-    m.ops = ops;
-    m.ctx = ctx;
-    m.n = n;
-    pthread_mutex_init(&m.lock, NULL);
-    if (threads > n)
-        threads = (unsigned)n;
-    if (threads < 1)
-        threads = 1;
-    pthread_t *tid = threads > 1 ? malloc((threads - 1) * sizeof *tid) : NULL;
-    unsigned started = 0;
-    if (tid)
-        for (unsigned t = 0; t + 1 < threads; t++) {
-            if (pthread_create(&tid[t], NULL, worker, &m) != 0)
-                break;
+    rows_job j = {f, first, n, PTHREAD_MUTEX_INITIALIZER, first, first, 0, AMSCR_OK, ""};
+    unsigned nt = threads < 1 ? 1u : threads, started = 0;
+    if (nt > n - first)
+        nt = (unsigned)(n - first);
+    pthread_t tid[64];
+    for (unsigned t = 1; t < nt && t < 64; t++)
+        if (pthread_create(&tid[started], NULL, rows_worker, &j) == 0)
             started++;
-        }
-    main_thread(&m, cells, progress, user);
+    rows_work(&j, progress, user);
     for (unsigned t = 0; t < started; t++)
         pthread_join(tid[t], NULL);
-    free(tid);
-    pthread_mutex_destroy(&m.lock);
-    if (m.failed)
-        return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", ops->what);
-    if (m.cancel)
-        return amscr__fail(AMSCR_E_CANCELLED, "%s: cancelled by the progress callback", ops->what);
-    if (progress && progress(user, n * cells, n * cells) != 0)
-        return amscr__fail(AMSCR_E_CANCELLED, "%s: cancelled by the progress callback at the end", ops->what);
+    pthread_mutex_destroy(&j.lock);
+    if (j.st != AMSCR_OK)
+        return amscr__fail(j.st, "%s", j.detail);
+    if (!j.cancel && progress && progress(user, n - first, n - first) != 0)
+        j.cancel = 1;
+    if (j.cancel)
+        return amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback");
     return AMSCR_OK;
 }

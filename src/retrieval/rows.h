@@ -1,24 +1,25 @@
-/* rows.h — a collection's rows on POSIX threads (rows.c): row i of n handed out dynamically,
- * each thread with its own scratch, so a result computed row by row does not depend on the
- * thread count. Never installed. */
+/* rows.h — a collection's rows on POSIX threads (rows.c): rows handed out one at a time, each
+ * computed by the same code whatever thread runs it, so a result computed row by row does not
+ * depend on the thread count. Never installed. */
 #ifndef AMSCR_ROWS_H
 #define AMSCR_ROWS_H
 
 #include "internal.h"
 
+/* Work on rows first..n-1: row(ctx, i, scratch) with a scratch per thread from init (may be
+ * NULL) freed by fini; `what` (NULL: "index") names the work in error details. */
 typedef struct {
-    /* a thread's scratch (*ws; may stay NULL): AMSCR_OK or AMSCR_E_NOMEM */
-    amscr_status (*ws_init)(const void *ctx, void **ws);
-    void (*ws_free)(void *ws);
-    /* row i's work (must not fail: a row that can fail records it in ctx) */
-    void (*row)(const void *ctx, size_t i, void *ws);
-    const char *what; /* the error messages' subject, e.g. "shape channel" */
-} amscr__rows_ops;
+    amscr_status (*init)(void *ctx, void **scratch);
+    void (*fini)(void *scratch);
+    amscr_status (*row)(void *ctx, size_t i, void *scratch);
+    void *ctx;
+    const char *what;
+} amscr__rows_fn;
 
-/* Runs ops->row for i = 0..n-1 on `threads` threads (the calling one too, which alone
- * reports progress: `cells` cells a row, of n * cells). AMSCR_E_NOMEM when a scratch could
- * not be made, AMSCR_E_CANCELLED when progress asked to stop (rows may then be missing). */
-amscr_status amscr__rows_run(size_t n, const amscr__rows_ops *ops, const void *ctx, unsigned threads, size_t cells,
+/* Runs f's rows on `threads` threads (the calling one too, which alone reports progress: rows
+ * done of n - first, and n - first of n - first at the end). The first failing row's status
+ * and detail; AMSCR_E_CANCELLED when progress asked to stop. */
+amscr_status amscr__run_rows(const amscr__rows_fn *f, size_t first, size_t n, unsigned threads,
                              amscr_progress_fn progress, void *user);
 
 #endif

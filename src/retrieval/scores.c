@@ -10,7 +10,7 @@
  *   scores.c        retrieval scores (this file); protocols.c the evaluation protocols
  *   db_io.c, bytes.c  the collection file format (little-endian readers and writers)
  *   index.c         the index object (amscr_index); index_build.c, index_add.c build it on
- *                   threads (index_threads.c), index_pairs.c the base distance pair by pair,
+ *                   threads (rows.c), index_pairs.c the base distance pair by pair,
  *                   index_features.c each shape's kept features, index_query.c one query's
  *                   exact re-ranked row, index_io.c its file section
  *   signature.c, affine_signature.c  the shortlist signature and its search
