@@ -88,6 +88,9 @@ int folds_local(const folds_data *fd, const char *datasets);
 int folds_halves(const folds_data *fd);
 /* perm = a seeded random permutation of 0..L-1 (xorshift64*, Fisher-Yates). */
 void folds_shuffle(int *perm, int L, unsigned long long *seed);
+/* The next seeded random subset of C of mpeg7-dev's L classes: its shapes' indices into idx
+ * (returns their count); perm and in are L-entry scratch. */
+size_t folds_subset(const folds_data *fd, int C, int L, unsigned long long *seed, int *perm, int *in, size_t *idx);
 /* The channel's band on random class subsets of mpeg7-dev and on the larger collections. */
 int folds_band(const folds_data *fd);
 /* The inner-distance graph's share in the re-ranking, the same way (folds_inner.c). */

@@ -40,13 +40,7 @@ static void band_subsets(const folds_data *fd, base_t *bd, int C)
     int wins[NB][2] = {{0}}, loss[NB][2] = {{0}};
     unsigned long long seed = 0x9E3779B97F4A7C15ull + (unsigned long long)C;
     for (int h = 0; h < NH; h++) {
-        folds_shuffle(perm, L, &seed);
-        for (int c = 0; c < L; c++)
-            in[perm[c]] = c < C;
-        size_t m = 0;
-        for (size_t i = 0; i < n; i++)
-            if (in[fd->dev.s.labels[i]])
-                idx[m++] = i;
+        size_t m = folds_subset(fd, C, L, &seed, perm, in, idx);
         for (int z = 0; z < 2; z++) {
             post_cfg p = POST_DEFAULT;
             if (z)

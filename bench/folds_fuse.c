@@ -178,6 +178,18 @@ void folds_shuffle(int *perm, int L, unsigned long long *seed)
     }
 }
 
+size_t folds_subset(const folds_data *fd, int C, int L, unsigned long long *seed, int *perm, int *in, size_t *idx)
+{
+    folds_shuffle(perm, L, seed);
+    for (int c = 0; c < L; c++)
+        in[perm[c]] = c < C;
+    size_t m = 0;
+    for (size_t i = 0; i < fd->dev.s.n; i++)
+        if (in[fd->dev.s.labels[i]])
+            idx[m++] = i;
+    return m;
+}
+
 /* Candidates against the preset on many random class halves of mpeg7-dev (`... halves`): each half
  * (17 or 18 of the 35 classes, seeded; HALVES_CLASSES=C: C and 35 - C) is its own collection; per
  * candidate the mean gain over the preset and the share of halves it helps (re-ranked and before

@@ -47,13 +47,7 @@ static void inner_subsets(const folds_data *fd, const base_t *b, int C)
     int wins[NS] = {0}, loss[NS] = {0};
     unsigned long long seed = 0x9E3779B97F4A7C15ull + (unsigned long long)C; /* folds_band's subsets */
     for (int h = 0; h < NH; h++) {
-        folds_shuffle(perm, L, &seed);
-        for (int c = 0; c < L; c++)
-            in[perm[c]] = c < C;
-        size_t m = 0;
-        for (size_t i = 0; i < n; i++)
-            if (in[fd->dev.s.labels[i]])
-                idx[m++] = i;
+        size_t m = folds_subset(fd, C, L, &seed, perm, in, idx);
         double ref = score_share(b, &fd->dev, idx, m, 0.0);
         base += ref / NH;
         for (int s = 1; s < NS; s++) {

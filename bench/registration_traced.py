@@ -12,7 +12,8 @@ then the target damaged in the image:
              shape's radius (RMS radius), plus 12 background specks (1-2 px disks);
   bite       a disk of 0.3 x radius removed at a random boundary point;
   touching   such a disk added outside, touching the boundary at a random point;
-  lowres     source and target reduced 4x (cv2.INTER_AREA: the shape 35 px across) and thresholded;
+  lowres     source and target reduced 4x (cv2.INTER_AREA: the shape 35 px across; --low-px N for
+             another size) and thresholded;
   grey       the same reduction kept as 8-bit antialiased grey (area coverage).
 
 Both PNGs are registered by the tool, `amscr register SRC TGT --json` (the default sub-pixel
@@ -40,6 +41,7 @@ ms/pair: wall time per pair (the tool's includes process start and PNG decoding)
 
 Usage: nice .venv/bin/python bench/registration_traced.py [--data DIR] [--tool PATH] [--draws 2]
        [--no-ecc] [--no-chain] [--reference] [--conditions clean,lowres,...] [--fold A|B] [--json OUT]
+       [--low-px 35]
 --json OUT writes one row per pair, each method as [RMS %, max %, confidence, ms].
 --conditions (alias --only) and --fold restrict the run (the tables then show what ran);
 --no-chain skips the --pixel-chain column; --breakdown splits the library's time (the traces,
@@ -187,8 +189,20 @@ def damage(key, tgt, g, rng):
     return tgt
 
 
+def set_low_px(px):
+    """The low-resolution conditions with the shape `px` pixels across (35 by default: the 4x
+    reduction; the reference evaluation states ~40): the reduced canvas and S_LOW."""
+    global LOW_SIDE, S_LOW
+    LOW_SIDE = int(round(CANVAS * px / SPAN))
+    r = CANVAS / LOW_SIDE
+    S_LOW = np.array([[1.0 / r, 0, (1.0 / r - 1) / 2], [0, 1.0 / r, (1.0 / r - 1) / 2]])
+
+
+LOW_SIDE = CANVAS // REDUCE
+
+
 def reduce(img, binary):
-    small = cv2.resize(img, (CANVAS // REDUCE, CANVAS // REDUCE), interpolation=cv2.INTER_AREA)
+    small = cv2.resize(img, (LOW_SIDE, LOW_SIDE), interpolation=cv2.INTER_AREA)
     return np.where(small > 127, 255, 0).astype(np.uint8) if binary else small
 
 
@@ -370,11 +384,15 @@ def main():
     ap.add_argument('--reference', action='store_true',
                     help="add the reference evaluation's calibration: scikit-image find_contours point lists through the tool")
     ap.add_argument('--classes', type=int, default=0, help='the first N classes only (0: all)')
+    ap.add_argument('--low-px', type=float, default=SPAN / REDUCE,
+                    help='the shape\'s size across in the lowres and grey conditions (default 35: a 4x reduction)')
     ap.add_argument('--json', default=None)
     a = ap.parse_args()
     if a.cpu_time:
         global CLOCK
         CLOCK = time.process_time
+    if a.low_px != SPAN / REDUCE:
+        set_low_px(a.low_px)
     if not os.path.isdir(a.data):
         print('registration_traced: no data at %s (skipped)' % a.data)
         return 0

@@ -1197,6 +1197,19 @@ static void as_older_version(unsigned char *b, size_t *len, size_t at, size_t dr
     fix_checksum(b, *len);
 }
 
+/* An empty collection with params p saved to memory (*len bytes; free with amscr_free), and
+ * the count of p's scales (the retrieval block starts 60 bytes after them). */
+static unsigned char *saved_empty(const amscr_params *p, size_t *len, size_t *nscales)
+{
+    amscr_db *db = NULL;
+    void *buf = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_save_memory(db, &buf, len), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_get_scales(p, NULL, nscales), AMSCR_OK);
+    amscr_db_free(db);
+    return buf;
+}
+
 START_TEST(format_v1_still_loads)
 {
     size_t len = 0;
@@ -1220,14 +1233,8 @@ START_TEST(format_v2_one_band)
     ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
     ck_assert_int_eq(amscr_params_set_channel_band(p, 0.125), AMSCR_OK);
     ck_assert(amscr_params_get_channel_affine_band(p) != 0.125);
-    amscr_db *db = NULL;
-    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
-    void *buf = NULL;
-    size_t len = 0;
-    ck_assert_int_eq(amscr_db_save_memory(db, &buf, &len), AMSCR_OK);
-    unsigned char *b = buf;
-    size_t nscales = 0;
-    ck_assert_int_eq(amscr_params_get_scales(p, NULL, &nscales), AMSCR_OK);
+    size_t len = 0, nscales = 0;
+    unsigned char *b = saved_empty(p, &len, &nscales);
     /* the affine band and the inner share, after the 52 bytes of version 2 */
     as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 52, 16, 2);
     amscr_db *back = NULL;
@@ -1241,8 +1248,7 @@ START_TEST(format_v2_one_band)
     fix_checksum(b, len);
     ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_E_FORMAT);
     ck_assert_ptr_null(back);
-    amscr_free(buf);
-    amscr_db_free(db);
+    amscr_free(b);
     amscr_params_free(p);
 }
 END_TEST
@@ -1255,22 +1261,15 @@ START_TEST(format_v5_one_graph)
     ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
     ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.05), AMSCR_OK);
     ck_assert_int_eq(amscr_params_set_channel_affine_band(p, 0.0625), AMSCR_OK);
-    amscr_db *db = NULL;
-    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
-    void *buf = NULL;
-    size_t len = 0;
-    ck_assert_int_eq(amscr_db_save_memory(db, &buf, &len), AMSCR_OK);
-    size_t nscales = 0;
-    ck_assert_int_eq(amscr_params_get_scales(p, NULL, &nscales), AMSCR_OK);
-    unsigned char *b = buf;
+    size_t len = 0, nscales = 0;
+    unsigned char *b = saved_empty(p, &len, &nscales);
     as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 60, 8, 5);
     amscr_db *back = NULL;
     ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_OK);
     ck_assert(amscr_params_get_rerank_inner_share(amscr_db_params(back)) == 0.0);
     ck_assert(amscr_params_get_channel_affine_band(amscr_db_params(back)) == 0.0625);
     amscr_db_free(back);
-    amscr_free(buf);
-    amscr_db_free(db);
+    amscr_free(b);
     amscr_params_free(p);
 }
 END_TEST
