@@ -1677,8 +1677,8 @@ AMSCR_API unsigned amscr_params_get_rerank_iterations(const amscr_params *p);
  *        retrieval distance; with a share s > 0 it diffuses over (1 - s) times that graph
  *        plus s times the kNN graph of the inner distance (the shortest path inside the
  *        shape between two boundary points, which a part bent at a joint hardly changes),
- *        so neighbours both distances agree on reinforce each other. It costs about a
- *        fifteenth of the channel's time and changes nothing without re-ranking. An index
+ *        so neighbours both distances agree on reinforce each other. It costs under a tenth
+ *        of the channel's time and changes nothing without re-ranking. An index
  *        re-ranks on the retrieval distance's graph alone: amscr_index_build gives its
  *        collection a share of 0 (amscr_index_db shows it). Set 0 for the ranking before 0.7.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (outside [0, 1), NaN).
