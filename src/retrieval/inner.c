@@ -38,37 +38,6 @@ amscr_status amscr__inner_ws_init(amscr__inner_ws *ws)
 
 void amscr__inner_ws_free(amscr__inner_ws *ws) { amscr__fft_plan_free(&ws->plan); }
 
-/* out: N points evenly spaced along the closed polygon xy (n points). 0 if it has no length. */
-static int resample(const double *xy, size_t n, double *out)
-{
-    double len = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        size_t j = (i + 1) % n;
-        len += hypot(xy[2 * j] - xy[2 * i], xy[2 * j + 1] - xy[2 * i + 1]);
-    }
-    if (!(len > 0.0) || !isfinite(len))
-        return 0;
-    double at = 0.0;
-    size_t seg = 0;
-    for (size_t t = 0; t < N; t++) {
-        double want = len * (double)t / (double)N;
-        for (;;) {
-            size_t j = (seg + 1) % n;
-            double l = hypot(xy[2 * j] - xy[2 * seg], xy[2 * j + 1] - xy[2 * seg + 1]);
-            if (at + l >= want || seg + 1 >= n) {
-                double u = l > 0.0 ? (want - at) / l : 0.0;
-                u = u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
-                out[2 * t] = xy[2 * seg] + u * (xy[2 * j] - xy[2 * seg]);
-                out[2 * t + 1] = xy[2 * seg + 1] + u * (xy[2 * j + 1] - xy[2 * seg + 1]);
-                break;
-            }
-            at += l;
-            seg++;
-        }
-    }
-    return 1;
-}
-
 static double cross(const double *o, const double *a, const double *b)
 {
     return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
@@ -136,7 +105,10 @@ static int inner_matrix_of(const double *V, double *D)
 
 amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, amscr__inner_ws *ws)
 {
-    if (n < 3 || !resample(xy, n, ws->xy) || !inner_matrix_of(ws->xy, ws->id))
+    amscr_status st = n < 3 ? AMSCR_E_DEGENERATE : amscr__resample_euclid(xy, n, 1, N, ws->xy);
+    if (st == AMSCR_E_NOMEM)
+        return st;
+    if (st != AMSCR_OK || !inner_matrix_of(ws->xy, ws->id))
         return amscr__fail(AMSCR_E_DEGENERATE, "inner distance: the curve has no extent");
     out->norm2 = 0.0;
     for (size_t k = 0; k < AMSCR__INNER_K; k++) {
