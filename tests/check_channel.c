@@ -1,11 +1,13 @@
 /* check_channel.c — the shape channel (amscr_channel_distance, amscr_db_channel_matrix) and
  * the fused retrieval matrix: invariance under the channel's group, self-distance 0, the
- * matrix against the pair function, articulation tolerance, and bad input. */
+ * matrix against the pair function, articulation tolerance, the four-lane DP against the
+ * one-pair DP, and bad input. */
 #include <amscr.h>
 #include <check.h>
 #include <math.h>
 #include <stdlib.h>
 
+#include "channel.h"
 #include "suites.h"
 
 #define NPTS 400
@@ -250,6 +252,48 @@ START_TEST(test_bad_input)
 }
 END_TEST
 
+/* The four-lane pair distance (the collection matrix's) equals the one-pair distance bit for
+ * bit: every count of pairs 1-4, bands up to N/2, both strides, skip costs, one or both
+ * orientations, reflections on and off; height sequences of random curves (N 128). */
+START_TEST(test_four_lanes)
+{
+    enum { NS = 9, N = 128 };
+    amscr__hf hf[NS];
+    double xy[2 * N];
+    for (int k = 0; k < NS; k++) {
+        for (int i = 0; i < N; i++) {
+            double t = 2.0 * PI * i / N;
+            double r = 1.0 + 0.3 * cos((k % 4 + 2) * t + k) + 0.15 * sin((k % 3 + 5) * t) + 0.05 * cos(11 * t * k);
+            xy[2 * i] = (1.0 + 0.1 * k) * r * cos(t);
+            xy[2 * i + 1] = r * sin(t);
+        }
+        ck_assert_int_eq(amscr__hf_build(xy, N, 4.0, &hf[k]), AMSCR_OK);
+    }
+    const size_t bands[3] = {3, 19, N / 2};
+    amscr__hf_ws ws;
+    ck_assert_int_eq(amscr__hf_ws_init(&ws, N, N / 2), AMSCR_OK);
+    for (int c = 0; c < 3 * 2 * 2 * 2 * 2; c++) {
+        amscr__hf_cfg cfg = {bands[c % 3], (c / 3) % 2 ? 0.5 : 1.25, (c / 6) % 2, (c / 12) % 2,
+                             (size_t)1 + (c / 24) % 2};
+        for (size_t count = 1; count <= 4; count++)
+            for (size_t j = 1; j + count <= NS; j += count) {
+                double four[4] = {-1, -1, -1, -1};
+                amscr__hf_distance4(&hf[0], &hf[j], count, &cfg, &ws, four);
+                for (size_t t = 0; t < count; t++) {
+                    double one = amscr__hf_distance(&hf[0], &hf[j + t], &cfg, &ws);
+                    ck_assert_msg(four[t] == one && one > 0.0, "config %d count %zu pair %zu: %.17g vs %.17g", c,
+                                  count, j + t, four[t], one);
+                }
+                for (size_t t = count; t < 4; t++)
+                    ck_assert(four[t] == -1.0); /* nothing written past count */
+            }
+    }
+    amscr__hf_ws_free(&ws);
+    for (int k = 0; k < NS; k++)
+        amscr__hf_free(&hf[k]);
+}
+END_TEST
+
 Suite *amscr_suite_channel(void)
 {
     Suite *s = suite_create("channel");
@@ -257,6 +301,7 @@ Suite *amscr_suite_channel(void)
     tcase_add_test(tc, test_invariance);
     tcase_add_test(tc, test_self_zero_and_articulation);
     tcase_add_test(tc, test_matrices);
+    tcase_add_test(tc, test_four_lanes);
     tcase_add_test(tc, test_bad_input);
     suite_add_tcase(s, tc);
     return s;

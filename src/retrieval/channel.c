@@ -23,14 +23,12 @@
  * to bytes (AMSCR__HF_QUANT), so the cell cost is an exact integer sum of absolute
  * differences (one SSE2 instruction per 16 bins) and the result is the same on every
  * platform. Cost O(N * band * bins) per pair; 0 for a shape against itself; d(a, b) and
- * d(b, a) agree unless the two shift searches pick different candidates. */
+ * d(b, a) agree unless the two shift searches pick different candidates. The DP itself is in
+ * channel_dp.c (one pair, or four side by side for a collection's rows: the same values). */
 #include "channel.h"
 
 #include <float.h>
 #include <stdint.h>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -164,9 +162,10 @@ amscr_status amscr__hf_ws_init(amscr__hf_ws *ws, size_t n, size_t band)
     ws->z = amscr__malloc_array(2 * n, sizeof *ws->z);
     ws->row = amscr__malloc_array(4 * W, sizeof *ws->row);
     ws->start = amscr__malloc_array(4 * W, sizeof *ws->start);
+    ws->lanes = amscr__malloc_array(5 * 4 * W, sizeof *ws->lanes); /* band_dp4: 5 arrays of 4 lanes */
     int ok = amscr__fft_plan_init(&ws->plan, n) == 0;
     ws->have_plan = ok;
-    if (!ws->z || !ws->row || !ws->start || !ok) {
+    if (!ws->z || !ws->row || !ws->start || !ws->lanes || !ok) {
         amscr__hf_ws_free(ws);
         return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
     }
@@ -180,6 +179,7 @@ void amscr__hf_ws_free(amscr__hf_ws *ws)
     free(ws->z);
     free(ws->row);
     free(ws->start);
+    free(ws->lanes);
     memset(ws, 0, sizeof *ws);
 }
 
@@ -229,107 +229,71 @@ static void best_shifts(const amscr__hf *a, const amscr__hf *b, int both, amscr_
     }
 }
 
-/* L1 distance of two quantized height vectors (integer: the same on every platform). */
-static inline int32_t l1(const uint8_t *x, const uint8_t *y)
+/* The DP jobs of the pair (a, b): the orientation(s) of b and their shifts; returns 1 or 2. */
+static int pair_jobs(const amscr__hf *a, const amscr__hf *b, const amscr__hf_cfg *cfg, amscr__hf_ws *ws,
+                     const uint8_t *seq[2], size_t shift[2])
 {
-#if defined(__SSE2__)
-    __m128i s = _mm_setzero_si128();
-    for (size_t d = 0; d < AMSCR__HF_BINS; d += 16) {
-        __m128i a = _mm_loadu_si128((const __m128i *)(const void *)(x + d));
-        __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(y + d));
-        s = _mm_add_epi64(s, _mm_sad_epu8(a, b));
-    }
-    return _mm_cvtsi128_si32(s) + _mm_extract_epi16(s, 4);
-#else
-    int32_t s = 0;
-    for (size_t d = 0; d < AMSCR__HF_BINS; d++)
-        s += x[d] > y[d] ? x[d] - y[d] : y[d] - x[d];
-    return s;
-#endif
-}
-
-/* One row of the banded DTW (see band_dp): cur[kk] = cost[kk] + the cheapest of prev[kk] (a
- * match), prev[kk + 1] + skip (this row's sample matched twice) and cur[kk - 1] + skip (the
- * other's), ties kept in that order; cs[kk] the start offset its path came from. Two passes: the
- * first two moves are independent across the row (branch-free selects the compiler vectorizes),
- * only the third chains along it — the same values and ties as one pass over the three. */
-static void band_row(const int32_t *restrict prev, const int *restrict ps, const int32_t *restrict cost, long W,
-                     int32_t skip, int32_t *restrict cur, int *restrict cs)
-{
-    for (long kk = 0; kk + 1 < W; kk++) { /* masks, not branches: the choice is data-dependent */
-        int32_t b = prev[kk], v = prev[kk + 1] + skip, m = -(int32_t)(v < b);
-        cur[kk] = (v & m) | (b & ~m);
-        cs[kk] = (ps[kk + 1] & m) | (ps[kk] & ~m);
-    }
-    cur[W - 1] = prev[W - 1];
-    cs[W - 1] = ps[W - 1];
-    int32_t c = cost[0] + cur[0];
-    int st = cs[0];
-    cur[0] = c;
-    for (long kk = 1; kk < W; kk++) { /* plain selects: conditional moves, the shortest chain */
-        int32_t h = c + skip, b = cur[kk];
-        int sb = cs[kk], lt = h < b;
-        c = (lt ? h : b) + cost[kk];
-        st = lt ? st : sb;
-        cur[kk] = c;
-        cs[kk] = st;
-    }
-}
-
-/* Banded DTW of a against b (orientation o) cyclically shifted by s; see the file comment. */
-static double band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, size_t band, size_t stride,
-                      int32_t skip, amscr__hf_ws *ws)
-{
-    const size_t D = AMSCR__HF_BINS, m = n / stride;
-    const long w = (long)(band / stride > 0 ? band / stride : 1), W = 2 * w + 1;
-    int32_t *prev = ws->row, *cur = ws->row + W;
-    int *ps = ws->start, *cs = ws->start + W;
-    int32_t *cost = ws->row + 2 * W;
-    for (long kk = 0; kk < W; kk++) { /* before the first row: every start free, paths cost 0 */
-        prev[kk] = 0;
-        ps[kk] = (int)(kk - w);
-    }
-    for (size_t i = 0; i < m; i++) {
-        const uint8_t *ai = A + i * stride * D;
-        size_t jb = (s + i * stride + n * stride - (size_t)w * stride) % n;
-        for (long kk = 0; kk < W; kk++) { /* the row's costs first: independent, pipelined */
-            cost[kk] = l1(ai, B + jb * D);
-            jb += stride;
-            if (jb >= n)
-                jb -= n;
-        }
-        band_row(prev, ps, cost, W, skip, cur, cs);
-        int32_t *t = prev;
-        prev = cur;
-        cur = t;
-        int *u = ps;
-        ps = cs;
-        cs = u;
-    }
-    double best = DBL_MAX;
-    for (long kk = 0; kk < W; kk++) {
-        double v = (double)prev[kk] + (double)skip * (double)labs((kk - w) - ps[kk]);
-        if (v < best)
-            best = v;
-    }
-    return best / ((double)m * AMSCR__HF_QUANT);
-}
-
-double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__hf_cfg *cfg, amscr__hf_ws *ws)
-{
-    const size_t n = a->n;
-    size_t band = cfg->band < n / 2 ? cfg->band : n / 2;
     size_t sh[2] = {0, 0};
     double corr[2] = {0.0, -DBL_MAX};
     best_shifts(a, b, cfg->reflections, ws, sh, corr);
-    size_t s0 = sh[0], s1 = sh[1];
-    double c0 = corr[0], c1 = corr[1];
-    int32_t skip = (int32_t)lround(cfg->skip * AMSCR__HF_QUANT);
     if (cfg->reflections && cfg->both_orientations) {
-        double d0 = band_dp(a->seq[0], b->seq[0], n, s0, band, cfg->stride, skip, ws);
-        double d1 = band_dp(a->seq[0], b->seq[1], n, s1, band, cfg->stride, skip, ws);
-        return d0 < d1 ? d0 : d1;
+        seq[0] = b->seq[0];
+        seq[1] = b->seq[1];
+        shift[0] = sh[0];
+        shift[1] = sh[1];
+        return 2;
     }
-    int o = c1 > c0 ? 1 : 0;
-    return band_dp(a->seq[0], b->seq[o], n, o ? s1 : s0, band, cfg->stride, skip, ws);
+    int o = corr[1] > corr[0] ? 1 : 0;
+    seq[0] = b->seq[o];
+    shift[0] = sh[o];
+    return 1;
+}
+
+static size_t pair_band(const amscr__hf *a, const amscr__hf_cfg *cfg)
+{
+    return cfg->band < a->n / 2 ? cfg->band : a->n / 2;
+}
+
+static int32_t pair_skip(const amscr__hf_cfg *cfg) { return (int32_t)lround(cfg->skip * AMSCR__HF_QUANT); }
+
+double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__hf_cfg *cfg, amscr__hf_ws *ws)
+{
+    const uint8_t *seq[2];
+    size_t shift[2];
+    int jobs = pair_jobs(a, b, cfg, ws, seq, shift);
+    double d = DBL_MAX;
+    for (int t = 0; t < jobs; t++) {
+        double v =
+            amscr__hf_band_dp(a->seq[0], seq[t], a->n, shift[t], pair_band(a, cfg), cfg->stride, pair_skip(cfg), ws);
+        d = v < d ? v : d;
+    }
+    return d;
+}
+
+void amscr__hf_distance4(const amscr__hf *a, const amscr__hf *b, size_t count, const amscr__hf_cfg *cfg,
+                         amscr__hf_ws *ws, double *out)
+{
+    const uint8_t *seq[8];
+    size_t shift[8], owner[8], jobs = 0;
+    for (size_t p = 0; p < count; p++) {
+        int k = pair_jobs(a, &b[p], cfg, ws, seq + jobs, shift + jobs);
+        for (int t = 0; t < k; t++)
+            owner[jobs + (size_t)t] = p;
+        jobs += (size_t)k;
+        out[p] = DBL_MAX;
+    }
+    for (size_t j0 = 0; j0 < jobs; j0 += 4) {
+        const uint8_t *B[4];
+        size_t s[4];
+        double d[4];
+        for (size_t l = 0; l < 4; l++) { /* a short last group repeats its last job */
+            size_t j = j0 + l < jobs ? j0 + l : jobs - 1;
+            B[l] = seq[j];
+            s[l] = shift[j];
+        }
+        amscr__hf_band_dp4(a->seq[0], B, s, a->n, pair_band(a, cfg), cfg->stride, pair_skip(cfg), ws, d);
+        for (size_t l = 0; l < 4 && j0 + l < jobs; l++)
+            if (d[l] < out[owner[j0 + l]])
+                out[owner[j0 + l]] = d[l];
+    }
 }

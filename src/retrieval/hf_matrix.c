@@ -36,8 +36,8 @@ static void hfm_fini(void *ws)
 static amscr_status hfm_row(void *ctx, size_t i, void *ws)
 {
     const hfm_t *m = ctx;
-    for (size_t j = i + 1; j < m->n; j++)
-        m->out[i * m->n + j] = amscr__hf_distance(&m->hf[i], &m->hf[j], m->cfg, ws);
+    for (size_t j = i + 1; j < m->n; j += 4) /* four pairs at once: the same values */
+        amscr__hf_distance4(&m->hf[i], &m->hf[j], m->n - j < 4 ? m->n - j : 4, m->cfg, ws, m->out + i * m->n + j);
     return AMSCR_OK;
 }
 

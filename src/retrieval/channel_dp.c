@@ -1,0 +1,248 @@
+/* channel_dp.c — the shape channel's banded DTW (the pair cost of channel.c): one pair, or
+ * four pairs of the same first shape at once in the lanes of SSE2 registers. The four-lane
+ * version runs the same integer operations in the same order as the one-pair version (the
+ * same moves, the same ties), so its distances are bit for bit the one-pair ones; it exists
+ * because the row's third move chains along the row, and four independent chains side by side
+ * keep the processor busy where one leaves it waiting on the previous cell. */
+#include "channel.h"
+
+#include <float.h>
+#include <stdint.h>
+#include <stdlib.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+/* L1 distance of two quantized height vectors (integer: the same on every platform). */
+static inline int32_t l1(const uint8_t *x, const uint8_t *y)
+{
+#if defined(__SSE2__)
+    __m128i s = _mm_setzero_si128();
+    for (size_t d = 0; d < AMSCR__HF_BINS; d += 16) {
+        __m128i a = _mm_loadu_si128((const __m128i *)(const void *)(x + d));
+        __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(y + d));
+        s = _mm_add_epi64(s, _mm_sad_epu8(a, b));
+    }
+    return _mm_cvtsi128_si32(s) + _mm_extract_epi16(s, 4);
+#else
+    int32_t s = 0;
+    for (size_t d = 0; d < AMSCR__HF_BINS; d++)
+        s += x[d] > y[d] ? x[d] - y[d] : y[d] - x[d];
+    return s;
+#endif
+}
+
+/* The band's geometry: m rows (samples of A visited), half width w, W = 2 w + 1 cells. */
+typedef struct {
+    size_t m, stride;
+    long w, W;
+} band_t;
+
+static band_t band_of(size_t n, size_t band, size_t stride)
+{
+    band_t g = {n / stride, stride, (long)(band / stride > 0 ? band / stride : 1), 0};
+    g.W = 2 * g.w + 1;
+    return g;
+}
+
+/* The cell costs of row i against B shifted by s: cost[kk * step] for kk = 0..W-1. */
+static void row_costs(const uint8_t *A, const uint8_t *B, size_t n, size_t s, const band_t *g, size_t i,
+                      int32_t *cost, size_t step)
+{
+    const size_t D = AMSCR__HF_BINS;
+    const uint8_t *ai = A + i * g->stride * D;
+    size_t jb = (s + i * g->stride + n * g->stride - (size_t)g->w * g->stride) % n;
+    for (long kk = 0; kk < g->W; kk++) { /* independent, pipelined */
+        cost[(size_t)kk * step] = l1(ai, B + jb * D);
+        jb += g->stride;
+        if (jb >= n)
+            jb -= n;
+    }
+}
+
+/* The distance from the last row: the cheapest end, each paying `skip` per sample its path's
+ * end offset differs from its start offset. */
+static double band_end(const int32_t *last, const int32_t *start, size_t step, const band_t *g, int32_t skip)
+{
+    double best = DBL_MAX;
+    for (long kk = 0; kk < g->W; kk++) {
+        size_t c = (size_t)kk * step;
+        double v = (double)last[c] + (double)skip * (double)labs((kk - g->w) - start[c]);
+        if (v < best)
+            best = v;
+    }
+    return best / ((double)g->m * AMSCR__HF_QUANT);
+}
+
+/* One row of the banded DTW: cur[kk] = cost[kk] + the cheapest of prev[kk] (a match),
+ * prev[kk + 1] + skip (this row's sample matched twice) and cur[kk - 1] + skip (the other's),
+ * ties kept in that order; cs[kk] the start offset its path came from. Two passes: the first
+ * two moves are independent across the row (branch-free selects the compiler vectorizes),
+ * only the third chains along it — the same values and ties as one pass over the three. */
+static void band_row(const int32_t *restrict prev, const int32_t *restrict ps, const int32_t *restrict cost, long W,
+                     int32_t skip, int32_t *restrict cur, int32_t *restrict cs)
+{
+    for (long kk = 0; kk + 1 < W; kk++) { /* masks, not branches: the choice is data-dependent */
+        int32_t b = prev[kk], v = prev[kk + 1] + skip, m = -(int32_t)(v < b);
+        cur[kk] = (v & m) | (b & ~m);
+        cs[kk] = (ps[kk + 1] & m) | (ps[kk] & ~m);
+    }
+    cur[W - 1] = prev[W - 1];
+    cs[W - 1] = ps[W - 1];
+    int32_t c = cost[0] + cur[0];
+    int32_t st = cs[0];
+    cur[0] = c;
+    for (long kk = 1; kk < W; kk++) { /* plain selects: conditional moves, the shortest chain */
+        int32_t h = c + skip, b = cur[kk];
+        int32_t sb = cs[kk];
+        int lt = h < b;
+        c = (lt ? h : b) + cost[kk];
+        st = lt ? st : sb;
+        cur[kk] = c;
+        cs[kk] = st;
+    }
+}
+
+double amscr__hf_band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, size_t band, size_t stride,
+                         int32_t skip, amscr__hf_ws *ws)
+{
+    const band_t g = band_of(n, band, stride);
+    int32_t *prev = ws->row, *cur = ws->row + g.W, *cost = ws->row + 2 * g.W;
+    int32_t *ps = ws->start, *cs = ws->start + g.W;
+    for (long kk = 0; kk < g.W; kk++) { /* before the first row: every start free, paths cost 0 */
+        prev[kk] = 0;
+        ps[kk] = (int32_t)(kk - g.w);
+    }
+    for (size_t i = 0; i < g.m; i++) {
+        row_costs(A, B, n, s, &g, i, cost, 1);
+        band_row(prev, ps, cost, g.W, skip, cur, cs);
+        int32_t *t = prev;
+        prev = cur;
+        cur = t;
+        int32_t *u = ps;
+        ps = cs;
+        cs = u;
+    }
+    return band_end(prev, ps, 1, &g, skip);
+}
+
+#if defined(__SSE2__)
+/* (m & x) | (~m & y), lane by lane */
+static inline __m128i sel(__m128i m, __m128i x, __m128i y)
+{
+    return _mm_or_si128(_mm_and_si128(m, x), _mm_andnot_si128(m, y));
+}
+
+#define LD(p, kk) _mm_loadu_si128((const __m128i *)(const void *)((p) + 4 * (kk)))
+#define ST(p, kk, v) _mm_storeu_si128((__m128i *)(void *)((p) + 4 * (kk)), (v))
+
+/* band_row on four lanes, cell kk of lane l at [4 kk + l], one lane in each 32 bits of an SSE2
+ * register: the same operations as band_row. */
+static void band_row4(const int32_t *restrict prev, const int32_t *restrict ps, const int32_t *restrict cost, long W,
+                      int32_t skip, int32_t *restrict cur, int32_t *restrict cs)
+{
+    const __m128i sk = _mm_set1_epi32(skip);
+    for (long kk = 0; kk + 1 < W; kk++) {
+        __m128i b = LD(prev, kk), v = _mm_add_epi32(LD(prev, kk + 1), sk), m = _mm_cmpgt_epi32(b, v); /* v < b */
+        ST(cur, kk, sel(m, v, b));
+        ST(cs, kk, sel(m, LD(ps, kk + 1), LD(ps, kk)));
+    }
+    ST(cur, W - 1, LD(prev, W - 1));
+    ST(cs, W - 1, LD(ps, W - 1));
+    __m128i c = _mm_add_epi32(LD(cost, 0), LD(cur, 0)), st = LD(cs, 0);
+    ST(cur, 0, c);
+    for (long kk = 1; kk < W; kk++) {
+        __m128i h = _mm_add_epi32(c, sk), b = LD(cur, kk), lt = _mm_cmpgt_epi32(b, h); /* h < b */
+        c = _mm_add_epi32(sel(lt, h, b), LD(cost, kk));
+        st = sel(lt, st, LD(cs, kk));
+        ST(cur, kk, c);
+        ST(cs, kk, st);
+    }
+}
+#undef LD
+#undef ST
+#else
+/* band_row on four lanes, cell kk of lane l at [4 kk + l]: the same operations lane by lane
+ * (the compiler keeps the four lanes in one vector register). */
+static void band_row4(const int32_t *restrict prev, const int32_t *restrict ps, const int32_t *restrict cost, long W,
+                      int32_t skip, int32_t *restrict cur, int32_t *restrict cs)
+{
+    for (long kk = 0; kk + 1 < W; kk++)
+        for (int l = 0; l < 4; l++) {
+            int32_t b = prev[4 * kk + l], v = prev[4 * kk + 4 + l] + skip, m = -(int32_t)(v < b);
+            cur[4 * kk + l] = (v & m) | (b & ~m);
+            cs[4 * kk + l] = (ps[4 * kk + 4 + l] & m) | (ps[4 * kk + l] & ~m);
+        }
+    int32_t c[4], st[4];
+    for (int l = 0; l < 4; l++) {
+        cur[4 * (W - 1) + l] = prev[4 * (W - 1) + l];
+        cs[4 * (W - 1) + l] = ps[4 * (W - 1) + l];
+        c[l] = cost[l] + cur[l];
+        st[l] = cs[l];
+        cur[l] = c[l];
+    }
+    for (long kk = 1; kk < W; kk++)
+        for (int l = 0; l < 4; l++) {
+            int32_t h = c[l] + skip, b = cur[4 * kk + l], m = -(int32_t)(h < b);
+            c[l] = ((h & m) | (b & ~m)) + cost[4 * kk + l];
+            st[l] = (st[l] & m) | (cs[4 * kk + l] & ~m);
+            cur[4 * kk + l] = c[l];
+            cs[4 * kk + l] = st[l];
+        }
+}
+#endif
+
+/* The cell costs of row i against the four (B, s) into cost[4 kk + l]: row_costs' values. */
+static void row_costs4(const uint8_t *A, const uint8_t *const B[4], size_t n, const size_t s[4], const band_t *g,
+                       size_t i, int32_t *cost)
+{
+#if defined(__SSE2__) && AMSCR__HF_BINS == 16
+    /* the row's vector loaded once; the four sums of absolute differences gathered into one
+     * register of four lanes (each below 2^12: the low 32 bits of the 64-bit halves) */
+    const __m128i a = _mm_loadu_si128((const __m128i *)(const void *)(A + i * g->stride * AMSCR__HF_BINS));
+    size_t jb[4];
+    for (size_t l = 0; l < 4; l++)
+        jb[l] = (s[l] + i * g->stride + n * g->stride - (size_t)g->w * g->stride) % n;
+    for (long kk = 0; kk < g->W; kk++) {
+        __m128i x[4];
+        for (size_t l = 0; l < 4; l++) {
+            x[l] = _mm_sad_epu8(a, _mm_loadu_si128((const __m128i *)(const void *)(B[l] + jb[l] * AMSCR__HF_BINS)));
+            jb[l] += g->stride;
+            if (jb[l] >= n)
+                jb[l] -= n;
+        }
+        __m128i t01 = _mm_add_epi64(_mm_unpacklo_epi64(x[0], x[1]), _mm_unpackhi_epi64(x[0], x[1]));
+        __m128i t23 = _mm_add_epi64(_mm_unpacklo_epi64(x[2], x[3]), _mm_unpackhi_epi64(x[2], x[3]));
+        __m128 v = _mm_shuffle_ps(_mm_castsi128_ps(t01), _mm_castsi128_ps(t23), _MM_SHUFFLE(2, 0, 2, 0));
+        _mm_storeu_si128((__m128i *)(void *)(cost + 4 * kk), _mm_castps_si128(v));
+    }
+#else
+    for (size_t l = 0; l < 4; l++)
+        row_costs(A, B[l], n, s[l], g, i, cost + l, 4);
+#endif
+}
+
+void amscr__hf_band_dp4(const uint8_t *A, const uint8_t *const B[4], const size_t s[4], size_t n, size_t band,
+                        size_t stride, int32_t skip, amscr__hf_ws *ws, double out[4])
+{
+    const band_t g = band_of(n, band, stride);
+    const size_t L = 4 * (size_t)g.W;
+    int32_t *prev = ws->lanes, *cur = prev + L, *cost = cur + L, *ps = cost + L, *cs = ps + L;
+    for (long kk = 0; kk < g.W; kk++)
+        for (size_t l = 0; l < 4; l++) {
+            prev[4 * kk + l] = 0;
+            ps[4 * kk + l] = (int32_t)(kk - g.w);
+        }
+    for (size_t i = 0; i < g.m; i++) {
+        row_costs4(A, B, n, s, &g, i, cost);
+        band_row4(prev, ps, cost, g.W, skip, cur, cs);
+        int32_t *t = prev;
+        prev = cur;
+        cur = t;
+        t = ps;
+        ps = cs;
+        cs = t;
+    }
+    for (size_t l = 0; l < 4; l++)
+        out[l] = band_end(prev + l, ps + l, 4, &g, skip);
+}
