@@ -252,9 +252,10 @@ START_TEST(test_bad_input)
 }
 END_TEST
 
-/* The four-lane pair distance (the collection matrix's) equals the one-pair distance bit for
- * bit: every count of pairs 1-4, bands up to N/2, both strides, skip costs, one or both
- * orientations, reflections on and off; height sequences of random curves (N 128). */
+/* The four-lane pair distance (the collection matrix's and the index's) equals the one-pair
+ * distance bit for bit: pairs of different first shapes, every count of pairs 1-4, bands up
+ * to N/2, both strides, skip costs, one or both orientations, reflections on and off; height
+ * sequences of random curves (N 128). */
 START_TEST(test_four_lanes)
 {
     enum { NS = 9, N = 128 };
@@ -278,9 +279,14 @@ START_TEST(test_four_lanes)
         for (size_t count = 1; count <= 4; count++)
             for (size_t j = 1; j + count <= NS; j += count) {
                 double four[4] = {-1, -1, -1, -1};
-                amscr__hf_distance4(&hf[0], &hf[j], count, &cfg, &ws, four);
+                const amscr__hf *a[4], *b[4]; /* lane t: (j + t, 0) when t is odd, else (0, j + t) */
                 for (size_t t = 0; t < count; t++) {
-                    double one = amscr__hf_distance(&hf[0], &hf[j + t], &cfg, &ws);
+                    a[t] = t % 2 ? &hf[j + t] : &hf[0];
+                    b[t] = t % 2 ? &hf[0] : &hf[j + t];
+                }
+                amscr__hf_distance4(a, b, count, &cfg, &ws, four);
+                for (size_t t = 0; t < count; t++) {
+                    double one = amscr__hf_distance(a[t], b[t], &cfg, &ws);
                     ck_assert_msg(four[t] == one && one > 0.0, "config %d count %zu pair %zu: %.17g vs %.17g", c,
                                   count, j + t, four[t], one);
                 }

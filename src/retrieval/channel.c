@@ -270,28 +270,29 @@ double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__h
     return d;
 }
 
-void amscr__hf_distance4(const amscr__hf *a, const amscr__hf *b, size_t count, const amscr__hf_cfg *cfg,
-                         amscr__hf_ws *ws, double *out)
+void amscr__hf_distance4(const amscr__hf *const a[4], const amscr__hf *const b[4], size_t count,
+                         const amscr__hf_cfg *cfg, amscr__hf_ws *ws, double *out)
 {
     const uint8_t *seq[8];
     size_t shift[8], owner[8], jobs = 0;
     for (size_t p = 0; p < count; p++) {
-        int k = pair_jobs(a, &b[p], cfg, ws, seq + jobs, shift + jobs);
+        int k = pair_jobs(a[p], b[p], cfg, ws, seq + jobs, shift + jobs);
         for (int t = 0; t < k; t++)
             owner[jobs + (size_t)t] = p;
         jobs += (size_t)k;
         out[p] = DBL_MAX;
     }
     for (size_t j0 = 0; j0 < jobs; j0 += 4) {
-        const uint8_t *B[4];
+        const uint8_t *A[4], *B[4];
         size_t s[4];
         double d[4];
         for (size_t l = 0; l < 4; l++) { /* a short last group repeats its last job */
             size_t j = j0 + l < jobs ? j0 + l : jobs - 1;
+            A[l] = a[owner[j]]->seq[0];
             B[l] = seq[j];
             s[l] = shift[j];
         }
-        amscr__hf_band_dp4(a->seq[0], B, s, a->n, pair_band(a, cfg), cfg->stride, pair_skip(cfg), ws, d);
+        amscr__hf_band_dp4(A, B, s, a[0]->n, pair_band(a[0], cfg), cfg->stride, pair_skip(cfg), ws, d);
         for (size_t l = 0; l < 4 && j0 + l < jobs; l++)
             if (d[l] < out[owner[j0 + l]])
                 out[owner[j0 + l]] = d[l];

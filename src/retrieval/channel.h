@@ -55,16 +55,16 @@ void amscr__hf_ws_free(amscr__hf_ws *ws);
 /* The channel distance of two shapes built with the same n (>= 0, 0 for identical ones). */
 double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__hf_cfg *cfg, amscr__hf_ws *ws);
 
-/* The channel distances of a against b[0..count-1] (count <= 4) into out: bit for bit
+/* The channel distances of the pairs (a[t], b[t]), t < count <= 4, into out[t]: bit for bit
  * amscr__hf_distance's, their DPs run side by side. */
-void amscr__hf_distance4(const amscr__hf *a, const amscr__hf *b, size_t count, const amscr__hf_cfg *cfg,
-                         amscr__hf_ws *ws, double *out);
+void amscr__hf_distance4(const amscr__hf *const a[4], const amscr__hf *const b[4], size_t count,
+                         const amscr__hf_cfg *cfg, amscr__hf_ws *ws, double *out);
 /* The banded DTW of A against B cyclically shifted by s (channel_dp.c; see channel.c's file
- * comment), and the same for four (B, s) at once, bit for bit. */
+ * comment), and the same for four (A, B, s) at once, bit for bit. */
 double amscr__hf_band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, size_t band, size_t stride,
                          int32_t skip, amscr__hf_ws *ws);
-void amscr__hf_band_dp4(const uint8_t *A, const uint8_t *const B[4], const size_t s[4], size_t n, size_t band,
-                        size_t stride, int32_t skip, amscr__hf_ws *ws, double out[4]);
+void amscr__hf_band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], const size_t s[4], size_t n,
+                        size_t band, size_t stride, int32_t skip, amscr__hf_ws *ws, double out[4]);
 
 /* Symmetric n x n matrix of channel distances (zero diagonal), on `threads` threads. */
 amscr_status amscr__hf_matrix(const amscr__hf *hf, size_t n, const amscr__hf_cfg *cfg, unsigned threads,

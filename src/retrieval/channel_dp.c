@@ -1,5 +1,5 @@
 /* channel_dp.c — the shape channel's banded DTW (the pair cost of channel.c): one pair, or
- * four pairs of the same first shape at once in the lanes of SSE2 registers. The four-lane
+ * four pairs at once in the lanes of SSE2 registers. The four-lane
  * version runs the same integer operations in the same order as the one-pair version (the
  * same moves, the same ties), so its distances are bit for bit the one-pair ones; it exists
  * because the row's third move chains along the row, and four independent chains side by side
@@ -192,21 +192,23 @@ static void band_row4(const int32_t *restrict prev, const int32_t *restrict ps, 
 }
 #endif
 
-/* The cell costs of row i against the four (B, s) into cost[4 kk + l]: row_costs' values. */
-static void row_costs4(const uint8_t *A, const uint8_t *const B[4], size_t n, const size_t s[4], const band_t *g,
-                       size_t i, int32_t *cost)
+/* The cell costs of row i of the four (A, B, s) into cost[4 kk + l]: row_costs' values. */
+static void row_costs4(const uint8_t *const A[4], const uint8_t *const B[4], size_t n, const size_t s[4],
+                       const band_t *g, size_t i, int32_t *cost)
 {
 #if defined(__SSE2__) && AMSCR__HF_BINS == 16
-    /* the row's vector loaded once; the four sums of absolute differences gathered into one
-     * register of four lanes (each below 2^12: the low 32 bits of the 64-bit halves) */
-    const __m128i a = _mm_loadu_si128((const __m128i *)(const void *)(A + i * g->stride * AMSCR__HF_BINS));
+    /* each lane's row vector loaded once; the four sums of absolute differences gathered into
+     * one register of four lanes (each below 2^12: the low 32 bits of the 64-bit halves) */
+    __m128i a[4];
     size_t jb[4];
-    for (size_t l = 0; l < 4; l++)
+    for (size_t l = 0; l < 4; l++) {
+        a[l] = _mm_loadu_si128((const __m128i *)(const void *)(A[l] + i * g->stride * AMSCR__HF_BINS));
         jb[l] = (s[l] + i * g->stride + n * g->stride - (size_t)g->w * g->stride) % n;
+    }
     for (long kk = 0; kk < g->W; kk++) {
         __m128i x[4];
         for (size_t l = 0; l < 4; l++) {
-            x[l] = _mm_sad_epu8(a, _mm_loadu_si128((const __m128i *)(const void *)(B[l] + jb[l] * AMSCR__HF_BINS)));
+            x[l] = _mm_sad_epu8(a[l], _mm_loadu_si128((const __m128i *)(const void *)(B[l] + jb[l] * AMSCR__HF_BINS)));
             jb[l] += g->stride;
             if (jb[l] >= n)
                 jb[l] -= n;
@@ -218,11 +220,11 @@ static void row_costs4(const uint8_t *A, const uint8_t *const B[4], size_t n, co
     }
 #else
     for (size_t l = 0; l < 4; l++)
-        row_costs(A, B[l], n, s[l], g, i, cost + l, 4);
+        row_costs(A[l], B[l], n, s[l], g, i, cost + l, 4);
 #endif
 }
 
-void amscr__hf_band_dp4(const uint8_t *A, const uint8_t *const B[4], const size_t s[4], size_t n, size_t band,
+void amscr__hf_band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], const size_t s[4], size_t n, size_t band,
                         size_t stride, int32_t skip, amscr__hf_ws *ws, double out[4])
 {
     const band_t g = band_of(n, band, stride);

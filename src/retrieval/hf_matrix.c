@@ -36,8 +36,15 @@ static void hfm_fini(void *ws)
 static amscr_status hfm_row(void *ctx, size_t i, void *ws)
 {
     const hfm_t *m = ctx;
-    for (size_t j = i + 1; j < m->n; j += 4) /* four pairs at once: the same values */
-        amscr__hf_distance4(&m->hf[i], &m->hf[j], m->n - j < 4 ? m->n - j : 4, m->cfg, ws, m->out + i * m->n + j);
+    for (size_t j = i + 1; j < m->n; j += 4) { /* four pairs at once: the same values */
+        size_t count = m->n - j < 4 ? m->n - j : 4;
+        const amscr__hf *a[4], *b[4];
+        for (size_t t = 0; t < count; t++) {
+            a[t] = &m->hf[i];
+            b[t] = &m->hf[j + t];
+        }
+        amscr__hf_distance4(a, b, count, m->cfg, ws, m->out + i * m->n + j);
+    }
     return AMSCR_OK;
 }
 

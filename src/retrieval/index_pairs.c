@@ -80,29 +80,6 @@ void amscr__base_hf_free(const amscr__base *b, amscr__hf hf[2])
         amscr__hf_free(&hf[f]);
 }
 
-/* The base distance of lo and hi (lo the lower index); hlo, hhi their channel sequences. */
-static amscr_status base_pair(const amscr__base *b, const amscr_descriptor *lo, const amscr__hf *hlo,
-                              const amscr_descriptor *hi, const amscr__hf *hhi, amscr__pair_ws *pw, double *out)
-{
-    double sym = 0.0, ch = 0.0;
-    if (b->w < 1.0) {
-        double f = 0.0, r = 0.0;
-        amscr_status st = amscr__distance_ws(b->p, lo, hi, pw->ws, &f);
-        if (st == AMSCR_OK)
-            st = amscr__distance_ws(b->p, hi, lo, pw->ws, &r);
-        if (st != AMSCR_OK)
-            return st;
-        sym = 0.5 * (f + r);
-    }
-    if (b->nf == 1)
-        ch = amscr__hf_distance(&hlo[0], &hhi[0], &pw->cfg[0], &pw->hws);
-    else if (b->nf == 2)
-        ch = b->share[0] * amscr__hf_distance(&hlo[0], &hhi[0], &pw->cfg[0], &pw->hws) +
-             b->share[1] * amscr__hf_distance(&hlo[1], &hhi[1], &pw->cfg[1], &pw->hws);
-    *out = amscr__fuse_pair(b->w, b->sa, b->sh, sym, ch);
-    return AMSCR_OK;
-}
-
 static void spectra_free(const amscr__base *b, amscr__hf out[2])
 {
     for (int f = 0; f < b->nf; f++) {
@@ -127,38 +104,98 @@ static amscr_status with_spectra(const amscr__base *b, const amscr__hf *stored, 
     return st;
 }
 
+/* A candidate's side of a pair: its channel sequences (stored, or built here: not kept, not
+ * built yet by a lazy load, or heights without spectra from a file) and, when the pair reads
+ * it, its prepared shape (a lazy load decodes it here). */
+typedef struct {
+    amscr__hf built[2];
+    const amscr__hf *hf;
+    const amscr_descriptor *d;
+    int build, spectra;
+} side_t;
+
+static amscr_status side_open(const amscr__base *b, const amscr_db *db, const amscr__hf *hfs, size_t c,
+                              amscr__pair_ws *pw, side_t *o)
+{
+    const amscr__hf *stored = hfs ? hfs + c * (size_t)b->nf : NULL;
+    o->build = !stored || (b->nf > 0 && stored[0].seq[0] == NULL);
+    o->spectra = !o->build && b->nf > 0 && stored[0].spec[0] == NULL;
+    o->hf = o->build || o->spectra ? o->built : stored;
+    o->d = o->build || b->w < 1.0 ? amscr_db_descriptor(db, c) : NULL;
+    amscr_status st = AMSCR_OK;
+    if ((o->build || b->w < 1.0) && !o->d)
+        st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    else if (o->build)
+        st = amscr__base_hf(b, o->d, o->built);
+    else if (o->spectra)
+        st = with_spectra(b, stored, pw->have_hws ? &pw->hws : NULL, o->built);
+    if (st != AMSCR_OK)
+        o->build = o->spectra = 0; /* nothing to release */
+    return st;
+}
+
+static void side_close(const amscr__base *b, side_t *o)
+{
+    if (o->build)
+        amscr__base_hf_free(b, o->built);
+    if (o->spectra)
+        spectra_free(b, o->built);
+}
+
+/* out[t] for m <= 4 pairs: the base distance of lo[t] and hi[t] (lo the lower index), their
+ * channel sequences hlo[t], hhi[t]; the channel's DPs side by side (the same values). */
+static amscr_status base_pairs4(const amscr__base *b, const amscr_descriptor *const lo[4],
+                                const amscr__hf *const hlo[4], const amscr_descriptor *const hi[4],
+                                const amscr__hf *const hhi[4], size_t m, amscr__pair_ws *pw, double *out)
+{
+    double ch[2][4] = {{0.0}};
+    for (int f = 0; f < b->nf; f++) {
+        const amscr__hf *a[4], *c[4];
+        for (size_t t = 0; t < m; t++) {
+            a[t] = &hlo[t][f];
+            c[t] = &hhi[t][f];
+        }
+        amscr__hf_distance4(a, c, m, &pw->cfg[f], &pw->hws, ch[f]);
+    }
+    for (size_t t = 0; t < m; t++) {
+        double sym = 0.0, f = 0.0, r = 0.0;
+        if (b->w < 1.0) {
+            amscr_status st = amscr__distance_ws(b->p, lo[t], hi[t], pw->ws, &f);
+            if (st == AMSCR_OK)
+                st = amscr__distance_ws(b->p, hi[t], lo[t], pw->ws, &r);
+            if (st != AMSCR_OK)
+                return st;
+            sym = 0.5 * (f + r);
+        }
+        double c = b->nf == 2 ? b->share[0] * ch[0][t] + b->share[1] * ch[1][t] : ch[0][t];
+        out[t] = amscr__fuse_pair(b->w, b->sa, b->sh, sym, c);
+    }
+    return AMSCR_OK;
+}
+
 amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const amscr__hf *hfs,
                                const amscr_descriptor *q, const amscr__hf hq[2], size_t qpos, const size_t *cand,
                                size_t m, amscr__pair_ws *pw, double *out)
 {
     amscr_status st = AMSCR_OK;
-    for (size_t t = 0; t < m && st == AMSCR_OK; t++) {
-        amscr__hf built[2];
-        const amscr__hf *stored = hfs ? hfs + cand[t] * (size_t)b->nf : NULL;
-        /* not kept, or not built yet (an index loaded with AMSCR_INDEX_LAZY): built here */
-        int build = !stored || (b->nf > 0 && stored[0].seq[0] == NULL);
-        int spectra = !build && b->nf > 0 && stored[0].spec[0] == NULL; /* the file's heights */
-        const amscr__hf *hd = build || spectra ? built : stored;
-        /* the prepared shape, when the pair reads it (a lazy load decodes it here) */
-        const amscr_descriptor *d = build || b->w < 1.0 ? amscr_db_descriptor(db, cand[t]) : NULL;
-        if ((build || b->w < 1.0) && !d) {
-            st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
-            break;
+    for (size_t t0 = 0; t0 < m && st == AMSCR_OK; t0 += 4) {
+        size_t g = m - t0 < 4 ? m - t0 : 4, open = 0;
+        side_t side[4];
+        const amscr_descriptor *lo[4], *hi[4];
+        const amscr__hf *hlo[4], *hhi[4];
+        for (; open < g && st == AMSCR_OK; open++) {
+            size_t c = cand[t0 + open];
+            st = side_open(b, db, hfs, c, pw, &side[open]);
+            int first = c < qpos; /* the candidate is the pair's lower index */
+            lo[open] = first ? side[open].d : q;
+            hlo[open] = first ? side[open].hf : hq;
+            hi[open] = first ? q : side[open].d;
+            hhi[open] = first ? hq : side[open].hf;
         }
-        if (build)
-            st = amscr__base_hf(b, d, built);
-        else if (spectra)
-            st = with_spectra(b, stored, pw->have_hws ? &pw->hws : NULL, built);
-        if (st != AMSCR_OK)
-            break;
-        if (cand[t] < qpos)
-            st = base_pair(b, d, hd, q, hq, pw, &out[t]);
-        else
-            st = base_pair(b, q, hq, d, hd, pw, &out[t]);
-        if (build)
-            amscr__base_hf_free(b, built);
-        if (spectra)
-            spectra_free(b, built);
+        if (st == AMSCR_OK)
+            st = base_pairs4(b, lo, hlo, hi, hhi, g, pw, out + t0);
+        for (size_t t = 0; t < open; t++)
+            side_close(b, &side[t]);
     }
     return st;
 }
