@@ -1,9 +1,10 @@
 /* channel_dp.c — the shape channel's banded DTW (the pair cost of channel.c): one pair, or
- * four pairs at once in the lanes of SSE2 registers. The four-lane
- * version runs the same integer operations in the same order as the one-pair version (the
- * same moves, the same ties), so its distances are bit for bit the one-pair ones; it exists
- * because the row's third move chains along the row, and four independent chains side by side
- * keep the processor busy where one leaves it waiting on the previous cell. */
+ * four pairs at once in the four 32-bit lanes of SSE2 registers (elsewhere the four-pair
+ * entry runs the one-pair DP four times). The lanes run the one-pair DP's integer operations
+ * in the same order (the same moves, the same ties), so their distances are bit for bit the
+ * one-pair ones; they exist because the row's third move chains along the row, and four
+ * independent chains side by side keep the processor busy where one leaves it waiting on the
+ * previous cell. */
 #include "channel.h"
 
 #include <float.h>
@@ -45,15 +46,15 @@ static band_t band_of(size_t n, size_t band, size_t stride)
     return g;
 }
 
-/* The cell costs of row i against B shifted by s: cost[kk * step] for kk = 0..W-1. */
+/* The cell costs of row i against B shifted by s: cost[kk] for kk = 0..W-1. */
 static void row_costs(const uint8_t *A, const uint8_t *B, size_t n, size_t s, const band_t *g, size_t i,
-                      int32_t *cost, size_t step)
+                      int32_t *cost)
 {
     const size_t D = AMSCR__HF_BINS;
     const uint8_t *ai = A + i * g->stride * D;
     size_t jb = (s + i * g->stride + n * g->stride - (size_t)g->w * g->stride) % n;
     for (long kk = 0; kk < g->W; kk++) { /* independent, pipelined */
-        cost[(size_t)kk * step] = l1(ai, B + jb * D);
+        cost[kk] = l1(ai, B + jb * D);
         jb += g->stride;
         if (jb >= n)
             jb -= n;
@@ -114,7 +115,7 @@ double amscr__hf_band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s,
         ps[kk] = (int32_t)(kk - g.w);
     }
     for (size_t i = 0; i < g.m; i++) {
-        row_costs(A, B, n, s, &g, i, cost, 1);
+        row_costs(A, B, n, s, &g, i, cost);
         band_row(prev, ps, cost, g.W, skip, cur, cs);
         int32_t *t = prev;
         prev = cur;
@@ -126,7 +127,7 @@ double amscr__hf_band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s,
     return band_end(prev, ps, 1, &g, skip);
 }
 
-#if defined(__SSE2__)
+#if defined(__SSE2__) && AMSCR__HF_BINS == 16
 /* (m & x) | (~m & y), lane by lane */
 static inline __m128i sel(__m128i m, __m128i x, __m128i y)
 {
@@ -161,42 +162,11 @@ static void band_row4(const int32_t *restrict prev, const int32_t *restrict ps, 
 }
 #undef LD
 #undef ST
-#else
-/* band_row on four lanes, cell kk of lane l at [4 kk + l]: the same operations lane by lane
- * (the compiler keeps the four lanes in one vector register). */
-static void band_row4(const int32_t *restrict prev, const int32_t *restrict ps, const int32_t *restrict cost, long W,
-                      int32_t skip, int32_t *restrict cur, int32_t *restrict cs)
-{
-    for (long kk = 0; kk + 1 < W; kk++)
-        for (int l = 0; l < 4; l++) {
-            int32_t b = prev[4 * kk + l], v = prev[4 * kk + 4 + l] + skip, m = -(int32_t)(v < b);
-            cur[4 * kk + l] = (v & m) | (b & ~m);
-            cs[4 * kk + l] = (ps[4 * kk + 4 + l] & m) | (ps[4 * kk + l] & ~m);
-        }
-    int32_t c[4], st[4];
-    for (int l = 0; l < 4; l++) {
-        cur[4 * (W - 1) + l] = prev[4 * (W - 1) + l];
-        cs[4 * (W - 1) + l] = ps[4 * (W - 1) + l];
-        c[l] = cost[l] + cur[l];
-        st[l] = cs[l];
-        cur[l] = c[l];
-    }
-    for (long kk = 1; kk < W; kk++)
-        for (int l = 0; l < 4; l++) {
-            int32_t h = c[l] + skip, b = cur[4 * kk + l], m = -(int32_t)(h < b);
-            c[l] = ((h & m) | (b & ~m)) + cost[4 * kk + l];
-            st[l] = (st[l] & m) | (cs[4 * kk + l] & ~m);
-            cur[4 * kk + l] = c[l];
-            cs[4 * kk + l] = st[l];
-        }
-}
-#endif
 
 /* The cell costs of row i of the four (A, B, s) into cost[4 kk + l]: row_costs' values. */
 static void row_costs4(const uint8_t *const A[4], const uint8_t *const B[4], size_t n, const size_t s[4],
                        const band_t *g, size_t i, int32_t *cost)
 {
-#if defined(__SSE2__) && AMSCR__HF_BINS == 16
     /* each lane's row vector loaded once; the four sums of absolute differences gathered into
      * one register of four lanes (each below 2^12: the low 32 bits of the 64-bit halves) */
     __m128i a[4];
@@ -218,14 +188,11 @@ static void row_costs4(const uint8_t *const A[4], const uint8_t *const B[4], siz
         __m128 v = _mm_shuffle_ps(_mm_castsi128_ps(t01), _mm_castsi128_ps(t23), _MM_SHUFFLE(2, 0, 2, 0));
         _mm_storeu_si128((__m128i *)(void *)(cost + 4 * kk), _mm_castps_si128(v));
     }
-#else
-    for (size_t l = 0; l < 4; l++)
-        row_costs(A[l], B[l], n, s[l], g, i, cost + l, 4);
-#endif
 }
 
-void amscr__hf_band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], const size_t s[4], size_t n, size_t band,
-                        size_t stride, int32_t skip, amscr__hf_ws *ws, double out[4])
+/* amscr__hf_band_dp on four lanes: lane l is (A[l], B[l], s[l]). */
+static void band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], const size_t s[4], size_t n, size_t band,
+                     size_t stride, int32_t skip, amscr__hf_ws *ws, double out[4])
 {
     const band_t g = band_of(n, band, stride);
     const size_t L = 4 * (size_t)g.W;
@@ -247,4 +214,16 @@ void amscr__hf_band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], co
     }
     for (size_t l = 0; l < 4; l++)
         out[l] = band_end(prev + l, ps + l, 4, &g, skip);
+}
+#endif
+
+void amscr__hf_band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], const size_t s[4], size_t n, size_t band,
+                        size_t stride, int32_t skip, amscr__hf_ws *ws, double out[4])
+{
+#if defined(__SSE2__) && AMSCR__HF_BINS == 16
+    band_dp4(A, B, s, n, band, stride, skip, ws, out);
+#else
+    for (size_t l = 0; l < 4; l++)
+        out[l] = amscr__hf_band_dp(A[l], B[l], n, s[l], band, stride, skip, ws);
+#endif
 }
