@@ -13,12 +13,12 @@
  * with the same first hit.
  * Then the neighbour lists (K = 8) of builds with candidates 32, 64, 128, 256 against the exact
  * lists: % of the exact neighbours kept (the build seeks them among min(candidates, its build
- * shortlist) shapes).
+ * shortlist) shapes), and the same of the inner distance's graph.
  * Part 2: collections of SIZES shapes, each an affine-warped, noisy copy of an mpeg7-dev shape
  * (shape i % 700, its own seed): build time at the default shortlist, the process's peak
  * resident memory (max RSS) and its growth per shape over the collection, the bytes a shape
- * of the index (channel features, signature and bound vector, neighbour lists and their
- * reverse) and of the collection (the prepared shape) holds, load time, median of 50 queries;
+ * of the index (channel and inner features, signature and bound vector, neighbour lists and
+ * their reverse) and of the collection (the prepared shape) holds, load time, median of 50 queries;
  * and the build's shortlist search per row: exact (every bound) against the coarse quantizer
  * (signature.h), with the quantizer's recall of the exact shortlist. Times are wall clock
  * with the process's CPU seconds (all threads) in parentheses: on a busy machine CPU / threads
@@ -157,27 +157,38 @@ static void load_time(const amscr_index *x, double *secs, double *mb)
     amscr_free(buf);
 }
 
-/* The K - 1 neighbours (itself left out) of the lists of builds with candidates c kept
- * against the exact lists of full. */
+/* The share of the K - 1 neighbours (itself left out) of lists (n x k) kept by lists got; *rows:
+ * the share of rows that keep them all. */
+static double kept_share(const uint32_t *got, const uint32_t *exact, size_t n, size_t k, double *rows)
+{
+    size_t kept = 0, all = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t here = 0;
+        for (size_t a = 1; a < k; a++)
+            for (size_t b = 1; b < k; b++)
+                here += got[i * k + a] == exact[i * k + b];
+        kept += here;
+        all += here == k - 1;
+    }
+    *rows = 100.0 * (double)all / (double)n;
+    return 100.0 * (double)kept / (double)(n * (k - 1));
+}
+
+/* The lists of builds with candidates c against the exact lists of full: the base distance's
+ * and the inner distance's (its graph's: among the build's shortlist and the base list). */
 static void list_recall(const amscr_db *db, const amscr_index *full)
 {
     static const size_t cs[] = {32, 64, 128, 256};
     size_t n = amscr_db_size(db), k = full->k;
-    printf("\n| candidates | build (M) | exact neighbours kept | rows with all kept |\n|---|---|---|---|\n");
+    printf("\n| candidates | build (M) | exact neighbours kept | rows with all kept | inner graph: kept | rows "
+           "|\n|---|---|---|---|---|---|\n");
     for (size_t u = 0; u < sizeof cs / sizeof *cs; u++) {
-        double tb[2];
+        double tb[2], rows, rows2 = 0.0;
         amscr_index *x = build(db, cs[u], tb);
-        size_t kept = 0, rows = 0;
-        for (size_t i = 0; i < n; i++) {
-            size_t here = 0;
-            for (size_t a = 1; a < k; a++)
-                for (size_t b = 1; b < k; b++)
-                    here += x->nb_idx[i * k + a] == full->nb_idx[i * k + b];
-            kept += here;
-            rows += here == k - 1;
-        }
-        printf("| %zu | %.1f s (%.1f) | %.2f %% | %.1f %% |\n", cs[u], tb[0], tb[1],
-               100.0 * (double)kept / (double)(n * (k - 1)), 100.0 * (double)rows / (double)n);
+        double kept = kept_share(x->nb_idx, full->nb_idx, n, k, &rows);
+        double kept2 = x->k2 ? kept_share(x->in_idx, full->in_idx, n, x->k2, &rows2) : 0.0;
+        printf("| %zu | %.1f s (%.1f) | %.2f %% | %.1f %% | %.2f %% | %.1f %% |\n", cs[u], tb[0], tb[1], kept, rows,
+               kept2, rows2);
         fflush(stdout);
         amscr_index_free(x);
     }
@@ -191,7 +202,9 @@ static void index_bytes(const amscr_index *x, double b[3])
         hf += 2 * (x->hf[i].n * AMSCR__HF_BINS + AMSCR__HF_BINS * 2 * x->hf[i].nfreq * sizeof(double));
     b[0] = (double)hf / (double)n;
     b[1] = (double)(x->sig_dim + AMSCR__SIG_LB_DIM) * sizeof(float);
-    b[2] = (double)x->k * (sizeof(uint32_t) + sizeof(double)) + (x->rev ? (double)x->k * 4 + 8 : 0.0);
+    b[2] = (double)(x->k + x->k2) * (sizeof(uint32_t) + sizeof(double)) + (x->rev ? (double)(x->k + x->k2) * 4 + 8
+                                                                                  : 0.0);
+    b[0] += x->k2 ? (double)sizeof(amscr__inner) : 0.0; /* the inner features with the channel's */
 }
 
 /* The build's shortlist search of SEARCH_ROWS rows: exact against the quantizer, ms a row, and

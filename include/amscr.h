@@ -96,8 +96,8 @@ extern "C" {
 
 /** Compile-time version; amscr_version_number() gives the runtime one. */
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 7
-#define AMSCR_VERSION_PATCH 1
+#define AMSCR_VERSION_MINOR 8
+#define AMSCR_VERSION_PATCH 0
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
 
@@ -1678,9 +1678,9 @@ AMSCR_API unsigned amscr_params_get_rerank_iterations(const amscr_params *p);
  *        plus s times the kNN graph of the inner distance (the shortest path inside the
  *        shape between two boundary points, which a part bent at a joint hardly changes),
  *        so neighbours both distances agree on reinforce each other. It costs under a tenth
- *        of the channel's time and changes nothing without re-ranking. An index
- *        re-ranks on the retrieval distance's graph alone: amscr_index_build gives its
- *        collection a share of 0 (amscr_index_db shows it). Set 0 for the ranking before 0.7.
+ *        of the channel's time and changes nothing without re-ranking. An index holds both
+ *        graphs (since 0.8; an index of 0.7 re-ranked on the first alone, its collection's
+ *        share 0). Set 0 for the ranking before 0.7.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (outside [0, 1), NaN).
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -2373,7 +2373,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_query_retrieval(const amscr_db *
 #define AMSCR_INDEX_CANDIDATES 256
 
 /** A retrieval index: a collection, each shape's nearest shapes under the retrieval matrix's
- *  base distance, shape signatures, optional names (amscr_index_build). @since 0.4 */
+ *  base distance (and under the inner distance, when the params give its graph a share of the
+ *  re-ranking), shape signatures, optional names (amscr_index_build). @since 0.4 */
 typedef struct amscr_index amscr_index;
 
 /**
@@ -2382,14 +2383,18 @@ typedef struct amscr_index amscr_index;
  *        shape's K (amscr_params_set_rerank_k: min(rerank_k, max(1, n / 2)); an index file of
  *        0.5 holds min(rerank_k, n)) nearest shapes under the base distance of
  *        amscr_db_retrieval_matrix (the fused distance before re-ranking), with the fusion's
- *        medians and the largest distance. candidates 0 computes the whole base matrix (the
- *        lists are exact: a query then gives exactly amscr_db_query_retrieval's scores);
- *        candidates M > 0 seeks each shape's neighbours among its min(M, 256)
+ *        medians and the largest distance; when the params give the inner distance's graph a
+ *        share (amscr_params_set_rerank_inner_share), also each shape's inner features (about
+ *        17 KB in memory, 8.7 KB in the file) and its K nearest shapes under the inner
+ *        distance. candidates 0 computes the whole base matrix (and inner matrix: the lists
+ *        are exact: a query then gives exactly amscr_db_query_retrieval's scores);
+ *        candidates M > 0 seeks each shape's neighbours among its min(M, 192)
  *        signature-nearest shapes only (O(n M) distances, for large collections; at least
  *        K - 1; fused medians estimated on 256 shapes; from 20,000 shapes each shortlist is
  *        sought among the shapes of the signature clusters nearest it, so it may miss a few
- *        of the nearest). Runs on the params' threads; the result does not depend
- *        on the thread count.
+ *        of the nearest), then among its neighbours' neighbours; the inner distance's among
+ *        the same shortlist and its base neighbours. Runs on the params' threads; the result
+ *        does not depend on the thread count.
  * @param[in]  db  the collection (copied; may be freed afterwards).
  * @param[in]  candidates  0, or the shortlist size M.
  * @param[in]  progress, user  optional progress callback (may be NULL).
@@ -2549,11 +2554,13 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_set_group(amscr_index *x, siz
 AMSCR_API const char *amscr_index_group(const amscr_index *x, size_t i);
 
 /**
- * @brief Writes the index (the collection file format, version 6 since 0.6, 4 in 0.5, 3 in
- *        0.4: amscr_db_load of it gives the collection; versions 4 and 6 also store each
- *        shape's channel features, so a load does not rebuild them; 6 adds the whitened
- *        frame's band to the settings) to a temporary name in the same folder and renames it.
- *        Every earlier version loads.
+ * @brief Writes the index (the collection file format, version 9 since 0.8, 8 in 0.7, 6 in
+ *        0.6, 4 in 0.5, 3 in 0.4: amscr_db_load of it gives the collection; versions 4 and up
+ *        also store each shape's channel features, so a load does not rebuild them; 6 adds the
+ *        whitened frame's band to the settings, 8 the inner distance's share, 9 the inner
+ *        distance's graph: its lists and each shape's inner features) to a temporary name in
+ *        the same folder and renames it. Every earlier version loads (one of 0.7 re-ranks on
+ *        one graph, as it did).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none. Thread-safety: const.
  * @since 0.4

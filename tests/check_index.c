@@ -83,21 +83,23 @@ static void assert_close(const double *a, const double *b, size_t n, double tol)
         ck_assert_msg(fabs(a[j] - b[j]) <= tol, "score %zu: %.17g vs %.17g", j, a[j], b[j]);
 }
 
-/* amscr_db_query_retrieval and the index query (every shape a candidate) against the matrix. */
-static void exact_case(double w, unsigned k)
+/* amscr_db_query_retrieval and the index query (every shape a candidate) against the matrix,
+ * the inner distance's graph at `share` of the re-ranking (0: one graph). */
+static void exact_case_share(double w, unsigned k, double share)
 {
     amscr_params *p = params_of(w, k, 2);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, share), AMSCR_OK);
     amscr_db *db = db_of(p, NSHAPES);
     amscr_descriptor *q = shape(p, 1000);
     double ref[NSHAPES], got[NSHAPES], viax[NSHAPES];
     reference_row(db, q, ref);
     ck_assert_int_eq(amscr_db_query_retrieval(db, q, NULL, NULL, got, NSHAPES), AMSCR_OK);
     assert_close(ref, got, NSHAPES, 1e-12);
-    if (w <= 0.0 || w >= 1.0) { /* an index: one graph (its collection's share is 0) */
+    if (w <= 0.0 || w >= 1.0) { /* an index: the collection's graphs */
         amscr_index *x = NULL;
         ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
-        ck_assert(amscr_params_get_rerank_inner_share(amscr_db_params(amscr_index_db(x))) == 0.0);
-        reference_row(amscr_index_db(x), q, ref);
+        ck_assert(amscr_params_get_rerank_inner_share(amscr_db_params(amscr_index_db(x))) == share);
+        ck_assert_uint_eq(x->k2, k > 0 && share > 0.0 ? x->k : 0);
         ck_assert_int_eq(amscr_index_query_scores(x, q, 0, viax, NSHAPES), AMSCR_OK);
         assert_close(ref, viax, NSHAPES, 1e-12);
         amscr_index_free(x);
@@ -106,6 +108,8 @@ static void exact_case(double w, unsigned k)
     amscr_db_free(db);
     amscr_params_free(p);
 }
+
+static void exact_case(double w, unsigned k) { exact_case_share(w, k, 0.05); }
 
 START_TEST(exact_channel_rerank) { exact_case(1.0, 8); }
 END_TEST
@@ -116,6 +120,12 @@ END_TEST
 START_TEST(exact_channel_plain) { exact_case(1.0, 0); }
 END_TEST
 START_TEST(exact_large_k) { exact_case(1.0, 40); }
+END_TEST
+START_TEST(exact_one_graph) { exact_case_share(1.0, 8, 0.0); }
+END_TEST
+START_TEST(exact_inner_heavy) { exact_case_share(1.0, 5, 0.6); }
+END_TEST
+START_TEST(exact_inner_amscr) { exact_case_share(0.0, 8, 0.3); }
 END_TEST
 
 /* Row i of the collection's own retrieval matrix. */
@@ -273,15 +283,16 @@ START_TEST(lazy_file_shapes)
 END_TEST
 
 /* The version 3 file of index x (no stored channel features, FNV-1a checksum, the 52-byte
- * retrieval block) from its version 6 bytes b (len): the groups flag (no groups), the features
- * and the whitened frame's band dropped. *out_len set. */
+ * retrieval block) from its version 9 bytes b (len; one graph): the groups flag (no groups),
+ * the features, the inner graph's count, the whitened frame's band and the inner share
+ * dropped. *out_len set. */
 static unsigned char *as_version3(const amscr_index *x, const unsigned char *b, size_t len, size_t *out_len)
 {
     void *dbuf = NULL;
     size_t dlen = 0, n = amscr_index_size(x);
     ck_assert_int_eq(amscr_db_save_memory(amscr_index_db(x), &dbuf, &dlen), AMSCR_OK);
     amscr_free(dbuf);
-    size_t feat = 12 + n * (size_t)x->nf * 2 * 64 * AMSCR__HF_BINS, keep = len - 8 - feat - 4, at = dlen - 8;
+    size_t feat = 12 + n * (size_t)x->nf * 2 * 64 * AMSCR__HF_BINS + 4, keep = len - 8 - feat - 4, at = dlen - 8;
     unsigned char *o = malloc(keep + 8);
     memcpy(o, b, keep);
     o[8] = 3;
@@ -309,6 +320,7 @@ static unsigned char *as_version3(const amscr_index *x, const unsigned char *b, 
 START_TEST(stored_features)
 {
     amscr_params *p = params_of(1.0, 8, 2);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.0), AMSCR_OK); /* all a version 3 file holds */
     /* one band for both frames: all a version 3 file can hold (it loads with the two equal) */
     ck_assert_int_eq(amscr_params_set_channel_affine_band(p, amscr_params_get_channel_band(p)), AMSCR_OK);
     amscr_index *x = named_index(p, 0), *y = NULL;
@@ -316,7 +328,7 @@ START_TEST(stored_features)
     void *buf = NULL;
     size_t len = 0, l3 = 0;
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    ck_assert_int_eq(((unsigned char *)buf)[8], 8);
+    ck_assert_int_eq(((unsigned char *)buf)[8], 9);
     ck_assert_int_eq(x->nf, 2);
     unsigned char *v3 = as_version3(x, buf, len, &l3);
     for (unsigned lazy = 0; lazy < 2; lazy++) {
@@ -359,7 +371,7 @@ START_TEST(stored_features)
     remove(path);
     /* two frames announced as one: refused */
     unsigned char *b = buf;
-    size_t at = len - 8 - (12 + NSHAPES * 2 * 2 * 64 * AMSCR__HF_BINS);
+    size_t at = len - 8 - (12 + NSHAPES * 2 * 2 * 64 * AMSCR__HF_BINS + 4);
     ck_assert_int_eq(b[at], 2);
     b[at] = 1;
     uint64_t h = amscr__db_checksum(4, b, len - 8);
@@ -373,6 +385,134 @@ START_TEST(stored_features)
     amscr_free(buf);
     amscr_index_free(x);
     amscr_descriptor_free(q);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* The trailing checksum of b (len bytes, version v) rewritten after an edit. */
+static void reseal(unsigned char *b, size_t len, uint32_t v)
+{
+    uint64_t h = amscr__db_checksum(v, b, len - 8);
+    for (int i = 0; i < 8; i++)
+        b[len - 8 + (size_t)i] = (unsigned char)(h >> (8 * i));
+}
+
+/* Index x's version 9 bytes b (len) as version 8 (0.7): the inner graph's section, `drop`
+ * bytes before the checksum, left out. *out_len set. */
+static unsigned char *as_version8(const amscr_index *x, const unsigned char *b, size_t len, size_t drop,
+                                  size_t *out_len)
+{
+    void *dbuf = NULL;
+    size_t dlen = 0, at;
+    ck_assert_int_eq(amscr_db_save_memory(amscr_index_db(x), &dbuf, &dlen), AMSCR_OK);
+    amscr_free(dbuf);
+    at = dlen - 8; /* the section's length */
+    unsigned char *o = malloc(len - drop);
+    memcpy(o, b, len - 8 - drop);
+    o[8] = 8;
+    uint64_t sec = 0;
+    for (int i = 0; i < 8; i++)
+        sec |= (uint64_t)o[at + (size_t)i] << (8 * i);
+    sec -= drop;
+    for (int i = 0; i < 8; i++)
+        o[at + (size_t)i] = (unsigned char)(sec >> (8 * i));
+    *out_len = len - drop;
+    reseal(o, *out_len, 8);
+    return o;
+}
+
+/* The inner graph's lists: itself first, by (distance, index), each distance the pair's; a
+ * full build's hold each shape's K nearest, a shortlist build's the nearest it saw. */
+START_TEST(inner_lists)
+{
+    amscr_params *p = params_of(1.0, 6, 2);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.3), AMSCR_OK);
+    amscr__inner_ws ws;
+    ck_assert_int_eq(amscr__inner_ws_init(&ws), AMSCR_OK);
+    for (size_t cand = 0; cand <= 10; cand += 10) {
+        amscr_index *x = named_index(p, cand);
+        size_t k2 = x->k2;
+        ck_assert_uint_eq(k2, x->k);
+        ck_assert_uint_eq(k2, 6);
+        for (size_t i = 0; i < NSHAPES; i++) {
+            const uint32_t *j = x->in_idx + i * k2;
+            const double *d = x->in_dist + i * k2;
+            ck_assert_uint_eq(j[0], i);
+            ck_assert(d[0] == 0.0);
+            for (size_t t = 1; t < k2; t++) {
+                ck_assert(j[t] != i && d[t] >= d[t - 1]);
+                ck_assert(d[t] == amscr__index_inner_pair(x, i, j[t], &ws));
+                ck_assert(d[t] <= x->dmax2);
+            }
+            for (size_t o = 0; cand == 0 && o < NSHAPES; o++) { /* nothing nearer outside the list */
+                size_t t = 0;
+                while (t < k2 && j[t] != o)
+                    t++;
+                if (t == k2)
+                    ck_assert(amscr__index_inner_pair(x, i, o, &ws) >= d[k2 - 1]);
+            }
+        }
+        amscr_index_free(x);
+    }
+    amscr__inner_ws_free(&ws);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* The inner graph's section of a file: a count that is not the params', a bad list entry or a
+ * feature that is not finite are refused with a detail; a version 8 file (0.7: one graph)
+ * loads to the same scores, but not one whose params give the inner graph a share. */
+START_TEST(inner_section)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_index *x = named_index(p, 0), *y = NULL;
+    size_t k2 = x->k2, fk = AMSCR__INNER_F * AMSCR__INNER_K, len = 0;
+    void *buf = NULL;
+    ck_assert_uint_gt(k2, 0);
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    size_t sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * 8 * (2 * fk + 1), at = len - 8 - sec;
+    unsigned char *b = malloc(len);
+    memcpy(b, buf, len);
+    ck_assert_uint_eq(b[at], k2);
+    b[at] = 0; /* no inner graph, the params give one */
+    reseal(b, len, 9);
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "inner graph") != NULL);
+    memcpy(b, buf, len);
+    b[at + 12] = 1; /* shape 0's inner list not starting with itself */
+    reseal(b, len, 9);
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "inner neighbour") != NULL);
+    memcpy(b, buf, len);
+    double nan = NAN;
+    memcpy(b + at + 12 + NSHAPES * k2 * 12 + 8 * 2 * fk, &nan, 8); /* shape 0's norm */
+    reseal(b, len, 9);
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);
+    ck_assert_ptr_null(y);
+    size_t l8 = 0;
+    unsigned char *v8 = as_version8(x, buf, len, sec, &l8);
+    ck_assert_int_eq(amscr_index_load_memory(v8, l8, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "no inner graph") != NULL);
+    free(v8);
+    free(b);
+    amscr_free(buf);
+    amscr_index_free(x);
+    /* one graph: a version 8 file is the version 9 file without its inner count */
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.0), AMSCR_OK);
+    x = named_index(p, 0);
+    ck_assert_uint_eq(x->k2, 0);
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    v8 = as_version8(x, buf, len, 4, &l8);
+    ck_assert_int_eq(amscr_index_load_memory(v8, l8, &y), AMSCR_OK);
+    amscr_descriptor *q = shape(p, 2000);
+    same_query(x, y, q, 0);
+    same_query(x, y, q, 6);
+    amscr_descriptor_free(q);
+    free(v8);
+    amscr_free(buf);
+    amscr_index_free(x);
+    amscr_index_free(y);
     amscr_params_free(p);
 }
 END_TEST
@@ -392,6 +532,11 @@ START_TEST(round_trips)
     same_query(x, y, q, 0);
     same_query(x, z, q, 0);
     same_query(x, y, q, 6);
+    /* the inner graph: its lists and features as built */
+    ck_assert_uint_gt(x->k2, 0);
+    ck_assert(memcmp(x->in_idx, y->in_idx, NSHAPES * x->k2 * sizeof *x->in_idx) == 0);
+    ck_assert(memcmp(x->in_dist, z->in_dist, NSHAPES * x->k2 * sizeof *x->in_dist) == 0);
+    ck_assert(memcmp(x->inner, y->inner, NSHAPES * sizeof *x->inner) == 0 && x->dmax2 == y->dmax2);
     ck_assert_str_eq(amscr_index_name(y, 3), "three.png");
     ck_assert_ptr_null(amscr_index_name(y, 4));
     ck_assert_str_eq(amscr_index_class_name(z, 2), "bird");
@@ -435,7 +580,7 @@ START_TEST(bad_files)
         ck_assert_int_ne(amscr_index_load_memory(b, len, &y), AMSCR_OK);
     }
     memcpy(b, buf, len);
-    b[8] = 9; /* a newer version */
+    b[8] = AMSCR__DB_VERSION_NEWEST + 1; /* a newer version */
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "newer") != NULL);
     memcpy(b, "AMSCRIDX", 8); /* the tool's index before 0.4 */
@@ -688,6 +833,11 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, exact_fused_rerank);
     tcase_add_test(tc, exact_channel_plain);
     tcase_add_test(tc, exact_large_k);
+    tcase_add_test(tc, exact_one_graph);
+    tcase_add_test(tc, exact_inner_heavy);
+    tcase_add_test(tc, exact_inner_amscr);
+    tcase_add_test(tc, inner_lists);
+    tcase_add_test(tc, inner_section);
     tcase_add_test(tc, member_rows);
     tcase_add_test(tc, round_trips);
     tcase_add_test(tc, lazy_load);

@@ -13,7 +13,8 @@
  * the shapes' channel features too, and the trailing checksum is amscr__sum64 instead of
  * FNV-1a; 5 and 6 (0.6): 2 and 4 (FNV-1a and amscr__sum64) with the longer retrieval block (the whitened frame's band
  * after the others; AMSCR__RETRIEVAL_BLOCK_V2); 7 and 8 (0.7): the same with the inner-distance
- * graph's share after those (AMSCR__RETRIEVAL_BLOCK_V3). Every version loads. */
+ * graph's share after those (AMSCR__RETRIEVAL_BLOCK_V3); 9 (0.8): 8 whose index section ends with
+ * the inner distance's graph (its lists and the shapes' inner features). Every version loads. */
 #define AMSCR__DB_VERSION_PLAIN 2u
 #define AMSCR__DB_VERSION_INDEX 3u
 #define AMSCR__DB_VERSION_FEATURES 4u
@@ -21,20 +22,22 @@
 #define AMSCR__DB_VERSION_INDEX_BANDS 6u
 #define AMSCR__DB_VERSION_PLAIN_INNER 7u
 #define AMSCR__DB_VERSION_INDEX_INNER 8u
-#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_INNER
+#define AMSCR__DB_VERSION_INDEX_GRAPHS 9u
+#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_GRAPHS
 
 /* Whether a file of `version` is an index file (an index section after the shapes). */
 static inline int amscr__db_is_index(uint32_t version)
 {
     return version == AMSCR__DB_VERSION_INDEX || version == AMSCR__DB_VERSION_FEATURES ||
-           version == AMSCR__DB_VERSION_INDEX_BANDS || version == AMSCR__DB_VERSION_INDEX_INNER;
+           version == AMSCR__DB_VERSION_INDEX_BANDS || version == AMSCR__DB_VERSION_INDEX_INNER ||
+           version == AMSCR__DB_VERSION_INDEX_GRAPHS;
 }
 
 /* Whether an index file of `version` stores the shapes' channel features. */
 static inline int amscr__db_has_features(uint32_t version)
 {
     return version == AMSCR__DB_VERSION_FEATURES || version == AMSCR__DB_VERSION_INDEX_BANDS ||
-           version == AMSCR__DB_VERSION_INDEX_INNER;
+           version == AMSCR__DB_VERSION_INDEX_INNER || version == AMSCR__DB_VERSION_INDEX_GRAPHS;
 }
 
 /* The bytes of the retrieval block in a file of `version` (0: none). */

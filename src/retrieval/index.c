@@ -5,6 +5,24 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The inner graph's arrays grown to cap rows (nothing without the graph); 0 when out of memory. */
+static int reserve_inner(amscr_index *x, size_t cap)
+{
+    size_t k2 = x->k2;
+    if (k2 == 0)
+        return 1;
+    amscr__inner *f = cap > SIZE_MAX / sizeof *f ? NULL : realloc(x->inner, cap * sizeof *f);
+    if (f)
+        x->inner = f;
+    uint32_t *ni = cap > SIZE_MAX / k2 / sizeof *ni ? NULL : realloc(x->in_idx, cap * k2 * sizeof *ni);
+    if (ni)
+        x->in_idx = ni;
+    double *nd = cap > SIZE_MAX / k2 / sizeof *nd ? NULL : realloc(x->in_dist, cap * k2 * sizeof *nd);
+    if (nd)
+        x->in_dist = nd;
+    return f && ni && nd;
+}
+
 amscr_status amscr__index_reserve(amscr_index *x, size_t n)
 {
     if (n <= x->cap)
@@ -32,6 +50,7 @@ amscr_status amscr__index_reserve(amscr_index *x, size_t n)
     double *nd = cap > SIZE_MAX / k / sizeof *nd ? NULL : realloc(x->nb_dist, cap * k * sizeof *nd);
     if (nd)
         x->nb_dist = nd;
+    int inner_ok = reserve_inner(x, cap);
     char **nm = realloc(x->names, cap * sizeof *nm);
     if (nm) {
         x->names = nm;
@@ -44,7 +63,7 @@ amscr_status amscr__index_reserve(amscr_index *x, size_t n)
         for (size_t i = x->cap; i < cap; i++)
             gr[i] = NULL;
     }
-    if (!sig || !lb || !hf || !ni || !nd || !nm || !gr)
+    if (!sig || !lb || !hf || !ni || !nd || !inner_ok || !nm || !gr)
         return amscr__fail(AMSCR_E_NOMEM, "index: out of memory for %zu shapes", n);
     x->cap = cap;
     return AMSCR_OK;
@@ -67,9 +86,8 @@ amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
     x->sig_dim = AMSCR__SIG_DIM;
     x->nf = amscr__index_frames(p);
     x->k = n > 0 ? amscr__rerank_k(p, n) : 0;
-    amscr_params q = *p; /* an index re-ranks on the retrieval distance's graph alone */
-    q.rerank_inner_share = 0.0;
-    amscr_status st = amscr_db_new(&q, &x->db);
+    x->k2 = amscr__index_k2(p, x->k);
+    amscr_status st = amscr_db_new(p, &x->db);
     for (size_t i = 0; st == AMSCR_OK && i < n; i++)
         st = amscr_db_add_descriptor(x->db, amscr_db_descriptor(db, i), amscr_db_label(db, i), NULL);
     if (st == AMSCR_OK)
@@ -118,6 +136,9 @@ void amscr_index_free(amscr_index *x)
     free(x->sig_lb);
     free(x->nb_idx);
     free(x->nb_dist);
+    free(x->inner);
+    free(x->in_idx);
+    free(x->in_dist);
     amscr__index_reverse_free(x);
     amscr_db_free(x->db);
     free(x);

@@ -5,6 +5,7 @@
 #define AMSCR_INDEX_H
 
 #include "channel.h"
+#include "inner.h"
 #include "internal.h"
 #include "rows.h"
 #include "signature.h"
@@ -28,13 +29,20 @@ struct amscr_index {
     size_t map_len;
     uint32_t *nb_idx;     /* n x k: itself first, then by (base distance, index) */
     double *nb_dist;      /* n x k */
+    size_t k2;            /* the inner distance's graph (index_inner.c): k when the params give it a share of
+                           * the re-ranking, else 0 (and the three below NULL) */
+    double dmax2;         /* largest inner distance of the collection */
+    amscr__inner *inner;  /* n inner features */
+    uint32_t *in_idx;     /* n x k2: itself first, then by (inner distance, index) */
+    double *in_dist;      /* n x k2 */
     char **names;         /* n entries (NULL: unnamed) */
     char **groups;        /* n entries (NULL: no group) */
     char **classes;       /* class name of label L (0 <= L < nclasses; NULL: unnamed) */
     size_t nclasses;
     size_t cap;           /* allocated rows of sig, nb_*, names */
     size_t *rev_start;    /* n + 1 offsets into rev (NULL: not built; a query builds its own) */
-    uint32_t *rev;        /* rows i holding shape j in their lists: rev[rev_start[j]..rev_start[j+1]) */
+    uint32_t *rev;        /* rows i holding shape j in their lists (either graph's; a row twice when both):
+                           * rev[rev_start[j]..rev_start[j+1]) */
 };
 
 /* How the base distance of the retrieval matrix (fuse.c) is computed pair by pair. */
@@ -100,10 +108,11 @@ size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const floa
                               size_t *cand);
 
 /* The scores (n entries) of row `self` (n: a query; < n: that shape of the index) against every
- * shape from its base distances dq[t] to the m candidates cand[t] (ascending): the row of the
+ * shape from its base distances dq[t] to the m candidates cand[t] (ascending) and, for a query
+ * of an index with the inner graph, its inner distances dq2[t] (else NULL): the row of the
  * retrieval matrix of the collection plus the query, or of the collection. */
-amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t *cand, const double *dq, size_t m,
-                                 double *out);
+amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t *cand, const double *dq,
+                                 const double *dq2, size_t m, double *out);
 /* Rows first..n-1 from their M signature-nearest shapes (index_build.c); x->dmax grows. */
 amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_progress_fn progress, void *user);
 /* Rows first..n-1's lists (their K nearest among their shortlists S, m each, ascending) refined
@@ -118,6 +127,21 @@ void amscr__index_detach_map(amscr_index *x);
  * file (AMSCR_INDEX_LAZY: the index keeps the mapping, its shapes decoded from it when needed);
  * the mapping is the callee's either way (unmapped when not kept). */
 amscr_status amscr__index_load_mapped(unsigned char *buf, size_t len, unsigned flags, amscr_index **out);
+/* The inner graph's neighbours a shape of an index of k neighbours with params p: k when p gives
+ * the inner distance a share of the re-ranking, else 0. */
+size_t amscr__index_k2(const amscr_params *p, size_t k);
+/* The inner distance of shapes i and j of x, computed as the matrix cell of the two (the lower
+ * index first). */
+double amscr__index_inner_pair(const amscr_index *x, size_t i, size_t j, amscr__inner_ws *ws);
+/* Lists from the full inner matrix (index_inner.c): x->in_*, x->dmax2. */
+amscr_status amscr__index_inner_full(amscr_index *x);
+/* Rows first..n-1's inner lists among their shortlists S (m each) and their base lists (a
+ * shortlist build); x->dmax2 grows. */
+amscr_status amscr__index_inner_rows(amscr_index *x, size_t first, const uint32_t *S, size_t m);
+/* Shape j (new, at distance d) into row i's list (idx, dist: k entries) when nearer than its
+ * last entry (ties: j stays behind). */
+void amscr__index_enter_list(uint32_t *idx, double *dist, size_t k, size_t j, double d);
+
 /* db can be indexed (closed curves for the channel, at most 2^32 - 1 shapes). */
 amscr_status amscr__index_check_db(const amscr_db *db, const char *what);
 

@@ -20,28 +20,9 @@ static const char *differing_option(const amscr_params *a, const amscr_params *b
     CMP(method) CMP(closed) CMP(reflections) CMP(parametrization) CMP(presmooth) CMP(arclength_passes)
     CMP(oversampling) CMP(kmax) CMP(symmetric) CMP(refine) CMP(invariance) CMP(penalty) CMP(channel_weight)
     CMP(channel_invariance) CMP(channel_affine_share) CMP(channel_band) CMP(channel_affine_band) CMP(channel_skip)
-    CMP(channel_locality) CMP(rerank_k) CMP(rerank_iterations)
+    CMP(channel_locality) CMP(rerank_k) CMP(rerank_iterations) CMP(rerank_inner_share)
 #undef CMP
     return NULL;
-}
-
-/* Shape j (new) into row i's list when it is nearer than the list's last entry (ties: j has the
- * highest index so far and stays behind). */
-static void enter_list(amscr_index *x, size_t i, size_t j, double d)
-{
-    size_t k = x->k;
-    uint32_t *ni = x->nb_idx + i * k;
-    double *nd = x->nb_dist + i * k;
-    if (k < 2 || !(d < nd[k - 1]))
-        return;
-    size_t t = k - 1;
-    while (t > 1 && nd[t - 1] > d) {
-        ni[t] = ni[t - 1];
-        nd[t] = nd[t - 1];
-        t--;
-    }
-    ni[t] = (uint32_t)j;
-    nd[t] = d;
 }
 
 /* New rows j0..j1-1 computed on threads: each one's shortlist and base distances. */
@@ -51,12 +32,38 @@ typedef struct {
     size_t j0, n;
     size_t *cand; /* (j1 - j0) x n */
     double *cd;
+    double *cd2;  /* the inner distances (with the inner graph) */
     size_t *m;
 } add_ctx;
 
-static amscr_status add_pw_init(void *ctx, void **scratch)
+/* A thread's scratch: the base distance's, and the inner distance's. */
+typedef struct {
+    void *pw;
+    amscr__inner_ws iw;
+} add_ws;
+
+static void add_ws_free(void *scratch)
 {
-    return amscr__pair_ws_new(&((add_ctx *)ctx)->b, scratch);
+    add_ws *w = scratch;
+    amscr__pair_ws_delete(w->pw);
+    amscr__inner_ws_free(&w->iw);
+    free(w);
+}
+
+static amscr_status add_ws_init(void *ctx, void **scratch)
+{
+    add_ws *w = calloc(1, sizeof *w);
+    if (!w)
+        return AMSCR_E_NOMEM;
+    amscr_status st = amscr__pair_ws_new(&((add_ctx *)ctx)->b, &w->pw);
+    if (st == AMSCR_OK && amscr__inner_ws_init(&w->iw) != AMSCR_OK)
+        st = AMSCR_E_NOMEM;
+    if (st != AMSCR_OK) {
+        add_ws_free(w);
+        return st;
+    }
+    *scratch = w;
+    return AMSCR_OK;
 }
 
 static amscr_status add_distances(void *ctx, size_t j, void *scratch)
@@ -70,7 +77,10 @@ static amscr_status add_distances(void *ctx, size_t j, void *scratch)
         return AMSCR_E_NOMEM;
     c->m[r] = m;
     const amscr__hf *hq = x->nf ? x->hf + j * (size_t)x->nf : NULL;
-    return amscr__base_pairs(&c->b, x->db, x->hf, amscr_db_descriptor(x->db, j), hq, j, cand, m, scratch,
+    add_ws *w = scratch;
+    for (size_t t = 0; x->k2 > 0 && t < m; t++)
+        c->cd2[r * c->n + t] = amscr__index_inner_pair(x, cand[t], j, &w->iw);
+    return amscr__base_pairs(&c->b, x->db, x->hf, amscr_db_descriptor(x->db, j), hq, j, cand, m, w->pw,
                              c->cd + r * c->n);
 }
 
@@ -79,18 +89,26 @@ static amscr_status add_distances(void *ctx, size_t j, void *scratch)
 static amscr_status add_rows(add_ctx *c, size_t j1, size_t n0)
 {
     amscr_index *x = c->x;
-    amscr__rows_fn f = {add_pw_init, amscr__pair_ws_delete, add_distances, c, NULL};
+    amscr__rows_fn f = {add_ws_init, add_ws_free, add_distances, c, NULL};
     amscr_status st = amscr__run_rows(&f, c->j0, j1, c->b.threads, NULL, NULL);
+    size_t k = x->k, k2 = x->k2;
     for (size_t j = c->j0; st == AMSCR_OK && j < j1; j++) {
         size_t r = j - c->j0, m = c->m[r], *cand = c->cand + r * c->n;
-        double *cd = c->cd + r * c->n;
+        double *cd = c->cd + r * c->n, *cd2 = c->cd2 + r * c->n;
         for (size_t t = 0; t < m; t++) {
             x->dmax = cd[t] > x->dmax ? cd[t] : x->dmax;
             if (cand[t] < n0)
-                enter_list(x, cand[t], j, cd[t]);
+                amscr__index_enter_list(x->nb_idx + cand[t] * k, x->nb_dist + cand[t] * k, k, j, cd[t]);
         }
-        if (x->k > 0)
-            st = amscr__knn_select(j, cand, cd, m, x->k, x->nb_idx + j * x->k, x->nb_dist + j * x->k);
+        for (size_t t = 0; k2 > 0 && t < m; t++) {
+            x->dmax2 = cd2[t] > x->dmax2 ? cd2[t] : x->dmax2;
+            if (cand[t] < n0)
+                amscr__index_enter_list(x->in_idx + cand[t] * k2, x->in_dist + cand[t] * k2, k2, j, cd2[t]);
+        }
+        if (k > 0)
+            st = amscr__knn_select(j, cand, cd, m, k, x->nb_idx + j * k, x->nb_dist + j * k);
+        if (st == AMSCR_OK && k2 > 0)
+            st = amscr__knn_select(j, cand, cd2, m, k2, x->in_idx + j * k2, x->in_dist + j * k2);
     }
     return st;
 }
@@ -111,21 +129,24 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
     if (st == AMSCR_OK && kp != x->k && n0 > 0) /* a list grows with the collection: rebuild */
         return amscr__fail(AMSCR_E_STATE, "amscr_index_add: the index holds %zu neighbours a shape and needs %zu "
                                           "with %zu shapes; rebuild it", x->k, kp, n);
-    if (st == AMSCR_OK && n0 == 0)
+    if (st == AMSCR_OK && n0 == 0) {
         x->k = kp;
+        x->k2 = amscr__index_k2(p, kp);
+    }
     if (st == AMSCR_OK)
         st = amscr__index_reserve(x, n);
     for (size_t i = 0; st == AMSCR_OK && i < add; i++)
         st = amscr_db_add_descriptor(x->db, amscr_db_descriptor(shapes, i), amscr_db_label(shapes, i), NULL);
     if (st == AMSCR_OK)
         st = amscr__index_features(x, n0, 0);
-    add_ctx c = {x, {0}, n0, n, NULL, NULL, NULL};
+    add_ctx c = {x, {0}, n0, n, NULL, NULL, NULL, NULL};
     amscr__base_init(&c.b, p, x->med_a, x->med_h);
     size_t batch = 4 * (size_t)c.b.threads; /* rows computed together (memory: batch x n) */
     c.cand = st == AMSCR_OK ? amscr__malloc_array(batch, n * sizeof *c.cand) : NULL;
     c.cd = st == AMSCR_OK ? amscr__malloc_array(batch, n * sizeof *c.cd) : NULL;
+    c.cd2 = st == AMSCR_OK && x->k2 > 0 ? amscr__malloc_array(batch, n * sizeof *c.cd2) : NULL;
     c.m = st == AMSCR_OK ? amscr__malloc_array(batch, sizeof *c.m) : NULL;
-    if (st == AMSCR_OK && (!c.cand || !c.cd || !c.m))
+    if (st == AMSCR_OK && (!c.cand || !c.cd || (x->k2 > 0 && !c.cd2) || !c.m))
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_index_add: out of memory");
     for (size_t j = n0; st == AMSCR_OK && j < n; j += batch) {
         if (progress && progress(user, j - n0, add) != 0)
@@ -140,6 +161,7 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
         st = amscr__index_reverse(x); /* the lists changed: their reverse for the queries */
     free(c.cand);
     free(c.cd);
+    free(c.cd2);
     free(c.m);
     return st;
 }

@@ -55,6 +55,20 @@ amscr_status amscr__knn_select(size_t i, const size_t *cj, const double *cd, siz
     return AMSCR_OK;
 }
 
+void amscr__index_enter_list(uint32_t *idx, double *dist, size_t k, size_t j, double d)
+{
+    if (k < 2 || !(d < dist[k - 1]))
+        return;
+    size_t t = k - 1;
+    while (t > 1 && dist[t - 1] > d) {
+        idx[t] = idx[t - 1];
+        dist[t] = dist[t - 1];
+        t--;
+    }
+    idx[t] = (uint32_t)j;
+    dist[t] = d;
+}
+
 size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,
                               size_t *cand)
 {
@@ -91,7 +105,7 @@ static amscr_status build_full(amscr_index *x, amscr_progress_fn progress, void 
     }
     free(D);
     free(cj);
-    return st;
+    return st == AMSCR_OK ? amscr__index_inner_full(x) : st;
 }
 
 /* The fusion's medians estimated on at most MEDIAN_SAMPLE shapes spread evenly. */
@@ -252,6 +266,8 @@ amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_pro
         st = amscr__run_rows(&f3, first, n, c.b.threads, NULL, NULL);
     if (st == AMSCR_OK)
         st = amscr__index_refine(x, &c.b, first, c.S, m);
+    if (st == AMSCR_OK)
+        st = amscr__index_inner_rows(x, first, c.S, m);
     for (size_t t = 0; st == AMSCR_OK && t < rows * m; t++)
         x->dmax = c.D[t] > x->dmax ? c.D[t] : x->dmax;
     free(c.S);

@@ -1,8 +1,9 @@
 /* index_features.c — what an index keeps of each shape for matching, computed once per shape
  * (after a build, an add or a load) on the params' threads: its shortlist signature with the
- * signature's lower-bound vector (signature.h) and its channel features in every frame of the
- * channel (channel.h), so a query or a row matches a shape without rebuilding anything. A
- * load from a file that holds the features' heights computes only their spectra; a lazy load
+ * signature's lower-bound vector (signature.h), its channel features in every frame of the
+ * channel (channel.h) and, with the inner distance's graph, its inner features (inner.h), so a
+ * query or a row matches a shape without rebuilding anything. A load from a file that holds
+ * the features' heights computes only their spectra (the inner features it reads); a lazy load
  * nothing (index_pairs.c computes what a pair needs). */
 #include "index.h"
 
@@ -53,5 +54,7 @@ amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig)
     amscr__rows_fn f = {NULL, NULL, feat_row, &j, NULL};
     amscr__index_reverse_free(x);
     amscr_status st = amscr__run_rows(&f, first, amscr_db_size(x->db), j.b.threads, NULL, NULL);
+    if (st == AMSCR_OK && !have_sig && x->k2 > 0) /* a load reads the inner features (index_io.c) */
+        st = amscr__inner_features(x->db, first, j.b.threads, x->inner);
     return st == AMSCR_OK && have_sig && first == 0 ? amscr__index_reverse(x) : st;
 }

@@ -1,5 +1,6 @@
-/* index_io.c — the index file: a collection file (db_io.c) of version 8 (6 in 0.6, 4 in 0.5, 3 in 0.4) whose
- * index section follows the shapes, so amscr_db_load of an index file gives its collection.
+/* index_io.c — the index file: a collection file (db_io.c) of version 9 (8 in 0.7, 6 in 0.6, 4
+ * in 0.5, 3 in 0.4) whose index section follows the shapes, so amscr_db_load of an index file
+ * gives its collection.
  * Little-endian:
  *   u64 section length (the bytes up to the trailing checksum), then
  *   u32 sig_dim, u32 4 (bytes of a signature value), u64 k, u64 candidates (0: full lists),
@@ -11,7 +12,11 @@
  *   versions 4, 6 and 8: u32 1 and n group names, or u32 0 (no shape has one); then the channel
  *     features: u32 frames F (0: no channel), u32 samples N, u32 bins B (AMSCR__HF_BINS), and
  *     per shape, per frame, its quantized height sequences (channel.h), forward then mirrored:
- *     2 N B bytes (F = 2, N = 128: 8 KB a shape).
+ *     2 N B bytes (F = 2, N = 128: 8 KB a shape);
+ *   version 9: then the inner distance's graph: u32 K2 (0: none; else K, when the params give it a
+ *     share), f64 its largest distance, n x K2 x (u32 neighbour, f64 distance) as the lists above,
+ *     and per shape its inner features (inner.h): F K f64 re, F K f64 im, f64 norm2 (8.7 KB a
+ *     shape; the reversed orientation's twist is recomputed).
  * Every count is bounded by the bytes left before anything is allocated; F, N and B must be the
  * params' (any byte is a valid height). The features' spectra are not stored: a load computes
  * them from the heights (an FFT, a fifth of building the features), or, with AMSCR_INDEX_LAZY,
@@ -86,6 +91,25 @@ static amscr_status write_features(const amscr_index *x, amscr__wbuf *w)
     return st;
 }
 
+/* The inner distance's graph (version 9). */
+static void write_inner(const amscr_index *x, amscr__wbuf *w)
+{
+    size_t n = amscr_db_size(x->db), k2 = x->k2;
+    amscr__w_u32(w, (uint32_t)k2);
+    if (k2 == 0)
+        return;
+    amscr__w_f64(w, x->dmax2);
+    for (size_t i = 0; i < n * k2; i++) {
+        amscr__w_u32(w, x->in_idx[i]);
+        amscr__w_f64(w, x->in_dist[i]);
+    }
+    for (size_t i = 0; i < n; i++) {
+        amscr__w_f64s(w, &x->inner[i].re[0][0], AMSCR__INNER_F * AMSCR__INNER_K);
+        amscr__w_f64s(w, &x->inner[i].im[0][0], AMSCR__INNER_F * AMSCR__INNER_K);
+        amscr__w_f64(w, x->inner[i].norm2);
+    }
+}
+
 amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_t *out_len)
 {
     amscr__clear_error();
@@ -96,11 +120,13 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
     if (st != AMSCR_OK)
         return st;
     amscr__wbuf w = {NULL, 0, 0, 0};
-    amscr__db_write(x->db, AMSCR__DB_VERSION_INDEX_INNER, &w);
+    amscr__db_write(x->db, AMSCR__DB_VERSION_INDEX_GRAPHS, &w);
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
     write_section(x, &w);
     st = write_features(x, &w);
+    if (st == AMSCR_OK)
+        write_inner(x, &w);
     if (st != AMSCR_OK) {
         free(w.buf);
         return st;
@@ -109,7 +135,7 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
         uint64_t sec = (uint64_t)(w.len - at - 8);
         for (int i = 0; i < 8; i++)
             w.buf[at + (size_t)i] = (unsigned char)(sec >> (8 * i));
-        amscr__w_u64(&w, amscr__db_checksum(AMSCR__DB_VERSION_INDEX_INNER, w.buf, w.len));
+        amscr__w_u64(&w, amscr__db_checksum(AMSCR__DB_VERSION_INDEX_GRAPHS, w.buf, w.len));
     }
     if (w.oom) {
         free(w.buf);
@@ -159,6 +185,7 @@ static amscr_status read_header(amscr__rbuf *r, amscr_index *x)
           isfinite(x->med_h)))
         return amscr__fail(AMSCR_E_FORMAT, "index file: bad largest distance or medians");
     x->k = (size_t)k;
+    x->k2 = amscr__index_k2(p, x->k);
     x->candidates = (size_t)m;
     uint64_t need = (uint64_t)n * (4u * sig_dim + 12u * k);
     if (need / (n ? n : 1) != 4u * sig_dim + 12u * k || need > r->len - r->pos)
@@ -166,27 +193,33 @@ static amscr_status read_header(amscr__rbuf *r, amscr_index *x)
     return amscr__index_reserve(x, n);
 }
 
+/* n lists of k (neighbour, distance) into idx, dist: row i itself first, then by distance. */
+static amscr_status read_list(amscr__rbuf *r, size_t n, size_t k, uint32_t *idx, double *dist, const char *what)
+{
+    for (size_t i = 0; i < n; i++)
+        for (size_t t = 0; t < k; t++) {
+            uint32_t j = amscr__r_u32(r);
+            double d = amscr__r_f64(r);
+            if (r->bad || j >= n || (t == 0) != (j == i) || !(d >= 0.0) || !isfinite(d) ||
+                (t > 0 && d < dist[i * k + t - 1]))
+                return amscr__fail(AMSCR_E_FORMAT, "index file: shape %zu's %sneighbour %zu is invalid", i, what, t);
+            idx[i * k + t] = j;
+            dist[i * k + t] = d;
+        }
+    return AMSCR_OK;
+}
+
 /* Signatures and neighbour lists. */
 static amscr_status read_lists(amscr__rbuf *r, amscr_index *x)
 {
-    size_t n = amscr_db_size(x->db), k = x->k;
+    size_t n = amscr_db_size(x->db);
     for (size_t i = 0; i < n * x->sig_dim; i++) {
         uint32_t u = amscr__r_u32(r);
         memcpy(&x->sig[i], &u, sizeof u);
         if (r->bad || !isfinite(x->sig[i]))
             return amscr__fail(AMSCR_E_FORMAT, "index file: a signature is not finite");
     }
-    for (size_t i = 0; i < n; i++)
-        for (size_t t = 0; t < k; t++) {
-            uint32_t j = amscr__r_u32(r);
-            double d = amscr__r_f64(r);
-            if (r->bad || j >= n || (t == 0) != (j == i) || !(d >= 0.0) || !isfinite(d) ||
-                (t > 0 && d < x->nb_dist[i * k + t - 1]))
-                return amscr__fail(AMSCR_E_FORMAT, "index file: shape %zu's neighbour %zu is invalid", i, t);
-            x->nb_idx[i * k + t] = j;
-            x->nb_dist[i * k + t] = d;
-        }
-    return AMSCR_OK;
+    return read_list(r, n, x->k, x->nb_idx, x->nb_dist, "");
 }
 
 /* Shape names and class names, then the groups (version 3: when bytes are left). */
@@ -249,10 +282,50 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
     return AMSCR_OK;
 }
 
-/* What follows the names: the features (versions 4, 6 and 8), then nothing. */
+/* The inner distance's graph of a version 9 file (its K2 must be the params'). */
+static amscr_status read_inner(amscr__rbuf *r, amscr_index *x)
+{
+    size_t n = amscr_db_size(x->db), fk = AMSCR__INNER_F * AMSCR__INNER_K;
+    uint32_t k2 = amscr__r_u32(r);
+    if (r->bad || k2 != x->k2)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: an inner graph of %u neighbours a shape; the params give %zu",
+                           (unsigned)k2, x->k2);
+    if (k2 == 0)
+        return AMSCR_OK;
+    x->dmax2 = amscr__r_f64(r);
+    if (r->bad || !(x->dmax2 >= 0.0) || !isfinite(x->dmax2))
+        return amscr__fail(AMSCR_E_FORMAT, "index file: bad largest inner distance");
+    size_t per = 12 * (size_t)k2 + 8 * (2 * fk + 1);
+    if ((r->len - r->pos) / per < n)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: the inner graph is truncated");
+    amscr_status st = read_list(r, n, k2, x->in_idx, x->in_dist, "inner ");
+    amscr__inner_ws ws;
+    if (st != AMSCR_OK)
+        return st;
+    if (amscr__inner_ws_init(&ws) != AMSCR_OK)
+        return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
+    for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
+        amscr__inner *f = &x->inner[i];
+        if (!amscr__r_f64s(r, &f->re[0][0], fk) || !amscr__r_f64s(r, &f->im[0][0], fk) ||
+            !amscr__r_f64s(r, &f->norm2, 1) || !(f->norm2 >= 0.0))
+            st = amscr__fail(AMSCR_E_FORMAT, "index file: shape %zu's inner features are invalid", i);
+        else
+            amscr__inner_twist(f, &ws);
+    }
+    amscr__inner_ws_free(&ws);
+    return st;
+}
+
+/* What follows the names: the features (versions 4, 6, 8 and 9), the inner graph (9), then
+ * nothing. */
 static amscr_status read_rest(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
     amscr_status st = amscr__db_has_features(version) ? read_features(r, x) : AMSCR_OK;
+    if (st == AMSCR_OK && version >= AMSCR__DB_VERSION_INDEX_GRAPHS)
+        st = read_inner(r, x);
+    else if (st == AMSCR_OK && x->k2 > 0)
+        st = amscr__fail(AMSCR_E_FORMAT, "index file: format %u has no inner graph, its params give one",
+                         (unsigned)version);
     if (st == AMSCR_OK && r->pos != r->len)
         st = amscr__fail(AMSCR_E_FORMAT, "index file: %zu unexpected bytes after the index section",
                          r->len - r->pos);

@@ -9,7 +9,9 @@
  * so row q is sum_t P^t (e_q P^t)^T + P^T (e_q P^T P)^T (as columns): sparse vector products
  * only, O(T^2 (n+1) K) instead of the O(T n^2 K) of the whole matrix. Adding the query
  * changes the neighbour list of every shape it is nearer to than that shape's K-th
- * neighbour, and nothing else, so the stored lists (plus the query) give P exactly. */
+ * neighbour, and nothing else, so the stored lists (plus the query) give P exactly. With the
+ * inner distance's graph, P = (1 - s) P1 + s P2: a row holds both lists (2K entries), each
+ * normalized to its share, and the query enters each list by its own distance. */
 #include "index.h"
 
 #include <math.h>
@@ -19,28 +21,33 @@
 /* The graph of the n + 1 (or n) shapes, its rows built on demand: a query touches only the
  * shapes its diffusion reaches, never the whole collection. */
 typedef struct {
-    size_t n, k;           /* rows (the query last, when there is one), k entries each */
+    size_t n, k, k2, kk;   /* rows (the query last, when there is one), kk = k + k2 entries each: k of the
+                            * base distance's graph, then k2 of the inner distance's (0: one graph) */
     uint32_t *j;           /* neighbours */
-    double *d, *w;         /* base distances, then the row-normalized affinities */
+    double *d, *w;         /* base (then inner) distances, then the affinities */
     unsigned char *state;  /* per row: 0 not built, 1 list built, 2 affinities too */
     const amscr_index *x;
     const double *dfull;   /* the query's distances (dfull[i] where have[i]) */
+    const double *dfull2;  /* and its inner distances (with the inner graph) */
     const unsigned char *have;
     int query;             /* row n - 1 is the query */
-    double tiny;
+    double tiny, tiny2;
+    double share;          /* the inner graph's share of a row's mass */
     const size_t *rs;      /* the stored lists' reverse (x's or built for this query) */
     const uint32_t *rv;
     const size_t *cand;    /* the query's candidates (the rows it may enter) */
     size_t m;
 } graph;
 
-static amscr_status graph_alloc(graph *g, size_t n, size_t k)
+static amscr_status graph_alloc(graph *g, size_t n, size_t k, size_t k2)
 {
     g->n = n;
     g->k = k;
-    g->j = amscr__malloc_array(n, k * sizeof *g->j);
-    g->d = amscr__malloc_array(n, k * sizeof *g->d);
-    g->w = amscr__malloc_array(n, k * sizeof *g->w);
+    g->k2 = k2;
+    g->kk = k + k2;
+    g->j = amscr__malloc_array(n, g->kk * sizeof *g->j);
+    g->d = amscr__malloc_array(n, g->kk * sizeof *g->d);
+    g->w = amscr__malloc_array(n, g->kk * sizeof *g->w);
     g->state = amscr__calloc_array(n, 1);
     return g->j && g->d && g->w && g->state ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
 }
@@ -53,73 +60,105 @@ static void graph_free(graph *g)
     free(g->state);
 }
 
-/* Row i of the graph: its stored list (x->k entries) with the query (index g->n - 1, distance
- * dq) merged in by (distance, index) when `have`, the first g->k kept. */
-static void collection_row(const amscr_index *x, size_t i, double dq, int have, graph *g)
+/* k entries (j, d) of a row from a stored list (sj, sd: ks entries) with the query (index q,
+ * distance dq) merged in by (distance, index) when `have`. */
+static void merge_row(const uint32_t *sj, const double *sd, size_t ks, size_t q, double dq, int have, size_t k,
+                      uint32_t *j, double *d)
 {
-    size_t k = g->k, ks = x->k, q = g->n - 1, o = 0;
-    const uint32_t *sj = x->nb_idx + i * ks;
-    const double *sd = x->nb_dist + i * ks;
+    size_t o = 0;
     int placed = !have;
     for (size_t t = 0; t < k; t++) {
         if (!placed && (o >= ks || (o > 0 && sd[o] > dq))) { /* ties: the query's index is the highest */
-            g->j[i * k + t] = (uint32_t)q;
-            g->d[i * k + t] = dq;
+            j[t] = (uint32_t)q;
+            d[t] = dq;
             placed = 1;
         } else { /* (past the stored list only for a shape the query was not matched with) */
-            g->j[i * k + t] = sj[o < ks ? o : ks - 1];
-            g->d[i * k + t] = sd[o < ks ? o : ks - 1];
+            j[t] = sj[o < ks ? o : ks - 1];
+            d[t] = sd[o < ks ? o : ks - 1];
             o++;
         }
     }
 }
 
-/* The query's row: itself, then its k - 1 nearest candidates by (distance, index). */
-static amscr_status query_row(const size_t *cand, const double *dq, size_t m, graph *g)
+/* Row i of the graph: its stored lists with the query (index g->n - 1) merged in when `have`. */
+static void collection_row(const amscr_index *x, size_t i, int have, graph *g)
 {
-    size_t k = g->k, q = g->n - 1, *order = amscr__malloc_array(m, sizeof *order);
+    size_t kk = g->kk, q = g->n - 1;
+    merge_row(x->nb_idx + i * x->k, x->nb_dist + i * x->k, x->k, q, have ? g->dfull[i] : 0.0, have, g->k,
+              g->j + i * kk, g->d + i * kk);
+    if (g->k2 > 0)
+        merge_row(x->in_idx + i * x->k2, x->in_dist + i * x->k2, x->k2, q, have ? g->dfull2[i] : 0.0, have, g->k2,
+                  g->j + i * kk + g->k, g->d + i * kk + g->k);
+}
+
+/* The query's k entries from (off): itself, then its k - 1 nearest candidates by (distance dq,
+ * index). */
+static amscr_status query_part(const size_t *cand, const double *dq, size_t m, size_t k, size_t off, graph *g)
+{
+    size_t kk = g->kk, q = g->n - 1, *order = amscr__malloc_array(m ? m : 1, sizeof *order);
     if (!order)
         return amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     amscr_status st = amscr_topk(dq, m, k - 1, SIZE_MAX, order);
     if (st == AMSCR_OK) {
-        g->j[q * k] = (uint32_t)q;
-        g->d[q * k] = 0.0;
+        g->j[q * kk + off] = (uint32_t)q;
+        g->d[q * kk + off] = 0.0;
         for (size_t t = 1; t < k; t++) {
-            g->j[q * k + t] = (uint32_t)cand[order[t - 1]];
-            g->d[q * k + t] = dq[order[t - 1]];
+            g->j[q * kk + off + t] = (uint32_t)cand[order[t - 1]];
+            g->d[q * kk + off + t] = dq[order[t - 1]];
         }
-        g->state[q] = 1;
     }
     free(order);
+    return st;
+}
+
+/* The query's row: each graph's part (dq2: the inner distances to the candidates). */
+static amscr_status query_row(const size_t *cand, const double *dq, const double *dq2, size_t m, graph *g)
+{
+    amscr_status st = query_part(cand, dq, m, g->k, 0, g);
+    if (st == AMSCR_OK && g->k2 > 0)
+        st = query_part(cand, dq2, m, g->k2, g->k, g);
+    if (st == AMSCR_OK)
+        g->state[g->n - 1] = 1;
     return st;
 }
 
 static void need_row(graph *g, size_t i)
 {
     if (g->state[i] == 0) {
-        collection_row(g->x, i, g->dfull[i], g->query && g->have[i], g);
+        collection_row(g->x, i, g->query && g->have[i], g);
         g->state[i] = 1;
     }
 }
 
-/* Row i's affinities exp(-D / sqrt(s_i s_j)), row-normalized (as amscr_rerank_diffusion), with
- * s the rows' k-th distances. */
+/* The affinities of a row's k entries from `off` (one graph's part) exp(-D / sqrt(s_i s_j)),
+ * normalized to sum `mass` (as amscr_rerank_diffusion), with s the rows' k-th distances. */
+static void part_weights(graph *g, size_t i, size_t off, size_t k, double tiny, double mass)
+{
+    size_t kk = g->kk;
+    double sum = 0.0, si = g->d[i * kk + off + k - 1], *w = g->w + i * kk + off;
+    const uint32_t *jj = g->j + i * kk + off;
+    const double *d = g->d + i * kk + off;
+    for (size_t t = 0; t < k; t++) {
+        double s = sqrt((si + tiny) * (g->d[(size_t)jj[t] * kk + off + k - 1] + tiny));
+        w[t] = exp(-d[t] / s);
+        sum += w[t];
+    }
+    for (size_t t = 0; t < k; t++)
+        w[t] = mass * (w[t] / sum); /* exactly w / sum for one graph */
+}
+
+/* Row i's affinities, each graph's part normalized to its share of the row's mass. */
 static void need_weights(graph *g, size_t i)
 {
-    size_t k = g->k;
+    size_t kk = g->kk;
     if (g->state[i] == 2)
         return;
     need_row(g, i);
-    for (size_t t = 0; t < k; t++)
-        need_row(g, g->j[i * k + t]);
-    double sum = 0.0, si = g->d[i * k + k - 1];
-    for (size_t t = 0; t < k; t++) {
-        double s = sqrt((si + g->tiny) * (g->d[(size_t)g->j[i * k + t] * k + k - 1] + g->tiny));
-        g->w[i * k + t] = exp(-g->d[i * k + t] / s);
-        sum += g->w[i * k + t];
-    }
-    for (size_t t = 0; t < k; t++)
-        g->w[i * k + t] /= sum;
+    for (size_t t = 0; t < kk; t++)
+        need_row(g, g->j[i * kk + t]);
+    part_weights(g, i, 0, g->k, g->tiny, g->k2 > 0 ? 1.0 - g->share : 1.0);
+    if (g->k2 > 0)
+        part_weights(g, i, g->k, g->k2, g->tiny2, g->share);
     g->state[i] = 2;
 }
 
@@ -142,10 +181,26 @@ typedef struct {
     size_t *list;
 } sscratch;
 
+/* The c entries of list (each marked in mark, of n) in ascending order: sorted, or, when they
+ * are many, read off the marks (the same order, without the sort's cost). */
+static void order_marked(size_t *list, size_t c, const unsigned char *mark, size_t n)
+{
+    if (c < 2)
+        return;
+    if (c * 16 < n) {
+        qsort(list, c, sizeof *list, cmp_size);
+        return;
+    }
+    size_t u = 0;
+    for (size_t j = 0; j < n && u < c; j++)
+        if (mark[j])
+            list[u++] = j;
+}
+
 /* out <- in P (in's rows pushed to their neighbours, rows in ascending order as the dense sum). */
 static void apply_rows(graph *g, const svec *in, svec *out, sscratch *s)
 {
-    size_t k = g->k, c = 0;
+    size_t k = g->kk, c = 0;
     for (size_t u = 0; u < in->len; u++) {
         size_t i = in->sup[u];
         if (in->v[i] == 0.0)
@@ -160,7 +215,7 @@ static void apply_rows(graph *g, const svec *in, svec *out, sscratch *s)
             s->tmp[j] += in->v[i] * g->w[i * k + t];
         }
     }
-    qsort(s->list, c, sizeof *s->list, cmp_size);
+    order_marked(s->list, c, s->mark, g->n);
     for (size_t u = 0; u < out->len; u++)
         out->v[out->sup[u]] = 0.0;
     for (size_t u = 0; u < c; u++) {
@@ -182,11 +237,12 @@ static void reach(sscratch *s, size_t i, size_t *c)
     }
 }
 
-/* v <- P v: only the rows holding a shape of v's support (the stored lists' reverse, plus the
- * query and the rows it may enter) can be nonzero. */
-static void apply_cols(graph *g, svec *v, sscratch *s)
+/* The rows P v may make nonzero into s->list (c, ascending; marked): those holding a shape of
+ * v's support (the stored lists' reverse), the shapes themselves, the query and the rows it may
+ * enter. */
+static void reach_rows(const graph *g, const svec *v, sscratch *s, size_t *c)
 {
-    size_t k = g->k, c = 0, n = g->query ? g->n - 1 : g->n;
+    size_t n = g->query ? g->n - 1 : g->n;
     int to_query = 0;
     for (size_t u = 0; u < v->len; u++) {
         size_t j = v->sup[u];
@@ -195,14 +251,27 @@ static void apply_cols(graph *g, svec *v, sscratch *s)
             continue;
         }
         for (size_t r = g->rs[j]; r < g->rs[j + 1]; r++)
-            reach(s, g->rv[r], &c);
-        reach(s, j, &c);
+            reach(s, g->rv[r], c);
+        reach(s, j, c);
     }
     if (g->query && v->len > 0)
-        reach(s, n, &c);
+        reach(s, n, c);
     for (size_t t = 0; to_query && t < g->m; t++)
-        reach(s, g->cand[t], &c);
-    qsort(s->list, c, sizeof *s->list, cmp_size);
+        reach(s, g->cand[t], c);
+    order_marked(s->list, *c, s->mark, g->n);
+}
+
+/* v <- P v: only the rows reach_rows finds can be nonzero; when v covers a quarter of the rows,
+ * every row is computed instead of finding them. */
+static void apply_cols(graph *g, svec *v, sscratch *s)
+{
+    size_t k = g->kk, c = 0;
+    if (v->len * 4 >= g->n) { /* most rows reachable: every row, in order (the others sum to 0) */
+        for (c = 0; c < g->n; c++)
+            s->list[c] = c;
+    } else {
+        reach_rows(g, v, s, &c);
+    }
     for (size_t u = 0; u < c; u++) {
         size_t i = s->list[u];
         need_weights(g, i);
@@ -314,18 +383,23 @@ static void scores(const double *r, const size_t *rsup, size_t rlen, size_t n, s
     }
 }
 
-/* The stored lists' reverse of x (n shapes, k each) into rs (n + 1) and rv (n k). */
+/* The stored lists' reverse of x (n shapes, k + k2 each: both graphs') into rs (n + 1) and rv. */
 static void reverse_lists(const amscr_index *x, size_t n, size_t *rs, uint32_t *rv)
 {
-    size_t k = x->k;
+    size_t k = x->k, k2 = x->k2;
     memset(rs, 0, (n + 1) * sizeof *rs);
     for (size_t e = 0; e < n * k; e++)
         rs[x->nb_idx[e] + 1]++;
+    for (size_t e = 0; e < n * k2; e++)
+        rs[x->in_idx[e] + 1]++;
     for (size_t j = 0; j < n; j++)
         rs[j + 1] += rs[j];
-    for (size_t i = 0; i < n; i++) /* rs[j] runs ahead while filling, then shifts back */
+    for (size_t i = 0; i < n; i++) { /* rs[j] runs ahead while filling, then shifts back */
         for (size_t t = 0; t < k; t++)
             rv[rs[x->nb_idx[i * k + t]]++] = (uint32_t)i;
+        for (size_t t = 0; t < k2; t++)
+            rv[rs[x->in_idx[i * k2 + t]]++] = (uint32_t)i;
+    }
     for (size_t j = n; j > 0; j--)
         rs[j] = rs[j - 1];
     rs[0] = 0;
@@ -346,7 +420,7 @@ amscr_status amscr__index_reverse(amscr_index *x)
     if (x->k == 0)
         return AMSCR_OK;
     x->rev_start = amscr__malloc_array(n + 1, sizeof *x->rev_start);
-    x->rev = amscr__malloc_array(n ? n : 1, x->k * sizeof *x->rev);
+    x->rev = amscr__malloc_array(n ? n : 1, (x->k + x->k2) * sizeof *x->rev);
     if (!x->rev_start || !x->rev) {
         amscr__index_reverse_free(x);
         return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
@@ -355,42 +429,67 @@ amscr_status amscr__index_reverse(amscr_index *x)
     return AMSCR_OK;
 }
 
-/* The diffusion's scores of row `self` (< n: a shape of the index; n: the query, with
- * distances dfull[j] where have[j]). */
-static amscr_status diffuse(const amscr_index *x, size_t self, const size_t *cand, const double *dq, size_t m,
-                            const double *dfull, const unsigned char *have, double *out)
+/* What a row knows of the query: its candidates cand (m) with their base distances dq and, with
+ * the inner graph, inner distances dq2; the same by shape (dfull[j], dfull2[j] where have[j]). */
+typedef struct {
+    const size_t *cand;
+    const double *dq, *dq2;
+    size_t m;
+    double *dfull, *dfull2;
+    unsigned char *have;
+} qrow;
+
+/* The largest of d0 and the m values d. */
+static double largest(double d0, const double *d, size_t m)
+{
+    for (size_t t = 0; t < m; t++)
+        d0 = d[t] > d0 ? d[t] : d0;
+    return d0;
+}
+
+/* The graph's fixed parts for row `self` (n: the query). */
+static void graph_setup(graph *g, const amscr_index *x, size_t self, const qrow *q)
+{
+    size_t n = amscr_db_size(x->db);
+    double dmax = self == n ? largest(x->dmax, q->dq, q->m) : x->dmax;
+    double dmax2 = self == n && q->dq2 ? largest(x->dmax2, q->dq2, q->m) : x->dmax2;
+    g->x = x;
+    g->dfull = q->dfull;
+    g->dfull2 = q->dfull2;
+    g->have = q->have;
+    g->query = self == n;
+    g->tiny = dmax > 0.0 ? 1e-12 * dmax : 1e-300;
+    g->tiny2 = dmax2 > 0.0 ? 1e-12 * dmax2 : 1e-300;
+    g->share = amscr_db_params(x->db)->rerank_inner_share;
+    g->cand = q->cand;
+    g->m = self == n ? q->m : 0;
+}
+
+/* The diffusion's scores of row `self` (< n: a shape of the index; n: the query). */
+static amscr_status diffuse(const amscr_index *x, size_t self, const qrow *q, double *out)
 {
     const amscr_params *p = amscr_db_params(x->db);
     size_t n = amscr_db_size(x->db), rows = self == n ? n + 1 : n, rlen = 0;
     size_t k = amscr__rerank_k(p, rows);
-    double dmax = x->dmax;
-    for (size_t t = 0; self == n && t < m; t++)
-        dmax = dq[t] > dmax ? dq[t] : dmax;
     graph g = {0};
     size_t *rs = x->rev_start ? NULL : amscr__malloc_array(n + 1, sizeof *rs), *rsup = NULL;
-    uint32_t *rv = x->rev_start ? NULL : amscr__malloc_array(n ? n : 1, x->k * sizeof *rv);
+    uint32_t *rv = x->rev_start ? NULL : amscr__malloc_array(n ? n : 1, (x->k + x->k2) * sizeof *rv);
     double *r = amscr__calloc_array(rows, sizeof *r);
     rsup = amscr__malloc_array(rows, sizeof *rsup);
     int have_rev = x->rev_start || (rs && rv);
-    amscr_status st = r && rsup && have_rev ? graph_alloc(&g, rows, k)
+    amscr_status st = r && rsup && have_rev ? graph_alloc(&g, rows, k, x->k2 > 0 ? k : 0)
                                             : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     if (st == AMSCR_OK && !x->rev_start)
         reverse_lists(x, n, rs, rv);
-    g.x = x;
-    g.dfull = dfull;
-    g.have = have;
-    g.query = self == n;
-    g.tiny = dmax > 0.0 ? 1e-12 * dmax : 1e-300;
+    graph_setup(&g, x, self, q);
     g.rs = x->rev_start ? x->rev_start : rs;
     g.rv = x->rev_start ? x->rev : rv;
-    g.cand = cand;
-    g.m = self == n ? m : 0;
     if (st == AMSCR_OK && self == n)
-        st = query_row(cand, dq, m, &g);
+        st = query_row(q->cand, q->dq, q->dq2, q->m, &g);
     if (st == AMSCR_OK)
         st = diffusion_row(&g, self, p->rerank_iterations, r, rsup, &rlen);
     if (st == AMSCR_OK)
-        scores(r, rsup, rlen, n, self, dfull, have, dmax, out);
+        scores(r, rsup, rlen, n, self, q->dfull, q->have, self == n ? largest(x->dmax, q->dq, q->m) : x->dmax, out);
     graph_free(&g);
     free(r);
     free(rsup);
@@ -399,25 +498,48 @@ static amscr_status diffuse(const amscr_index *x, size_t self, const size_t *can
     return st;
 }
 
-amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t *cand, const double *dq, size_t m,
-                                 double *out)
+amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t *cand, const double *dq,
+                                 const double *dq2, size_t m, double *out)
 {
     size_t n = amscr_db_size(x->db);
-    double *dfull = amscr__calloc_array(n, sizeof *dfull);
-    unsigned char *have = amscr__calloc_array(n, 1);
-    amscr_status st = dfull && have ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    qrow q = {cand, dq, dq2, m, amscr__calloc_array(n, sizeof(double)), NULL, amscr__calloc_array(n, 1)};
+    q.dfull2 = dq2 ? amscr__calloc_array(n, sizeof(double)) : NULL;
+    amscr_status st = q.dfull && q.have && (!dq2 || q.dfull2) ? AMSCR_OK
+                                                            : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     for (size_t t = 0; st == AMSCR_OK && t < m; t++) {
-        dfull[cand[t]] = dq[t];
-        have[cand[t]] = 1;
+        q.dfull[cand[t]] = dq[t];
+        if (dq2)
+            q.dfull2[cand[t]] = dq2[t];
+        q.have[cand[t]] = 1;
     }
     if (st == AMSCR_OK && x->k == 0) { /* no re-ranking: the base distances */
         for (size_t j = 0; j < n; j++)
-            out[j] = j == self ? 0.0 : have[j] ? dfull[j] : INFINITY;
+            out[j] = j == self ? 0.0 : q.have[j] ? q.dfull[j] : INFINITY;
     } else if (st == AMSCR_OK) {
-        st = diffuse(x, self, cand, dq, m, dfull, have, out);
+        st = diffuse(x, self, &q, out);
     }
-    free(dfull);
-    free(have);
+    free(q.dfull);
+    free(q.dfull2);
+    free(q.have);
+    return st;
+}
+
+/* The inner distances of q to the m candidates (the query's inner graph). */
+static amscr_status query_inner(const amscr_index *x, const amscr_descriptor *q, const size_t *cand, size_t m,
+                                double *out)
+{
+    amscr__inner_ws ws;
+    amscr__inner *f = malloc(sizeof *f);
+    if (!f || amscr__inner_ws_init(&ws) != AMSCR_OK) {
+        free(f);
+        return amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    }
+    amscr_status st = amscr__inner_build(q->input, q->n, f, &ws);
+    int refl = amscr_db_params(x->db)->reflections;
+    for (size_t t = 0; st == AMSCR_OK && t < m; t++) /* cell (j, query): the query's index is the highest */
+        out[t] = amscr__inner_distance(&x->inner[cand[t]], f, refl, &ws);
+    amscr__inner_ws_free(&ws);
+    free(f);
     return st;
 }
 
@@ -468,10 +590,15 @@ static amscr_status query_scores(const amscr_index *x, const amscr_descriptor *q
     amscr__base_init(&b, amscr_db_params(x->db), x->med_a, x->med_h);
     if (st == AMSCR_OK)
         st = amscr__base_row(&b, x->db, x->hf, q, self == SIZE_MAX ? SIZE_MAX : self, cand, m, progress, user, dq);
+    double *dq2 = st == AMSCR_OK && x->k2 > 0 && self == SIZE_MAX ? amscr__malloc_array(n ? n : 1, sizeof *dq2)
+                                                                   : NULL;
+    if (st == AMSCR_OK && x->k2 > 0 && self == SIZE_MAX)
+        st = dq2 ? query_inner(x, q, cand, m, dq2) : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     if (st == AMSCR_OK)
-        st = amscr__index_scores(x, self == SIZE_MAX ? n : self, cand, dq, m, out);
+        st = amscr__index_scores(x, self == SIZE_MAX ? n : self, cand, dq, dq2, m, out);
     free(cand);
     free(dq);
+    free(dq2);
     return st;
 }
 
@@ -577,9 +704,8 @@ amscr_status amscr_db_query_retrieval(const amscr_db *db, const amscr_descriptor
         return AMSCR_E_INVALID_ARG;
     const amscr_params *p = amscr_db_params(db);
     double w = p->channel_weight;
-    /* fused weights: the medians move with the query; the inner-distance graph: an index holds
-     * one graph. Both: the whole matrix. */
-    if ((w > 0.0 && w < 1.0) || (p->rerank_k > 0 && p->rerank_inner_share > 0.0))
+    /* fused weights: the medians move with the query: the whole matrix */
+    if (w > 0.0 && w < 1.0)
         return query_by_matrix(db, q, progress, user, out_scores);
     if (p->rerank_k == 0) /* the base distances alone: nothing of the collection's is needed */
         return plain_row(db, q, progress, user, out_scores);

@@ -103,6 +103,18 @@ static int inner_matrix_of(const double *V, double *D)
     return 1;
 }
 
+/* The reversed orientation's twist of column k: tre + i tim = (re + i im) e^{-2 pi i f (k + 1) / N}. */
+static void twist(amscr__inner *f, const double *cs)
+{
+    for (size_t k = 0; k < AMSCR__INNER_K; k++)
+        for (size_t q = 0; q < AMSCR__INNER_F; q++) {
+            const double *c = cs + 2 * ((q * (k + 1)) % N);
+            double br = f->re[q][k], bi = f->im[q][k];
+            f->tre[q][k] = br * c[0] - bi * c[1];
+            f->tim[q][k] = br * c[1] + bi * c[0];
+        }
+}
+
 amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, amscr__inner_ws *ws)
 {
     amscr_status st = n < 3 ? AMSCR_E_DEGENERATE : amscr__resample_euclid(xy, n, 1, N, ws->xy);
@@ -122,15 +134,15 @@ amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, a
         for (size_t f = 0; f < AMSCR__INNER_F; f++) {
             double br = ws->z[2 * f], bi = ws->z[2 * f + 1];
             out->norm2 += (f == 0 || 2 * f == N ? 1.0 : 2.0) * (br * br + bi * bi) / (double)N;
-            const double *c = ws->cs + 2 * ((f * off) % N);
             out->re[f][k] = br;
             out->im[f][k] = bi;
-            out->tre[f][k] = br * c[0] - bi * c[1];
-            out->tim[f][k] = br * c[1] + bi * c[0];
         }
     }
+    twist(out, ws->cs);
     return AMSCR_OK;
 }
+
+void amscr__inner_twist(amscr__inner *f, const amscr__inner_ws *ws) { twist(f, ws->cs); }
 
 /* Z(f), f = 0..N/2, into ws->z with its Hermitian rest: the correlation of a and b over the
  * shifts (real part: sum_k conj(A) B, sum_i a[i] b[i + s]) and, when `refl`, of a and b
@@ -180,8 +192,9 @@ double amscr__inner_distance(const amscr__inner *a, const amscr__inner *b, int r
 /* ------------------------------------------------------------ the collection */
 
 typedef struct {
-    const amscr_descriptor **d;
-    amscr__inner *f;
+    const amscr_db *db;
+    amscr__inner *f;        /* the features built */
+    const amscr__inner *cf; /* the features compared */
     size_t n;
     int reflections;
     double *out;
@@ -208,26 +221,35 @@ static void job_fini(void *ws)
 static amscr_status feature_row(void *ctx, size_t i, void *ws)
 {
     const inner_job *m = ctx;
-    return amscr__inner_build(m->d[i]->input, m->d[i]->n, &m->f[i], ws);
+    const amscr_descriptor *d = amscr_db_descriptor(m->db, i);
+    if (!d)
+        return amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
+    return amscr__inner_build(d->input, d->n, &m->f[i], ws);
 }
 
 static amscr_status pair_row(void *ctx, size_t i, void *ws)
 {
     const inner_job *m = ctx;
     for (size_t j = i + 1; j < m->n; j++)
-        m->out[i * m->n + j] = amscr__inner_distance(&m->f[i], &m->f[j], m->reflections, ws);
+        m->out[i * m->n + j] = amscr__inner_distance(&m->cf[i], &m->cf[j], m->reflections, ws);
     return AMSCR_OK;
 }
 
-static amscr_status run(inner_job *m, unsigned threads, amscr_progress_fn progress, void *user)
+amscr_status amscr__inner_features(const amscr_db *db, size_t first, unsigned threads, amscr__inner *f)
 {
-    amscr__rows_fn features = {job_init, job_fini, feature_row, m, "inner distance"};
-    amscr__rows_fn pairs = {job_init, job_fini, pair_row, m, "inner distance"};
-    amscr_status st = amscr__run_rows(&features, 0, m->n, threads, NULL, NULL);
+    inner_job m = {db, f, NULL, amscr_db_size(db), 0, NULL};
+    amscr__rows_fn features = {job_init, job_fini, feature_row, &m, "inner distance"};
+    return amscr__run_rows(&features, first, m.n, threads, NULL, NULL);
+}
+
+amscr_status amscr__inner_matrix_from(const amscr__inner *f, size_t n, int reflections, unsigned threads,
+                                      amscr_progress_fn progress, void *user, double *out)
+{
+    inner_job m = {NULL, NULL, f, n, reflections, out};
+    amscr__rows_fn pairs = {job_init, job_fini, pair_row, &m, "inner distance"};
+    amscr_status st = amscr__run_rows(&pairs, 0, n, threads, progress, user);
     if (st == AMSCR_OK)
-        st = amscr__run_rows(&pairs, 0, m->n, threads, progress, user);
-    if (st == AMSCR_OK)
-        amscr__mirror_upper(m->out, m->n);
+        amscr__mirror_upper(out, n);
     return st;
 }
 
@@ -235,19 +257,15 @@ amscr_status amscr__inner_matrix(const amscr_db *db, unsigned threads, amscr_pro
                                  double *out)
 {
     size_t n = amscr_db_size(db);
-    inner_job m = {NULL, NULL, n, amscr_db_params(db)->reflections, out};
-    m.d = amscr__malloc_array(n, sizeof *m.d);
-    m.f = amscr__malloc_array(n, sizeof *m.f);
-    amscr_status st = m.d && m.f ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
-    for (size_t i = 0; st == AMSCR_OK && i < n; i++)
-        if (!(m.d[i] = amscr_db_descriptor(db, i)))
-            st = amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
+    amscr__inner *f = amscr__malloc_array(n, sizeof *f);
+    amscr_status st = f ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
     if (st == AMSCR_OK)
-        st = run(&m, threads, progress, user);
+        st = amscr__inner_features(db, 0, threads, f);
+    if (st == AMSCR_OK)
+        st = amscr__inner_matrix_from(f, n, amscr_db_params(db)->reflections, threads, progress, user, out);
     if (st != AMSCR_OK)
         for (size_t i = 0; i < n * n; i++)
             out[i] = NAN;
-    free(m.d);
-    free(m.f);
+    free(f);
     return st;
 }

@@ -42,6 +42,14 @@ amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, a
  * divided by its mean) at the best cyclic shift, and orientation when `reflections`; 0 for
  * a shape against itself, symmetric. */
 double amscr__inner_distance(const amscr__inner *a, const amscr__inner *b, int reflections, amscr__inner_ws *ws);
+/* tre, tim of f from its re, im (features read from a file). */
+void amscr__inner_twist(amscr__inner *f, const amscr__inner_ws *ws);
+/* The features of shapes first..n-1 of db into f[first..n-1], on `threads` threads. */
+amscr_status amscr__inner_features(const amscr_db *db, size_t first, unsigned threads, amscr__inner *f);
+/* The symmetric n x n matrix of the inner distances of features f (zero diagonal; cell (i, j),
+ * i < j, is amscr__inner_distance(f + i, f + j)), on `threads` threads. */
+amscr_status amscr__inner_matrix_from(const amscr__inner *f, size_t n, int reflections, unsigned threads,
+                                      amscr_progress_fn progress, void *user, double *out);
 /* The symmetric n x n matrix of the collection's inner distances (zero diagonal), on
  * `threads` threads; independent of the thread count. */
 amscr_status amscr__inner_matrix(const amscr_db *db, unsigned threads, amscr_progress_fn progress, void *user,

@@ -12,11 +12,6 @@ from imgutil import affine, run, write_points
 from test_collection import AFFINE, MAPS, base_shapes
 from test_protocols import make_manifest
 
-# An index re-ranks on one graph (the inner-distance graph's share 0): a folder or manifest
-# gives the index's results with this option.
-ONE_GRAPH = ("--inner-share", "0")
-
-
 def build(tmp_path, manifest, *opts, name="shapes.idx"):
     out = tmp_path / name
     r = run("index", manifest, "-o", out, *opts)
@@ -44,7 +39,7 @@ def test_search_index_equals_manifest(tmp_path, opts):
     for q in ("star_2.txt", "blob_1.txt", "wave_3.txt"):
         qp = tmp_path / "shapes" / q
         a = json.loads(run("search", qp, idx, "--json", *rerank).stdout)
-        b = json.loads(run("search", qp, m, "--json", *opts, *ONE_GRAPH).stdout)
+        b = json.loads(run("search", qp, m, "--json", *opts).stdout)
         same_results(a["results"], b["results"])
 
 
@@ -144,7 +139,7 @@ def test_no_rerank_index(tmp_path):
     plain = run("search", q, idx, "--json", "--no-rerank")
     assert json.loads(r.stdout)["results"] == json.loads(plain.stdout)["results"]
     a = json.loads(run("search", q, idx, "--json", "--rerank", "3").stdout)["results"]
-    b = json.loads(run("search", q, m, "--json", *AFFINE, "--rerank", "3", *ONE_GRAPH).stdout)["results"]
+    b = json.loads(run("search", q, m, "--json", *AFFINE, "--rerank", "3").stdout)["results"]
     same_results(a, b)
 
 
@@ -158,7 +153,7 @@ def test_corrupt_index(tmp_path, damage):
     elif damage == "flip":
         data[len(data) // 3] ^= 0x40
     elif damage == "version":
-        data[8] = 9
+        data[8] = 10
     elif damage == "magic-only":
         data = data[:8]
     elif damage == "short-header":  # magic and version, then the file ends inside the lengths (a fuzzer find)
@@ -177,7 +172,7 @@ def test_corrupt_index(tmp_path, damage):
     if damage == "flip":  # the names and tables are checksummed, every shape is checked by the library
         assert "checksum" in r.stderr or "damaged shape" in r.stderr
     if damage == "version":
-        assert "version 9" in r.stderr
+        assert "version 10" in r.stderr
     for args in (("eval", bad), ("matrix", bad, "-o", "-"), ("index", m, "-o", bad, "--add")):
         r = run(*args)
         assert r.returncode == 1 and r.stdout == ""
@@ -207,7 +202,7 @@ def test_candidates(tmp_path):
     idx = build(tmp_path, m, "--refine", "0")
     q = tmp_path / "shapes" / "wave_1.txt"
     a = json.loads(run("search", q, idx, "--json", "--top", "2", "--candidates", "0").stdout)["results"]
-    b = json.loads(run("search", q, m, "--json", "--top", "2", "--refine", "0", *ONE_GRAPH).stdout)["results"]
+    b = json.loads(run("search", q, m, "--json", "--top", "2", "--refine", "0").stdout)["results"]
     same_results(a, b)
     few = build(tmp_path, m, "--refine", "0", "--candidates", "3", "--rerank", "3", name="few.idx")
     r = run("search", q, few, "--json", "--candidates", "4", "--rerank", "3", "--top", "3")
@@ -227,17 +222,17 @@ def test_retrieval_defaults_from_an_index(tmp_path, opts):
     m = make_manifest(tmp_path)
     idx = build(tmp_path, m, *opts)
     a = run("matrix", idx, "-o", "-").stdout
-    b = run("matrix", m, "-o", "-", *opts, *ONE_GRAPH).stdout
+    b = run("matrix", m, "-o", "-", *opts).stdout
     assert a.splitlines()[1:] == b.splitlines()[1:] and len(a.splitlines()) == 10
     ja = json.loads(run("eval", idx, "--json", "--protocol", "groups").stdout)
-    jb = json.loads(run("eval", m, "--json", "--protocol", "groups", *opts, *ONE_GRAPH).stdout)
+    jb = json.loads(run("eval", m, "--json", "--protocol", "groups", *opts).stdout)
     assert ja["groups"] == jb["groups"] and ja["per_class"] == jb["per_class"]
     member = tmp_path / "shapes" / "blob_2.txt"
     new = tmp_path / "new.txt"
     write_points(new, affine(((0.8, 0.3, 4.0), (-0.2, 1.2, 1.0)), base_shapes()["wave"]))
     for q in (member, new):
         a = json.loads(run("search", q, idx, "--json", "--candidates", "0").stdout)["results"]
-        b = json.loads(run("search", q, m, "--json", *opts, *ONE_GRAPH).stdout)["results"]
+        b = json.loads(run("search", q, m, "--json", *opts).stdout)["results"]
         assert all(0.0 <= r["distance"] <= 1.0 for r in a)
         if q == member:
             assert a[0]["file"].endswith("blob_2.txt") and a[0]["distance"] == 0.0
@@ -262,17 +257,22 @@ def test_channel_options_that_conflict_with_the_index(tmp_path):
 
 
 def test_inner_share_and_the_index(tmp_path):
-    """The default re-ranks on two graphs (the inner distance's at share 0.05), an index on one:
-    the index records share 0; --inner-share with an index ranks by the collection's matrix,
-    as the manifest does; `index --inner-share S` (S > 0) is refused with the way out."""
+    """The default re-ranks on two graphs (the inner distance's at share 0.05) and an index
+    built with it holds both: its search is the manifest's; `index --inner-share 0` holds one
+    graph and searches as the manifest with --inner-share 0; an --inner-share other than the
+    index's ranks by the collection's matrix, as the manifest does; --add with another share is
+    refused."""
     m = make_manifest(tmp_path)
     idx = build(tmp_path, m)
+    one_idx = build(tmp_path, m, "--inner-share", "0", name="one.idx")
     q = tmp_path / "shapes" / "wave_2.txt"
     two = json.loads(run("search", q, m, "--json").stdout)["results"]
-    one = json.loads(run("search", q, m, "--json", *ONE_GRAPH).stdout)["results"]
+    one = json.loads(run("search", q, m, "--json", "--inner-share", "0").stdout)["results"]
     assert [r["distance"] for r in two] != [r["distance"] for r in one]
-    same_results(json.loads(run("search", q, idx, "--json").stdout)["results"], one)
-    same_results(json.loads(run("search", q, idx, "--json", "--inner-share", "0.05").stdout)["results"], two)
-    r = run("index", m, "-o", tmp_path / "x.idx", "--inner-share", "0.1")
-    assert r.returncode == 2 and "one graph" in r.stderr and not (tmp_path / "x.idx").exists()
+    same_results(json.loads(run("search", q, idx, "--json").stdout)["results"], two)
+    same_results(json.loads(run("search", q, one_idx, "--json").stdout)["results"], one)
+    same_results(json.loads(run("search", q, idx, "--json", "--inner-share", "0").stdout)["results"], one)
+    same_results(json.loads(run("search", q, one_idx, "--json", "--inner-share", "0.05").stdout)["results"], two)
+    r = run("index", m, "-o", one_idx, "--add", "--inner-share", "0.1")
+    assert r.returncode != 0 and "inner_share" in r.stderr
     assert run("search", q, m, "--inner-share", "1").returncode == 2

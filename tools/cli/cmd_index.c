@@ -46,9 +46,6 @@ int cmd_index(opts *o)
 {
     if (o->out == NULL || strcmp(o->out, "-") == 0)
         return usage_error("index", "missing -o FILE (the index file)");
-    if (o->inner_share_set && o->inner_share > 0.0)
-        return usage_error("--inner-share", "an index re-ranks on one graph (share 0); give --inner-share to "
-                                            "search instead (it then ranks by the collection's matrix)");
     amscr_index *x = NULL;
     collection c;
     memset(&c, 0, sizeof c);
@@ -69,8 +66,13 @@ int cmd_index(opts *o)
         for (size_t i = 0; i < amscr_index_size(x); i++)
             if ((size_t)amscr_index_label(x, i) + 1 > nclasses)
                 nclasses = (size_t)amscr_index_label(x, i) + 1;
-        printf("index %s: %zu shapes, %zu classes, %zu neighbours per shape (re-ranking on one graph)\n", o->out,
-               amscr_index_size(x), nclasses, amscr_index_neighbours(x));
+        double share = amscr_params_get_rerank_inner_share(amscr_db_params(amscr_index_db(x)));
+        printf("index %s: %zu shapes, %zu classes, %zu neighbours per shape", o->out, amscr_index_size(x), nclasses,
+               amscr_index_neighbours(x));
+        if (amscr_index_neighbours(x) > 0 && share > 0.0)
+            printf(" (re-ranking on two graphs, the inner distance's at share %g)\n", share);
+        else
+            printf(amscr_index_neighbours(x) > 0 ? " (re-ranking on one graph)\n" : "\n");
     }
     collection_free(&c);
     amscr_index_free(x);

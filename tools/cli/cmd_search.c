@@ -95,8 +95,8 @@ static int query_distances(const amscr_db *db, const amscr_descriptor *dq, size_
 
 /* The query's scores against an index: its stored lists (amscr_index_query_scores, or the
  * member's row) when the user's params are the index's; the collection's matrix (as a folder)
- * when --rerank/--no-rerank/--inner-share differs from the build's (an index holds one graph:
- * share 0); the plain distance without the channel. */
+ * when --rerank/--no-rerank/--inner-share differs from the build's (an index holds the build's
+ * graphs); the plain distance without the channel. */
 static int index_distances(const amscr_index *x, const amscr_params *p, const amscr_descriptor *dq, size_t cand,
                            const char *qpath, const char *cpath, double *dist)
 {

@@ -238,7 +238,7 @@ static void print_retrieval_options(const amscr_params *ret)
            "                          graph, ITER iterations (default %u,%u; ITER default %d)\n"
            "  --no-rerank             the fused pairwise distances\n"
            "  --inner-share S         share of the inner-distance graph in the re-ranking,\n"
-           "                          0 <= S < 1 (default %g; 0 = one graph, as an index ranks)\n"
+           "                          0 <= S < 1 (default %g; 0 = one graph)\n"
            "  --paper                 the paper's method: the AMSCR distance alone, affine group,\n"
            "                          no refinement, no re-ranking (= --channel-weight 0\n"
            "                          --no-rerank --invariance affine --refine 0)\n",

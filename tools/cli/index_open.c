@@ -81,7 +81,7 @@ int index_params(const opts *o, const char *path, const amscr_params *built, ams
         st = amscr_params_set_rerank_k(*out, (unsigned)o->rerank_k);
     if (st == AMSCR_OK && o->rerank_set && o->rerank_k > 0)
         st = amscr_params_set_rerank_iterations(*out, o->rerank_iters);
-    /* --inner-share: the same (an index re-ranks on one graph, share 0) */
+    /* --inner-share: the same (an index holds the graphs of its build's share) */
     if (st == AMSCR_OK && o->inner_share_set)
         st = amscr_params_set_rerank_inner_share(*out, o->inner_share);
     if (st != AMSCR_OK) {

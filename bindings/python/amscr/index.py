@@ -35,15 +35,13 @@ class Index:
     """A collection prepared for one-vs-many retrieval (C ``amscr_index``): each shape's nearest
     shapes under the retrieval matrix's base distance, so one query is ranked by the scores of
     :meth:`Collection.retrieval_matrix` (shape channel, fusion, re-ranking, as the collection's
-    :class:`Params` say) without the collection's matrix. An index re-ranks on one graph: its
-    params have ``rerank_inner_share`` 0 whatever the collection's (:meth:`collection_params`),
-    so its scores are those of the collection with that share. The ``amscr`` tool's ``index``,
-    ``search`` and this class read and write the same files.
+    :class:`Params` say, the inner-distance graph's share included) without the collection's
+    matrix. The ``amscr`` tool's ``index``, ``search`` and this class read and write the same
+    files.
 
     ``Index(collection, progress=False, candidates=0)`` builds the index of a
     :class:`Collection` on its threads (the collection is copied). ``candidates=0`` computes the
-    whole base matrix (exact lists: a query then ranks exactly as ``collection.query`` with
-    ``rerank_inner_share`` 0);
+    whole base matrix (exact lists: a query then ranks exactly as ``collection.query``);
     ``candidates=M`` seeks each shape's neighbours among its M signature-nearest shapes only
     (large collections). Thread-safety: any number of threads may query at once; :meth:`add`
     waits for them.
@@ -247,8 +245,7 @@ class Index:
 
     def scores(self, points: PointsLike, candidates: Optional[int] = None, *, order: str = 'xy') -> np.ndarray:
         """The query's retrieval score against every shape (lower is better): its row of
-        :meth:`Collection.retrieval_matrix` on the collection plus the query (with the index's
-        params: the inner share 0).
+        :meth:`Collection.retrieval_matrix` on the collection plus the query.
 
         Args:
             points: the query: points or a :class:`Shape`.

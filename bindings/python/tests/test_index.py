@@ -40,9 +40,9 @@ def same_ranking(idx, scores, full, top=10):
     np.testing.assert_allclose(scores, full[order], rtol=0, atol=1e-9)
 
 
-@pytest.mark.parametrize('weight', [1.0, 0.0])
-def test_query_equals_collection_query(weight):
-    params = amscr.Params.retrieval(points=64, channel_weight=weight)
+@pytest.mark.parametrize('weight,share', [(1.0, 0.05), (0.0, 0.05), (1.0, 0.0)])
+def test_query_equals_collection_query(weight, share):
+    params = amscr.Params.retrieval(points=64, channel_weight=weight, rerank_inner_share=share)
     coll = synthetic(params)
     index = amscr.Index(coll)
     q = warp(blob(300, seed=2), np.random.default_rng(9))
@@ -52,13 +52,15 @@ def test_query_equals_collection_query(weight):
         plus.add(coll.shape(i))
     plus.add(q)
     np.testing.assert_allclose(coll.query(q), plus.retrieval_matrix()[-1, :-1], rtol=0, atol=1e-12)
-    # an Index re-ranks on one graph: the collection's query with the inner share 0
-    assert index.collection_params().rerank_inner_share == 0.0
-    full = synthetic(amscr.Params.retrieval(points=64, channel_weight=weight, rerank_inner_share=0)).query(q)
+    # an Index holds the collection's graphs: its query
+    assert index.collection_params().rerank_inner_share == share
+    full = coll.query(q)
     idx, sc = index.query(q, top=10, candidates=0)
     same_ranking(idx, sc, full)
     np.testing.assert_allclose(index.scores(q), full, rtol=0, atol=1e-12)
-    assert coll.labels[idx[0]] == 'class2'
+    # its class's 4 shapes hold 3 of the top 4 (class3's blobs are near: at the channel alone the
+    # first two scores are within 0.002)
+    assert sum(coll.labels[i] == 'class2' for i in idx[:4]) >= 3
 
 
 def test_round_trips_names_labels(tmp_path):
@@ -120,7 +122,7 @@ def dataset_shapes(name, count):
 @pytest.mark.parametrize('name', ['kimia216', 'mpeg7-dev'])
 def test_datasets_affine_queries(name):
     shapes = dataset_shapes(name, 60)
-    params = amscr.Params.retrieval(rerank_inner_share=0)  # an Index re-ranks on one graph
+    params = amscr.Params.retrieval()
     coll = amscr.Collection(params)
     for pts, cls in shapes:
         coll.add(pts, label=cls)

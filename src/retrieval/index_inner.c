@@ -1,0 +1,120 @@
+/* index_inner.c — the inner distance's graph in an index (inner.c; the re-ranking's second
+ * graph when the params give it a share): each shape's inner features and its K nearest shapes
+ * under the inner distance, from the full inner matrix (a build with every shape: a query then
+ * equals the matrix of the collection plus the query) or among each shape's signature-nearest
+ * shapes and its base neighbours (a shortlist build). */
+#include "index.h"
+
+#include <stdlib.h>
+
+size_t amscr__index_k2(const amscr_params *p, size_t k)
+{
+    return p->rerank_k > 0 && p->rerank_inner_share > 0.0 ? k : 0;
+}
+
+double amscr__index_inner_pair(const amscr_index *x, size_t i, size_t j, amscr__inner_ws *ws)
+{
+    int refl = amscr_db_params(x->db)->reflections;
+    return i < j ? amscr__inner_distance(&x->inner[i], &x->inner[j], refl, ws)
+                 : amscr__inner_distance(&x->inner[j], &x->inner[i], refl, ws);
+}
+
+amscr_status amscr__index_inner_full(amscr_index *x)
+{
+    size_t n = amscr_db_size(x->db), k2 = x->k2;
+    if (k2 == 0)
+        return AMSCR_OK;
+    const amscr_params *p = amscr_db_params(x->db);
+    double *D = amscr__malloc_array(n * n, sizeof *D);
+    size_t *cj = amscr__malloc_array(n, sizeof *cj);
+    amscr_status st = D && cj ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "amscr_index_build: out of memory");
+    if (st == AMSCR_OK)
+        st = amscr__inner_matrix_from(x->inner, n, p->reflections, amscr__resolve_threads(p->num_threads), NULL,
+                                      NULL, D);
+    for (size_t j = 0; j < n; j++)
+        cj[j] = j;
+    x->dmax2 = 0.0;
+    for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
+        for (size_t j = 0; j < n; j++)
+            x->dmax2 = D[i * n + j] > x->dmax2 ? D[i * n + j] : x->dmax2;
+        st = amscr__knn_select(i, cj, D + i * n, n, k2, x->in_idx + i * k2, x->in_dist + i * k2);
+    }
+    free(D);
+    free(cj);
+    return st;
+}
+
+/* ------------------------------------------------ shortlist build: rows on threads */
+
+typedef struct {
+    amscr_index *x;
+    size_t first, m;
+    const uint32_t *S; /* rows first..n-1: their shortlists, m each */
+    double *rmax;      /* per row: its largest inner distance */
+} rows_ctx;
+
+static amscr_status ws_init(void *ctx, void **scratch)
+{
+    (void)ctx;
+    amscr__inner_ws *w = malloc(sizeof *w);
+    if (!w || amscr__inner_ws_init(w) != AMSCR_OK) {
+        free(w);
+        return AMSCR_E_NOMEM;
+    }
+    *scratch = w;
+    return AMSCR_OK;
+}
+
+static void ws_fini(void *scratch)
+{
+    amscr__inner_ws_free(scratch);
+    free(scratch);
+}
+
+/* Row i: its shortlist and its base list (those the shortlist missed). */
+static amscr_status inner_row(void *ctx, size_t i, void *scratch)
+{
+    rows_ctx *c = ctx;
+    amscr_index *x = c->x;
+    size_t k = x->k, got = 0, *cand = amscr__malloc_array(c->m + k, sizeof *cand);
+    double *d = amscr__malloc_array(c->m + k, sizeof *d);
+    amscr_status st = cand && d ? AMSCR_OK : AMSCR_E_NOMEM;
+    const uint32_t *S = c->S + (i - c->first) * c->m;
+    for (size_t t = 0; st == AMSCR_OK && t < c->m; t++)
+        cand[got++] = S[t];
+    for (size_t t = 1; st == AMSCR_OK && t < k; t++) { /* the base list beyond the shortlist */
+        size_t j = x->nb_idx[i * k + t], u = 0;
+        while (u < c->m && S[u] != j)
+            u++;
+        if (u == c->m && j != i)
+            cand[got++] = j;
+    }
+    double rmax = 0.0;
+    for (size_t t = 0; st == AMSCR_OK && t < got; t++) {
+        d[t] = amscr__index_inner_pair(x, i, cand[t], scratch);
+        rmax = d[t] > rmax ? d[t] : rmax;
+    }
+    c->rmax[i - c->first] = rmax;
+    if (st == AMSCR_OK)
+        st = amscr__knn_select(i, cand, d, got, x->k2, x->in_idx + i * x->k2, x->in_dist + i * x->k2);
+    free(cand);
+    free(d);
+    return st;
+}
+
+amscr_status amscr__index_inner_rows(amscr_index *x, size_t first, const uint32_t *S, size_t m)
+{
+    size_t n = amscr_db_size(x->db);
+    if (x->k2 == 0 || first >= n)
+        return AMSCR_OK;
+    rows_ctx c = {x, first, m, S, amscr__calloc_array(n - first, sizeof(double))};
+    if (!c.rmax)
+        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    amscr__rows_fn f = {ws_init, ws_fini, inner_row, &c, "inner distance"};
+    amscr_status st = amscr__run_rows(&f, first, n, amscr__resolve_threads(amscr_db_params(x->db)->num_threads),
+                                      NULL, NULL);
+    for (size_t t = 0; st == AMSCR_OK && t < n - first; t++)
+        x->dmax2 = c.rmax[t] > x->dmax2 ? c.rmax[t] : x->dmax2;
+    free(c.rmax);
+    return st;
+}
