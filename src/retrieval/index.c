@@ -5,22 +5,27 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Neighbour lists (*idx, *dist) grown to cap rows of k; 0 when out of memory (what grew kept). */
+static int grow_lists(uint32_t **idx, double **dist, size_t cap, size_t k)
+{
+    uint32_t *ni = cap > SIZE_MAX / k / sizeof *ni ? NULL : realloc(*idx, cap * k * sizeof *ni);
+    if (ni)
+        *idx = ni;
+    double *nd = cap > SIZE_MAX / k / sizeof *nd ? NULL : realloc(*dist, cap * k * sizeof *nd);
+    if (nd)
+        *dist = nd;
+    return ni && nd;
+}
+
 /* The inner graph's arrays grown to cap rows (nothing without the graph); 0 when out of memory. */
 static int reserve_inner(amscr_index *x, size_t cap)
 {
-    size_t k2 = x->k2;
-    if (k2 == 0)
+    if (x->k2 == 0)
         return 1;
     amscr__inner *f = cap > SIZE_MAX / sizeof *f ? NULL : realloc(x->inner, cap * sizeof *f);
     if (f)
         x->inner = f;
-    uint32_t *ni = cap > SIZE_MAX / k2 / sizeof *ni ? NULL : realloc(x->in_idx, cap * k2 * sizeof *ni);
-    if (ni)
-        x->in_idx = ni;
-    double *nd = cap > SIZE_MAX / k2 / sizeof *nd ? NULL : realloc(x->in_dist, cap * k2 * sizeof *nd);
-    if (nd)
-        x->in_dist = nd;
-    return f && ni && nd;
+    return grow_lists(&x->in_idx, &x->in_dist, cap, x->k2) && f;
 }
 
 amscr_status amscr__index_reserve(amscr_index *x, size_t n)
@@ -44,12 +49,7 @@ amscr_status amscr__index_reserve(amscr_index *x, size_t n)
         x->hf = hf;
         memset(hf + x->cap * nf, 0, (cap - x->cap) * nf * sizeof *hf);
     }
-    uint32_t *ni = cap > SIZE_MAX / k / sizeof *ni ? NULL : realloc(x->nb_idx, cap * k * sizeof *ni);
-    if (ni)
-        x->nb_idx = ni;
-    double *nd = cap > SIZE_MAX / k / sizeof *nd ? NULL : realloc(x->nb_dist, cap * k * sizeof *nd);
-    if (nd)
-        x->nb_dist = nd;
+    int lists_ok = grow_lists(&x->nb_idx, &x->nb_dist, cap, k);
     int inner_ok = reserve_inner(x, cap);
     char **nm = realloc(x->names, cap * sizeof *nm);
     if (nm) {
@@ -63,7 +63,7 @@ amscr_status amscr__index_reserve(amscr_index *x, size_t n)
         for (size_t i = x->cap; i < cap; i++)
             gr[i] = NULL;
     }
-    if (!sig || !lb || !hf || !ni || !nd || !inner_ok || !nm || !gr)
+    if (!sig || !lb || !hf || !lists_ok || !inner_ok || !nm || !gr)
         return amscr__fail(AMSCR_E_NOMEM, "index: out of memory for %zu shapes", n);
     x->cap = cap;
     return AMSCR_OK;

@@ -36,28 +36,29 @@ typedef struct {
     size_t *m;
 } add_ctx;
 
-/* A thread's scratch: the base distance's, and the inner distance's. */
+/* A thread's scratch: the base distance's, and the inner distance's (with the inner graph). */
 typedef struct {
-    void *pw;
-    amscr__inner_ws iw;
+    void *pw, *iw;
 } add_ws;
 
 static void add_ws_free(void *scratch)
 {
     add_ws *w = scratch;
-    amscr__pair_ws_delete(w->pw);
-    amscr__inner_ws_free(&w->iw);
+    if (w->pw)
+        amscr__pair_ws_delete(w->pw);
+    amscr__inner_ws_delete(w->iw);
     free(w);
 }
 
 static amscr_status add_ws_init(void *ctx, void **scratch)
 {
+    add_ctx *c = ctx;
     add_ws *w = calloc(1, sizeof *w);
     if (!w)
         return AMSCR_E_NOMEM;
-    amscr_status st = amscr__pair_ws_new(&((add_ctx *)ctx)->b, &w->pw);
-    if (st == AMSCR_OK && amscr__inner_ws_init(&w->iw) != AMSCR_OK)
-        st = AMSCR_E_NOMEM;
+    amscr_status st = amscr__pair_ws_new(&c->b, &w->pw);
+    if (st == AMSCR_OK && c->x->k2 > 0)
+        st = amscr__inner_ws_new(&w->iw);
     if (st != AMSCR_OK) {
         add_ws_free(w);
         return st;
@@ -79,7 +80,7 @@ static amscr_status add_distances(void *ctx, size_t j, void *scratch)
     const amscr__hf *hq = x->nf ? x->hf + j * (size_t)x->nf : NULL;
     add_ws *w = scratch;
     for (size_t t = 0; x->k2 > 0 && t < m; t++)
-        c->cd2[r * c->n + t] = amscr__index_inner_pair(x, cand[t], j, &w->iw);
+        c->cd2[r * c->n + t] = amscr__index_inner_pair(x, cand[t], j, w->iw);
     return amscr__base_pairs(&c->b, x->db, x->hf, amscr_db_descriptor(x->db, j), hq, j, cand, m, w->pw,
                              c->cd + r * c->n);
 }

@@ -56,19 +56,7 @@ typedef struct {
 static amscr_status ws_init(void *ctx, void **scratch)
 {
     (void)ctx;
-    amscr__inner_ws *w = malloc(sizeof *w);
-    if (!w || amscr__inner_ws_init(w) != AMSCR_OK) {
-        free(w);
-        return AMSCR_E_NOMEM;
-    }
-    *scratch = w;
-    return AMSCR_OK;
-}
-
-static void ws_fini(void *scratch)
-{
-    amscr__inner_ws_free(scratch);
-    free(scratch);
+    return amscr__inner_ws_new(scratch);
 }
 
 /* Row i: its shortlist and its base list (those the shortlist missed). */
@@ -110,7 +98,7 @@ amscr_status amscr__index_inner_rows(amscr_index *x, size_t first, const uint32_
     rows_ctx c = {x, first, m, S, amscr__calloc_array(n - first, sizeof(double))};
     if (!c.rmax)
         return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
-    amscr__rows_fn f = {ws_init, ws_fini, inner_row, &c, "inner distance"};
+    amscr__rows_fn f = {ws_init, amscr__inner_ws_delete, inner_row, &c, "inner distance"};
     amscr_status st = amscr__run_rows(&f, first, n, amscr__resolve_threads(amscr_db_params(x->db)->num_threads),
                                       NULL, NULL);
     for (size_t t = 0; st == AMSCR_OK && t < n - first; t++)

@@ -200,22 +200,28 @@ typedef struct {
     double *out;
 } inner_job;
 
-static amscr_status job_init(void *ctx, void **ws)
+amscr_status amscr__inner_ws_new(void **out)
 {
-    (void)ctx;
     amscr__inner_ws *w = malloc(sizeof *w);
     if (!w || amscr__inner_ws_init(w) != AMSCR_OK) {
         free(w);
         return AMSCR_E_NOMEM;
     }
-    *ws = w;
+    *out = w;
     return AMSCR_OK;
 }
 
-static void job_fini(void *ws)
+void amscr__inner_ws_delete(void *ws)
 {
-    amscr__inner_ws_free(ws);
+    if (ws)
+        amscr__inner_ws_free(ws);
     free(ws);
+}
+
+static amscr_status job_init(void *ctx, void **ws)
+{
+    (void)ctx;
+    return amscr__inner_ws_new(ws);
 }
 
 static amscr_status feature_row(void *ctx, size_t i, void *ws)
@@ -238,7 +244,7 @@ static amscr_status pair_row(void *ctx, size_t i, void *ws)
 amscr_status amscr__inner_features(const amscr_db *db, size_t first, unsigned threads, amscr__inner *f)
 {
     inner_job m = {db, f, NULL, amscr_db_size(db), 0, NULL};
-    amscr__rows_fn features = {job_init, job_fini, feature_row, &m, "inner distance"};
+    amscr__rows_fn features = {job_init, amscr__inner_ws_delete, feature_row, &m, "inner distance"};
     return amscr__run_rows(&features, first, m.n, threads, NULL, NULL);
 }
 
@@ -246,7 +252,7 @@ amscr_status amscr__inner_matrix_from(const amscr__inner *f, size_t n, int refle
                                       amscr_progress_fn progress, void *user, double *out)
 {
     inner_job m = {NULL, NULL, f, n, reflections, out};
-    amscr__rows_fn pairs = {job_init, job_fini, pair_row, &m, "inner distance"};
+    amscr__rows_fn pairs = {job_init, amscr__inner_ws_delete, pair_row, &m, "inner distance"};
     amscr_status st = amscr__run_rows(&pairs, 0, n, threads, progress, user);
     if (st == AMSCR_OK)
         amscr__mirror_upper(out, n);

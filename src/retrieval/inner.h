@@ -36,6 +36,9 @@ typedef struct {
 
 amscr_status amscr__inner_ws_init(amscr__inner_ws *ws);
 void amscr__inner_ws_free(amscr__inner_ws *ws);
+/* A workspace on the heap (*out: the threads' scratch of rows.c) and its release (NULL: none). */
+amscr_status amscr__inner_ws_new(void **out);
+void amscr__inner_ws_delete(void *ws);
 /* The features of the closed curve of n points xy (the descriptor's samples). */
 amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, amscr__inner_ws *ws);
 /* The distance of two shapes: the RMS difference of their inner-distance matrices (each
