@@ -2393,8 +2393,8 @@ typedef struct amscr_index amscr_index;
  *        K - 1; fused medians estimated on 256 shapes; from 20,000 shapes each shortlist is
  *        sought among the shapes of the signature clusters nearest it, so it may miss a few
  *        of the nearest), then among its neighbours' neighbours; the inner distance's among
- *        the same shortlist and its base neighbours. Runs on the params' threads; the result
- *        does not depend on the thread count.
+ *        the same shortlist and its base neighbours, then its inner neighbours' neighbours.
+ *        Runs on the params' threads; the result does not depend on the thread count.
  * @param[in]  db  the collection (copied; may be freed afterwards).
  * @param[in]  candidates  0, or the shortlist size M.
  * @param[in]  progress, user  optional progress callback (may be NULL).

@@ -95,6 +95,10 @@ amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig);
 amscr_status amscr__knn_select(size_t i, const size_t *cj, const double *cd, size_t m, size_t k, uint32_t *out_idx,
                                double *out_dist);
 
+/* Refined lists (*nidx, *ndist) replace (*idx, *dist), their first `keep` entries (the rows
+ * not refined) copied over; the old freed, *nidx and *ndist NULL. */
+void amscr__index_take_lists(uint32_t **idx, double **dist, uint32_t **nidx, double **ndist, size_t keep);
+
 /* Grows the per-shape arrays to hold n rows. */
 amscr_status amscr__index_reserve(amscr_index *x, size_t n);
 /* The channel frames whose features an index with params p keeps (0: no channel). */

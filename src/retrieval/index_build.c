@@ -69,6 +69,18 @@ void amscr__index_enter_list(uint32_t *idx, double *dist, size_t k, size_t j, do
     dist[t] = d;
 }
 
+void amscr__index_take_lists(uint32_t **idx, double **dist, uint32_t **nidx, double **ndist, size_t keep)
+{
+    memcpy(*nidx, *idx, keep * sizeof **nidx);
+    memcpy(*ndist, *dist, keep * sizeof **ndist);
+    free(*idx);
+    free(*dist);
+    *idx = *nidx;
+    *dist = *ndist;
+    *nidx = NULL;
+    *ndist = NULL;
+}
+
 size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,
                               size_t *cand)
 {

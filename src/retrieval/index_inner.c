@@ -2,7 +2,8 @@
  * graph when the params give it a share): each shape's inner features and its K nearest shapes
  * under the inner distance, from the full inner matrix (a build with every shape: a query then
  * equals the matrix of the collection plus the query) or among each shape's signature-nearest
- * shapes and its base neighbours (a shortlist build). */
+ * shapes and its base neighbours, then its inner neighbours' inner neighbours (a shortlist
+ * build). */
 #include "index.h"
 
 #include <stdlib.h>
@@ -90,6 +91,82 @@ static amscr_status inner_row(void *ctx, size_t i, void *scratch)
     return st;
 }
 
+/* ------------------------------------------------ refined from the neighbours' lists */
+
+typedef struct {
+    amscr_index *x;
+    uint32_t *idx; /* the refined lists (x->cap x k2; rows before first: as they were) */
+    double *dist;
+    double *rmax;  /* per row (from first): its largest new inner distance */
+    size_t first;
+} refine_ctx;
+
+static int listed(const size_t *c, size_t m, size_t v)
+{
+    for (size_t t = 0; t < m; t++)
+        if (c[t] == v)
+            return 1;
+    return 0;
+}
+
+/* Row i's K2 nearest of its list and its neighbours' lists (a shape's inner neighbours are
+ * mostly among its neighbours' neighbours), into c->idx / c->dist. */
+static amscr_status refine_row(void *ctx, size_t i, void *scratch)
+{
+    refine_ctx *c = ctx;
+    const amscr_index *x = c->x;
+    size_t k2 = x->k2, m = 0, cap = (k2 - 1) * k2;
+    const uint32_t *nb = x->in_idx + i * k2;
+    size_t *cj = amscr__malloc_array(cap, sizeof *cj);
+    double *cd = amscr__malloc_array(cap, sizeof *cd), rmax = 0.0;
+    if (!cj || !cd) {
+        free(cj);
+        free(cd);
+        return AMSCR_E_NOMEM;
+    }
+    for (size_t t = 1; t < k2; t++, m++) {
+        cj[m] = nb[t];
+        cd[m] = x->in_dist[i * k2 + t];
+    }
+    for (size_t t = 1; t < k2; t++)
+        for (size_t u = 1; u < k2; u++) {
+            size_t l = x->in_idx[(size_t)nb[t] * k2 + u];
+            if (l != i && !listed(cj, m, l)) {
+                cj[m] = l;
+                cd[m] = amscr__index_inner_pair(x, i, l, scratch);
+                rmax = cd[m] > rmax ? cd[m] : rmax;
+                m++;
+            }
+        }
+    c->rmax[i - c->first] = rmax;
+    amscr_status st = amscr__knn_select(i, cj, cd, m, k2, c->idx + i * k2, c->dist + i * k2);
+    free(cj);
+    free(cd);
+    return st;
+}
+
+/* Rows first..n-1's inner lists refined from their neighbours' lists (one pass). */
+static amscr_status refine(amscr_index *x, size_t first, unsigned threads)
+{
+    size_t n = amscr_db_size(x->db), k2 = x->k2;
+    refine_ctx c = {x, amscr__malloc_array(x->cap, k2 * sizeof(uint32_t)), NULL, NULL, first};
+    c.dist = amscr__malloc_array(x->cap, k2 * sizeof(double)); /* as amscr__index_reserve's */
+    c.rmax = amscr__calloc_array(n - first, sizeof(double));
+    amscr_status st = c.idx && c.dist && c.rmax ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    amscr__rows_fn f = {ws_init, amscr__inner_ws_delete, refine_row, &c, "inner distance"};
+    if (st == AMSCR_OK && k2 > 2)
+        st = amscr__run_rows(&f, first, n, threads, NULL, NULL);
+    if (st == AMSCR_OK && k2 > 2) {
+        amscr__index_take_lists(&x->in_idx, &x->in_dist, &c.idx, &c.dist, first * k2);
+        for (size_t t = 0; t < n - first; t++)
+            x->dmax2 = c.rmax[t] > x->dmax2 ? c.rmax[t] : x->dmax2;
+    }
+    free(c.idx);
+    free(c.dist);
+    free(c.rmax);
+    return st;
+}
+
 amscr_status amscr__index_inner_rows(amscr_index *x, size_t first, const uint32_t *S, size_t m)
 {
     size_t n = amscr_db_size(x->db);
@@ -98,11 +175,11 @@ amscr_status amscr__index_inner_rows(amscr_index *x, size_t first, const uint32_
     rows_ctx c = {x, first, m, S, amscr__calloc_array(n - first, sizeof(double))};
     if (!c.rmax)
         return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    unsigned threads = amscr__resolve_threads(amscr_db_params(x->db)->num_threads);
     amscr__rows_fn f = {ws_init, amscr__inner_ws_delete, inner_row, &c, "inner distance"};
-    amscr_status st = amscr__run_rows(&f, first, n, amscr__resolve_threads(amscr_db_params(x->db)->num_threads),
-                                      NULL, NULL);
+    amscr_status st = amscr__run_rows(&f, first, n, threads, NULL, NULL);
     for (size_t t = 0; st == AMSCR_OK && t < n - first; t++)
         x->dmax2 = c.rmax[t] > x->dmax2 ? c.rmax[t] : x->dmax2;
     free(c.rmax);
-    return st;
+    return st == AMSCR_OK ? refine(x, first, threads) : st;
 }

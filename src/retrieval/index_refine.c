@@ -117,18 +117,8 @@ amscr_status amscr__index_refine(amscr_index *x, const amscr__base *b, size_t fi
     for (size_t row = 0; st == AMSCR_OK && row < rows; row++)
         for (size_t t = 0; t < c.nr[row]; t++)
             x->dmax = c.D[row * c.rmax + t] > x->dmax ? c.D[row * c.rmax + t] : x->dmax;
-    if (st == AMSCR_OK) { /* rows before first keep their lists */
-        for (size_t e = 0; e < first * k; e++) {
-            c.nb_idx[e] = x->nb_idx[e];
-            c.nb_dist[e] = x->nb_dist[e];
-        }
-        free(x->nb_idx);
-        free(x->nb_dist);
-        x->nb_idx = c.nb_idx;
-        x->nb_dist = c.nb_dist;
-        c.nb_idx = NULL;
-        c.nb_dist = NULL;
-    }
+    if (st == AMSCR_OK) /* rows before first keep their lists */
+        amscr__index_take_lists(&x->nb_idx, &x->nb_dist, &c.nb_idx, &c.nb_dist, first * k);
     free(c.R);
     free(c.D);
     free(c.nr);
