@@ -155,7 +155,7 @@ class Params:
     rerank_iterations = _Option('rerank_iterations', _UINT, 'diffusion iterations of that re-ranking (1..1000)')
     rerank_inner_share = _Option('rerank_inner_share', _FLOAT,
                                  'share, in [0, 1), of the inner-distance graph in that re-ranking (0 = one graph, '
-                                 'the default; 0.05 in the retrieval preset; an Index uses 0)')
+                                 'the default; 0.05 in the retrieval preset; an Index holds both graphs)')
 
     #: The option names, in the order of the table above.
     OPTIONS: Tuple[str, ...] = ()
