@@ -31,6 +31,7 @@ typedef struct {
     const double *dfull2;  /* and its inner distances (with the inner graph) */
     const unsigned char *have;
     int query;             /* row n - 1 is the query */
+    double dmax;           /* largest base distance (the query's included) */
     double tiny, tiny2;
     double share;          /* the inner graph's share of a row's mass */
     const size_t *rs;      /* the stored lists' reverse (x's or built for this query) */
@@ -454,6 +455,7 @@ static void graph_setup(graph *g, const amscr_index *x, size_t self, const qrow 
     double dmax = self == n ? largest(x->dmax, q->dq, q->m) : x->dmax;
     double dmax2 = self == n && q->dq2 ? largest(x->dmax2, q->dq2, q->m) : x->dmax2;
     g->x = x;
+    g->dmax = dmax;
     g->dfull = q->dfull;
     g->dfull2 = q->dfull2;
     g->have = q->have;
@@ -489,7 +491,7 @@ static amscr_status diffuse(const amscr_index *x, size_t self, const qrow *q, do
     if (st == AMSCR_OK)
         st = diffusion_row(&g, self, p->rerank_iterations, r, rsup, &rlen);
     if (st == AMSCR_OK)
-        scores(r, rsup, rlen, n, self, q->dfull, q->have, self == n ? largest(x->dmax, q->dq, q->m) : x->dmax, out);
+        scores(r, rsup, rlen, n, self, q->dfull, q->have, g.dmax, out);
     graph_free(&g);
     free(r);
     free(rsup);
