@@ -4,6 +4,7 @@ import math
 import os
 import struct
 import subprocess
+import tempfile
 import zlib
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -22,6 +23,16 @@ def run(*args, cwd=None, timeout=300):
     """Runs the tool; returns CompletedProcess with text stdout/stderr."""
     return subprocess.run([tool_path()] + [str(a) for a in args], capture_output=True, text=True, cwd=cwd,
                           timeout=timeout)
+
+
+def run_peak_memory(*args):
+    """Runs the tool; returns (exit status, stderr, the child's peak resident memory in KiB)."""
+    with tempfile.TemporaryFile() as err:
+        p = subprocess.Popen([tool_path()] + [str(a) for a in args], stdout=subprocess.DEVNULL, stderr=err)
+        _, status, usage = os.wait4(p.pid, 0)
+        p.returncode = os.waitstatus_to_exitcode(status)
+        err.seek(0)
+        return p.returncode, err.read().decode(), usage.ru_maxrss
 
 
 # --------------------------------------------------------------------------- masks
@@ -113,6 +124,14 @@ def png_bytes(img, color_type=0, depth=8, palette=None, trns=None, interlace=Fal
 def png_header_only(w, h, depth=8, color_type=0):
     ihdr = struct.pack(">IIBBBBB", w, h, depth, color_type, 0, 0, 0)
     return b"\x89PNG\r\n\x1a\n" + _chunk(b"IHDR", ihdr)
+
+
+def png_short_claim(w, h):
+    """An interlaced 1-bit palette image with transparency (expanded to 4 bytes a pixel) whose
+    header claims w x h pixels while its image data is a few kilobytes of compressed zeros."""
+    ihdr = struct.pack(">IIBBBBB", w, h, 1, 3, 0, 0, 1)
+    return (b"\x89PNG\r\n\x1a\n" + _chunk(b"IHDR", ihdr) + _chunk(b"PLTE", b"\x00\x00\x00\xff\xff\xff") +
+            _chunk(b"tRNS", b"\x00\xff") + _chunk(b"IDAT", zlib.compress(bytes(4000000), 9)) + _chunk(b"IEND", b""))
 
 
 # --------------------------------------------------------------------------- PGM

@@ -6,8 +6,8 @@ import zlib
 
 import pytest
 
-from imgutil import (blank, have_png, pgm_bytes, png_bytes, png_header_only, rect_mask, run, smooth_shape,
-                     write_points)
+from imgutil import (blank, have_png, pgm_bytes, png_bytes, png_header_only, png_short_claim, rect_mask, run,
+                     run_peak_memory, smooth_shape, write_points)
 
 GOOD_PNG = png_bytes(rect_mask(fg=255), 0, 8)
 
@@ -43,6 +43,7 @@ BAD_FILES = {
     "huge.png": (png_header_only(40000, 40000), "too large"),
     "huge-pixels.png": (png_header_only(20000, 20000), "too large"),
     "wide.png": (png_header_only(32769, 1), "too large"),
+    "short-claim.png": (png_short_claim(32768, 8192), "truncated PNG: 32768 x 8192 pixels need at least"),
     "zero.png": (png_header_only(0, 10), "PNG"),
     "trunc.pgm": (pgm_bytes(rect_mask(fg=255))[:200], "truncated"),
     "trunc16.pgm": (pgm_bytes(rect_mask(fg=999), maxval=1000)[:-1], "truncated"),
@@ -67,6 +68,33 @@ BAD_FILES = {
     "comments-only.txt": (b"# nothing here\n\n", "comments-only.txt"),
     "binary.dat": (bytes(range(1, 256)) * 4, "binary.dat"),
 }
+
+
+def png_huge_text_chunk():
+    """A 16 x 12 gray image whose tEXt chunk claims 2 GB, in a file of a hundred bytes."""
+    ihdr = struct.pack(">IIBBBBB", 16, 12, 8, 0, 0, 0, 0)
+    ihdr_chunk = struct.pack(">I", 13) + b"IHDR" + ihdr + struct.pack(">I", zlib.crc32(b"IHDR" + ihdr))
+    return b"\x89PNG\r\n\x1a\n" + ihdr_chunk + struct.pack(">I", 2054847098) + b"tEXtComment\0" + b"z" * 40
+
+
+MEMORY_FILES = {
+    "huge-text-chunk.png": (png_huge_text_chunk(), "truncated PNG"),
+    "short-claim.png": (png_short_claim(32768, 8192), "truncated PNG"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(MEMORY_FILES))
+def test_memory_bounded_by_the_file(tmp_path, name):
+    """A small PNG whose chunks or header claim gigabytes is refused without taking them
+    (libpng allocates a chunk's claimed size; a claimed image is allocated before its data is read)."""
+    if not have_png():
+        pytest.skip("tool built without libpng")
+    data, needle = MEMORY_FILES[name]
+    p = tmp_path / name
+    p.write_bytes(data)
+    code, err, peak_kib = run_peak_memory("contour", p)
+    assert code == 1 and needle in err, (code, err)
+    assert peak_kib < 128 * 1024, f"{name}: {len(data)} bytes took {peak_kib / 1024:.0f} MiB"
 
 
 @pytest.mark.parametrize("name", sorted(BAD_FILES))

@@ -18,6 +18,7 @@
 #include "image.h"
 
 #include <errno.h>
+#include <math.h>
 #include <setjmp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -50,8 +51,8 @@ void image_free(tool_image *img)
     }
 }
 
-/* Ancillary PNG chunks: at most this many bytes each and this many in all (libpng's own
- * defaults in builds that set them; Debian's libpng sets no byte limit). */
+/* The chunks libpng still reads into memory (png_set_input): at most this many bytes each and
+ * this many in all (libpng's defaults in builds that set them). */
 #define PNG_CHUNK_MAX_BYTES 8000000u
 #define PNG_CHUNK_MAX_COUNT 1000u
 
@@ -280,7 +281,8 @@ typedef struct png_ctx {
     uint8_t *volatile alpha;
     uint8_t *volatile buf;
     png_bytep *volatile rows;
-    volatile int limit_failed;
+    volatile int limit_failed; /* reported already (a size limit, or too small a file) */
+    size_t file_size;          /* bytes, 0 when unknown (not a regular file) */
 } png_ctx;
 
 static void png_err_fn(png_structp png, png_const_charp msg)
@@ -431,17 +433,20 @@ static int png_create(png_ctx *ctx, const char *path, png_structp *out_png, png_
     return 0;
 }
 
-/* Reading through ctx's file, with the tool's limits instead of libpng's. */
+/* Reading through ctx's file, with the tool's limits instead of libpng's. Every ancillary chunk
+ * but tRNS is skipped unread (none changes the luminance read here): libpng would otherwise
+ * allocate what a text or profile chunk claims, up to 2 GiB, before finding the file ends
+ * (fuzz_png: a 130-byte file with a 2 GB tEXt chunk; its "chunk data is too large" check is a
+ * warning on read, so the chunk size limit alone does not stop it). */
 static void png_set_input(png_structp png, png_ctx *ctx)
 {
     png_set_read_fn(png, ctx, png_read_fn);
     png_set_user_limits(png, 0x7fffffffu, 0x7fffffffu); /* our own limits are checked in png_decode */
-#ifdef PNG_SET_CHUNK_MALLOC_LIMIT_SUPPORTED
-    /* An ancillary chunk may claim up to 2 GiB, which libpng would allocate before reading it
-     * (found by fuzz_png: a 16 x 12 image with a 2 GB text chunk); none we need is large. */
-    png_set_chunk_malloc_max(png, PNG_CHUNK_MAX_BYTES);
+#if defined(PNG_HANDLE_AS_UNKNOWN_SUPPORTED)
+    png_set_keep_unknown_chunks(png, PNG_HANDLE_CHUNK_NEVER, NULL, -1);
 #endif
-#ifdef PNG_SET_CHUNK_CACHE_LIMIT_SUPPORTED
+#if defined(PNG_SET_USER_LIMITS_SUPPORTED)
+    png_set_chunk_malloc_max(png, PNG_CHUNK_MAX_BYTES);
     png_set_chunk_cache_max(png, PNG_CHUNK_MAX_COUNT);
 #endif
 }
@@ -477,6 +482,26 @@ static void png_alloc(png_structp png, png_ctx *ctx, png_uint_32 w, png_uint_32 
     }
 }
 
+/* Deflate's largest compression ratio (a 258-byte match coded in 2 bits). */
+#define PNG_DEFLATE_MAX_RATIO 1032.0
+
+/* A file too small to hold the header's image even at deflate's largest ratio is truncated:
+ * refused before the pixels are allocated (an 8 KB file claiming 2^28 pixels would otherwise
+ * make the decoder take and fill gigabytes before it finds the data missing). */
+static int png_check_data_size(png_structp png, png_infop info, const png_ctx *ctx, const char *path)
+{
+    if (ctx->file_size == 0)
+        return 0;
+    double bits = (double)png_get_bit_depth(png, info) * (double)png_get_channels(png, info);
+    double w = png_get_image_width(png, info), h = png_get_image_height(png, info);
+    double raw = h * ceil(w * bits / 8.0); /* filtered rows without their filter bytes */
+    if ((double)ctx->file_size * PNG_DEFLATE_MAX_RATIO >= raw)
+        return 0;
+    tool_error(path, "truncated PNG: %.0f x %.0f pixels need at least %.0f bytes of compressed data, the file has %zu",
+               w, h, ceil(raw / PNG_DEFLATE_MAX_RATIO), ctx->file_size);
+    return -1;
+}
+
 /* The image after the signature: header, size limits, conversion to 8-bit luminance (and
  * alpha), pixels, alpha policy; longjmps on any failure (ctx says why). */
 static void png_decode(png_structp png, png_infop info, png_ctx *ctx, const char *path, tool_image *out)
@@ -484,7 +509,7 @@ static void png_decode(png_structp png, png_infop info, png_ctx *ctx, const char
     png_read_info(png, info);
     png_uint_32 w = png_get_image_width(png, info);
     png_uint_32 h = png_get_image_height(png, info);
-    if (check_limits(path, "PNG", w, h) != 0) {
+    if (check_limits(path, "PNG", w, h) != 0 || png_check_data_size(png, info, ctx, path) != 0) {
         ctx->limit_failed = 1;
         png_longjmp(png, 1);
     }
@@ -524,6 +549,9 @@ static int read_png(FILE *fp, const char *path, tool_image *out)
     png_ctx ctx;
     memset(&ctx, 0, sizeof ctx);
     ctx.fp = fp;
+    struct stat st;
+    if (fstat(fileno(fp), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0)
+        ctx.file_size = (size_t)st.st_size;
     png_structp png;
     png_infop info;
     if (png_create(&ctx, path, &png, &info) != 0)
