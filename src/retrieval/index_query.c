@@ -6,8 +6,9 @@
  * With P the row-normalized kNN affinities of the n + 1 shapes, Q_0 = P and
  * Q <- P Q P^T + I for T iterations give
  *     Q_T = sum_{t=0}^{T-1} P^t (P^T)^t + P^T P (P^T)^T   (powers),
- * so row q is sum_t P^t (e_q P^t)^T + P^T (e_q P^T P)^T (as columns): sparse vector products
- * only, O(T^2 (n+1) K) instead of the O(T n^2 K) of the whole matrix. Adding the query
+ * so row q is sum_t P^t (e_q P^t)^T + P^T (e_q P^T P)^T (as columns), summed by Horner's rule:
+ * 2T + 1 sparse vector products, O(T (n+1) K) instead of the O(T n^2 K) of the whole matrix
+ * (O(T^2 (n+1) K) term by term, as before 0.8). Adding the query
  * changes the neighbour list of every shape it is nearer to than that shape's K-th
  * neighbour, and nothing else, so the stored lists (plus the query) give P exactly. With the
  * inner distance's graph, P = (1 - s) P1 + s P2: a row holds both lists (2K entries), each
@@ -307,20 +308,58 @@ static void svec_copy(svec *dst, const svec *src)
     dst->len = src->len;
 }
 
-/* r += v (r's support marked in rmark, listed in rsup). */
-static void accumulate(double *r, unsigned char *rmark, size_t *rsup, size_t *rlen, const svec *v)
+/* A sparse vector's values on its support, kept while the diffusion goes on. */
+typedef struct {
+    double *v;
+    size_t *sup, len;
+} spacked;
+
+static amscr_status pack(const svec *x, spacked *out)
 {
-    for (size_t u = 0; u < v->len; u++) {
-        size_t i = v->sup[u];
-        r[i] += v->v[i];
-        if (!rmark[i]) {
-            rmark[i] = 1;
-            rsup[(*rlen)++] = i;
-        }
+    out->len = x->len;
+    out->v = amscr__malloc_array(x->len ? x->len : 1, sizeof *out->v);
+    out->sup = amscr__malloc_array(x->len ? x->len : 1, sizeof *out->sup);
+    if (!out->v || !out->sup)
+        return amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    for (size_t u = 0; u < x->len; u++) {
+        out->sup[u] = x->sup[u];
+        out->v[u] = x->v[x->sup[u]];
+    }
+    return AMSCR_OK;
+}
+
+/* y += x (y's values are positive on its support and zero elsewhere; x's zeros are skipped). */
+static void add_packed(svec *y, const spacked *x)
+{
+    for (size_t u = 0; u < x->len; u++) {
+        size_t i = x->sup[u];
+        if (x->v[u] == 0.0)
+            continue;
+        if (y->v[i] == 0.0)
+            y->sup[y->len++] = i;
+        y->v[i] += x->v[u];
     }
 }
 
-/* Row `start` of Q_T into r (g->n entries, zero on entry); its support into rsup / rlen. */
+/* The row vectors a_t = e_start P^t, t = 0..iters - 1, packed into rows[t], and a_(iters + 1)
+ * into last (a, b: work vectors, a holding e_start on entry). */
+static amscr_status row_powers(graph *g, unsigned iters, svec *a, svec *b, sscratch *s, spacked *rows, svec *last)
+{
+    amscr_status st = AMSCR_OK;
+    for (unsigned t = 0; st == AMSCR_OK && t < iters; t++) {
+        st = pack(a, &rows[t]);
+        apply_rows(g, a, b, s);
+        svec_copy(a, b);
+    }
+    if (st == AMSCR_OK)
+        apply_rows(g, a, last, s); /* e_start P^iters P */
+    return st;
+}
+
+/* Row `start` of Q_T into r (g->n entries, zero on entry); its support into rsup / rlen. With
+ * v_t = (e_start P^t)^T for t < T and v_T = (e_start P^(T+1))^T the row is
+ * sum_t P^t v_t = v_0 + P (v_1 + P (... + P v_T)), by Horner's rule: T products P v (not the
+ * T (T + 1) / 2 of the sum term by term); the values are the same to rounding. */
 static amscr_status diffusion_row(graph *g, size_t start, unsigned iters, double *r, size_t *rsup, size_t *rlen)
 {
     size_t n = g->n;
@@ -329,8 +368,8 @@ static amscr_status diffusion_row(graph *g, size_t start, unsigned iters, double
     svec b = {amscr__calloc_array(n, sizeof(double)), amscr__malloc_array(n, sizeof(size_t)), 0};
     sscratch s = {amscr__calloc_array(n, sizeof(double)), amscr__calloc_array(n, 1),
                   amscr__malloc_array(n, sizeof(size_t))};
-    unsigned char *rmark = amscr__calloc_array(n, 1);
-    amscr_status st = a.v && a.sup && v.v && v.sup && b.v && b.sup && s.tmp && s.mark && s.list && rmark
+    spacked *rows = calloc(iters ? iters : 1, sizeof *rows);
+    amscr_status st = a.v && a.sup && v.v && v.sup && b.v && b.sup && s.tmp && s.mark && s.list && rows
                           ? AMSCR_OK
                           : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     *rlen = 0;
@@ -338,20 +377,21 @@ static amscr_status diffusion_row(graph *g, size_t start, unsigned iters, double
         a.v[start] = 1.0;
         a.sup[0] = start;
         a.len = 1;
-        for (unsigned t = 0; t <= iters; t++) {
-            if (t == iters)
-                apply_rows(g, &a, &v, &s); /* the last term: e_q P^T P */
-            else
-                svec_copy(&v, &a);
-            for (unsigned u = 0; u < t; u++)
-                apply_cols(g, &v, &s);
-            accumulate(r, rmark, rsup, rlen, &v);
-            if (t < iters) {
-                apply_rows(g, &a, &b, &s);
-                svec_copy(&a, &b);
-            }
-        }
+        st = row_powers(g, iters, &a, &b, &s, rows, &v);
     }
+    for (unsigned t = iters; st == AMSCR_OK && t-- > 0;) {
+        apply_cols(g, &v, &s);
+        add_packed(&v, &rows[t]);
+    }
+    for (size_t u = 0; st == AMSCR_OK && u < v.len; u++) {
+        r[v.sup[u]] = v.v[v.sup[u]];
+        rsup[(*rlen)++] = v.sup[u];
+    }
+    for (unsigned t = 0; rows && t < iters; t++) {
+        free(rows[t].v);
+        free(rows[t].sup);
+    }
+    free(rows);
     free(a.v);
     free(a.sup);
     free(v.v);
@@ -361,7 +401,6 @@ static amscr_status diffusion_row(graph *g, size_t start, unsigned iters, double
     free(s.tmp);
     free(s.mark);
     free(s.list);
-    free(rmark);
     return st;
 }
 
