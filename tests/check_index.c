@@ -731,6 +731,45 @@ static amscr_descriptor *shape_of(const amscr_params *p, unsigned i, unsigned cl
     return d;
 }
 
+/* In a collection of many small classes a query enters few rows' lists: the rows it leaves
+ * alone keep the affinities stored at build time (x->w_fixed), the others are recomputed. The
+ * query row still equals the matrix row of the collection plus the query, at either graph's
+ * share, for queries near and far from the collection's shapes. */
+static void left_alone_case(double share)
+{
+    enum { N = 72, CLASSES = 24 };
+    amscr_params *p = params_of(1.0, 4, 2);
+    ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, share), AMSCR_OK);
+    amscr_db *db = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
+    for (unsigned i = 0; i < N; i++) {
+        amscr_descriptor *d = shape_of(p, i, CLASSES);
+        ck_assert_int_eq(amscr_db_add_descriptor(db, d, (int32_t)(i % CLASSES), NULL), AMSCR_OK);
+        amscr_descriptor_free(d);
+    }
+    amscr_index *x = NULL;
+    ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
+    ck_assert_ptr_nonnull(x->w_fixed);
+    double ref[N], got[N];
+    for (unsigned t = 0; t < 4; t++) {
+        amscr_descriptor *q = shape_of(p, t < 2 ? 5 + 24 * t : 500 + t, CLASSES);
+        reference_row(db, q, ref);
+        ck_assert_int_eq(amscr_index_query_scores(x, q, 0, got, N), AMSCR_OK);
+        assert_close(ref, got, N, 1e-12);
+        amscr_descriptor_free(q);
+    }
+    amscr_index_free(x);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+
+START_TEST(rows_left_alone)
+{
+    left_alone_case(0.0);
+    left_alone_case(0.3);
+}
+END_TEST
+
 /* The default shortlist (AMSCR_INDEX_CANDIDATES, build and query) finds the exact first hit of
  * affine-warped queries in a collection larger than the shortlist. */
 START_TEST(default_shortlist_first_hit)
@@ -850,6 +889,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, default_shortlist_first_hit);
     tcase_add_test(tc, groups);
     tcase_add_test(tc, kept_and_own_reverse);
+    tcase_add_test(tc, rows_left_alone);
     tcase_add_test(tc, quantizer_shortlist);
     suite_add_tcase(s, tc);
     return s;

@@ -43,6 +43,10 @@ struct amscr_index {
     size_t *rev_start;    /* n + 1 offsets into rev (NULL: not built; a query builds its own) */
     uint32_t *rev;        /* rows i holding shape j in their lists (either graph's; a row twice when both):
                            * rev[rev_start[j]..rev_start[j+1]) */
+    double *w_fixed;      /* n rows of w_kk affinities: each stored row's as a query that enters neither
+                           * it nor its neighbours' rows sees them (index_query.c; NULL: none) */
+    size_t w_k, w_kk;     /* the graph's k they were computed for (amscr__rerank_k of n + 1), and k + k2 */
+    double w_tiny, w_tiny2; /* and its distance floors */
 };
 
 /* How the base distance of the retrieval matrix (fuse.c) is computed pair by pair. */
@@ -122,7 +126,8 @@ amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_pro
 /* Rows first..n-1's lists (their K nearest among their shortlists S, m each, ascending) refined
  * from the neighbours' lists (index_refine.c); x->dmax grows. */
 amscr_status amscr__index_refine(amscr_index *x, const amscr__base *b, size_t first, const uint32_t *S, size_t m);
-/* The lists' reverse (x->rev_start, x->rev) from x's lists (index_query.c); frees the old. */
+/* The lists' reverse (x->rev_start, x->rev) and the stored rows' affinities (x->w_fixed) from
+ * x's lists (index_query.c); frees the old. */
 amscr_status amscr__index_reverse(amscr_index *x);
 void amscr__index_reverse_free(amscr_index *x);
 /* Drops x's hold on its mapped file: the heights that point into it forgotten, x->map NULL. */

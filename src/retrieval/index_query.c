@@ -12,7 +12,9 @@
  * changes the neighbour list of every shape it is nearer to than that shape's K-th
  * neighbour, and nothing else, so the stored lists (plus the query) give P exactly. With the
  * inner distance's graph, P = (1 - s) P1 + s P2: a row holds both lists (2K entries), each
- * normalized to its share, and the query enters each list by its own distance. */
+ * normalized to its share, and the query enters each list by its own distance. A row the query
+ * enters neither directly nor through a neighbour's list has the affinities the index computed
+ * once (x->w_fixed): the query copies them instead of recomputing its exponentials. */
 #include "index.h"
 
 #include <math.h>
@@ -39,6 +41,7 @@ typedef struct {
     const uint32_t *rv;
     const size_t *cand;    /* the query's candidates (the rows it may enter) */
     size_t m;
+    const double *fixed;   /* the stored rows' affinities (x->w_fixed) when they hold for this graph, else NULL */
 } graph;
 
 static amscr_status graph_alloc(graph *g, size_t n, size_t k, size_t k2)
@@ -149,6 +152,34 @@ static void part_weights(graph *g, size_t i, size_t off, size_t k, double tiny, 
         w[t] = mass * (w[t] / sum); /* exactly w / sum for one graph */
 }
 
+/* Whether the query enters stored row i's list (either graph's), as merge_row places it: before
+ * the k-th entry, ties after the stored ones. */
+static int entered(const graph *g, size_t i)
+{
+    const amscr_index *x = g->x;
+    if (!g->query || !g->have[i])
+        return 0;
+    if (g->k >= 2 && (g->k > x->k || x->nb_dist[i * x->k + g->k - 1] > g->dfull[i]))
+        return 1;
+    return g->k2 >= 2 && (g->k2 > x->k2 || x->in_dist[i * x->k2 + g->k2 - 1] > g->dfull2[i]);
+}
+
+/* Whether stored row i keeps the affinities of x->w_fixed: the query enters neither its lists
+ * nor its neighbours' (whose k-th distances scale its affinities). */
+static int left_alone(const graph *g, size_t i)
+{
+    const amscr_index *x = g->x;
+    if (!g->fixed || (g->query && i == g->n - 1) || entered(g, i))
+        return 0;
+    for (size_t t = 0; t < g->k; t++)
+        if (entered(g, x->nb_idx[i * x->k + t]))
+            return 0;
+    for (size_t t = 0; t < g->k2; t++)
+        if (entered(g, x->in_idx[i * x->k2 + t]))
+            return 0;
+    return 1;
+}
+
 /* Row i's affinities, each graph's part normalized to its share of the row's mass. */
 static void need_weights(graph *g, size_t i)
 {
@@ -156,6 +187,11 @@ static void need_weights(graph *g, size_t i)
     if (g->state[i] == 2)
         return;
     need_row(g, i);
+    if (left_alone(g, i)) {
+        memcpy(g->w + i * kk, g->fixed + i * kk, kk * sizeof *g->w);
+        g->state[i] = 2;
+        return;
+    }
     for (size_t t = 0; t < kk; t++)
         need_row(g, g->j[i * kk + t]);
     part_weights(g, i, 0, g->k, g->tiny, g->k2 > 0 ? 1.0 - g->share : 1.0);
@@ -449,25 +485,12 @@ void amscr__index_reverse_free(amscr_index *x)
 {
     free(x->rev_start);
     free(x->rev);
+    free(x->w_fixed);
     x->rev_start = NULL;
     x->rev = NULL;
+    x->w_fixed = NULL;
 }
 
-amscr_status amscr__index_reverse(amscr_index *x)
-{
-    size_t n = amscr_db_size(x->db);
-    amscr__index_reverse_free(x);
-    if (x->k == 0)
-        return AMSCR_OK;
-    x->rev_start = amscr__malloc_array(n + 1, sizeof *x->rev_start);
-    x->rev = amscr__malloc_array(n ? n : 1, (x->k + x->k2) * sizeof *x->rev);
-    if (!x->rev_start || !x->rev) {
-        amscr__index_reverse_free(x);
-        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
-    }
-    reverse_lists(x, n, x->rev_start, x->rev);
-    return AMSCR_OK;
-}
 
 /* What a row knows of the query: its candidates cand (m) with their base distances dq and, with
  * the inner graph, inner distances dq2; the same by shape (dfull[j], dfull2[j] where have[j]). */
@@ -506,6 +529,51 @@ static void graph_setup(graph *g, const amscr_index *x, size_t self, const qrow 
     g->m = self == n ? q->m : 0;
 }
 
+/* x->w_fixed: every stored row's affinities in the graph of a query that enters no row (n + 1
+ * rows, the collection's largest distances), computed by the query's own code. */
+static amscr_status fixed_weights(amscr_index *x)
+{
+    size_t n = amscr_db_size(x->db), k = amscr__rerank_k(amscr_db_params(x->db), n + 1);
+    graph g = {0};
+    unsigned char *have = amscr__calloc_array(n ? n : 1, 1);
+    qrow q = {NULL, NULL, NULL, 0, NULL, NULL, have};
+    amscr_status st = have ? graph_alloc(&g, n + 1, k, x->k2 > 0 ? k : 0)
+                           : amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    if (st == AMSCR_OK) {
+        graph_setup(&g, x, n, &q);
+        for (size_t i = 0; i < n; i++)
+            need_weights(&g, i);
+        x->w_fixed = g.w;
+        g.w = NULL;
+        x->w_k = k;
+        x->w_kk = g.kk;
+        x->w_tiny = g.tiny;
+        x->w_tiny2 = g.tiny2;
+    }
+    graph_free(&g);
+    free(have);
+    return st;
+}
+
+amscr_status amscr__index_reverse(amscr_index *x)
+{
+    size_t n = amscr_db_size(x->db);
+    amscr__index_reverse_free(x);
+    if (x->k == 0)
+        return AMSCR_OK;
+    x->rev_start = amscr__malloc_array(n + 1, sizeof *x->rev_start);
+    x->rev = amscr__malloc_array(n ? n : 1, (x->k + x->k2) * sizeof *x->rev);
+    if (!x->rev_start || !x->rev) {
+        amscr__index_reverse_free(x);
+        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    }
+    reverse_lists(x, n, x->rev_start, x->rev);
+    amscr_status st = n > 0 && x->k <= n ? fixed_weights(x) : AMSCR_OK;
+    if (st != AMSCR_OK)
+        amscr__index_reverse_free(x);
+    return st;
+}
+
 /* The diffusion's scores of row `self` (< n: a shape of the index; n: the query). */
 static amscr_status diffuse(const amscr_index *x, size_t self, const qrow *q, double *out)
 {
@@ -523,6 +591,9 @@ static amscr_status diffuse(const amscr_index *x, size_t self, const qrow *q, do
     if (st == AMSCR_OK && !x->rev_start)
         reverse_lists(x, n, rs, rv);
     graph_setup(&g, x, self, q);
+    if (x->w_fixed && g.k == x->w_k && g.kk == x->w_kk && g.k <= x->k && g.k2 <= x->k2 && g.tiny == x->w_tiny &&
+        g.tiny2 == x->w_tiny2)
+        g.fixed = x->w_fixed;
     g.rs = x->rev_start ? x->rev_start : rs;
     g.rv = x->rev_start ? x->rev : rv;
     if (st == AMSCR_OK && self == n)
