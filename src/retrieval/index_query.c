@@ -491,7 +491,6 @@ void amscr__index_reverse_free(amscr_index *x)
     x->w_fixed = NULL;
 }
 
-
 /* What a row knows of the query: its candidates cand (m) with their base distances dq and, with
  * the inner graph, inner distances dq2; the same by shape (dfull[j], dfull2[j] where have[j]). */
 typedef struct {
