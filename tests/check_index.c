@@ -731,6 +731,19 @@ static amscr_descriptor *shape_of(const amscr_params *p, unsigned i, unsigned cl
     return d;
 }
 
+/* n shapes of shape_of, labelled by class. */
+static amscr_db *db_of_classes(const amscr_params *p, unsigned n, unsigned classes)
+{
+    amscr_db *db = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
+    for (unsigned i = 0; i < n; i++) {
+        amscr_descriptor *d = shape_of(p, i, classes);
+        ck_assert_int_eq(amscr_db_add_descriptor(db, d, (int32_t)(i % classes), NULL), AMSCR_OK);
+        amscr_descriptor_free(d);
+    }
+    return db;
+}
+
 /* In a collection of many small classes a query enters few rows' lists: the rows it leaves
  * alone keep the affinities stored at build time (x->w_fixed), the others are recomputed. The
  * query row still equals the matrix row of the collection plus the query, at either graph's
@@ -740,13 +753,7 @@ static void left_alone_case(double share)
     enum { N = 72, CLASSES = 24 };
     amscr_params *p = params_of(1.0, 4, 2);
     ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, share), AMSCR_OK);
-    amscr_db *db = NULL;
-    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
-    for (unsigned i = 0; i < N; i++) {
-        amscr_descriptor *d = shape_of(p, i, CLASSES);
-        ck_assert_int_eq(amscr_db_add_descriptor(db, d, (int32_t)(i % CLASSES), NULL), AMSCR_OK);
-        amscr_descriptor_free(d);
-    }
+    amscr_db *db = db_of_classes(p, N, CLASSES);
     amscr_index *x = NULL;
     ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
     ck_assert_ptr_nonnull(x->w_fixed);
@@ -776,13 +783,7 @@ START_TEST(default_shortlist_first_hit)
 {
     enum { N = 320, CLASSES = 40 };
     amscr_params *p = params_of(1.0, 8, 2);
-    amscr_db *db = NULL;
-    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
-    for (unsigned i = 0; i < N; i++) {
-        amscr_descriptor *d = shape_of(p, i, CLASSES);
-        ck_assert_int_eq(amscr_db_add_descriptor(db, d, (int32_t)(i % CLASSES), NULL), AMSCR_OK);
-        amscr_descriptor_free(d);
-    }
+    amscr_db *db = db_of_classes(p, N, CLASSES);
     amscr_index *x = NULL, *full = NULL;
     ck_assert_int_eq(amscr_index_build(db, AMSCR_INDEX_CANDIDATES, NULL, NULL, &x), AMSCR_OK);
     ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &full), AMSCR_OK);
