@@ -3,7 +3,8 @@
  * once through the library — the AMSCR distance (the paper's method: affine group, no
  * refinement, mirror images), the shape channel in the similarity frame (band 0.15) and in the
  * affine (whitened) frame (its own band, 0.08) — plus the inner distance of the re-ranking's
- * second graph, and every row is composed from them exactly as amscr_db_retrieval_matrix
+ * second graph (inside each silhouette closed at 0.08 sqrt(area), the default, and on the
+ * silhouette as traced, 0.8's), and every row is composed from them exactly as amscr_db_retrieval_matrix
  * composes them (channel frames mixed 0.8 / 0.2, fusion = each matrix over its median
  * off-diagonal value, re-ranking k 8, 10 iterations, on one graph or with the inner distance's
  * graph at share 0.05). A row's time is the wall time of the base
@@ -23,14 +24,15 @@
 #include "mcd_set.h"
 #include "../tools/cli/collection.h"
 
-enum { M_AMSCR, M_SIM, M_AFF, M_INNER, NBASE };
+enum { M_AMSCR, M_SIM, M_AFF, M_INNER, M_INNER_OPEN, NBASE };
 
 typedef struct {
     const char *name;
-    int use[NBASE];     /* base matrices: AMSCR, channel similarity, channel affine, inner distance */
+    int use[NBASE];     /* base matrices: AMSCR, channel similarity, channel affine, inner distance (closed
+                         * silhouette, silhouette as traced) */
     double weight;      /* channel weight of the fusion with AMSCR (used when both are in) */
     double share;       /* affine share of the channel (when both frames are in) */
-    int rerank;         /* re-ranking k 8, 10 iterations (with use[M_INNER]: the inner graph at 0.05) */
+    int rerank;         /* re-ranking k 8, 10 iterations (with an inner distance: its graph at 0.05) */
 } row_t;
 
 static const row_t ROWS[] = {
@@ -40,11 +42,12 @@ static const row_t ROWS[] = {
     {"channel, affine frame (band 0.08)", {0, 0, 1, 0}, 1, 1, 0},
     {"channel, both frames (0.8 / 0.2)", {0, 1, 1, 0}, 1, 0.2, 0},
     {"AMSCR + channel fused (w 0.5)", {1, 1, 1, 0}, 0.5, 0.2, 0},
-    {"inner distance alone", {0, 0, 0, 1}, 1, 0, 0},
+    {"inner distance alone (closed silhouette)", {0, 0, 0, 1}, 1, 0, 0},
     {"channel, similarity frame + re-ranking", {0, 1, 0, 0}, 1, 0, 1},
     {"channel, affine frame (band 0.08) + re-ranking", {0, 0, 1, 0}, 1, 1, 1},
     {"AMSCR + channel fused (w 0.5) + re-ranking", {1, 1, 1, 0}, 0.5, 0.2, 1},
     {"channel, both frames + re-ranking on one graph (0.6's default)", {0, 1, 1, 0}, 1, 0.2, 1},
+    {"channel, both frames + two graphs, the silhouette as traced (0.8's default)", {0, 1, 1, 0, 1}, 1, 0.2, 1},
     {"channel, similarity frame + re-ranking on two graphs (--fast)", {0, 1, 0, 1}, 1, 0, 1},
     {"**default: channel, both frames + re-ranking on two graphs**", {0, 1, 1, 1}, 1, 0.2, 1},
 };
@@ -106,6 +109,8 @@ static void compute_bases(set_run *r)
         if (b == M_AFF && (amscr_params_set_channel_invariance(p, AMSCR_INVARIANCE_AFFINE) != AMSCR_OK ||
                            amscr_params_set_channel_band(p, amscr_params_get_channel_affine_band(p)) != AMSCR_OK))
             die("params");
+        if (b == M_INNER_OPEN && amscr_params_set_inner_closing(p, 0.0) != AMSCR_OK)
+            die("params");
         double t0 = now();
         amscr_db *db = NULL;
         if (amscr_db_new(p, &db) != AMSCR_OK)
@@ -120,7 +125,7 @@ static void compute_bases(set_run *r)
             die("memory");
         t0 = now();
         amscr_status st = b == M_AMSCR   ? amscr_db_distance_matrix(db, NULL, NULL, r->base[b])
-                          : b == M_INNER ? amscr__inner_matrix(db, amscr__resolve_threads(0), NULL, NULL, r->base[b])
+                          : b >= M_INNER ? amscr__inner_matrix(db, amscr__resolve_threads(0), NULL, NULL, r->base[b])
                                          : amscr_db_channel_matrix(db, NULL, NULL, r->base[b]);
         if (st != AMSCR_OK)
             die("matrix");
@@ -166,8 +171,9 @@ static void compose(const set_run *r, const row_t *w, double *out)
     }
     free(H);
     size_t k = n < 8 ? n : 8;
-    if (w->rerank && (w->use[M_INNER] ? amscr__rerank_normalized2(out, r->base[M_INNER], 0.05, n, k, 10, out)
-                                      : amscr__rerank_normalized(out, n, k, 10, out)) != AMSCR_OK)
+    const double *inner = w->use[M_INNER] ? r->base[M_INNER] : w->use[M_INNER_OPEN] ? r->base[M_INNER_OPEN] : NULL;
+    if (w->rerank && (inner ? amscr__rerank_normalized2(out, inner, 0.05, n, k, 10, out)
+                            : amscr__rerank_normalized(out, n, k, 10, out)) != AMSCR_OK)
         die("re-ranking");
 }
 

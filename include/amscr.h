@@ -96,7 +96,7 @@ extern "C" {
 
 /** Compile-time version; amscr_version_number() gives the runtime one. */
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 8
+#define AMSCR_VERSION_MINOR 9
 #define AMSCR_VERSION_PATCH 0
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
@@ -1696,6 +1696,36 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_rerank_inner_share(amscr
  * @since 0.7
  */
 AMSCR_API double amscr_params_get_rerank_inner_share(const amscr_params *p);
+
+/**
+ * @brief Sets the closing of the silhouette the inner distance is taken in, as a radius in
+ *        units of the square root of the area the curve bounds, in [0, 1] (default 0; 0.04 in
+ *        the retrieval preset). With c > 0 the inner distance's paths run inside the region
+ *        the curve bounds closed morphologically by a disk of radius c sqrt(area): cracks,
+ *        slots and gaps narrower than the disk no longer force a path around them, while
+ *        parts and wider inlets stay. A cut that reaches the outline then changes the inner
+ *        distance as little as it changes the shape. Only the inner-distance graph uses it
+ *        (amscr_params_set_rerank_inner_share); a curve that bounds no area is taken as it
+ *        is. The outline is made from the whole contour when a shape is prepared with c > 0
+ *        (about 1 ms) and kept with it; a shape prepared with another value is closed from
+ *        its N samples instead, which on a long slotted outline approximates it poorly.
+ *        Set 0 for the ranking before 0.9. Collection and index files keep the value and the
+ *        outlines; files written before 0.9 load with 0.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (outside [0, 1], NaN).
+ * Ownership: none.
+ * Thread-safety: exclusive on p.
+ * @since 0.9
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_inner_closing(amscr_params *p, double radius);
+
+/**
+ * @brief The closing radius of the inner distance's silhouette (amscr_params_set_inner_closing).
+ * @return the value; 0 for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.9
+ */
+AMSCR_API double amscr_params_get_inner_closing(const amscr_params *p);
 
 /* ============================================================================
  * Workspace

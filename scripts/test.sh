@@ -13,7 +13,7 @@ scripts/setup.sh
 meson test -C build --no-suite all --no-suite unit --print-errorlogs --num-processes 2
 meson test -C build --no-rebuild oom_register --print-errorlogs
 # sanitizers (ASan+UBSan, TSan), valgrind, ABI diff against the committed baseline, a short
-# fuzz pass (AMSCR_FUZZ_SECONDS, default 30 s a target); AMSCR_NO_HARDENING=1 skips it
+# fuzz pass (AMSCR_FUZZ_SECONDS, default 20 s a target); AMSCR_NO_HARDENING=1 skips it
 [ -n "${AMSCR_NO_HARDENING:-}" ] || scripts/hardening.sh
 # the Python package for distribution: sdist + wheel, manylinux repair, a clean install of it
 # (scripts/wheel.sh, about a minute); AMSCR_NO_WHEEL=1 skips it

@@ -1169,7 +1169,7 @@ START_TEST(blob_layout_sanity)
     unsigned char *b = small_blob(&len);
     ck_assert(len > 100);
     ck_assert(memcmp(b, "AMSCRDB", 8) == 0);
-    ck_assert(b[8] == 7 && b[9] == 0 && b[10] == 0 && b[11] == 0); /* version 7, little-endian */
+    ck_assert(b[8] == 10 && b[9] == 0 && b[10] == 0 && b[11] == 0); /* version 10, little-endian */
     uint64_t h = 0;
     for (int i = 0; i < 8; i++)
         h |= (uint64_t)b[len - 8 + i] << (8 * i);
@@ -1182,8 +1182,8 @@ START_TEST(blob_layout_sanity)
 }
 END_TEST
 
-/* Format version 7 puts the retrieval settings (68 bytes; 60 in version 5, 52 in version 2)
- * right after the params, which end 60 bytes after the scales; version 1 files (the same
+/* Format version 10 puts the retrieval settings (76 bytes; 68 in version 7, 60 in version 5, 52
+ * in version 2) right after the params, which end 60 bytes after the scales; version 1 files (the same
  * without that block) still load, with the retrieval settings at their defaults. */
 #define BLOB_RETRIEVAL_OFFSET (BLOB_SCALE_OFFSET + 8 + 60)
 
@@ -1214,7 +1214,7 @@ START_TEST(format_v1_still_loads)
 {
     size_t len = 0;
     unsigned char *b = small_blob(&len);
-    as_older_version(b, &len, BLOB_RETRIEVAL_OFFSET, 68, 1);
+    as_older_version(b, &len, BLOB_RETRIEVAL_OFFSET, 76, 1);
     amscr_db *db = NULL;
     ck_assert_int_eq(load_exact(b, len, &db), AMSCR_OK);
     ck_assert_uint_eq(amscr_db_size(db), 2);
@@ -1235,8 +1235,8 @@ START_TEST(format_v2_one_band)
     ck_assert(amscr_params_get_channel_affine_band(p) != 0.125);
     size_t len = 0, nscales = 0;
     unsigned char *b = saved_empty(p, &len, &nscales);
-    /* the affine band and the inner share, after the 52 bytes of version 2 */
-    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 52, 16, 2);
+    /* the affine band, the inner share and the closing, after the 52 bytes of version 2 */
+    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 52, 24, 2);
     amscr_db *back = NULL;
     ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_OK);
     ck_assert(amscr_params_get_channel_band(amscr_db_params(back)) == 0.125);
@@ -1244,7 +1244,7 @@ START_TEST(format_v2_one_band)
     ck_assert(amscr_params_get_rerank_inner_share(amscr_db_params(back)) == 0.0);
     amscr_db_free(back);
     back = NULL;
-    b[8] = 7; /* read as version 7, the block runs 16 bytes into the counts: refused or inconsistent */
+    b[8] = 10; /* read as version 10, the block runs 24 bytes into the counts: refused or inconsistent */
     fix_checksum(b, len);
     ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_E_FORMAT);
     ck_assert_ptr_null(back);
@@ -1263,10 +1263,11 @@ START_TEST(format_v5_one_graph)
     ck_assert_int_eq(amscr_params_set_channel_affine_band(p, 0.0625), AMSCR_OK);
     size_t len = 0, nscales = 0;
     unsigned char *b = saved_empty(p, &len, &nscales);
-    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 60, 8, 5);
+    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 60, 16, 5);
     amscr_db *back = NULL;
     ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_OK);
     ck_assert(amscr_params_get_rerank_inner_share(amscr_db_params(back)) == 0.0);
+    ck_assert(amscr_params_get_inner_closing(amscr_db_params(back)) == 0.0);
     ck_assert(amscr_params_get_channel_affine_band(amscr_db_params(back)) == 0.0625);
     amscr_db_free(back);
     amscr_free(b);

@@ -2,7 +2,9 @@
  * distance against a brute-force search over shifts and orientations (direct DFTs for the
  * low-pass along the curve), invariance under
  * similarity maps and mirror images, tolerance to a bent part, degenerate curves, the
- * collection matrix for any thread count, and the retrieval matrix with the graph's share. */
+ * collection matrix for any thread count, and the retrieval matrix with the graph's share; the
+ * silhouette closed at a scale (src/shape/closing.c): slots close, wide notches stay, invariance,
+ * the prepared shape's outline and its round trip through a file. */
 #include <amscr.h>
 #include <check.h>
 #include <math.h>
@@ -240,6 +242,151 @@ START_TEST(test_params)
 }
 END_TEST
 
+/* A 10 x 10 square with a notch of width `w` and depth 6 cut from its top edge (w 0: none), at
+ * about 30 points an edge. */
+static size_t notched(double w, const double m[6], double *xy)
+{
+    double a = 5.0 - 0.5 * w, b = 5.0 + 0.5 * w;
+    const double sq[] = {0, 0, 10, 0, 10, 10, 0, 10};
+    const double v[] = {0, 0, 10, 0, 10, 10, b, 10, b, 4, a, 4, a, 10, 0, 10};
+    double tmp[2 * NPTS];
+    size_t n = amscr_test_polygon(w > 0.0 ? v : sq, w > 0.0 ? 8 : 4, 30, tmp);
+    amscr_test_apply_affine(m, tmp, n, xy);
+    return n;
+}
+
+static double area_of(const double *xy, size_t n)
+{
+    double s = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        size_t j = (i + 1) % n;
+        s += xy[2 * i] * xy[2 * j + 1] - xy[2 * j] * xy[2 * i + 1];
+    }
+    return 0.5 * s;
+}
+
+/* The closing at c = 0.08 (a disk of radius ~0.78 here): a slot 0.4 wide closes (the square's
+ * area, its inner distances), a notch 4 wide stays; a similarity map of the slotted square gives
+ * the same closed inner distances; a collinear curve bounds no area. */
+START_TEST(test_closing)
+{
+    double xy[2 * NPTS], V[2 * AMSCR__OUTLINE_N], *out = NULL;
+    size_t nout = 0, n = notched(0.4, ident, xy);
+    ck_assert_int_eq(amscr__close_curve(xy, n, 0.08, &out, &nout), AMSCR_OK);
+    ck_assert_msg(fabs(area_of(out, nout) - 100.0) < 2.0, "slot closed: area %g", area_of(out, nout));
+    free(out);
+    n = notched(4.0, ident, xy);
+    ck_assert_int_eq(amscr__close_curve(xy, n, 0.08, &out, &nout), AMSCR_OK);
+    ck_assert_msg(fabs(area_of(out, nout) - 76.0) < 2.0, "notch kept: area %g", area_of(out, nout));
+    free(out);
+    amscr__inner_ws ws;
+    ck_assert_int_eq(amscr__inner_ws_init(&ws), AMSCR_OK);
+    feat *f = malloc(4 * sizeof *f);
+    const double sim[6] = {0.8 * cos(1.1), -0.8 * sin(1.1), 40, 0.8 * sin(1.1), 0.8 * cos(1.1), -7};
+    build(xy, notched(0.0, ident, xy), &f[0], &ws);                     /* the square */
+    build(xy, notched(0.4, ident, xy), &f[1], &ws);                     /* the slotted square */
+    ck_assert_int_eq(amscr__outline(xy, notched(0.4, ident, xy), 0.08, V), AMSCR_OK);
+    build(V, AMSCR__OUTLINE_N, &f[2], &ws);                             /* ... closed */
+    ck_assert_int_eq(amscr__outline(xy, notched(0.4, sim, xy), 0.08, V), AMSCR_OK);
+    build(V, AMSCR__OUTLINE_N, &f[3], &ws);                             /* ... moved, closed */
+    double open = amscr__inner_distance(&f[0].f, &f[1].f, 1, &ws);
+    double shut = amscr__inner_distance(&f[0].f, &f[2].f, 1, &ws);
+    double moved = amscr__inner_distance(&f[2].f, &f[3].f, 1, &ws);
+    ck_assert_msg(shut < 0.2 * open && moved < 0.2 * open, "slot %g, closed %g, moved %g", open, shut, moved);
+    const double line[] = {0, 0, 1, 1, 2, 2, 3, 3};
+    ck_assert_int_eq(amscr__outline(line, 4, 0.08, V), AMSCR_E_DEGENERATE);
+    ck_assert_int_eq(amscr__close_curve(xy, n, 0.0, &out, &nout), AMSCR_E_DEGENERATE);
+    free(f);
+    amscr__inner_ws_free(&ws);
+}
+END_TEST
+
+/* A prepared shape keeps the outline of its input points (all of them, not its samples) when its
+ * params close the inner distance's silhouette, and its features under that closing are the
+ * outline's (they differ from the samples'); not otherwise; a collection with it saved and loaded gives the same retrieval matrix bit for bit,
+ * and a file whose outline is not finite is refused. */
+START_TEST(test_outline_kept)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_rerank_k(p, 3), AMSCR_OK);
+    double xy[2 * NPTS];
+    size_t n = notched(0.4, ident, xy);
+    amscr_contour *c = NULL;
+    amscr_descriptor *d = NULL, *d0 = NULL;
+    ck_assert_int_eq(amscr_contour_new(xy, n, &c), AMSCR_OK);
+    ck_assert_int_eq(amscr_descriptor_new(p, c, &d), AMSCR_OK);
+    ck_assert_ptr_nonnull(d->outline);
+    double cl = amscr_params_get_inner_closing(p), V[2 * AMSCR__OUTLINE_N];
+    ck_assert(cl > 0.0);
+    ck_assert_int_eq(amscr__outline(xy, n, cl, V), AMSCR_OK); /* the contour is counter-clockwise */
+    ck_assert(memcmp(V, d->outline, sizeof V) == 0);
+    amscr__inner_ws ws;
+    ck_assert_int_eq(amscr__inner_ws_init(&ws), AMSCR_OK);
+    feat *f = malloc(3 * sizeof *f);
+    ck_assert_int_eq(amscr__inner_build_shape(d, cl, &f[0].f, &ws), AMSCR_OK);
+    ck_assert_int_eq(amscr__inner_build_shape(d, 0.0, &f[1].f, &ws), AMSCR_OK);
+    build(d->outline, AMSCR__OUTLINE_N, &f[2], &ws);
+    ck_assert(amscr__inner_distance(&f[0].f, &f[2].f, 1, &ws) == 0.0);
+    ck_assert(amscr__inner_distance(&f[0].f, &f[1].f, 1, &ws) > 0.0);
+    ck_assert_int_eq(amscr_params_set_inner_closing(p, 0.0), AMSCR_OK);
+    ck_assert_int_eq(amscr_descriptor_new(p, c, &d0), AMSCR_OK);
+    ck_assert_ptr_null(d0->outline);
+    amscr_descriptor_free(d0);
+    amscr_descriptor_free(d);
+    amscr_contour_free(c);
+    free(f);
+    amscr__inner_ws_free(&ws);
+    ck_assert_int_eq(amscr_params_set_inner_closing(p, cl), AMSCR_OK);
+    enum { m = 12 };
+    double R[m * m], B[m * m];
+    amscr_db *db = collection(p, 2), *back = NULL;
+    void *buf = NULL;
+    size_t len = 0;
+    ck_assert_int_eq(amscr_db_retrieval_matrix(db, NULL, NULL, R), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_save_memory(db, &buf, &len), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_load_memory(buf, len, &back), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_retrieval_matrix(back, NULL, NULL, B), AMSCR_OK);
+    ck_assert(memcmp(R, B, sizeof R) == 0);
+    amscr_db_free(back);
+    back = NULL;
+    unsigned char *b = buf;
+    double nan = NAN;
+    memcpy(b + len - 8 - 8 * AMSCR__OUTLINE_N, &nan, 8); /* in the last shape's outline */
+    uint64_t h = 14695981039346656037ull;                /* FNV-1a, the plain file's trailer */
+    for (size_t i = 0; i < len - 8; i++)
+        h = (h ^ b[i]) * 1099511628211ull;
+    for (int i = 0; i < 8; i++)
+        b[len - 8 + (size_t)i] = (unsigned char)(h >> (8 * i));
+    ck_assert_int_eq(amscr_db_load_memory(buf, len, &back), AMSCR_E_FORMAT);
+    ck_assert_ptr_null(back);
+    amscr_free(buf);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* The closing's setter: [0, 1] only; the presets: 0, and 0.04 for retrieval. */
+START_TEST(test_closing_params)
+{
+    amscr_params *p = NULL, *r = NULL;
+    ck_assert_int_eq(amscr_params_new(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new_retrieval(&r), AMSCR_OK);
+    ck_assert(amscr_params_get_inner_closing(p) == 0.0);
+    ck_assert(amscr_params_get_inner_closing(r) == 0.04);
+    ck_assert(amscr_params_get_inner_closing(NULL) == 0.0);
+    ck_assert_int_eq(amscr_params_set_inner_closing(p, -0.01), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_inner_closing(p, 1.5), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_inner_closing(p, NAN), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_inner_closing(NULL, 0.1), AMSCR_E_INVALID_ARG);
+    ck_assert(amscr_params_get_inner_closing(p) == 0.0);
+    ck_assert_int_eq(amscr_params_set_inner_closing(p, 1.0), AMSCR_OK);
+    ck_assert(amscr_params_get_inner_closing(p) == 1.0);
+    amscr_params_free(p);
+    amscr_params_free(r);
+}
+END_TEST
+
 Suite *amscr_suite_inner(void)
 {
     Suite *s = suite_create("inner");
@@ -248,6 +395,9 @@ Suite *amscr_suite_inner(void)
     tcase_add_test(tc, test_invariance_and_articulation);
     tcase_add_test(tc, test_matrices);
     tcase_add_test(tc, test_params);
+    tcase_add_test(tc, test_closing);
+    tcase_add_test(tc, test_outline_kept);
+    tcase_add_test(tc, test_closing_params);
     suite_add_tcase(s, tc);
     return s;
 }

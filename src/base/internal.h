@@ -80,6 +80,7 @@ struct amscr_params {
     unsigned rerank_k;                 /* re-ranking neighbours, 0 = no re-ranking */
     unsigned rerank_iterations;
     double rerank_inner_share;         /* share of the inner-distance graph in the re-ranking (0.7) */
+    double inner_closing;              /* closing radius of the inner distance's silhouette / sqrt(area) (0.9) */
 };
 
 /* The stages of amscr_register in pipeline order (register/stages.c holds the table). */
@@ -128,6 +129,16 @@ int amscr__sym2_invsqrt(const double cov[3], double W[4], double Winv[4]);
 amscr_status amscr__parametrize(const double *P, size_t np, int closed, amscr_parametrization kind, double sigma0_frac,
                                 unsigned passes, size_t M, size_t m, double *out);
 amscr_status amscr__whiten(const double *xy, size_t n, double *out_xy, double fwd[6], double inv[6]);
+/* closing.c: the outline of the region the closed curve xy (n points) bounds, closed by a disk of
+ * radius c sqrt(|area|) (c > 0): *out (2 *out_n doubles, caller frees), counter-clockwise.
+ * AMSCR_E_DEGENERATE when the curve bounds no area; AMSCR_E_NOMEM. */
+amscr_status amscr__close_curve(const double *xy, size_t n, double c, double **out, size_t *out_n);
+/* Vertices of a prepared shape's outline (the inner distance's polygon, retrieval/inner.h). */
+#define AMSCR__OUTLINE_N 64
+/* That outline closed at c (amscr__close_curve) resampled to AMSCR__OUTLINE_N points evenly along
+ * its length into V (2 AMSCR__OUTLINE_N doubles); at most 4096 points of xy are read (every
+ * k-th: the grid's pixels are coarser). AMSCR_E_DEGENERATE when the curve bounds no area; AMSCR_E_NOMEM. */
+amscr_status amscr__outline(const double *xy, size_t n, double c, double *V);
 void amscr__affine_compose(const double a[6], const double b[6], double out[6]);
 void amscr__params_defaults(amscr_params *p);
 void amscr__params_registration(amscr_params *p);
@@ -171,6 +182,10 @@ struct amscr_descriptor {
      * invariance; NULL in collections (amscr_db) and after a load. */
     double *raw;
     size_t nraw;
+    /* closed curves prepared with params.inner_closing > 0: the outline of the silhouette closed
+     * at that radius, from the input points (amscr__outline), AMSCR__OUTLINE_N points; kept in
+     * collection files of version 10 and 11. NULL otherwise. */
+    double *outline;
 };
 
 /* Most input points a descriptor keeps for the polish: a fit on more is not measurably better. */
@@ -215,14 +230,16 @@ amscr_status amscr__rerank_normalized2(const double *dist, const double *dist2, 
  * little-endian f64 channel_weight, u32 channel_invariance, f64 channel_affine_share,
  * f64 channel_band, f64 channel_skip, f64 channel_locality, u32 rerank_k,
  * u32 rerank_iterations; versions 5 and 6 (0.6) then f64 channel_affine_band (_V2); versions 7
- * and 8 (0.7) then f64 rerank_inner_share (_V3). A shorter block reads with
- * channel_affine_band = channel_band (one band for both frames before 0.6) and
- * rerank_inner_share = 0 (one graph before 0.7).
+ * and 8 (0.7) then f64 rerank_inner_share (_V3); versions 10 and 11 (0.9) then f64
+ * inner_closing (_V4). A shorter block reads with channel_affine_band = channel_band (one band
+ * for both frames before 0.6), rerank_inner_share = 0 (one graph before 0.7) and
+ * inner_closing = 0 (the inner distance on the curve itself before 0.9).
  * read validates through the setters' rules (AMSCR_E_FORMAT). */
 #define AMSCR__RETRIEVAL_BLOCK 52
 #define AMSCR__RETRIEVAL_BLOCK_V2 60
 #define AMSCR__RETRIEVAL_BLOCK_V3 68
-/* size: AMSCR__RETRIEVAL_BLOCK, _V2 or _V3. */
+#define AMSCR__RETRIEVAL_BLOCK_V4 76
+/* size: AMSCR__RETRIEVAL_BLOCK, _V2, _V3 or _V4. */
 void amscr__retrieval_block_write(const amscr_params *p, unsigned char *out, size_t size);
 amscr_status amscr__retrieval_block_read(const unsigned char *in, size_t size, amscr_params *p);
 

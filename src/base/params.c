@@ -23,6 +23,7 @@ static void retrieval_defaults(amscr_params *p)
     p->rerank_k = 0;
     p->rerank_iterations = 10;
     p->rerank_inner_share = 0.0;
+    p->inner_closing = 0.0;
 }
 
 void amscr__params_defaults(amscr_params *p)
@@ -92,6 +93,7 @@ void amscr__params_retrieval(amscr_params *p)
     p->channel_weight = 1.0;
     p->rerank_k = 8;
     p->rerank_inner_share = 0.05;
+    p->inner_closing = 0.04;
 }
 
 amscr_status amscr_params_new_retrieval(amscr_params **out)
@@ -177,6 +179,8 @@ SETTER(rerank_iterations, unsigned, rerank_iterations, v >= 1 && v <= 1000, "%u 
 GETTER(rerank_iterations, unsigned, rerank_iterations)
 SETTER(rerank_inner_share, double, rerank_inner_share, v >= 0.0 && v < 1.0, "%g is not in [0, 1)")
 GETTER(rerank_inner_share, double, rerank_inner_share)
+SETTER(inner_closing, double, inner_closing, v >= 0.0 && v <= 1.0, "%g is not in [0, 1]")
+GETTER(inner_closing, double, inner_closing)
 
 /* ---- robust registration: partial matching, polish ---- */
 SETTER(partial, int, partial, v == 0 || v == 1, "%d is not 0 or 1")

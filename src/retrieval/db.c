@@ -114,6 +114,14 @@ static amscr_status descriptor_copy(const amscr_descriptor *s, amscr_descriptor 
     d->norm2 = s->norm2;
     d->nyq2 = s->nyq2;
     d->finest = s->finest;
+    if (s->outline) {
+        d->outline = amscr__malloc_array(2 * AMSCR__OUTLINE_N, sizeof *d->outline);
+        if (!d->outline) {
+            amscr_descriptor_free(d);
+            return amscr__fail(AMSCR_E_NOMEM, "descriptor: out of memory");
+        }
+        memcpy(d->outline, s->outline, 2 * AMSCR__OUTLINE_N * sizeof *d->outline);
+    }
     *out = d;
     return AMSCR_OK;
 }

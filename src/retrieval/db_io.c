@@ -1,13 +1,16 @@
 /* db_io.c — the collection file, little-endian whatever the host.
  * Header: "AMSCRDB\0", u32 version, u32 reserved, params, (version >= 2) the retrieval
  * settings (retrieval_io.c), u64 count, u64 N, u64 p; per shape: i32 label, f64 fwd[6],
- * f64 inv[6], f64 input[2N], base[2N], scaled[2Np]; (version 3) u64 length and the index
+ * f64 inv[6], f64 input[2N], base[2N], scaled[2Np], and (versions 10 and 11, closed curves whose
+ * params close the inner distance's silhouette) f64 outline[2 AMSCR__OUTLINE_N], the vertices
+ * of its inner distance (inner.h); (version 3) u64 length and the index
  * section (index_io.c); trailer: u64 checksum of everything before it (FNV-1a; versions 4, 6
  * and 8: amscr__sum64). A collection file does not store the shape channel (derived from the
  * prepared shapes on demand); an index file of version 4, 6 or 8 does, in its section. */
 #define _DEFAULT_SOURCE /* MAP_POPULATE, where the system has it */
 #include "db_io.h"
 #include "dense.h"
+#include "inner.h" /* amscr__inner_vertices */
 
 #include <errno.h>
 #include <pthread.h>
@@ -52,7 +55,7 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
     amscr__w_u32(w, version);
     amscr__w_u32(w, 0);
     w_params(w, prm);
-    unsigned char rblock[AMSCR__RETRIEVAL_BLOCK_V3];
+    unsigned char rblock[AMSCR__RETRIEVAL_BLOCK_V4];
     size_t rsize = amscr__db_retrieval_block(version);
     amscr__retrieval_block_write(prm, rblock, rsize);
     amscr__w_bytes(w, rblock, rsize);
@@ -68,6 +71,11 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
         amscr__w_f64s(w, d->input, 2 * N);
         amscr__w_f64s(w, d->base, 2 * N);
         amscr__w_f64s(w, d->scaled, 2 * N * p);
+        double V[2 * AMSCR__OUTLINE_N];
+        if (amscr__db_has_outline(version, prm) && amscr__inner_vertices(d, prm->inner_closing, V) != AMSCR_OK)
+            w->oom = 1; /* only out of memory: a prepared shape's samples always resample */
+        else if (amscr__db_has_outline(version, prm))
+            amscr__w_f64s(w, V, 2 * AMSCR__OUTLINE_N);
     }
 }
 
@@ -81,7 +89,7 @@ amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *ou
     if (st != AMSCR_OK)
         return st;
     amscr__wbuf w = {NULL, 0, 0, 0};
-    amscr__db_write(db, AMSCR__DB_VERSION_PLAIN_INNER, &w);
+    amscr__db_write(db, AMSCR__DB_VERSION_PLAIN_CLOSING, &w);
     if (!w.oom)
         amscr__w_u64(&w, amscr__fnv1a(w.buf, w.len));
     if (w.oom) {
@@ -189,6 +197,7 @@ static int decode_shape(const unsigned char *p, size_t at, size_t per, const ams
                         amscr_descriptor **out)
 {
     size_t N = prm->num_samples, np = prm->num_scales;
+    int outline = per > 4 + 8 * (12 + 4 * N + 2 * N * np);
     amscr__rbuf r = {p, at + per, at, 0};
     *label = (int32_t)amscr__r_u32(&r);
     amscr_descriptor *d = NULL;
@@ -198,6 +207,10 @@ static int decode_shape(const unsigned char *p, size_t at, size_t per, const ams
     int bad = 0;
     if (!amscr__r_f64s(&r, d->fwd, 6) || !amscr__r_f64s(&r, d->inv, 6) || !amscr__r_f64s(&r, d->input, 2 * N) ||
         !amscr__r_f64s(&r, d->base, 2 * N) || !amscr__r_f64s(&r, d->scaled, 2 * N * np))
+        bad = 1;
+    else if (outline && !(d->outline = amscr__malloc_array(2 * AMSCR__OUTLINE_N, sizeof *d->outline)))
+        bad = 3;
+    else if (outline && !amscr__r_f64s(&r, d->outline, 2 * AMSCR__OUTLINE_N))
         bad = 1;
     else {
         amscr_status st = amscr__descriptor_finish(d);
@@ -271,6 +284,8 @@ static void check_shape(const shapes_job *j, uint64_t i, double *scratch)
         if (!level_ok(scratch, N))
             j->bad[i] = 2;
     }
+    if (j->per > r.pos - at && !amscr__r_f64s(&r, scratch, 2 * AMSCR__OUTLINE_N)) /* the outline */
+        j->bad[i] = 1;
 }
 
 static void read_shape(const shapes_job *j, uint64_t i)
@@ -282,7 +297,8 @@ static void read_shape(const shapes_job *j, uint64_t i)
 static void *shapes_worker(void *arg)
 {
     const shapes_job *j = arg;
-    double *scratch = j->check_only ? amscr__malloc_array(2 * j->prm->num_samples, sizeof *scratch) : NULL;
+    size_t len = 2 * j->prm->num_samples > 2 * AMSCR__OUTLINE_N ? 2 * j->prm->num_samples : 2 * AMSCR__OUTLINE_N;
+    double *scratch = j->check_only ? amscr__malloc_array(len, sizeof *scratch) : NULL;
     for (uint64_t i = j->t; i < j->count; i += j->nt)
         if (!j->check_only)
             read_shape(j, i);
@@ -324,10 +340,11 @@ static void run_shapes(shapes_job *j)
 
 /* The count shapes into db (params prm), decoded on the params' threads, entered in order
  * (lazy: checked, and left to decode from r's buffer when asked for). */
-static amscr_status r_shapes(amscr__rbuf *r, const amscr_params *prm, uint64_t count, int lazy, amscr_db *db)
+static amscr_status r_shapes(amscr__rbuf *r, uint32_t version, const amscr_params *prm, uint64_t count, int lazy,
+                             amscr_db *db)
 {
-    size_t N = prm->num_samples, p = prm->num_scales;
-    shapes_job j = {r->p, r->pos, 4 + 8 * (12 + 4 * N + 2 * N * p), prm, count, NULL, NULL, NULL, lazy, 0, 1};
+    size_t per = (size_t)amscr__db_shape_bytes(version, prm);
+    shapes_job j = {r->p, r->pos, per, prm, count, NULL, NULL, NULL, lazy, 0, 1};
     j.d = amscr__calloc_array(count ? count : 1, sizeof *j.d);
     j.label = amscr__malloc_array(count ? count : 1, sizeof *j.label);
     j.bad = amscr__calloc_array(count ? count : 1, 1);
@@ -393,14 +410,14 @@ amscr_status amscr__db_parse(const unsigned char *buf, size_t len, int lazy, ams
     uint64_t count = amscr__r_u64(&r), N = amscr__r_u64(&r), p = amscr__r_u64(&r);
     if (r.bad || N != prm.num_samples || p != prm.num_scales)
         return amscr__fail(AMSCR_E_FORMAT, "collection header: inconsistent sizes");
-    uint64_t per = 4 + 8 * (12 + 4 * N + 2 * N * p);
+    uint64_t per = amscr__db_shape_bytes(version, &prm);
     if (count > (r.len - r.pos) / per)
         return amscr__fail(AMSCR_E_FORMAT, "collection: %llu shapes announced, the file is too short",
                            (unsigned long long)count);
     amscr_db *db = NULL;
     st = amscr_db_new(&prm, &db);
     if (st == AMSCR_OK)
-        st = r_shapes(&r, &prm, count, lazy, db);
+        st = r_shapes(&r, version, &prm, count, lazy, db);
     if (st != AMSCR_OK) {
         amscr_db_free(db);
         return st;

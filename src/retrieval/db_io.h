@@ -14,7 +14,9 @@
  * FNV-1a; 5 and 6 (0.6): 2 and 4 (FNV-1a and amscr__sum64) with the longer retrieval block (the whitened frame's band
  * after the others; AMSCR__RETRIEVAL_BLOCK_V2); 7 and 8 (0.7): the same with the inner-distance
  * graph's share after those (AMSCR__RETRIEVAL_BLOCK_V3); 9 (0.8): 8 whose index section ends with
- * the inner distance's graph (its lists and the shapes' inner features). Every version loads. */
+ * the inner distance's graph (its lists and the shapes' inner features); 10 and 11 (0.9): 7 and 9
+ * with the inner distance's closing after the share (AMSCR__RETRIEVAL_BLOCK_V4). Every version
+ * loads. */
 #define AMSCR__DB_VERSION_PLAIN 2u
 #define AMSCR__DB_VERSION_INDEX 3u
 #define AMSCR__DB_VERSION_FEATURES 4u
@@ -23,30 +25,49 @@
 #define AMSCR__DB_VERSION_PLAIN_INNER 7u
 #define AMSCR__DB_VERSION_INDEX_INNER 8u
 #define AMSCR__DB_VERSION_INDEX_GRAPHS 9u
-#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_GRAPHS
+#define AMSCR__DB_VERSION_PLAIN_CLOSING 10u
+#define AMSCR__DB_VERSION_INDEX_CLOSING 11u
+#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_CLOSING
 
 /* Whether a file of `version` is an index file (an index section after the shapes). */
 static inline int amscr__db_is_index(uint32_t version)
 {
     return version == AMSCR__DB_VERSION_INDEX || version == AMSCR__DB_VERSION_FEATURES ||
            version == AMSCR__DB_VERSION_INDEX_BANDS || version == AMSCR__DB_VERSION_INDEX_INNER ||
-           version == AMSCR__DB_VERSION_INDEX_GRAPHS;
+           version == AMSCR__DB_VERSION_INDEX_GRAPHS || version == AMSCR__DB_VERSION_INDEX_CLOSING;
 }
 
 /* Whether an index file of `version` stores the shapes' channel features. */
 static inline int amscr__db_has_features(uint32_t version)
 {
     return version == AMSCR__DB_VERSION_FEATURES || version == AMSCR__DB_VERSION_INDEX_BANDS ||
-           version == AMSCR__DB_VERSION_INDEX_INNER || version == AMSCR__DB_VERSION_INDEX_GRAPHS;
+           version == AMSCR__DB_VERSION_INDEX_INNER || version == AMSCR__DB_VERSION_INDEX_GRAPHS ||
+           version == AMSCR__DB_VERSION_INDEX_CLOSING;
 }
 
 /* The bytes of the retrieval block in a file of `version` (0: none). */
 static inline size_t amscr__db_retrieval_block(uint32_t version)
 {
-    return version >= AMSCR__DB_VERSION_PLAIN_INNER   ? AMSCR__RETRIEVAL_BLOCK_V3
+    return version >= AMSCR__DB_VERSION_PLAIN_CLOSING ? AMSCR__RETRIEVAL_BLOCK_V4
+           : version >= AMSCR__DB_VERSION_PLAIN_INNER ? AMSCR__RETRIEVAL_BLOCK_V3
            : version >= AMSCR__DB_VERSION_PLAIN_BANDS ? AMSCR__RETRIEVAL_BLOCK_V2
            : version >= AMSCR__DB_VERSION_PLAIN     ? AMSCR__RETRIEVAL_BLOCK
                                                     : 0;
+}
+
+/* Whether the shapes of a file of `version` with params p keep their outline (versions 10 and
+ * 11: closed curves whose params close the inner distance's silhouette). */
+static inline int amscr__db_has_outline(uint32_t version, const amscr_params *p)
+{
+    return version >= AMSCR__DB_VERSION_PLAIN_CLOSING && p->closed && p->inner_closing > 0.0;
+}
+
+/* The bytes of one shape in a file of `version` with params p (db_io.c's layout). */
+static inline uint64_t amscr__db_shape_bytes(uint32_t version, const amscr_params *p)
+{
+    uint64_t N = p->num_samples, np = p->num_scales;
+    uint64_t outline = amscr__db_has_outline(version, p) ? 2 * AMSCR__OUTLINE_N : 0;
+    return 4 + 8 * (12 + 4 * N + 2 * N * np + outline);
 }
 
 /* The trailing checksum of a file of `version` over its first n bytes. */

@@ -645,7 +645,7 @@ static amscr_status query_inner(const amscr_index *x, const amscr_descriptor *q,
         free(f);
         return amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     }
-    amscr_status st = amscr__inner_build(q->input, q->n, f, &ws);
+    amscr_status st = amscr__inner_build_shape(q, amscr_db_params(x->db)->inner_closing, f, &ws);
     int refl = amscr_db_params(x->db)->reflections;
     for (size_t t = 0; st == AMSCR_OK && t < m; t++) /* cell (j, query): the query's index is the highest */
         out[t] = amscr__inner_distance(&x->inner[cand[t]], f, refl, &ws);

@@ -115,12 +115,10 @@ static void twist(amscr__inner *f, const double *cs)
         }
 }
 
-amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, amscr__inner_ws *ws)
+/* The features of the N vertices in ws->xy. */
+static amscr_status from_vertices(amscr__inner *out, amscr__inner_ws *ws)
 {
-    amscr_status st = n < 3 ? AMSCR_E_DEGENERATE : amscr__resample_euclid(xy, n, 1, N, ws->xy);
-    if (st == AMSCR_E_NOMEM)
-        return st;
-    if (st != AMSCR_OK || !inner_matrix_of(ws->xy, ws->id))
+    if (!inner_matrix_of(ws->xy, ws->id))
         return amscr__fail(AMSCR_E_DEGENERATE, "inner distance: the curve has no extent");
     out->norm2 = 0.0;
     for (size_t k = 0; k < AMSCR__INNER_K; k++) {
@@ -140,6 +138,41 @@ amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, a
     }
     twist(out, ws->cs);
     return AMSCR_OK;
+}
+
+amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, amscr__inner_ws *ws)
+{
+    amscr_status st = n < 3 ? AMSCR_E_DEGENERATE : amscr__resample_euclid(xy, n, 1, N, ws->xy);
+    if (st == AMSCR_E_NOMEM)
+        return st;
+    if (st != AMSCR_OK)
+        return amscr__fail(AMSCR_E_DEGENERATE, "inner distance: the curve has no extent");
+    return from_vertices(out, ws);
+}
+
+amscr_status amscr__inner_vertices(const amscr_descriptor *d, double closing, double *V)
+{
+    if (closing > 0.0 && d->outline && d->params.inner_closing == closing) {
+        memcpy(V, d->outline, 2 * N * sizeof *V);
+        return AMSCR_OK;
+    }
+    amscr_status st = closing > 0.0 ? amscr__outline(d->input, d->n, closing, V) : AMSCR_E_DEGENERATE;
+    if (st == AMSCR_E_DEGENERATE) { /* no closing, or no area to close: the samples themselves */
+        amscr__clear_error();
+        st = amscr__resample_euclid(d->input, d->n, 1, N, V);
+    }
+    return st;
+}
+
+amscr_status amscr__inner_build_shape(const amscr_descriptor *d, double closing, amscr__inner *out,
+                                      amscr__inner_ws *ws)
+{
+    amscr_status st = amscr__inner_vertices(d, closing, ws->xy);
+    if (st == AMSCR_E_NOMEM)
+        return st;
+    if (st != AMSCR_OK)
+        return amscr__fail(AMSCR_E_DEGENERATE, "inner distance: the curve has no extent");
+    return from_vertices(out, ws);
 }
 
 void amscr__inner_twist(amscr__inner *f, const amscr__inner_ws *ws) { twist(f, ws->cs); }
@@ -230,7 +263,7 @@ static amscr_status feature_row(void *ctx, size_t i, void *ws)
     const amscr_descriptor *d = amscr_db_descriptor(m->db, i);
     if (!d)
         return amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
-    return amscr__inner_build(d->input, d->n, &m->f[i], ws);
+    return amscr__inner_build_shape(d, amscr_db_params(m->db)->inner_closing, &m->f[i], ws);
 }
 
 static amscr_status pair_row(void *ctx, size_t i, void *ws)

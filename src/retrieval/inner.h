@@ -9,7 +9,7 @@
  * repeat them: ID(i, i + N - k) = ID(i - k, i)), and the frequencies kept along the contour
  * (0..N/4: the matrices are compared smoothed along the curve; the full spectrum scores the
  * same, at twice the cost: docs/results-retrieval.md). */
-#define AMSCR__INNER_N 64
+#define AMSCR__INNER_N AMSCR__OUTLINE_N
 #define AMSCR__INNER_K (AMSCR__INNER_N / 2)
 #define AMSCR__INNER_F (AMSCR__INNER_N / 4 + 1)
 
@@ -39,8 +39,16 @@ void amscr__inner_ws_free(amscr__inner_ws *ws);
 /* A workspace on the heap (*out: the threads' scratch of rows.c) and its release (NULL: none). */
 amscr_status amscr__inner_ws_new(void **out);
 void amscr__inner_ws_delete(void *ws);
-/* The features of the closed curve of n points xy (the descriptor's samples). */
+/* The features of the closed curve of n points xy, resampled to N vertices. */
 amscr_status amscr__inner_build(const double *xy, size_t n, amscr__inner *out, amscr__inner_ws *ws);
+/* The N vertices (2N doubles) whose inner distances are a prepared shape's features under a
+ * closing c (amscr_params_set_inner_closing): c = 0, its input samples resampled (as before
+ * 0.9); c > 0, its outline (d->outline) when d was prepared with c, else the outline of its input
+ * samples closed (amscr__outline; the samples themselves when they bound no area). */
+amscr_status amscr__inner_vertices(const amscr_descriptor *d, double closing, double *V);
+/* The features of the prepared shape d under the closing c (amscr__inner_vertices). */
+amscr_status amscr__inner_build_shape(const amscr_descriptor *d, double closing, amscr__inner *out,
+                                      amscr__inner_ws *ws);
 /* The distance of two shapes: the RMS difference of their inner-distance matrices (each
  * divided by its mean) at the best cyclic shift, and orientation when `reflections`; 0 for
  * a shape against itself, symmetric. */

@@ -55,6 +55,7 @@ void amscr_descriptor_free(amscr_descriptor *d)
     free(d->minv);
     free(d->spec);
     free(d->gain);
+    free(d->outline);
     free(d);
 }
 
@@ -197,6 +198,19 @@ static void keep_points(amscr_descriptor *d, double *pts, size_t m)
     d->nraw = n;
 }
 
+/* d->outline from the m input points pts (retrieval with the inner distance's closing); the input
+ * samples' outline when pts bound no area. */
+static amscr_status keep_outline(amscr_descriptor *d, const double *pts, size_t m)
+{
+    d->outline = amscr__malloc_array(2 * AMSCR__OUTLINE_N, sizeof *d->outline);
+    if (!d->outline)
+        return amscr__fail(AMSCR_E_NOMEM, "descriptor: out of memory");
+    amscr_status st = amscr__outline(pts, m, d->params.inner_closing, d->outline);
+    if (st == AMSCR_E_DEGENERATE)
+        st = amscr__resample_euclid(d->input, d->n, 1, AMSCR__OUTLINE_N, d->outline);
+    return st == AMSCR_E_NOMEM ? amscr__fail(st, "descriptor: out of memory") : st;
+}
+
 amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out)
 {
     amscr__clear_error();
@@ -248,6 +262,8 @@ amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c,
         st = amscr__smooth(d->base, N, closed, p->scales[k], d->scaled + 2 * N * k);
     if (st == AMSCR_OK)
         st = amscr__descriptor_finish(d);
+    if (st == AMSCR_OK && closed && p->inner_closing > 0.0)
+        st = keep_outline(d, pts, m);
     if (st == AMSCR_OK && p->invariance == AMSCR_INVARIANCE_AFFINE)
         keep_points(d, pts, m);
     else

@@ -162,7 +162,7 @@ def ok(st):
         raise RuntimeError('amscr call failed: %d' % st)
 
 
-def db_bytes(shapes, n=16, scales=(1.0, 2.0), closed=1):
+def db_bytes(shapes, n=16, scales=(1.0, 2.0), closed=1, closing=0.0):
     prm = P()
     ok(lib.amscr_params_new(ctypes.byref(prm)))
     ok(lib.amscr_params_set_num_samples(prm, ctypes.c_size_t(n)))
@@ -170,6 +170,7 @@ def db_bytes(shapes, n=16, scales=(1.0, 2.0), closed=1):
     ok(lib.amscr_params_set_scales(prm, arr, ctypes.c_size_t(len(scales))))
     ok(lib.amscr_params_set_closed(prm, closed))
     ok(lib.amscr_params_set_num_threads(prm, 1))
+    ok(lib.amscr_params_set_inner_closing(prm, ctypes.c_double(closing)))  # > 0: each shape keeps its outline
     db = P()
     ok(lib.amscr_db_new(prm, ctypes.byref(db)))
     for label, pts in enumerate(shapes):
@@ -192,4 +193,5 @@ put('dbload', 'two-shapes', db_bytes([src, polygon(30, 5, 9, 0.1)]))
 put('dbload', 'one-shape-scale0', db_bytes([src], scales=(0.0,)))
 put('dbload', 'empty', db_bytes([]))
 put('dbload', 'open-curve', db_bytes([src[:15]], scales=(1.0,), closed=0))
+put('dbload', 'two-shapes-closing', db_bytes([src, polygon(30, 5, 9, 0.1)], closing=0.08))
 print('seeds written under', os.path.join(HERE, 'corpus'))

@@ -153,7 +153,7 @@ def test_corrupt_index(tmp_path, damage):
     elif damage == "flip":
         data[len(data) // 3] ^= 0x40
     elif damage == "version":
-        data[8] = 10
+        data[8] = 12
     elif damage == "magic-only":
         data = data[:8]
     elif damage == "short-header":  # magic and version, then the file ends inside the lengths (a fuzzer find)
@@ -172,7 +172,7 @@ def test_corrupt_index(tmp_path, damage):
     if damage == "flip":  # the names and tables are checksummed, every shape is checked by the library
         assert "checksum" in r.stderr or "damaged shape" in r.stderr
     if damage == "version":
-        assert "version 10" in r.stderr
+        assert "version 12" in r.stderr
     for args in (("eval", bad), ("matrix", bad, "-o", "-"), ("index", m, "-o", bad, "--add")):
         r = run(*args)
         assert r.returncode == 1 and r.stdout == ""
@@ -276,3 +276,27 @@ def test_inner_share_and_the_index(tmp_path):
     r = run("index", m, "-o", one_idx, "--add", "--inner-share", "0.1")
     assert r.returncode != 0 and "inner_share" in r.stderr
     assert run("search", q, m, "--inner-share", "1").returncode == 2
+
+
+def test_inner_closing_and_the_index(tmp_path):
+    """The default takes the inner distance inside each silhouette closed at 0.08 sqrt(area), and
+    an index built with it keeps each shape's closed outline: its search is the manifest's;
+    `index --inner-closing 0` searches as the manifest with --inner-closing 0, and so does the
+    default index searched with --inner-closing 0; a closing the index was not built with
+    (its outlines come from the contours, which it does not keep) and --add with another
+    closing are refused; a closing outside 0..1 is a usage error."""
+    m = make_manifest(tmp_path)
+    idx = build(tmp_path, m)
+    open_idx = build(tmp_path, m, "--inner-closing", "0", name="open.idx")
+    q = tmp_path / "shapes" / "wave_2.txt"
+    closed = json.loads(run("search", q, m, "--json").stdout)["results"]
+    plain = json.loads(run("search", q, m, "--json", "--inner-closing", "0").stdout)["results"]
+    assert [r["distance"] for r in closed] != [r["distance"] for r in plain]
+    same_results(json.loads(run("search", q, idx, "--json").stdout)["results"], closed)
+    same_results(json.loads(run("search", q, open_idx, "--json").stdout)["results"], plain)
+    same_results(json.loads(run("search", q, idx, "--json", "--inner-closing", "0").stdout)["results"], plain)
+    r = run("search", q, open_idx, "--inner-closing", "0.08")
+    assert r.returncode == 1 and r.stdout == "" and "rebuild the index" in r.stderr
+    r = run("index", m, "-o", open_idx, "--add", "--inner-closing", "0.1")
+    assert r.returncode != 0 and "inner_closing" in r.stderr
+    assert run("search", q, m, "--inner-closing", "2").returncode == 2

@@ -117,6 +117,8 @@ typedef struct opts {
     double affine_share;
     int inner_share_set;
     double inner_share;
+    int inner_closing_set;
+    double inner_closing;
 } opts;
 
 typedef struct tool_command {

@@ -66,11 +66,12 @@ int cmd_index(opts *o)
         for (size_t i = 0; i < amscr_index_size(x); i++)
             if ((size_t)amscr_index_label(x, i) + 1 > nclasses)
                 nclasses = (size_t)amscr_index_label(x, i) + 1;
-        double share = amscr_params_get_rerank_inner_share(amscr_db_params(amscr_index_db(x)));
+        const amscr_params *ip = amscr_db_params(amscr_index_db(x));
+        double share = amscr_params_get_rerank_inner_share(ip), closing = amscr_params_get_inner_closing(ip);
         printf("index %s: %zu shapes, %zu classes, %zu neighbours per shape", o->out, amscr_index_size(x), nclasses,
                amscr_index_neighbours(x));
         if (amscr_index_neighbours(x) > 0 && share > 0.0)
-            printf(" (re-ranking on two graphs, the inner distance's at share %g)\n", share);
+            printf(" (re-ranking on two graphs, the inner distance's at share %g, closing %g)\n", share, closing);
         else
             printf(amscr_index_neighbours(x) > 0 ? " (re-ranking on one graph)\n" : "\n");
     }

@@ -51,6 +51,7 @@ int make_params(const opts *o, int registration, amscr_params **out)
     SET(o->channel_weight_set, "--channel-weight", amscr_params_set_channel_weight(p, o->channel_weight));
     SET(o->affine_share_set, "--affine-share", amscr_params_set_channel_affine_share(p, o->affine_share));
     SET(o->inner_share_set, "--inner-share", amscr_params_set_rerank_inner_share(p, o->inner_share));
+    SET(o->inner_closing_set, "--inner-closing", amscr_params_set_inner_closing(p, o->inner_closing));
     SET(o->rerank_set, "--rerank", amscr_params_set_rerank_k(p, (unsigned)o->rerank_k));
     SET(o->rerank_set && o->rerank_k > 0, "--rerank", amscr_params_set_rerank_iterations(p, o->rerank_iters));
 #undef SET

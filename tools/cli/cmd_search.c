@@ -95,7 +95,7 @@ static int query_distances(const amscr_db *db, const amscr_descriptor *dq, size_
 
 /* The query's scores against an index: its stored lists (amscr_index_query_scores, or the
  * member's row) when the user's params are the index's; the collection's matrix (as a folder)
- * when --rerank/--no-rerank/--inner-share differs from the build's (an index holds the build's
+ * when --rerank/--no-rerank/--inner-share/--inner-closing differs from the build's (an index holds the build's
  * graphs); the plain distance without the channel. */
 static int index_distances(const amscr_index *x, const amscr_params *p, const amscr_descriptor *dq, size_t cand,
                            const char *qpath, const char *cpath, double *dist)
@@ -107,9 +107,18 @@ static int index_distances(const amscr_index *x, const amscr_params *p, const am
     int own = amscr_params_get_channel_weight(p) >= 1.0 && amscr_params_get_rerank_k(p) == 0;
     if (retrieval_is_plain(p))
         return query_distances(idb, dq, SIZE_MAX, qpath, cpath, dist);
+    double c = amscr_params_get_inner_closing(p), cb = amscr_params_get_inner_closing(b);
+    if (c > 0.0 && c != cb && amscr_params_get_rerank_k(p) > 0 && amscr_params_get_rerank_inner_share(p) > 0.0) {
+        /* the outlines come from the shapes' contours, which an index does not keep */
+        tool_error(cpath, "built with --inner-closing %g; searching with --inner-closing %g needs its shapes' "
+                          "outlines closed at %g: rebuild the index with it, or search the folder",
+                   cb, c, c);
+        return -1;
+    }
     if (amscr_params_get_rerank_k(p) != amscr_params_get_rerank_k(b) ||
         amscr_params_get_rerank_iterations(p) != amscr_params_get_rerank_iterations(b) ||
-        amscr_params_get_rerank_inner_share(p) != amscr_params_get_rerank_inner_share(b)) {
+        amscr_params_get_rerank_inner_share(p) != amscr_params_get_rerank_inner_share(b) ||
+        amscr_params_get_inner_closing(p) != amscr_params_get_inner_closing(b)) {
         amscr_db *db = NULL;
         size_t member = own ? SIZE_MAX : member_of(idb, dq);
         int r = index_db_with_params(x, p, cpath, &db) == 0 ? query_distances(db, dq, member, qpath, cpath, dist) : -1;

@@ -239,12 +239,15 @@ static void print_retrieval_options(const amscr_params *ret)
            "  --no-rerank             the fused pairwise distances\n"
            "  --inner-share S         share of the inner-distance graph in the re-ranking,\n"
            "                          0 <= S < 1 (default %g; 0 = one graph)\n"
+           "  --inner-closing C       the inner distance's paths run inside the silhouette closed\n"
+           "                          by a disk of radius C sqrt(area), 0..1 (default %g;\n"
+           "                          0 = the silhouette as it is)\n"
            "  --paper                 the paper's method: the AMSCR distance alone, affine group,\n"
            "                          no refinement, no re-ranking (= --channel-weight 0\n"
            "                          --no-rerank --invariance affine --refine 0)\n",
            amscr_params_get_channel_weight(ret), amscr_params_get_channel_affine_share(ret),
            amscr_params_get_rerank_k(ret), amscr_params_get_rerank_iterations(ret), TOOL_RERANK_ITERS,
-           amscr_params_get_rerank_inner_share(ret));
+           amscr_params_get_rerank_inner_share(ret), amscr_params_get_inner_closing(ret));
 }
 
 /* The image and shape options, their defaults read from reg (register's params) and ret

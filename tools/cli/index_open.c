@@ -81,9 +81,11 @@ int index_params(const opts *o, const char *path, const amscr_params *built, ams
         st = amscr_params_set_rerank_k(*out, (unsigned)o->rerank_k);
     if (st == AMSCR_OK && o->rerank_set && o->rerank_k > 0)
         st = amscr_params_set_rerank_iterations(*out, o->rerank_iters);
-    /* --inner-share: the same (an index holds the graphs of its build's share) */
+    /* --inner-share, --inner-closing: the same (an index holds the graphs of its build's settings) */
     if (st == AMSCR_OK && o->inner_share_set)
         st = amscr_params_set_rerank_inner_share(*out, o->inner_share);
+    if (st == AMSCR_OK && o->inner_closing_set)
+        st = amscr_params_set_inner_closing(*out, o->inner_closing);
     if (st != AMSCR_OK) {
         amscr_params_free(*out);
         *out = NULL;

@@ -52,6 +52,7 @@ typedef enum opt_id {
     O_CHANNEL_WEIGHT,
     O_AFFINE_SHARE,
     O_INNER_SHARE,
+    O_INNER_CLOSING,
     O_FAST,
     O_PAPER,
     O_PIXEL_CHAIN
@@ -106,6 +107,7 @@ static const optdef OPTS[] = {
     {"--channel-weight", O_CHANNEL_WEIGHT, 1, C_RETRIEVAL, "W"},
     {"--affine-share", O_AFFINE_SHARE, 1, C_RETRIEVAL, "S"},
     {"--inner-share", O_INNER_SHARE, 1, C_RETRIEVAL, "S"},
+    {"--inner-closing", O_INNER_CLOSING, 1, C_RETRIEVAL, "C"},
     {"--fast", O_FAST, 0, C_RETRIEVAL, NULL},
     {"--paper", O_PAPER, 0, C_RETRIEVAL, NULL},
     {"--pixel-chain", O_PIXEL_CHAIN, 0, C_ALL, NULL},
@@ -233,7 +235,8 @@ static int parse_rerank(const char *opt, const char *v, opts *o)
     return 0;
 }
 
-/* A fraction 0..1 (--channel-weight, --affine-share, --inner-share) into *out, setting *set. */
+/* A fraction 0..1 (--channel-weight, --affine-share, --inner-share, --inner-closing) into *out,
+ * setting *set. */
 static int parse_fraction(const char *opt, const char *v, int *set, double *out)
 {
     char *end = NULL;
@@ -372,6 +375,7 @@ static int set_option(opts *o, const optdef *d, const char *v)
     case O_CHANNEL_WEIGHT: return parse_fraction(n, v, &o->channel_weight_set, &o->channel_weight);
     case O_AFFINE_SHARE: return parse_fraction(n, v, &o->affine_share_set, &o->affine_share);
     case O_INNER_SHARE: return parse_fraction(n, v, &o->inner_share_set, &o->inner_share);
+    case O_INNER_CLOSING: return parse_fraction(n, v, &o->inner_closing_set, &o->inner_closing);
     case O_FAST:
         o->affine_share_set = 1;
         o->affine_share = 0.0;

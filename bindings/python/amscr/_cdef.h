@@ -2,9 +2,9 @@
 /* Regenerate with: python3 scripts/gen_cdef.py -o bindings/python/amscr/_cdef.h */
 
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 8
+#define AMSCR_VERSION_MINOR 9
 #define AMSCR_VERSION_PATCH 0
-#define AMSCR_VERSION_NUMBER 800
+#define AMSCR_VERSION_NUMBER 900
 #define AMSCR_MAX_IMAGE_SIDE 32768
 #define AMSCR_MAX_IMAGE_PIXELS 268435456
 #define AMSCR_MAX_POINTS 16777216
@@ -194,6 +194,8 @@ amscr_status amscr_params_set_rerank_iterations(amscr_params *p, unsigned iterat
 unsigned amscr_params_get_rerank_iterations(const amscr_params *p);
 amscr_status amscr_params_set_rerank_inner_share(amscr_params *p, double share);
 double amscr_params_get_rerank_inner_share(const amscr_params *p);
+amscr_status amscr_params_set_inner_closing(amscr_params *p, double radius);
+double amscr_params_get_inner_closing(const amscr_params *p);
 amscr_status amscr_workspace_new(amscr_workspace **out);
 void amscr_workspace_free(amscr_workspace *ws);
 amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out);

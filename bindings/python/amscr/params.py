@@ -156,6 +156,9 @@ class Params:
     rerank_inner_share = _Option('rerank_inner_share', _FLOAT,
                                  'share, in [0, 1), of the inner-distance graph in that re-ranking (0 = one graph, '
                                  'the default; 0.05 in the retrieval preset; an Index holds both graphs)')
+    inner_closing = _Option('inner_closing', _FLOAT,
+                            'closing radius, in units of sqrt(area) in [0, 1], of the silhouette the inner '
+                            'distance is taken in (0 = as it is, the default; 0.04 in the retrieval preset)')
 
     #: The option names, in the order of the table above.
     OPTIONS: Tuple[str, ...] = ()
