@@ -255,16 +255,6 @@ static size_t notched(double w, const double m[6], double *xy)
     return n;
 }
 
-static double area_of(const double *xy, size_t n)
-{
-    double s = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        size_t j = (i + 1) % n;
-        s += xy[2 * i] * xy[2 * j + 1] - xy[2 * j] * xy[2 * i + 1];
-    }
-    return 0.5 * s;
-}
-
 /* The closing at c = 0.08 (a disk of radius ~0.78 here): a slot 0.4 wide closes (the square's
  * area, its inner distances), a notch 4 wide stays; a similarity map of the slotted square gives
  * the same closed inner distances; a collinear curve bounds no area. */
@@ -273,11 +263,11 @@ START_TEST(test_closing)
     double xy[2 * NPTS], V[2 * AMSCR__OUTLINE_N], *out = NULL;
     size_t nout = 0, n = notched(0.4, ident, xy);
     ck_assert_int_eq(amscr__close_curve(xy, n, 0.08, &out, &nout), AMSCR_OK);
-    ck_assert_msg(fabs(area_of(out, nout) - 100.0) < 2.0, "slot closed: area %g", area_of(out, nout));
+    ck_assert_msg(fabs(amscr_test_shoelace(out, nout) - 100.0) < 2.0, "slot closed: area %g", amscr_test_shoelace(out, nout));
     free(out);
     n = notched(4.0, ident, xy);
     ck_assert_int_eq(amscr__close_curve(xy, n, 0.08, &out, &nout), AMSCR_OK);
-    ck_assert_msg(fabs(area_of(out, nout) - 76.0) < 2.0, "notch kept: area %g", area_of(out, nout));
+    ck_assert_msg(fabs(amscr_test_shoelace(out, nout) - 76.0) < 2.0, "notch kept: area %g", amscr_test_shoelace(out, nout));
     free(out);
     amscr__inner_ws ws;
     ck_assert_int_eq(amscr__inner_ws_init(&ws), AMSCR_OK);

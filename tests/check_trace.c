@@ -39,17 +39,6 @@ static void fill_disk(uint8_t *img, size_t w, size_t h, size_t stride, double cx
                 img[y * stride + x] = v;
 }
 
-/* Signed (shoelace) area of the points as given. */
-static double shoelace(const double *xy, size_t n)
-{
-    double s = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        size_t j = (i + 1) % n;
-        s += xy[2 * i] * xy[2 * j + 1] - xy[2 * j] * xy[2 * i + 1];
-    }
-    return 0.5 * s;
-}
-
 /* Traces and asserts success. */
 static amscr_contour *trace_ok(const uint8_t *img, size_t w, size_t h, size_t stride, int thr)
 {
@@ -180,7 +169,7 @@ static void check_against_mask(const uint8_t *fg, size_t w, size_t h, const amsc
         ck_assert_msg(ddx <= 1 && ddy <= 1 && ddx + ddy > 0, "points %zu, %zu not distinct 8-neighbours", i, j);
     }
     ck_assert_uint_eq(distinct, expected);
-    ck_assert(shoelace(p, m) > 0.0);
+    ck_assert(amscr_test_shoelace(p, m) > 0.0);
     free(lab);
     free(queue);
     free(outer);
@@ -212,7 +201,7 @@ START_TEST(rectangle)
     bbox(c, &x0, &y0, &x1, &y1);
     ck_assert(x0 == 3 && x1 == 12 && y0 == 4 && y1 == 10);
     /* Polygon through the pixel centres: 9 x 6. */
-    ck_assert_double_eq(shoelace(amscr_contour_xy(c), amscr_contour_size(c)), 54.0);
+    ck_assert_double_eq(amscr_test_shoelace(amscr_contour_xy(c), amscr_contour_size(c)), 54.0);
     ck_assert(amscr_contour_xy(c)[0] == 3 && amscr_contour_xy(c)[1] == 4);
     double area = 0.0;
     ck_assert_int_eq(amscr_contour_signed_area(c, &area), AMSCR_OK);
@@ -384,7 +373,7 @@ START_TEST(touching_all_borders)
     /* The polygon through the centres: the bar 19 x 3 plus two arms 3 x 8, plus a
      * triangle of 1/2 at each of the 4 concave corners (the corner pixel touches the
      * background only diagonally, so the trace cuts across the background there). */
-    ck_assert_double_eq_tol(shoelace(amscr_contour_xy(c), amscr_contour_size(c)), 19.0 * 3 + 2 * 8 * 3 + 2.0,
+    ck_assert_double_eq_tol(amscr_test_shoelace(amscr_contour_xy(c), amscr_contour_size(c)), 19.0 * 3 + 2 * 8 * 3 + 2.0,
                             1e-9);
     free(fg);
     amscr_contour_free(c);
@@ -514,7 +503,7 @@ START_TEST(degenerate_and_not_found)
     img[3 * w + 3] = img[3 * w + 4] = img[4 * w + 3] = 255;
     c = trace_ok(img, w, h, w, 127);
     ck_assert_uint_eq(amscr_contour_size(c), 3);
-    ck_assert_double_eq(shoelace(amscr_contour_xy(c), 3), 0.5);
+    ck_assert_double_eq(amscr_test_shoelace(amscr_contour_xy(c), 3), 0.5);
     amscr_contour_free(c);
     /* A 1 x 1 image and 1-pixel-wide images. */
     uint8_t one = 255;
@@ -635,7 +624,7 @@ START_TEST(large_image)
     double x0, y0, x1, y1;
     bbox(c, &x0, &y0, &x1, &y1);
     ck_assert(x0 == 248 && x1 == 3848 && y0 == 248 && y1 == 3848);
-    ck_assert(shoelace(amscr_contour_xy(c), amscr_contour_size(c)) > 0.9 * 3.14159 * 1800 * 1800);
+    ck_assert(amscr_test_shoelace(amscr_contour_xy(c), amscr_contour_size(c)) > 0.9 * 3.14159 * 1800 * 1800);
     amscr_contour_free(c);
     free(img);
 }
@@ -665,7 +654,7 @@ static int trace_folder(const char *dir)
         double area = 0.0;
         ck_assert_int_eq(amscr_contour_signed_area(c, &area), AMSCR_OK);
         ck_assert_msg(area > 0.0, "%s: area %g", path, area);
-        ck_assert(shoelace(amscr_contour_xy(c), amscr_contour_size(c)) > 0.0);
+        ck_assert(amscr_test_shoelace(amscr_contour_xy(c), amscr_contour_size(c)) > 0.0);
         amscr_contour_free(c);
         free(px);
         count++;

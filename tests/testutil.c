@@ -211,6 +211,16 @@ int amscr_test_read_png_gray(const char *path, unsigned char **out_pixels, size_
     return 0;
 }
 
+double amscr_test_shoelace(const double *xy, size_t n)
+{
+    double s = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        size_t j = (i + 1) % n;
+        s += xy[2 * i] * xy[2 * j + 1] - xy[2 * j] * xy[2 * i + 1];
+    }
+    return 0.5 * s;
+}
+
 size_t amscr_test_polygon(const double *v, size_t nv, size_t m, double *out)
 {
     size_t k = 0;

@@ -26,6 +26,8 @@ void amscr_test_random_affine(amscr_test_rng *r, double smax, double shear, doub
 void amscr_test_apply_affine(const double m6[6], const double *xy, size_t n, double *out);
 /* A closed polygon through v (nv vertices), each edge split into m points; returns nv * m. */
 size_t amscr_test_polygon(const double *v, size_t nv, size_t m, double *out);
+/* Signed (shoelace) area of the n points as given (positive counter-clockwise in a y-up frame). */
+double amscr_test_shoelace(const double *xy, size_t n);
 /* The 10 vertices (20 doubles) of a regular 5-pointed star (outer radius 1, inner 0.4). */
 void amscr_test_star5(double *v);
 /* out[i] = xy[(i + shift) % n] */
