@@ -72,10 +72,12 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
         amscr__w_f64s(w, d->base, 2 * N);
         amscr__w_f64s(w, d->scaled, 2 * N * p);
         double V[2 * AMSCR__OUTLINE_N];
-        if (amscr__db_has_outline(version, prm) && amscr__inner_vertices(d, prm->inner_closing, V) != AMSCR_OK)
-            w->oom = 1; /* only out of memory: a prepared shape's samples always resample */
-        else if (amscr__db_has_outline(version, prm))
+        if (!amscr__db_has_outline(version, prm))
+            continue;
+        if (amscr__inner_vertices(d, prm->inner_closing, V) == AMSCR_OK)
             amscr__w_f64s(w, V, 2 * AMSCR__OUTLINE_N);
+        else
+            w->oom = 1; /* only out of memory: a prepared shape's samples always resample */
     }
 }
 
@@ -192,12 +194,19 @@ static amscr_status r_params(amscr__rbuf *r, uint32_t version, amscr_params *prm
     return AMSCR_OK;
 }
 
+/* Whether shape records of `per` bytes (params prm) end with an outline: longer than a record
+ * without one. */
+static int outline_kept(size_t per, const amscr_params *prm)
+{
+    return per > amscr__db_shape_bytes(AMSCR__DB_VERSION_PLAIN, prm);
+}
+
 /* Shape bytes at `at` decoded: 0, or 1 truncated / not finite, 2 degenerate, 3 out of memory. */
 static int decode_shape(const unsigned char *p, size_t at, size_t per, const amscr_params *prm, int32_t *label,
                         amscr_descriptor **out)
 {
     size_t N = prm->num_samples, np = prm->num_scales;
-    int outline = per > 4 + 8 * (12 + 4 * N + 2 * N * np);
+    int outline = outline_kept(per, prm);
     amscr__rbuf r = {p, at + per, at, 0};
     *label = (int32_t)amscr__r_u32(&r);
     amscr_descriptor *d = NULL;
@@ -284,7 +293,7 @@ static void check_shape(const shapes_job *j, uint64_t i, double *scratch)
         if (!level_ok(scratch, N))
             j->bad[i] = 2;
     }
-    if (j->per > r.pos - at && !amscr__r_f64s(&r, scratch, 2 * AMSCR__OUTLINE_N)) /* the outline */
+    if (outline_kept(j->per, j->prm) && !amscr__r_f64s(&r, scratch, 2 * AMSCR__OUTLINE_N))
         j->bad[i] = 1;
 }
 
