@@ -281,9 +281,9 @@ double *eval_matrix(const base_t *b, const size_t *idx, size_t m, const post_cfg
     amscr_status st = AMSCR_OK;
     if (k != 0 && pc->inner > 0.0) { /* the inner-distance graph beside the fused distance's */
         sub(b->in, n, idx, m, X);
-        st = amscr__rerank_normalized2(F, X, pc->inner, m, k, pc->iters, F);
+        st = amscr__rerank_normalized2(F, X, pc->inner, m, k, pc->iters, amscr__resolve_threads(0), F);
     } else if (k != 0)
-        st = amscr__rerank_normalized(F, m, k, pc->iters, F);
+        st = amscr__rerank_normalized(F, m, k, pc->iters, amscr__resolve_threads(0), F);
     if (st != AMSCR_OK) {
         free(F);
         F = NULL;

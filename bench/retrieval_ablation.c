@@ -172,8 +172,8 @@ static void compose(const set_run *r, const row_t *w, double *out)
     free(H);
     size_t k = n < 8 ? n : 8;
     const double *inner = w->use[M_INNER] ? r->base[M_INNER] : w->use[M_INNER_OPEN] ? r->base[M_INNER_OPEN] : NULL;
-    if (w->rerank && (inner ? amscr__rerank_normalized2(out, inner, 0.05, n, k, 10, out)
-                            : amscr__rerank_normalized(out, n, k, 10, out)) != AMSCR_OK)
+    if (w->rerank && (inner ? amscr__rerank_normalized2(out, inner, 0.05, n, k, 10, amscr__resolve_threads(0), out)
+                            : amscr__rerank_normalized(out, n, k, 10, amscr__resolve_threads(0), out)) != AMSCR_OK)
         die("re-ranking");
 }
 

@@ -240,7 +240,7 @@ static void run_set(const char *spec, const cfg_t *c)
     }
     double sf = score(&s, F);
     if ((c->rowmax ? amscr_rerank_diffusion(F, n, c->k, c->iters, F)
-                   : amscr__rerank_normalized(F, n, c->k, c->iters, F)) != AMSCR_OK)
+                   : amscr__rerank_normalized(F, n, c->k, c->iters, amscr__resolve_threads(0), F)) != AMSCR_OK)
         return;
     double tfr = now() - t0;
     double sr = score(&s, F);

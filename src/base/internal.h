@@ -219,12 +219,14 @@ void amscr__kmeans1d_dp(const double *sorted, size_t n, size_t kmax, double *scr
 size_t amscr__elbow_choose(const double *sse, size_t m, size_t k_min);
 
 /* Re-ranking as amscr_rerank_diffusion with the output halved into [0, 1] (< 0.5: reached by
- * the diffusion) and a zero diagonal (rerank.c). */
-amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);
+ * the diffusion) and a zero diagonal (rerank.c); the diffusion's rows on `threads` threads
+ * (the result does not depend on their number). */
+amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, unsigned threads,
+                                      double *out_dist);
 /* The same on two graphs: the kNN graphs of dist and of dist2 (n x n, symmetric) mixed as
  * (1 - share) P + share P2 before the diffusion; unreached pairs ordered by dist. */
 amscr_status amscr__rerank_normalized2(const double *dist, const double *dist2, double share, size_t n, size_t k,
-                                       unsigned iterations, double *out_dist);
+                                       unsigned iterations, unsigned threads, double *out_dist);
 
 /* The retrieval settings in the saved collection (format versions 2-4, retrieval_io.c):
  * little-endian f64 channel_weight, u32 channel_invariance, f64 channel_affine_share,

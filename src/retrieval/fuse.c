@@ -3,6 +3,7 @@
  * re-ranked retrieval matrix. */
 #include "channel.h"
 #include "inner.h"
+#include "rows.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -156,6 +157,23 @@ static int stage_cb(void *user, size_t done, size_t total)
     return sp->fn(sp->user, sp->stage * total + done, whole);
 }
 
+/* The features of every shape in one frame, a row each (on the collection's threads). */
+typedef struct {
+    const amscr_db *db;
+    amscr_invariance frame;
+    amscr__hf *hf;
+} frame_job;
+
+static amscr_status frame_row(void *ctx, size_t i, void *scratch)
+{
+    (void)scratch;
+    const frame_job *j = ctx;
+    const amscr_descriptor *d = amscr_db_descriptor(j->db, i);
+    if (!d)
+        return amscr__fail(AMSCR_E_FORMAT, "shape channel: shape %zu could not be read", i);
+    return amscr__hf_of_descriptor(amscr_db_params(j->db), j->frame, d, &j->hf[i]);
+}
+
 /* The channel matrix in one frame (the second of amscr__channel_frames when `second`) into out. */
 static amscr_status matrix_in_frame(const amscr_db *db, amscr_invariance frame, int second,
                                     amscr_progress_fn progress, void *user, double *out)
@@ -165,13 +183,14 @@ static amscr_status matrix_in_frame(const amscr_db *db, amscr_invariance frame, 
     amscr__hf *hf = calloc(n, sizeof *hf);
     if (!hf)
         return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
-    amscr_status st = AMSCR_OK;
-    for (size_t i = 0; i < n && st == AMSCR_OK; i++)
-        st = amscr__hf_of_descriptor(p, frame, amscr_db_descriptor(db, i), &hf[i]);
+    unsigned threads = amscr__resolve_threads(p->num_threads);
+    frame_job job = {db, frame, hf};
+    amscr__rows_fn rows = {NULL, NULL, frame_row, &job, "shape channel"};
+    amscr_status st = amscr__run_rows(&rows, 0, n, threads, NULL, NULL);
     if (st == AMSCR_OK) {
         amscr__hf_cfg cfg;
         amscr__hf_cfg_from(p, hf[0].n, second, &cfg);
-        st = amscr__hf_matrix(hf, n, &cfg, amscr__resolve_threads(p->num_threads), progress, user, out);
+        st = amscr__hf_matrix(hf, n, &cfg, threads, progress, user, out);
     }
     free_hfs(hf, n);
     return st;
@@ -322,14 +341,15 @@ static amscr_status rerank_base(const amscr_db *db, size_t n, double *D)
 {
     const amscr_params *p = amscr_db_params(db);
     size_t k = amscr__rerank_k(p, n);
+    unsigned threads = amscr__resolve_threads(p->num_threads);
     if (!(p->rerank_inner_share > 0.0))
-        return amscr__rerank_normalized(D, n, k, p->rerank_iterations, D);
+        return amscr__rerank_normalized(D, n, k, p->rerank_iterations, threads, D);
     double *I = amscr__malloc_array(n * n, sizeof *I);
     if (!I)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_db_retrieval_matrix: out of memory");
-    amscr_status st = amscr__inner_matrix(db, amscr__resolve_threads(p->num_threads), NULL, NULL, I);
+    amscr_status st = amscr__inner_matrix(db, threads, NULL, NULL, I);
     if (st == AMSCR_OK)
-        st = amscr__rerank_normalized2(D, I, p->rerank_inner_share, n, k, p->rerank_iterations, D);
+        st = amscr__rerank_normalized2(D, I, p->rerank_inner_share, n, k, p->rerank_iterations, threads, D);
     free(I);
     return st;
 }

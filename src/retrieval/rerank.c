@@ -2,6 +2,7 @@
  * tensor-product graph (Yang, Prasad, Latecki, CVPR 2012). See amscr_rerank_diffusion in
  * amscr.h for the definition. */
 #include "index.h" /* amscr__knn_select: the neighbour order the index stores too */
+#include "rows.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -114,40 +115,66 @@ static amscr_status knn_graph(rerank_buf *b, const double *D, size_t n, size_t k
     return AMSCR_OK;
 }
 
-/* Q = P, then `iterations` times Q <- P Q P^T + I (P sparse: k entries a row). */
-static void diffuse(rerank_buf *b, size_t n, unsigned iterations)
+/* One row of a diffusion step: T_i = (P Q)_i, or Q_i = (T P^T)_i + e_i (Q_ij = Σ_t P_jt T_i,pj(t)). */
+typedef struct {
+    const rerank_buf *b;
+    size_t n;
+} diffuse_job;
+
+static amscr_status product_row(void *ctx, size_t i, void *scratch)
+{
+    (void)scratch;
+    const diffuse_job *j = ctx;
+    size_t n = j->n, k = j->b->kk;
+    const double *pw = j->b->pw;
+    const size_t *pj = j->b->pj;
+    double *ti = j->b->T + i * n;
+    memset(ti, 0, n * sizeof *ti);
+    for (size_t t = 0; t < k; t++) {
+        double w = pw[i * k + t];
+        const double *qr = j->b->Q + pj[i * k + t] * n;
+        for (size_t c = 0; c < n; c++)
+            ti[c] += w * qr[c];
+    }
+    return AMSCR_OK;
+}
+
+static amscr_status transpose_row(void *ctx, size_t i, void *scratch)
+{
+    (void)scratch;
+    const diffuse_job *j = ctx;
+    size_t n = j->n, k = j->b->kk;
+    const double *pw = j->b->pw, *ti = j->b->T + i * n;
+    const size_t *pj = j->b->pj;
+    double *qi = j->b->Q + i * n;
+    for (size_t c = 0; c < n; c++) {
+        double v = 0.0;
+        for (size_t t = 0; t < k; t++)
+            v += pw[c * k + t] * ti[pj[c * k + t]];
+        qi[c] = v + (i == c ? 1.0 : 0.0);
+    }
+    return AMSCR_OK;
+}
+
+/* Q = P, then `iterations` times Q <- P Q P^T + I (P sparse: k entries a row), each step's
+ * rows on `threads` threads (a row is computed the same way on any thread). */
+static amscr_status diffuse(rerank_buf *b, size_t n, unsigned iterations, unsigned threads)
 {
     size_t k = b->kk;
-    double *Q = b->Q, *T = b->T;
-    const double *pw = b->pw;
-    const size_t *pj = b->pj;
-    memset(Q, 0, n * n * sizeof *Q);
+    memset(b->Q, 0, n * n * sizeof *b->Q);
     for (size_t i = 0; i < n; i++)
         for (size_t t = 0; t < k; t++)
-            Q[i * n + pj[i * k + t]] += pw[i * k + t];
-    for (unsigned it = 0; it < iterations; it++) {
-        /* T = P Q */
-        for (size_t i = 0; i < n; i++) {
-            double *ti = T + i * n;
-            memset(ti, 0, n * sizeof *ti);
-            for (size_t t = 0; t < k; t++) {
-                double w = pw[i * k + t];
-                const double *qr = Q + pj[i * k + t] * n;
-                for (size_t j = 0; j < n; j++)
-                    ti[j] += w * qr[j];
-            }
-        }
-        /* Q = T P^T + I: Q_ij = Σ_t P_jt T_i,pj(t) */
-        for (size_t i = 0; i < n; i++) {
-            const double *ti = T + i * n;
-            for (size_t j = 0; j < n; j++) {
-                double v = 0.0;
-                for (size_t t = 0; t < k; t++)
-                    v += pw[j * k + t] * ti[pj[j * k + t]];
-                Q[i * n + j] = v + (i == j ? 1.0 : 0.0);
-            }
-        }
+            b->Q[i * n + b->pj[i * k + t]] += b->pw[i * k + t];
+    diffuse_job j = {b, n};
+    amscr__rows_fn product = {NULL, NULL, product_row, &j, "re-ranking"};
+    amscr__rows_fn transpose = {NULL, NULL, transpose_row, &j, "re-ranking"};
+    amscr_status st = AMSCR_OK;
+    for (unsigned it = 0; it < iterations && st == AMSCR_OK; it++) {
+        st = amscr__run_rows(&product, 0, n, threads, NULL, NULL);
+        if (st == AMSCR_OK)
+            st = amscr__run_rows(&transpose, 0, n, threads, NULL, NULL);
     }
+    return st;
 }
 
 /* The output distances from the diffused affinity Q, row by row: 1 - q / (the row's largest q),
@@ -175,7 +202,7 @@ static void to_distances(const double *Q, const double *D, size_t n, double dmax
 
 /* dist2 (NULL: one graph) enters with `share` of every row's mass. */
 static amscr_status rerank(const double *dist, const double *dist2, double share, size_t n, size_t k,
-                           unsigned iterations, int norm, double *out_dist, const char *what)
+                           unsigned iterations, unsigned threads, int norm, double *out_dist, const char *what)
 {
     amscr__clear_error();
     amscr_status st = check_args(dist, n, k, iterations, out_dist, what);
@@ -190,26 +217,27 @@ static amscr_status rerank(const double *dist, const double *dist2, double share
     st = knn_graph(&b, b.D, n, k, 0, dist2 ? 1.0 - share : 1.0, dmax);
     if (st == AMSCR_OK && dist2)
         st = knn_graph(&b, b.D2, n, k, k, share, symmetrize(dist2, n, b.D2));
-    if (st == AMSCR_OK) {
-        diffuse(&b, n, iterations);
+    if (st == AMSCR_OK)
+        st = diffuse(&b, n, iterations, threads);
+    if (st == AMSCR_OK)
         to_distances(b.Q, b.D, n, dmax, norm, out_dist);
-    }
     buf_free(&b);
     return st;
 }
 
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
 {
-    return rerank(dist, NULL, 0.0, n, k, iterations, NORM_ROW_MAX, out_dist, "amscr_rerank_diffusion");
+    return rerank(dist, NULL, 0.0, n, k, iterations, 1, NORM_ROW_MAX, out_dist, "amscr_rerank_diffusion");
 }
 
-amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
+amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, unsigned threads,
+                                      double *out_dist)
 {
-    return rerank(dist, NULL, 0.0, n, k, iterations, NORM_UNIT, out_dist, "re-ranking");
+    return rerank(dist, NULL, 0.0, n, k, iterations, threads, NORM_UNIT, out_dist, "re-ranking");
 }
 
 amscr_status amscr__rerank_normalized2(const double *dist, const double *dist2, double share, size_t n, size_t k,
-                                       unsigned iterations, double *out_dist)
+                                       unsigned iterations, unsigned threads, double *out_dist)
 {
-    return rerank(dist, dist2, share, n, k, iterations, NORM_UNIT, out_dist, "re-ranking");
+    return rerank(dist, dist2, share, n, k, iterations, threads, NORM_UNIT, out_dist, "re-ranking");
 }

@@ -260,3 +260,29 @@ def test_progress_on_terminal(manifest):
     assert p.returncode == 0
     json.loads(p.stdout)  # stdout stays clean
     assert b"matching" in err and b"100%" in err
+
+
+def test_shapes_prepared_on_threads(manifest, tmp_path):
+    """A collection is decoded and prepared on threads: the matrix is the same for every thread
+    count, and a collection with bad shapes fails naming the first bad one in its order, with
+    the message a load on one thread gives (a bad point list: a failed decode; a collinear one:
+    a failed preparation), however many threads load it."""
+    one = run("matrix", manifest, "-o", "-", "--threads", "1").stdout
+    for t in ("2", "3", "8"):
+        assert run("matrix", manifest, "-o", "-", "--threads", t).stdout == one, t
+    (tmp_path / "shapes" / "line.txt").write_text("".join("%d %d\n" % (i, 2 * i) for i in range(12)))
+    (tmp_path / "shapes" / "bad.txt").write_text("1 2\nthree four\n")
+    rows = manifest.read_text().splitlines()
+    for first, later in (("line.txt", "bad.txt"), ("bad.txt", "line.txt")):
+        mf = tmp_path / ("m-%s.tsv" % first)
+        bad = rows[:3] + ["shapes/%s\tBAD" % first] + rows[3:7] + ["shapes/%s\tBAD" % later] + rows[7:]
+        mf.write_text("\n".join(bad) + "\n")
+        seen = set()
+        for t in ("1", "2", "3", "8", "8", "8"):
+            r = run("eval", mf, "--threads", t)
+            assert r.returncode == 1 and r.stdout == "", (t, r.returncode, r.stderr)
+            lines = r.stderr.splitlines()
+            assert len(lines) == 1 and first in lines[0] and later not in lines[0], (t, r.stderr)
+            seen.add(lines[0])
+        assert len(seen) == 1, seen
+        assert ("cannot use this shape" in seen.pop()) == (first == "line.txt")

@@ -6,43 +6,6 @@
 
 #include "image.h"
 
-/* Loads every shape of a collection into a new db (params p). */
-int load_db(const amscr_params *p, const collection *c, int threshold, amscr_db **out)
-{
-    amscr_db *db = NULL;
-    amscr_status st = amscr_db_new(p, &db);
-    if (st != AMSCR_OK) {
-        tool_lib_error(NULL, st);
-        return -1;
-    }
-    tool_progress pr;
-    progress_init(&pr, "preparing shapes");
-    for (size_t i = 0; i < c->n; i++) {
-        amscr_contour *ct = NULL;
-        if (shape_load(c->items[i].path, threshold, &ct) != 0) {
-            progress_end(&pr);
-            amscr_db_free(db);
-            return -1;
-        }
-        st = amscr_db_add_contour(db, ct, c->items[i].label, NULL);
-        amscr_contour_free(ct);
-        if (st != AMSCR_OK) {
-            progress_end(&pr);
-            const char *d = lib_detail();
-            if (st == AMSCR_E_DEGENERATE)
-                tool_error(c->items[i].path, "cannot use this shape: %s", d[0] ? d : "degenerate");
-            else
-                tool_lib_error(c->items[i].path, st);
-            amscr_db_free(db);
-            return -1;
-        }
-        progress_update(&pr, i + 1, c->n);
-    }
-    progress_end(&pr);
-    *out = db;
-    return 0;
-}
-
 int retrieval_is_plain(const amscr_params *p)
 {
     return amscr_params_get_channel_weight(p) <= 0.0 && amscr_params_get_rerank_k(p) == 0;

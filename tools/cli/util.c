@@ -13,8 +13,10 @@
 #include <unistd.h>
 
 static int g_error_printed;
+static int g_muted; /* set only while no other thread runs (see util.h) */
 
 int tool_error_printed(void) { return g_error_printed; }
+void tool_errors_mute(int on) { g_muted = on; }
 
 static void print_line(const char *what, const char *msg)
 {
@@ -33,7 +35,7 @@ static void print_line(const char *what, const char *msg)
 
 void tool_error(const char *what, const char *fmt, ...)
 {
-    if (g_error_printed)
+    if (g_muted || g_error_printed)
         return;
     g_error_printed = 1;
     char msg[900];
@@ -61,7 +63,7 @@ const char *lib_detail(void)
 void tool_lib_error(const char *what, amscr_status st)
 {
     const char *detail = lib_detail();
-    if (g_error_printed)
+    if (g_muted || g_error_printed)
         return;
     if (detail != NULL && detail[0] != '\0') {
         size_t wl = what ? strlen(what) : 0;

@@ -30,6 +30,10 @@ void tool_lib_error(const char *what, amscr_status st);
 const char *lib_detail(void);
 /* Non-zero once an error has been printed. */
 int tool_error_printed(void);
+/* While muted (on != 0) errors are not printed, and do not count as printed: work on several
+ * threads is muted and the main thread prints the first failure again after it. Set only while
+ * no other thread of the tool runs. */
+void tool_errors_mute(int on);
 
 /* Overflow-checked allocation; prints "amscr: out of memory" and returns NULL on failure. */
 void *xmalloc_array(size_t n, size_t size);
