@@ -27,26 +27,31 @@ typedef struct {
     size_t j;
 } nb_t;
 
-static int cmp_nb(const void *a, const void *b)
-{
-    const nb_t *x = a, *y = b;
-    if (x->d != y->d)
-        return x->d < y->d ? -1 : 1;
-    return x->j < y->j ? -1 : (x->j > y->j);
-}
+/* x before y: by distance, ties by index */
+static int nb_less(nb_t x, nb_t y) { return x.d < y.d || (x.d == y.d && x.j < y.j); }
 
 amscr_status amscr__knn_select(size_t i, const size_t *cj, const double *cd, size_t m, size_t k, uint32_t *out_idx,
                                double *out_dist)
 {
-    nb_t *row = amscr__malloc_array(m + 1, sizeof *row);
+    /* the k first of the candidates sorted by nb_less (itself first), kept by insertion */
+    if (k == 0)
+        return AMSCR_OK;
+    nb_t *row = amscr__malloc_array(k + 1, sizeof *row);
     if (!row)
         return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
     size_t r = 0;
     row[r++] = (nb_t){-1.0, i}; /* itself first, as amscr_rerank_diffusion */
-    for (size_t t = 0; t < m; t++)
-        if (cj[t] != i)
-            row[r++] = (nb_t){cd[t], cj[t]};
-    qsort(row, r, sizeof *row, cmp_nb);
+    for (size_t t = 0; t < m; t++) {
+        nb_t x = {cd[t], cj[t]};
+        if (cj[t] == i || (r >= k && !nb_less(x, row[k - 1])))
+            continue;
+        size_t at = r < k ? r++ : k - 1;
+        while (at > 0 && nb_less(x, row[at - 1])) {
+            row[at] = row[at - 1];
+            at--;
+        }
+        row[at] = x;
+    }
     for (size_t t = 0; t < k; t++) {
         out_idx[t] = (uint32_t)row[t < r ? t : r - 1].j;
         out_dist[t] = t == 0 ? 0.0 : row[t < r ? t : r - 1].d;
