@@ -16,6 +16,7 @@ inner-distance share 0) and at each --shares value (the library's retrieval_matr
 
 Usage: .venv/bin/python bench/retrieval_views.py [--data ../shared/datasets] [--seeds 1,2,3]
        [--fold A|B] [--objects 4] [--views 10] [--shares 0.05]          # ~1.5 min a seed
+       [--classes 8] [--k 16,41]    # ETH-80's shape: 8 classes drawn per seed, x 10 objects x 41 views
 """
 import argparse
 import os
@@ -73,6 +74,15 @@ def view(img, rng):
     return cv2.copyMakeBorder(img, 4, 4, 4, 4, cv2.BORDER_CONSTANT, 0)
 
 
+def draw(by, n, seed):
+    """n of the classes drawn with the seed (all when n is 0)."""
+    if not n:
+        return by
+    names = sorted(by)
+    pick = np.random.default_rng(seed).choice(len(names), n, replace=False)
+    return {names[i]: by[names[i]] for i in sorted(pick)}
+
+
 def build(by, objects, views, seed):
     rng = np.random.default_rng(seed)
     shapes, cls, grp = [], [], []
@@ -100,21 +110,25 @@ def main(argv=None):
     ap.add_argument('--objects', type=int, default=4)
     ap.add_argument('--views', type=int, default=10)
     ap.add_argument('--shares', default='0.05')
+    ap.add_argument('--classes', type=int, default=0, help="that many classes drawn with each seed (0: all)")
+    ap.add_argument('--k', default='', help="re-ranking k values for more columns (the preset otherwise)")
     a = ap.parse_args(argv)
-    by = classes(a.data, a.fold)
     shares = [float(x) for x in a.shares.split(',')]
-    cols = ['before re-ranking', 'share 0'] + ['share %g' % s for s in shares]
+    ks = [int(x) for x in a.k.split(',') if x]
+    cols = ['before re-ranking', 'share 0'] + ['share %g' % s for s in shares] + ['k %d' % k for k in ks]
     print('objects in views, 1-NN leave one object out (%s classes, %d objects x %d views, amscr %s)'
-          % (len(by), a.objects, a.views, amscr.__version__))
+          % (a.classes or len(classes(a.data, a.fold)), a.objects, a.views, amscr.__version__))
     print('| seed | ' + ' | '.join(cols) + ' | s |')
     print('|---' * (len(cols) + 2) + '|')
     sums = np.zeros(len(cols))
     seeds = [int(x) for x in a.seeds.split(',')]
     for seed in seeds:
         t = time.time()
+        by = draw(classes(a.data, a.fold), a.classes, seed)
         shapes, cls, grp = build(by, a.objects, a.views, seed)
         row = [accuracy(shapes, cls, grp, rerank_k=0), accuracy(shapes, cls, grp, rerank_inner_share=0.0)]
         row += [accuracy(shapes, cls, grp, rerank_inner_share=s) for s in shares]
+        row += [accuracy(shapes, cls, grp, rerank_k=k) for k in ks]
         sums += row
         print('| %d | ' % seed + ' | '.join('%.2f' % v for v in row) + ' | %.0f |' % (time.time() - t), flush=True)
     print('| mean | ' + ' | '.join('%.2f' % v for v in sums / len(seeds)) + ' | |')
