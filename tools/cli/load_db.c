@@ -82,8 +82,12 @@ static amscr_status add_ready(load_job *j, amscr_db *db, size_t *added)
             return AMSCR_OK;
         amscr_status st = amscr_db_add_descriptor(db, d, j->c->items[i].label, NULL);
         amscr_descriptor_free(d);
-        if (st != AMSCR_OK)
+        if (st != AMSCR_OK) { /* no new shape for the other threads either */
+            pthread_mutex_lock(&j->lock);
+            j->failed = i;
+            pthread_mutex_unlock(&j->lock);
             return st;
+        }
         (*added)++;
     }
 }
