@@ -887,11 +887,59 @@ START_TEST(quantizer_shortlist)
 }
 END_TEST
 
+/* The reference order of amscr__knn_select: itself first, then by distance, ties by index. */
+typedef struct {
+    double d;
+    size_t j;
+} ref_nb;
+
+static int ref_cmp(const void *a, const void *b)
+{
+    const ref_nb *x = a, *y = b;
+    if (x->d != y->d)
+        return x->d < y->d ? -1 : 1;
+    return x->j < y->j ? -1 : (x->j > y->j);
+}
+
+/* The k nearest kept by insertion equal the first k of the whole candidate list sorted: with
+ * many ties, the shape itself among the candidates or not, fewer candidates than k (the last
+ * repeated) and k = 1. */
+START_TEST(knn_select_is_the_sorted_prefix)
+{
+    unsigned long long s = 12345;
+    for (int trial = 0; trial < 300; trial++) {
+        size_t m = (size_t)(trial % 37), k = 1 + (size_t)(trial % 11), self = (size_t)(trial % 5);
+        size_t cj[40];
+        double cd[40];
+        ref_nb ref[41];
+        size_t r = 0;
+        ref[r++] = (ref_nb){-1.0, self};
+        for (size_t t = 0; t < m; t++) {
+            s = s * 6364136223846793005ull + 1442695040888963407ull;
+            cj[t] = (size_t)(s >> 33) % 50;   /* repeats, and now and then itself */
+            cd[t] = (double)((s >> 20) % 4); /* many ties */
+            if (cj[t] != self)
+                ref[r++] = (ref_nb){cd[t], cj[t]};
+        }
+        qsort(ref, r, sizeof *ref, ref_cmp);
+        uint32_t idx[16];
+        double dist[16];
+        ck_assert_int_eq(amscr__knn_select(self, cj, cd, m, k, idx, dist), AMSCR_OK);
+        for (size_t t = 0; t < k; t++) {
+            const ref_nb *e = &ref[t < r ? t : r - 1];
+            ck_assert_uint_eq(idx[t], e->j);
+            ck_assert(dist[t] == (t == 0 ? 0.0 : e->d));
+        }
+    }
+}
+END_TEST
+
 Suite *amscr_suite_index(void)
 {
     Suite *s = suite_create("index");
     TCase *tc = tcase_create("index");
     tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, knn_select_is_the_sorted_prefix);
     tcase_add_test(tc, exact_channel_rerank);
     tcase_add_test(tc, exact_amscr_rerank);
     tcase_add_test(tc, exact_fused_rerank);
