@@ -96,8 +96,8 @@ extern "C" {
 
 /** Compile-time version; amscr_version_number() gives the runtime one. */
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 9
-#define AMSCR_VERSION_PATCH 1
+#define AMSCR_VERSION_MINOR 10
+#define AMSCR_VERSION_PATCH 0
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
 
@@ -2210,6 +2210,31 @@ AMSCR_API void amscr_db_free(amscr_db *db);
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_add_contour(amscr_db *db, const amscr_contour *c, int32_t label,
                                                             size_t *out_index);
+
+/**
+ * @brief Prepares n contours with the db's params on the db's threads and stores them, in
+ *        order, after the shapes it has (as n calls of amscr_db_add_contour would).
+ * @param contours  n contours (none NULL).
+ * @param labels    n labels, or NULL for 0 each.
+ * @param n         number of contours (0: nothing to do).
+ * @param progress  called with (contours prepared, n) from the calling thread; non-zero
+ *                  cancels (may be NULL).
+ * @param[out] out_failed  on failure, the index of the first contour, in order, that could not
+ *                  be prepared (n when the failure was not one contour's: out of memory,
+ *                  cancelled); may be NULL.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL); as amscr_descriptor_new for the contour
+ *         *out_failed names (the error detail starts "contour I: "); AMSCR_E_CANCELLED;
+ *         AMSCR_E_NOMEM. All or nothing: on failure no shape is added.
+ * Threads: amscr_params_set_num_threads of the db's params (0 = all cores); the shapes are the
+ *          same for any thread count.
+ * Ownership: none (the contours are not kept).
+ * Thread-safety: exclusive on db; the contours are only read.
+ * @since 0.10
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_add_contours(amscr_db *db, const amscr_contour *const *contours,
+                                                             const int32_t *labels, size_t n,
+                                                             amscr_progress_fn progress, void *user,
+                                                             size_t *out_failed);
 
 /**
  * @brief Stores a copy of a prepared shape with a label.

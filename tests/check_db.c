@@ -965,6 +965,141 @@ static void assert_db_equal(const amscr_db *a, const amscr_db *b)
     }
 }
 
+/* ------------------------------------------------- many contours at once */
+
+static amscr_db *retrieval_db(unsigned threads)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_num_threads(p, threads), AMSCR_OK);
+    amscr_db *db = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
+    amscr_params_free(p);
+    return db;
+}
+
+static void assert_same_retrieval(const amscr_db *a, const amscr_db *b)
+{
+    size_t n = amscr_db_size(a);
+    double *ma = alloc_doubles(n * n), *mb = alloc_doubles(n * n);
+    ck_assert_int_eq(amscr_db_retrieval_matrix(a, NULL, NULL, ma), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_retrieval_matrix(b, NULL, NULL, mb), AMSCR_OK);
+    ck_assert_msg(memcmp(ma, mb, n * n * sizeof *ma) == 0, "retrieval matrices differ");
+    free(ma);
+    free(mb);
+}
+
+enum { MB = 12 };
+
+/* amscr_db_add_contours = MB calls of amscr_db_add_contour after the shapes already there, on
+ * any thread count (the prepared shapes, their closed outlines through the retrieval matrix, the
+ * labels); progress from the calling thread up to MB. */
+START_TEST(db_add_contours_as_one_by_one)
+{
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, 505);
+    amscr_contour *c[MB];
+    int32_t lab[MB];
+    for (size_t i = 0; i < MB; i++) {
+        c[i] = random_contour(&rng, 3 + (int)(i % 5));
+        lab[i] = label_of(i);
+    }
+    for (unsigned threads = 1; threads <= 3; threads += 2) {
+        amscr_db *one = retrieval_db(threads), *batch = retrieval_db(threads);
+        ck_assert_int_eq(amscr_db_add_contour(one, c[5], 77, NULL), AMSCR_OK);
+        ck_assert_int_eq(amscr_db_add_contour(batch, c[5], 77, NULL), AMSCR_OK);
+        for (size_t i = 0; i < MB; i++)
+            ck_assert_int_eq(amscr_db_add_contour(one, c[i], lab[i], NULL), AMSCR_OK);
+        prog_rec r;
+        prog_init(&r, 0);
+        size_t failed = 999;
+        ck_assert_int_eq(amscr_db_add_contours(batch, (const amscr_contour *const *)c, lab, MB, prog_cb, &r, &failed),
+                         AMSCR_OK);
+        ck_assert_uint_eq(failed, MB);
+        prog_check_complete(&r, MB, "amscr_db_add_contours");
+        assert_db_equal(one, batch);
+        assert_same_retrieval(one, batch);
+        /* labels NULL: 0 each; n = 0: nothing */
+        ck_assert_int_eq(amscr_db_add_contours(batch, (const amscr_contour *const *)c, NULL, 2, NULL, NULL, NULL),
+                         AMSCR_OK);
+        ck_assert_int_eq(amscr_db_add_contours(batch, NULL, NULL, 0, NULL, NULL, &failed), AMSCR_OK);
+        ck_assert_uint_eq(amscr_db_size(batch), MB + 3);
+        ck_assert_int_eq(amscr_db_label(batch, MB + 1), 0);
+        ck_assert_int_eq(amscr_db_label(batch, MB + 2), 0);
+        amscr_db_free(one);
+        amscr_db_free(batch);
+    }
+    for (size_t i = 0; i < MB; i++)
+        amscr_contour_free(c[i]);
+}
+END_TEST
+
+/* A failing batch adds nothing and names its first failing contour in order, with the same
+ * status and detail for any thread count: a collinear contour (3) before a non-finite one (7),
+ * a NULL contour, a cancelled batch, NULL arguments. */
+START_TEST(db_add_contours_all_or_nothing)
+{
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, 506);
+    amscr_contour *c[MB];
+    for (size_t i = 0; i < MB; i++)
+        c[i] = random_contour(&rng, 4);
+    double line[2 * 20], xy[2 * NPTS];
+    for (int i = 0; i < 20; i++) {
+        line[2 * i] = i;
+        line[2 * i + 1] = 2.0 * i + 1.0;
+    }
+    amscr_test_random_shape(&rng, NPTS, 4, xy);
+    xy[17] = NAN;
+    amscr_contour *collinear = NULL, *nonfinite = NULL;
+    ck_assert_int_eq(amscr_contour_new(line, 20, &collinear), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_new(xy, NPTS, &nonfinite), AMSCR_OK);
+    const amscr_contour *bad[MB];
+    for (size_t i = 0; i < MB; i++)
+        bad[i] = c[i];
+    bad[3] = collinear;
+    bad[7] = nonfinite;
+    char first[256] = "";
+    for (unsigned threads = 1; threads <= 4; threads++) {
+        amscr_db *db = retrieval_db(threads);
+        ck_assert_int_eq(amscr_db_add_contour(db, c[0], 1, NULL), AMSCR_OK);
+        size_t failed = 999;
+        ck_assert_int_eq(amscr_db_add_contours(db, bad, NULL, MB, NULL, NULL, &failed), AMSCR_E_DEGENERATE);
+        ck_assert_uint_eq(failed, 3);
+        ck_assert_uint_eq(amscr_db_size(db), 1);
+        const char *d = amscr_last_error_detail();
+        ck_assert_msg(strncmp(d, "contour 3: ", 11) == 0, "detail: %s", d);
+        if (threads == 1)
+            snprintf(first, sizeof first, "%s", d);
+        ck_assert_str_eq(d, first);
+        /* a NULL contour */
+        bad[3] = c[3];
+        bad[5] = NULL;
+        ck_assert_int_eq(amscr_db_add_contours(db, bad, NULL, MB, NULL, NULL, &failed), AMSCR_E_INVALID_ARG);
+        ck_assert_uint_eq(failed, 5);
+        bad[3] = collinear;
+        bad[5] = c[5];
+        /* cancelled on the first report */
+        prog_rec r;
+        prog_init(&r, 1);
+        ck_assert_int_eq(amscr_db_add_contours(db, (const amscr_contour *const *)c, NULL, MB, prog_cb, &r, &failed),
+                         AMSCR_E_CANCELLED);
+        ck_assert_uint_eq(failed, MB);
+        ck_assert_uint_eq(amscr_db_size(db), 1);
+        /* NULL arguments */
+        ck_assert_int_eq(amscr_db_add_contours(NULL, bad, NULL, MB, NULL, NULL, &failed), AMSCR_E_INVALID_ARG);
+        ck_assert_int_eq(amscr_db_add_contours(db, NULL, NULL, MB, NULL, NULL, NULL), AMSCR_E_INVALID_ARG);
+        ck_assert_uint_eq(amscr_db_size(db), 1);
+        amscr_db_free(db);
+    }
+    amscr_contour_free(collinear);
+    amscr_contour_free(nonfinite);
+    for (size_t i = 0; i < MB; i++)
+        amscr_contour_free(c[i]);
+}
+END_TEST
+
+
 /* non-default values for every parameter */
 static amscr_params *odd_params(void)
 {
@@ -1633,6 +1768,8 @@ Suite *amscr_suite_db(void)
     tcase_add_test(tc, db_add_descriptor_copies);
     tcase_add_test(tc, db_add_descriptor_incompatible);
     tcase_add_test(tc, db_add_degenerate_contour);
+    tcase_add_test(tc, db_add_contours_as_one_by_one);
+    tcase_add_test(tc, db_add_contours_all_or_nothing);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("batch");

@@ -54,20 +54,32 @@ void amscr_db_free(amscr_db *db)
     free(db);
 }
 
+amscr_status amscr__db_reserve(amscr_db *db, size_t extra)
+{
+    if (extra <= db->cap - db->n)
+        return AMSCR_OK;
+    if (extra > SIZE_MAX / 2 / sizeof(amscr_descriptor *) - db->n)
+        return amscr__fail(AMSCR_E_NOMEM, "db: out of memory");
+    size_t cap = db->cap ? 2 * db->cap : 64;
+    if (cap < db->n + extra)
+        cap = db->n + extra;
+    amscr_descriptor **nd = realloc(db->d, cap * sizeof *nd);
+    if (!nd)
+        return amscr__fail(AMSCR_E_NOMEM, "db: out of memory");
+    db->d = nd;
+    int32_t *nl = realloc(db->labels, cap * sizeof *nl);
+    if (!nl)
+        return amscr__fail(AMSCR_E_NOMEM, "db: out of memory");
+    db->labels = nl;
+    db->cap = cap;
+    return AMSCR_OK;
+}
+
 amscr_status amscr__db_push(amscr_db *db, amscr_descriptor *d, int32_t label, size_t *out_index)
 {
-    if (db->n == db->cap) {
-        size_t cap = db->cap ? 2 * db->cap : 64;
-        amscr_descriptor **nd = realloc(db->d, cap * sizeof *nd);
-        if (!nd)
-            return amscr__fail(AMSCR_E_NOMEM, "db: out of memory");
-        db->d = nd;
-        int32_t *nl = realloc(db->labels, cap * sizeof *nl);
-        if (!nl)
-            return amscr__fail(AMSCR_E_NOMEM, "db: out of memory");
-        db->labels = nl;
-        db->cap = cap;
-    }
+    amscr_status st = amscr__db_reserve(db, 1);
+    if (st != AMSCR_OK)
+        return st;
     db->d[db->n] = d;
     db->labels[db->n] = label;
     if (out_index)

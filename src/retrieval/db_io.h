@@ -75,6 +75,8 @@ uint64_t amscr__db_checksum(uint32_t version, const unsigned char *p, size_t n);
 
 /* Appends db.c's row (db_push) to a collection. */
 amscr_status amscr__db_push(amscr_db *db, amscr_descriptor *d, int32_t label, size_t *out_index);
+/* Room for `extra` more shapes, so that as many pushes cannot fail. */
+amscr_status amscr__db_reserve(amscr_db *db, size_t extra);
 
 /* Shape bytes [at, at + per) of a file with params prm decoded into *out (caller frees);
  * *label when label is not NULL. AMSCR_E_FORMAT when truncated, not finite or degenerate. */

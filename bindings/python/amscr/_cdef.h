@@ -2,9 +2,9 @@
 /* Regenerate with: python3 scripts/gen_cdef.py -o bindings/python/amscr/_cdef.h */
 
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 9
+#define AMSCR_VERSION_MINOR 10
 #define AMSCR_VERSION_PATCH 0
-#define AMSCR_VERSION_NUMBER 900
+#define AMSCR_VERSION_NUMBER 1000
 #define AMSCR_MAX_IMAGE_SIDE 32768
 #define AMSCR_MAX_IMAGE_PIXELS 268435456
 #define AMSCR_MAX_POINTS 16777216
@@ -237,6 +237,7 @@ amscr_status amscr_distance(const amscr_params *p, const amscr_descriptor *src, 
 amscr_status amscr_db_new(const amscr_params *p, amscr_db **out);
 void amscr_db_free(amscr_db *db);
 amscr_status amscr_db_add_contour(amscr_db *db, const amscr_contour *c, int32_t label, size_t *out_index);
+amscr_status amscr_db_add_contours(amscr_db *db, const amscr_contour *const *contours, const int32_t *labels, size_t n, amscr_progress_fn progress, void *user, size_t *out_failed);
 amscr_status amscr_db_add_descriptor(amscr_db *db, const amscr_descriptor *d, int32_t label, size_t *out_index);
 size_t amscr_db_size(const amscr_db *db);
 int32_t amscr_db_label(const amscr_db *db, size_t i);

@@ -113,23 +113,42 @@ class Collection:
             return int(idx[0])
 
     def extend(self, shapes: Iterable[PointsLike], labels: Optional[Iterable[Any]] = None, *,
-               order: str = 'xy') -> List[int]:
-        """Adds many shapes, as :meth:`add`.
+               order: str = 'xy', progress: ProgressArg = False) -> List[int]:
+        """Adds many shapes, as :meth:`add`; point arrays are prepared together on the
+        collection's threads with the GIL released (C ``amscr_db_add_contours``).
 
         Args:
             shapes: point arrays or :class:`Shape` s.
             labels: one label per shape (None: all 0).
             order: 'xy' (default) or 'rc', the order of every shape's points.
+            progress: True for a progress bar on stderr, or a callable (done, total) -> bool
+                (True cancels); point arrays only.
         Returns:
             the indices of the new shapes.
         Raises:
             InvalidArgumentError: as many labels as shapes are needed; as :meth:`add`.
+            DegenerateError: a shape cannot be prepared (the message names the first such
+                shape by its position in ``shapes``). Point arrays are added all or nothing.
         """
         shapes = list(shapes)
         labels = [0] * len(shapes) if labels is None else list(labels)
         if len(labels) != len(shapes):
             raise bad('extend: %d shapes but %d labels' % (len(shapes), len(labels)))
-        return [self.add(s, lab, order=order) for s, lab in zip(shapes, labels)]
+        if not shapes or any(isinstance(s, Shape) for s in shapes):
+            return [self.add(s, lab, order=order) for s, lab in zip(shapes, labels)]
+        contours = [contour_new(as_points(s, 'shapes[%d]' % i, order)) for i, s in enumerate(shapes)]
+        with self._lock.write():
+            kept = (None if self._label_names is None else list(self._label_names), dict(self._label_codes),
+                    self._int_labels)
+            try:
+                codes = ffi.new('int32_t[]', [self._label_code(lab) for lab in labels])
+                first = len(self)
+                progress_call(lib.amscr_db_add_contours, (self._db, ffi.new('amscr_contour *[]', contours), codes,
+                                                          len(contours)), (ffi.NULL,), progress)
+            except BaseException:
+                self._label_names, self._label_codes, self._int_labels = kept
+                raise
+            return list(range(first, first + len(contours)))
 
     # -- reading ----------------------------------------------------------------------
     def __len__(self) -> int:

@@ -274,6 +274,31 @@ def test_collection_string_labels(shapes):
     assert amscr.bullseye(D, db.labels) == 1.0
 
 
+def test_extend_on_threads_is_add_one_by_one_and_all_or_nothing(shapes):
+    """extend prepares point arrays together on the collection's threads: the collection equals
+    one made by add, for any thread count; a degenerate shape adds nothing, names its position
+    and registers none of the batch's new label names."""
+    pts, labels = shapes
+    names = list(np.array(['bird', 'fish', 'leaf'])[labels])
+    one = amscr.Collection(amscr.Params.retrieval(threads=1))
+    for p, n in zip(pts, names):
+        one.add(p, n)
+    for threads in (1, 3):
+        many = amscr.Collection(amscr.Params.retrieval(threads=threads))
+        seen = []
+        assert many.extend(pts, names, progress=lambda done, total: seen.append((done, total))) == list(range(12))
+        assert seen and seen[-1] == (12, 12)
+        assert list(many.labels) == names
+        np.testing.assert_array_equal(many.retrieval_matrix(), one.retrieval_matrix())
+        line = np.column_stack([np.arange(20.0), 2.0 * np.arange(20.0)])
+        batch = [pts[0], pts[1], pts[2], line, pts[3], line]
+        with pytest.raises(amscr.DegenerateError, match='contour 3'):
+            many.extend(batch, ['new', 'bird', 'bird', 'bird', 'bird', 'other'])
+        assert len(many) == 12 and list(many.labels) == names
+        assert many.extend([pts[0]], ['new']) == [12] and many.labels[12] == 'new'
+        assert int(many.label_codes[12]) == 3  # 'new' got the next code: the failed batch left none
+
+
 def test_collection_add_shape_and_mismatch(shapes):
     pts, _ = shapes
     db = amscr.Collection(points=64)
