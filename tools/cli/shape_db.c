@@ -4,8 +4,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 
-#include "image.h"
-
 int retrieval_is_plain(const amscr_params *p)
 {
     return amscr_params_get_channel_weight(p) <= 0.0 && amscr_params_get_rerank_k(p) == 0;

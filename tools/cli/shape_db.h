@@ -7,8 +7,9 @@
 #include "cli.h"
 #include "collection.h"
 
-/* Loads every shape of collection c into a new db (params p); on failure prints the error
- * naming the file and returns -1. */
+/* Loads every shape of collection c into a new db (params p), decoding, tracing and preparing
+ * on the params' threads (load_db.c; the db is the one a loop over the shapes builds); on
+ * failure prints the error naming the first bad file in order and returns -1. */
 int load_db(const amscr_params *p, const collection *c, int threshold, amscr_db **out);
 /* 1 when the params ask for the AMSCR distance alone (channel weight 0, no re-ranking): the
  * plain, directional matrix of 0.1 (amscr_db_distance_matrix), bit for bit. */
