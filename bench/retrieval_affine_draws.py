@@ -54,7 +54,7 @@ def warped(img, A):
     return cv2.warpAffine(small, M, size, flags=cv2.INTER_LINEAR)
 
 
-def build(by, r, mode, seed=1):
+def build(by, r, mode, seed=1, join=False):
     rng = np.random.default_rng(seed * 1000 + r)
     shapes, labels = [], []
     for k, c in enumerate(sorted(by)):
@@ -67,7 +67,7 @@ def build(by, r, mode, seed=1):
                 rms = np.sqrt(((q - q.mean(0)) ** 2).sum(1).mean())
                 shapes.append(q + 0.005 * rms * rng.standard_normal(q.shape))
             else:
-                shapes.append(amscr.contour_from_mask(warped(img, A) > 127))
+                shapes.append(amscr.contour_from_mask(warped(img, A) > 127, join=join))
             labels.append(k)
     return shapes, np.array(labels)
 
@@ -111,6 +111,7 @@ def main(argv=None):
     ap.add_argument('--draws', type=int, default=20)
     ap.add_argument('--options', nargs='*', default=[])
     ap.add_argument('--collections', action='store_true', help="score the collections instead of the views")
+    ap.add_argument('--join', action='store_true', help="images traced with broken pieces joined (as the tool)")
     a = ap.parse_args(argv)
     by = classes(a.data)
     variants = [{}] + [json.loads(o) for o in a.options]
@@ -122,7 +123,7 @@ def main(argv=None):
     print('| draw | ' + ' | '.join(names) + ' |\n' + '|---' * (len(names) + 1) + '|')
     rows = []
     for r in range(a.draws):
-        shapes, labels = build(by, r, a.mode)
+        shapes, labels = build(by, r, a.mode, join=a.join)
         rows.append([bullseye(shapes, labels, v) for v in variants])
         print('| %d | ' % r + ' | '.join('%.2f' % v for v in rows[-1]) + ' |', flush=True)
     m = np.array(rows)

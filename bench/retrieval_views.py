@@ -17,6 +17,7 @@ inner-distance share 0) and at each --shares value (the library's retrieval_matr
 Usage: .venv/bin/python bench/retrieval_views.py [--data ../shared/datasets] [--seeds 1,2,3]
        [--fold A|B] [--objects 4] [--views 10] [--shares 0.05]          # ~1.5 min a seed
        [--classes 8] [--k 16,41]    # ETH-80's shape: 8 classes drawn per seed, x 10 objects x 41 views
+       [--join]                     # views traced as the tool's retrieval commands trace them
 """
 import argparse
 import os
@@ -83,14 +84,14 @@ def draw(by, n, seed):
     return {names[i]: by[names[i]] for i in sorted(pick)}
 
 
-def build(by, objects, views, seed):
+def build(by, objects, views, seed, join=False):
     rng = np.random.default_rng(seed)
     shapes, cls, grp = [], [], []
     for ci, c in enumerate(sorted(by)):
         for oi, path in enumerate(by[c][:objects]):
             img = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
             for _ in range(views):
-                shapes.append(amscr.contour_from_mask(view(img, rng), threshold=127))
+                shapes.append(amscr.contour_from_mask(view(img, rng), threshold=127, join=join))
                 cls.append(ci)
                 grp.append(ci * 1000 + oi)
     return shapes, np.array(cls), np.array(grp)
@@ -112,6 +113,7 @@ def main(argv=None):
     ap.add_argument('--shares', default='0.05')
     ap.add_argument('--classes', type=int, default=0, help="that many classes drawn with each seed (0: all)")
     ap.add_argument('--k', default='', help="re-ranking k values for more columns (the preset otherwise)")
+    ap.add_argument('--join', action='store_true', help="trace as the tool's retrieval commands: broken pieces joined")
     a = ap.parse_args(argv)
     shares = [float(x) for x in a.shares.split(',')]
     ks = [int(x) for x in a.k.split(',') if x]
@@ -125,7 +127,7 @@ def main(argv=None):
     for seed in seeds:
         t = time.time()
         by = draw(classes(a.data, a.fold), a.classes, seed)
-        shapes, cls, grp = build(by, a.objects, a.views, seed)
+        shapes, cls, grp = build(by, a.objects, a.views, seed, a.join)
         row = [accuracy(shapes, cls, grp, rerank_k=0), accuracy(shapes, cls, grp, rerank_inner_share=0.0)]
         row += [accuracy(shapes, cls, grp, rerank_inner_share=s) for s in shares]
         row += [accuracy(shapes, cls, grp, rerank_k=k) for k in ks]

@@ -7,7 +7,7 @@ import struct
 
 import pytest
 
-from imgutil import affine, image_bytes, img_ext, rasterize, run, smooth_shape, write_points
+from imgutil import affine, blank, fill_rect, image_bytes, img_ext, rasterize, run, smooth_shape, write_points
 
 MAPS = [((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
         ((0.9, 0.4, 10.0), (-0.3, 1.1, -5.0)),
@@ -286,3 +286,30 @@ def test_shapes_prepared_on_threads(manifest, tmp_path):
             seen.add(lines[0])
         assert len(seen) == 1, seen
         assert ("cannot use this shape" in seen.pop()) == (first == "line.txt")
+
+
+def test_retrieval_joins_broken_pieces(tmp_path):
+    """Retrieval commands trace images as `register` does: a large piece near the largest
+    component (a limb broken off by a 2-pixel gap) is part of the shape. The broken shape then
+    ranks nearer the whole one than the body alone, which it would equal if the piece were
+    dropped (as `contour`, which traces the largest component only, shows)."""
+    def draw(*rects):
+        img = blank(110, 80)
+        for x0, y0, x1, y1 in rects:
+            fill_rect(img, x0, y0, x1, y1, 255)
+        return img
+    ext = img_ext()
+    d = tmp_path / "set"
+    d.mkdir()
+    shapes = {"a_whole": draw((10, 20, 70, 50), (70, 28, 95, 42)),
+              "b_broken": draw((10, 20, 70, 50), (72, 28, 95, 42)),
+              "c_body": draw((10, 20, 70, 50))}
+    for name, img in shapes.items():
+        (d / (name + ext)).write_bytes(image_bytes(img, name + ext))
+    r = run("matrix", d, "-o", "-", "--no-rerank")
+    assert r.returncode == 0, r.stderr
+    rows = [[float(v) for v in line.split("\t")] for line in r.stdout.splitlines() if not line.startswith("#")]
+    broken = rows[1]
+    assert broken[0] < broken[2], broken  # nearer the whole shape than the body alone
+    body = run("contour", d / ("b_broken" + ext)).stdout
+    assert body == run("contour", d / ("c_body" + ext)).stdout  # contour keeps the largest piece

@@ -315,6 +315,7 @@ int cmd_eval(opts *o)
     s.want_groups = pr == PROTO_GROUPS;
     s.be = s.nn = NAN;
     s.t0 = now_seconds();
+    retrieval_tracing();
     amscr_params *p = NULL;
     collection c;
     amscr_db *db = NULL;

@@ -49,6 +49,7 @@ int cmd_index(opts *o)
     amscr_index *x = NULL;
     collection c;
     memset(&c, 0, sizeof c);
+    retrieval_tracing();
     int r = TOOL_EXIT_FAIL;
     if (o->add && index_open(o->out, 0, &x) != 0)
         return TOOL_EXIT_FAIL;

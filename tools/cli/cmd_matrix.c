@@ -23,6 +23,7 @@ int cmd_matrix(opts *o)
     amscr_params *p = NULL;
     collection c;
     amscr_db *db = NULL;
+    retrieval_tracing();
     double *d = NULL;
     int ret = TOOL_EXIT_FAIL;
     memset(&c, 0, sizeof c);

@@ -261,6 +261,7 @@ int cmd_search(opts *o)
     memset(&c, 0, sizeof c);
     double t0 = now_seconds();
 
+    retrieval_tracing();
     int r = open_target(o, &x, &p, &c, &db);
     if (r != 0) {
         ret = r;

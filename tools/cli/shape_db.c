@@ -4,6 +4,10 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+#include "image.h"
+
+void retrieval_tracing(void) { image_set_trace_flags(image_trace_flags() | AMSCR_TRACE_JOIN); }
+
 int retrieval_is_plain(const amscr_params *p)
 {
     return amscr_params_get_channel_weight(p) <= 0.0 && amscr_params_get_rerank_k(p) == 0;

@@ -11,6 +11,11 @@
  * on the params' threads (load_db.c; the db is the one a loop over the shapes builds); on
  * failure prints the error naming the first bad file in order and returns -1. */
 int load_db(const amscr_params *p, const collection *c, int threshold, amscr_db **out);
+/* Images of a collection and of a query are traced as `amscr register` traces them: the other
+ * large pieces near the largest component (a thin part low resolution or damage broke off) are
+ * joined to its outline (AMSCR_TRACE_JOIN; sub-pixel tracing only). Called by search, matrix,
+ * eval and index before any image is read. */
+void retrieval_tracing(void);
 /* 1 when the params ask for the AMSCR distance alone (channel weight 0, no re-ranking): the
  * plain, directional matrix of 0.1 (amscr_db_distance_matrix), bit for bit. */
 int retrieval_is_plain(const amscr_params *p);
