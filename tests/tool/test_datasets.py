@@ -102,3 +102,48 @@ def test_kimia99_eval_json_fields():
     assert j["n"] == 99 and j["classes"] == 9
     assert len(j["topk"]) == 10 and all(0 <= c <= 99 for c in j["topk"])
     assert 0 <= j["bullseye"] <= 1 and 0 <= j["nn_accuracy"] <= 1
+
+
+# The README's ablation table ("What each part of the retrieval default adds"), the rows the tool
+# can give: mpeg7-dev's bull's eye with each part taken away, and the default and --fast on its
+# two class folds (folds.tsv), each fold its own collection. Asserted to 0.1 point (one query of
+# mpeg7-dev's 700 moves the bull's eye by a few hundredths).
+ABLATION = [
+    ("mpeg7-dev", ["--no-rerank"], 88.84),
+    ("mpeg7-dev", ["--inner-share", "0"], 95.63),
+    ("mpeg7-dev", ["--inner-closing", "0"], 96.41),
+    ("mpeg7-dev", ["--fast"], 97.39),
+    ("A", [], 97.18),
+    ("A", ["--fast"], 96.85),
+    ("B", [], 100.00),
+]
+
+
+def fold_manifest(fold, tmp_path):
+    """mpeg7-dev's rows of one fold of its folds.tsv, as a manifest of absolute paths."""
+    d = os.path.join(DATA or "", "mpeg7-dev")
+    if not DATA or not os.path.exists(os.path.join(d, "folds.tsv")):
+        pytest.skip("mpeg7-dev: datasets not found (set AMSCR_DATASETS)")
+    with open(os.path.join(d, "folds.tsv")) as f:
+        folds = dict(line.rstrip("\n").split("\t") for line in list(f)[1:])
+    with open(os.path.join(d, "manifest.tsv")) as f:
+        rows = [line.rstrip("\n").split("\t") for line in list(f)[1:]]
+    path = tmp_path / ("fold%s.tsv" % fold)
+    path.write_text("file\tclass\n" + "".join("%s\t%s\n" % (os.path.join(d, p), c)
+                                             for p, c in rows if folds[c] == fold))
+    assert len(path.read_text().splitlines()) > 300
+    return str(path)
+
+
+@pytest.mark.parametrize("where,flags,published", ABLATION)
+def test_ablation_rows(where, flags, published, tmp_path):
+    if where == "mpeg7-dev":
+        mf = os.path.join(DATA or "", where, "manifest.tsv")
+        if not DATA or not os.path.exists(mf):
+            pytest.skip("mpeg7-dev: datasets not found (set AMSCR_DATASETS)")
+    else:
+        mf = fold_manifest(where, tmp_path)
+    r = run("eval", mf, "--json", *flags, timeout=900)
+    assert r.returncode == 0, r.stderr
+    got = 100 * json.loads(r.stdout)["bullseye"]
+    assert abs(got - published) <= 0.1, "%s %s: bull's eye %.2f %%, published %.2f %%" % (where, flags, got, published)
