@@ -5,7 +5,8 @@
  * affine (whitened) frame (its own band, 0.08) — plus the inner distance of the re-ranking's
  * second graph (inside each silhouette closed at 0.08 sqrt(area), the default, and on the
  * silhouette as traced, 0.8's), and every row is composed from them exactly as amscr_db_retrieval_matrix
- * composes them (channel frames mixed 0.8 / 0.2, fusion = each matrix over its median
+ * composes them (channel frames mixed 0.8 / 0.2, a pair the affine frame finds twice as near as
+ * the mix taken at twice its affine distance in the default's row, fusion = each matrix over its median
  * off-diagonal value, re-ranking k 8, 10 iterations, on one graph or with the inner distance's
  * graph at share 0.05). A row's time is the wall time of the base
  * matrices it needs plus its fusion and re-ranking (decode, trace and preparation are listed
@@ -19,6 +20,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "channel.h"
 #include "inner.h"
 #include "internal.h"
 #include "mcd_set.h"
@@ -33,6 +35,7 @@ typedef struct {
     double weight;      /* channel weight of the fusion with AMSCR (used when both are in) */
     double share;       /* affine share of the channel (when both frames are in) */
     int rerank;         /* re-ranking k 8, 10 iterations (with an inner distance: its graph at 0.05) */
+    double view;        /* the affine-view factor f (both frames): min(mix, f d_affine); 0: the mix */
 } row_t;
 
 static const row_t ROWS[] = {
@@ -48,8 +51,10 @@ static const row_t ROWS[] = {
     {"AMSCR + channel fused (w 0.5) + re-ranking", {1, 1, 1, 0}, 0.5, 0.2, 1},
     {"channel, both frames + re-ranking on one graph (0.6's default)", {0, 1, 1, 0}, 1, 0.2, 1},
     {"channel, both frames + two graphs, the silhouette as traced (0.8's default)", {0, 1, 1, 0, 1}, 1, 0.2, 1},
+    {"channel, both frames + re-ranking on two graphs (0.10's default)", {0, 1, 1, 1}, 1, 0.2, 1},
     {"channel, similarity frame + re-ranking on two graphs (--fast)", {0, 1, 0, 1}, 1, 0, 1},
-    {"**default: channel, both frames + re-ranking on two graphs**", {0, 1, 1, 1}, 1, 0.2, 1},
+    {"**default: channel, both frames, affine views by the affine frame + two graphs**", {0, 1, 1, 1}, 1, 0.2, 1,
+     2.0},
 };
 enum { NROWS = sizeof ROWS / sizeof ROWS[0] };
 
@@ -148,10 +153,14 @@ static void compose(const set_run *r, const row_t *w, double *out)
         free(H);
         return;
     }
+    amscr_params vp; /* the frames' rule of the row: its share and affine-view factor */
+    memset(&vp, 0, sizeof vp);
+    vp.channel_affine_view = w->view;
+    const double share[2] = {1.0 - w->share, w->share};
     for (size_t i = 0; ch && i < nn; i++)
         H[i] = !w->use[M_AFF] ? r->base[M_SIM][i]
              : !w->use[M_SIM] ? r->base[M_AFF][i]
-                              : (1.0 - w->share) * r->base[M_SIM][i] + w->share * r->base[M_AFF][i];
+                              : amscr__channel_combine(&vp, 2, share, r->base[M_SIM][i], r->base[M_AFF][i]);
     if (!w->use[M_AMSCR]) {
         memcpy(out, H, nn * sizeof *out);
     } else {

@@ -18,8 +18,10 @@ Usage: .venv/bin/python bench/retrieval_views.py [--data ../shared/datasets] [--
        [--fold A|B] [--objects 4] [--views 10] [--shares 0.05]          # ~1.5 min a seed
        [--classes 8] [--k 16,41]    # ETH-80's shape: 8 classes drawn per seed, x 10 objects x 41 views
        [--join]                     # views traced as the tool's retrieval commands trace them
+       [--options '{"channel_affine_view": 0}' ...]   # a column for each set of Params options
 """
 import argparse
+import json
 import os
 import sys
 import time
@@ -114,10 +116,13 @@ def main(argv=None):
     ap.add_argument('--classes', type=int, default=0, help="that many classes drawn with each seed (0: all)")
     ap.add_argument('--k', default='', help="re-ranking k values for more columns (the preset otherwise)")
     ap.add_argument('--join', action='store_true', help="trace as the tool's retrieval commands: broken pieces joined")
+    ap.add_argument('--options', nargs='*', default=[], help='JSON objects of Params options, a column each')
     a = ap.parse_args(argv)
     shares = [float(x) for x in a.shares.split(',')]
     ks = [int(x) for x in a.k.split(',') if x]
+    opts = [json.loads(o) for o in a.options]
     cols = ['before re-ranking', 'share 0'] + ['share %g' % s for s in shares] + ['k %d' % k for k in ks]
+    cols += [json.dumps(o) for o in opts]
     print('objects in views, 1-NN leave one object out (%s classes, %d objects x %d views, amscr %s)'
           % (a.classes or len(classes(a.data, a.fold)), a.objects, a.views, amscr.__version__))
     print('| seed | ' + ' | '.join(cols) + ' | s |')
@@ -131,6 +136,7 @@ def main(argv=None):
         row = [accuracy(shapes, cls, grp, rerank_k=0), accuracy(shapes, cls, grp, rerank_inner_share=0.0)]
         row += [accuracy(shapes, cls, grp, rerank_inner_share=s) for s in shares]
         row += [accuracy(shapes, cls, grp, rerank_k=k) for k in ks]
+        row += [accuracy(shapes, cls, grp, **o) for o in opts]
         sums += row
         print('| %d | ' % seed + ' | '.join('%.2f' % v for v in row) + ' | %.0f |' % (time.time() - t), flush=True)
     print('| mean | ' + ' | '.join('%.2f' % v for v in sums / len(seeds)) + ' | |')

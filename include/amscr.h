@@ -96,7 +96,7 @@ extern "C" {
 
 /** Compile-time version; amscr_version_number() gives the runtime one. */
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 10
+#define AMSCR_VERSION_MINOR 11
 #define AMSCR_VERSION_PATCH 0
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
@@ -1726,6 +1726,33 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_inner_closing(amscr_para
  * @since 0.9
  */
 AMSCR_API double amscr_params_get_inner_closing(const amscr_params *p);
+
+/**
+ * @brief Sets the factor f by which the whitened (affine) frame alone must find a pair nearer
+ *        than the two frames' mix for the pair to be ranked by it: with the similarity frame
+ *        and an affine share s strictly between 0 and 1 (amscr_params_set_channel_affine_share),
+ *        a pair's channel distance is m = (1 - s) d_similarity + s d_affine, and with f > 0 it is
+ *        min(m, f d_affine). An affine view of a shape (a photograph at an angle, a sheared or
+ *        stretched copy) is far nearer in the whitened frame than in the similarity frame and
+ *        is then ranked by the whitened frame; any other pair keeps the mix. 0 (the default)
+ *        keeps the mix for every pair, the rule before 0.11; 2 in the retrieval preset. With
+ *        one frame (share 0 or 1, or the affine frame) it changes nothing.
+ *        Collection and index files keep the value; files written before 0.11 load with 0.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (not 0 and outside [1, 100], NaN).
+ * Ownership: none.
+ * Thread-safety: exclusive on p.
+ * @since 0.11
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_affine_view(amscr_params *p, double factor);
+
+/**
+ * @brief The channel's affine-view factor (amscr_params_set_channel_affine_view).
+ * @return the value; 0 for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.11
+ */
+AMSCR_API double amscr_params_get_channel_affine_view(const amscr_params *p);
 
 /* ============================================================================
  * Workspace

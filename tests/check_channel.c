@@ -88,6 +88,62 @@ START_TEST(test_invariance)
 }
 END_TEST
 
+/* The frames' rule: with the affine-view factor f a pair's channel distance is min(m, f d_a),
+ * m the shares' mix, d_a the whitened frame's distance (read with the affine share 1, the
+ * bands made equal so that the frame alone is computed as in the mix); with f = 0 it is m. A
+ * sheared and stretched copy of a shape is ranked by the whitened frame, a bent copy and
+ * another shape keep the mix. */
+START_TEST(test_affine_view_rule)
+{
+    amscr_params *p = NULL, *ps = NULL, *pa = NULL;
+    ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
+    ck_assert(amscr_params_get_channel_affine_view(p) == 2.0);
+    ck_assert_int_eq(amscr_params_set_channel_affine_band(p, amscr_params_get_channel_band(p)), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new_retrieval(&ps), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new_retrieval(&pa), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_channel_affine_share(ps, 0.0), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_channel_affine_share(pa, 1.0), AMSCR_OK);
+    double sh[6] = {1.6, 0.9, 0.0, -0.2, 0.55, 1.0}; /* stretched x1.6 / x0.55, sheared */
+    amscr_descriptor *f = prep(p, radial(0.3, 5, 0.1, 3, 0.0, ident));
+    amscr_descriptor *g[3] = {prep(p, radial(0.3, 5, 0.1, 3, 0.02, sh)), prep(p, radial(0.3, 5, 0.1, 3, 0.25, ident)),
+                              prep(p, radial(0.35, 3, 0.15, 2, 0.0, ident))};
+    double s = amscr_params_get_channel_affine_share(p);
+    for (int i = 0; i < 3; i++) {
+        double ds = chan(ps, f, g[i]), da = chan(pa, f, g[i]), m = (1.0 - s) * ds + s * da;
+        double want = 2.0 * da < m ? 2.0 * da : m;
+        ck_assert_msg(chan(p, f, g[i]) == want, "pair %d: %g, want min(%g, 2 x %g)", i, chan(p, f, g[i]), m, da);
+        if (i == 0)
+            ck_assert_msg(2.0 * da < m, "the affine copy: whitened %g, mix %g", da, m);
+        else
+            ck_assert_msg(2.0 * da >= m, "pair %d keeps the mix: whitened %g, mix %g", i, da, m);
+        ck_assert_int_eq(amscr_params_set_channel_affine_view(p, 0.0), AMSCR_OK);
+        ck_assert(chan(p, f, g[i]) == m);
+        ck_assert_int_eq(amscr_params_set_channel_affine_view(p, 2.0), AMSCR_OK);
+        /* one frame: the factor changes nothing */
+        ck_assert(chan(ps, f, g[i]) == ds);
+    }
+    ck_assert_int_eq(amscr_params_set_channel_affine_view(p, 0.5), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_channel_affine_view(p, -1.0), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_channel_affine_view(p, 101.0), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_channel_affine_view(p, NAN), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_params_set_channel_affine_view(NULL, 2.0), AMSCR_E_INVALID_ARG);
+    ck_assert(amscr_params_get_channel_affine_view(p) == 2.0);
+    ck_assert(amscr_params_get_channel_affine_view(NULL) == 0.0);
+    amscr_params *base = NULL;
+    ck_assert_int_eq(amscr_params_new(&base), AMSCR_OK);
+    ck_assert(amscr_params_get_channel_affine_view(base) == 0.0);
+    ck_assert_int_eq(amscr_params_set_channel_affine_view(base, 1.0), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_channel_affine_view(base, 100.0), AMSCR_OK);
+    amscr_params_free(base);
+    amscr_descriptor_free(f);
+    for (int i = 0; i < 3; i++)
+        amscr_descriptor_free(g[i]);
+    amscr_params_free(p);
+    amscr_params_free(ps);
+    amscr_params_free(pa);
+}
+END_TEST
+
 START_TEST(test_self_zero_and_articulation)
 {
     amscr_params *p = NULL;
@@ -305,6 +361,7 @@ Suite *amscr_suite_channel(void)
     Suite *s = suite_create("channel");
     TCase *tc = tcase_create("core");
     tcase_add_test(tc, test_invariance);
+    tcase_add_test(tc, test_affine_view_rule);
     tcase_add_test(tc, test_self_zero_and_articulation);
     tcase_add_test(tc, test_matrices);
     tcase_add_test(tc, test_four_lanes);

@@ -1304,7 +1304,7 @@ START_TEST(blob_layout_sanity)
     unsigned char *b = small_blob(&len);
     ck_assert(len > 100);
     ck_assert(memcmp(b, "AMSCRDB", 8) == 0);
-    ck_assert(b[8] == 10 && b[9] == 0 && b[10] == 0 && b[11] == 0); /* version 10, little-endian */
+    ck_assert(b[8] == 12 && b[9] == 0 && b[10] == 0 && b[11] == 0); /* version 12, little-endian */
     uint64_t h = 0;
     for (int i = 0; i < 8; i++)
         h |= (uint64_t)b[len - 8 + i] << (8 * i);
@@ -1317,8 +1317,8 @@ START_TEST(blob_layout_sanity)
 }
 END_TEST
 
-/* Format version 10 puts the retrieval settings (76 bytes; 68 in version 7, 60 in version 5, 52
- * in version 2) right after the params, which end 60 bytes after the scales; version 1 files (the same
+/* Format version 12 puts the retrieval settings (84 bytes; 76 in version 10, 68 in version 7, 60
+ * in version 5, 52 in version 2) right after the params, which end 60 bytes after the scales; version 1 files (the same
  * without that block) still load, with the retrieval settings at their defaults. */
 #define BLOB_RETRIEVAL_OFFSET (BLOB_SCALE_OFFSET + 8 + 60)
 
@@ -1349,7 +1349,7 @@ START_TEST(format_v1_still_loads)
 {
     size_t len = 0;
     unsigned char *b = small_blob(&len);
-    as_older_version(b, &len, BLOB_RETRIEVAL_OFFSET, 76, 1);
+    as_older_version(b, &len, BLOB_RETRIEVAL_OFFSET, 84, 1);
     amscr_db *db = NULL;
     ck_assert_int_eq(load_exact(b, len, &db), AMSCR_OK);
     ck_assert_uint_eq(amscr_db_size(db), 2);
@@ -1370,8 +1370,9 @@ START_TEST(format_v2_one_band)
     ck_assert(amscr_params_get_channel_affine_band(p) != 0.125);
     size_t len = 0, nscales = 0;
     unsigned char *b = saved_empty(p, &len, &nscales);
-    /* the affine band, the inner share and the closing, after the 52 bytes of version 2 */
-    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 52, 24, 2);
+    /* the affine band, the inner share, the closing and the affine-view factor, after the 52
+     * bytes of version 2 */
+    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 52, 32, 2);
     amscr_db *back = NULL;
     ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_OK);
     ck_assert(amscr_params_get_channel_band(amscr_db_params(back)) == 0.125);
@@ -1379,7 +1380,7 @@ START_TEST(format_v2_one_band)
     ck_assert(amscr_params_get_rerank_inner_share(amscr_db_params(back)) == 0.0);
     amscr_db_free(back);
     back = NULL;
-    b[8] = 10; /* read as version 10, the block runs 24 bytes into the counts: refused or inconsistent */
+    b[8] = 12; /* read as version 12, the block runs 32 bytes into the counts: refused or inconsistent */
     fix_checksum(b, len);
     ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_E_FORMAT);
     ck_assert_ptr_null(back);
@@ -1398,13 +1399,52 @@ START_TEST(format_v5_one_graph)
     ck_assert_int_eq(amscr_params_set_channel_affine_band(p, 0.0625), AMSCR_OK);
     size_t len = 0, nscales = 0;
     unsigned char *b = saved_empty(p, &len, &nscales);
-    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 60, 16, 5);
+    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 60, 24, 5);
     amscr_db *back = NULL;
     ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_OK);
     ck_assert(amscr_params_get_rerank_inner_share(amscr_db_params(back)) == 0.0);
     ck_assert(amscr_params_get_inner_closing(amscr_db_params(back)) == 0.0);
     ck_assert(amscr_params_get_channel_affine_band(amscr_db_params(back)) == 0.0625);
+    ck_assert(amscr_params_get_channel_affine_view(amscr_db_params(back)) == 0.0);
     amscr_db_free(back);
+    amscr_free(b);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* A version 10 file (0.9-0.10: a 76-byte block, the frames' mix for every pair) loads with the
+ * affine-view factor 0, as it was computed, its closing kept; the factor round-trips in 12. */
+START_TEST(format_v10_mix_for_every_pair)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
+    ck_assert(amscr_params_get_channel_affine_view(p) == 2.0);
+    ck_assert_int_eq(amscr_params_set_channel_affine_view(p, 3.5), AMSCR_OK);
+    size_t len = 0, nscales = 0;
+    unsigned char *b = saved_empty(p, &len, &nscales);
+    amscr_db *back = NULL;
+    ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_OK);
+    ck_assert(amscr_params_get_channel_affine_view(amscr_db_params(back)) == 3.5);
+    amscr_db_free(back);
+    back = NULL;
+    as_older_version(b, &len, BLOB_SCALE_OFFSET + 8 * nscales + 60 + 76, 8, 10);
+    ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_OK);
+    ck_assert(amscr_params_get_channel_affine_view(amscr_db_params(back)) == 0.0);
+    ck_assert(amscr_params_get_inner_closing(amscr_db_params(back)) == 0.04);
+    amscr_db_free(back);
+    back = NULL;
+    amscr_free(b);
+    /* a factor the setter refuses, written into a version 12 block, is a format error */
+    ck_assert_int_eq(amscr_params_set_channel_affine_view(p, 0.0), AMSCR_OK);
+    b = saved_empty(p, &len, &nscales);
+    double bad = 0.5;
+    uint64_t v;
+    memcpy(&v, &bad, 8);
+    for (size_t i = 0; i < 8; i++)
+        b[BLOB_SCALE_OFFSET + 8 * nscales + 60 + 76 + i] = (unsigned char)(v >> (8 * i));
+    fix_checksum(b, len);
+    ck_assert_int_eq(amscr_db_load_memory(b, len, &back), AMSCR_E_FORMAT);
+    ck_assert_ptr_null(back);
     amscr_free(b);
     amscr_params_free(p);
 }
@@ -1800,6 +1840,7 @@ Suite *amscr_suite_db(void)
     tcase_add_test(tc, retrieval_settings_roundtrip);
     tcase_add_test(tc, format_v2_one_band);
     tcase_add_test(tc, format_v5_one_graph);
+    tcase_add_test(tc, format_v10_mix_for_every_pair);
     tcase_add_test(tc, corrupt_truncated);
     tcase_add_test(tc, corrupt_flipped_bytes);
     tcase_add_test(tc, crafted_files_valid_checksum);

@@ -282,25 +282,27 @@ START_TEST(lazy_file_shapes)
 }
 END_TEST
 
-/* Index x's bytes b (len; version 11, its params' closing 0, so no shape keeps an outline) as
- * version 9 (0.8): the closing's 8 bytes of the retrieval block left out. *out_len set; *at: the
+/* Index x's bytes b (len; version 13, its params' closing 0, so no shape keeps an outline) as
+ * version 9 (0.8): the closing's and the affine-view factor's 16 bytes of the retrieval block
+ * left out. *out_len set; *at: the
  * offset of the index section's length. */
 static unsigned char *as_version9(const amscr_index *x, const unsigned char *b, size_t len, size_t *out_len,
                                   size_t *at)
 {
     ck_assert(amscr_params_get_inner_closing(amscr_db_params(amscr_index_db(x))) == 0.0);
+    ck_assert(amscr_params_get_channel_affine_view(amscr_db_params(amscr_index_db(x))) == 0.0);
     void *dbuf = NULL;
     size_t dlen = 0, ns = 0;
     ck_assert_int_eq(amscr_db_save_memory(amscr_index_db(x), &dbuf, &dlen), AMSCR_OK);
     amscr_free(dbuf);
     ck_assert_int_eq(amscr_params_get_scales(amscr_db_params(amscr_index_db(x)), NULL, &ns), AMSCR_OK);
     size_t cut = 32 + 8 * ns + 60 + 68; /* magic .. scales, the params, the version 7 block */
-    unsigned char *o = malloc(len - 8);
+    unsigned char *o = malloc(len - 16);
     memcpy(o, b, cut);
-    memcpy(o + cut, b + cut + 8, len - cut - 8);
+    memcpy(o + cut, b + cut + 16, len - cut - 16);
     o[8] = 9;
-    *out_len = len - 8;
-    *at = dlen - 8 - 8;
+    *out_len = len - 16;
+    *at = dlen - 8 - 16;
     uint64_t h = amscr__db_checksum(9, o, *out_len - 8);
     for (int i = 0; i < 8; i++)
         o[*out_len - 8 + (size_t)i] = (unsigned char)(h >> (8 * i));
@@ -311,10 +313,10 @@ static unsigned char *as_version9(const amscr_index *x, const unsigned char *b, 
  * retrieval block) from its version 9 bytes b (len; one graph): the groups flag (no groups),
  * the features, the inner graph's count, the whitened frame's band and the inner share
  * dropped. *out_len set. */
-static unsigned char *as_version3(const amscr_index *x, const unsigned char *b11, size_t len11, size_t *out_len)
+static unsigned char *as_version3(const amscr_index *x, const unsigned char *b13, size_t len13, size_t *out_len)
 {
     size_t len = 0, at = 0, n = amscr_index_size(x);
-    unsigned char *b = as_version9(x, b11, len11, &len, &at);
+    unsigned char *b = as_version9(x, b13, len13, &len, &at);
     size_t feat = 12 + n * (size_t)x->nf * 2 * 64 * AMSCR__HF_BINS + 4, keep = len - 8 - feat - 4;
     unsigned char *o = malloc(keep + 8);
     memcpy(o, b, keep);
@@ -346,6 +348,7 @@ START_TEST(stored_features)
     amscr_params *p = params_of(1.0, 8, 2);
     ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.0), AMSCR_OK); /* all a version 3 file holds */
     ck_assert_int_eq(amscr_params_set_inner_closing(p, 0.0), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_channel_affine_view(p, 0.0), AMSCR_OK); /* the mix: all before 0.11 */
     /* one band for both frames: all a version 3 file can hold (it loads with the two equal) */
     ck_assert_int_eq(amscr_params_set_channel_affine_band(p, amscr_params_get_channel_band(p)), AMSCR_OK);
     amscr_index *x = named_index(p, 0), *y = NULL;
@@ -353,7 +356,7 @@ START_TEST(stored_features)
     void *buf = NULL;
     size_t len = 0, l3 = 0;
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    ck_assert_int_eq(((unsigned char *)buf)[8], 11);
+    ck_assert_int_eq(((unsigned char *)buf)[8], 13);
     ck_assert_int_eq(x->nf, 2);
     unsigned char *v3 = as_version3(x, buf, len, &l3);
     for (unsigned lazy = 0; lazy < 2; lazy++) {
@@ -422,13 +425,13 @@ static void reseal(unsigned char *b, size_t len, uint32_t v)
         b[len - 8 + (size_t)i] = (unsigned char)(h >> (8 * i));
 }
 
-/* Index x's version 11 bytes b11 (len11) as version 8 (0.7): as version 9, then the inner graph's
+/* Index x's version 13 bytes b13 (len13) as version 8 (0.7): as version 9, then the inner graph's
  * section, `drop` bytes before the checksum, left out. *out_len set. */
-static unsigned char *as_version8(const amscr_index *x, const unsigned char *b11, size_t len11, size_t drop,
+static unsigned char *as_version8(const amscr_index *x, const unsigned char *b13, size_t len13, size_t drop,
                                   size_t *out_len)
 {
     size_t len = 0, at = 0;
-    unsigned char *b = as_version9(x, b11, len11, &len, &at);
+    unsigned char *b = as_version9(x, b13, len13, &len, &at);
     unsigned char *o = malloc(len - drop);
     memcpy(o, b, len - 8 - drop);
     free(b);
@@ -489,6 +492,7 @@ START_TEST(inner_section)
 {
     amscr_params *p = params_of(1.0, 8, 2);
     ck_assert_int_eq(amscr_params_set_inner_closing(p, 0.0), AMSCR_OK); /* no outlines: all version 8 holds */
+    ck_assert_int_eq(amscr_params_set_channel_affine_view(p, 0.0), AMSCR_OK); /* the mix: all it holds too */
     amscr_index *x = named_index(p, 0), *y = NULL;
     size_t k2 = x->k2, fk = AMSCR__INNER_F * AMSCR__INNER_K, len = 0;
     void *buf = NULL;
@@ -499,18 +503,18 @@ START_TEST(inner_section)
     memcpy(b, buf, len);
     ck_assert_uint_eq(b[at], k2);
     b[at] = 0; /* no inner graph, the params give one */
-    reseal(b, len, 11);
+    reseal(b, len, 13);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner graph") != NULL);
     memcpy(b, buf, len);
     b[at + 12] = 1; /* shape 0's inner list not starting with itself */
-    reseal(b, len, 11);
+    reseal(b, len, 13);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner neighbour") != NULL);
     memcpy(b, buf, len);
     double nan = NAN;
     memcpy(b + at + 12 + NSHAPES * k2 * 12 + 8 * 2 * fk, &nan, 8); /* shape 0's norm */
-    reseal(b, len, 11);
+    reseal(b, len, 13);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);
     ck_assert_ptr_null(y);

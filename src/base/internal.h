@@ -81,6 +81,7 @@ struct amscr_params {
     unsigned rerank_iterations;
     double rerank_inner_share;         /* share of the inner-distance graph in the re-ranking (0.7) */
     double inner_closing;              /* closing radius of the inner distance's silhouette / sqrt(area) (0.9) */
+    double channel_affine_view;        /* > 0: a pair's channel = min(the mix, this x d_affine) (0.11) */
 };
 
 /* The stages of amscr_register in pipeline order (register/stages.c holds the table). */
@@ -228,20 +229,23 @@ amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, un
 amscr_status amscr__rerank_normalized2(const double *dist, const double *dist2, double share, size_t n, size_t k,
                                        unsigned iterations, unsigned threads, double *out_dist);
 
-/* The retrieval settings in the saved collection (format versions 2-4, retrieval_io.c):
+/* The retrieval settings in the saved collection (format versions 2 and up, retrieval_io.c):
  * little-endian f64 channel_weight, u32 channel_invariance, f64 channel_affine_share,
  * f64 channel_band, f64 channel_skip, f64 channel_locality, u32 rerank_k,
  * u32 rerank_iterations; versions 5 and 6 (0.6) then f64 channel_affine_band (_V2); versions 7
  * and 8 (0.7) then f64 rerank_inner_share (_V3); versions 10 and 11 (0.9) then f64
- * inner_closing (_V4). A shorter block reads with channel_affine_band = channel_band (one band
- * for both frames before 0.6), rerank_inner_share = 0 (one graph before 0.7) and
- * inner_closing = 0 (the inner distance on the curve itself before 0.9).
+ * inner_closing (_V4); versions 12 and 13 (0.11) then f64 channel_affine_view (_V5). A shorter
+ * block reads with channel_affine_band = channel_band (one band for both frames before 0.6),
+ * rerank_inner_share = 0 (one graph before 0.7), inner_closing = 0 (the inner distance on the
+ * curve itself before 0.9) and channel_affine_view = 0 (the frames' mix for every pair before
+ * 0.11).
  * read validates through the setters' rules (AMSCR_E_FORMAT). */
 #define AMSCR__RETRIEVAL_BLOCK 52
 #define AMSCR__RETRIEVAL_BLOCK_V2 60
 #define AMSCR__RETRIEVAL_BLOCK_V3 68
 #define AMSCR__RETRIEVAL_BLOCK_V4 76
-/* size: AMSCR__RETRIEVAL_BLOCK, _V2, _V3 or _V4. */
+#define AMSCR__RETRIEVAL_BLOCK_V5 84
+/* size: AMSCR__RETRIEVAL_BLOCK, _V2, _V3, _V4 or _V5. */
 void amscr__retrieval_block_write(const amscr_params *p, unsigned char *out, size_t size);
 amscr_status amscr__retrieval_block_read(const unsigned char *in, size_t size, amscr_params *p);
 

@@ -24,6 +24,7 @@ static void retrieval_defaults(amscr_params *p)
     p->rerank_iterations = 10;
     p->rerank_inner_share = 0.0;
     p->inner_closing = 0.0;
+    p->channel_affine_view = 0.0;
 }
 
 void amscr__params_defaults(amscr_params *p)
@@ -94,6 +95,7 @@ void amscr__params_retrieval(amscr_params *p)
     p->rerank_k = 8;
     p->rerank_inner_share = 0.05;
     p->inner_closing = 0.04;
+    p->channel_affine_view = 2.0;
 }
 
 amscr_status amscr_params_new_retrieval(amscr_params **out)
@@ -181,6 +183,9 @@ SETTER(rerank_inner_share, double, rerank_inner_share, v >= 0.0 && v < 1.0, "%g 
 GETTER(rerank_inner_share, double, rerank_inner_share)
 SETTER(inner_closing, double, inner_closing, v >= 0.0 && v <= 1.0, "%g is not in [0, 1]")
 GETTER(inner_closing, double, inner_closing)
+SETTER(channel_affine_view, double, channel_affine_view, v == 0.0 || (v >= 1.0 && v <= 100.0),
+       "%g is not 0 or in [1, 100]")
+GETTER(channel_affine_view, double, channel_affine_view)
 
 /* ---- robust registration: partial matching, polish ---- */
 SETTER(partial, int, partial, v == 0 || v == 1, "%d is not 0 or 1")

@@ -79,8 +79,20 @@ void amscr__hf_cfg_from(const amscr_params *p, size_t n, int second, amscr__hf_c
 
 /* The frames of the channel and their shares (fuse.c): the primary frame, plus the whitened
  * frame with channel_affine_share when the primary one is the similarity frame. Returns the
- * count (1 or 2); the channel distance is the shares' sum of the frames' distances. */
+ * count (1 or 2); the channel distance combines the frames' distances (amscr__channel_combine). */
 int amscr__channel_frames(const amscr_params *p, amscr_invariance frames[2], double share[2]);
+/* A pair's channel distance from its distances d0, d1 in the frames of amscr__channel_frames
+ * (nf of them): the shares' sum m = s0 d0 + s1 d1; with channel_affine_view f > 0 and two
+ * frames, min(m, f d1): a pair the whitened frame alone finds f times nearer (an affine view)
+ * is ranked by it. */
+static inline double amscr__channel_combine(const amscr_params *p, int nf, const double share[2], double d0,
+                                            double d1)
+{
+    if (nf < 2)
+        return d0;
+    double m = share[0] * d0 + share[1] * d1, a = p->channel_affine_view * d1;
+    return p->channel_affine_view > 0.0 && a < m ? a : m;
+}
 /* The weights sa, sh of the fusion (fuse.c) for channel weight w and the medians. */
 void amscr__fuse_scales(double w, double med_a, double med_h, double *sa, double *sh);
 /* The base distance of one pair, as the fusion computes its cell: sym (the symmetrized AMSCR

@@ -55,7 +55,7 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
     amscr__w_u32(w, version);
     amscr__w_u32(w, 0);
     w_params(w, prm);
-    unsigned char rblock[AMSCR__RETRIEVAL_BLOCK_V4];
+    unsigned char rblock[AMSCR__RETRIEVAL_BLOCK_V5];
     size_t rsize = amscr__db_retrieval_block(version);
     amscr__retrieval_block_write(prm, rblock, rsize);
     amscr__w_bytes(w, rblock, rsize);
@@ -91,7 +91,7 @@ amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *ou
     if (st != AMSCR_OK)
         return st;
     amscr__wbuf w = {NULL, 0, 0, 0};
-    amscr__db_write(db, AMSCR__DB_VERSION_PLAIN_CLOSING, &w);
+    amscr__db_write(db, AMSCR__DB_VERSION_PLAIN_VIEW, &w);
     if (!w.oom)
         amscr__w_u64(&w, amscr__fnv1a(w.buf, w.len));
     if (w.oom) {

@@ -15,8 +15,9 @@
  * after the others; AMSCR__RETRIEVAL_BLOCK_V2); 7 and 8 (0.7): the same with the inner-distance
  * graph's share after those (AMSCR__RETRIEVAL_BLOCK_V3); 9 (0.8): 8 whose index section ends with
  * the inner distance's graph (its lists and the shapes' inner features); 10 and 11 (0.9): 7 and 9
- * with the inner distance's closing after the share (AMSCR__RETRIEVAL_BLOCK_V4). Every version
- * loads. */
+ * with the inner distance's closing after the share (AMSCR__RETRIEVAL_BLOCK_V4); 12 and 13
+ * (0.11): 10 and 11 with the channel's affine-view factor after the closing
+ * (AMSCR__RETRIEVAL_BLOCK_V5). Every version loads. */
 #define AMSCR__DB_VERSION_PLAIN 2u
 #define AMSCR__DB_VERSION_INDEX 3u
 #define AMSCR__DB_VERSION_FEATURES 4u
@@ -27,14 +28,17 @@
 #define AMSCR__DB_VERSION_INDEX_GRAPHS 9u
 #define AMSCR__DB_VERSION_PLAIN_CLOSING 10u
 #define AMSCR__DB_VERSION_INDEX_CLOSING 11u
-#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_CLOSING
+#define AMSCR__DB_VERSION_PLAIN_VIEW 12u
+#define AMSCR__DB_VERSION_INDEX_VIEW 13u
+#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_VIEW
 
 /* Whether a file of `version` is an index file (an index section after the shapes). */
 static inline int amscr__db_is_index(uint32_t version)
 {
     return version == AMSCR__DB_VERSION_INDEX || version == AMSCR__DB_VERSION_FEATURES ||
            version == AMSCR__DB_VERSION_INDEX_BANDS || version == AMSCR__DB_VERSION_INDEX_INNER ||
-           version == AMSCR__DB_VERSION_INDEX_GRAPHS || version == AMSCR__DB_VERSION_INDEX_CLOSING;
+           version == AMSCR__DB_VERSION_INDEX_GRAPHS || version == AMSCR__DB_VERSION_INDEX_CLOSING ||
+           version == AMSCR__DB_VERSION_INDEX_VIEW;
 }
 
 /* Whether an index file of `version` stores the shapes' channel features. */
@@ -42,21 +46,22 @@ static inline int amscr__db_has_features(uint32_t version)
 {
     return version == AMSCR__DB_VERSION_FEATURES || version == AMSCR__DB_VERSION_INDEX_BANDS ||
            version == AMSCR__DB_VERSION_INDEX_INNER || version == AMSCR__DB_VERSION_INDEX_GRAPHS ||
-           version == AMSCR__DB_VERSION_INDEX_CLOSING;
+           version == AMSCR__DB_VERSION_INDEX_CLOSING || version == AMSCR__DB_VERSION_INDEX_VIEW;
 }
 
 /* The bytes of the retrieval block in a file of `version` (0: none). */
 static inline size_t amscr__db_retrieval_block(uint32_t version)
 {
-    return version >= AMSCR__DB_VERSION_PLAIN_CLOSING ? AMSCR__RETRIEVAL_BLOCK_V4
+    return version >= AMSCR__DB_VERSION_PLAIN_VIEW      ? AMSCR__RETRIEVAL_BLOCK_V5
+           : version >= AMSCR__DB_VERSION_PLAIN_CLOSING ? AMSCR__RETRIEVAL_BLOCK_V4
            : version >= AMSCR__DB_VERSION_PLAIN_INNER ? AMSCR__RETRIEVAL_BLOCK_V3
            : version >= AMSCR__DB_VERSION_PLAIN_BANDS ? AMSCR__RETRIEVAL_BLOCK_V2
            : version >= AMSCR__DB_VERSION_PLAIN     ? AMSCR__RETRIEVAL_BLOCK
                                                     : 0;
 }
 
-/* Whether the shapes of a file of `version` with params p keep their outline (versions 10 and
- * 11: closed curves whose params close the inner distance's silhouette). */
+/* Whether the shapes of a file of `version` with params p keep their outline (versions 10 to
+ * 13: closed curves whose params close the inner distance's silhouette). */
 static inline int amscr__db_has_outline(uint32_t version, const amscr_params *p)
 {
     return version >= AMSCR__DB_VERSION_PLAIN_CLOSING && p->closed && p->inner_closing > 0.0;

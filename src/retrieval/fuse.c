@@ -121,16 +121,14 @@ amscr_status amscr_channel_distance(const amscr_params *p, const amscr_descripto
     if (a->n != b->n)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_channel_distance: N differs (%zu vs %zu)", a->n, b->n);
     amscr_invariance frames[2];
-    double share[2], sum = 0.0;
+    double share[2], d[2] = {0.0, 0.0};
     int nf = amscr__channel_frames(p, frames, share);
     for (int f = 0; f < nf; f++) {
-        double d = 0.0;
-        amscr_status st = pair_in_frame(p, frames[f], f, a, b, &d);
+        amscr_status st = pair_in_frame(p, frames[f], f, a, b, &d[f]);
         if (st != AMSCR_OK)
             return st;
-        sum += share[f] * d;
     }
-    *out_dist = sum;
+    *out_dist = amscr__channel_combine(p, nf, share, d[0], d[1]);
     return AMSCR_OK;
 }
 
@@ -218,7 +216,7 @@ static amscr_status channel_matrix(const amscr_db *db, amscr_progress_fn progres
     if (st == AMSCR_OK)
         st = matrix_in_frame(db, frames[1], 1, progress ? stage_cb : NULL, &sp, second);
     for (size_t i = 0; st == AMSCR_OK && i < n * n; i++)
-        out[i] = share[0] * out[i] + share[1] * second[i];
+        out[i] = amscr__channel_combine(p, nf, share, out[i], second[i]);
     if (st != AMSCR_OK)
         for (size_t i = 0; i < n * n; i++)
             out[i] = NAN;

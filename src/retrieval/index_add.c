@@ -21,7 +21,7 @@ static const char *differing_option(const amscr_params *a, const amscr_params *b
     CMP(oversampling) CMP(kmax) CMP(symmetric) CMP(refine) CMP(invariance) CMP(penalty) CMP(channel_weight)
     CMP(channel_invariance) CMP(channel_affine_share) CMP(channel_band) CMP(channel_affine_band) CMP(channel_skip)
     CMP(channel_locality) CMP(rerank_k) CMP(rerank_iterations) CMP(rerank_inner_share)
-    CMP(inner_closing)
+    CMP(inner_closing) CMP(channel_affine_view)
 #undef CMP
     return NULL;
 }

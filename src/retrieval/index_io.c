@@ -1,5 +1,5 @@
-/* index_io.c — the index file: a collection file (db_io.c) of version 11 (9 in 0.8, 8 in 0.7, 6
- * in 0.6, 4 in 0.5, 3 in 0.4) whose index section follows the shapes, so amscr_db_load of an index file
+/* index_io.c — the index file: a collection file (db_io.c) of version 13 (11 in 0.9, 9 in 0.8, 8
+ * in 0.7, 6 in 0.6, 4 in 0.5, 3 in 0.4) whose index section follows the shapes, so amscr_db_load of an index file
  * gives its collection.
  * Little-endian:
  *   u64 section length (the bytes up to the trailing checksum), then
@@ -13,7 +13,7 @@
  *     features: u32 frames F (0: no channel), u32 samples N, u32 bins B (AMSCR__HF_BINS), and
  *     per shape, per frame, its quantized height sequences (channel.h), forward then mirrored:
  *     2 N B bytes (F = 2, N = 128: 8 KB a shape);
- *   versions 9 and 11: then the inner distance's graph: u32 K2 (0: none; else K, when the params give it a
+ *   versions 9, 11 and 13: then the inner distance's graph: u32 K2 (0: none; else K, when the params give it a
  *     share), f64 its largest distance, n x K2 x (u32 neighbour, f64 distance) as the lists above,
  *     and per shape its inner features (inner.h): F K f64 re, F K f64 im, f64 norm2 (8.7 KB a
  *     shape; the reversed orientation's twist is recomputed).
@@ -120,7 +120,7 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
     if (st != AMSCR_OK)
         return st;
     amscr__wbuf w = {NULL, 0, 0, 0};
-    amscr__db_write(x->db, AMSCR__DB_VERSION_INDEX_CLOSING, &w);
+    amscr__db_write(x->db, AMSCR__DB_VERSION_INDEX_VIEW, &w);
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
     write_section(x, &w);
@@ -135,7 +135,7 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
         uint64_t sec = (uint64_t)(w.len - at - 8);
         for (int i = 0; i < 8; i++)
             w.buf[at + (size_t)i] = (unsigned char)(sec >> (8 * i));
-        amscr__w_u64(&w, amscr__db_checksum(AMSCR__DB_VERSION_INDEX_CLOSING, w.buf, w.len));
+        amscr__w_u64(&w, amscr__db_checksum(AMSCR__DB_VERSION_INDEX_VIEW, w.buf, w.len));
     }
     if (w.oom) {
         free(w.buf);

@@ -167,7 +167,7 @@ static amscr_status base_pairs4(const amscr__base *b, const amscr_descriptor *co
                 return st;
             sym = 0.5 * (f + r);
         }
-        double c = b->nf == 2 ? b->share[0] * ch[0][t] + b->share[1] * ch[1][t] : ch[0][t];
+        double c = amscr__channel_combine(b->p, b->nf, b->share, ch[0][t], ch[1][t]);
         out[t] = amscr__fuse_pair(b->w, b->sa, b->sh, sym, c);
     }
     return AMSCR_OK;

@@ -52,6 +52,8 @@ void amscr__retrieval_block_write(const amscr_params *p, unsigned char *out, siz
         put_f64(out + 60, p->rerank_inner_share);
     if (size >= AMSCR__RETRIEVAL_BLOCK_V4)
         put_f64(out + 68, p->inner_closing);
+    if (size >= AMSCR__RETRIEVAL_BLOCK_V5)
+        put_f64(out + 76, p->channel_affine_view);
 }
 
 amscr_status amscr__retrieval_block_read(const unsigned char *in, size_t size, amscr_params *p)
@@ -61,6 +63,7 @@ amscr_status amscr__retrieval_block_read(const unsigned char *in, size_t size, a
     double affine_band = size >= AMSCR__RETRIEVAL_BLOCK_V2 ? get_f64(in + 52) : get_f64(in + 20);
     double inner_share = size >= AMSCR__RETRIEVAL_BLOCK_V3 ? get_f64(in + 60) : 0.0;
     double closing = size >= AMSCR__RETRIEVAL_BLOCK_V4 ? get_f64(in + 68) : 0.0;
+    double view = size >= AMSCR__RETRIEVAL_BLOCK_V5 ? get_f64(in + 76) : 0.0;
     if (inv > 1u || amscr_params_set_channel_weight(&q, get_f64(in)) != AMSCR_OK ||
         amscr_params_set_channel_invariance(&q, (amscr_invariance)inv) != AMSCR_OK ||
         amscr_params_set_channel_affine_share(&q, get_f64(in + 12)) != AMSCR_OK ||
@@ -71,7 +74,8 @@ amscr_status amscr__retrieval_block_read(const unsigned char *in, size_t size, a
         amscr_params_set_rerank_k(&q, get_u32(in + 44)) != AMSCR_OK ||
         amscr_params_set_rerank_iterations(&q, get_u32(in + 48)) != AMSCR_OK ||
         amscr_params_set_rerank_inner_share(&q, inner_share) != AMSCR_OK ||
-        amscr_params_set_inner_closing(&q, closing) != AMSCR_OK) {
+        amscr_params_set_inner_closing(&q, closing) != AMSCR_OK ||
+        amscr_params_set_channel_affine_view(&q, view) != AMSCR_OK) {
         amscr__clear_error();
         return AMSCR_E_FORMAT;
     }

@@ -44,19 +44,21 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* Bytes 12..15 are the reserved u32 (read and ignored, written as 0); the checksum
      * covers them, so compare everything before the checksum except them. */
     FUZZ_CHECK(size >= 16);
-    if (buf[8] == 10) {
+    if (buf[8] == 12) {
         FUZZ_CHECK(outlen == size + 8);
         FUZZ_CHECK(memcmp(out, buf, 12) == 0 && memcmp((char *)out + 16, buf + 16, size - 16) == 0);
     } else {
-        /* an older file is saved as version 10 (version 1: 76 more bytes, the retrieval
-         * settings; version 2: 24 more, the whitened frame's band, the inner share and the
-         * closing; version 5: 16 more, the inner share and the closing; version 7: 8 more, the
-         * closing, 0 in these files, so no shape gains an outline); those bytes round-trip */
-        FUZZ_CHECK(((unsigned char *)out)[8] == 10);
-        FUZZ_CHECK(buf[8] != 1 || outlen == size + 8 + 76);
-        FUZZ_CHECK(buf[8] != 2 || outlen == size + 8 + 24);
-        FUZZ_CHECK(buf[8] != 5 || outlen == size + 8 + 16);
-        FUZZ_CHECK(buf[8] != 7 || outlen == size + 8 + 8);
+        /* an older file is saved as version 12 (version 1: 84 more bytes, the retrieval
+         * settings; version 2: 32 more, the whitened frame's band, the inner share, the closing
+         * and the affine-view factor; version 5: 24 more, the inner share, the closing and the
+         * factor; version 7: 16 more, the closing, 0 in these files, so no shape gains an
+         * outline, and the factor; version 10: 8 more, the factor); those bytes round-trip */
+        FUZZ_CHECK(((unsigned char *)out)[8] == 12);
+        FUZZ_CHECK(buf[8] != 1 || outlen == size + 8 + 84);
+        FUZZ_CHECK(buf[8] != 2 || outlen == size + 8 + 32);
+        FUZZ_CHECK(buf[8] != 5 || outlen == size + 8 + 24);
+        FUZZ_CHECK(buf[8] != 7 || outlen == size + 8 + 16);
+        FUZZ_CHECK(buf[8] != 10 || outlen == size + 8 + 8);
         amscr_db *again = NULL;
         FUZZ_CHECK(amscr_db_load_memory(out, outlen, &again) == AMSCR_OK);
         FUZZ_CHECK(amscr_db_size(again) == amscr_db_size(db));

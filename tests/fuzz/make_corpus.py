@@ -162,7 +162,7 @@ def ok(st):
         raise RuntimeError('amscr call failed: %d' % st)
 
 
-def db_bytes(shapes, n=16, scales=(1.0, 2.0), closed=1, closing=0.0):
+def db_bytes(shapes, n=16, scales=(1.0, 2.0), closed=1, closing=0.0, view=0.0):
     prm = P()
     ok(lib.amscr_params_new(ctypes.byref(prm)))
     ok(lib.amscr_params_set_num_samples(prm, ctypes.c_size_t(n)))
@@ -171,6 +171,7 @@ def db_bytes(shapes, n=16, scales=(1.0, 2.0), closed=1, closing=0.0):
     ok(lib.amscr_params_set_closed(prm, closed))
     ok(lib.amscr_params_set_num_threads(prm, 1))
     ok(lib.amscr_params_set_inner_closing(prm, ctypes.c_double(closing)))  # > 0: each shape keeps its outline
+    ok(lib.amscr_params_set_channel_affine_view(prm, ctypes.c_double(view)))
     db = P()
     ok(lib.amscr_db_new(prm, ctypes.byref(db)))
     for label, pts in enumerate(shapes):
@@ -194,4 +195,5 @@ put('dbload', 'one-shape-scale0', db_bytes([src], scales=(0.0,)))
 put('dbload', 'empty', db_bytes([]))
 put('dbload', 'open-curve', db_bytes([src[:15]], scales=(1.0,), closed=0))
 put('dbload', 'two-shapes-closing', db_bytes([src, polygon(30, 5, 9, 0.1)], closing=0.08))
+put('dbload', 'two-shapes-view', db_bytes([src, polygon(30, 5, 9, 0.1)], closing=0.08, view=3.0))
 print('seeds written under', os.path.join(HERE, 'corpus'))

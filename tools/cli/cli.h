@@ -119,6 +119,8 @@ typedef struct opts {
     double inner_share;
     int inner_closing_set;
     double inner_closing;
+    int affine_view_set;
+    double affine_view; /* 0: the frames mixed by the share for every pair */
 } opts;
 
 typedef struct tool_command {

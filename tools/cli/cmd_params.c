@@ -50,6 +50,7 @@ int make_params(const opts *o, int registration, amscr_params **out)
     SET(o->open && !registration && !o->channel_weight_set, "--open", amscr_params_set_channel_weight(p, 0.0));
     SET(o->channel_weight_set, "--channel-weight", amscr_params_set_channel_weight(p, o->channel_weight));
     SET(o->affine_share_set, "--affine-share", amscr_params_set_channel_affine_share(p, o->affine_share));
+    SET(o->affine_view_set, "--affine-view", amscr_params_set_channel_affine_view(p, o->affine_view));
     SET(o->inner_share_set, "--inner-share", amscr_params_set_rerank_inner_share(p, o->inner_share));
     SET(o->inner_closing_set, "--inner-closing", amscr_params_set_inner_closing(p, o->inner_closing));
     SET(o->rerank_set, "--rerank", amscr_params_set_rerank_k(p, (unsigned)o->rerank_k));

@@ -233,6 +233,9 @@ static void print_retrieval_options(const amscr_params *ret)
            "                          0 with --open)\n"
            "  --affine-share S        share of the channel computed in the affine (whitened)\n"
            "                          frame, the rest in the similarity frame (default %g)\n"
+           "  --affine-view F         a pair the affine frame alone finds F times nearer than\n"
+           "                          the frames' mix is ranked by it (an affine view of a\n"
+           "                          shape); 0 = the mix for every pair (default %g)\n"
            "  --fast                  --affine-share 0: the channel in one frame, less time\n"
            "  --rerank K[,ITER]       contextual re-ranking: diffusion on the K-nearest-neighbour\n"
            "                          graph, ITER iterations (default %u,%u; ITER default %d)\n"
@@ -246,6 +249,7 @@ static void print_retrieval_options(const amscr_params *ret)
            "                          no refinement, no re-ranking (= --channel-weight 0\n"
            "                          --no-rerank --invariance affine --refine 0)\n",
            amscr_params_get_channel_weight(ret), amscr_params_get_channel_affine_share(ret),
+           amscr_params_get_channel_affine_view(ret),
            amscr_params_get_rerank_k(ret), amscr_params_get_rerank_iterations(ret), TOOL_RERANK_ITERS,
            amscr_params_get_rerank_inner_share(ret), amscr_params_get_inner_closing(ret));
 }

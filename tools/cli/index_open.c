@@ -52,6 +52,7 @@ static int check_options(const opts *o, const char *path, const amscr_params *p)
     /* the neighbour lists are of the base distance these two define (the retrieval matrix's base distance) */
     NUM(o->channel_weight_set, "--channel-weight", amscr_params_get_channel_weight(p), o->channel_weight)
     NUM(o->affine_share_set, "--affine-share", amscr_params_get_channel_affine_share(p), o->affine_share)
+    NUM(o->affine_view_set, "--affine-view", amscr_params_get_channel_affine_view(p), o->affine_view)
 #undef NUM
 #undef NAME
     if (o->reflections >= 0 && o->reflections != amscr_params_get_reflections(p))

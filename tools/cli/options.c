@@ -51,6 +51,7 @@ typedef enum opt_id {
     O_NO_RERANK,
     O_CHANNEL_WEIGHT,
     O_AFFINE_SHARE,
+    O_AFFINE_VIEW,
     O_INNER_SHARE,
     O_INNER_CLOSING,
     O_FAST,
@@ -106,6 +107,7 @@ static const optdef OPTS[] = {
     {"--no-rerank", O_NO_RERANK, 0, C_RETRIEVAL, NULL},
     {"--channel-weight", O_CHANNEL_WEIGHT, 1, C_RETRIEVAL, "W"},
     {"--affine-share", O_AFFINE_SHARE, 1, C_RETRIEVAL, "S"},
+    {"--affine-view", O_AFFINE_VIEW, 1, C_RETRIEVAL, "F"},
     {"--inner-share", O_INNER_SHARE, 1, C_RETRIEVAL, "S"},
     {"--inner-closing", O_INNER_CLOSING, 1, C_RETRIEVAL, "C"},
     {"--fast", O_FAST, 0, C_RETRIEVAL, NULL},
@@ -249,6 +251,19 @@ static int parse_fraction(const char *opt, const char *v, int *set, double *out)
     return 0;
 }
 
+/* --affine-view F: 0, or a factor in [1, 100]. */
+static int parse_affine_view(const char *opt, const char *v, opts *o)
+{
+    char *end = NULL;
+    errno = 0;
+    double x = strtod(v, &end);
+    if (end == v || *end != '\0' || errno != 0 || !(x == 0.0 || (x >= 1.0 && x <= 100.0)))
+        return usage_error(opt, "expected 0 or a factor in [1, 100], got '%s'", v);
+    o->affine_view_set = 1;
+    o->affine_view = x;
+    return 0;
+}
+
 /* --paper: the paper's method exactly as 0.1 computed it (the AMSCR distance alone in the
  * affine group, no refinement, no re-ranking); later options still override. */
 static void set_paper(opts *o)
@@ -374,6 +389,7 @@ static int set_option(opts *o, const optdef *d, const char *v)
         return 0;
     case O_CHANNEL_WEIGHT: return parse_fraction(n, v, &o->channel_weight_set, &o->channel_weight);
     case O_AFFINE_SHARE: return parse_fraction(n, v, &o->affine_share_set, &o->affine_share);
+    case O_AFFINE_VIEW: return parse_affine_view(n, v, o);
     case O_INNER_SHARE: return parse_fraction(n, v, &o->inner_share_set, &o->inner_share);
     case O_INNER_CLOSING: return parse_fraction(n, v, &o->inner_closing_set, &o->inner_closing);
     case O_FAST:

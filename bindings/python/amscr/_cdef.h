@@ -2,9 +2,9 @@
 /* Regenerate with: python3 scripts/gen_cdef.py -o bindings/python/amscr/_cdef.h */
 
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 10
+#define AMSCR_VERSION_MINOR 11
 #define AMSCR_VERSION_PATCH 0
-#define AMSCR_VERSION_NUMBER 1000
+#define AMSCR_VERSION_NUMBER 1100
 #define AMSCR_MAX_IMAGE_SIDE 32768
 #define AMSCR_MAX_IMAGE_PIXELS 268435456
 #define AMSCR_MAX_POINTS 16777216
@@ -196,6 +196,8 @@ amscr_status amscr_params_set_rerank_inner_share(amscr_params *p, double share);
 double amscr_params_get_rerank_inner_share(const amscr_params *p);
 amscr_status amscr_params_set_inner_closing(amscr_params *p, double radius);
 double amscr_params_get_inner_closing(const amscr_params *p);
+amscr_status amscr_params_set_channel_affine_view(amscr_params *p, double factor);
+double amscr_params_get_channel_affine_view(const amscr_params *p);
 amscr_status amscr_workspace_new(amscr_workspace **out);
 void amscr_workspace_free(amscr_workspace *ws);
 amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out);

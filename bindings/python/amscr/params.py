@@ -159,6 +159,10 @@ class Params:
     inner_closing = _Option('inner_closing', _FLOAT,
                             'closing radius, in units of sqrt(area) in [0, 1], of the silhouette the inner '
                             'distance is taken in (0 = as it is, the default; 0.04 in the retrieval preset)')
+    channel_affine_view = _Option('channel_affine_view', _FLOAT,
+                                  'with two frames: a pair the affine frame alone finds f times nearer than the '
+                                  "frames' mix is ranked by it, min(mix, f * d_affine) (0 = the mix for every pair, "
+                                  'the default; 2 in the retrieval preset; f in [1, 100])')
 
     #: The option names, in the order of the table above.
     OPTIONS: Tuple[str, ...] = ()

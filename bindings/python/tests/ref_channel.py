@@ -160,14 +160,17 @@ def channel_in_frame(pa, pb, kind, band, skip, locality, reflections, exact):
 
 
 def channel_distance(pa, pb, *, invariance='similarity', affine_share=0.2, band=0.15, affine_band=0.08, skip=1.0,
-                     locality=4.0, reflections=True, exact=False):
+                     locality=4.0, reflections=True, affine_view=2.0, exact=False):
     """The channel distance of two shapes given their prepared samples (N x 2 each); exact=True
     minimizes step 5 over every start instead of following the library's rule. The whitened
-    frame mixed in with affine_share uses affine_band; a frame alone uses band."""
+    frame mixed in with affine_share uses affine_band; a frame alone uses band. With both frames
+    and affine_view f > 0 the distance is min(mix, f * the whitened frame's)."""
     opts = dict(skip=skip, locality=locality, reflections=reflections, exact=exact)
     if invariance == 'affine' or affine_share >= 1.0:
         return channel_in_frame(pa, pb, 'affine', band=band, **opts)
     d = channel_in_frame(pa, pb, invariance, band=band, **opts)
     if affine_share <= 0.0:
         return d
-    return (1.0 - affine_share) * d + affine_share * channel_in_frame(pa, pb, 'affine', band=affine_band, **opts)
+    da = channel_in_frame(pa, pb, 'affine', band=affine_band, **opts)
+    mix = (1.0 - affine_share) * d + affine_share * da
+    return min(mix, affine_view * da) if affine_view > 0 else mix

@@ -52,7 +52,7 @@ def lib(S, a, b, **opts):
 def ref(S, a, b, exact=False, **opts):
     names = {'channel_band': 'band', 'channel_affine_band': 'affine_band', 'channel_skip': 'skip', 'channel_locality': 'locality',
              'channel_affine_share': 'affine_share', 'channel_invariance': 'invariance',
-             'reflections': 'reflections'}
+             'reflections': 'reflections', 'channel_affine_view': 'affine_view'}
     return ref_channel.channel_distance(S[a].input_points, S[b].input_points,
                                         exact=exact, **{names[k]: v for k, v in opts.items()})
 
@@ -67,7 +67,17 @@ CASES = [
     ('body', 'rolled', {'channel_affine_share': 0.5, 'channel_band': 0.08}),
     ('body', 'bent', {'channel_affine_share': 0.5, 'channel_affine_band': 0.2}),
     ('blob1', 'mirrored', {'reflections': False}),
+    ('body', 'sheared', {'channel_affine_view': 0.0}),
+    ('body', 'sheared', {'channel_affine_view': 1.0}),
+    ('body', 'bent', {'channel_affine_view': 1.0}),
 ]
+
+
+def test_affine_view_takes_the_sheared_pair_by_the_affine_frame(S):
+    """The sheared copy is nearer in the whitened frame by more than the preset's factor: the
+    rule ranks it there (below the mix); the bent copy keeps the mix."""
+    assert lib(S, 'body', 'sheared') < lib(S, 'body', 'sheared', channel_affine_view=0.0)
+    assert lib(S, 'body', 'bent') == lib(S, 'body', 'bent', channel_affine_view=0.0)
 
 
 @pytest.mark.parametrize('a,b,opts', CASES)
@@ -117,15 +127,17 @@ def test_locality_discounts_far_parts(S):
 
 
 def test_affine_share_mixes_the_two_frames(S):
-    """The distance is (1 - share) * similarity frame + share * affine frame: on a sheared copy
-    the affine frame sees (almost) nothing, so a larger share lowers the distance."""
+    """Without the affine-view rule the distance is (1 - share) * similarity frame + share *
+    affine frame: on a sheared copy the affine frame sees (almost) nothing, so a larger share
+    lowers the distance."""
     sim = lib(S, 'body', 'sheared', channel_affine_share=0.0)
     aff = lib(S, 'body', 'sheared', channel_invariance='affine')
     for share in (0.2, 0.5):
-        mixed = lib(S, 'body', 'sheared', channel_affine_share=share)
+        mixed = lib(S, 'body', 'sheared', channel_affine_share=share, channel_affine_view=0.0)
         assert mixed == pytest.approx((1 - share) * sim + share * aff, rel=1e-12, abs=1e-15)
     assert aff < 0.1 * sim, (aff, sim)
-    assert lib(S, 'body', 'sheared', channel_affine_share=0.5) < lib(S, 'body', 'sheared', channel_affine_share=0.2)
+    assert lib(S, 'body', 'sheared', channel_affine_share=0.5, channel_affine_view=0.0) < \
+        lib(S, 'body', 'sheared', channel_affine_share=0.2, channel_affine_view=0.0)
 
 
 def test_invariance_frames(S):

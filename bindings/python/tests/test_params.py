@@ -13,7 +13,7 @@ CHANGED = {
     'symmetric': True, 'refine': 3, 'threads': 2, 'invariance': 'penalized', 'penalty': 0.25,
     'partial': True, 'channel_weight': 0.5, 'channel_invariance': 'affine', 'channel_affine_share': 0.5,
     'channel_band': 0.2, 'channel_affine_band': 0.1, 'channel_skip': 0.5, 'channel_locality': 8.0, 'rerank_k': 3, 'rerank_iterations': 4,
-    'rerank_inner_share': 0.125, 'inner_closing': 0.25, 'polish': True,
+    'rerank_inner_share': 0.125, 'inner_closing': 0.25, 'channel_affine_view': 3.5, 'polish': True,
     'stages': {'despike': True, 'recovery': False, 'polish': False, 'order': True, 'even_spacing': True},
 }
 # the presets disagree on these flags: each preset gets the other value
@@ -25,7 +25,7 @@ REFUSED = {
     'symmetric': None, 'refine': 51, 'threads': -1, 'invariance': 'projective', 'penalty': -1.0,
     'partial': 2, 'channel_weight': 1.5, 'channel_invariance': 'penalized', 'channel_affine_share': -0.1,
     'channel_band': 0.0, 'channel_affine_band': 0.6, 'channel_skip': -1.0, 'channel_locality': -1.0, 'rerank_k': 1001, 'rerank_iterations': 0,
-    'rerank_inner_share': 1.0, 'inner_closing': 1.5, 'polish': 2, 'stages': {'search': False},
+    'rerank_inner_share': 1.0, 'inner_closing': 1.5, 'channel_affine_view': 0.5, 'polish': 2, 'stages': {'search': False},
 }
 
 
