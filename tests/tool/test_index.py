@@ -300,3 +300,28 @@ def test_inner_closing_and_the_index(tmp_path):
     r = run("index", m, "-o", open_idx, "--add", "--inner-closing", "0.1")
     assert r.returncode != 0 and "inner_closing" in r.stderr
     assert run("search", q, m, "--inner-closing", "2").returncode == 2
+
+
+def test_affine_view_and_the_index(tmp_path):
+    """The default ranks a pair the affine frame finds twice as near as the frames' mix by the
+    affine frame (the manifest's shapes are affine copies of three shapes): its distances differ
+    from `--affine-view 0`'s (the mix for every pair). An index keeps its build's factor: built
+    with 0 it searches as the manifest with 0; searched with another factor (a usage error
+    naming the option) or --add with one, it is refused; a factor outside [1, 100] other than 0
+    is a usage error."""
+    m = make_manifest(tmp_path)
+    q = tmp_path / "shapes" / "wave_2.txt"
+    view = json.loads(run("search", q, m, "--json").stdout)["results"]
+    mix = json.loads(run("search", q, m, "--json", "--affine-view", "0").stdout)["results"]
+    dv, dm = {r["file"]: r["distance"] for r in view}, {r["file"]: r["distance"] for r in mix}
+    assert dv != dm
+    idx = build(tmp_path, m)
+    mix_idx = build(tmp_path, m, "--affine-view", "0", name="mix.idx")
+    same_results(json.loads(run("search", q, idx, "--json").stdout)["results"], view)
+    same_results(json.loads(run("search", q, mix_idx, "--json").stdout)["results"], mix)
+    r = run("search", q, idx, "--affine-view", "0")
+    assert r.returncode == 2 and r.stdout == "" and "rebuild it" in r.stderr and "--affine-view 2" in r.stderr
+    r = run("index", m, "-o", mix_idx, "--add", "--affine-view", "3")
+    assert r.returncode != 0 and "affine" in r.stderr
+    for bad in ("0.5", "101", "x", "-1"):
+        assert run("search", q, m, "--affine-view", bad).returncode == 2
