@@ -88,18 +88,26 @@ amscr_status amscr__db_push(amscr_db *db, amscr_descriptor *d, int32_t label, si
     return AMSCR_OK;
 }
 
+amscr_status amscr__db_prepare(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out)
+{
+    amscr_status st = amscr_descriptor_new(p, c, out);
+    if (st == AMSCR_OK) { /* a collection keeps no input points: it never polishes a registration */
+        free((*out)->raw);
+        (*out)->raw = NULL;
+        (*out)->nraw = 0;
+    }
+    return st;
+}
+
 amscr_status amscr_db_add_contour(amscr_db *db, const amscr_contour *c, int32_t label, size_t *out_index)
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(db);
     AMSCR_CHECK_NULL(c);
     amscr_descriptor *d = NULL;
-    amscr_status st = amscr_descriptor_new(&db->params, c, &d);
+    amscr_status st = amscr__db_prepare(&db->params, c, &d);
     if (st != AMSCR_OK)
         return st;
-    free(d->raw); /* a collection keeps no input points: it never polishes a registration */
-    d->raw = NULL;
-    d->nraw = 0;
     st = amscr__db_push(db, d, label, out_index);
     if (st != AMSCR_OK)
         amscr_descriptor_free(d);

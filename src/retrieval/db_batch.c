@@ -19,13 +19,8 @@ static amscr_status prepare_row(void *ctx, size_t i, void *scratch)
 {
     (void)scratch;
     const batch_job *j = ctx;
-    amscr_status st = j->c[i] ? amscr_descriptor_new(j->p, j->c[i], &j->d[i])
+    amscr_status st = j->c[i] ? amscr__db_prepare(j->p, j->c[i], &j->d[i])
                               : amscr__fail(AMSCR_E_INVALID_ARG, "a NULL contour");
-    if (st == AMSCR_OK) { /* a collection keeps no input points, as amscr_db_add_contour */
-        free(j->d[i]->raw);
-        j->d[i]->raw = NULL;
-        j->d[i]->nraw = 0;
-    }
     j->st[i] = st;
     return st;
 }

@@ -80,6 +80,8 @@ uint64_t amscr__db_checksum(uint32_t version, const unsigned char *p, size_t n);
 
 /* Appends db.c's row (db_push) to a collection. */
 amscr_status amscr__db_push(amscr_db *db, amscr_descriptor *d, int32_t label, size_t *out_index);
+/* c prepared with p as a collection keeps it (amscr_descriptor_new without the input points). */
+amscr_status amscr__db_prepare(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out);
 /* Room for `extra` more shapes, so that as many pushes cannot fail. */
 amscr_status amscr__db_reserve(amscr_db *db, size_t extra);
 
