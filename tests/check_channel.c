@@ -308,13 +308,15 @@ START_TEST(test_bad_input)
 }
 END_TEST
 
-/* The four-lane pair distance (the collection matrix's and the index's) equals the one-pair
- * distance bit for bit: pairs of different first shapes, every count of pairs 1-4, bands up
- * to N/2, both strides, skip costs, one or both orientations, reflections on and off; height
- * sequences of random curves (N 128). */
-START_TEST(test_four_lanes)
+/* The side-by-side pair distances (the collection matrix's and the index's) equal the one-pair
+ * distance bit for bit: pairs of different first shapes, every count of pairs 1-8 (eight DPs
+ * in AVX2 lanes when the processor has them, groups of four otherwise and for the last four
+ * or fewer), bands up to N/2, both strides, skip costs, one or both orientations, reflections
+ * on and off; height sequences of random curves (N 128). */
+START_TEST(test_side_by_side)
 {
-    enum { NS = 9, N = 128 };
+    enum { NS = 12, N = 128 };
+    ck_assert(amscr__hf_lanes() == 4 || amscr__hf_lanes() == 8);
     amscr__hf hf[NS];
     double xy[2 * N];
     for (int k = 0; k < NS; k++) {
@@ -332,21 +334,21 @@ START_TEST(test_four_lanes)
     for (int c = 0; c < 3 * 2 * 2 * 2 * 2; c++) {
         amscr__hf_cfg cfg = {bands[c % 3], (c / 3) % 2 ? 0.5 : 1.25, (c / 6) % 2, (c / 12) % 2,
                              (size_t)1 + (c / 24) % 2};
-        for (size_t count = 1; count <= 4; count++)
+        for (size_t count = 1; count <= AMSCR__HF_GROUP; count++)
             for (size_t j = 1; j + count <= NS; j += count) {
-                double four[4] = {-1, -1, -1, -1};
-                const amscr__hf *a[4], *b[4]; /* lane t: (j + t, 0) when t is odd, else (0, j + t) */
+                double four[AMSCR__HF_GROUP] = {-1, -1, -1, -1, -1, -1, -1, -1};
+                const amscr__hf *a[AMSCR__HF_GROUP], *b[AMSCR__HF_GROUP]; /* lane t: (j + t, 0) when t is odd, else (0, j + t) */
                 for (size_t t = 0; t < count; t++) {
                     a[t] = t % 2 ? &hf[j + t] : &hf[0];
                     b[t] = t % 2 ? &hf[0] : &hf[j + t];
                 }
-                amscr__hf_distance4(a, b, count, &cfg, &ws, four);
+                amscr__hf_distances(a, b, count, &cfg, &ws, four);
                 for (size_t t = 0; t < count; t++) {
                     double one = amscr__hf_distance(a[t], b[t], &cfg, &ws);
                     ck_assert_msg(four[t] == one && one > 0.0, "config %d count %zu pair %zu: %.17g vs %.17g", c,
                                   count, j + t, four[t], one);
                 }
-                for (size_t t = count; t < 4; t++)
+                for (size_t t = count; t < AMSCR__HF_GROUP; t++)
                     ck_assert(four[t] == -1.0); /* nothing written past count */
             }
     }
@@ -364,7 +366,7 @@ Suite *amscr_suite_channel(void)
     tcase_add_test(tc, test_affine_view_rule);
     tcase_add_test(tc, test_self_zero_and_articulation);
     tcase_add_test(tc, test_matrices);
-    tcase_add_test(tc, test_four_lanes);
+    tcase_add_test(tc, test_side_by_side);
     tcase_add_test(tc, test_bad_input);
     suite_add_tcase(s, tc);
     return s;

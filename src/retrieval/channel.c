@@ -160,12 +160,13 @@ amscr_status amscr__hf_ws_init(amscr__hf_ws *ws, size_t n, size_t band)
     size_t W = 2 * band + 1;
     ws->n = n;
     ws->z = amscr__malloc_array(2 * n, sizeof *ws->z);
+    ws->acc = amscr__malloc_array(4 * (AMSCR__HF_FREQS(n) + 1), sizeof *ws->acc);
     ws->row = amscr__malloc_array(4 * W, sizeof *ws->row);
     ws->start = amscr__malloc_array(4 * W, sizeof *ws->start);
-    ws->lanes = amscr__malloc_array(5 * 4 * W, sizeof *ws->lanes); /* band_dp4: 5 arrays of 4 lanes */
+    ws->lanes = amscr__malloc_array(5 * 8 * W, sizeof *ws->lanes); /* 5 arrays of up to 8 lanes */
     int ok = amscr__fft_plan_init(&ws->plan, n) == 0;
     ws->have_plan = ok;
-    if (!ws->z || !ws->row || !ws->start || !ws->lanes || !ok) {
+    if (!ws->z || !ws->acc || !ws->row || !ws->start || !ws->lanes || !ok) {
         amscr__hf_ws_free(ws);
         return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
     }
@@ -177,47 +178,60 @@ void amscr__hf_ws_free(amscr__hf_ws *ws)
     if (ws->have_plan)
         amscr__fft_plan_free(&ws->plan);
     free(ws->z);
+    free(ws->acc);
     free(ws->row);
     free(ws->start);
     free(ws->lanes);
     memset(ws, 0, sizeof *ws);
 }
 
-/* The low-passed cross-spectrum conj(A) B of every bin, orientation o of b, added into z with
- * weight i^q (q 0: real part, q 1: imaginary part), its Hermitian half as well. */
-static void cross_spectrum(const amscr__hf *a, const amscr__hf *b, int o, int q, double *z)
+/* The low-passed cross-spectra conj(A) B summed over the bins, for orientation 0 of b and,
+ * when `both`, orientation 1: acc[4 f + 2 o] real, acc[4 f + 2 o + 1] imaginary part. The bins
+ * are the outer loop and the frequencies the inner one (independent sums, side by side in
+ * vector registers); each frequency's sum still runs over the bins in order. */
+static void cross_spectra(const amscr__hf *a, const amscr__hf *b, int both, double *restrict acc)
 {
-    const size_t D = AMSCR__HF_BINS, n = a->n, half = n / 2, fmax = AMSCR__HF_FREQS(n), F = a->nfreq;
-    for (size_t f = 0; f <= fmax; f++) {
-        double re = 0.0, im = 0.0;
-        for (size_t bin = 0; bin < D; bin++) {
-            const double *fa = a->spec[0] + bin * 2 * F + 2 * f, *fb = b->spec[o] + bin * 2 * F + 2 * f;
-            re += fa[0] * fb[0] + fa[1] * fb[1];
-            im += fa[0] * fb[1] - fa[1] * fb[0];
+    const size_t D = AMSCR__HF_BINS, fmax = AMSCR__HF_FREQS(a->n), F = a->nfreq;
+    memset(acc, 0, 4 * (fmax + 1) * sizeof *acc);
+    for (size_t bin = 0; bin < D; bin++)
+        for (int o = 0; o < (both ? 2 : 1); o++) {
+            const double *restrict fa = a->spec[0] + bin * 2 * F, *restrict fb = b->spec[o] + bin * 2 * F;
+            for (size_t f = 0; f <= fmax; f++) {
+                acc[4 * f + 2 * o] += fa[2 * f] * fb[2 * f] + fa[2 * f + 1] * fb[2 * f + 1];
+                acc[4 * f + 2 * o + 1] += fa[2 * f] * fb[2 * f + 1] - fa[2 * f + 1] * fb[2 * f];
+            }
         }
-        /* X = re + i im enters as X (q 0) or i X (q 1); its mirror n - f as conj(X) or i conj(X) */
-        double xr = q ? -im : re, xi = q ? re : im;
-        z[2 * f] += xr;
-        z[2 * f + 1] += xi;
-        if (f > 0 && n - f > half) {
-            z[2 * (n - f)] += q ? im : re;
-            z[2 * (n - f) + 1] += q ? re : -im;
+}
+
+/* The spectrum whose inverse FFT carries both orientations' correlations into z: orientation
+ * 0's cross-spectrum X0 as it is, orientation 1's X1 times i (both correlations are real, so
+ * the second rides in the imaginary part), each with its Hermitian half. */
+static void pack_spectra(const double *acc, size_t n, int both, double *z)
+{
+    const size_t half = n / 2, fmax = AMSCR__HF_FREQS(n);
+    memset(z, 0, 2 * n * sizeof *z);
+    for (int q = 0; q < (both ? 2 : 1); q++)
+        for (size_t f = 0; f <= fmax; f++) {
+            double re = acc[4 * f + 2 * q], im = acc[4 * f + 2 * q + 1];
+            double xr = q ? -im : re, xi = q ? re : im;
+            z[2 * f] += xr;
+            z[2 * f + 1] += xi;
+            if (f > 0 && n - f > half) {
+                z[2 * (n - f)] += q ? im : re;
+                z[2 * (n - f) + 1] += q ? re : -im;
+            }
         }
-    }
 }
 
 /* The cyclic shift of b that maximizes its correlation with a, for orientation 0 and, when
- * `both`, orientation 1 — one inverse FFT for the two: both correlations are real, so
- * orientation 1 rides in the imaginary part. shift[o] and corr[o] receive them. */
+ * `both`, orientation 1 — one inverse FFT for the two. shift[o] and corr[o] receive them. */
 static void best_shifts(const amscr__hf *a, const amscr__hf *b, int both, amscr__hf_ws *ws, size_t shift[2],
                         double corr[2])
 {
     const size_t n = a->n;
     double *z = ws->z;
-    memset(z, 0, 2 * n * sizeof *z);
-    cross_spectrum(a, b, 0, 0, z);
-    if (both)
-        cross_spectrum(a, b, 1, 1, z);
+    cross_spectra(a, b, both, ws->acc);
+    pack_spectra(ws->acc, n, both, z);
     amscr__fft(&ws->plan, z, 1);
     for (int o = 0; o < (both ? 2 : 1); o++) {
         size_t best = 0;
@@ -270,31 +284,53 @@ double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__h
     return d;
 }
 
-void amscr__hf_distance4(const amscr__hf *const a[4], const amscr__hf *const b[4], size_t count,
+/* The DPs of the jobs (A[j], B[j], s[j]), j < jobs, into d[j]: eight side by side while more
+ * than four remain and the processor runs eight, else four (a short group repeats its last). */
+static void band_dps(const uint8_t *const A[], const uint8_t *const B[], const size_t s[], size_t jobs,
+                     const amscr__hf *a, const amscr__hf_cfg *cfg, amscr__hf_ws *ws, double *d)
+{
+    size_t lanes = (size_t)amscr__hf_lanes();
+    for (size_t j0 = 0; j0 < jobs;) {
+        size_t g = jobs - j0 > 4 && lanes == 8 ? 8 : 4;
+        const uint8_t *gA[8], *gB[8];
+        size_t gs[8];
+        double gd[8];
+        for (size_t l = 0; l < g; l++) {
+            size_t j = j0 + l < jobs ? j0 + l : jobs - 1;
+            gA[l] = A[j];
+            gB[l] = B[j];
+            gs[l] = s[j];
+        }
+        if (g == 8)
+            amscr__hf_band_dp8(gA, gB, gs, a->n, pair_band(a, cfg), cfg->stride, pair_skip(cfg), ws, gd);
+        else
+            amscr__hf_band_dp4(gA, gB, gs, a->n, pair_band(a, cfg), cfg->stride, pair_skip(cfg), ws, gd);
+        for (size_t l = 0; l < g && j0 + l < jobs; l++)
+            d[j0 + l] = gd[l];
+        j0 += g;
+    }
+}
+
+void amscr__hf_distances(const amscr__hf *const a[], const amscr__hf *const b[], size_t count,
                          const amscr__hf_cfg *cfg, amscr__hf_ws *ws, double *out)
 {
-    const uint8_t *seq[8];
-    size_t shift[8], owner[8], jobs = 0;
+    enum { J = 2 * AMSCR__HF_GROUP };
+    const uint8_t *A[J], *B[J];
+    size_t shift[J], owner[J], jobs = 0;
+    double d[J];
     for (size_t p = 0; p < count; p++) {
-        int k = pair_jobs(a[p], b[p], cfg, ws, seq + jobs, shift + jobs);
-        for (int t = 0; t < k; t++)
+        int k = pair_jobs(a[p], b[p], cfg, ws, B + jobs, shift + jobs);
+        for (int t = 0; t < k; t++) {
             owner[jobs + (size_t)t] = p;
+            A[jobs + (size_t)t] = a[p]->seq[0];
+        }
         jobs += (size_t)k;
         out[p] = DBL_MAX;
     }
-    for (size_t j0 = 0; j0 < jobs; j0 += 4) {
-        const uint8_t *A[4], *B[4];
-        size_t s[4];
-        double d[4];
-        for (size_t l = 0; l < 4; l++) { /* a short last group repeats its last job */
-            size_t j = j0 + l < jobs ? j0 + l : jobs - 1;
-            A[l] = a[owner[j]]->seq[0];
-            B[l] = seq[j];
-            s[l] = shift[j];
-        }
-        amscr__hf_band_dp4(A, B, s, a[0]->n, pair_band(a[0], cfg), cfg->stride, pair_skip(cfg), ws, d);
-        for (size_t l = 0; l < 4 && j0 + l < jobs; l++)
-            if (d[l] < out[owner[j0 + l]])
-                out[owner[j0 + l]] = d[l];
-    }
+    if (jobs == 0)
+        return;
+    band_dps(A, B, shift, jobs, a[0], cfg, ws, d);
+    for (size_t j = 0; j < jobs; j++)
+        if (d[j] < out[owner[j]])
+            out[owner[j]] = d[j];
 }

@@ -38,9 +38,10 @@ struct amscr__hf_ws {
     amscr__fft_plan plan;
     int have_plan;
     double *z;
+    double *acc; /* the shift search's cross-spectra: 4 (AMSCR__HF_FREQS(n) + 1) */
     int32_t *row;
     int32_t *start;
-    int32_t *lanes; /* amscr__hf_band_dp4's rows: 5 arrays of 4 lanes x (2 band + 1) */
+    int32_t *lanes; /* the side-by-side DPs' rows: 5 arrays of 8 lanes x (2 band + 1) */
 };
 
 amscr_status amscr__hf_build(const double *base, size_t n, double locality, amscr__hf *out);
@@ -55,16 +56,23 @@ void amscr__hf_ws_free(amscr__hf_ws *ws);
 /* The channel distance of two shapes built with the same n (>= 0, 0 for identical ones). */
 double amscr__hf_distance(const amscr__hf *a, const amscr__hf *b, const amscr__hf_cfg *cfg, amscr__hf_ws *ws);
 
-/* The channel distances of the pairs (a[t], b[t]), t < count <= 4, into out[t]: bit for bit
- * amscr__hf_distance's, their DPs run side by side. */
-void amscr__hf_distance4(const amscr__hf *const a[4], const amscr__hf *const b[4], size_t count,
+/* Pairs amscr__hf_distances takes at once. */
+#define AMSCR__HF_GROUP 8
+/* The channel distances of the pairs (a[t], b[t]), t < count <= AMSCR__HF_GROUP, into out[t]:
+ * bit for bit amscr__hf_distance's, their DPs run side by side. */
+void amscr__hf_distances(const amscr__hf *const a[], const amscr__hf *const b[], size_t count,
                          const amscr__hf_cfg *cfg, amscr__hf_ws *ws, double *out);
 /* The banded DTW of A against B cyclically shifted by s (channel_dp.c; see channel.c's file
- * comment), and the same for four (A, B, s) at once, bit for bit. */
+ * comment), and the same for four or eight (A, B, s) at once, bit for bit. */
 double amscr__hf_band_dp(const uint8_t *A, const uint8_t *B, size_t n, size_t s, size_t band, size_t stride,
                          int32_t skip, amscr__hf_ws *ws);
 void amscr__hf_band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], const size_t s[4], size_t n,
                         size_t band, size_t stride, int32_t skip, amscr__hf_ws *ws, double out[4]);
+void amscr__hf_band_dp8(const uint8_t *const A[8], const uint8_t *const B[8], const size_t s[8], size_t n,
+                        size_t band, size_t stride, int32_t skip, amscr__hf_ws *ws, double out[8]);
+/* The lanes this processor runs side by side: 8 with AVX2 (amscr__hf_band_dp8 in one pass),
+ * else 4 (amscr__hf_band_dp8 runs amscr__hf_band_dp4 twice). */
+int amscr__hf_lanes(void);
 
 /* Symmetric n x n matrix of channel distances (zero diagonal), on `threads` threads. */
 amscr_status amscr__hf_matrix(const amscr__hf *hf, size_t n, const amscr__hf_cfg *cfg, unsigned threads,

@@ -1,10 +1,11 @@
-/* channel_dp.c — the shape channel's banded DTW (the pair cost of channel.c): one pair, or
- * four pairs at once in the four 32-bit lanes of SSE2 registers (elsewhere the four-pair
- * entry runs the one-pair DP four times). The lanes run the one-pair DP's integer operations
- * in the same order (the same moves, the same ties), so their distances are bit for bit the
- * one-pair ones; they exist because the row's third move chains along the row, and four
- * independent chains side by side keep the processor busy where one leaves it waiting on the
- * previous cell. */
+/* channel_dp.c — the shape channel's banded DTW (the pair cost of channel.c): one pair, four
+ * pairs at once in the four 32-bit lanes of SSE2 registers (elsewhere the four-pair entry runs
+ * the one-pair DP four times), or eight in the eight lanes of AVX2 registers when the
+ * processor has AVX2 (asked at run time; elsewhere the eight-pair entry runs the four-pair one
+ * twice). The lanes run the one-pair DP's integer operations in the same order (the same
+ * moves, the same ties), so their distances are bit for bit the one-pair ones; they exist
+ * because the row's third move chains along the row, and independent chains side by side keep
+ * the processor busy where one leaves it waiting on the previous cell. */
 #include "channel.h"
 
 #include <float.h>
@@ -226,4 +227,128 @@ void amscr__hf_band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], co
     for (size_t l = 0; l < 4; l++)
         out[l] = amscr__hf_band_dp(A[l], B[l], n, s[l], band, stride, skip, ws);
 #endif
+}
+
+/* Eight lanes: AVX2 code in functions compiled for it (the rest of the library stays
+ * baseline x86-64), called only when the processor reports AVX2. */
+#if defined(__x86_64__) && AMSCR__HF_BINS == 16 && (defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 5))
+#define DP8 1
+#include <immintrin.h>
+#define AVX2 __attribute__((target("avx2")))
+
+#define LD(p, kk) _mm256_loadu_si256((const __m256i *)(const void *)((p) + 8 * (kk)))
+#define ST(p, kk, v) _mm256_storeu_si256((__m256i *)(void *)((p) + 8 * (kk)), (v))
+
+/* band_row on eight lanes, cell kk of lane l at [8 kk + l]: band_row's selects written as a
+ * minimum (the value v < b ? v : b is min(v, b)) and a blend of the start offsets by the
+ * same comparison. */
+AVX2 static void band_row8(const int32_t *restrict prev, const int32_t *restrict ps, const int32_t *restrict cost,
+                           long W, int32_t skip, int32_t *restrict cur, int32_t *restrict cs)
+{
+    const __m256i sk = _mm256_set1_epi32(skip);
+    for (long kk = 0; kk + 1 < W; kk++) {
+        __m256i b = LD(prev, kk), v = _mm256_add_epi32(LD(prev, kk + 1), sk), m = _mm256_cmpgt_epi32(b, v);
+        ST(cur, kk, _mm256_min_epi32(v, b));
+        ST(cs, kk, _mm256_blendv_epi8(LD(ps, kk), LD(ps, kk + 1), m));
+    }
+    ST(cur, W - 1, LD(prev, W - 1));
+    ST(cs, W - 1, LD(ps, W - 1));
+    __m256i c = _mm256_add_epi32(LD(cost, 0), LD(cur, 0)), st = LD(cs, 0);
+    ST(cur, 0, c);
+    for (long kk = 1; kk < W; kk++) {
+        __m256i h = _mm256_add_epi32(c, sk), b = LD(cur, kk), lt = _mm256_cmpgt_epi32(b, h); /* h < b */
+        c = _mm256_add_epi32(_mm256_min_epi32(h, b), LD(cost, kk));
+        st = _mm256_blendv_epi8(LD(cs, kk), st, lt);
+        ST(cur, kk, c);
+        ST(cs, kk, st);
+    }
+}
+#undef LD
+#undef ST
+
+/* Two 16-byte rows in one register: lo in the low half, hi in the high half. */
+AVX2 static inline __m256i two_rows(const uint8_t *lo, const uint8_t *hi)
+{
+    __m128i a = _mm_loadu_si128((const __m128i *)(const void *)lo);
+    __m128i b = _mm_loadu_si128((const __m128i *)(const void *)hi);
+    return _mm256_inserti128_si256(_mm256_castsi128_si256(a), b, 1);
+}
+
+/* The cell costs of row i of the eight (A, B, s) into cost[8 kk + l]: row_costs' values.
+ * Lanes p and p + 4 share a register (their sums of absolute differences in its two halves),
+ * gathered into the lane order by the same unpack and shuffle in each half. */
+AVX2 static void row_costs8(const uint8_t *const A[8], const uint8_t *const B[8], size_t n, const size_t s[8],
+                            const band_t *g, size_t i, int32_t *cost)
+{
+    const size_t D = AMSCR__HF_BINS, off = i * g->stride * D;
+    __m256i a[4];
+    size_t jb[8];
+    for (size_t p = 0; p < 4; p++)
+        a[p] = two_rows(A[p] + off, A[p + 4] + off);
+    for (size_t l = 0; l < 8; l++)
+        jb[l] = (s[l] + i * g->stride + n * g->stride - (size_t)g->w * g->stride) % n;
+    for (long kk = 0; kk < g->W; kk++) {
+        __m256i x[4];
+        for (size_t p = 0; p < 4; p++)
+            x[p] = _mm256_sad_epu8(a[p], two_rows(B[p] + jb[p] * D, B[p + 4] + jb[p + 4] * D));
+        for (size_t l = 0; l < 8; l++) {
+            jb[l] += g->stride;
+            if (jb[l] >= n)
+                jb[l] -= n;
+        }
+        __m256i t01 = _mm256_add_epi64(_mm256_unpacklo_epi64(x[0], x[1]), _mm256_unpackhi_epi64(x[0], x[1]));
+        __m256i t23 = _mm256_add_epi64(_mm256_unpacklo_epi64(x[2], x[3]), _mm256_unpackhi_epi64(x[2], x[3]));
+        __m256 v = _mm256_shuffle_ps(_mm256_castsi256_ps(t01), _mm256_castsi256_ps(t23), _MM_SHUFFLE(2, 0, 2, 0));
+        _mm256_storeu_si256((__m256i *)(void *)(cost + 8 * kk), _mm256_castps_si256(v));
+    }
+}
+
+/* amscr__hf_band_dp on eight lanes: lane l is (A[l], B[l], s[l]). */
+AVX2 static void band_dp8(const uint8_t *const A[8], const uint8_t *const B[8], const size_t s[8], size_t n,
+                          size_t band, size_t stride, int32_t skip, amscr__hf_ws *ws, double out[8])
+{
+    const band_t g = band_of(n, band, stride);
+    const size_t L = 8 * (size_t)g.W;
+    int32_t *prev = ws->lanes, *cur = prev + L, *cost = cur + L, *ps = cost + L, *cs = ps + L;
+    for (long kk = 0; kk < g.W; kk++)
+        for (size_t l = 0; l < 8; l++) {
+            prev[8 * kk + l] = 0;
+            ps[8 * kk + l] = (int32_t)(kk - g.w);
+        }
+    for (size_t i = 0; i < g.m; i++) {
+        row_costs8(A, B, n, s, &g, i, cost);
+        band_row8(prev, ps, cost, g.W, skip, cur, cs);
+        int32_t *t = prev;
+        prev = cur;
+        cur = t;
+        t = ps;
+        ps = cs;
+        cs = t;
+    }
+    for (size_t l = 0; l < 8; l++)
+        out[l] = band_end(prev + l, ps + l, 8, &g, skip);
+}
+#undef AVX2
+#endif
+
+int amscr__hf_lanes(void)
+{
+#if defined(DP8)
+    return __builtin_cpu_supports("avx2") ? 8 : 4;
+#else
+    return 4;
+#endif
+}
+
+void amscr__hf_band_dp8(const uint8_t *const A[8], const uint8_t *const B[8], const size_t s[8], size_t n, size_t band,
+                        size_t stride, int32_t skip, amscr__hf_ws *ws, double out[8])
+{
+#if defined(DP8)
+    if (__builtin_cpu_supports("avx2")) {
+        band_dp8(A, B, s, n, band, stride, skip, ws, out);
+        return;
+    }
+#endif
+    amscr__hf_band_dp4(A, B, s, n, band, stride, skip, ws, out);
+    amscr__hf_band_dp4(A + 4, B + 4, s + 4, n, band, stride, skip, ws, out + 4);
 }

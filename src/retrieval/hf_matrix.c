@@ -36,14 +36,14 @@ static void hfm_fini(void *ws)
 static amscr_status hfm_row(void *ctx, size_t i, void *ws)
 {
     const hfm_t *m = ctx;
-    for (size_t j = i + 1; j < m->n; j += 4) { /* four pairs at once: the same values */
-        size_t count = m->n - j < 4 ? m->n - j : 4;
-        const amscr__hf *a[4], *b[4];
+    for (size_t j = i + 1; j < m->n; j += AMSCR__HF_GROUP) { /* pairs side by side: the same values */
+        size_t count = m->n - j < AMSCR__HF_GROUP ? m->n - j : AMSCR__HF_GROUP;
+        const amscr__hf *a[AMSCR__HF_GROUP], *b[AMSCR__HF_GROUP];
         for (size_t t = 0; t < count; t++) {
             a[t] = &m->hf[i];
             b[t] = &m->hf[j + t];
         }
-        amscr__hf_distance4(a, b, count, m->cfg, ws, m->out + i * m->n + j);
+        amscr__hf_distances(a, b, count, m->cfg, ws, m->out + i * m->n + j);
     }
     return AMSCR_OK;
 }

@@ -155,7 +155,7 @@ static amscr_status base_pairs4(const amscr__base *b, const amscr_descriptor *co
             a[t] = &hlo[t][f];
             c[t] = &hhi[t][f];
         }
-        amscr__hf_distance4(a, c, m, &pw->cfg[f], &pw->hws, ch[f]);
+        amscr__hf_distances(a, c, m, &pw->cfg[f], &pw->hws, ch[f]);
     }
     for (size_t t = 0; t < m; t++) {
         double sym = 0.0, f = 0.0, r = 0.0;
