@@ -164,9 +164,10 @@ amscr_status amscr__hf_ws_init(amscr__hf_ws *ws, size_t n, size_t band)
     ws->row = amscr__malloc_array(4 * W, sizeof *ws->row);
     ws->start = amscr__malloc_array(4 * W, sizeof *ws->start);
     ws->lanes = amscr__malloc_array(5 * 8 * W, sizeof *ws->lanes); /* 5 arrays of up to 8 lanes */
+    ws->bands = amscr__malloc_array(8 * (n + 2 * band + 4) * AMSCR__HF_BINS, sizeof *ws->bands); /* strides 1, 2 */
     int ok = amscr__fft_plan_init(&ws->plan, n) == 0;
     ws->have_plan = ok;
-    if (!ws->z || !ws->acc || !ws->row || !ws->start || !ws->lanes || !ok) {
+    if (!ws->z || !ws->acc || !ws->row || !ws->start || !ws->lanes || !ws->bands || !ok) {
         amscr__hf_ws_free(ws);
         return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
     }
@@ -182,6 +183,7 @@ void amscr__hf_ws_free(amscr__hf_ws *ws)
     free(ws->row);
     free(ws->start);
     free(ws->lanes);
+    free(ws->bands);
     memset(ws, 0, sizeof *ws);
 }
 

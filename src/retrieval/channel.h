@@ -42,6 +42,7 @@ struct amscr__hf_ws {
     int32_t *row;
     int32_t *start;
     int32_t *lanes; /* the side-by-side DPs' rows: 5 arrays of 8 lanes x (2 band + 1) */
+    uint8_t *bands; /* their B samples in band order: 8 lanes x (n + 2 band + 4) x AMSCR__HF_BINS */
 };
 
 amscr_status amscr__hf_build(const double *base, size_t n, double locality, amscr__hf *out);

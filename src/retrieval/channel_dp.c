@@ -11,6 +11,7 @@
 #include <float.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -34,17 +35,35 @@ static inline int32_t l1(const uint8_t *x, const uint8_t *y)
 #endif
 }
 
-/* The band's geometry: m rows (samples of A visited), half width w, W = 2 w + 1 cells. */
+/* The band's geometry: m rows (samples of A visited), half width w, W = 2 w + 1 cells; the
+ * samples of B the band visits, in order from its first cell (row 0, cell 0): R. */
 typedef struct {
     size_t m, stride;
     long w, W;
+    size_t R;
 } band_t;
 
 static band_t band_of(size_t n, size_t band, size_t stride)
 {
-    band_t g = {n / stride, stride, (long)(band / stride > 0 ? band / stride : 1), 0};
+    band_t g = {n / stride, stride, (long)(band / stride > 0 ? band / stride : 1), 0, 0};
     g.W = 2 * g.w + 1;
+    g.R = (g.m - 1 + (size_t)g.W - 1) * stride + 1;
     return g;
+}
+
+/* B's samples as the band of shift s visits them, into out (g->R rows): row r is sample
+ * s - w stride + r (cyclic), so cell kk of row i reads row (i + kk) stride, without wrapping.
+ * The side-by-side DPs copy each lane's B once (a few hundred bytes per cell row's work). */
+static void band_samples(const uint8_t *B, size_t n, size_t s, const band_t *g, uint8_t *out)
+{
+    const size_t D = AMSCR__HF_BINS;
+    size_t j = (s + n * g->stride - (size_t)g->w * g->stride) % n;
+    for (size_t r = 0; r < g->R;) {
+        size_t run = n - j < g->R - r ? n - j : g->R - r;
+        memcpy(out + r * D, B + j * D, run * D);
+        r += run;
+        j = 0;
+    }
 }
 
 /* The cell costs of row i against B shifted by s: cost[kk] for kk = 0..W-1. */
@@ -164,26 +183,23 @@ static void band_row4(const int32_t *restrict prev, const int32_t *restrict ps, 
 #undef LD
 #undef ST
 
-/* The cell costs of row i of the four (A, B, s) into cost[4 kk + l]: row_costs' values. */
-static void row_costs4(const uint8_t *const A[4], const uint8_t *const B[4], size_t n, const size_t s[4],
-                       const band_t *g, size_t i, int32_t *cost)
+/* The cell costs of row i of the four lanes into cost[4 kk + l]: row_costs' values, lane l's
+ * B samples at Bv + l R D (band_samples). */
+static void row_costs4(const uint8_t *const A[4], const uint8_t *Bv, const band_t *g, size_t i, int32_t *cost)
 {
     /* each lane's row vector loaded once; the four sums of absolute differences gathered into
      * one register of four lanes (each below 2^12: the low 32 bits of the 64-bit halves) */
+    const size_t D = AMSCR__HF_BINS, step = g->stride * D;
     __m128i a[4];
-    size_t jb[4];
+    const uint8_t *b[4];
     for (size_t l = 0; l < 4; l++) {
-        a[l] = _mm_loadu_si128((const __m128i *)(const void *)(A[l] + i * g->stride * AMSCR__HF_BINS));
-        jb[l] = (s[l] + i * g->stride + n * g->stride - (size_t)g->w * g->stride) % n;
+        a[l] = _mm_loadu_si128((const __m128i *)(const void *)(A[l] + i * step));
+        b[l] = Bv + l * g->R * D + i * step;
     }
     for (long kk = 0; kk < g->W; kk++) {
         __m128i x[4];
-        for (size_t l = 0; l < 4; l++) {
-            x[l] = _mm_sad_epu8(a[l], _mm_loadu_si128((const __m128i *)(const void *)(B[l] + jb[l] * AMSCR__HF_BINS)));
-            jb[l] += g->stride;
-            if (jb[l] >= n)
-                jb[l] -= n;
-        }
+        for (size_t l = 0; l < 4; l++)
+            x[l] = _mm_sad_epu8(a[l], _mm_loadu_si128((const __m128i *)(const void *)(b[l] + (size_t)kk * step)));
         __m128i t01 = _mm_add_epi64(_mm_unpacklo_epi64(x[0], x[1]), _mm_unpackhi_epi64(x[0], x[1]));
         __m128i t23 = _mm_add_epi64(_mm_unpacklo_epi64(x[2], x[3]), _mm_unpackhi_epi64(x[2], x[3]));
         __m128 v = _mm_shuffle_ps(_mm_castsi128_ps(t01), _mm_castsi128_ps(t23), _MM_SHUFFLE(2, 0, 2, 0));
@@ -198,13 +214,15 @@ static void band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], const
     const band_t g = band_of(n, band, stride);
     const size_t L = 4 * (size_t)g.W;
     int32_t *prev = ws->lanes, *cur = prev + L, *cost = cur + L, *ps = cost + L, *cs = ps + L;
+    for (size_t l = 0; l < 4; l++)
+        band_samples(B[l], n, s[l], &g, ws->bands + l * g.R * AMSCR__HF_BINS);
     for (long kk = 0; kk < g.W; kk++)
         for (size_t l = 0; l < 4; l++) {
             prev[4 * kk + l] = 0;
             ps[4 * kk + l] = (int32_t)(kk - g.w);
         }
     for (size_t i = 0; i < g.m; i++) {
-        row_costs4(A, B, n, s, &g, i, cost);
+        row_costs4(A, ws->bands, &g, i, cost);
         band_row4(prev, ps, cost, g.W, skip, cur, cs);
         int32_t *t = prev;
         prev = cur;
@@ -274,28 +292,21 @@ AVX2 static inline __m256i two_rows(const uint8_t *lo, const uint8_t *hi)
     return _mm256_inserti128_si256(_mm256_castsi128_si256(a), b, 1);
 }
 
-/* The cell costs of row i of the eight (A, B, s) into cost[8 kk + l]: row_costs' values.
- * Lanes p and p + 4 share a register (their sums of absolute differences in its two halves),
- * gathered into the lane order by the same unpack and shuffle in each half. */
-AVX2 static void row_costs8(const uint8_t *const A[8], const uint8_t *const B[8], size_t n, const size_t s[8],
-                            const band_t *g, size_t i, int32_t *cost)
+/* The cell costs of row i of the eight lanes into cost[8 kk + l]: row_costs' values, lane l's
+ * B samples at Bv + l R D (band_samples). Lanes p and p + 4 share a register (their sums of
+ * absolute differences in its two halves), gathered into the lane order by the same unpack
+ * and shuffle in each half. */
+AVX2 static void row_costs8(const uint8_t *const A[8], const uint8_t *Bv, const band_t *g, size_t i, int32_t *cost)
 {
-    const size_t D = AMSCR__HF_BINS, off = i * g->stride * D;
+    const size_t D = AMSCR__HF_BINS, step = g->stride * D, lane = g->R * D;
+    const uint8_t *b = Bv + i * step;
     __m256i a[4];
-    size_t jb[8];
     for (size_t p = 0; p < 4; p++)
-        a[p] = two_rows(A[p] + off, A[p + 4] + off);
-    for (size_t l = 0; l < 8; l++)
-        jb[l] = (s[l] + i * g->stride + n * g->stride - (size_t)g->w * g->stride) % n;
-    for (long kk = 0; kk < g->W; kk++) {
+        a[p] = two_rows(A[p] + i * step, A[p + 4] + i * step);
+    for (long kk = 0; kk < g->W; kk++, b += step) {
         __m256i x[4];
         for (size_t p = 0; p < 4; p++)
-            x[p] = _mm256_sad_epu8(a[p], two_rows(B[p] + jb[p] * D, B[p + 4] + jb[p + 4] * D));
-        for (size_t l = 0; l < 8; l++) {
-            jb[l] += g->stride;
-            if (jb[l] >= n)
-                jb[l] -= n;
-        }
+            x[p] = _mm256_sad_epu8(a[p], two_rows(b + p * lane, b + (p + 4) * lane));
         __m256i t01 = _mm256_add_epi64(_mm256_unpacklo_epi64(x[0], x[1]), _mm256_unpackhi_epi64(x[0], x[1]));
         __m256i t23 = _mm256_add_epi64(_mm256_unpacklo_epi64(x[2], x[3]), _mm256_unpackhi_epi64(x[2], x[3]));
         __m256 v = _mm256_shuffle_ps(_mm256_castsi256_ps(t01), _mm256_castsi256_ps(t23), _MM_SHUFFLE(2, 0, 2, 0));
@@ -310,13 +321,15 @@ AVX2 static void band_dp8(const uint8_t *const A[8], const uint8_t *const B[8], 
     const band_t g = band_of(n, band, stride);
     const size_t L = 8 * (size_t)g.W;
     int32_t *prev = ws->lanes, *cur = prev + L, *cost = cur + L, *ps = cost + L, *cs = ps + L;
+    for (size_t l = 0; l < 8; l++)
+        band_samples(B[l], n, s[l], &g, ws->bands + l * g.R * AMSCR__HF_BINS);
     for (long kk = 0; kk < g.W; kk++)
         for (size_t l = 0; l < 8; l++) {
             prev[8 * kk + l] = 0;
             ps[8 * kk + l] = (int32_t)(kk - g.w);
         }
     for (size_t i = 0; i < g.m; i++) {
-        row_costs8(A, B, n, s, &g, i, cost);
+        row_costs8(A, ws->bands, &g, i, cost);
         band_row8(prev, ps, cost, g.W, skip, cur, cs);
         int32_t *t = prev;
         prev = cur;
