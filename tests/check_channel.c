@@ -1,7 +1,7 @@
 /* check_channel.c — the shape channel (amscr_channel_distance, amscr_db_channel_matrix) and
  * the fused retrieval matrix: invariance under the channel's group, self-distance 0, the
- * matrix against the pair function, articulation tolerance, the four-lane DP against the
- * one-pair DP, and bad input. */
+ * matrix against the pair function, articulation tolerance, the shift search, the
+ * side-by-side DPs against the one-pair DP, and bad input. */
 #include <amscr.h>
 #include <check.h>
 #include <math.h>
@@ -308,6 +308,50 @@ START_TEST(test_bad_input)
 }
 END_TEST
 
+/* The shift search finds the cyclic shift and the orientation: a curve against its samples
+ * rotated by more than the band, and against its mirror image rotated, is at distance 0
+ * exactly in a band of 3 samples (the DP could not bridge the shift); without reflections
+ * the mirror image is not. The side-by-side entry agrees. */
+START_TEST(test_shift_search)
+{
+    enum { N = 128 };
+    double xy[2 * N], rot[2 * N], mir[2 * N];
+    for (int i = 0; i < N; i++) {
+        double t = 2.0 * PI * i / N, r = 1.0 + 0.3 * cos(3 * t + 0.4) + 0.2 * sin(5 * t) + 0.1 * cos(7 * t);
+        xy[2 * i] = 1.3 * r * cos(t);
+        xy[2 * i + 1] = r * sin(t);
+    }
+    amscr__hf a, b, m;
+    amscr__hf_ws ws;
+    ck_assert_int_eq(amscr__hf_build(xy, N, 4.0, &a), AMSCR_OK);
+    ck_assert_int_eq(amscr__hf_ws_init(&ws, N, 3), AMSCR_OK);
+    const int shifts[3] = {37, 64, 101};
+    for (int s = 0; s < 3; s++) {
+        for (int i = 0; i < N; i++) {
+            int j = (i + shifts[s]) % N, k = (N - 1 - i + shifts[s]) % N; /* mirror: x -> -x, reversed */
+            rot[2 * i] = xy[2 * j];
+            rot[2 * i + 1] = xy[2 * j + 1];
+            mir[2 * i] = -xy[2 * k];
+            mir[2 * i + 1] = xy[2 * k + 1];
+        }
+        ck_assert_int_eq(amscr__hf_build(rot, N, 4.0, &b), AMSCR_OK);
+        ck_assert_int_eq(amscr__hf_build(mir, N, 4.0, &m), AMSCR_OK);
+        amscr__hf_cfg on = {3, 1.0, 1, 0, 1}, off = {3, 1.0, 0, 0, 1};
+        ck_assert_msg(amscr__hf_distance(&a, &b, &off, &ws) == 0.0, "shift %d", shifts[s]);
+        ck_assert_msg(amscr__hf_distance(&a, &m, &on, &ws) == 0.0, "mirrored, shift %d", shifts[s]);
+        ck_assert(amscr__hf_distance(&a, &m, &off, &ws) > 0.1);
+        const amscr__hf *l[3] = {&a, &a, &b}, *r[3] = {&b, &m, &a};
+        double d[3] = {-1, -1, -1};
+        amscr__hf_distances(l, r, 3, &on, &ws, d);
+        ck_assert(d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0);
+        amscr__hf_free(&b);
+        amscr__hf_free(&m);
+    }
+    amscr__hf_ws_free(&ws);
+    amscr__hf_free(&a);
+}
+END_TEST
+
 /* The side-by-side pair distances (the collection matrix's and the index's) equal the one-pair
  * distance bit for bit: pairs of different first shapes, every count of pairs 1-8 (eight DPs
  * in AVX2 lanes when the processor has them, groups of four otherwise and for the last four
@@ -367,6 +411,7 @@ Suite *amscr_suite_channel(void)
     tcase_add_test(tc, test_self_zero_and_articulation);
     tcase_add_test(tc, test_matrices);
     tcase_add_test(tc, test_side_by_side);
+    tcase_add_test(tc, test_shift_search);
     tcase_add_test(tc, test_bad_input);
     suite_add_tcase(s, tc);
     return s;

@@ -58,9 +58,12 @@ static void heights(const double *P, size_t n, double locality, uint8_t *seq, do
         double nx = tl > 0.0 ? -ty / tl : 0.0, ny = tl > 0.0 ? tx / tl : 0.0;
         memset(acc, 0, D * sizeof *acc);
         memset(cnt, 0, D * sizeof *cnt);
-        for (size_t j = 1; j < n; j++) {
-            size_t q = (i + j) % n;
-            size_t b = (j - 1) * D / (n - 1);
+        for (size_t j = 1, b = 0, next = n - 1; j < n; j++) { /* bin (j - 1) D / (n - 1) */
+            size_t q = i + j < n ? i + j : i + j - n;
+            while ((j - 1) * D >= next) {
+                b++;
+                next += n - 1;
+            }
             acc[b] += (P[2 * q] - P[2 * i]) * nx + (P[2 * q + 1] - P[2 * i + 1]) * ny;
             cnt[b]++;
         }
@@ -74,17 +77,24 @@ static void heights(const double *P, size_t n, double locality, uint8_t *seq, do
     }
 }
 
+/* The kept frequencies of every bin column's DFT into spec (AMSCR__HF_SPEC(nfreq) values):
+ * bin b's real parts at spec + 2 b P, its imaginary parts at spec + (2 b + 1) P, P =
+ * AMSCR__HF_PAD(nfreq), the padding zero. */
 static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, double *spec, amscr__fft_plan *plan,
-                            double *z)
+                           double *z)
 {
-    const size_t D = AMSCR__HF_BINS;
+    const size_t D = AMSCR__HF_BINS, P = AMSCR__HF_PAD(nfreq);
+    memset(spec, 0, AMSCR__HF_SPEC(nfreq) * sizeof *spec);
     for (size_t b = 0; b < D; b++) {
         for (size_t i = 0; i < n; i++) {
             z[2 * i] = (double)seq[i * D + b] - 128.0;
             z[2 * i + 1] = 0.0;
         }
         amscr__fft(plan, z, 0);
-        memcpy(spec + b * 2 * nfreq, z, 2 * nfreq * sizeof *z);
+        for (size_t f = 0; f < nfreq; f++) {
+            spec[2 * b * P + f] = z[2 * f];
+            spec[(2 * b + 1) * P + f] = z[2 * f + 1];
+        }
     }
     return AMSCR_OK;
 }
@@ -105,7 +115,7 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
     amscr_status st = AMSCR_OK;
     for (int o = 0; o < 2; o++) {
         out->seq[o] = amscr__malloc_array(n * D, sizeof(uint8_t));
-        out->spec[o] = amscr__malloc_array(D * 2 * out->nfreq, sizeof(double));
+        out->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(out->nfreq), sizeof(double));
         if (!out->seq[o] || !out->spec[o])
             st = AMSCR_E_NOMEM;
     }
@@ -141,7 +151,7 @@ amscr_status amscr__hf_spectra(amscr__hf *h, amscr__hf_ws *ws)
     int have_plan = own && amscr__fft_plan_init(&plan, h->n) == 0;
     amscr_status st = z && (have_plan || !own) ? AMSCR_OK : AMSCR_E_NOMEM;
     for (int o = 0; o < 2 && st == AMSCR_OK; o++) {
-        h->spec[o] = amscr__malloc_array(AMSCR__HF_BINS * 2 * h->nfreq, sizeof(double));
+        h->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(h->nfreq), sizeof(double));
         if (h->spec[o])
             spectra(h->seq[o], h->n, h->nfreq, h->spec[o], own ? &plan : &ws->plan, z);
         else
@@ -188,21 +198,29 @@ void amscr__hf_ws_free(amscr__hf_ws *ws)
 }
 
 /* The low-passed cross-spectra conj(A) B summed over the bins, for orientation 0 of b and,
- * when `both`, orientation 1: acc[4 f + 2 o] real, acc[4 f + 2 o + 1] imaginary part. The bins
- * are the outer loop and the frequencies the inner one (independent sums, side by side in
- * vector registers); each frequency's sum still runs over the bins in order. */
+ * when `both`, orientation 1: acc[4 f + 2 o] real, acc[4 f + 2 o + 1] imaginary part. Four
+ * frequencies at a time side by side (vector registers), each summed over the bins in order. */
 static void cross_spectra(const amscr__hf *a, const amscr__hf *b, int both, double *restrict acc)
 {
-    const size_t D = AMSCR__HF_BINS, fmax = AMSCR__HF_FREQS(a->n), F = a->nfreq;
-    memset(acc, 0, 4 * (fmax + 1) * sizeof *acc);
-    for (size_t bin = 0; bin < D; bin++)
-        for (int o = 0; o < (both ? 2 : 1); o++) {
-            const double *restrict fa = a->spec[0] + bin * 2 * F, *restrict fb = b->spec[o] + bin * 2 * F;
-            for (size_t f = 0; f <= fmax; f++) {
-                acc[4 * f + 2 * o] += fa[2 * f] * fb[2 * f] + fa[2 * f + 1] * fb[2 * f + 1];
-                acc[4 * f + 2 * o + 1] += fa[2 * f] * fb[2 * f + 1] - fa[2 * f + 1] * fb[2 * f];
+    const size_t D = AMSCR__HF_BINS, F = a->nfreq, P = AMSCR__HF_PAD(F);
+    for (size_t f0 = 0; f0 < F; f0 += 4) {
+        double re[2][4] = {{0.0}}, im[2][4] = {{0.0}};
+        for (size_t bin = 0; bin < D; bin++) {
+            const double *ar = a->spec[0] + 2 * bin * P + f0, *ai = ar + P;
+            for (int o = 0; o < (both ? 2 : 1); o++) {
+                const double *br = b->spec[o] + 2 * bin * P + f0, *bi = br + P;
+                for (size_t t = 0; t < 4; t++) {
+                    re[o][t] += ar[t] * br[t] + ai[t] * bi[t];
+                    im[o][t] += ar[t] * bi[t] - ai[t] * br[t];
+                }
             }
         }
+        for (size_t t = 0; t < 4 && f0 + t < F; t++)
+            for (int o = 0; o < 2; o++) {
+                acc[4 * (f0 + t) + 2 * (size_t)o] = re[o][t];
+                acc[4 * (f0 + t) + 2 * (size_t)o + 1] = im[o][t];
+            }
+    }
 }
 
 /* The spectrum whose inverse FFT carries both orientations' correlations into z: orientation

@@ -14,6 +14,11 @@
 /* Frequencies used by the shift search (the correlation is low-passed; the DP band absorbs
  * the coarser shift): the first N/8, at most N/2. */
 #define AMSCR__HF_FREQS(n) ((n) / 8 < (n) / 2 ? (n) / 8 : (n) / 2)
+/* The kept frequencies of a bin's DFT padded to a multiple of 4 (the shift search reads four
+ * at a time), and the values of one orientation's spectra: real and imaginary parts of every
+ * bin (amscr__hf.spec). */
+#define AMSCR__HF_PAD(nfreq) (((nfreq) + 3) / 4 * 4)
+#define AMSCR__HF_SPEC(nfreq) (2 * AMSCR__HF_BINS * AMSCR__HF_PAD(nfreq))
 
 /* A shape's height-function sequences: forward and mirrored, with the DFT of every bin (only
  * the frequencies the shift search reads). */
@@ -21,7 +26,7 @@ typedef struct {
     size_t n;
     size_t nfreq;    /* frequencies kept of each bin's DFT: AMSCR__HF_FREQS(n) + 1 */
     uint8_t *seq[2]; /* n * AMSCR__HF_BINS, weighted heights, quantized: 128 + QUANT * h */
-    double *spec[2]; /* AMSCR__HF_BINS * 2 nfreq, complex interleaved */
+    double *spec[2]; /* AMSCR__HF_SPEC(nfreq): per bin nfreq real parts, then imaginary, padded */
 } amscr__hf;
 
 typedef struct {
