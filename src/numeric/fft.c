@@ -6,6 +6,9 @@
 
 #include <math.h>
 #include <stdlib.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 int amscr__fft_plan_init(amscr__fft_plan *p, size_t n)
 {
@@ -46,6 +49,33 @@ void amscr__fft_plan_free(amscr__fft_plan *p)
     p->tw = NULL;
     p->rev = NULL;
     p->tmp = NULL;
+}
+
+/* One radix-2 stage of butterflies of length len: b * w added to and taken from a. With SSE2
+ * a complex value is one register and x = b w is (b0 wr - b1 wi, b1 wr + b0 wi): the scalar
+ * products and sums (a difference as the sum of the negated product), so the same values. */
+static void stage(const amscr__fft_plan *p, double *z, size_t len, double sgn)
+{
+    size_t n = p->n, half = len >> 1, step = n / len;
+    for (size_t i = 0; i < n; i += len)
+        for (size_t j = 0; j < half; j++) {
+            double wr = p->tw[2 * j * step], wi = sgn * p->tw[2 * j * step + 1];
+            double *a = z + 2 * (i + j), *b = z + 2 * (i + j + half);
+#if defined(__SSE2__)
+            __m128d B = _mm_loadu_pd(b), A = _mm_loadu_pd(a);
+            __m128d P = _mm_mul_pd(B, _mm_set1_pd(wr));
+            __m128d Q = _mm_mul_pd(_mm_shuffle_pd(B, B, 1), _mm_set1_pd(wi)); /* (b1 wi, b0 wi) */
+            __m128d X = _mm_add_pd(P, _mm_xor_pd(Q, _mm_set_pd(0.0, -0.0)));  /* (-b1 wi, b0 wi) */
+            _mm_storeu_pd(b, _mm_sub_pd(A, X));
+            _mm_storeu_pd(a, _mm_add_pd(A, X));
+#else
+            double xr = b[0] * wr - b[1] * wi, xi = b[0] * wi + b[1] * wr;
+            b[0] = a[0] - xr;
+            b[1] = a[1] - xi;
+            a[0] += xr;
+            a[1] += xi;
+#endif
+        }
 }
 
 /* In-place transform of n interleaved complex values. inverse: e^{+i...}, unscaled. */
@@ -103,18 +133,6 @@ void amscr__fft(const amscr__fft_plan *p, double *z, int inverse)
         }
         start = 8;
     }
-    for (size_t len = start; len <= n; len <<= 1) {
-        size_t half = len >> 1, step = n / len;
-        for (size_t i = 0; i < n; i += len) {
-            for (size_t j = 0; j < half; j++) {
-                double wr = p->tw[2 * j * step], wi = sgn * p->tw[2 * j * step + 1];
-                double *a = z + 2 * (i + j), *b = z + 2 * (i + j + half);
-                double xr = b[0] * wr - b[1] * wi, xi = b[0] * wi + b[1] * wr;
-                b[0] = a[0] - xr;
-                b[1] = a[1] - xi;
-                a[0] += xr;
-                a[1] += xi;
-            }
-        }
-    }
+    for (size_t len = start; len <= n; len <<= 1)
+        stage(p, z, len, sgn);
 }

@@ -243,6 +243,34 @@ static void pack_spectra(const double *acc, size_t n, int both, double *z)
         }
 }
 
+/* The first s of the largest z[2 s + o], o < no (orientation o's correlations over the n
+ * shifts), into best[o] and its value into top[o]: the shift a scan keeping the first strict
+ * maximum picks. The maximum by eight independent running maxima (two orientations x four
+ * shifts: no chain of comparisons through all n), then its first place. */
+static void first_max(const double *z, size_t n, size_t no, size_t best[2], double top[2])
+{
+    double m[8];
+    for (size_t i = 0; i < 8; i++)
+        m[i] = z[i % 2];
+    size_t s4 = n / 4 * 4;
+    for (size_t s = 0; s < s4; s += 4)
+        for (size_t i = 0; i < 8; i++)
+            m[i] = z[2 * s + i] > m[i] ? z[2 * s + i] : m[i];
+    for (size_t s = s4; s < n; s++)
+        for (size_t o = 0; o < 2; o++)
+            m[o] = z[2 * s + o] > m[o] ? z[2 * s + o] : m[o];
+    for (size_t o = 0; o < no; o++) {
+        double t = m[o];
+        for (size_t k = 1; k < 4; k++)
+            t = m[2 * k + o] > t ? m[2 * k + o] : t;
+        size_t s = 0;
+        while (s + 1 < n && z[2 * s + o] != t)
+            s++;
+        best[o] = s;
+        top[o] = t;
+    }
+}
+
 /* The cyclic shift of b that maximizes its correlation with a, for orientation 0 and, when
  * `both`, orientation 1 — one inverse FFT for the two. shift[o] and corr[o] receive them. */
 static void best_shifts(const amscr__hf *a, const amscr__hf *b, int both, amscr__hf_ws *ws, size_t shift[2],
@@ -253,14 +281,7 @@ static void best_shifts(const amscr__hf *a, const amscr__hf *b, int both, amscr_
     cross_spectra(a, b, both, ws->acc);
     pack_spectra(ws->acc, n, both, z);
     amscr__fft(&ws->plan, z, 1);
-    for (int o = 0; o < (both ? 2 : 1); o++) {
-        size_t best = 0;
-        for (size_t s = 1; s < n; s++)
-            if (z[2 * s + o] > z[2 * best + o])
-                best = s;
-        shift[o] = best;
-        corr[o] = z[2 * best + o];
-    }
+    first_max(z, n, both ? 2 : 1, shift, corr);
 }
 
 /* The DP jobs of the pair (a, b): the orientation(s) of b and their shifts; returns 1 or 2. */
