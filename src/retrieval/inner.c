@@ -180,21 +180,43 @@ void amscr__inner_twist(amscr__inner *f, const amscr__inner_ws *ws) { twist(f, w
 /* Z(f), f = 0..N/2, into ws->z with its Hermitian rest: the correlation of a and b over the
  * shifts (real part: sum_k conj(A) B, sum_i a[i] b[i + s]) and, when `refl`, of a and b
  * reversed (imaginary part: sum_k A B e^{-2 pi i f (k + 1) / N}, sum_i a[i] b[-i - s - k - 1]). */
+/* The four sums over the columns k of frequencies f0 .. f0 + g - 1 into s[f][0..3] (X's real and
+ * imaginary part, Y's; Y 0 without `refl`): the g frequencies side by side, each summed over
+ * k in order (the chain of one sum no longer waits on itself alone). */
+static inline void column_sums(const amscr__inner *a, const amscr__inner *b, int refl, size_t f0, size_t g,
+                               double (*s)[4])
+{
+    double xr[4] = {0.0}, xi[4] = {0.0}, yr[4] = {0.0}, yi[4] = {0.0};
+    for (size_t k = 0; k < AMSCR__INNER_K; k++)
+        for (size_t t = 0; t < g; t++) {
+            double ar = a->re[f0 + t][k], ai = a->im[f0 + t][k], br = b->re[f0 + t][k], bi = b->im[f0 + t][k];
+            xr[t] += ar * br + ai * bi;
+            xi[t] += ar * bi - ai * br;
+        }
+    for (size_t k = 0; refl && k < AMSCR__INNER_K; k++)
+        for (size_t t = 0; t < g; t++) {
+            double ar = a->re[f0 + t][k], ai = a->im[f0 + t][k], tr = b->tre[f0 + t][k], ti = b->tim[f0 + t][k];
+            yr[t] += ar * tr - ai * ti;
+            yi[t] += ar * ti + ai * tr;
+        }
+    for (size_t t = 0; t < g; t++) {
+        s[f0 + t][0] = xr[t];
+        s[f0 + t][1] = xi[t];
+        s[f0 + t][2] = yr[t];
+        s[f0 + t][3] = yi[t];
+    }
+}
+
 static void spectrum(const amscr__inner *a, const amscr__inner *b, int refl, amscr__inner_ws *ws)
 {
-    double *z = ws->z;
+    double *z = ws->z, s[AMSCR__INNER_F][4];
+    size_t f0 = 0;
+    for (; f0 + 4 <= AMSCR__INNER_F; f0 += 4)
+        column_sums(a, b, refl, f0, 4, s);
+    for (; f0 < AMSCR__INNER_F; f0++)
+        column_sums(a, b, refl, f0, 1, s);
     for (size_t f = 0; f < AMSCR__INNER_F; f++) {
-        const double *ar = a->re[f], *ai = a->im[f], *br = b->re[f], *bi = b->im[f];
-        const double *tr = b->tre[f], *ti = b->tim[f];
-        double xr = 0.0, xi = 0.0, yr = 0.0, yi = 0.0;
-        for (size_t k = 0; k < AMSCR__INNER_K; k++) {
-            xr += ar[k] * br[k] + ai[k] * bi[k];
-            xi += ar[k] * bi[k] - ai[k] * br[k];
-        }
-        for (size_t k = 0; refl && k < AMSCR__INNER_K; k++) {
-            yr += ar[k] * tr[k] - ai[k] * ti[k];
-            yi += ar[k] * ti[k] + ai[k] * tr[k];
-        }
+        double xr = s[f][0], xi = s[f][1], yr = s[f][2], yi = s[f][3];
         z[2 * f] = xr - yi; /* X + i Y */
         z[2 * f + 1] = xi + yr;
         if (f > 0 && f < N / 2) { /* conj(X) + i conj(Y) at N - f */
