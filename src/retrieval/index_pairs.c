@@ -142,15 +142,16 @@ static void side_close(const amscr__base *b, side_t *o)
         spectra_free(b, o->built);
 }
 
-/* out[t] for m <= 4 pairs: the base distance of lo[t] and hi[t] (lo the lower index), their
- * channel sequences hlo[t], hhi[t]; the channel's DPs side by side (the same values). */
-static amscr_status base_pairs4(const amscr__base *b, const amscr_descriptor *const lo[4],
-                                const amscr__hf *const hlo[4], const amscr_descriptor *const hi[4],
-                                const amscr__hf *const hhi[4], size_t m, amscr__pair_ws *pw, double *out)
+/* out[t] for m <= AMSCR__HF_GROUP pairs: the base distance of lo[t] and hi[t] (lo the lower
+ * index), their channel sequences hlo[t], hhi[t]; the channel's DPs side by side (the same
+ * values). */
+static amscr_status base_group(const amscr__base *b, const amscr_descriptor *const lo[],
+                               const amscr__hf *const hlo[], const amscr_descriptor *const hi[],
+                               const amscr__hf *const hhi[], size_t m, amscr__pair_ws *pw, double *out)
 {
-    double ch[2][4] = {{0.0}};
+    double ch[2][AMSCR__HF_GROUP] = {{0.0}};
     for (int f = 0; f < b->nf; f++) {
-        const amscr__hf *a[4], *c[4];
+        const amscr__hf *a[AMSCR__HF_GROUP], *c[AMSCR__HF_GROUP];
         for (size_t t = 0; t < m; t++) {
             a[t] = &hlo[t][f];
             c[t] = &hhi[t][f];
@@ -178,11 +179,12 @@ amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const a
                                size_t m, amscr__pair_ws *pw, double *out)
 {
     amscr_status st = AMSCR_OK;
-    for (size_t t0 = 0; t0 < m && st == AMSCR_OK; t0 += 4) {
-        size_t g = m - t0 < 4 ? m - t0 : 4, open = 0;
-        side_t side[4];
-        const amscr_descriptor *lo[4], *hi[4];
-        const amscr__hf *hlo[4], *hhi[4];
+    enum { G = AMSCR__HF_GROUP };
+    for (size_t t0 = 0; t0 < m && st == AMSCR_OK; t0 += G) {
+        size_t g = m - t0 < G ? m - t0 : G, open = 0;
+        side_t side[G];
+        const amscr_descriptor *lo[G], *hi[G];
+        const amscr__hf *hlo[G], *hhi[G];
         for (; open < g && st == AMSCR_OK; open++) {
             size_t c = cand[t0 + open];
             st = side_open(b, db, hfs, c, pw, &side[open]);
@@ -193,7 +195,7 @@ amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const a
             hhi[open] = first ? hq : side[open].hf;
         }
         if (st == AMSCR_OK)
-            st = base_pairs4(b, lo, hlo, hi, hhi, g, pw, out + t0);
+            st = base_group(b, lo, hlo, hi, hhi, g, pw, out + t0);
         for (size_t t = 0; t < open; t++)
             side_close(b, &side[t]);
     }
@@ -202,7 +204,7 @@ amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const a
 
 /* ---------------------------------------------------------------- one row on threads */
 
-enum { CHUNK = 4 };
+enum { CHUNK = AMSCR__HF_GROUP };
 
 typedef struct {
     const amscr__base *b;
