@@ -23,6 +23,7 @@
 #include "channel.h"
 #include "inner.h"
 #include "internal.h"
+#include "folds_tsv.h"
 #include "mcd_set.h"
 #include "../tools/cli/collection.h"
 
@@ -220,34 +221,6 @@ static void free_bases(set_run *r)
         free(r->base[b]);
 }
 
-/* Fold (0 A, 1 B) of every class of the manifest from folds.tsv beside it; -1 without it. */
-static int read_folds(const char *manifest, int32_t *fold_of_class, size_t cap)
-{
-    char path[4096], line[256];
-    collection col;
-    snprintf(path, sizeof path, "%.*s/folds.tsv", (int)(strrchr(manifest, '/') - manifest), manifest);
-    FILE *f = fopen(path, "r");
-    if (!f || collection_open(manifest, &col) != 0) {
-        if (f)
-            fclose(f);
-        return -1;
-    }
-    for (size_t k = 0; k < cap; k++)
-        fold_of_class[k] = 0;
-    while (fgets(line, sizeof line, f)) {
-        char *tab = strchr(line, '\t');
-        if (!tab)
-            continue;
-        *tab = '\0';
-        for (size_t k = 0; k < col.nclasses && k < cap; k++)
-            if (strcmp(col.classes[k], line) == 0)
-                fold_of_class[k] = tab[1] == 'B';
-    }
-    fclose(f);
-    collection_free(&col);
-    return 0;
-}
-
 /* The fold `which` of the set `all` as its own collection: sub-matrices of the base matrices
  * (a pair's distance does not depend on the rest; the medians and the re-ranking graph are the
  * fold's own); its times are the fusion and re-ranking only. */
@@ -301,7 +274,7 @@ int ablation_main(const char *dir)
         sets[k].t_load = now() - t0;
         compute_bases(&sets[k]);
         score_rows(&sets[k]);
-        if (k == 0 && read_folds(path, fold_of_class, sizeof fold_of_class / sizeof fold_of_class[0]) == 0) {
+        if (k == 0 && folds_tsv_read(path, fold_of_class, sizeof fold_of_class / sizeof fold_of_class[0]) == 0) {
             for (int w = 0; w < 2; w++) {
                 fold_set(&sets[0], fold_of_class, w, &folds[w]);
                 folds[w].title = w ? "fold B (bull's eye %)" : "fold A (bull's eye %)";
