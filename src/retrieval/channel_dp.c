@@ -185,7 +185,7 @@ static void band_row4(const int32_t *restrict prev, const int32_t *restrict ps, 
 
 /* The cell costs of row i of the four lanes into cost[4 kk + l]: row_costs' values, lane l's
  * B samples at Bv + l R D (band_samples). */
-static void row_costs4(const uint8_t *const A[4], const uint8_t *Bv, const band_t *g, size_t i, int32_t *cost)
+static void row_costs4(const uint8_t *const *A, const uint8_t *Bv, const band_t *g, size_t i, int32_t *cost)
 {
     /* each lane's row vector loaded once; the four sums of absolute differences gathered into
      * one register of four lanes (each below 2^12: the low 32 bits of the 64-bit halves) */
@@ -207,23 +207,31 @@ static void row_costs4(const uint8_t *const A[4], const uint8_t *Bv, const band_
     }
 }
 
-/* amscr__hf_band_dp on four lanes: lane l is (A[l], B[l], s[l]). */
-static void band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], const size_t s[4], size_t n, size_t band,
-                     size_t stride, int32_t skip, amscr__hf_ws *ws, double out[4])
+/* A row's cell costs and its DP step on `nl` lanes side by side (row_costs4 / band_row4 and
+ * their eight-lane forms). */
+typedef void (*lane_costs_fn)(const uint8_t *const *A, const uint8_t *Bv, const band_t *g, size_t i, int32_t *cost);
+typedef void (*lane_row_fn)(const int32_t *prev, const int32_t *ps, const int32_t *cost, long W, int32_t skip,
+                            int32_t *cur, int32_t *cs);
+
+/* amscr__hf_band_dp on nl lanes (4 or 8): lane l is (A[l], B[l], s[l]), cell kk of lane l at
+ * [nl kk + l]. */
+static void band_lanes(size_t nl, lane_costs_fn costs, lane_row_fn step, const uint8_t *const *A,
+                       const uint8_t *const *B, const size_t *s, size_t n, size_t band, size_t stride, int32_t skip,
+                       amscr__hf_ws *ws, double *out)
 {
     const band_t g = band_of(n, band, stride);
-    const size_t L = 4 * (size_t)g.W;
+    const size_t L = nl * (size_t)g.W;
     int32_t *prev = ws->lanes, *cur = prev + L, *cost = cur + L, *ps = cost + L, *cs = ps + L;
-    for (size_t l = 0; l < 4; l++)
+    for (size_t l = 0; l < nl; l++)
         band_samples(B[l], n, s[l], &g, ws->bands + l * g.R * AMSCR__HF_BINS);
     for (long kk = 0; kk < g.W; kk++)
-        for (size_t l = 0; l < 4; l++) {
-            prev[4 * kk + l] = 0;
-            ps[4 * kk + l] = (int32_t)(kk - g.w);
+        for (size_t l = 0; l < nl; l++) {
+            prev[nl * (size_t)kk + l] = 0;
+            ps[nl * (size_t)kk + l] = (int32_t)(kk - g.w);
         }
     for (size_t i = 0; i < g.m; i++) {
-        row_costs4(A, ws->bands, &g, i, cost);
-        band_row4(prev, ps, cost, g.W, skip, cur, cs);
+        costs(A, ws->bands, &g, i, cost);
+        step(prev, ps, cost, g.W, skip, cur, cs);
         int32_t *t = prev;
         prev = cur;
         cur = t;
@@ -231,8 +239,8 @@ static void band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], const
         ps = cs;
         cs = t;
     }
-    for (size_t l = 0; l < 4; l++)
-        out[l] = band_end(prev + l, ps + l, 4, &g, skip);
+    for (size_t l = 0; l < nl; l++)
+        out[l] = band_end(prev + l, ps + l, nl, &g, skip);
 }
 #endif
 
@@ -240,7 +248,7 @@ void amscr__hf_band_dp4(const uint8_t *const A[4], const uint8_t *const B[4], co
                         size_t stride, int32_t skip, amscr__hf_ws *ws, double out[4])
 {
 #if defined(__SSE2__) && AMSCR__HF_BINS == 16
-    band_dp4(A, B, s, n, band, stride, skip, ws, out);
+    band_lanes(4, row_costs4, band_row4, A, B, s, n, band, stride, skip, ws, out);
 #else
     for (size_t l = 0; l < 4; l++)
         out[l] = amscr__hf_band_dp(A[l], B[l], n, s[l], band, stride, skip, ws);
@@ -296,7 +304,7 @@ AVX2 static inline __m256i two_rows(const uint8_t *lo, const uint8_t *hi)
  * B samples at Bv + l R D (band_samples). Lanes p and p + 4 share a register (their sums of
  * absolute differences in its two halves), gathered into the lane order by the same unpack
  * and shuffle in each half. */
-AVX2 static void row_costs8(const uint8_t *const A[8], const uint8_t *Bv, const band_t *g, size_t i, int32_t *cost)
+AVX2 static void row_costs8(const uint8_t *const *A, const uint8_t *Bv, const band_t *g, size_t i, int32_t *cost)
 {
     const size_t D = AMSCR__HF_BINS, step = g->stride * D, lane = g->R * D;
     const uint8_t *b = Bv + i * step;
@@ -314,33 +322,6 @@ AVX2 static void row_costs8(const uint8_t *const A[8], const uint8_t *Bv, const 
     }
 }
 
-/* amscr__hf_band_dp on eight lanes: lane l is (A[l], B[l], s[l]). */
-AVX2 static void band_dp8(const uint8_t *const A[8], const uint8_t *const B[8], const size_t s[8], size_t n,
-                          size_t band, size_t stride, int32_t skip, amscr__hf_ws *ws, double out[8])
-{
-    const band_t g = band_of(n, band, stride);
-    const size_t L = 8 * (size_t)g.W;
-    int32_t *prev = ws->lanes, *cur = prev + L, *cost = cur + L, *ps = cost + L, *cs = ps + L;
-    for (size_t l = 0; l < 8; l++)
-        band_samples(B[l], n, s[l], &g, ws->bands + l * g.R * AMSCR__HF_BINS);
-    for (long kk = 0; kk < g.W; kk++)
-        for (size_t l = 0; l < 8; l++) {
-            prev[8 * kk + l] = 0;
-            ps[8 * kk + l] = (int32_t)(kk - g.w);
-        }
-    for (size_t i = 0; i < g.m; i++) {
-        row_costs8(A, ws->bands, &g, i, cost);
-        band_row8(prev, ps, cost, g.W, skip, cur, cs);
-        int32_t *t = prev;
-        prev = cur;
-        cur = t;
-        t = ps;
-        ps = cs;
-        cs = t;
-    }
-    for (size_t l = 0; l < 8; l++)
-        out[l] = band_end(prev + l, ps + l, 8, &g, skip);
-}
 #undef AVX2
 #endif
 
@@ -358,7 +339,7 @@ void amscr__hf_band_dp8(const uint8_t *const A[8], const uint8_t *const B[8], co
 {
 #if defined(DP8)
     if (__builtin_cpu_supports("avx2")) {
-        band_dp8(A, B, s, n, band, stride, skip, ws, out);
+        band_lanes(8, row_costs8, band_row8, A, B, s, n, band, stride, skip, ws, out);
         return;
     }
 #endif
