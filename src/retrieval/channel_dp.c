@@ -53,7 +53,7 @@ static band_t band_of(size_t n, size_t band, size_t stride)
 
 /* B's samples as the band of shift s visits them, into out (g->R rows): row r is sample
  * s - w stride + r (cyclic), so cell kk of row i reads row (i + kk) stride, without wrapping.
- * The side-by-side DPs copy each lane's B once (a few hundred bytes per cell row's work). */
+ * The side-by-side DPs copy each lane's B once (R rows of 16 bytes, for m rows of W cells). */
 static void band_samples(const uint8_t *B, size_t n, size_t s, const band_t *g, uint8_t *out)
 {
     const size_t D = AMSCR__HF_BINS;
