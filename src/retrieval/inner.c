@@ -55,17 +55,19 @@ static int inside(const double *V, double x, double y)
     return in;
 }
 
-/* Whether the chord from vertex i to vertex j stays inside the polygon V. */
+/* Whether the chord from vertex i to vertex j stays inside the polygon V. Each vertex's side of
+ * the chord's line is computed once and carried to the next edge. */
 static int visible(const double *V, size_t i, size_t j)
 {
     const double *p = V + 2 * i, *q = V + 2 * j;
+    double ce = cross(p, q, V);
     for (size_t e = 0; e < N; e++) {
         size_t f = (e + 1) % N;
-        if (e == i || e == j || f == i || f == j)
-            continue;
         const double *a = V + 2 * e, *b = V + 2 * f;
-        if (cross(p, q, a) * cross(p, q, b) < 0.0 && cross(a, b, p) * cross(a, b, q) < 0.0)
+        double cf = cross(p, q, b);
+        if (!(e == i || e == j || f == i || f == j) && ce * cf < 0.0 && cross(a, b, p) * cross(a, b, q) < 0.0)
             return 0;
+        ce = cf;
     }
     return inside(V, 0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]));
 }
