@@ -183,9 +183,6 @@ amscr_status amscr__inner_build_shape(const amscr_descriptor *d, double closing,
 
 void amscr__inner_twist(amscr__inner *f, const amscr__inner_ws *ws) { twist(f, ws->cs); }
 
-/* Z(f), f = 0..N/2, into ws->z with its Hermitian rest: the correlation of a and b over the
- * shifts (real part: sum_k conj(A) B, sum_i a[i] b[i + s]) and, when `refl`, of a and b
- * reversed (imaginary part: sum_k A B e^{-2 pi i f (k + 1) / N}, sum_i a[i] b[-i - s - k - 1]). */
 /* The four sums over the columns k of frequencies f0 .. f0 + g - 1 into s[f][0..3] (X's real and
  * imaginary part, Y's; Y 0 without `refl`): the g frequencies side by side, each summed over
  * k in order (the chain of one sum no longer waits on itself alone). */
@@ -213,6 +210,9 @@ static inline void column_sums(const amscr__inner *a, const amscr__inner *b, int
     }
 }
 
+/* Z(f), f = 0..N/2, into ws->z with its Hermitian rest: the correlation of a and b over the
+ * shifts (real part: sum_k conj(A) B, sum_i a[i] b[i + s]) and, when `refl`, of a and b
+ * reversed (imaginary part: sum_k A B e^{-2 pi i f (k + 1) / N}, sum_i a[i] b[-i - s - k - 1]). */
 static void spectrum(const amscr__inner *a, const amscr__inner *b, int refl, amscr__inner_ws *ws)
 {
     double *z = ws->z, s[AMSCR__INNER_F][4];

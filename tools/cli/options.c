@@ -237,14 +237,21 @@ static int parse_rerank(const char *opt, const char *v, opts *o)
     return 0;
 }
 
+/* v as a whole finite number into *x: 1, or 0 when v is not one. */
+static int whole_number(const char *v, double *x)
+{
+    char *end = NULL;
+    errno = 0;
+    *x = strtod(v, &end);
+    return end != v && *end == '\0' && errno == 0 && isfinite(*x);
+}
+
 /* A fraction 0..1 (--channel-weight, --affine-share, --inner-share, --inner-closing) into *out,
  * setting *set. */
 static int parse_fraction(const char *opt, const char *v, int *set, double *out)
 {
-    char *end = NULL;
-    errno = 0;
-    double x = strtod(v, &end);
-    if (end == v || *end != '\0' || errno != 0 || !(x >= 0.0 && x <= 1.0))
+    double x;
+    if (!whole_number(v, &x) || !(x >= 0.0 && x <= 1.0))
         return usage_error(opt, "expected a number 0..1, got '%s'", v);
     *set = 1;
     *out = x;
@@ -254,10 +261,8 @@ static int parse_fraction(const char *opt, const char *v, int *set, double *out)
 /* --affine-view F: 0, or a factor in [1, 100]. */
 static int parse_affine_view(const char *opt, const char *v, opts *o)
 {
-    char *end = NULL;
-    errno = 0;
-    double x = strtod(v, &end);
-    if (end == v || *end != '\0' || errno != 0 || !(x == 0.0 || (x >= 1.0 && x <= 100.0)))
+    double x;
+    if (!whole_number(v, &x) || !(x == 0.0 || (x >= 1.0 && x <= 100.0)))
         return usage_error(opt, "expected 0 or a factor in [1, 100], got '%s'", v);
     o->affine_view_set = 1;
     o->affine_view = x;
