@@ -1,10 +1,12 @@
 /* check_rerank.c — contextual re-ranking (amscr_rerank_diffusion) on hand-made matrices whose
- * correct answer is known, and its argument checks. */
+ * correct answer is known, and its argument checks; the re-ranking on several graphs
+ * (amscr__rerank_graphs) against the one- and two-graph entries. */
 #include <amscr.h>
 #include <check.h>
 #include <math.h>
 #include <stdlib.h>
 
+#include "internal.h"
 #include "suites.h"
 
 /* Two classes: A = {0, 1, 2, 3}, B = {4, 5, 6, 7}. Item 3 is a loose member of A (0.30 from
@@ -103,6 +105,56 @@ START_TEST(test_invalid)
 }
 END_TEST
 
+/* A symmetric random distance matrix (zero diagonal) from a seeded generator. */
+static void random_matrix(double *D, int n, unsigned seed)
+{
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j <= i; j++) {
+            seed = seed * 1103515245u + 12345u;
+            D[i * n + j] = D[j * n + i] = i == j ? 0.0 : 0.1 + (double)(seed >> 8 & 0xffff) / 65536.0;
+        }
+}
+
+START_TEST(test_graphs)
+{
+    enum { N = 14 };
+    double A[N * N], B[N * N], C[N * N], R1[N * N], R2[N * N];
+    random_matrix(A, N, 1);
+    random_matrix(B, N, 2);
+    random_matrix(C, N, 3);
+    /* one graph and two graphs: exactly the entries the library used before */
+    const double *one[1] = {A}, *two[2] = {A, B}, *halves[3] = {A, B, B}, *unused[3] = {A, B, C};
+    double s1[1] = {0.0}, s2[2] = {0.0, 0.3}, sh[3] = {0.0, 0.15, 0.15}, s0[3] = {0.0, 0.3, 0.0};
+    ck_assert_int_eq(amscr__rerank_normalized(A, N, 4, 10, 1, R1), AMSCR_OK);
+    ck_assert_int_eq(amscr__rerank_graphs(one, s1, 1, N, 4, 10, 2, R2), AMSCR_OK);
+    for (int i = 0; i < N * N; i++)
+        ck_assert(R1[i] == R2[i]);
+    ck_assert_int_eq(amscr__rerank_normalized2(A, B, 0.3, N, 4, 10, 1, R1), AMSCR_OK);
+    ck_assert_int_eq(amscr__rerank_graphs(two, s2, 2, N, 4, 10, 2, R2), AMSCR_OK);
+    for (int i = 0; i < N * N; i++)
+        ck_assert(R1[i] == R2[i]);
+    /* a graph split in two halves is the same graph; a graph of share 0 changes nothing */
+    ck_assert_int_eq(amscr__rerank_graphs(halves, sh, 3, N, 4, 10, 1, R2), AMSCR_OK);
+    for (int i = 0; i < N * N; i++)
+        ck_assert_double_eq_tol(R1[i], R2[i], 1e-12);
+    ck_assert_int_eq(amscr__rerank_graphs(unused, s0, 3, N, 4, 10, 1, R2), AMSCR_OK);
+    for (int i = 0; i < N * N; i++)
+        ck_assert_double_eq_tol(R1[i], R2[i], 1e-12);
+    /* a third graph with a share moves the ranking */
+    double s3[3] = {0.0, 0.3, 0.3};
+    ck_assert_int_eq(amscr__rerank_graphs(unused, s3, 3, N, 4, 10, 1, R2), AMSCR_OK);
+    int differ = 0;
+    for (int i = 0; i < N * N; i++)
+        differ |= fabs(R1[i] - R2[i]) > 1e-9;
+    ck_assert(differ);
+    ck_assert_int_eq(amscr__rerank_graphs(unused, s3, 0, N, 4, 10, 1, R2), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr__rerank_graphs(unused, s3, AMSCR__RERANK_GRAPHS + 1, N, 4, 10, 1, R2),
+                     AMSCR_E_INVALID_ARG);
+    C[5] = NAN;
+    ck_assert_int_eq(amscr__rerank_graphs(unused, s3, 3, N, 4, 10, 1, R2), AMSCR_E_INVALID_ARG);
+}
+END_TEST
+
 Suite *amscr_suite_rerank(void)
 {
     Suite *s = suite_create("rerank");
@@ -110,6 +162,7 @@ Suite *amscr_suite_rerank(void)
     tcase_add_test(tc, test_known_answer);
     tcase_add_test(tc, test_blocks_and_unreached);
     tcase_add_test(tc, test_invalid);
+    tcase_add_test(tc, test_graphs);
     suite_add_tcase(s, tc);
     return s;
 }

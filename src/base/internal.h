@@ -228,6 +228,11 @@ amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, un
  * (1 - share) P + share P2 before the diffusion; unreached pairs ordered by dist. */
 amscr_status amscr__rerank_normalized2(const double *dist, const double *dist2, double share, size_t n, size_t k,
                                        unsigned iterations, unsigned threads, double *out_dist);
+/* The same on 1..AMSCR__RERANK_GRAPHS graphs: graph g > 0 takes share[g] of every row's mass,
+ * graph 0 the rest (share[0] not read); unreached pairs ordered by dist[0]. */
+enum { AMSCR__RERANK_GRAPHS = 4 };
+amscr_status amscr__rerank_graphs(const double *const *dist, const double *share, int graphs, size_t n, size_t k,
+                                  unsigned iterations, unsigned threads, double *out_dist);
 
 /* The retrieval settings in the saved collection (format versions 2 and up, retrieval_io.c):
  * little-endian f64 channel_weight, u32 channel_invariance, f64 channel_affine_share,

@@ -28,9 +28,10 @@ static amscr_status check_args(const double *dist, size_t n, size_t k, unsigned 
     return AMSCR_OK;
 }
 
-/* The working buffers: D the symmetrized distances (D2 the second graph's), Q the diffused
- * affinity, T a product, sc the self-tuning scales, (pj, pw) the kNN graph P (kk entries a
- * row: k neighbours of each graph); row (0..n-1) and nb (k) the neighbour selection's scratch. */
+/* The working buffers: D the symmetrized distances (D2 the other graphs' in turn), Q the
+ * diffused affinity, T a product, sc the self-tuning scales, (pj, pw) the kNN graph P (kk
+ * entries a row: k neighbours of each graph); row (0..n-1) and nb (k) the neighbour
+ * selection's scratch. */
 typedef struct {
     double *D, *D2, *Q, *T, *sc, *pw;
     size_t *pj, *row;
@@ -200,23 +201,33 @@ static void to_distances(const double *Q, const double *D, size_t n, double dmax
     }
 }
 
-/* dist2 (NULL: one graph) enters with `share` of every row's mass. */
-static amscr_status rerank(const double *dist, const double *dist2, double share, size_t n, size_t k,
+/* The mass of graph 0 in every row: 1 minus the other graphs' shares (exactly 1 for one). */
+static double first_mass(const double *share, int graphs)
+{
+    double rest = 0.0;
+    for (int g = 1; g < graphs; g++)
+        rest += share[g];
+    return graphs > 1 ? 1.0 - rest : 1.0;
+}
+
+/* dist[0] and the graphs' distances dist[1..graphs-1], each entering with share[g] of every
+ * row's mass (graph 0 with the rest; share[0] is not read). */
+static amscr_status rerank(const double *const *dist, const double *share, int graphs, size_t n, size_t k,
                            unsigned iterations, unsigned threads, int norm, double *out_dist, const char *what)
 {
     amscr__clear_error();
-    amscr_status st = check_args(dist, n, k, iterations, out_dist, what);
-    if (st == AMSCR_OK && dist2)
-        st = check_args(dist2, n, k, iterations, out_dist, what);
+    amscr_status st = AMSCR_OK;
+    for (int g = 0; g < graphs && st == AMSCR_OK; g++)
+        st = check_args(dist[g], n, k, iterations, out_dist, what);
     if (st != AMSCR_OK)
         return st;
     rerank_buf b;
-    if (!buf_alloc(&b, n, k, dist2 ? 2 : 1))
+    if (!buf_alloc(&b, n, k, graphs))
         return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", what);
-    double dmax = symmetrize(dist, n, b.D);
-    st = knn_graph(&b, b.D, n, k, 0, dist2 ? 1.0 - share : 1.0, dmax);
-    if (st == AMSCR_OK && dist2)
-        st = knn_graph(&b, b.D2, n, k, k, share, symmetrize(dist2, n, b.D2));
+    double dmax = symmetrize(dist[0], n, b.D);
+    st = knn_graph(&b, b.D, n, k, 0, first_mass(share, graphs), dmax);
+    for (int g = 1; g < graphs && st == AMSCR_OK; g++) /* b.D2 is reused graph by graph */
+        st = knn_graph(&b, b.D2, n, k, (size_t)g * k, share[g], symmetrize(dist[g], n, b.D2));
     if (st == AMSCR_OK)
         st = diffuse(&b, n, iterations, threads);
     if (st == AMSCR_OK)
@@ -227,17 +238,29 @@ static amscr_status rerank(const double *dist, const double *dist2, double share
 
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
 {
-    return rerank(dist, NULL, 0.0, n, k, iterations, 1, NORM_ROW_MAX, out_dist, "amscr_rerank_diffusion");
+    double share = 1.0;
+    return rerank(&dist, &share, 1, n, k, iterations, 1, NORM_ROW_MAX, out_dist, "amscr_rerank_diffusion");
 }
 
 amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, unsigned threads,
                                       double *out_dist)
 {
-    return rerank(dist, NULL, 0.0, n, k, iterations, threads, NORM_UNIT, out_dist, "re-ranking");
+    double share = 1.0;
+    return rerank(&dist, &share, 1, n, k, iterations, threads, NORM_UNIT, out_dist, "re-ranking");
 }
 
 amscr_status amscr__rerank_normalized2(const double *dist, const double *dist2, double share, size_t n, size_t k,
                                        unsigned iterations, unsigned threads, double *out_dist)
 {
-    return rerank(dist, dist2, share, n, k, iterations, threads, NORM_UNIT, out_dist, "re-ranking");
+    const double *d[2] = {dist, dist2};
+    double sh[2] = {1.0 - share, share};
+    return rerank(d, sh, dist2 ? 2 : 1, n, k, iterations, threads, NORM_UNIT, out_dist, "re-ranking");
+}
+
+amscr_status amscr__rerank_graphs(const double *const *dist, const double *share, int graphs, size_t n, size_t k,
+                                  unsigned iterations, unsigned threads, double *out_dist)
+{
+    if (!dist || !share || graphs < 1 || graphs > AMSCR__RERANK_GRAPHS)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "re-ranking: 1 to %d graphs", AMSCR__RERANK_GRAPHS);
+    return rerank(dist, share, graphs, n, k, iterations, threads, NORM_UNIT, out_dist, "re-ranking");
 }
