@@ -221,14 +221,14 @@ START_TEST(test_matrices)
 }
 END_TEST
 
-/* The setter: [0, 1) only; the presets: 0, and 0.05 for retrieval. */
+/* The setter: [0, 1) only; the presets: 0, and 0.1 for retrieval. */
 START_TEST(test_params)
 {
     amscr_params *p = NULL, *r = NULL;
     ck_assert_int_eq(amscr_params_new(&p), AMSCR_OK);
     ck_assert_int_eq(amscr_params_new_retrieval(&r), AMSCR_OK);
     ck_assert(amscr_params_get_rerank_inner_share(p) == 0.0);
-    ck_assert(amscr_params_get_rerank_inner_share(r) == 0.05);
+    ck_assert(amscr_params_get_rerank_inner_share(r) == 0.1);
     ck_assert(amscr_params_get_rerank_inner_share(NULL) == 0.0);
     ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, -0.1), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 1.0), AMSCR_E_INVALID_ARG);

@@ -93,7 +93,7 @@ void amscr__params_retrieval(amscr_params *p)
     p->reflections = 1;
     p->channel_weight = 1.0;
     p->rerank_k = 8;
-    p->rerank_inner_share = 0.05;
+    p->rerank_inner_share = 0.1;
     p->inner_closing = 0.04;
     p->channel_affine_view = 2.0;
 }

@@ -257,7 +257,7 @@ def test_channel_options_that_conflict_with_the_index(tmp_path):
 
 
 def test_inner_share_and_the_index(tmp_path):
-    """The default re-ranks on two graphs (the inner distance's at share 0.05) and an index
+    """The default re-ranks on two graphs (the inner distance's at share 0.1) and an index
     built with it holds both: its search is the manifest's; `index --inner-share 0` holds one
     graph and searches as the manifest with --inner-share 0; an --inner-share other than the
     index's ranks by the collection's matrix, as the manifest does; --add with another share is
@@ -272,8 +272,8 @@ def test_inner_share_and_the_index(tmp_path):
     same_results(json.loads(run("search", q, idx, "--json").stdout)["results"], two)
     same_results(json.loads(run("search", q, one_idx, "--json").stdout)["results"], one)
     same_results(json.loads(run("search", q, idx, "--json", "--inner-share", "0").stdout)["results"], one)
-    same_results(json.loads(run("search", q, one_idx, "--json", "--inner-share", "0.05").stdout)["results"], two)
-    r = run("index", m, "-o", one_idx, "--add", "--inner-share", "0.1")
+    same_results(json.loads(run("search", q, one_idx, "--json", "--inner-share", "0.1").stdout)["results"], two)
+    r = run("index", m, "-o", one_idx, "--add", "--inner-share", "0.05")
     assert r.returncode != 0 and "inner_share" in r.stderr
     assert run("search", q, m, "--inner-share", "1").returncode == 2
 
