@@ -1673,7 +1673,7 @@ AMSCR_API unsigned amscr_params_get_rerank_iterations(const amscr_params *p);
 
 /**
  * @brief Sets the share of the inner-distance graph in the re-ranking, in [0, 1) (default 0;
- *        0.1 in the retrieval preset, 0.05 before 0.12). The re-ranking diffuses over the kNN graph of the
+ *        0.1 in the retrieval preset). The re-ranking diffuses over the kNN graph of the
  *        retrieval distance; with a share s > 0 it diffuses over (1 - s) times that graph
  *        plus s times the kNN graph of the inner distance (the shortest path inside the
  *        shape between two boundary points, which a part bent at a joint hardly changes),

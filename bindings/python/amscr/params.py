@@ -155,7 +155,7 @@ class Params:
     rerank_iterations = _Option('rerank_iterations', _UINT, 'diffusion iterations of that re-ranking (1..1000)')
     rerank_inner_share = _Option('rerank_inner_share', _FLOAT,
                                  'share, in [0, 1), of the inner-distance graph in that re-ranking (0 = one graph, '
-                                 'the default; 0.1 in the retrieval preset, 0.05 before 0.12; an Index holds both graphs)')
+                                 'the default; 0.1 in the retrieval preset; an Index holds both graphs)')
     inner_closing = _Option('inner_closing', _FLOAT,
                             'closing radius, in units of sqrt(area) in [0, 1], of the silhouette the inner '
                             'distance is taken in (0 = as it is, the default; 0.04 in the retrieval preset)')
