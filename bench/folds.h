@@ -4,6 +4,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "folds_tsv.h"
 #include "mcd_set.h"
 
 /* Settings a base matrix depends on. */
@@ -86,8 +87,6 @@ int folds_fourier(const folds_data *fd);
 int folds_fuse(const folds_data *fd, const char *datasets);
 int folds_local(const folds_data *fd, const char *datasets);
 int folds_halves(const folds_data *fd);
-/* perm = a seeded random permutation of 0..L-1 (xorshift64*, Fisher-Yates). */
-void folds_shuffle(int *perm, int L, unsigned long long *seed);
 /* The next seeded random subset of C of mpeg7-dev's L classes: its shapes' indices into idx
  * (returns their count); perm and in are L-entry scratch. */
 size_t folds_subset(const folds_data *fd, int C, int L, unsigned long long *seed, int *perm, int *in, size_t *idx);

@@ -164,20 +164,6 @@ int folds_local(const folds_data *fd, const char *datasets)
     return 0;
 }
 
-void folds_shuffle(int *perm, int L, unsigned long long *seed)
-{
-    for (int c = 0; c < L; c++)
-        perm[c] = c;
-    for (int c = L - 1; c > 0; c--) {
-        *seed ^= *seed >> 12;
-        *seed ^= *seed << 25;
-        *seed ^= *seed >> 27;
-        int r = (int)((*seed * 2685821657736338717ull >> 33) % (unsigned long long)(c + 1)), t = perm[c];
-        perm[c] = perm[r];
-        perm[r] = t;
-    }
-}
-
 size_t folds_subset(const folds_data *fd, int C, int L, unsigned long long *seed, int *perm, int *in, size_t *idx)
 {
     folds_shuffle(perm, L, seed);

@@ -171,13 +171,7 @@ static void halves(const shape_set *s, int k, const double *C, const double *E, 
     unsigned long long seed = 0x2545F4914F6CDD1Dull;
     for (int h = 0; h < 2 * HALVES; h++) {
         if (h % 2 == 0)
-            for (int c = 0; c < L; c++) /* xorshift Fisher-Yates */
-                perm[c] = c;
-        for (int c = L - 1; h % 2 == 0 && c > 0; c--) {
-            seed ^= seed >> 12, seed ^= seed << 25, seed ^= seed >> 27;
-            int r = (int)((seed * 2685821657736338717ull >> 33) % (unsigned long long)(c + 1)), t = perm[c];
-            perm[c] = perm[r], perm[r] = t;
-        }
+            folds_shuffle(perm, L, &seed);
         size_t m = 0;
         for (size_t i = 0; i < s->n; i++)
             if ((perm[s->labels[i]] < L / 2) == (h % 2 == 0))
