@@ -36,19 +36,9 @@ import amscr
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import retrieval_views  # noqa: E402
+from retrieval_rerank_probe import diffuse, graph, neighbours  # noqa: E402
 
 K, ITERS = 8, 10
-
-
-def knn(D, k):
-    """Each row's k nearest by (distance, index), itself first (rerank.c's selection)."""
-    n = len(D)
-    E = D.copy()
-    E[np.arange(n), np.arange(n)] = -1.0
-    part = np.argpartition(E, k - 1, axis=1)[:, :k] if k < n else np.tile(np.arange(n), (n, 1))
-    d = np.take_along_axis(E, part, 1)
-    o = np.lexsort((part, d), axis=1)
-    return np.take_along_axis(part, o, 1)
 
 
 def weights(d, idx, dmax):
@@ -60,21 +50,16 @@ def weights(d, idx, dmax):
     return w / w.sum(1, keepdims=True)
 
 
-def whole(F):
-    """The re-ranked matrix of every shape (rerank.c, halved into [0, 1])."""
-    n = len(F)
+def sym(F):
     D = 0.5 * (F + F.T)
     np.fill_diagonal(D, 0.0)
-    idx = knn(D, min(K, n))
-    P = sp.csr_matrix((weights(np.take_along_axis(D, idx, 1), idx, D.max()).ravel(), idx.ravel(),
-                       np.arange(0, idx.size + 1, idx.shape[1])), shape=(n, n))
-    Q = P.toarray()
-    for _ in range(ITERS):
-        Q = (P @ (P @ Q).T).T
-        Q[np.arange(n), np.arange(n)] += 1.0
-    out = 0.5 * np.where(Q > 0, 1.0 - Q / Q.max(1, keepdims=True), 1.0 + D / D.max())
-    np.fill_diagonal(out, 0.0)
-    return out
+    return D
+
+
+def whole(F):
+    """The re-ranked matrix of every shape (rerank.c, halved into [0, 1])."""
+    D = sym(F)
+    return diffuse(graph(D, neighbours(D, min(K, len(D)))), D, ITERS)
 
 
 class Context:
@@ -86,7 +71,7 @@ class Context:
         self.D = D[np.ix_(self.S, self.S)]
         m = len(self.S)
         self.k = min(K, m + 1)
-        self.idx = knn(self.D, min(self.k, m))  # each row's list within S
+        self.idx = neighbours(self.D, min(self.k, m))  # each row's list within S
         self.dl = np.take_along_axis(self.D, self.idx, 1)
         self.kth = self.dl[:, -1]
         self.dmax = self.D.max()
@@ -100,7 +85,7 @@ class Context:
             Dq = np.zeros((n, n))
             Dq[:m, :m] = self.D
             Dq[:m, m] = Dq[m, :m] = dq
-            idx = knn(Dq, k)
+            idx = neighbours(Dq, k)
             d = np.take_along_axis(Dq, idx, 1)
         else:
             idx = np.empty((n, k), dtype=np.int64)
@@ -128,12 +113,6 @@ class Context:
             v = P @ v + rows[t]
         r = v[:m]
         return 0.5 * np.where(r > 0, 1.0 - r / v.max(), 1.0 + dq / dmax)
-
-
-def sym(F):
-    D = 0.5 * (F + F.T)
-    np.fill_diagonal(D, 0.0)
-    return D
 
 
 def groups_scores(F, cls, grp):

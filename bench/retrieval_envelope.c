@@ -39,8 +39,8 @@
 #include "mcd_set.h"
 
 enum { ROWS = 9, MAXC = 8 };
-static const char *ROW_NAMES[ROWS] = {"0.11 (inner 0.05)",    "min",       "mean",      "graph 0.05",         "graph 0.1",
-                                      "graph 0.2",  "inner 0.1", "inner 0.15", "inner 0.1, graph 0.1"};
+static const char *ROW_NAMES[ROWS] = {"0.11 (inner 0.05)", "min", "mean", "graph 0.05", "graph 0.1", "graph 0.2",
+                                      "inner 0.1", "inner 0.15", "inner 0.1, graph 0.1"};
 static const double GRAPH_SHARE[ROWS] = {0, 0, 0, 0.05, 0.1, 0.2, 0, 0, 0.1};
 static const double INNER_SHARE[ROWS] = {0.05, 0.05, 0.05, 0.05, 0.05, 0.05, 0.1, 0.15, 0.1};
 
@@ -157,7 +157,8 @@ static double score(int r, const double *C, const double *E, const double *I, si
 }
 
 /* Random class halves of s (HALVES seeded shuffles, both halves of each: 2 HALVES collections):
- * each row's mean gain over the default and how many halves it lifts / lowers, for closing k. */
+ * each row's mean gain over the first (0.11's default) and how many halves it lifts / lowers, for
+ * closing k. */
 enum { HALVES = 12 };
 static double half_gain[MAXC + 1][ROWS], half_up[MAXC + 1][ROWS], half_down[MAXC + 1][ROWS];
 
