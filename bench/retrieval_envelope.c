@@ -7,6 +7,10 @@
  *                                 collection): each row's mean gain over the first, and how many
  *                                 halves it lifts / lowers
  *   AMSCR_ENVELOPE_CLASSES=1 ...  each class's bull's eye of every row on stderr
+ *   AMSCR_ENVELOPE_DUMP=DIR ...   also write each collection's matrices for probes in NumPy:
+ *                                 DIR/NAME_labels.i32 (int32), NAME_C.f64, NAME_I.f64 and
+ *                                 NAME_E<closing>.f64 (float64, n x n, C order; NAME mpeg7-dev,
+ *                                 kimia99, kimia216 or mcd)
  *
  * For each collection (mpeg7-dev with its class folds A and B as collections of their own,
  * Kimia-99, Kimia-216): the default's base channel matrix C (amscr_db_channel_matrix of the
@@ -189,6 +193,22 @@ static void halves(const shape_set *s, int k, const double *C, const double *E, 
     free(idx);
 }
 
+/* Writes n doubles (or int32 labels when d is NULL) to $AMSCR_ENVELOPE_DUMP/NAME_WHAT. */
+static void dump(const char *name, const char *what, const double *d, const int32_t *lab, size_t n)
+{
+    const char *dir = getenv("AMSCR_ENVELOPE_DUMP");
+    if (!dir)
+        return;
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s_%s", dir, name, what);
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(d ? (const void *)d : (const void *)lab, d ? sizeof *d : sizeof *lab, n, f) != n ||
+        fclose(f) != 0) {
+        fprintf(stderr, "amscr-retrieval-envelope: cannot write %s\n", path);
+        exit(1);
+    }
+}
+
 /* One collection's columns: the whole (and its folds when fold_of_class is not NULL); mcd: the
  * MCD-style set of its first shapes instead. */
 static int columns(const char *dir, const char *name, const double *cs, int nc, int topk, int mcd,
@@ -211,8 +231,17 @@ static int columns(const char *dir, const char *name, const double *cs, int nc, 
             idx[1 + fold_of_class[s.labels[i]]][m[1 + fold_of_class[s.labels[i]]]++] = i;
     }
     double *I = xmalloc(n * n * sizeof *I), *C = channel_of(&s, 0.0, I);
+    const char *tag = mcd ? "mcd" : name;
+    dump(tag, "labels.i32", NULL, s.labels, n);
+    dump(tag, "C.f64", C, NULL, n * n);
+    dump(tag, "I.f64", I, NULL, n * n);
     for (int k = 0; k <= nc; k++) { /* k 0: the default row alone */
         double *E = k ? channel_of(&s, cs[k - 1], NULL) : C;
+        if (k) {
+            char what[64];
+            snprintf(what, sizeof what, "E%g.f64", cs[k - 1]);
+            dump(tag, what, E, NULL, n * n);
+        }
         for (int g = 0; g < (folds ? 3 : 1); g++)
             for (int r = k ? 1 : 0; r < (k ? ROWS : 1); r++)
                 out[g][k][r] = score(r, C, E, I, n, idx[g], m[g], s.labels, topk);
