@@ -7,6 +7,8 @@
  *                                 collection): each row's mean gain over the first, and how many
  *                                 halves it lifts / lowers
  *   AMSCR_ENVELOPE_CLASSES=1 ...  each class's bull's eye of every row on stderr
+ *   AMSCR_ENVELOPE_OUTLINE=1 ...  E from each contour's 64-point closed outline (amscr__outline,
+ *                                 the inner distance's) instead of the traced closed curve
  *   AMSCR_ENVELOPE_DUMP=DIR ...   also write each collection's matrices for probes in NumPy:
  *                                 DIR/NAME_labels.i32 (int32), NAME_C.f64, NAME_I.f64 and
  *                                 NAME_E<closing>.f64 (float64, n x n, C order; NAME mpeg7-dev,
@@ -29,7 +31,8 @@
  *   inner i   C, the inner distance's graph at share i instead of 0.05 (E not used)
  *
  * Scores: bull's eye % (mpeg7-dev and its folds, and the MCD-style set of mpeg7-dev's first
- * shapes: mcd_set.h, seed 7), top-k sums (Kimia). Deterministic; ~15 s a closing on 2 cores,
+ * shapes: mcd_set.h, seed 7), top-k sums (Kimia). Images are traced as the tool's retrieval
+ * commands trace them (broken pieces joined: AMSCR_TRACE_JOIN). Deterministic; ~15 s a closing on 2 cores,
  * ~1 min with the halves. */
 #include <math.h>
 #include <stdio.h>
@@ -37,6 +40,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "../tools/cli/image.h"
 #include "folds_tsv.h"
 #include "inner.h"
 #include "internal.h"
@@ -78,7 +82,13 @@ static double *channel_of(const shape_set *s, double c, double *I)
         double *xy = NULL;
         size_t m = 0;
         amscr_contour *ci = s->c[i];
-        if (c > 0.0 && amscr__close_curve(amscr_contour_xy(s->c[i]), amscr_contour_size(s->c[i]), c, &xy, &m) ==
+        if (c > 0.0 && getenv("AMSCR_ENVELOPE_OUTLINE")) { /* the inner distance's 64-point outline */
+            xy = xmalloc(2 * AMSCR__OUTLINE_N * sizeof *xy);
+            m = AMSCR__OUTLINE_N;
+            if (amscr__outline(amscr_contour_xy(s->c[i]), amscr_contour_size(s->c[i]), c, xy) != AMSCR_OK ||
+                amscr_contour_new(xy, m, &ci) != AMSCR_OK)
+                die("outline");
+        } else if (c > 0.0 && amscr__close_curve(amscr_contour_xy(s->c[i]), amscr_contour_size(s->c[i]), c, &xy, &m) ==
                            AMSCR_OK) {
             if (amscr_contour_new(xy, m, &ci) != AMSCR_OK)
                 die("closed contour");
@@ -261,6 +271,7 @@ static int columns(const char *dir, const char *name, const double *cs, int nc, 
 
 int main(int argc, char **argv)
 {
+    image_set_trace_flags(AMSCR_TRACE_JOIN); /* trace as the tool's retrieval commands */
     ONE_FRAME = argc > 3 && strcmp(argv[3], "--one-frame") == 0;
     if (argc < 2 || argc > 4 || (argc == 4 && !ONE_FRAME)) {
         fprintf(stderr, "usage: amscr-retrieval-envelope DATASETS [C1,C2,...] [--one-frame]\n");
