@@ -122,7 +122,8 @@ def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] =
         join: True: the other large components near the largest (at least 5 % of its pixels,
             within its RMS radius, not in its holes) are joined to its outline by zero-width
             bridges — a shape an occluder cut in pieces keeps all its boundary (as ``amscr
-            register`` traces images; sub-pixel only, ignored with subpixel=False).
+            register``, ``search``, ``matrix``, ``eval`` and ``index`` trace images; sub-pixel
+            only, ignored with subpixel=False).
     Returns:
         (n, 2) float array (x = column, y = row; pixel centres at integers), with positive
         signed area (counter-clockwise in a y-up frame), no repeated end point.

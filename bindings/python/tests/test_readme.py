@@ -62,8 +62,8 @@ def test_readme_has_the_tutorial():
     blocks = _blocks()
     assert len(blocks) >= 4
     code = '\n'.join(c for _, c in blocks)
-    for needed in ('amscr.register(', 'Collection(', '.query(', 'distance_matrix(progress=True)',
-                   "order='rc'", 'cv2.warpAffine', 'AffineTransform(matrix='):
+    for needed in ('amscr.register(', 'Collection(', 'Params.retrieval()', '.query(', 'Index(db)',
+                   'retrieval_matrix(progress=True)', "order='rc'", 'cv2.warpAffine', 'AffineTransform(matrix='):
         assert needed in code, needed
 
 
