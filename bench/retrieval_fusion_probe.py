@@ -31,6 +31,10 @@ import scipy.sparse as sp
 
 import amscr
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from retrieval_context_probe import sym, weights  # noqa: E402
+from retrieval_rerank_probe import neighbours  # noqa: E402
+
 K, ITERS = 8, 10
 
 
@@ -41,27 +45,6 @@ def load(dump, name, closing='0.08'):
             for w in ('C', 'I', 'E' + closing)}
     mats['E'] = mats.pop('E' + closing)
     return mats, lab
-
-
-def sym(F):
-    D = 0.5 * (F + F.T)
-    np.fill_diagonal(D, 0.0)
-    return D
-
-
-def neighbours(D, k):
-    """Each row's k nearest (itself first, ties by index), as rerank.c selects them."""
-    order = np.argsort(D + np.diag(np.full(len(D), -1.0)), axis=1, kind='stable')
-    return order[:, :k]
-
-
-def weights(D, idx):
-    """rerank.c's self-tuning affinities over each row's list, rows summing to 1."""
-    d = np.take_along_axis(D, idx, 1)
-    sc = d[:, -1]
-    tiny = 1e-12 * D.max() if D.max() > 0 else 1e-300
-    w = np.exp(-d / np.sqrt((sc[:, None] + tiny) * (sc[idx] + tiny)))
-    return w / w.sum(1, keepdims=True)
 
 
 def consistency(idx, kind):
@@ -99,7 +82,8 @@ def rerank(dists, shares, kind='fixed', k=K, iters=ITERS):
             continue
         rows.append(np.repeat(np.arange(n), k))
         cols.append(idx.ravel())
-        vals.append((weights(D, idx) * mass[:, g:g + 1]).ravel())
+        w = weights(np.take_along_axis(D, idx, 1), idx, D.max())
+        vals.append((w * mass[:, g:g + 1]).ravel())
     P = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
     Q = P.toarray()
     for _ in range(iters):
