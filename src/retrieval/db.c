@@ -303,9 +303,9 @@ static void *batch_worker(void *arg)
     return NULL;
 }
 
-static amscr_status batch_run(batch_t *b, unsigned threads, amscr_progress_fn progress, void *user)
+/* Items of b (row blocks, or column blocks of a single row) and the shared state reset. */
+static void batch_setup(batch_t *b)
 {
-    size_t total_cells = b->nrows * b->ncols;
     if (b->nrows == 1) {
         b->cols_per_item = 32;
         b->nitems = (b->ncols + 31) / 32;
@@ -313,74 +313,60 @@ static amscr_status batch_run(batch_t *b, unsigned threads, amscr_progress_fn pr
         b->rows_per_item = 1;
         b->nitems = b->nrows;
     }
-    if (total_cells == 0)
-        return AMSCR_OK;
-    pthread_mutex_init(&b->lock, NULL);
     b->next = b->done = 0;
     b->cancel = 0;
     b->status = AMSCR_OK;
     b->detail[0] = '\0';
-    if (threads > b->nitems)
-        threads = (unsigned)b->nitems;
-    if (threads < 1)
-        threads = 1;
-    /* The first report (0 done) comes before any worker starts, so every callback sees the
-     * start and (below) the end, whatever the scheduling. */
-    size_t last_reported = (size_t)-1;
-    if (progress) {
-        last_reported = 0;
-        if (progress(user, 0, total_cells) != 0)
-            b->cancel = 1;
+}
+
+/* The calling thread's report of the cells done so far, when it changed since *last (a
+ * callback asking to stop sets b->cancel). */
+static void batch_report(batch_t *b, amscr_progress_fn progress, void *user, size_t *last)
+{
+    pthread_mutex_lock(&b->lock);
+    size_t done = b->done;
+    pthread_mutex_unlock(&b->lock);
+    if (done == *last)
+        return;
+    *last = done;
+    size_t cells = b->nrows == 1 ? (done * b->cols_per_item < b->ncols ? done * b->cols_per_item : b->ncols)
+                                 : done * b->ncols;
+    if (progress(user, cells, b->nrows * b->ncols) != 0) {
+        pthread_mutex_lock(&b->lock);
+        b->cancel = 1;
+        pthread_mutex_unlock(&b->lock);
     }
-    pthread_t *tid = NULL;
-    unsigned started = 0;
-    if (threads > 1 && !b->cancel) {
-        tid = malloc((threads - 1) * sizeof *tid);
-        if (tid)
-            for (unsigned t = 0; t + 1 < threads; t++) {
-                if (pthread_create(&tid[t], NULL, batch_worker, b) != 0)
-                    break;
-                started++;
-            }
-    }
-    /* the calling thread works too, and reports progress between its items */
+}
+
+/* The calling thread works too, and reports progress between its items. */
+static void batch_own_items(batch_t *b, amscr_progress_fn progress, void *user, size_t *last)
+{
     amscr_workspace *ws = NULL;
     amscr_status own = amscr_workspace_new(&ws);
     size_t item;
     if (own != AMSCR_OK) {
+        amscr_workspace_free(ws);
         batch_finish_item(b, own);
-    } else {
-        for (;;) {
-            if (progress) {
-                pthread_mutex_lock(&b->lock);
-                size_t done = b->done;
-                pthread_mutex_unlock(&b->lock);
-                if (done != last_reported) {
-                    last_reported = done;
-                    size_t cells = b->nrows == 1 ? (done * b->cols_per_item < b->ncols ? done * b->cols_per_item
-                                                                                         : b->ncols)
-                                                 : done * b->ncols;
-                    if (progress(user, cells, total_cells) != 0) {
-                        pthread_mutex_lock(&b->lock);
-                        b->cancel = 1;
-                        pthread_mutex_unlock(&b->lock);
-                    }
-                }
-            }
-            if (!batch_take(b, &item))
-                break;
-            amscr_status st = AMSCR_OK;
-            batch_item(b, ws, item, &st);
-            batch_finish_item(b, st);
-        }
+        return;
     }
-    for (unsigned t = 0; t < started; t++)
-        pthread_join(tid[t], NULL);
-    free(tid);
+    for (;;) {
+        if (progress)
+            batch_report(b, progress, user, last);
+        if (!batch_take(b, &item))
+            break;
+        amscr_status st = AMSCR_OK;
+        batch_item(b, ws, item, &st);
+        batch_finish_item(b, st);
+    }
     amscr_workspace_free(ws);
-    pthread_mutex_destroy(&b->lock);
+}
+
+/* The outcome of a finished run: a failure or a cancel leaves every cell NaN (never a silently
+ * partial matrix); a run that ends with a callback not yet told so reports the end. */
+static amscr_status batch_result(batch_t *b, amscr_progress_fn progress, void *user, size_t last)
+{
+    size_t total_cells = b->nrows * b->ncols;
     if (b->status != AMSCR_OK || b->cancel) {
-        /* never a silently partial matrix: every cell becomes NaN */
         for (size_t i = 0; i < total_cells; i++)
             b->out[i] = NAN;
         if (b->status != AMSCR_OK)
@@ -388,10 +374,43 @@ static amscr_status batch_run(batch_t *b, unsigned threads, amscr_progress_fn pr
         return amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback after %zu of %zu items", b->done,
                            b->nitems);
     }
-    if (progress && last_reported != b->nitems)
+    if (progress && last != b->nitems)
         if (progress(user, total_cells, total_cells) != 0)
             return amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback at the end");
     return AMSCR_OK;
+}
+
+static amscr_status batch_run(batch_t *b, unsigned threads, amscr_progress_fn progress, void *user)
+{
+    batch_setup(b);
+    if (b->nrows * b->ncols == 0)
+        return AMSCR_OK;
+    pthread_mutex_init(&b->lock, NULL);
+    if (threads > b->nitems)
+        threads = (unsigned)b->nitems;
+    if (threads < 1)
+        threads = 1;
+    /* The first report (0 done) comes before any worker starts, so every callback sees the
+     * start and (batch_result) the end, whatever the scheduling. */
+    size_t last = (size_t)-1;
+    if (progress) {
+        last = 0;
+        if (progress(user, 0, b->nrows * b->ncols) != 0)
+            b->cancel = 1;
+    }
+    pthread_t *tid = NULL;
+    unsigned started = 0;
+    if (threads > 1 && !b->cancel) {
+        tid = malloc((threads - 1) * sizeof *tid);
+        for (unsigned t = 0; tid && t + 1 < threads && pthread_create(&tid[t], NULL, batch_worker, b) == 0; t++)
+            started++;
+    }
+    batch_own_items(b, progress, user, &last);
+    for (unsigned t = 0; t < started; t++)
+        pthread_join(tid[t], NULL);
+    free(tid);
+    pthread_mutex_destroy(&b->lock);
+    return batch_result(b, progress, user, last);
 }
 
 amscr_status amscr_db_query(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress, void *user,
