@@ -86,6 +86,70 @@ static void gmm_sort_components(size_t k, double *w, double *mu, double *var)
     }
 }
 
+/* The variance floor: floor_rel times the data's variance (two passes), and at least
+ * 1e-300 times its squared magnitude. */
+static double gmm_variance_floor(const double *x, size_t n, double floor_rel)
+{
+    double m = 0.0;
+    for (size_t i = 0; i < n; i++)
+        m += x[i];
+    m /= (double)n;
+    double v = 0.0;
+    for (size_t i = 0; i < n; i++)
+        v += (x[i] - m) * (x[i] - m);
+    v /= (double)n;
+    double am = fabs(m) > 1.0 ? fabs(m) : 1.0;
+    double vfloor = 1e-300 * am * am;
+    if (!(vfloor <= DBL_MAX))
+        vfloor = DBL_MAX;
+    if (floor_rel * v > vfloor)
+        vfloor = floor_rel * v;
+    return vfloor;
+}
+
+/* The components of the K-means split of sorted data (row: the k clusters' first indices):
+ * each cluster's share, mean and variance (at least vfloor). */
+static void gmm_start(const double *sorted, size_t n, size_t k, const size_t *row, double vfloor, double *w,
+                      double *mu, double *var)
+{
+    for (size_t c = 0; c < k; c++) {
+        size_t a = row[c], b = c + 1 < k ? row[c + 1] : n;
+        double s = 0.0;
+        for (size_t i = a; i < b; i++)
+            s += sorted[i];
+        double cm = s / (double)(b - a);
+        double q = 0.0;
+        for (size_t i = a; i < b; i++)
+            q += (sorted[i] - cm) * (sorted[i] - cm);
+        q /= (double)(b - a);
+        w[c] = (double)(b - a) / (double)n;
+        mu[c] = cm;
+        var[c] = q > vfloor ? q : vfloor;
+    }
+}
+
+/* The M step from the statistics of the last pass (sr: responsibilities, srd / srd2: their
+ * first and second moments about the old means). */
+static void gmm_m_step(size_t n, size_t k, const double *sr, const double *srd, const double *srd2, double vfloor,
+                       double *w, double *mu, double *var)
+{
+    double wsum = 0.0;
+    for (size_t c = 0; c < k; c++) {
+        if (sr[c] > 0.0) {
+            double dm = srd[c] / sr[c];
+            double vc = srd2[c] / sr[c] - dm * dm;
+            mu[c] += dm;
+            var[c] = vc > vfloor ? vc : vfloor;
+        }
+        w[c] = sr[c] / (double)n;
+        if (!(w[c] >= GMM_WEIGHT_FLOOR))
+            w[c] = GMM_WEIGHT_FLOOR;
+        wsum += w[c];
+    }
+    for (size_t c = 0; c < k; c++)
+        w[c] /= wsum;
+}
+
 /* The fit shared by amscr_gmm1d_fit and amscr__gmm1d_fit_small/_sorted. x: n finite values
  * (ascending when presorted; may then be scratch itself), 1 <= k <= n; scratch:
  * amscr__gmm1d_small_scratch(n, k) doubles; split: k*k. */
@@ -103,62 +167,16 @@ static amscr_status gmm_fit_core(const double *x, int presorted, size_t n, size_
     if (!presorted)
         amscr__sort_doubles(sorted, n);
 
-    /* Data mean and variance (two passes), and the variance floor. */
-    double m = 0.0;
-    for (size_t i = 0; i < n; i++)
-        m += sorted[i];
-    m /= (double)n;
-    double v = 0.0;
-    for (size_t i = 0; i < n; i++)
-        v += (sorted[i] - m) * (sorted[i] - m);
-    v /= (double)n;
-    double am = fabs(m) > 1.0 ? fabs(m) : 1.0;
-    double vfloor = 1e-300 * am * am;
-    if (!(vfloor <= DBL_MAX))
-        vfloor = DBL_MAX;
-    if (floor_rel * v > vfloor)
-        vfloor = floor_rel * v;
-
-    /* Start: exact 1-D K-means. */
-    amscr__kmeans1d_dp(sorted, n, k, dp, sse, split);
-    const size_t *row = split + (k - 1) * k;
-    for (size_t c = 0; c < k; c++) {
-        size_t a = row[c], b = c + 1 < k ? row[c + 1] : n;
-        double s = 0.0;
-        for (size_t i = a; i < b; i++)
-            s += sorted[i];
-        double cm = s / (double)(b - a);
-        double q = 0.0;
-        for (size_t i = a; i < b; i++)
-            q += (sorted[i] - cm) * (sorted[i] - cm);
-        q /= (double)(b - a);
-        w[c] = (double)(b - a) / (double)n;
-        mu[c] = cm;
-        var[c] = q > vfloor ? q : vfloor;
-    }
-
+    double vfloor = gmm_variance_floor(sorted, n, floor_rel);
+    amscr__kmeans1d_dp(sorted, n, k, dp, sse, split); /* the start: exact 1-D K-means */
+    gmm_start(sorted, n, k, split + (k - 1) * k, vfloor, w, mu, var);
     double ll = gmm_pass(sorted, n, k, w, mu, var, lc, iv, lp, sr, srd, srd2);
     if (!isfinite(ll))
         return amscr__fail(AMSCR_E_NUMERIC, "gmm1d: non-finite log-likelihood at the start");
     unsigned it = 0;
     int converged = 0;
     while (it < max_iter) {
-        /* M step from the statistics of the last pass. */
-        double wsum = 0.0;
-        for (size_t c = 0; c < k; c++) {
-            if (sr[c] > 0.0) {
-                double dm = srd[c] / sr[c];
-                double vc = srd2[c] / sr[c] - dm * dm;
-                mu[c] += dm;
-                var[c] = vc > vfloor ? vc : vfloor;
-            }
-            w[c] = sr[c] / (double)n;
-            if (!(w[c] >= GMM_WEIGHT_FLOOR))
-                w[c] = GMM_WEIGHT_FLOOR;
-            wsum += w[c];
-        }
-        for (size_t c = 0; c < k; c++)
-            w[c] /= wsum;
+        gmm_m_step(n, k, sr, srd, srd2, vfloor, w, mu, var);
         it++;
         double ll_new = gmm_pass(sorted, n, k, w, mu, var, lc, iv, lp, sr, srd, srd2);
         if (!isfinite(ll_new))
