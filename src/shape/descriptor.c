@@ -76,10 +76,11 @@ int amscr__params_compatible(const amscr_params *a, const amscr_params *b, const
     return 1;
 }
 
-amscr_status amscr__descriptor_finish(amscr_descriptor *d)
+/* The moments of the base curve and of every smoothed one, and their inverted moment matrices. */
+static amscr_status descriptor_moments(amscr_descriptor *d)
 {
-    size_t n = d->n, p = d->p;
-    for (size_t k = 0; k <= p; k++) {
+    size_t n = d->n;
+    for (size_t k = 0; k <= d->p; k++) {
         const double *xy = k == 0 ? d->base : d->scaled + 2 * n * (k - 1);
         double M9[9];
         amscr__moments(xy, n, d->mom + 6 * k);
@@ -93,63 +94,72 @@ amscr_status amscr__descriptor_finish(amscr_descriptor *d)
                                d->params.scales[k - 1], n);
         }
     }
-    d->norm2 = d->mom[0] + d->mom[2];
-    d->finest = 0;
-    for (size_t k = 1; k < p; k++)
-        if (d->params.scales[k] < d->params.scales[d->finest])
-            d->finest = k;
-    /* spectra of the base curve and the gains |G_k|^2 of the circular kernels */
-    amscr__fft_plan plan;
-    if (amscr__fft_plan_init(&plan, n) != 0)
-        return amscr__fail(AMSCR_E_NOMEM, "descriptor: out of memory");
+    return AMSCR_OK;
+}
+
+/* The spectra of the base curve's x and y, and the energy of its Nyquist element. */
+static void descriptor_spectra(amscr_descriptor *d, amscr__fft_plan *plan)
+{
+    size_t n = d->n;
     for (size_t c = 0; c < 2; c++) {
         double *z = d->spec + 2 * n * c;
         for (size_t a = 0; a < n; a++) {
             z[2 * a] = d->base[2 * a + c];
             z[2 * a + 1] = 0.0;
         }
-        amscr__fft(&plan, z, 0);
+        amscr__fft(plan, z, 0);
     }
     d->nyq2 = 0.0;
     if (n % 2 == 0) {
         const double *X = d->spec + n, *Y = d->spec + 2 * n + n; /* element N/2 (complex) */
         d->nyq2 = (X[0] * X[0] + X[1] * X[1] + Y[0] * Y[0] + Y[1] * Y[1]) / (double)n;
     }
-    double *tmp = amscr__malloc_array(2 * n + n, sizeof *tmp);
-    if (!tmp) {
-        amscr__fft_plan_free(&plan);
-        return amscr__fail(AMSCR_E_NOMEM, "descriptor: out of memory");
+}
+
+/* w (n) = the Gaussian kernel of scale sigma wrapped onto a circle of n samples (sigma 0: the
+ * identity); 0 when out of memory. */
+static int circular_kernel(double sigma, size_t n, double *w)
+{
+    memset(w, 0, n * sizeof *w);
+    if (sigma == 0.0) {
+        w[0] = 1.0;
+        return 1;
     }
+    size_t r = amscr__kernel_radius(sigma);
+    double *g = amscr__malloc_array(2 * r + 1, sizeof *g);
+    if (!g)
+        return 0;
+    amscr__kernel_fill(sigma, r, g);
+    for (size_t j = 0; j <= 2 * r; j++) {
+        long long off = ((long long)j - (long long)r) % (long long)n;
+        if (off < 0)
+            off += (long long)n;
+        w[off] += g[j];
+    }
+    free(g);
+    return 1;
+}
+
+/* The gains |G_k|^2 of the circular kernels of every scale, and their sum. */
+static amscr_status descriptor_gains(amscr_descriptor *d, amscr__fft_plan *plan)
+{
+    size_t n = d->n, p = d->p;
+    double *tmp = amscr__malloc_array(2 * n + n, sizeof *tmp);
+    if (!tmp)
+        return amscr__fail(AMSCR_E_NOMEM, "descriptor: out of memory");
     double *sum = d->gain + p * n;
     memset(sum, 0, n * sizeof *sum);
     for (size_t k = 0; k < p; k++) {
-        double sigma = d->params.scales[k];
         double *z = tmp, *w = tmp + 2 * n;
-        memset(w, 0, n * sizeof *w);
-        if (sigma == 0.0) {
-            w[0] = 1.0;
-        } else {
-            size_t r = amscr__kernel_radius(sigma);
-            double *g = amscr__malloc_array(2 * r + 1, sizeof *g);
-            if (!g) {
-                free(tmp);
-                amscr__fft_plan_free(&plan);
-                return amscr__fail(AMSCR_E_NOMEM, "descriptor: out of memory");
-            }
-            amscr__kernel_fill(sigma, r, g);
-            for (size_t j = 0; j <= 2 * r; j++) {
-                long long off = ((long long)j - (long long)r) % (long long)n;
-                if (off < 0)
-                    off += (long long)n;
-                w[off] += g[j];
-            }
-            free(g);
+        if (!circular_kernel(d->params.scales[k], n, w)) {
+            free(tmp);
+            return amscr__fail(AMSCR_E_NOMEM, "descriptor: out of memory");
         }
         for (size_t a = 0; a < n; a++) {
             z[2 * a] = w[a];
             z[2 * a + 1] = 0.0;
         }
-        amscr__fft(&plan, z, 0);
+        amscr__fft(plan, z, 0);
         for (size_t a = 0; a < n; a++) {
             double g2 = z[2 * a] * z[2 * a] + z[2 * a + 1] * z[2 * a + 1];
             d->gain[k * n + a] = g2;
@@ -157,8 +167,26 @@ amscr_status amscr__descriptor_finish(amscr_descriptor *d)
         }
     }
     free(tmp);
-    amscr__fft_plan_free(&plan);
     return AMSCR_OK;
+}
+
+amscr_status amscr__descriptor_finish(amscr_descriptor *d)
+{
+    amscr_status st = descriptor_moments(d);
+    if (st != AMSCR_OK)
+        return st;
+    d->norm2 = d->mom[0] + d->mom[2];
+    d->finest = 0;
+    for (size_t k = 1; k < d->p; k++)
+        if (d->params.scales[k] < d->params.scales[d->finest])
+            d->finest = k;
+    amscr__fft_plan plan;
+    if (amscr__fft_plan_init(&plan, d->n) != 0)
+        return amscr__fail(AMSCR_E_NOMEM, "descriptor: out of memory");
+    descriptor_spectra(d, &plan);
+    st = descriptor_gains(d, &plan);
+    amscr__fft_plan_free(&plan);
+    return st;
 }
 
 /* Similarity normalization: centroid to the origin, RMS radius to 1 (no whitening). */
