@@ -224,6 +224,44 @@ amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descripto
     return amscr__match_partial_min(prm, f, h, PART_PHI_MIN, ws, m);
 }
 
+/* The fragment f and the target h sampled along their affine arc lengths (each smoothed at
+ * PART_SIGMA first; sm: 2n scratch): PART_K points of f from end to end into F, PART_U points
+ * around h into Hu with their arc positions Hp; cumF / cumH (n each) and the lengths LF / LH
+ * kept for the partners. */
+static amscr_status partial_samples(const amscr_descriptor *f, const amscr_descriptor *h, double *sm, double *cumF,
+                                    double *cumH, double *LF, double *LH, double *F, double *Hu, double *Hp)
+{
+    size_t n = f->n;
+    amscr_status st = amscr__smooth(f->base, n, 0, PART_SIGMA, sm);
+    if (st == AMSCR_OK)
+        st = amscr__affine_cum(sm, n, 0, 0.0, cumF, LF);
+    if (st == AMSCR_OK)
+        st = amscr__smooth(h->base, n, 1, PART_SIGMA, sm);
+    if (st == AMSCR_OK)
+        st = amscr__affine_cum(sm, n, 1, 0.0, cumH, LH);
+    if (st != AMSCR_OK)
+        return st;
+    for (size_t j = 0; j < PART_K; j++)
+        point_at(f->base, cumF, n, 0, *LF, *LF * (double)j / (double)(PART_K - 1), &F[2 * j], &F[2 * j + 1], NULL);
+    for (size_t i = 0; i < PART_U; i++)
+        point_at(h->base, cumH, n, 1, *LH, *LH * (double)i / (double)PART_U, &Hu[2 * i], &Hu[2 * i + 1], &Hp[i]);
+    return AMSCR_OK;
+}
+
+/* The ambiguity of the winner among nb refined placements: the largest ratio of its cost to
+ * a distinct placement's (both floored), at most 1; 0 when no other placement is distinct. */
+static double partial_ambiguity(const amscr_descriptor *f, const placement *best, size_t nb, size_t win)
+{
+    double amb = 0.0;
+    for (size_t c = 0; c < nb; c++)
+        if (c != win && amscr__map_gap2(f, best[c].X, best[win].X) > AMSCR__DISTINCT_GAP2) {
+            double ratio = (best[win].tcost + AMSCR__AMBIGUITY_FLOOR) / (best[c].tcost + AMSCR__AMBIGUITY_FLOOR);
+            if (ratio > amb)
+                amb = ratio > 1.0 ? 1.0 : ratio;
+        }
+    return amb;
+}
+
 amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                       double phi_min, amscr_workspace *ws, match_t *m)
 {
@@ -245,22 +283,12 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
     double *sm = buf, *cumF = sm + 2 * n, *cumH = cumF + n, *F = cumH + n, *Hu = F + 2 * PART_K,
            *Hp = Hu + 2 * PART_U;
     double LF, LH;
-    st = amscr__smooth(f->base, n, 0, PART_SIGMA, sm);
-    if (st == AMSCR_OK)
-        st = amscr__affine_cum(sm, n, 0, 0.0, cumF, &LF);
-    if (st == AMSCR_OK)
-        st = amscr__smooth(h->base, n, 1, PART_SIGMA, sm);
-    if (st == AMSCR_OK)
-        st = amscr__affine_cum(sm, n, 1, 0.0, cumH, &LH);
+    st = partial_samples(f, h, sm, cumF, cumH, &LF, &LH, F, Hu, Hp);
     if (st != AMSCR_OK) {
         free(buf);
         free(b);
         return st;
     }
-    for (size_t j = 0; j < PART_K; j++)
-        point_at(f->base, cumF, n, 0, LF, LF * (double)j / (double)(PART_K - 1), &F[2 * j], &F[2 * j + 1], NULL);
-    for (size_t i = 0; i < PART_U; i++)
-        point_at(h->base, cumH, n, 1, LH, LH * (double)i / (double)PART_U, &Hu[2 * i], &Hu[2 * i + 1], &Hp[i]);
     placement best[PART_KEEP];
     size_t nb = search_placements(prm, F, Hu, phi_min, best);
     double *q = ws->rbuf, *r2 = q + 2 * n, *sorted = r2 + n, *Hd = q + 8 * n;
@@ -279,13 +307,7 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
         free(b);
         return amscr__fail(AMSCR_E_DEGENERATE, "partial registration: no placement of the fragment fits");
     }
-    m->ambiguity = 0.0;
-    for (size_t c = 0; c < nb; c++)
-        if (c != win && amscr__map_gap2(f, best[c].X, best[win].X) > AMSCR__DISTINCT_GAP2) {
-            double ratio = (best[win].tcost + AMSCR__AMBIGUITY_FLOOR) / (best[c].tcost + AMSCR__AMBIGUITY_FLOOR);
-            if (ratio > m->ambiguity)
-                m->ambiguity = ratio > 1.0 ? 1.0 : ratio;
-        }
+    m->ambiguity = partial_ambiguity(f, best, nb, win);
     /* the winner again, so that ws->rbuf holds its pairs for the reported QR solve (they are
      * there already when it was the last refined: the refinement is deterministic) */
     double X[6], cost = best[win].tcost;
