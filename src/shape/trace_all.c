@@ -122,6 +122,45 @@ static amscr_status label_regions(const uint8_t *on, size_t W, size_t H, uint32_
     return AMSCR_OK;
 }
 
+/* Doubles the room of a trace's pixels and back directions (*cap entries each). */
+static amscr_status grow_trace(uint32_t **pts, uint8_t **backs, size_t *cap)
+{
+    size_t ncap = 2 * *cap;
+    uint32_t *np2 = realloc(*pts, ncap * sizeof *np2);
+    if (np2)
+        *pts = np2;
+    uint8_t *nb = np2 ? realloc(*backs, ncap) : NULL;
+    if (nb)
+        *backs = nb;
+    if (!np2 || !nb)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_contours_from_mask: out of memory (%zu points)", ncap);
+    *cap = ncap;
+    return AMSCR_OK;
+}
+
+/* The traced pixels pts (*n) cut to their cycle (from index `first`, where the walk came back)
+ * and started at the start pixel when it is on it (as trace.c). */
+static amscr_status keep_cycle(uint32_t *pts, size_t *n, size_t first, size_t start)
+{
+    if (first > 0 && first < *n) {
+        memmove(pts, pts + first, (*n - first) * sizeof *pts);
+        *n -= first;
+    }
+    size_t rot = 0;
+    while (rot < *n && pts[rot] != start)
+        rot++;
+    if (rot == 0 || rot >= *n)
+        return AMSCR_OK;
+    uint32_t *tmp = malloc(rot * sizeof *tmp);
+    if (!tmp)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_contours_from_mask: out of memory");
+    memcpy(tmp, pts, rot * sizeof *tmp);
+    memmove(pts, pts + rot, (*n - rot) * sizeof *pts);
+    memcpy(pts + *n - rot, tmp, rot * sizeof *tmp);
+    free(tmp);
+    return AMSCR_OK;
+}
+
 /* Moore tracing of region `label` from its first pixel (backtrack W); the cycle's pixel
  * indices into *pts (grown as needed), their count into *np. `st` holds 4 state bits a
  * pixel and is left cleared. */
@@ -164,20 +203,8 @@ static amscr_status trace_region(const uint32_t *lab, uint8_t *st, size_t W, siz
                             (unsigned)AMSCR_MAX_POINTS);
             break;
         }
-        if (n == *cap) {
-            size_t ncap = 2 * *cap;
-            uint32_t *np2 = realloc(*pts, ncap * sizeof *np2);
-            if (np2)
-                *pts = np2;
-            uint8_t *nb = np2 ? realloc(backs, ncap) : NULL;
-            if (nb)
-                backs = nb;
-            if (!np2 || !nb) {
-                s = amscr__fail(AMSCR_E_NOMEM, "amscr_contours_from_mask: out of memory (%zu points)", ncap);
-                break;
-            }
-            *cap = ncap;
-        }
+        if (n == *cap && (s = grow_trace(pts, &backs, cap)) != AMSCR_OK)
+            break;
         (*pts)[n] = (uint32_t)q;
         backs[n++] = (uint8_t)nback;
         p = q;
@@ -186,22 +213,8 @@ static amscr_status trace_region(const uint32_t *lab, uint8_t *st, size_t W, siz
     for (size_t i = 0; i < n; i++)
         st[(*pts)[i]] = 0;
     free(backs);
-    if (s == AMSCR_OK && first > 0 && first < n) { /* keep the cycle only */
-        memmove(*pts, *pts + first, (n - first) * sizeof **pts);
-        n -= first;
-    }
-    size_t rot = 0; /* start the cycle at the start pixel when it is on it (as trace.c) */
-    while (s == AMSCR_OK && rot < n && (*pts)[rot] != start)
-        rot++;
-    if (rot > 0 && rot < n) {
-        uint32_t *tmp = malloc(rot * sizeof *tmp);
-        if (!tmp)
-            return amscr__fail(AMSCR_E_NOMEM, "amscr_contours_from_mask: out of memory");
-        memcpy(tmp, *pts, rot * sizeof *tmp);
-        memmove(*pts, *pts + rot, (n - rot) * sizeof **pts);
-        memcpy(*pts + n - rot, tmp, rot * sizeof *tmp);
-        free(tmp);
-    }
+    if (s == AMSCR_OK)
+        s = keep_cycle(*pts, &n, first, start);
     *np = n;
     return s;
 }
