@@ -273,6 +273,29 @@ static double wlength_cum(const double *Q, size_t n, int closed, const double W[
     return closed ? total : cum[n - 1];
 }
 
+/* dst (cnt): positions in the index space of the M samples taken at positions pos of a polygon
+ * of np vertices, mapped in place to positions on the polygon (vertex index + fraction). */
+static void positions_on_polygon(const double *pos, size_t M, size_t np, int closed, double *dst, size_t cnt)
+{
+    for (size_t k = 0; k < cnt; k++) {
+        double q = dst[k], fl = floor(q);
+        size_t a = (size_t)fl;
+        double u = q - fl;
+        if (a >= M)
+            a = M - 1;
+        double pa = pos[a], pb;
+        if (a + 1 < M)
+            pb = pos[a + 1];
+        else
+            pb = closed ? pos[0] + (double)np : pos[M - 1];
+        if (pb < pa) /* wrapped past the end of a closed polygon */
+            pb += (double)np;
+        dst[k] = pa + u * (pb - pa);
+        if (closed && dst[k] >= (double)np)
+            dst[k] -= (double)np;
+    }
+}
+
 /* The parametrizations. P: the input polygon (np vertices). It is first densified to M
  * points equally spaced in arc length of the polygon after the whitening W (W = I for the
  * Euclidean and affine kinds; region moments for the whitened kind, which makes the
@@ -331,24 +354,7 @@ amscr_status amscr__parametrize(const double *P, size_t np, int closed, amscr_pa
         equal_params(total, cnt, closed, tgt);
         double *dst = last ? finalpos : newpos;
         invert_cum(cum, M, closed, total, tgt, cnt, dst);
-        /* dst: positions in the index space of C; map them to positions on P */
-        for (size_t k = 0; k < cnt; k++) {
-            double q = dst[k], fl = floor(q);
-            size_t a = (size_t)fl;
-            double u = q - fl;
-            if (a >= M)
-                a = M - 1;
-            double pa = pos[a], pb;
-            if (a + 1 < M)
-                pb = pos[a + 1];
-            else
-                pb = closed ? pos[0] + (double)np : pos[M - 1];
-            if (pb < pa) /* wrapped past the end of a closed polygon */
-                pb += (double)np;
-            dst[k] = pa + u * (pb - pa);
-            if (closed && dst[k] >= (double)np)
-                dst[k] -= (double)np;
-        }
+        positions_on_polygon(pos, M, np, closed, dst, cnt);
         if (!last)
             memcpy(pos, newpos, M * sizeof *pos);
     }
