@@ -190,3 +190,32 @@ def test_pixel_chain_option_everywhere(tmp_path):
     for cmd in (("contour", p), ("register", p, p)):
         r = run(*cmd, "--pixel-chain")
         assert r.returncode == 0, r.stderr
+
+
+def test_contour_join(tmp_path):
+    """`contour --join` traces the outline the retrieval commands and `register` use: a piece
+    broken off by a 2-pixel gap is joined to the largest component (its area counts, by zero-width
+    bridges), a shape in one piece is traced as without it, and --join with --all or
+    --pixel-chain is a usage error."""
+    def write(name, *rects):
+        img = blank(110, 80)
+        for x0, y0, x1, y1 in rects:
+            fill_rect(img, x0, y0, x1, y1, 255)
+        p = tmp_path / (name + img_ext())
+        p.write_bytes(image_bytes(img, p.name))
+        return p
+    broken = write("broken", (10, 20, 70, 50), (72, 28, 95, 42))
+    body = write("body", (10, 20, 70, 50))
+    area = {}
+    for name, p, extra in (("body", body, ()), ("largest", broken, ()), ("joined", broken, ("--join",)),
+                           ("body joined", body, ("--join",))):
+        r = run("contour", p, *extra)
+        assert r.returncode == 0, r.stderr
+        area[name] = signed_area(read_points(r.stdout))
+    assert area["largest"] == pytest.approx(area["body"])  # the piece dropped
+    assert area["body joined"] == pytest.approx(area["body"])  # nothing to join
+    piece = (95 - 72 + 1) * (42 - 28 + 1)
+    assert area["joined"] == pytest.approx(area["body"] + piece, rel=0.02)
+    for extra in (("--all",), ("--pixel-chain",)):
+        r = run("contour", broken, "--join", *extra)
+        assert r.returncode == 2 and "--join" in r.stderr, (extra, r.stderr)

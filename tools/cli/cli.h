@@ -68,6 +68,7 @@ typedef struct opts {
     const char *plot;
     const char *sheet; /* search --sheet FILE */
     int all;           /* contour --all */
+    int join;          /* contour --join */
     double min_area;   /* --min-area A (pixels^2) */
     long component;    /* --component N; -1: the largest outer contour */
     int add;           /* index --add */

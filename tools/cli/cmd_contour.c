@@ -1,4 +1,4 @@
-/* cmd_contour.c — `amscr contour IMG [-o FILE] [--all [--json]]`: the traced points of a
+/* cmd_contour.c — `amscr contour IMG [-o FILE] [--join | --all [--json]]`: the traced points of a
  * silhouette, or every contour of the image with its hierarchy. */
 #include <errno.h>
 #include <stdio.h>
@@ -110,8 +110,13 @@ int cmd_contour(opts *o)
 {
     if (o->json && !o->all)
         return usage_error("--json", "only with --all (the single contour is a plain point list)");
+    if (o->join && (o->all || (image_trace_flags() & AMSCR_TRACE_PIXEL_CHAIN)))
+        return usage_error("--join", "joins pieces to the one sub-pixel outline (not with %s)",
+                           o->all ? "--all" : "--pixel-chain");
     if (o->all)
         return contour_all(o);
+    if (o->join)
+        image_set_trace_flags(image_trace_flags() | AMSCR_TRACE_JOIN);
     amscr_contour *c = NULL;
     if (shape_load(o->pos[0], o->threshold, &c) != 0)
         return TOOL_EXIT_FAIL;

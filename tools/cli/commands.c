@@ -9,7 +9,7 @@
 #include "cmd_params.h"
 
 static const char HELP_CONTOUR[] =
-    "usage: amscr contour IMG [-o FILE] [--threshold N|auto] [--pixel-chain]\n"
+    "usage: amscr contour IMG [-o FILE] [--threshold N|auto] [--pixel-chain | --join]\n"
     "       amscr contour IMG --all [--json] [--min-area A] [-o FILE]\n"
     "\n"
     "Traces the outer boundary of the largest 8-connected foreground component of a\n"
@@ -27,6 +27,10 @@ static const char HELP_CONTOUR[] =
     "  -o, --output FILE       write the points to FILE instead of stdout\n"
     "  --threshold N|auto      pixels > N are 'on' (0..254, default 127); auto = Otsu\n"
     "  --pixel-chain           the chain of boundary pixel centres instead of the iso-line\n"
+    "  --join                  also the other large pieces near the largest (at least 5 %\n"
+    "                          of its pixels, within its RMS radius, not in its holes),\n"
+    "                          joined to its outline: the outline register, search,\n"
+    "                          matrix, eval and index use\n"
     "  --all                   every contour: each 8-connected component's outer boundary\n"
     "                          (counter-clockwise) and each hole's (clockwise; with\n"
     "                          --pixel-chain through the hole's own pixels), with its\n"

@@ -21,6 +21,7 @@ typedef enum opt_id {
     O_PLOT,
     O_SHEET,
     O_ALL,
+    O_JOIN,
     O_MIN_AREA,
     O_COMPONENT,
     O_ADD,
@@ -78,6 +79,7 @@ static const optdef OPTS[] = {
     {"--plot", O_PLOT, 1, C_REGISTER | C_EVAL, "FILE"},
     {"--sheet", O_SHEET, 1, C_SEARCH, "FILE"},
     {"--all", O_ALL, 0, C_CONTOUR, NULL},
+    {"--join", O_JOIN, 0, C_CONTOUR, NULL},
     {"--min-area", O_MIN_AREA, 1, C_CONTOUR | C_REGISTER | C_SEARCH, "A"},
     {"--component", O_COMPONENT, 1, C_REGISTER | C_SEARCH, "N"},
     {"--names", O_NAMES, 1, C_MATRIX, "FILE"},
@@ -339,6 +341,7 @@ static int set_option(opts *o, const optdef *d, const char *v)
         return 0;
     }
     case O_ALL: o->all = 1; return 0;
+    case O_JOIN: o->join = 1; return 0;
     case O_ADD: o->add = 1; return 0;
     case O_CANDIDATES:
         o->candidates_set = 1;
