@@ -9,6 +9,7 @@
  * pixel for the queue, plus the boundary itself. */
 #include "internal.h"
 #include "iso_level.h"
+#include "trace_all.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -166,12 +167,10 @@ static amscr_status tr_largest_component(uint8_t *map, size_t w, size_t h, const
     return AMSCR_OK;
 }
 
-/* Room for one more boundary point (pts and backs grow together, up to AMSCR_MAX_POINTS). */
-static amscr_status tr_grow(uint32_t **pts, uint8_t **backs, size_t np, size_t *cap)
+amscr_status amscr__trace_grow(uint32_t **pts, uint8_t **backs, size_t np, size_t *cap, const char *fn)
 {
     if (np == AMSCR_MAX_POINTS)
-        return amscr__fail(AMSCR_E_LIMIT, "amscr_contour_from_mask: boundary exceeds %u points",
-                           (unsigned)AMSCR_MAX_POINTS);
+        return amscr__fail(AMSCR_E_LIMIT, "%s: a boundary exceeds %u points", fn, (unsigned)AMSCR_MAX_POINTS);
     if (np < *cap)
         return AMSCR_OK;
     size_t ncap = 2 * *cap > AMSCR_MAX_POINTS ? AMSCR_MAX_POINTS : 2 * *cap;
@@ -182,7 +181,7 @@ static amscr_status tr_grow(uint32_t **pts, uint8_t **backs, size_t np, size_t *
     if (nbacks)
         *backs = nbacks;
     if (!npts || !nbacks)
-        return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_from_mask: out of memory (%zu boundary points)", ncap);
+        return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory (%zu boundary points)", fn, ncap);
     *cap = ncap;
     return AMSCR_OK;
 }
@@ -236,7 +235,7 @@ static amscr_status tr_trace(uint8_t *map, const ptrdiff_t off[8], size_t start,
             break;
         }
         map[q] |= bit;
-        st = tr_grow(&pts, &backs, np, &cap);
+        st = amscr__trace_grow(&pts, &backs, np, &cap, "amscr_contour_from_mask");
         if (st != AMSCR_OK)
             break;
         pts[np] = (uint32_t)q;
@@ -347,7 +346,6 @@ amscr_status amscr_contour_from_mask(const uint8_t *pixels, size_t width, size_t
 }
 
 /* ------------------------------------------------------------------ shared with trace_all.c */
-#include "trace_all.h"
 
 void amscr__mask_threshold(const uint8_t *pixels, size_t w, size_t h, size_t stride, int threshold, int *out_t,
                            int *out_invert)

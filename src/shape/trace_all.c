@@ -122,22 +122,6 @@ static amscr_status label_regions(const uint8_t *on, size_t W, size_t H, uint32_
     return AMSCR_OK;
 }
 
-/* Doubles the room of a trace's pixels and back directions (*cap entries each). */
-static amscr_status grow_trace(uint32_t **pts, uint8_t **backs, size_t *cap)
-{
-    size_t ncap = 2 * *cap;
-    uint32_t *np2 = realloc(*pts, ncap * sizeof *np2);
-    if (np2)
-        *pts = np2;
-    uint8_t *nb = np2 ? realloc(*backs, ncap) : NULL;
-    if (nb)
-        *backs = nb;
-    if (!np2 || !nb)
-        return amscr__fail(AMSCR_E_NOMEM, "amscr_contours_from_mask: out of memory (%zu points)", ncap);
-    *cap = ncap;
-    return AMSCR_OK;
-}
-
 /* The traced pixels pts (*n) cut to their cycle (from index `first`, where the walk came back)
  * and started at the start pixel when it is on it (as trace.c). */
 static amscr_status keep_cycle(uint32_t *pts, size_t *n, size_t first, size_t start)
@@ -198,12 +182,7 @@ static amscr_status trace_region(const uint32_t *lab, uint8_t *st, size_t W, siz
             break;
         }
         st[q] |= bit;
-        if (n == AMSCR_MAX_POINTS) {
-            s = amscr__fail(AMSCR_E_LIMIT, "amscr_contours_from_mask: a boundary exceeds %u points",
-                            (unsigned)AMSCR_MAX_POINTS);
-            break;
-        }
-        if (n == *cap && (s = grow_trace(pts, &backs, cap)) != AMSCR_OK)
+        if ((s = amscr__trace_grow(pts, &backs, n, cap, "amscr_contours_from_mask")) != AMSCR_OK)
             break;
         (*pts)[n] = (uint32_t)q;
         backs[n++] = (uint8_t)nback;

@@ -1,6 +1,7 @@
-/* trace_all.h — internal: the threshold and polarity rules of amscr_contour_from_mask
- * (trace.c), shared with amscr_contours_from_mask (trace_all.c); the region labelling and
- * hierarchy of trace_all.c, shared with the sub-pixel tracer (trace_image.c). */
+/* trace_all.h — internal: the threshold and polarity rules and the boundary's growth of
+ * amscr_contour_from_mask (trace.c), shared with amscr_contours_from_mask (trace_all.c); the
+ * region labelling and hierarchy of trace_all.c, shared with the sub-pixel tracer
+ * (trace_image.c). */
 #ifndef AMSCR_TRACE_ALL_H
 #define AMSCR_TRACE_ALL_H
 
@@ -14,6 +15,11 @@
  * arguments are validated by the caller. */
 void amscr__mask_threshold(const uint8_t *pixels, size_t w, size_t h, size_t stride, int threshold, int *out_t,
                            int *out_invert);
+
+/* Room for one more boundary point of a Moore trace: pts and backs (*cap entries each) grow
+ * together, doubled up to AMSCR_MAX_POINTS; AMSCR_E_LIMIT when np reached it (fn names the
+ * public call in messages). */
+amscr_status amscr__trace_grow(uint32_t **pts, uint8_t **backs, size_t np, size_t *cap, const char *fn);
 
 /* Regions of a padded mask (W x H, a frame of background): foreground 8-connected, background
  * 4-connected, labelled in raster order of their first pixel. */
