@@ -121,6 +121,7 @@ VARIANTS = [  # (name, graphs, shares, kind)
     ('inner 0.1, density of the collection', 'CI', (0.1,), 'density collection'),
     ('inner 0.2, density of the collection', 'CI', (0.2,), 'density collection'),
     ('inner 0.1, E 0.1, density of the collection', 'CIE', (0.1, 0.1), 'density collection'),
+    ('inner 0.1, E 0.05', 'CIE', (0.1, 0.05), 'fixed'),
 ]
 
 
