@@ -32,8 +32,8 @@
  *
  * Scores: bull's eye % (mpeg7-dev and its folds, and the MCD-style set of mpeg7-dev's first
  * shapes: mcd_set.h, seed 7), top-k sums (Kimia). Images are traced as the tool's retrieval
- * commands trace them (broken pieces joined: AMSCR_TRACE_JOIN). Deterministic; ~15 s a closing on 2 cores,
- * ~1 min with the halves. */
+ * commands trace them (broken pieces joined: AMSCR_TRACE_JOIN). Deterministic; ~15 s a closing
+ * on 2 cores, ~1 min with the halves. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -69,6 +69,7 @@ static void *xmalloc(size_t bytes)
 /* The channel matrix of s's contours under the retrieval preset, each closed at c first (c 0:
  * as they are); with the inner distance's matrix into I when I is not NULL. */
 static int ONE_FRAME; /* --one-frame: E in the similarity frame alone */
+static int OUTLINE;   /* AMSCR_ENVELOPE_OUTLINE: E from the 64-point outline */
 
 static double *channel_of(const shape_set *s, double c, double *I)
 {
@@ -82,7 +83,7 @@ static double *channel_of(const shape_set *s, double c, double *I)
         double *xy = NULL;
         size_t m = 0;
         amscr_contour *ci = s->c[i];
-        if (c > 0.0 && getenv("AMSCR_ENVELOPE_OUTLINE")) { /* the inner distance's 64-point outline */
+        if (c > 0.0 && OUTLINE) { /* the inner distance's 64-point outline */
             xy = xmalloc(2 * AMSCR__OUTLINE_N * sizeof *xy);
             m = AMSCR__OUTLINE_N;
             if (amscr__outline(amscr_contour_xy(s->c[i]), amscr_contour_size(s->c[i]), c, xy) != AMSCR_OK ||
@@ -273,6 +274,7 @@ int main(int argc, char **argv)
 {
     image_set_trace_flags(AMSCR_TRACE_JOIN); /* trace as the tool's retrieval commands */
     ONE_FRAME = argc > 3 && strcmp(argv[3], "--one-frame") == 0;
+    OUTLINE = getenv("AMSCR_ENVELOPE_OUTLINE") != NULL;
     if (argc < 2 || argc > 4 || (argc == 4 && !ONE_FRAME)) {
         fprintf(stderr, "usage: amscr-retrieval-envelope DATASETS [C1,C2,...] [--one-frame]\n");
         return 2;

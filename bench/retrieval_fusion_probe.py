@@ -29,11 +29,10 @@ import sys
 import numpy as np
 import scipy.sparse as sp
 
-import amscr
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from retrieval_context_probe import sym, weights  # noqa: E402
-from retrieval_rerank_probe import neighbours  # noqa: E402
+from retrieval_rerank_probe import diffuse, neighbours, score  # noqa: E402
 
 K, ITERS = 8, 10
 
@@ -85,21 +84,7 @@ def rerank(dists, shares, kind='fixed', k=K, iters=ITERS):
         w = weights(np.take_along_axis(D, idx, 1), idx, D.max())
         vals.append((w * mass[:, g:g + 1]).ravel())
     P = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
-    Q = P.toarray()
-    for _ in range(iters):
-        Q = (P @ (P @ Q).T).T
-        Q[np.arange(n), np.arange(n)] += 1.0
-    D = Ds[0]
-    qmax = Q.max(1, keepdims=True)
-    out = 0.5 * np.where(Q > 0, 1.0 - Q / qmax, 1.0 + D / D.max())
-    np.fill_diagonal(out, 0.0)
-    return out
-
-
-def score(R, lab, kind):
-    if kind == 'bull':
-        return 100.0 * amscr.bullseye(R, lab)
-    return float(amscr.topk_table(R, lab, 10 if kind == 'top10' else 11).sum())
+    return diffuse(P, Ds[0], iters)
 
 
 def sub(mats, idx):
@@ -127,7 +112,7 @@ VARIANTS = [  # (name, graphs, shares, kind)
 
 def run(mats, lab, v, kind):
     name, g, shares, how = v
-    return score(rerank([mats[c] for c in g], shares, how), lab, kind)
+    return score(kind, rerank([mats[c] for c in g], shares, how), lab)
 
 
 def main(argv=None):
