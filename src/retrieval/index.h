@@ -7,6 +7,7 @@
 #include "channel.h"
 #include "inner.h"
 #include "internal.h"
+#include "rank.h"
 #include "rows.h"
 #include "signature.h"
 
@@ -94,11 +95,6 @@ amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const ams
  * reverse, and rebuilds it when have_sig and first == 0 (a load: the lists are in place). */
 amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig);
 
-/* Row i's k nearest (itself first, then by (distance, index)) among m candidates cj[t] with
- * distances cd[t] (i may be among them; k <= m + 1). */
-amscr_status amscr__knn_select(size_t i, const size_t *cj, const double *cd, size_t m, size_t k, uint32_t *out_idx,
-                               double *out_dist);
-
 /* Refined lists (*nidx, *ndist) replace (*idx, *dist), their first `keep` entries (the rows
  * not refined) copied over; the old freed, *nidx and *ndist NULL. */
 void amscr__index_take_lists(uint32_t **idx, double **dist, uint32_t **nidx, double **ndist, size_t keep);
@@ -147,9 +143,6 @@ amscr_status amscr__index_inner_full(amscr_index *x);
 /* Rows first..n-1's inner lists among their shortlists S (m each) and their base lists (a
  * shortlist build); x->dmax2 grows. */
 amscr_status amscr__index_inner_rows(amscr_index *x, size_t first, const uint32_t *S, size_t m);
-/* Shape j (new, at distance d) into row i's list (idx, dist: k entries) when nearer than its
- * last entry (ties: j stays behind). */
-void amscr__index_enter_list(uint32_t *idx, double *dist, size_t k, size_t j, double d);
 
 /* db can be indexed (closed curves for the channel, at most 2^32 - 1 shapes). */
 amscr_status amscr__index_check_db(const amscr_db *db, const char *what);

@@ -100,12 +100,12 @@ static amscr_status add_rows(add_ctx *c, size_t j1, size_t n0)
         for (size_t t = 0; t < m; t++) {
             x->dmax = cd[t] > x->dmax ? cd[t] : x->dmax;
             if (cand[t] < n0)
-                amscr__index_enter_list(x->nb_idx + cand[t] * k, x->nb_dist + cand[t] * k, k, j, cd[t]);
+                amscr__knn_enter(x->nb_idx + cand[t] * k, x->nb_dist + cand[t] * k, k, j, cd[t]);
         }
         for (size_t t = 0; k2 > 0 && t < m; t++) {
             x->dmax2 = cd2[t] > x->dmax2 ? cd2[t] : x->dmax2;
             if (cand[t] < n0)
-                amscr__index_enter_list(x->in_idx + cand[t] * k2, x->in_dist + cand[t] * k2, k2, j, cd2[t]);
+                amscr__knn_enter(x->in_idx + cand[t] * k2, x->in_dist + cand[t] * k2, k2, j, cd2[t]);
         }
         if (k > 0)
             st = amscr__knn_select(j, cand, cd, m, k, x->nb_idx + j * k, x->nb_dist + j * k);

@@ -22,58 +22,6 @@ enum { BUILD_SHORTLIST = 192 };
  * (signature.h) instead of scanning every shape's lower bound. */
 enum { IVF_MIN_SHAPES = 20000 };
 
-typedef struct {
-    double d;
-    size_t j;
-} nb_t;
-
-/* x before y: by distance, ties by index */
-static int nb_less(nb_t x, nb_t y) { return x.d < y.d || (x.d == y.d && x.j < y.j); }
-
-amscr_status amscr__knn_select(size_t i, const size_t *cj, const double *cd, size_t m, size_t k, uint32_t *out_idx,
-                               double *out_dist)
-{
-    /* the k first of the candidates sorted by nb_less (itself first), kept by insertion */
-    if (k == 0)
-        return AMSCR_OK;
-    nb_t *row = amscr__malloc_array(k + 1, sizeof *row);
-    if (!row)
-        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
-    size_t r = 0;
-    row[r++] = (nb_t){-1.0, i}; /* itself first, as amscr_rerank_diffusion */
-    for (size_t t = 0; t < m; t++) {
-        nb_t x = {cd[t], cj[t]};
-        if (cj[t] == i || (r >= k && !nb_less(x, row[k - 1])))
-            continue;
-        size_t at = r < k ? r++ : k - 1;
-        while (at > 0 && nb_less(x, row[at - 1])) {
-            row[at] = row[at - 1];
-            at--;
-        }
-        row[at] = x;
-    }
-    for (size_t t = 0; t < k; t++) {
-        out_idx[t] = (uint32_t)row[t < r ? t : r - 1].j;
-        out_dist[t] = t == 0 ? 0.0 : row[t < r ? t : r - 1].d;
-    }
-    free(row);
-    return AMSCR_OK;
-}
-
-void amscr__index_enter_list(uint32_t *idx, double *dist, size_t k, size_t j, double d)
-{
-    if (k < 2 || !(d < dist[k - 1]))
-        return;
-    size_t t = k - 1;
-    while (t > 1 && dist[t - 1] > d) {
-        idx[t] = idx[t - 1];
-        dist[t] = dist[t - 1];
-        t--;
-    }
-    idx[t] = (uint32_t)j;
-    dist[t] = d;
-}
-
 void amscr__index_take_lists(uint32_t **idx, double **dist, uint32_t **nidx, double **ndist, size_t keep)
 {
     memcpy(*nidx, *idx, keep * sizeof **nidx);

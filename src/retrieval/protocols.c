@@ -4,8 +4,7 @@
  * distance ascending, ties to the lower index; +inf is allowed, NaN and -inf are refused.
  * Classes (and groups) are the distinct label values in ascending order; every per-class
  * output is indexed by that order. */
-#include "internal.h"
-#include "scores.h"
+#include "rank.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -141,7 +140,7 @@ amscr_status amscr_score_per_class(const double *dist, size_t n, const int32_t *
         nn[k] += labels[amscr__rank_argmin(dist + i * n, n, i)] == labels[i];
         if (!out_bullseye)
             continue;
-        amscr__rank_select(dist + i * n, n, w, SIZE_MAX, idx);
+        amscr__rank_select(dist + i * n, NULL, n, w, SIZE_MAX, idx);
         for (size_t t = 0; t < w; t++)
             hits += labels[idx[t]] == labels[i];
         be[k] += (double)hits;
@@ -441,7 +440,7 @@ amscr_status amscr_score_precision_recall(const double *dist, size_t n, const in
         size_t relevant = c.sizes[c.id[i]] - 1;
         if (relevant == 0)
             continue;
-        amscr__rank_select(dist + i * n, n, n - 1, i, order);
+        amscr__rank_select(dist + i * n, NULL, n, n - 1, i, order);
         pt_query_pr(labels, i, order, n - 1, relevant, nlevels, acc + nlevels, acc);
         queries++;
     }

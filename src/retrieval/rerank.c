@@ -1,7 +1,7 @@
 /* rerank.c — contextual re-ranking of a distance matrix by affinity diffusion on a kNN
  * tensor-product graph (Yang, Prasad, Latecki, CVPR 2012). See amscr_rerank_diffusion in
  * amscr.h for the definition. */
-#include "index.h" /* amscr__knn_select: the neighbour order the index stores too */
+#include "rank.h" /* amscr__knn_select: the neighbour order the index stores too */
 #include "rows.h"
 
 #include <math.h>

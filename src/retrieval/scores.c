@@ -21,69 +21,11 @@
  * Cost: O(n^2 log w) for the matrix scores (w the window or kmax), with one allocation
  * per call. */
 #include "internal.h"
-#include "scores.h"
+#include "rank.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* (d[a], a) < (d[b], b) lexicographically. */
-static inline int rt_before(const double *d, size_t a, size_t b)
-{
-    return d[a] < d[b] || (d[a] == d[b] && a < b);
-}
-
-/* Max-heap (by rt_before) sift-down of heap[0..len-1] from position i. */
-static void rt_sift_down(const double *d, size_t *heap, size_t len, size_t i)
-{
-    size_t v = heap[i];
-    for (;;) {
-        size_t c = 2 * i + 1;
-        if (c >= len)
-            break;
-        if (c + 1 < len && rt_before(d, heap[c], heap[c + 1]))
-            c++;
-        if (!rt_before(d, v, heap[c]))
-            break;
-        heap[i] = heap[c];
-        i = c;
-    }
-    heap[i] = v;
-}
-
-/* The k first indices of a row (scores.h). */
-void amscr__rank_select(const double *d, size_t n, size_t k, size_t exclude, size_t *out)
-{
-    if (k == 0)
-        return;
-    size_t len = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (i == exclude)
-            continue;
-        if (len < k) {
-            /* sift up */
-            size_t j = len++;
-            while (j > 0) {
-                size_t p = (j - 1) / 2;
-                if (!rt_before(d, out[p], i))
-                    break;
-                out[j] = out[p];
-                j = p;
-            }
-            out[j] = i;
-        } else if (rt_before(d, i, out[0])) {
-            out[0] = i;
-            rt_sift_down(d, out, len, 0);
-        }
-    }
-    /* Heap sort in place: ascending. */
-    for (size_t end = len; end > 1; end--) {
-        size_t t = out[0];
-        out[0] = out[end - 1];
-        out[end - 1] = t;
-        rt_sift_down(d, out, end - 1, 0);
-    }
-}
 
 /* 1 when any of the n values is NaN. */
 static int rt_has_nan(const double *v, size_t n)
@@ -116,7 +58,7 @@ amscr_status amscr_topk(const double *dist, size_t n, size_t k, size_t exclude, 
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_topk: k = %zu > %zu candidates", k, avail);
     if (rt_has_nan(dist, n))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_topk: NaN distance");
-    amscr__rank_select(dist, n, k, exclude, out_indices);
+    amscr__rank_select(dist, NULL, n, k, exclude, out_indices);
     return AMSCR_OK;
 }
 
@@ -182,7 +124,7 @@ amscr_status amscr_score_bullseye(const double *dist, size_t n, const int32_t *l
         size_t w = window ? window : 2 * counts[i];
         if (w > n)
             w = n;
-        amscr__rank_select(dist + i * n, n, w, SIZE_MAX, idx);
+        amscr__rank_select(dist + i * n, NULL, n, w, SIZE_MAX, idx);
         size_t h = 0;
         for (size_t r = 0; r < w; r++)
             h += labels[idx[r]] == labels[i];
@@ -217,7 +159,7 @@ amscr_status amscr_score_topk_table(const double *dist, size_t n, const int32_t 
         return amscr__fail(AMSCR_E_NOMEM, "amscr_score_topk_table: out of memory");
     }
     for (size_t i = 0; i < n; i++) {
-        amscr__rank_select(dist + i * n, n, kmax, i, idx);
+        amscr__rank_select(dist + i * n, NULL, n, kmax, i, idx);
         for (size_t r = 0; r < kmax; r++)
             counts[r] += labels[idx[r]] == labels[i];
     }
@@ -225,19 +167,6 @@ amscr_status amscr_score_topk_table(const double *dist, size_t n, const int32_t 
     free(idx);
     free(counts);
     return AMSCR_OK;
-}
-
-/* Index of the smallest of a row other than `exclude` (scores.h). */
-size_t amscr__rank_argmin(const double *row, size_t n, size_t exclude)
-{
-    size_t best = SIZE_MAX;
-    for (size_t j = 0; j < n; j++) {
-        if (j == exclude)
-            continue;
-        if (best == SIZE_MAX || row[j] < row[best])
-            best = j;
-    }
-    return best;
 }
 
 amscr_status amscr_score_nn_accuracy(const double *dist, size_t n, const int32_t *labels, double *out_accuracy)
