@@ -14,9 +14,7 @@
  * a pair and orientation. */
 #include "inner.h"
 
-#include "channel.h" /* amscr__mirror_upper */
-#include "dense.h"   /* AMSCR__PI */
-#include "rows.h"
+#include "dense.h" /* AMSCR__PI */
 
 #include <math.h>
 #include <stdlib.h>
@@ -250,16 +248,7 @@ double amscr__inner_distance(const amscr__inner *a, const amscr__inner *b, int r
     return d2 > 1e-12 * (a->norm2 + b->norm2) ? sqrt(d2 / (double)(N * N)) : 0.0;
 }
 
-/* ------------------------------------------------------------ the collection */
-
-typedef struct {
-    const amscr_db *db;
-    amscr__inner *f;        /* the features built */
-    const amscr__inner *cf; /* the features compared */
-    size_t n;
-    int reflections;
-    double *out;
-} inner_job;
+/* ------------------------------------------------- a workspace on the heap (rows.c) */
 
 amscr_status amscr__inner_ws_new(void **out)
 {
@@ -277,69 +266,4 @@ void amscr__inner_ws_delete(void *ws)
     if (ws)
         amscr__inner_ws_free(ws);
     free(ws);
-}
-
-static amscr_status job_init(void *ctx, void **ws)
-{
-    (void)ctx;
-    return amscr__inner_ws_new(ws);
-}
-
-static amscr_status feature_row(void *ctx, size_t i, void *ws)
-{
-    const inner_job *m = ctx;
-    const amscr_descriptor *d = amscr_db_descriptor(m->db, i);
-    if (!d)
-        return amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
-    return amscr__inner_build_shape(d, amscr_db_params(m->db)->inner_closing, &m->f[i], ws);
-}
-
-/* Rows a task takes, and the columns each row takes at a time: a column group's features
- * (~17 KB a shape) are read for the task's rows while they are in the processor's cache. */
-enum { PAIR_ROWS = 4, PAIR_COLS = 8 };
-
-static amscr_status pair_row(void *ctx, size_t t, void *ws)
-{
-    const inner_job *m = ctx;
-    size_t i0 = t * PAIR_ROWS, i1 = i0 + PAIR_ROWS < m->n ? i0 + PAIR_ROWS : m->n;
-    for (size_t c = i0 + 1; c < m->n; c += PAIR_COLS)
-        for (size_t i = i0; i < i1; i++)
-            for (size_t j = c > i + 1 ? c : i + 1; j < c + PAIR_COLS && j < m->n; j++)
-                m->out[i * m->n + j] = amscr__inner_distance(&m->cf[i], &m->cf[j], m->reflections, ws);
-    return AMSCR_OK;
-}
-
-amscr_status amscr__inner_features(const amscr_db *db, size_t first, unsigned threads, amscr__inner *f)
-{
-    inner_job m = {db, f, NULL, amscr_db_size(db), 0, NULL};
-    amscr__rows_fn features = {job_init, amscr__inner_ws_delete, feature_row, &m, "inner distance"};
-    return amscr__run_rows(&features, first, m.n, threads, NULL, NULL);
-}
-
-amscr_status amscr__inner_matrix_from(const amscr__inner *f, size_t n, int reflections, unsigned threads,
-                                      amscr_progress_fn progress, void *user, double *out)
-{
-    inner_job m = {NULL, NULL, f, n, reflections, out};
-    amscr__rows_fn pairs = {job_init, amscr__inner_ws_delete, pair_row, &m, "inner distance"};
-    amscr_status st = amscr__run_rows(&pairs, 0, (n + PAIR_ROWS - 1) / PAIR_ROWS, threads, progress, user);
-    if (st == AMSCR_OK)
-        amscr__mirror_upper(out, n);
-    return st;
-}
-
-amscr_status amscr__inner_matrix(const amscr_db *db, unsigned threads, amscr_progress_fn progress, void *user,
-                                 double *out)
-{
-    size_t n = amscr_db_size(db);
-    amscr__inner *f = amscr__malloc_array(n, sizeof *f);
-    amscr_status st = f ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
-    if (st == AMSCR_OK)
-        st = amscr__inner_features(db, 0, threads, f);
-    if (st == AMSCR_OK)
-        st = amscr__inner_matrix_from(f, n, amscr_db_params(db)->reflections, threads, progress, user, out);
-    if (st != AMSCR_OK)
-        for (size_t i = 0; i < n * n; i++)
-            out[i] = NAN;
-    free(f);
-    return st;
 }

@@ -1,4 +1,5 @@
-/* inner.h — the inner-distance graph of the re-ranking (inner.c). Never installed. */
+/* inner.h — the inner-distance graph of the re-ranking: one pair (inner.c) and a whole
+ * collection (inner_matrix.c). Never installed. */
 #ifndef AMSCR_INNER_H
 #define AMSCR_INNER_H
 
@@ -55,6 +56,9 @@ amscr_status amscr__inner_build_shape(const amscr_descriptor *d, double closing,
 double amscr__inner_distance(const amscr__inner *a, const amscr__inner *b, int reflections, amscr__inner_ws *ws);
 /* tre, tim of f from its re, im (features read from a file). */
 void amscr__inner_twist(amscr__inner *f, const amscr__inner_ws *ws);
+
+/* ------------------------------------------------ over a collection (inner_matrix.c) */
+
 /* The features of shapes first..n-1 of db into f[first..n-1], on `threads` threads. */
 amscr_status amscr__inner_features(const amscr_db *db, size_t first, unsigned threads, amscr__inner *f);
 /* The symmetric n x n matrix of the inner distances of features f (zero diagonal; cell (i, j),
