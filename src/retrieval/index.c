@@ -1,4 +1,7 @@
-/* index.c — the retrieval index object: allocation, the per-shape arrays, names, getters. */
+/* index.c — the retrieval index object: allocation, the per-shape arrays, names, getters, and
+ * the rules every index file shares: what an index with given params keeps (the channel's
+ * frames, the inner distance's graph), which collections can be indexed, a shape's shortlist.
+ * It calls no other index file. */
 #include "db_io.h"
 #include "index.h"
 
@@ -69,11 +72,39 @@ amscr_status amscr__index_reserve(amscr_index *x, size_t n)
     return AMSCR_OK;
 }
 
+void amscr__index_take_lists(uint32_t **idx, double **dist, uint32_t **nidx, double **ndist, size_t keep)
+{
+    memcpy(*nidx, *idx, keep * sizeof **nidx);
+    memcpy(*ndist, *dist, keep * sizeof **ndist);
+    free(*idx);
+    free(*dist);
+    *idx = *nidx;
+    *dist = *ndist;
+    *nidx = NULL;
+    *ndist = NULL;
+}
+
 int amscr__index_frames(const amscr_params *p)
 {
     amscr_invariance frames[2];
     double share[2];
     return p->channel_weight > 0.0 ? amscr__channel_frames(p, frames, share) : 0;
+}
+
+size_t amscr__index_k2(const amscr_params *p, size_t k)
+{
+    return p->rerank_k > 0 && p->rerank_inner_share > 0.0 ? k : 0;
+}
+
+amscr_status amscr__index_check_db(const amscr_db *db, const char *what)
+{
+    const amscr_params *p = amscr_db_params(db);
+    if (p->channel_weight > 0.0 && !p->closed)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: the shape channel needs closed curves; set the channel weight "
+                                                "to 0 for open ones", what);
+    if (amscr_db_size(db) > UINT32_MAX)
+        return amscr__fail(AMSCR_E_LIMIT, "%s: %zu shapes exceed 2^32 - 1", what, amscr_db_size(db));
+    return AMSCR_OK;
 }
 
 amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
@@ -100,6 +131,20 @@ amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
     return AMSCR_OK;
 }
 
+size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,
+                              size_t *cand)
+{
+    size_t n = amscr_db_size(x->db), avail = exclude < n ? n - 1 : n;
+    if (m == 0 || m >= avail) {
+        size_t c = 0;
+        for (size_t j = 0; j < n; j++)
+            if (j != exclude)
+                cand[c++] = j;
+        return c;
+    }
+    return amscr__sig_nearest(x->sig, x->sig_lb, n, sig, lb, m, exclude, cand);
+}
+
 void amscr__index_detach_map(amscr_index *x)
 {
     for (size_t e = 0; x->map && x->hf && e < x->cap * (size_t)x->nf; e++)
@@ -108,6 +153,16 @@ void amscr__index_detach_map(amscr_index *x)
                 x->hf[e].seq[o] = NULL;
     x->map = NULL;
     x->map_len = 0;
+}
+
+void amscr__index_reverse_free(amscr_index *x)
+{
+    free(x->rev_start);
+    free(x->rev);
+    free(x->w_fixed);
+    x->rev_start = NULL;
+    x->rev = NULL;
+    x->w_fixed = NULL;
 }
 
 void amscr_index_free(amscr_index *x)

@@ -45,7 +45,7 @@ struct amscr_index {
     uint32_t *rev;        /* rows i holding shape j in their lists (either graph's; a row twice when both):
                            * rev[rev_start[j]..rev_start[j+1]) */
     double *w_fixed;      /* n rows of w_kk affinities: each stored row's as a query that enters neither
-                           * it nor its neighbours' rows sees them (index_query.c; NULL: none) */
+                           * it nor its neighbours' rows sees them (index_graph.c; NULL: none) */
     size_t w_k, w_kk;     /* the graph's k they were computed for (amscr__rerank_k of n + 1), and k + k2 */
     double w_tiny, w_tiny2; /* and its distance floors */
 };
@@ -67,6 +67,34 @@ typedef struct {
     amscr__hf_ws hws;
     int have_hws;
 } amscr__pair_ws;
+
+/* ------------------------------------------------------------ the object (index.c) */
+
+/* An empty index of a copy of db (no lists yet). */
+amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out);
+/* Grows the per-shape arrays to hold n rows. */
+amscr_status amscr__index_reserve(amscr_index *x, size_t n);
+/* Refined lists (*nidx, *ndist) replace (*idx, *dist), their first `keep` entries (the rows
+ * not refined) copied over; the old freed, *nidx and *ndist NULL. */
+void amscr__index_take_lists(uint32_t **idx, double **dist, uint32_t **nidx, double **ndist, size_t keep);
+/* The channel frames whose features an index with params p keeps (0: no channel). */
+int amscr__index_frames(const amscr_params *p);
+/* The inner graph's neighbours a shape of an index of k neighbours with params p: k when p gives
+ * the inner distance a share of the re-ranking, else 0. */
+size_t amscr__index_k2(const amscr_params *p, size_t k);
+/* db can be indexed (closed curves for the channel, at most 2^32 - 1 shapes). */
+amscr_status amscr__index_check_db(const amscr_db *db, const char *what);
+/* The candidates of shape-like q: every shape (m = 0 or >= n) or the m whose signatures are
+ * nearest sig / lb (exclude: an index to leave out or SIZE_MAX), ascending; 0 when out of
+ * memory. */
+size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,
+                              size_t *cand);
+/* Frees the lists' reverse and the stored rows' affinities (index_reverse.c builds them). */
+void amscr__index_reverse_free(amscr_index *x);
+/* Drops x's hold on its mapped file: the heights that point into it forgotten, x->map NULL. */
+void amscr__index_detach_map(amscr_index *x);
+
+/* ------------------------------------------ the base distance pair by pair (index_pairs.c) */
 
 void amscr__base_init(amscr__base *b, const amscr_params *p, double med_a, double med_h);
 amscr_status amscr__pair_ws_init(const amscr__base *b, amscr__pair_ws *pw);
@@ -90,62 +118,49 @@ amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const ams
                              const amscr_descriptor *q, size_t qpos, const size_t *cand, size_t m,
                              amscr_progress_fn progress, void *user, double *out);
 
+/* --------------------------------------------- each shape's kept features (index_features.c) */
+
 /* Signatures, lower-bound vectors (unless have_sig: then the signatures are there) and channel
- * features of shapes first..n-1 (index_features.c), on the params' threads; drops the lists'
- * reverse, and rebuilds it when have_sig and first == 0 (a load: the lists are in place). */
+ * features of shapes first..n-1, on the params' threads; drops the lists' reverse, and rebuilds
+ * it when have_sig and first == 0 (a load: the lists are in place). */
 amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig);
 
-/* Refined lists (*nidx, *ndist) replace (*idx, *dist), their first `keep` entries (the rows
- * not refined) copied over; the old freed, *nidx and *ndist NULL. */
-void amscr__index_take_lists(uint32_t **idx, double **dist, uint32_t **nidx, double **ndist, size_t keep);
+/* ------------------------------------------------------------------- the neighbour lists */
 
-/* Grows the per-shape arrays to hold n rows. */
-amscr_status amscr__index_reserve(amscr_index *x, size_t n);
-/* The channel frames whose features an index with params p keeps (0: no channel). */
-int amscr__index_frames(const amscr_params *p);
-/* An empty index of a copy of db (no lists yet). */
-amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out);
-/* The candidates of shape-like q: every shape (m = 0 or >= n) or the m whose signatures are
- * nearest sig / lb (exclude: an index to leave out or SIZE_MAX), ascending; 0 when out of
- * memory. */
-size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,
-                              size_t *cand);
-
-/* The scores (n entries) of row `self` (n: a query; < n: that shape of the index) against every
- * shape from its base distances dq[t] to the m candidates cand[t] (ascending) and, for a query
- * of an index with the inner graph, its inner distances dq2[t] (else NULL): the row of the
- * retrieval matrix of the collection plus the query, or of the collection. */
-amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t *cand, const double *dq,
-                                 const double *dq2, size_t m, double *out);
 /* Rows first..n-1 from their M signature-nearest shapes (index_build.c); x->dmax grows. */
 amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_progress_fn progress, void *user);
 /* Rows first..n-1's lists (their K nearest among their shortlists S, m each, ascending) refined
  * from the neighbours' lists (index_refine.c); x->dmax grows. */
 amscr_status amscr__index_refine(amscr_index *x, const amscr__base *b, size_t first, const uint32_t *S, size_t m);
-/* The lists' reverse (x->rev_start, x->rev) and the stored rows' affinities (x->w_fixed) from
- * x's lists (index_query.c); frees the old. */
-amscr_status amscr__index_reverse(amscr_index *x);
-void amscr__index_reverse_free(amscr_index *x);
-/* Drops x's hold on its mapped file: the heights that point into it forgotten, x->map NULL. */
-void amscr__index_detach_map(amscr_index *x);
-/* An index file's bytes buf (len) mapped with mmap: loaded as amscr_index_load_with loads a
- * file (AMSCR_INDEX_LAZY: the index keeps the mapping, its shapes decoded from it when needed);
- * the mapping is the callee's either way (unmapped when not kept). */
-amscr_status amscr__index_load_mapped(unsigned char *buf, size_t len, unsigned flags, amscr_index **out);
-/* The inner graph's neighbours a shape of an index of k neighbours with params p: k when p gives
- * the inner distance a share of the re-ranking, else 0. */
-size_t amscr__index_k2(const amscr_params *p, size_t k);
 /* The inner distance of shapes i and j of x, computed as the matrix cell of the two (the lower
- * index first). */
+ * index first; index_inner.c). */
 double amscr__index_inner_pair(const amscr_index *x, size_t i, size_t j, amscr__inner_ws *ws);
-/* Lists from the full inner matrix (index_inner.c): x->in_*, x->dmax2. */
+/* Lists from the full inner matrix: x->in_*, x->dmax2. */
 amscr_status amscr__index_inner_full(amscr_index *x);
 /* Rows first..n-1's inner lists among their shortlists S (m each) and their base lists (a
  * shortlist build); x->dmax2 grows. */
 amscr_status amscr__index_inner_rows(amscr_index *x, size_t first, const uint32_t *S, size_t m);
 
-/* db can be indexed (closed curves for the channel, at most 2^32 - 1 shapes). */
-amscr_status amscr__index_check_db(const amscr_db *db, const char *what);
+/* -------------------------------------------------------- what a query reads of the lists */
 
+/* The lists' reverse (x->rev_start, x->rev) and the stored rows' affinities (x->w_fixed) from
+ * x's lists (index_reverse.c); frees the old. */
+amscr_status amscr__index_reverse(amscr_index *x);
+/* The stored lists' reverse of x (n shapes, k + k2 entries each: both graphs') into rs (n + 1
+ * offsets) and rv. */
+void amscr__index_reverse_lists(const amscr_index *x, size_t n, size_t *rs, uint32_t *rv);
+/* The scores (n entries) of row `self` (n: a query; < n: that shape of the index) against every
+ * shape from its base distances dq[t] to the m candidates cand[t] (ascending) and, for a query
+ * of an index with the inner graph, its inner distances dq2[t] (else NULL): the row of the
+ * retrieval matrix of the collection plus the query, or of the collection (index_diffuse.c). */
+amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t *cand, const double *dq,
+                                 const double *dq2, size_t m, double *out);
+
+/* -------------------------------------------------------------------- loading (index_io.c) */
+
+/* An index file's bytes buf (len) mapped with mmap: loaded as amscr_index_load_with loads a
+ * file (AMSCR_INDEX_LAZY: the index keeps the mapping, its shapes decoded from it when needed);
+ * the mapping is the callee's either way (unmapped when not kept). */
+amscr_status amscr__index_load_mapped(unsigned char *buf, size_t len, unsigned flags, amscr_index **out);
 
 #endif

@@ -22,32 +22,6 @@ enum { BUILD_SHORTLIST = 192 };
  * (signature.h) instead of scanning every shape's lower bound. */
 enum { IVF_MIN_SHAPES = 20000 };
 
-void amscr__index_take_lists(uint32_t **idx, double **dist, uint32_t **nidx, double **ndist, size_t keep)
-{
-    memcpy(*nidx, *idx, keep * sizeof **nidx);
-    memcpy(*ndist, *dist, keep * sizeof **ndist);
-    free(*idx);
-    free(*dist);
-    *idx = *nidx;
-    *dist = *ndist;
-    *nidx = NULL;
-    *ndist = NULL;
-}
-
-size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,
-                              size_t *cand)
-{
-    size_t n = amscr_db_size(x->db), avail = exclude < n ? n - 1 : n;
-    if (m == 0 || m >= avail) {
-        size_t c = 0;
-        for (size_t j = 0; j < n; j++)
-            if (j != exclude)
-                cand[c++] = j;
-        return c;
-    }
-    return amscr__sig_nearest(x->sig, x->sig_lb, n, sig, lb, m, exclude, cand);
-}
-
 /* Lists and dmax from the full base matrix (the retrieval matrix before its re-ranking). */
 static amscr_status build_full(amscr_index *x, amscr_progress_fn progress, void *user)
 {
@@ -239,17 +213,6 @@ amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_pro
     free(c.D);
     amscr__sig_ivf_free(&ivf);
     return st;
-}
-
-amscr_status amscr__index_check_db(const amscr_db *db, const char *what)
-{
-    const amscr_params *p = amscr_db_params(db);
-    if (p->channel_weight > 0.0 && !p->closed)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: the shape channel needs closed curves; set the channel weight "
-                                                "to 0 for open ones", what);
-    if (amscr_db_size(db) > UINT32_MAX)
-        return amscr__fail(AMSCR_E_LIMIT, "%s: %zu shapes exceed 2^32 - 1", what, amscr_db_size(db));
-    return AMSCR_OK;
 }
 
 amscr_status amscr_index_build(const amscr_db *db, size_t candidates, amscr_progress_fn progress, void *user,

@@ -8,11 +8,6 @@
 
 #include <stdlib.h>
 
-size_t amscr__index_k2(const amscr_params *p, size_t k)
-{
-    return p->rerank_k > 0 && p->rerank_inner_share > 0.0 ? k : 0;
-}
-
 double amscr__index_inner_pair(const amscr_index *x, size_t i, size_t j, amscr__inner_ws *ws)
 {
     int refl = amscr_db_params(x->db)->reflections;

@@ -1,23 +1,31 @@
 /* The retrieval area (src/retrieval/): collections and what ranks their shapes (docs/method.md
- * §4, §10):
- *   db.c            the collection object (amscr_db): prepared shapes with labels, distance
- *                   matrices on threads, progress and cancellation, the versioned binary format
- *   retrieval_io.c  the retrieval settings block of the saved collection
- *   channel.c       the shape channel (height functions) of one pair
- *   hf_matrix.c     the shape channel over a whole collection
+ * §4, §10), from the bottom up: a file calls only files listed above it, except db.c and
+ * db_io.c (the collection and its file format), which call each other.
+ *   rank.c          the one ranking order, (distance, index), and the neighbour lists kept in it
+ *   rows.c          a collection's rows on threads
+ *   bytes.c, retrieval_io.c  little-endian readers and writers; the retrieval settings block
+ *   inner.c         the inner distance of one pair
+ *   channel.c, channel_dp.c  the shape channel (height functions) of one pair
+ *   db.c, db_io.c   the collection object (amscr_db): prepared shapes with labels, distance
+ *                   matrices on threads, progress and cancellation; its versioned binary format;
+ *                   db_batch.c many shapes at once
+ *   hf_matrix.c, inner_matrix.c  the channel and the inner distance over a whole collection
+ *   rerank.c        contextual re-ranking of a matrix by affinity diffusion
  *   fuse.c          the fused, re-ranked retrieval matrix
- *   rerank.c        contextual re-ranking by affinity diffusion
  *   scores.c        retrieval scores (this file); protocols.c the evaluation protocols
- *   db_io.c, bytes.c  the collection file format (little-endian readers and writers)
- *   index.c         the index object (amscr_index); index_build.c, index_add.c build it on
- *                   threads (rows.c), index_pairs.c the base distance pair by pair,
- *                   index_features.c each shape's kept features, index_query.c one query's
- *                   exact re-ranked row, index_io.c its file section
- *   signature.c, affine_signature.c  the shortlist signature and its search
+ *   affine_signature.c, signature.c  the shortlist signature and its search
+ *   index.c         the index object (amscr_index) and the rules its files share
+ *   index_pairs.c   the base distance pair by pair
+ *   index_graph.c, index_reverse.c, index_diffuse.c  one row's re-ranked scores from the
+ *                   neighbour lists (the graph, the lists' reverse, the diffusion)
+ *   index_features.c  each shape's kept features
+ *   index_refine.c, index_inner.c, index_build.c, index_add.c  the neighbour lists (rows on threads)
+ *   index_query.c   one query against an index; index_io.c the index's file section
+ *   retrieval_query.c  one query against a collection that keeps no index
  *
  * scores.c — retrieval scores on a distance matrix (docs/method.md §4): top-k selection,
  * bull's eye, the Kimia top-k table and 1-NN accuracies. Ranking is by distance
- * ascending, ties broken by the lower index; +inf is allowed, NaN is rejected.
+ * ascending, ties broken by the lower index (rank.c); +inf is allowed, NaN is rejected.
  * Cost: O(n^2 log w) for the matrix scores (w the window or kmax), with one allocation
  * per call. */
 #include "internal.h"
