@@ -1754,6 +1754,30 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_channel_affine_view(amsc
  */
 AMSCR_API double amscr_params_get_channel_affine_view(const amscr_params *p);
 
+/* ------------------------------------------------- which scores the params rank by */
+
+/** The scores a collection ranks its shapes by under given params (amscr_params_ranking).
+ *  @since 0.13 */
+typedef enum amscr_ranking {
+    AMSCR_RANKING_DISTANCE = 0,  /**< the AMSCR distance: amscr_db_query, amscr_db_distance_matrix */
+    AMSCR_RANKING_RETRIEVAL = 1  /**< the retrieval scores: amscr_db_query_retrieval,
+                                      amscr_db_retrieval_matrix, an amscr_index */
+} amscr_ranking;
+
+/**
+ * @brief Which scores params p rank a collection by: the retrieval scores when p asks for the
+ *        shape channel (channel weight > 0) or for re-ranking (rerank_k > 0), else the AMSCR
+ *        distance (with neither, amscr_db_retrieval_matrix is the symmetrized AMSCR distance,
+ *        not the one-way distance of amscr_db_query).
+ * @param[in]  p            the params.
+ * @param[out] out_ranking  AMSCR_RANKING_DISTANCE or AMSCR_RANKING_RETRIEVAL.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL).
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.13
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_ranking(const amscr_params *p, amscr_ranking *out_ranking);
+
 /* ============================================================================
  * Workspace
  * ============================================================================ */

@@ -1,4 +1,4 @@
-/* check_retrieval.c — top-k, bull's eye, top-k table, 1-NN accuracies. */
+/* check_retrieval.c — top-k, bull's eye, top-k table, 1-NN accuracies; which scores params rank by. */
 #include <check.h>
 #include <math.h>
 #include <stdlib.h>
@@ -300,6 +300,39 @@ START_TEST(scores_invalid)
 }
 END_TEST
 
+/* Which scores params rank by: the retrieval scores as soon as they ask for the shape channel or
+ * for re-ranking, the AMSCR distance otherwise; NULL refused, the output untouched. */
+START_TEST(ranking_of_params)
+{
+    amscr_params *p = NULL;
+    amscr_ranking r = AMSCR_RANKING_RETRIEVAL;
+    ck_assert_int_eq(amscr_params_new(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_ranking(p, &r), AMSCR_OK);
+    ck_assert_int_eq(r, AMSCR_RANKING_DISTANCE);
+    ck_assert_int_eq(amscr_params_set_rerank_k(p, 8), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_ranking(p, &r), AMSCR_OK);
+    ck_assert_int_eq(r, AMSCR_RANKING_RETRIEVAL);
+    ck_assert_int_eq(amscr_params_set_rerank_k(p, 0), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_channel_weight(p, 0.25), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_ranking(p, &r), AMSCR_OK);
+    ck_assert_int_eq(r, AMSCR_RANKING_RETRIEVAL);
+    amscr_params_free(p);
+    ck_assert_int_eq(amscr_params_new_retrieval(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_ranking(p, &r), AMSCR_OK);
+    ck_assert_int_eq(r, AMSCR_RANKING_RETRIEVAL);
+    ck_assert_int_eq(amscr_params_set_channel_weight(p, 0.0), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_rerank_k(p, 0), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_ranking(p, &r), AMSCR_OK);
+    ck_assert_int_eq(r, AMSCR_RANKING_DISTANCE);
+    r = AMSCR_RANKING_RETRIEVAL;
+    ck_assert_int_eq(amscr_params_ranking(NULL, &r), AMSCR_E_INVALID_ARG);
+    ck_assert_str_ne(amscr_last_error_detail(), "");
+    ck_assert_int_eq(r, AMSCR_RANKING_RETRIEVAL);
+    ck_assert_int_eq(amscr_params_ranking(p, NULL), AMSCR_E_INVALID_ARG);
+    amscr_params_free(p);
+}
+END_TEST
+
 Suite *amscr_suite_retrieval(void)
 {
     Suite *s = suite_create("retrieval");
@@ -312,6 +345,7 @@ Suite *amscr_suite_retrieval(void)
     tcase_add_loop_test(tc, scores_random, 0, 60);
     tcase_add_test(tc, scores_large);
     tcase_add_test(tc, scores_invalid);
+    tcase_add_test(tc, ranking_of_params);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -1,4 +1,5 @@
-/* retrieval_query.c — one query's retrieval scores against a collection that keeps no index
+/* retrieval_query.c — which scores a collection ranks its shapes by (amscr_params_ranking), and
+ * one query's retrieval scores against a collection that keeps no index
  * (amscr_db_query_retrieval): the base distances alone without re-ranking, the collection's
  * neighbour lists built for the call (an exact index) with it, and the matrix of the collection
  * plus the query when the fusion's medians move with the query. */
@@ -6,6 +7,15 @@
 
 #include <stdlib.h>
 #include <string.h>
+
+amscr_status amscr_params_ranking(const amscr_params *p, amscr_ranking *out_ranking)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(p);
+    AMSCR_CHECK_NULL(out_ranking);
+    *out_ranking = p->channel_weight > 0.0 || p->rerank_k > 0 ? AMSCR_RANKING_RETRIEVAL : AMSCR_RANKING_DISTANCE;
+    return AMSCR_OK;
+}
 
 /* The last row of the retrieval matrix of db plus q. */
 static amscr_status query_by_matrix(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress,

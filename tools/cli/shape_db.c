@@ -10,7 +10,8 @@ void retrieval_tracing(void) { image_set_trace_flags(image_trace_flags() | AMSCR
 
 int retrieval_is_plain(const amscr_params *p)
 {
-    return amscr_params_get_channel_weight(p) <= 0.0 && amscr_params_get_rerank_k(p) == 0;
+    amscr_ranking r = AMSCR_RANKING_RETRIEVAL;
+    return amscr_params_ranking(p, &r) == AMSCR_OK && r == AMSCR_RANKING_DISTANCE;
 }
 
 int compute_matrix(const amscr_db *db, const char *what, double **out)

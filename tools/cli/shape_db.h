@@ -16,8 +16,8 @@ int load_db(const amscr_params *p, const collection *c, int threshold, amscr_db 
  * joined to its outline (AMSCR_TRACE_JOIN; sub-pixel tracing only). Called by search, matrix,
  * eval and index before any image is read. */
 void retrieval_tracing(void);
-/* 1 when the params ask for the AMSCR distance alone (channel weight 0, no re-ranking): the
- * plain, directional matrix of 0.1 (amscr_db_distance_matrix), bit for bit. */
+/* 1 when the params rank by the AMSCR distance alone (amscr_params_ranking: channel weight 0,
+ * no re-ranking): the plain, directional matrix of 0.1 (amscr_db_distance_matrix), bit for bit. */
 int retrieval_is_plain(const amscr_params *p);
 /* The n x n retrieval matrix of db (malloc'ed): amscr_db_retrieval_matrix (shape channel,
  * fusion, re-ranking), or the plain matrix when retrieval_is_plain; on failure prints the

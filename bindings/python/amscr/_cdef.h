@@ -198,6 +198,11 @@ amscr_status amscr_params_set_inner_closing(amscr_params *p, double radius);
 double amscr_params_get_inner_closing(const amscr_params *p);
 amscr_status amscr_params_set_channel_affine_view(amscr_params *p, double factor);
 double amscr_params_get_channel_affine_view(const amscr_params *p);
+typedef enum amscr_ranking {
+    AMSCR_RANKING_DISTANCE = 0,
+    AMSCR_RANKING_RETRIEVAL = 1
+} amscr_ranking;
+amscr_status amscr_params_ranking(const amscr_params *p, amscr_ranking *out_ranking);
 amscr_status amscr_workspace_new(amscr_workspace **out);
 void amscr_workspace_free(amscr_workspace *ws);
 amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out);

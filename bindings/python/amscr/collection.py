@@ -218,9 +218,9 @@ class Collection:
         params: the plain AMSCR distance (query -> shape) with the defaults, and the retrieval
         scores (C ``amscr_db_query_retrieval``: the query's row of :meth:`retrieval_matrix` on
         the collection plus the query, shape channel, fusion and re-ranking) when the params
-        ask for retrieval (``channel_weight`` > 0 or ``rerank_k`` > 0, e.g.
-        :meth:`Params.retrieval`). To query a collection many times that way, build an
-        :class:`Index` once.
+        ask for retrieval (:attr:`Params.ranking` 'retrieval': ``channel_weight`` > 0 or
+        ``rerank_k`` > 0, e.g. :meth:`Params.retrieval`). To query a collection many times that
+        way, build an :class:`Index` once.
 
         Args:
             shape: the query: (n, 2) points, an OpenCV (n, 1, 2) contour or a :class:`Shape`.
@@ -238,7 +238,7 @@ class Collection:
             p = self.params
             q = as_shape(shape, p, 'shape', order)
             out = np.zeros(len(self), dtype=np.float64)
-            if p.channel_weight > 0 or p.rerank_k > 0:
+            if p.ranking == 'retrieval':
                 src, _ = self._with_threads(threads)
                 progress_call(lib.amscr_db_query_retrieval, (src._db, q._d), (dbuf(out), len(out)), progress)
             elif threads is None or int(threads) == p.threads:

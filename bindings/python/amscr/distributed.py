@@ -23,9 +23,10 @@ How it runs:
   :meth:`amscr.Collection.query` element for element.
 * :func:`topk` keeps the k best of each tile row and merges these partial lists in a tree,
   without ever materializing the full matrix. When the collection's params ask for retrieval
-  (channel weight > 0 or re-ranking on), a query's scores depend on the whole collection (the
-  retrieval matrix's fusion and re-ranking), so a tile is a block of queries against every
-  shape, each scored by ``amscr_db_query_retrieval`` as :meth:`amscr.Collection.query` does. Ranking is by (distance, index): the order of
+  (:attr:`amscr.Params.ranking`: channel weight > 0 or re-ranking on), a query's scores depend
+  on the whole collection (the retrieval matrix's fusion and re-ranking), so a tile is a block
+  of queries against every shape, each scored by ``amscr_db_query_retrieval`` as
+  :meth:`amscr.Collection.query` does. Ranking is by (distance, index): the order of
   ``np.argsort(row, kind='stable')`` (NaN last), so ties go to the lower index.
 * ``client=None`` starts a local cluster (one single-threaded worker process per core), computes
   and closes it. With a client, :func:`distance_matrix` and :func:`cross_matrix` return a lazy
@@ -241,11 +242,6 @@ def _retrieval_tile(qpayload: _Payload, tpayload: _Payload, k: int, exclude: Opt
             _check(lib.amscr_db_query_retrieval(coll._db, lib.amscr_db_descriptor(q._db, i), ffi.NULL, ffi.NULL,
                                                 dbuf(D[i]), D.shape[1]))
     return _tile_candidates(D, 0, k, exclude)
-
-
-def _wants_retrieval(p) -> bool:
-    """The params ask for the retrieval scores (as :meth:`Collection.query` decides)."""
-    return p.channel_weight > 0 or p.rerank_k > 0
 
 
 def _merge(k: int, *parts: Tuple[np.ndarray, np.ndarray]) -> Tuple[np.ndarray, np.ndarray]:
@@ -596,7 +592,7 @@ def topk(queries: Union[Collection, Iterable[Any], bytes], collection: Union[Col
         (indices, distances), each (len(queries), k): for query i the targets ordered as
         ``np.argsort(collection.query(q_i), kind='stable')`` (ascending distance, NaN last, ties
         by lower index), excluded target removed. With params that ask for retrieval
-        (``channel_weight`` > 0 or ``rerank_k`` > 0) the distances are the retrieval scores of
+        (:attr:`Params.ranking` 'retrieval') the distances are the retrieval scores of
         :meth:`Collection.query`, each query scored against the whole collection (one tile a
         query block).
     """
@@ -620,7 +616,7 @@ def topk(queries: Union[Collection, Iterable[Any], bytes], collection: Union[Col
     distances = np.zeros((nq, k), dtype=np.float64)
     if nq == 0 or k == 0:
         return indices, distances
-    retrieval = _wants_retrieval(t.params)
+    retrieval = t.params.ranking == 'retrieval'  # as Collection.query decides
     with _client_or_local(client) as c:
         row_b, col_b, th, tmaker, qmakers = _cross_layout(c, q, t, tile, threads)
         tpay, qpays = _Scattered(c, [tmaker], broadcast=True), _Scattered(c, qmakers, broadcast=False)

@@ -19,6 +19,9 @@ INVARIANCES: Dict[str, int] = {
     'affine': lib.AMSCR_INVARIANCE_AFFINE, 'similarity': lib.AMSCR_INVARIANCE_SIMILARITY,
     'penalized': lib.AMSCR_INVARIANCE_PENALIZED}
 
+#: which scores params rank a collection by (C ``amscr_ranking``, :attr:`Params.ranking`).
+RANKINGS: Dict[str, int] = {'distance': lib.AMSCR_RANKING_DISTANCE, 'retrieval': lib.AMSCR_RANKING_RETRIEVAL}
+
 
 def enum_in(table: Dict[str, int], value: Any, what: str) -> int:
     """The C value of the name `value` ('Binary_EM' and 'binary-em' are the same name)."""

@@ -12,7 +12,7 @@ import numpy as np
 
 from ._lib import ffi, lib
 from ._util import as_bool, as_count, as_float_array, as_scalar, as_uint, dbuf, new_object, sized_arrays
-from .enums import INVARIANCES, METHODS, PARAMETRIZATIONS, enum_in, enum_out
+from .enums import INVARIANCES, METHODS, PARAMETRIZATIONS, RANKINGS, enum_in, enum_out
 from .errors import InternalError, _check
 
 T = TypeVar('T')
@@ -254,6 +254,21 @@ class Params:
             if v is not None:
                 setattr(self, k, v)
         return self
+
+    @property
+    def ranking(self) -> str:
+        """Which scores these params rank a collection by (C ``amscr_params_ranking``): 'retrieval'
+        (the scores of :meth:`Collection.retrieval_matrix`, of :meth:`Collection.query` and of an
+        :class:`Index`) when they ask for the shape channel (``channel_weight`` > 0) or for
+        re-ranking (``rerank_k`` > 0), else 'distance' (the AMSCR distance of
+        :meth:`Collection.distance_matrix`).
+
+        Returns:
+            'distance' or 'retrieval'.
+        """
+        out = ffi.new('amscr_ranking *')
+        _check(lib.amscr_params_ranking(self._p, out))
+        return enum_out(RANKINGS, out[0])
 
     def to_dict(self) -> Dict[str, Any]:
         """Every option and its value.

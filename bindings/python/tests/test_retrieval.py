@@ -29,6 +29,35 @@ def test_the_preset():
     assert d.channel_weight == 0.0 and d.rerank_k == 0  # the plain defaults keep 0.1's distance
 
 
+def test_which_scores_params_rank_by():
+    """Params.ranking (C amscr_params_ranking): the retrieval scores as soon as the params ask
+    for the shape channel or re-ranking, the AMSCR distance otherwise; read-only."""
+    assert amscr.Params().ranking == 'distance'
+    assert amscr.Params.retrieval().ranking == 'retrieval'
+    assert amscr.Params(rerank_k=8).ranking == 'retrieval'
+    assert amscr.Params(channel_weight=0.25).ranking == 'retrieval'
+    assert amscr.Params.retrieval(channel_weight=0, rerank_k=0).ranking == 'distance'
+    with pytest.raises(TypeError):
+        amscr.Params(ranking='retrieval')
+    with pytest.raises(AttributeError):
+        amscr.Params().ranking = 'retrieval'
+
+
+def test_query_follows_the_ranking():
+    """Collection.query scores a query as its params rank: the one-way AMSCR distance (the
+    query's row of distance_matrix) or the retrieval scores (its row of retrieval_matrix), each
+    on the collection plus the query."""
+    shapes = [blob(200, seed=s) for s in range(7)]
+    for params in (amscr.Params.retrieval(channel_weight=0, rerank_k=0), amscr.Params.retrieval()):
+        coll, whole = amscr.Collection(params), amscr.Collection(params)
+        for s in shapes[1:]:
+            coll.add(s)
+            whole.add(s)
+        whole.add(shapes[0])
+        full = whole.distance_matrix() if params.ranking == 'distance' else whole.retrieval_matrix()
+        np.testing.assert_allclose(coll.query(shapes[0]), full[-1, :-1], rtol=0, atol=1e-12)
+
+
 def test_channel_distance_is_zero_to_itself_and_invariant():
     a, b = blob(300, seed=1), blob(300, seed=2)
     assert amscr.channel_distance(a, a) == 0.0
