@@ -29,10 +29,10 @@ static void sift_down(const double *d, const size_t *id, size_t *heap, size_t le
     heap[i] = v;
 }
 
-void amscr__rank_select(const double *d, const size_t *id, size_t n, size_t k, size_t exclude, size_t *out)
+size_t amscr__rank_select(const double *d, const size_t *id, size_t n, size_t k, size_t exclude, size_t *out)
 {
     if (k == 0)
-        return;
+        return 0;
     size_t len = 0;
     for (size_t i = 0; i < n; i++) {
         if ((id ? id[i] : i) == exclude)
@@ -60,6 +60,7 @@ void amscr__rank_select(const double *d, const size_t *id, size_t n, size_t k, s
         out[end - 1] = t;
         sift_down(d, id, out, end - 1, 0);
     }
+    return len;
 }
 
 size_t amscr__rank_argmin(const double *row, size_t n, size_t exclude)
@@ -79,13 +80,10 @@ amscr_status amscr__knn_select(size_t i, const size_t *cj, const double *cd, siz
 {
     if (k == 0)
         return AMSCR_OK;
-    size_t avail = 0;
-    for (size_t t = 0; t < m; t++)
-        avail += cj[t] != i;
-    size_t take = avail < k - 1 ? avail : k - 1, *pos = amscr__malloc_array(take ? take : 1, sizeof *pos);
+    size_t *pos = amscr__malloc_array(k > 1 ? k - 1 : 1, sizeof *pos);
     if (!pos)
         return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
-    amscr__rank_select(cd, cj, m, take, i, pos);
+    size_t take = amscr__rank_select(cd, cj, m, k - 1, i, pos);
     out_idx[0] = (uint32_t)i; /* itself first, as amscr_rerank_diffusion */
     out_dist[0] = 0.0;
     for (size_t t = 1; t < k; t++) {

@@ -7,9 +7,10 @@
 #include "internal.h"
 
 /* The positions of the k first of d[0..n-1] in (distance, index) order, written ascending to
- * out[0..k-1]. An entry's index is id[t] (NULL: its position t); entries whose index is
- * `exclude` (SIZE_MAX for none) are skipped. k must not exceed the entries left. O(n log k). */
-void amscr__rank_select(const double *d, const size_t *id, size_t n, size_t k, size_t exclude, size_t *out);
+ * out[0..k-1] (all of them when fewer are left); returns how many. An entry's index is id[t]
+ * (NULL: its position t); entries whose index is `exclude` (SIZE_MAX for none) are skipped.
+ * O(n log k). */
+size_t amscr__rank_select(const double *d, const size_t *id, size_t n, size_t k, size_t exclude, size_t *out);
 
 /* Index of the smallest of row[0..n-1] other than `exclude` (ties: lower index); SIZE_MAX
  * when there is no candidate. */
