@@ -84,7 +84,8 @@ struct amscr_params {
     double channel_affine_view;        /* > 0: a pair's channel = min(the mix, this x d_affine) (0.11) */
 };
 
-/* The stages of amscr_register in pipeline order (register/stages.c holds the table). */
+/* The stages of amscr_register in pipeline order: their names in base/stage_names.c, their
+ * functions and conditions in register/stages.c. */
 enum {
     AMSCR__STAGE_DESPIKE,
     AMSCR__STAGE_SEARCH,
@@ -103,7 +104,9 @@ enum {
 #define AMSCR__STAGE_BIT(i) (1u << (unsigned)(i))
 /* Whether params p leave switchable stage i on. */
 #define AMSCR__STAGE_ON(p, i) (!((p)->stages_off & AMSCR__STAGE_BIT(i)))
-/* Index of the switchable stage called name, or -1 (register/stages.c). */
+/* Name of stage i (NULL past the last). */
+const char *amscr__stage_name(size_t i);
+/* Index of the switchable stage called name, or -1. */
 int amscr__stage_switch(const char *name);
 
 /* ---- geometry internals (contour.c, smooth.c, resample.c, affine.c) ---- */

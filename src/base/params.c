@@ -226,7 +226,7 @@ amscr_status amscr_params_get_scales(const amscr_params *p, double *out_sigmas, 
     return AMSCR_OK;
 }
 
-/* ---- switchable stages of amscr_register (register/stages.c) ---- */
+/* ---- switchable stages of amscr_register (their names: stage_names.c) ---- */
 amscr_status amscr_params_set_stage(amscr_params *p, const char *name, int on)
 {
     amscr__clear_error();

@@ -21,7 +21,7 @@
  *   alternatives.c      the distinct maps that fit about as well as the chosen one
  *   correspond.c        confidence, inliers, the part covered, dense correspondences
  *   result.c            the result object and its getters
- * and base/workspace.c, the caller-owned scratch of all of the above. */
+ * and workspace.c, the caller-owned scratch of all of the above. */
 #ifndef AMSCR_MATCH_H
 #define AMSCR_MATCH_H
 
@@ -286,7 +286,6 @@ void amscr__polish_end(amscr__polish_state *w);
 amscr_status amscr__run_stages(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                amscr_workspace *ws, amscr_result *r);
 /* The name of stage i (< AMSCR__NUM_STAGES). */
-const char *amscr__stage_name(size_t i);
 
 /* alternatives.c: the result's alternatives (r->alt*, input coordinates) from the last ranking
  * of r->m: the chosen map first, then each distinct ranked map about as good, best first. */
