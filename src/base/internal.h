@@ -25,6 +25,25 @@ void amscr__clear_error(void);
             return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %s is NULL", __func__, #ptr);         \
     } while (0)
 
+/* AMSCR_OK when cond holds, else AMSCR_E_INVALID_ARG with the printf-style detail given. */
+#define AMSCR__REQUIRE(cond, ...) ((cond) ? AMSCR_OK : amscr__fail(AMSCR_E_INVALID_ARG, __VA_ARGS__))
+/* Defines the validating setter `amscr_status fn(obj_t *obj, vtype v)` of obj->field: it clears
+ * the calling thread's detail, refuses a NULL obj and stores v when `check`, an amscr_status
+ * expression of v (AMSCR__REQUIRE), is AMSCR_OK; it returns that status (obj unchanged otherwise). */
+#define AMSCR__SETTER(fn, obj_t, obj, vtype, field, check)                                     \
+    amscr_status fn(obj_t *obj, vtype v)                                                       \
+    {                                                                                          \
+        amscr__clear_error();                                                                  \
+        AMSCR_CHECK_NULL(obj);                                                                 \
+        amscr_status check_ = (check);                                                         \
+        if (check_ == AMSCR_OK)                                                                \
+            obj->field = v;                                                                    \
+        return check_;                                                                         \
+    }
+/* Defines the getter `vtype fn(const obj_t *obj)` of obj->field: 0 for a NULL obj. */
+#define AMSCR__GETTER(fn, obj_t, vtype, field)                                                 \
+    vtype fn(const obj_t *obj) { return obj ? obj->field : (vtype)0; }
+
 /* ---- small helpers -------------------------------------------------- */
 /* Overflow-checked malloc of n*size bytes (NULL on overflow or failure; n == 0 gives a
  * valid 1-byte block). */

@@ -119,17 +119,9 @@ amscr_status amscr_params_copy(const amscr_params *p, amscr_params **out)
 void amscr_params_free(amscr_params *p) { free(p); }
 
 #define SETTER(name, type, field, cond, fmt)                                                      \
-    amscr_status amscr_params_set_##name(amscr_params *p, type v)                                  \
-    {                                                                                              \
-        amscr__clear_error();                                                                      \
-        AMSCR_CHECK_NULL(p);                                                                       \
-        if (!(cond))                                                                               \
-            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_params_set_" #name ": " fmt, v);        \
-        p->field = v;                                                                              \
-        return AMSCR_OK;                                                                           \
-    }
-#define GETTER(name, type, field)                                                                 \
-    type amscr_params_get_##name(const amscr_params *p) { return p ? p->field : (type)0; }
+    AMSCR__SETTER(amscr_params_set_##name, amscr_params, p, type, field,                           \
+                  AMSCR__REQUIRE(cond, "amscr_params_set_" #name ": " fmt, v))
+#define GETTER(name, type, field) AMSCR__GETTER(amscr_params_get_##name, amscr_params, type, field)
 
 SETTER(num_samples, size_t, num_samples, v >= 16 && v <= AMSCR_MAX_SAMPLES, "%zu is outside 16..65536")
 GETTER(num_samples, size_t, num_samples)
