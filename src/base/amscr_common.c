@@ -1,6 +1,7 @@
 /* The base area (src/base/): what every other area builds on:
  *   amscr_common.c  errors (status strings, the thread-local detail), version, features, allocation
- *   params.c        the options object: documented defaults, presets, validating setters
+ *   params.c        the options object: documented defaults, presets, the scales, the stage switches
+ *   options.c       its numbers and flags, each declared once: the named and the keyed setters
  *   stage_names.c   the names of amscr_register's stages and which ones are switchable
  *   internal.h      the shared internals of libamscr (never installed)
  *
