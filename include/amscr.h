@@ -1778,6 +1778,116 @@ typedef enum amscr_ranking {
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_ranking(const amscr_params *p, amscr_ranking *out_ranking);
 
+/* ----------------------------------------------- every option by key (since 0.13) */
+
+/**
+ * Option keys of the keyed calls amscr_params_set_int / _set_real / _get_int / _get_real /
+ * _get_bounds: one key per number or flag of amscr_params. Each key sets the same value, with the
+ * same validation, as its named pair (AMSCR_OPT_NUM_SAMPLES and amscr_params_set_num_samples);
+ * the ranges, units and defaults below are those of the pair. The values are pinned forever:
+ * new keys are only appended, and options added from now on get a key and no named pair.
+ * Integer keys (flags are 0 or 1; enumerations take their enum's values) go through the _int
+ * calls, real keys through the _real calls.
+ * @since 0.13
+ */
+typedef enum amscr_option {
+    AMSCR_OPT_NUM_SAMPLES = 1,           /**< int: N, samples per scale, 16..AMSCR_MAX_SAMPLES */
+    AMSCR_OPT_CLOSED = 2,                /**< int: closed (1) or open (0) curves */
+    AMSCR_OPT_PARAMETRIZATION = 3,       /**< int: an amscr_parametrization */
+    AMSCR_OPT_PRESMOOTH = 4,             /**< real: pre-smoothing, fraction of the curve length, 0..0.25 */
+    AMSCR_OPT_ARCLENGTH_PASSES = 5,      /**< int: parametrization passes, 1..10 */
+    AMSCR_OPT_OVERSAMPLING = 6,          /**< int: dense resampling factor, 1..64 */
+    AMSCR_OPT_METHOD = 7,                /**< int: an amscr_method */
+    AMSCR_OPT_KMAX = 8,                  /**< int: Kmax of the elbow, 1..16 */
+    AMSCR_OPT_REFLECTIONS = 9,           /**< int: flag, mirror matches tried */
+    AMSCR_OPT_SYMMETRIC = 10,            /**< int: flag, distance averaged over both directions */
+    AMSCR_OPT_INVARIANCE = 11,           /**< int: an amscr_invariance */
+    AMSCR_OPT_PENALTY = 12,              /**< real: penalty weight of AMSCR_INVARIANCE_PENALIZED, 0..1e6 */
+    AMSCR_OPT_REFINE = 13,               /**< int: refinement iterations, 0..50 */
+    AMSCR_OPT_PARTIAL = 14,              /**< int: flag, partial matching */
+    AMSCR_OPT_POLISH = 15,               /**< int: flag, polish on the input points */
+    AMSCR_OPT_NUM_THREADS = 16,          /**< int: threads of batch calls, 0 (all cores)..1024 */
+    AMSCR_OPT_CHANNEL_WEIGHT = 17,       /**< real: share of the shape channel, 0..1 */
+    AMSCR_OPT_CHANNEL_INVARIANCE = 18,   /**< int: the channel's frame, AMSCR_INVARIANCE_AFFINE or _SIMILARITY */
+    AMSCR_OPT_CHANNEL_AFFINE_SHARE = 19, /**< real: share of the whitened frame's channel, 0..1 */
+    AMSCR_OPT_CHANNEL_BAND = 20,         /**< real: DP band half width, fraction of N, (0, 0.5] */
+    AMSCR_OPT_CHANNEL_AFFINE_BAND = 21,  /**< real: the whitened second frame's band, fraction of N, (0, 0.5] */
+    AMSCR_OPT_CHANNEL_SKIP = 22,         /**< real: cost of a sample matched twice, height units, 0..1000 */
+    AMSCR_OPT_CHANNEL_LOCALITY = 23,     /**< real: locality of the height functions, 0..1000 */
+    AMSCR_OPT_RERANK_K = 24,             /**< int: re-ranking neighbours, 0 (none)..1000 */
+    AMSCR_OPT_RERANK_ITERATIONS = 25,    /**< int: diffusion iterations, 1..1000 */
+    AMSCR_OPT_RERANK_INNER_SHARE = 26,   /**< real: share of the inner-distance graph, [0, 1) */
+    AMSCR_OPT_INNER_CLOSING = 27,        /**< real: closing radius, units of sqrt(area), 0..1 */
+    AMSCR_OPT_CHANNEL_AFFINE_VIEW = 28   /**< real: affine-view factor, 0 or 1..100 */
+} amscr_option;
+
+/**
+ * @brief Sets the integer option `key` to v, validated as by its named pair.
+ * @param[in,out] p    the params.
+ * @param[in]     key  an integer option key (amscr_option).
+ * @param[in]     v    the value, in the key's range (amscr_params_get_bounds).
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL p, an unknown key, a real key, v out of range),
+ *         leaving p unchanged.
+ * Ownership: none.
+ * Thread-safety: exclusive on p.
+ * @since 0.13
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_int(amscr_params *p, amscr_option key, int v);
+
+/**
+ * @brief Sets the real option `key` to v, validated as by its named pair.
+ * @param[in,out] p    the params.
+ * @param[in]     key  a real option key (amscr_option).
+ * @param[in]     v    the value, in the key's range (amscr_params_get_bounds); never NaN.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL p, an unknown key, an integer key, v out of range
+ *         or NaN), leaving p unchanged.
+ * Ownership: none.
+ * Thread-safety: exclusive on p.
+ * @since 0.13
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_set_real(amscr_params *p, amscr_option key, double v);
+
+/**
+ * @brief The value of the integer option `key`.
+ * @param[in]  p      the params.
+ * @param[in]  key    an integer option key (amscr_option).
+ * @param[out] out_v  the value.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL p or out_v, an unknown key, a real key).
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.13
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_get_int(const amscr_params *p, amscr_option key, int *out_v);
+
+/**
+ * @brief The value of the real option `key`.
+ * @param[in]  p      the params.
+ * @param[in]  key    a real option key (amscr_option).
+ * @param[out] out_v  the value.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL p or out_v, an unknown key, an integer key).
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.13
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_get_real(const amscr_params *p, amscr_option key,
+                                                             double *out_v);
+
+/**
+ * @brief The range of option `key`, integer or real: every accepted value v has
+ *        lo <= v <= hi, in the key's units. Three keys also refuse values inside it:
+ *        AMSCR_OPT_CHANNEL_BAND and AMSCR_OPT_CHANNEL_AFFINE_BAND refuse 0,
+ *        AMSCR_OPT_RERANK_INNER_SHARE refuses 1, and AMSCR_OPT_CHANNEL_AFFINE_VIEW accepts 0
+ *        and [1, 100] only.
+ * @param[in]  key     an option key (amscr_option).
+ * @param[out] out_lo  the least value.
+ * @param[out] out_hi  the greatest value.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL out_lo or out_hi, an unknown key).
+ * Ownership: none.
+ * Thread-safety: safe.
+ * @since 0.13
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_get_bounds(amscr_option key, double *out_lo, double *out_hi);
+
 /* ============================================================================
  * Workspace
  * ============================================================================ */

@@ -1,6 +1,7 @@
 /* check_params.c — registration parameters: defaults, range checks, getters, deep copy, NULL. */
 #include <amscr.h>
 #include <check.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -430,6 +431,276 @@ START_TEST(test_independent_objects)
 }
 END_TEST
 
+/* ---- the keyed calls (amscr_params_set_int / _set_real / _get_int / _get_real / _get_bounds) ---- */
+
+/* Every key, with its kind (1 = real). */
+static const struct {
+    amscr_option key;
+    int real;
+} KEYS[] = {
+    {AMSCR_OPT_NUM_SAMPLES, 0},          {AMSCR_OPT_CLOSED, 0},
+    {AMSCR_OPT_PARAMETRIZATION, 0},      {AMSCR_OPT_PRESMOOTH, 1},
+    {AMSCR_OPT_ARCLENGTH_PASSES, 0},     {AMSCR_OPT_OVERSAMPLING, 0},
+    {AMSCR_OPT_METHOD, 0},               {AMSCR_OPT_KMAX, 0},
+    {AMSCR_OPT_REFLECTIONS, 0},          {AMSCR_OPT_SYMMETRIC, 0},
+    {AMSCR_OPT_INVARIANCE, 0},           {AMSCR_OPT_PENALTY, 1},
+    {AMSCR_OPT_REFINE, 0},               {AMSCR_OPT_PARTIAL, 0},
+    {AMSCR_OPT_POLISH, 0},               {AMSCR_OPT_NUM_THREADS, 0},
+    {AMSCR_OPT_CHANNEL_WEIGHT, 1},       {AMSCR_OPT_CHANNEL_INVARIANCE, 0},
+    {AMSCR_OPT_CHANNEL_AFFINE_SHARE, 1}, {AMSCR_OPT_CHANNEL_BAND, 1},
+    {AMSCR_OPT_CHANNEL_AFFINE_BAND, 1},  {AMSCR_OPT_CHANNEL_SKIP, 1},
+    {AMSCR_OPT_CHANNEL_LOCALITY, 1},     {AMSCR_OPT_RERANK_K, 0},
+    {AMSCR_OPT_RERANK_ITERATIONS, 0},    {AMSCR_OPT_RERANK_INNER_SHARE, 1},
+    {AMSCR_OPT_INNER_CLOSING, 1},        {AMSCR_OPT_CHANNEL_AFFINE_VIEW, 1},
+};
+#define NUM_KEYS (sizeof KEYS / sizeof KEYS[0])
+
+/* The named setter of an integer key (the value cast to its type as a caller would). */
+static amscr_status named_set_int(amscr_params *q, amscr_option key, int v)
+{
+    switch (key) {
+    case AMSCR_OPT_NUM_SAMPLES: return amscr_params_set_num_samples(q, (size_t)v);
+    case AMSCR_OPT_CLOSED: return amscr_params_set_closed(q, v);
+    case AMSCR_OPT_PARAMETRIZATION: return amscr_params_set_parametrization(q, (amscr_parametrization)v);
+    case AMSCR_OPT_ARCLENGTH_PASSES: return amscr_params_set_arclength_passes(q, (unsigned)v);
+    case AMSCR_OPT_OVERSAMPLING: return amscr_params_set_oversampling(q, (unsigned)v);
+    case AMSCR_OPT_METHOD: return amscr_params_set_method(q, (amscr_method)v);
+    case AMSCR_OPT_KMAX: return amscr_params_set_kmax(q, (unsigned)v);
+    case AMSCR_OPT_REFLECTIONS: return amscr_params_set_reflections(q, v);
+    case AMSCR_OPT_SYMMETRIC: return amscr_params_set_symmetric(q, v);
+    case AMSCR_OPT_INVARIANCE: return amscr_params_set_invariance(q, (amscr_invariance)v);
+    case AMSCR_OPT_REFINE: return amscr_params_set_refine(q, (unsigned)v);
+    case AMSCR_OPT_PARTIAL: return amscr_params_set_partial(q, v);
+    case AMSCR_OPT_POLISH: return amscr_params_set_polish(q, v);
+    case AMSCR_OPT_NUM_THREADS: return amscr_params_set_num_threads(q, (unsigned)v);
+    case AMSCR_OPT_CHANNEL_INVARIANCE: return amscr_params_set_channel_invariance(q, (amscr_invariance)v);
+    case AMSCR_OPT_RERANK_K: return amscr_params_set_rerank_k(q, (unsigned)v);
+    case AMSCR_OPT_RERANK_ITERATIONS: return amscr_params_set_rerank_iterations(q, (unsigned)v);
+    default: ck_abort_msg("key %d is not an integer key", (int)key);
+    }
+    return AMSCR_E_INVALID_ARG;
+}
+
+static amscr_status named_set_real(amscr_params *q, amscr_option key, double v)
+{
+    switch (key) {
+    case AMSCR_OPT_PRESMOOTH: return amscr_params_set_presmooth(q, v);
+    case AMSCR_OPT_PENALTY: return amscr_params_set_penalty(q, v);
+    case AMSCR_OPT_CHANNEL_WEIGHT: return amscr_params_set_channel_weight(q, v);
+    case AMSCR_OPT_CHANNEL_AFFINE_SHARE: return amscr_params_set_channel_affine_share(q, v);
+    case AMSCR_OPT_CHANNEL_BAND: return amscr_params_set_channel_band(q, v);
+    case AMSCR_OPT_CHANNEL_AFFINE_BAND: return amscr_params_set_channel_affine_band(q, v);
+    case AMSCR_OPT_CHANNEL_SKIP: return amscr_params_set_channel_skip(q, v);
+    case AMSCR_OPT_CHANNEL_LOCALITY: return amscr_params_set_channel_locality(q, v);
+    case AMSCR_OPT_RERANK_INNER_SHARE: return amscr_params_set_rerank_inner_share(q, v);
+    case AMSCR_OPT_INNER_CLOSING: return amscr_params_set_inner_closing(q, v);
+    case AMSCR_OPT_CHANNEL_AFFINE_VIEW: return amscr_params_set_channel_affine_view(q, v);
+    default: ck_abort_msg("key %d is not a real key", (int)key);
+    }
+    return AMSCR_E_INVALID_ARG;
+}
+
+/* The named getter of any key, as a double. */
+static double named_get(const amscr_params *q, amscr_option key)
+{
+    switch (key) {
+    case AMSCR_OPT_NUM_SAMPLES: return (double)amscr_params_get_num_samples(q);
+    case AMSCR_OPT_CLOSED: return amscr_params_get_closed(q);
+    case AMSCR_OPT_PARAMETRIZATION: return amscr_params_get_parametrization(q);
+    case AMSCR_OPT_PRESMOOTH: return amscr_params_get_presmooth(q);
+    case AMSCR_OPT_ARCLENGTH_PASSES: return amscr_params_get_arclength_passes(q);
+    case AMSCR_OPT_OVERSAMPLING: return amscr_params_get_oversampling(q);
+    case AMSCR_OPT_METHOD: return amscr_params_get_method(q);
+    case AMSCR_OPT_KMAX: return amscr_params_get_kmax(q);
+    case AMSCR_OPT_REFLECTIONS: return amscr_params_get_reflections(q);
+    case AMSCR_OPT_SYMMETRIC: return amscr_params_get_symmetric(q);
+    case AMSCR_OPT_INVARIANCE: return amscr_params_get_invariance(q);
+    case AMSCR_OPT_PENALTY: return amscr_params_get_penalty(q);
+    case AMSCR_OPT_REFINE: return amscr_params_get_refine(q);
+    case AMSCR_OPT_PARTIAL: return amscr_params_get_partial(q);
+    case AMSCR_OPT_POLISH: return amscr_params_get_polish(q);
+    case AMSCR_OPT_NUM_THREADS: return amscr_params_get_num_threads(q);
+    case AMSCR_OPT_CHANNEL_WEIGHT: return amscr_params_get_channel_weight(q);
+    case AMSCR_OPT_CHANNEL_INVARIANCE: return amscr_params_get_channel_invariance(q);
+    case AMSCR_OPT_CHANNEL_AFFINE_SHARE: return amscr_params_get_channel_affine_share(q);
+    case AMSCR_OPT_CHANNEL_BAND: return amscr_params_get_channel_band(q);
+    case AMSCR_OPT_CHANNEL_AFFINE_BAND: return amscr_params_get_channel_affine_band(q);
+    case AMSCR_OPT_CHANNEL_SKIP: return amscr_params_get_channel_skip(q);
+    case AMSCR_OPT_CHANNEL_LOCALITY: return amscr_params_get_channel_locality(q);
+    case AMSCR_OPT_RERANK_K: return amscr_params_get_rerank_k(q);
+    case AMSCR_OPT_RERANK_ITERATIONS: return amscr_params_get_rerank_iterations(q);
+    case AMSCR_OPT_RERANK_INNER_SHARE: return amscr_params_get_rerank_inner_share(q);
+    case AMSCR_OPT_INNER_CLOSING: return amscr_params_get_inner_closing(q);
+    case AMSCR_OPT_CHANNEL_AFFINE_VIEW: return amscr_params_get_channel_affine_view(q);
+    }
+    ck_abort_msg("unknown key %d", (int)key);
+    return 0.0;
+}
+
+/* The keyed getter of any key, as a double. */
+static double keyed_get(const amscr_params *q, amscr_option key, int real)
+{
+    double v = NAN;
+    int i = -1;
+    if (real) {
+        ck_assert_int_eq(amscr_params_get_real(q, key, &v), AMSCR_OK);
+        return v;
+    }
+    ck_assert_int_eq(amscr_params_get_int(q, key, &i), AMSCR_OK);
+    return i;
+}
+
+static amscr_status keyed_set(amscr_params *q, amscr_option key, int real, double v)
+{
+    return real ? amscr_params_set_real(q, key, v) : amscr_params_set_int(q, key, (int)v);
+}
+
+/* Every key: the keyed getter reads what the named getter reads (defaults of all three presets),
+ * and both bounds (or, at an open end, the nearest value inside), set by key, read back by key and
+ * by name. */
+START_TEST(test_keyed_round_trip)
+{
+    amscr_status (*presets[3])(amscr_params **) = {amscr_params_new, amscr_params_new_registration,
+                                                  amscr_params_new_retrieval};
+    for (int k = 0; k < 3; k++) {
+        amscr_params *q = NULL;
+        ck_assert_int_eq(presets[k](&q), AMSCR_OK);
+        for (size_t i = 0; i < NUM_KEYS; i++)
+            ck_assert_double_eq(keyed_get(q, KEYS[i].key, KEYS[i].real), named_get(q, KEYS[i].key));
+        amscr_params_free(q);
+    }
+    for (size_t i = 0; i < NUM_KEYS; i++) {
+        amscr_option key = KEYS[i].key;
+        double lo = NAN, hi = NAN;
+        ck_assert_int_eq(amscr_params_get_bounds(key, &lo, &hi), AMSCR_OK);
+        ck_assert(lo < hi);
+        double vals[2] = {lo, hi};
+        for (int j = 0; j < 2; j++) {
+            double v = vals[j];
+            if (keyed_set(p, key, KEYS[i].real, v) != AMSCR_OK) { /* an open end (test_keyed_bounds) */
+                ck_assert(KEYS[i].real);
+                v = nextafter(v, vals[1 - j]);
+                ck_assert_msg(keyed_set(p, key, 1, v) == AMSCR_OK, "key %d = %g", (int)key, v);
+            }
+            ck_assert_double_eq(keyed_get(p, key, KEYS[i].real), v);
+            ck_assert_double_eq(named_get(p, key), v);
+        }
+    }
+}
+END_TEST
+
+/* The documented bounds of a few keys, and the values inside them that three keys refuse. */
+START_TEST(test_keyed_bounds)
+{
+    double lo = NAN, hi = NAN;
+    ck_assert_int_eq(amscr_params_get_bounds(AMSCR_OPT_NUM_SAMPLES, &lo, &hi), AMSCR_OK);
+    ck_assert_double_eq(lo, 16.0);
+    ck_assert_double_eq(hi, (double)AMSCR_MAX_SAMPLES);
+    ck_assert_int_eq(amscr_params_get_bounds(AMSCR_OPT_METHOD, &lo, &hi), AMSCR_OK);
+    ck_assert_double_eq(lo, AMSCR_METHOD_ACMA);
+    ck_assert_double_eq(hi, AMSCR_METHOD_MULTICLASS_EM);
+    ck_assert_int_eq(amscr_params_get_bounds(AMSCR_OPT_PENALTY, &lo, &hi), AMSCR_OK);
+    ck_assert_double_eq(lo, 0.0);
+    ck_assert_double_eq(hi, 1e6);
+    ck_assert_int_eq(amscr_params_get_bounds(AMSCR_OPT_CHANNEL_AFFINE_VIEW, &lo, &hi), AMSCR_OK);
+    ck_assert_double_eq(lo, 0.0);
+    ck_assert_double_eq(hi, 100.0);
+    EXPECT_INVALID(amscr_params_set_real(p, AMSCR_OPT_CHANNEL_BAND, 0.0));
+    EXPECT_INVALID(amscr_params_set_real(p, AMSCR_OPT_CHANNEL_AFFINE_BAND, 0.0));
+    EXPECT_INVALID(amscr_params_set_real(p, AMSCR_OPT_RERANK_INNER_SHARE, 1.0));
+    EXPECT_INVALID(amscr_params_set_real(p, AMSCR_OPT_CHANNEL_AFFINE_VIEW, 0.5));
+    ck_assert_int_eq(amscr_params_set_real(p, AMSCR_OPT_CHANNEL_AFFINE_VIEW, 0.0), AMSCR_OK);
+}
+END_TEST
+
+/* Outside the bounds, NaN and infinities: refused with a detail, p unchanged. */
+START_TEST(test_keyed_rejects)
+{
+    for (size_t i = 0; i < NUM_KEYS; i++) {
+        amscr_option key = KEYS[i].key;
+        double lo = NAN, hi = NAN, before = named_get(p, key);
+        ck_assert_int_eq(amscr_params_get_bounds(key, &lo, &hi), AMSCR_OK);
+        if (KEYS[i].real) {
+            const double bad[] = {lo - 0.5, nextafter(lo, -INFINITY), nextafter(hi, INFINITY), hi + 0.5,
+                                  NAN, INFINITY, -INFINITY};
+            for (size_t j = 0; j < sizeof bad / sizeof bad[0]; j++)
+                EXPECT_INVALID(amscr_params_set_real(p, key, bad[j]));
+            EXPECT_INVALID(amscr_params_set_int(p, key, 0)); /* a real key by the integer call */
+            int iv = 0;
+            EXPECT_INVALID(amscr_params_get_int(p, key, &iv));
+        } else {
+            EXPECT_INVALID(amscr_params_set_int(p, key, (int)lo - 1));
+            EXPECT_INVALID(amscr_params_set_int(p, key, (int)hi + 1));
+            EXPECT_INVALID(amscr_params_set_int(p, key, INT_MIN));
+            EXPECT_INVALID(amscr_params_set_int(p, key, INT_MAX));
+            EXPECT_INVALID(amscr_params_set_real(p, key, lo)); /* an integer key by the real call */
+            double rv = 0.0;
+            EXPECT_INVALID(amscr_params_get_real(p, key, &rv));
+        }
+        ck_assert_double_eq(named_get(p, key), before);
+    }
+}
+END_TEST
+
+START_TEST(test_keyed_unknown_and_null)
+{
+    const int unknown[] = {0, -1, (int)AMSCR_OPT_CHANNEL_AFFINE_VIEW + 1, 1000, INT_MAX, INT_MIN};
+    int iv = 0;
+    double rv = 0.0, lo = 0.0, hi = 0.0;
+    for (size_t j = 0; j < sizeof unknown / sizeof unknown[0]; j++) {
+        amscr_option key = (amscr_option)unknown[j];
+        EXPECT_INVALID(amscr_params_set_int(p, key, 1));
+        EXPECT_INVALID(amscr_params_set_real(p, key, 0.5));
+        EXPECT_INVALID(amscr_params_get_int(p, key, &iv));
+        EXPECT_INVALID(amscr_params_get_real(p, key, &rv));
+        EXPECT_INVALID(amscr_params_get_bounds(key, &lo, &hi));
+    }
+    EXPECT_INVALID(amscr_params_set_int(NULL, AMSCR_OPT_NUM_SAMPLES, 128));
+    EXPECT_INVALID(amscr_params_set_real(NULL, AMSCR_OPT_PENALTY, 1.0));
+    EXPECT_INVALID(amscr_params_get_int(NULL, AMSCR_OPT_NUM_SAMPLES, &iv));
+    EXPECT_INVALID(amscr_params_get_int(p, AMSCR_OPT_NUM_SAMPLES, NULL));
+    EXPECT_INVALID(amscr_params_get_real(NULL, AMSCR_OPT_PENALTY, &rv));
+    EXPECT_INVALID(amscr_params_get_real(p, AMSCR_OPT_PENALTY, NULL));
+    EXPECT_INVALID(amscr_params_get_bounds(AMSCR_OPT_PENALTY, NULL, &hi));
+    EXPECT_INVALID(amscr_params_get_bounds(AMSCR_OPT_PENALTY, &lo, NULL));
+}
+END_TEST
+
+/* The keyed and the named setter of every key accept and refuse the same values and store the
+ * same result. */
+START_TEST(test_keyed_agrees_with_named)
+{
+    amscr_params *a = NULL, *b = NULL;
+    ck_assert_int_eq(amscr_params_new(&a), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_new(&b), AMSCR_OK);
+    for (size_t i = 0; i < NUM_KEYS; i++) {
+        amscr_option key = KEYS[i].key;
+        double lo = NAN, hi = NAN;
+        ck_assert_int_eq(amscr_params_get_bounds(key, &lo, &hi), AMSCR_OK);
+        const double vals[] = {lo - 1.0, lo, nextafter(lo, INFINITY), 0.5, 1.0, 1.5, 2.0, 3.0, 16.0, 0.5 * (lo + hi),
+                               nextafter(hi, -INFINITY), hi, hi + 1.0, -1.0, NAN, INFINITY};
+        for (size_t j = 0; j < sizeof vals / sizeof vals[0]; j++) {
+            double v = vals[j];
+            amscr_status sa, sb;
+            if (KEYS[i].real) {
+                sa = named_set_real(a, key, v);
+                sb = amscr_params_set_real(b, key, v);
+            } else {
+                if (!isfinite(v) || v != floor(v))
+                    continue;
+                sa = named_set_int(a, key, (int)v);
+                sb = amscr_params_set_int(b, key, (int)v);
+            }
+            ck_assert_msg(sa == sb, "key %d = %g: named %d, keyed %d", (int)key, v, (int)sa, (int)sb);
+            ck_assert_double_eq(named_get(a, key), named_get(b, key));
+            ck_assert_double_eq(keyed_get(a, key, KEYS[i].real), named_get(a, key));
+        }
+    }
+    amscr_params_free(a);
+    amscr_params_free(b);
+}
+END_TEST
+
 Suite *amscr_suite_params(void)
 {
     Suite *s = suite_create("params");
@@ -448,6 +719,11 @@ Suite *amscr_suite_params(void)
     tcase_add_test(tc, test_copy_of_defaults);
     tcase_add_test(tc, test_null_handling);
     tcase_add_test(tc, test_independent_objects);
+    tcase_add_test(tc, test_keyed_round_trip);
+    tcase_add_test(tc, test_keyed_bounds);
+    tcase_add_test(tc, test_keyed_rejects);
+    tcase_add_test(tc, test_keyed_unknown_and_null);
+    tcase_add_test(tc, test_keyed_agrees_with_named);
     suite_add_tcase(s, tc);
     return s;
 }

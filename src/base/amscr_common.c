@@ -1,7 +1,8 @@
 /* The base area (src/base/): what every other area builds on:
  *   amscr_common.c  errors (status strings, the thread-local detail), version, features, allocation
- *   params.c        the options object: documented defaults, presets, validating setters
- *   workspace.c     the caller-owned scratch of a registration
+ *   params.c        the options object: documented defaults, presets, the scales, the stage switches
+ *   options.c       its numbers and flags, each declared once: the named and the keyed setters
+ *   stage_names.c   the names of amscr_register's stages and which ones are switchable
  *   internal.h      the shared internals of libamscr (never installed)
  *
  * amscr_common.c — errors, version, features, allocation helpers. */

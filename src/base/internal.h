@@ -25,6 +25,25 @@ void amscr__clear_error(void);
             return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %s is NULL", __func__, #ptr);         \
     } while (0)
 
+/* AMSCR_OK when cond holds, else AMSCR_E_INVALID_ARG with the printf-style detail given. */
+#define AMSCR__REQUIRE(cond, ...) ((cond) ? AMSCR_OK : amscr__fail(AMSCR_E_INVALID_ARG, __VA_ARGS__))
+/* Defines the validating setter `amscr_status fn(obj_t *obj, vtype v)` of obj->field: it clears
+ * the calling thread's detail, refuses a NULL obj and stores v when `check`, an amscr_status
+ * expression of v (AMSCR__REQUIRE), is AMSCR_OK; it returns that status (obj unchanged otherwise). */
+#define AMSCR__SETTER(fn, obj_t, obj, vtype, field, check)                                     \
+    amscr_status fn(obj_t *obj, vtype v)                                                       \
+    {                                                                                          \
+        amscr__clear_error();                                                                  \
+        AMSCR_CHECK_NULL(obj);                                                                 \
+        amscr_status check_ = (check);                                                         \
+        if (check_ == AMSCR_OK)                                                                \
+            obj->field = v;                                                                    \
+        return check_;                                                                         \
+    }
+/* Defines the getter `vtype fn(const obj_t *obj)` of obj->field: 0 for a NULL obj. */
+#define AMSCR__GETTER(fn, obj_t, vtype, field)                                                 \
+    vtype fn(const obj_t *obj) { return obj ? obj->field : (vtype)0; }
+
 /* ---- small helpers -------------------------------------------------- */
 /* Overflow-checked malloc of n*size bytes (NULL on overflow or failure; n == 0 gives a
  * valid 1-byte block). */
@@ -84,7 +103,8 @@ struct amscr_params {
     double channel_affine_view;        /* > 0: a pair's channel = min(the mix, this x d_affine) (0.11) */
 };
 
-/* The stages of amscr_register in pipeline order (register/stages.c holds the table). */
+/* The stages of amscr_register in pipeline order: their names in base/stage_names.c, their
+ * functions and conditions in register/stages.c. */
 enum {
     AMSCR__STAGE_DESPIKE,
     AMSCR__STAGE_SEARCH,
@@ -103,7 +123,9 @@ enum {
 #define AMSCR__STAGE_BIT(i) (1u << (unsigned)(i))
 /* Whether params p leave switchable stage i on. */
 #define AMSCR__STAGE_ON(p, i) (!((p)->stages_off & AMSCR__STAGE_BIT(i)))
-/* Index of the switchable stage called name, or -1 (register/stages.c). */
+/* Name of stage i (NULL past the last). */
+const char *amscr__stage_name(size_t i);
+/* Index of the switchable stage called name, or -1. */
 int amscr__stage_switch(const char *name);
 
 /* ---- geometry internals (contour.c, smooth.c, resample.c, affine.c) ---- */

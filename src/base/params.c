@@ -1,4 +1,5 @@
-/* params.c — the registration options object: documented defaults, validating setters. */
+/* params.c — the registration options object: documented defaults, presets, the scale list and the
+ * stage switches (its numbers and flags, with their setters and getters: options.c). */
 #include "internal.h"
 
 #include <math.h>
@@ -118,80 +119,7 @@ amscr_status amscr_params_copy(const amscr_params *p, amscr_params **out)
 
 void amscr_params_free(amscr_params *p) { free(p); }
 
-#define SETTER(name, type, field, cond, fmt)                                                      \
-    amscr_status amscr_params_set_##name(amscr_params *p, type v)                                  \
-    {                                                                                              \
-        amscr__clear_error();                                                                      \
-        AMSCR_CHECK_NULL(p);                                                                       \
-        if (!(cond))                                                                               \
-            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_params_set_" #name ": " fmt, v);        \
-        p->field = v;                                                                              \
-        return AMSCR_OK;                                                                           \
-    }
-#define GETTER(name, type, field)                                                                 \
-    type amscr_params_get_##name(const amscr_params *p) { return p ? p->field : (type)0; }
-
-SETTER(num_samples, size_t, num_samples, v >= 16 && v <= AMSCR_MAX_SAMPLES, "%zu is outside 16..65536")
-GETTER(num_samples, size_t, num_samples)
-SETTER(method, amscr_method, method, (int)v >= 0 && (int)v <= 3, "unknown method %d")
-GETTER(method, amscr_method, method)
-SETTER(closed, int, closed, v == 0 || v == 1, "%d is not 0 or 1")
-GETTER(closed, int, closed)
-SETTER(reflections, int, reflections, v == 0 || v == 1, "%d is not 0 or 1")
-GETTER(reflections, int, reflections)
-SETTER(parametrization, amscr_parametrization, parametrization, (int)v >= 0 && (int)v <= 2,
-       "unknown parametrization %d")
-GETTER(parametrization, amscr_parametrization, parametrization)
-SETTER(presmooth, double, presmooth, v >= 0.0 && v <= 0.25, "%g is outside 0..0.25")
-GETTER(presmooth, double, presmooth)
-SETTER(arclength_passes, unsigned, arclength_passes, v >= 1 && v <= 10, "%u is outside 1..10")
-GETTER(arclength_passes, unsigned, arclength_passes)
-SETTER(oversampling, unsigned, oversampling, v >= 1 && v <= 64, "%u is outside 1..64")
-GETTER(oversampling, unsigned, oversampling)
-SETTER(kmax, unsigned, kmax, v >= 1 && v <= AMSCR__KMAX, "%u is outside 1..16")
-GETTER(kmax, unsigned, kmax)
-SETTER(symmetric, int, symmetric, v == 0 || v == 1, "%d is not 0 or 1")
-GETTER(symmetric, int, symmetric)
-SETTER(refine, unsigned, refine, v <= 50, "%u is outside 0..50")
-GETTER(refine, unsigned, refine)
-SETTER(num_threads, unsigned, num_threads, v <= 1024, "%u is outside 0..1024")
-GETTER(num_threads, unsigned, num_threads)
-SETTER(invariance, amscr_invariance, invariance, (int)v >= 0 && (int)v <= 2, "unknown invariance %d")
-GETTER(invariance, amscr_invariance, invariance)
-SETTER(penalty, double, penalty, v >= 0.0 && v <= 1e6, "%g is not in 0..1e6")
-GETTER(penalty, double, penalty)
-SETTER(channel_weight, double, channel_weight, v >= 0.0 && v <= 1.0, "%g is not in 0..1")
-GETTER(channel_weight, double, channel_weight)
-SETTER(channel_invariance, amscr_invariance, channel_invariance,
-       v == AMSCR_INVARIANCE_AFFINE || v == AMSCR_INVARIANCE_SIMILARITY, "%d is not affine (0) or similarity (1)")
-GETTER(channel_invariance, amscr_invariance, channel_invariance)
-SETTER(channel_affine_share, double, channel_affine_share, v >= 0.0 && v <= 1.0, "%g is not in 0..1")
-GETTER(channel_affine_share, double, channel_affine_share)
-SETTER(channel_band, double, channel_band, v > 0.0 && v <= 0.5, "%g is not in (0, 0.5]")
-GETTER(channel_band, double, channel_band)
-SETTER(channel_affine_band, double, channel_affine_band, v > 0.0 && v <= 0.5, "%g is not in (0, 0.5]")
-GETTER(channel_affine_band, double, channel_affine_band)
-SETTER(channel_skip, double, channel_skip, v >= 0.0 && v <= 1e3, "%g is not in 0..1000")
-GETTER(channel_skip, double, channel_skip)
-SETTER(channel_locality, double, channel_locality, v >= 0.0 && v <= 1e3, "%g is not in 0..1000")
-GETTER(channel_locality, double, channel_locality)
-SETTER(rerank_k, unsigned, rerank_k, v <= 1000, "%u is outside 0..1000")
-GETTER(rerank_k, unsigned, rerank_k)
-SETTER(rerank_iterations, unsigned, rerank_iterations, v >= 1 && v <= 1000, "%u is outside 1..1000")
-GETTER(rerank_iterations, unsigned, rerank_iterations)
-SETTER(rerank_inner_share, double, rerank_inner_share, v >= 0.0 && v < 1.0, "%g is not in [0, 1)")
-GETTER(rerank_inner_share, double, rerank_inner_share)
-SETTER(inner_closing, double, inner_closing, v >= 0.0 && v <= 1.0, "%g is not in [0, 1]")
-GETTER(inner_closing, double, inner_closing)
-SETTER(channel_affine_view, double, channel_affine_view, v == 0.0 || (v >= 1.0 && v <= 100.0),
-       "%g is not 0 or in [1, 100]")
-GETTER(channel_affine_view, double, channel_affine_view)
-
-/* ---- robust registration: partial matching, polish ---- */
-SETTER(partial, int, partial, v == 0 || v == 1, "%d is not 0 or 1")
-GETTER(partial, int, partial)
-SETTER(polish, int, polish, v == 0 || v == 1, "%d is not 0 or 1")
-GETTER(polish, int, polish)
+/* The numbers and flags, each with its named pair and its key: options.c. */
 
 amscr_status amscr_params_set_scales(amscr_params *p, const double *sigmas, size_t n)
 {
@@ -226,7 +154,7 @@ amscr_status amscr_params_get_scales(const amscr_params *p, double *out_sigmas, 
     return AMSCR_OK;
 }
 
-/* ---- switchable stages of amscr_register (register/stages.c) ---- */
+/* ---- switchable stages of amscr_register (their names: stage_names.c) ---- */
 amscr_status amscr_params_set_stage(amscr_params *p, const char *name, int on)
 {
     amscr__clear_error();

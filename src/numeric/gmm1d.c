@@ -281,39 +281,16 @@ void amscr_gmm1d_free(amscr_gmm1d *g)
     free(g);
 }
 
-amscr_status amscr_gmm1d_set_max_iterations(amscr_gmm1d *g, unsigned n)
-{
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(g);
-    if (n < 1)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_gmm1d_set_max_iterations: must be >= 1");
-    g->max_iterations = n;
-    return AMSCR_OK;
-}
+AMSCR__SETTER(amscr_gmm1d_set_max_iterations, amscr_gmm1d, g, unsigned, max_iterations,
+              AMSCR__REQUIRE(v >= 1, "amscr_gmm1d_set_max_iterations: must be >= 1"))
+AMSCR__SETTER(amscr_gmm1d_set_tolerance, amscr_gmm1d, g, double, tol,
+              AMSCR__REQUIRE(v >= 0.0 && isfinite(v), "amscr_gmm1d_set_tolerance: %g is not a finite value >= 0", v))
+AMSCR__SETTER(amscr_gmm1d_set_variance_floor, amscr_gmm1d, g, double, var_floor,
+              AMSCR__REQUIRE(v >= 0.0 && v <= 1.0, "amscr_gmm1d_set_variance_floor: %g not in [0, 1]", v))
 
-amscr_status amscr_gmm1d_set_tolerance(amscr_gmm1d *g, double tol)
-{
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(g);
-    if (!(tol >= 0.0) || !isfinite(tol))
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_gmm1d_set_tolerance: %g is not a finite value >= 0", tol);
-    g->tol = tol;
-    return AMSCR_OK;
-}
-
-amscr_status amscr_gmm1d_set_variance_floor(amscr_gmm1d *g, double v)
-{
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(g);
-    if (!(v >= 0.0 && v <= 1.0))
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_gmm1d_set_variance_floor: %g not in [0, 1]", v);
-    g->var_floor = v;
-    return AMSCR_OK;
-}
-
-unsigned amscr_gmm1d_get_max_iterations(const amscr_gmm1d *g) { return g ? g->max_iterations : 0; }
-double amscr_gmm1d_get_tolerance(const amscr_gmm1d *g) { return g ? g->tol : 0.0; }
-double amscr_gmm1d_get_variance_floor(const amscr_gmm1d *g) { return g ? g->var_floor : 0.0; }
+AMSCR__GETTER(amscr_gmm1d_get_max_iterations, amscr_gmm1d, unsigned, max_iterations)
+AMSCR__GETTER(amscr_gmm1d_get_tolerance, amscr_gmm1d, double, tol)
+AMSCR__GETTER(amscr_gmm1d_get_variance_floor, amscr_gmm1d, double, var_floor)
 size_t amscr_gmm1d_num_components(const amscr_gmm1d *g) { return g ? g->k : 0; }
 const double *amscr_gmm1d_weights(const amscr_gmm1d *g) { return g && g->params ? g->params : NULL; }
 const double *amscr_gmm1d_means(const amscr_gmm1d *g) { return g && g->params ? g->params + g->k : NULL; }

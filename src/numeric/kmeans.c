@@ -210,48 +210,18 @@ void amscr_kmeans_free(amscr_kmeans *km)
     free(km);
 }
 
-amscr_status amscr_kmeans_set_seed(amscr_kmeans *km, uint64_t seed)
-{
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(km);
-    km->seed = seed;
-    return AMSCR_OK;
-}
+AMSCR__SETTER(amscr_kmeans_set_seed, amscr_kmeans, km, uint64_t, seed, AMSCR_OK)
+AMSCR__SETTER(amscr_kmeans_set_max_iterations, amscr_kmeans, km, unsigned, max_iterations,
+              AMSCR__REQUIRE(v >= 1, "amscr_kmeans_set_max_iterations: must be >= 1"))
+AMSCR__SETTER(amscr_kmeans_set_tolerance, amscr_kmeans, km, double, tol,
+              AMSCR__REQUIRE(v >= 0.0 && isfinite(v), "amscr_kmeans_set_tolerance: %g is not a finite value >= 0", v))
+AMSCR__SETTER(amscr_kmeans_set_restarts, amscr_kmeans, km, unsigned, restarts,
+              AMSCR__REQUIRE(v >= 1, "amscr_kmeans_set_restarts: must be >= 1"))
 
-amscr_status amscr_kmeans_set_max_iterations(amscr_kmeans *km, unsigned n)
-{
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(km);
-    if (n < 1)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_kmeans_set_max_iterations: must be >= 1");
-    km->max_iterations = n;
-    return AMSCR_OK;
-}
-
-amscr_status amscr_kmeans_set_tolerance(amscr_kmeans *km, double tol)
-{
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(km);
-    if (!(tol >= 0.0) || !isfinite(tol))
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_kmeans_set_tolerance: %g is not a finite value >= 0", tol);
-    km->tol = tol;
-    return AMSCR_OK;
-}
-
-amscr_status amscr_kmeans_set_restarts(amscr_kmeans *km, unsigned r)
-{
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(km);
-    if (r < 1)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_kmeans_set_restarts: must be >= 1");
-    km->restarts = r;
-    return AMSCR_OK;
-}
-
-uint64_t amscr_kmeans_get_seed(const amscr_kmeans *km) { return km ? km->seed : 0; }
-unsigned amscr_kmeans_get_max_iterations(const amscr_kmeans *km) { return km ? km->max_iterations : 0; }
-double amscr_kmeans_get_tolerance(const amscr_kmeans *km) { return km ? km->tol : 0.0; }
-unsigned amscr_kmeans_get_restarts(const amscr_kmeans *km) { return km ? km->restarts : 0; }
+AMSCR__GETTER(amscr_kmeans_get_seed, amscr_kmeans, uint64_t, seed)
+AMSCR__GETTER(amscr_kmeans_get_max_iterations, amscr_kmeans, unsigned, max_iterations)
+AMSCR__GETTER(amscr_kmeans_get_tolerance, amscr_kmeans, double, tol)
+AMSCR__GETTER(amscr_kmeans_get_restarts, amscr_kmeans, unsigned, restarts)
 size_t amscr_kmeans_num_clusters(const amscr_kmeans *km) { return km ? km->k : 0; }
 size_t amscr_kmeans_dim(const amscr_kmeans *km) { return km ? km->dim : 0; }
 const double *amscr_kmeans_centers(const amscr_kmeans *km) { return km ? km->centers : NULL; }

@@ -5,6 +5,7 @@
  *   register.c          the public entry points: check the pair, run the stages below, top-down
  *   stages.c            the stage table of amscr_register: each stage's name, function and
  *                       when it runs, in pipeline order (the list below and amscr_result_stage)
+ *   spectral.c          closed curves' cross sums at a continuous shift, for the two below
  *   shift_search.c      spectral start-point search: candidates and their one ranking rule
  *   method.c            the method at one start point: per-scale solves, residuals, stacked solve
  *   scale_select.c      which scales enter the stacked solve (all, finest, EM + Bayes threshold)
@@ -20,7 +21,7 @@
  *   alternatives.c      the distinct maps that fit about as well as the chosen one
  *   correspond.c        confidence, inliers, the part covered, dense correspondences
  *   result.c            the result object and its getters
- * and base/workspace.c, the caller-owned scratch of all of the above. */
+ * and workspace.c, the caller-owned scratch of all of the above. */
 #ifndef AMSCR_MATCH_H
 #define AMSCR_MATCH_H
 
@@ -168,12 +169,17 @@ void amscr__select_scales(const amscr_params *prm, size_t finest, match_t *m, do
 /* Scratch (doubles) of the selection at p scales. */
 size_t amscr__select_scratch(size_t p);
 
-/* ---- shift_search.c ---- */
+/* ---- spectral.c ---- */
+/* The rotation recurrence e^{iθw} of the spectral sums is re-computed exactly every 256
+ * frequencies (mask 255) so its rounding does not grow with N. */
+#define AMSCR__REANCHOR 255
 /* P_ij(w) = H_i(w) conj(F_j(w)) of orientation o into ws->P (closed curves). */
 void amscr__spectral_prepare(const amscr_descriptor *f, const amscr_descriptor *h, int o, amscr_workspace *ws);
 /* Cross sums R_0 (unsmoothed) .. R_p (scale k) at the continuous shift s from ws->P. */
 void amscr__spectral_cross_sums(const amscr_descriptor *f, const amscr_descriptor *h, double s, amscr_workspace *ws,
                                 double R[][6]);
+
+/* ---- shift_search.c ---- */
 /* The start-point search's outcome: the candidates, their scores and the winner. */
 typedef struct {
     double s[2 * AMSCR__CANDIDATES_MAX]; /* continuous shift */
@@ -280,7 +286,6 @@ void amscr__polish_end(amscr__polish_state *w);
 amscr_status amscr__run_stages(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                amscr_workspace *ws, amscr_result *r);
 /* The name of stage i (< AMSCR__NUM_STAGES). */
-const char *amscr__stage_name(size_t i);
 
 /* alternatives.c: the result's alternatives (r->alt*, input coordinates) from the last ranking
  * of r->m: the chosen map first, then each distinct ranked map about as good, best first. */

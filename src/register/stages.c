@@ -1,5 +1,5 @@
-/* stages.c — the stage table of amscr_register (docs/method.md §12): every stage's name, its
- * function and when it runs, in pipeline order. The runner calls each stage whose condition
+/* stages.c — the stage table of amscr_register (docs/method.md §12): every stage's function and
+ * when it runs, in pipeline order (the names: base/stage_names.c). The runner calls each stage whose condition
  * holds, records that it ran (amscr_result_stage) and stops at the first status that is not
  * AMSCR_OK, which it returns unchanged (an allocation failure anywhere reaches the caller as
  * AMSCR_E_NOMEM). The batch path (amscr_distance, register.c) runs search, method and the
@@ -24,11 +24,11 @@ typedef struct {
     amscr__polish_state *pol; /* the polish's state, for its order and even-spacing steps */
 } stage_ctx;
 
+/* A stage's function and condition; its name and whether it is switchable are in
+ * base/stage_names.c, under the same index. */
 typedef struct {
-    const char *name;
     amscr_status (*run)(stage_ctx *c); /* NULL: runs when a shape is prepared */
     int (*when)(const stage_ctx *c);
-    int optional; /* switchable by amscr_params_set_stage */
 } stage_t;
 
 static int affine(const stage_ctx *c) { return c->prm->invariance == AMSCR_INVARIANCE_AFFINE; }
@@ -102,28 +102,18 @@ static amscr_status run_correspond(stage_ctx *c) { return amscr__correspond(c->f
 
 /* The pipeline, in order (indexed by AMSCR__STAGE_*). */
 static const stage_t STAGES[AMSCR__NUM_STAGES] = {
-    [AMSCR__STAGE_DESPIKE] = {"despike", NULL, when_despike, 1},
-    [AMSCR__STAGE_SEARCH] = {"search", run_search, always, 0},
-    [AMSCR__STAGE_METHOD] = {"method", run_method, always, 0},
-    [AMSCR__STAGE_RECOVERY] = {"recovery", run_recovery, when_recovery, 1},
-    [AMSCR__STAGE_FINAL_SOLVE] = {"final_solve", run_final, when_final, 0},
-    [AMSCR__STAGE_SYMMETRIC] = {"symmetric", run_symmetric, when_symmetric, 0},
-    [AMSCR__STAGE_POLISH] = {"polish", run_polish, when_polish, 1},
-    [AMSCR__STAGE_ORDER] = {"order", run_order, when_order, 1},
-    [AMSCR__STAGE_EVEN] = {"even_spacing", run_even, when_even, 1},
-    [AMSCR__STAGE_ALTERNATIVES] = {"alternatives", run_alternatives, always, 0},
-    [AMSCR__STAGE_CORRESPOND] = {"correspondences", run_correspond, always, 0},
+    [AMSCR__STAGE_DESPIKE] = {NULL, when_despike},
+    [AMSCR__STAGE_SEARCH] = {run_search, always},
+    [AMSCR__STAGE_METHOD] = {run_method, always},
+    [AMSCR__STAGE_RECOVERY] = {run_recovery, when_recovery},
+    [AMSCR__STAGE_FINAL_SOLVE] = {run_final, when_final},
+    [AMSCR__STAGE_SYMMETRIC] = {run_symmetric, when_symmetric},
+    [AMSCR__STAGE_POLISH] = {run_polish, when_polish},
+    [AMSCR__STAGE_ORDER] = {run_order, when_order},
+    [AMSCR__STAGE_EVEN] = {run_even, when_even},
+    [AMSCR__STAGE_ALTERNATIVES] = {run_alternatives, always},
+    [AMSCR__STAGE_CORRESPOND] = {run_correspond, always},
 };
-
-const char *amscr__stage_name(size_t i) { return i < AMSCR__NUM_STAGES ? STAGES[i].name : NULL; }
-
-int amscr__stage_switch(const char *name)
-{
-    for (int i = 0; name && i < AMSCR__NUM_STAGES; i++)
-        if (STAGES[i].optional && strcmp(STAGES[i].name, name) == 0)
-            return i;
-    return -1;
-}
 
 amscr_status amscr__run_stages(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                amscr_workspace *ws, amscr_result *r)

@@ -203,6 +203,41 @@ typedef enum amscr_ranking {
     AMSCR_RANKING_RETRIEVAL = 1
 } amscr_ranking;
 amscr_status amscr_params_ranking(const amscr_params *p, amscr_ranking *out_ranking);
+typedef enum amscr_option {
+    AMSCR_OPT_NUM_SAMPLES = 1,
+    AMSCR_OPT_CLOSED = 2,
+    AMSCR_OPT_PARAMETRIZATION = 3,
+    AMSCR_OPT_PRESMOOTH = 4,
+    AMSCR_OPT_ARCLENGTH_PASSES = 5,
+    AMSCR_OPT_OVERSAMPLING = 6,
+    AMSCR_OPT_METHOD = 7,
+    AMSCR_OPT_KMAX = 8,
+    AMSCR_OPT_REFLECTIONS = 9,
+    AMSCR_OPT_SYMMETRIC = 10,
+    AMSCR_OPT_INVARIANCE = 11,
+    AMSCR_OPT_PENALTY = 12,
+    AMSCR_OPT_REFINE = 13,
+    AMSCR_OPT_PARTIAL = 14,
+    AMSCR_OPT_POLISH = 15,
+    AMSCR_OPT_NUM_THREADS = 16,
+    AMSCR_OPT_CHANNEL_WEIGHT = 17,
+    AMSCR_OPT_CHANNEL_INVARIANCE = 18,
+    AMSCR_OPT_CHANNEL_AFFINE_SHARE = 19,
+    AMSCR_OPT_CHANNEL_BAND = 20,
+    AMSCR_OPT_CHANNEL_AFFINE_BAND = 21,
+    AMSCR_OPT_CHANNEL_SKIP = 22,
+    AMSCR_OPT_CHANNEL_LOCALITY = 23,
+    AMSCR_OPT_RERANK_K = 24,
+    AMSCR_OPT_RERANK_ITERATIONS = 25,
+    AMSCR_OPT_RERANK_INNER_SHARE = 26,
+    AMSCR_OPT_INNER_CLOSING = 27,
+    AMSCR_OPT_CHANNEL_AFFINE_VIEW = 28
+} amscr_option;
+amscr_status amscr_params_set_int(amscr_params *p, amscr_option key, int v);
+amscr_status amscr_params_set_real(amscr_params *p, amscr_option key, double v);
+amscr_status amscr_params_get_int(const amscr_params *p, amscr_option key, int *out_v);
+amscr_status amscr_params_get_real(const amscr_params *p, amscr_option key, double *out_v);
+amscr_status amscr_params_get_bounds(amscr_option key, double *out_lo, double *out_hi);
 amscr_status amscr_workspace_new(amscr_workspace **out);
 void amscr_workspace_free(amscr_workspace *ws);
 amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out);
