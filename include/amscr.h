@@ -101,9 +101,9 @@ extern "C" {
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
 
-/** Largest image side accepted by amscr_contour_from_mask (pixels). @since 0.1 */
+/** Largest image side accepted by the tracing calls (pixels). @since 0.1 */
 #define AMSCR_MAX_IMAGE_SIDE 32768
-/** Largest number of pixels accepted by amscr_contour_from_mask. @since 0.1 */
+/** Largest number of pixels accepted by the tracing calls. @since 0.1 */
 #define AMSCR_MAX_IMAGE_PIXELS 268435456u /* 2^28 */
 /** Largest number of points in a contour. @since 0.1 */
 #define AMSCR_MAX_POINTS 16777216u /* 2^24 */
@@ -163,7 +163,7 @@ typedef struct amscr_db amscr_db;
 typedef struct amscr_kmeans amscr_kmeans;
 /** A 1-D Gaussian mixture (amscr_gmm1d_new). @since 0.1 */
 typedef struct amscr_gmm1d amscr_gmm1d;
-/** A list of contours with their hierarchy (amscr_contours_from_mask). @since 0.2 */
+/** A list of contours with their hierarchy (amscr_contours_from_image). @since 0.2 */
 typedef struct amscr_contour_set amscr_contour_set;
 
 /**
@@ -352,6 +352,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_write_text(const amscr_cont
  * components are dropped; shapes touching the border are handled (the image is treated as
  * padded with background). The result is the sequence of boundary pixel centres (x = column,
  * y = row) with positive signed area (counter-clockwise in a y-up frame), no repeated point.
+ * Prefer amscr_contour_from_image (8/16 bits, sub-pixel; AMSCR_TRACE_PIXEL_CHAIN at level T + 0.5 is this call).
  *
  * @param[in] pixels  width*height bytes, rows `stride` bytes apart.
  * @param[in] width, height  1..AMSCR_MAX_IMAGE_SIDE, width*height <= AMSCR_MAX_IMAGE_PIXELS.
@@ -384,6 +385,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_from_mask(const uint8_t *pi
  * of their first pixel, so a parent comes before its children. A contour is kept when it has
  * at least 3 points, its polygon area (pixels^2) is >= min_area and its parent is kept;
  * contours of no area (single pixels, lines) are always dropped.
+ * Prefer amscr_contours_from_image (8/16 bits, sub-pixel; AMSCR_TRACE_PIXEL_CHAIN at level T + 0.5 is this call).
  *
  * @param[in] pixels, width, height, stride, threshold  as amscr_contour_from_mask.
  * @param[in] min_area  pixels^2, >= 0 and finite (0 keeps every contour with an area).
@@ -2228,6 +2230,7 @@ AMSCR_API void amscr_db_free(amscr_db *db);
 
 /**
  * @brief Prepares a contour with the db's params and stores it with a label.
+ * Prefer amscr_db_add_contours (many at once on the db's threads, all or nothing; n = 1 is this call).
  * @param[out] out_index  index of the new shape (may be NULL).
  * @return AMSCR_OK; as amscr_descriptor_new.
  * Ownership: none (the contour is not kept).
@@ -2355,6 +2358,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_cross_distances(const amscr_db *
  * @brief The n x n matrix of shape-channel distances (amscr_channel_distance; symmetric, zero
  *        diagonal, d(i, j) for i < j in both cells), on the db's threads; the result does not
  *        depend on the thread count. NaN on failure as amscr_db_query.
+ * Prefer amscr_db_retrieval_matrix (channel weight 1, rerank_k 0: this matrix over its median, the same ranking).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, open curves); AMSCR_E_CANCELLED; AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: const.
@@ -2393,7 +2397,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_retrieval_matrix(const amscr_db 
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_save(const amscr_db *db, const char *path);
 
 /**
- * @brief Reads a saved collection.
+ * @brief Reads a saved collection file of any format version (of an index file: its collection).
+ * Prefer amscr_index_load_with for an index file (this call reads only its collection).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_LIMIT (file too large);
  *         AMSCR_E_FORMAT (wrong magic, newer version, bad checksum, truncated); AMSCR_E_NOMEM.
  * Ownership: caller frees *out with amscr_db_free.
@@ -2414,6 +2419,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_save_memory(const amscr_db *db, 
 
 /**
  * @brief Deserializes a buffer made by amscr_db_save_memory (or a file's bytes).
+ * Prefer amscr_index_load_memory_with for an index's bytes (this call reads only its collection).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_FORMAT (as amscr_db_load); AMSCR_E_NOMEM.
  * Ownership: caller frees *out with amscr_db_free; buf is not kept.
  * Thread-safety: reentrant.
@@ -2430,6 +2436,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  *       doubles; otherwise, with re-ranking, the collection's neighbour lists as
  *       amscr_index_build with candidates 0 makes them, on every call: n^2 pair distances,
  *       n^2 doubles of scratch; without re-ranking, n pair distances.
+ * Prefer amscr_index_query_scores on an index built once (candidates 0, channel weight 0 or 1: the same scores).
  * @param[in]  q  a shape prepared with params compatible with the collection's.
  * @param[in]  progress, user  optional progress callback (may be NULL).
  * @param[out] out_scores  n scores, lower is better (see amscr_db_retrieval_matrix).
@@ -2663,14 +2670,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_save_memory(const amscr_index
                                                                size_t *out_len);
 
 /**
- * @brief Reads an index file (mapped read-only while it is read, where the system can map
- *        it: replace an index file by renaming, as amscr_index_save does, not by rewriting it
- *        in place). Every earlier format version loads; a file that lacks the channel features
- *        has them built from its shapes. A collection file without an index (amscr_db_save)
- *        and index files of an older, separate format are AMSCR_E_FORMAT with a detail saying
- *        to build the index again.
- * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_LIMIT; AMSCR_E_FORMAT (wrong
- *         magic, version, checksum, truncated or inconsistent content); AMSCR_E_NOMEM.
+ * @brief Reads an index file: amscr_index_load_with with flags 0.
+ * Prefer amscr_index_load_with (the same with flags 0; AMSCR_INDEX_LAZY for a few queries).
+ * @return as amscr_index_load_with.
  * Ownership: caller frees *out with amscr_index_free.
  * Thread-safety: reentrant.
  * @since 0.4
@@ -2678,8 +2680,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_save_memory(const amscr_index
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load(const char *path, amscr_index **out);
 
 /**
- * @brief Deserializes a buffer made by amscr_index_save_memory (or an index file's bytes).
- * @return as amscr_index_load (no AMSCR_E_IO).
+ * @brief Deserializes an index from memory: amscr_index_load_memory_with with flags 0.
+ * Prefer amscr_index_load_memory_with (the same with flags 0).
+ * @return as amscr_index_load_memory_with.
  * Ownership: caller frees *out with amscr_index_free; buf is not kept.
  * Thread-safety: reentrant.
  * @since 0.4
@@ -2696,8 +2699,16 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory(const void *buf, 
 #define AMSCR_INDEX_LAZY 1u
 
 /**
- * @brief amscr_index_load with flags (0 or AMSCR_INDEX_LAZY).
- * @return as amscr_index_load; AMSCR_E_INVALID_ARG for an unknown flag.
+ * @brief Reads an index file (amscr_index_save) with flags 0 or AMSCR_INDEX_LAZY. The file is
+ *        mapped read-only where the system can map it, while it is read (for the index's
+ *        lifetime with AMSCR_INDEX_LAZY): replace an index file by renaming, as
+ *        amscr_index_save does, not by rewriting it in place. Every earlier format version
+ *        loads; a file that lacks the channel features has them built from its shapes. A
+ *        collection file without an index (amscr_db_save) and index files of an older,
+ *        separate format are AMSCR_E_FORMAT with a detail saying to build the index again.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, an unknown flag); AMSCR_E_IO; AMSCR_E_LIMIT;
+ *         AMSCR_E_FORMAT (wrong magic, version, checksum, truncated or inconsistent
+ *         content); AMSCR_E_NOMEM.
  * Ownership: caller frees *out with amscr_index_free.
  * Thread-safety: reentrant.
  * @since 0.4
@@ -2705,8 +2716,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory(const void *buf, 
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index **out);
 
 /**
- * @brief amscr_index_load_memory with flags (0 or AMSCR_INDEX_LAZY).
- * @return as amscr_index_load_memory; AMSCR_E_INVALID_ARG for an unknown flag.
+ * @brief Deserializes a buffer made by amscr_index_save_memory (or an index file's bytes) with
+ *        flags 0 or AMSCR_INDEX_LAZY; formats as amscr_index_load_with.
+ * @return as amscr_index_load_with, without AMSCR_E_IO.
  * Ownership: caller frees *out with amscr_index_free; buf is not kept.
  * Thread-safety: reentrant.
  * @since 0.4
