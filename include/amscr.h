@@ -52,10 +52,11 @@ extern "C" {
  * Ownership.   Functions whose names contain _new, _copy, _read, _parse or
  *              _load, and amscr_register, amscr_register_contours,
  *              amscr_contour_from_mask, amscr_contours_from_mask,
- *              amscr_contour_from_image, amscr_contours_from_image and
- *              amscr_db_save_memory, hand the caller something to free: an object
- *              with its own amscr_<obj>_free() (each accepts NULL), or for
- *              amscr_db_save_memory a buffer for amscr_free(). Every other pointer
+ *              amscr_contour_from_image, amscr_contours_from_image,
+ *              amscr_index_build, amscr_db_save_memory and amscr_index_save_memory,
+ *              hand the caller something to free: an object with its own
+ *              amscr_<obj>_free() (each accepts NULL), or for the two _save_memory
+ *              calls a buffer for amscr_free(). Every other pointer
  *              returned is borrowed: valid until its owner is freed or
  *              modified. Inputs are copied when kept; the caller keeps its buffers.
  *
@@ -64,10 +65,11 @@ extern "C" {
  *      (the only global is the thread-local error detail).
  *   2. A non-const object is used by one thread at a time.
  *   3. Objects passed as `const` (amscr_params, amscr_contour, amscr_contour_set,
- *      amscr_descriptor, a finished amscr_db, fitted amscr_kmeans/amscr_gmm1d,
- *      amscr_result) may be shared by any number of threads. Adding to a db while
- *      another thread queries it is not allowed. Bindings that release their
- *      interpreter lock during calls (Python's cffi) rely on these laws.
+ *      amscr_descriptor, a finished amscr_db or amscr_index, fitted
+ *      amscr_kmeans/amscr_gmm1d, amscr_result) may be shared by any number of threads.
+ *      Adding to a db or an index while another thread queries it is not allowed.
+ *      Bindings that release their interpreter lock during calls (Python's cffi)
+ *      rely on these laws.
  *   Each call below says which applies: "safe" (no object, or a static one),
  *   "const" (reads its objects: law 3), "exclusive on X" (modifies X: law 2),
  *   "reentrant" (creates a new object from shared inputs).
