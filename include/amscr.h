@@ -52,10 +52,11 @@ extern "C" {
  * Ownership.   Functions whose names contain _new, _copy, _read, _parse or
  *              _load, and amscr_register, amscr_register_contours,
  *              amscr_contour_from_mask, amscr_contours_from_mask,
- *              amscr_contour_from_image, amscr_contours_from_image and
- *              amscr_db_save_memory, hand the caller something to free: an object
- *              with its own amscr_<obj>_free() (each accepts NULL), or for
- *              amscr_db_save_memory a buffer for amscr_free(). Every other pointer
+ *              amscr_contour_from_image, amscr_contours_from_image,
+ *              amscr_index_build, amscr_db_save_memory and amscr_index_save_memory,
+ *              hand the caller something to free: an object with its own
+ *              amscr_<obj>_free() (each accepts NULL), or for the two _save_memory
+ *              calls a buffer for amscr_free(). Every other pointer
  *              returned is borrowed: valid until its owner is freed or
  *              modified. Inputs are copied when kept; the caller keeps its buffers.
  *
@@ -64,10 +65,11 @@ extern "C" {
  *      (the only global is the thread-local error detail).
  *   2. A non-const object is used by one thread at a time.
  *   3. Objects passed as `const` (amscr_params, amscr_contour, amscr_contour_set,
- *      amscr_descriptor, a finished amscr_db, fitted amscr_kmeans/amscr_gmm1d,
- *      amscr_result) may be shared by any number of threads. Adding to a db while
- *      another thread queries it is not allowed. Bindings that release their
- *      interpreter lock during calls (Python's cffi) rely on these laws.
+ *      amscr_descriptor, a finished amscr_db or amscr_index, fitted
+ *      amscr_kmeans/amscr_gmm1d, amscr_result) may be shared by any number of threads.
+ *      Adding to a db or an index while another thread queries it is not allowed.
+ *      Bindings that release their interpreter lock during calls (Python's cffi)
+ *      rely on these laws.
  *   Each call below says which applies: "safe" (no object, or a static one),
  *   "const" (reads its objects: law 3), "exclusive on X" (modifies X: law 2),
  *   "reentrant" (creates a new object from shared inputs).
@@ -101,9 +103,9 @@ extern "C" {
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
 
-/** Largest image side accepted by amscr_contour_from_mask (pixels). @since 0.1 */
+/** Largest image side accepted by the tracing calls (pixels). @since 0.1 */
 #define AMSCR_MAX_IMAGE_SIDE 32768
-/** Largest number of pixels accepted by amscr_contour_from_mask. @since 0.1 */
+/** Largest number of pixels accepted by the tracing calls. @since 0.1 */
 #define AMSCR_MAX_IMAGE_PIXELS 268435456u /* 2^28 */
 /** Largest number of points in a contour. @since 0.1 */
 #define AMSCR_MAX_POINTS 16777216u /* 2^24 */
@@ -163,7 +165,7 @@ typedef struct amscr_db amscr_db;
 typedef struct amscr_kmeans amscr_kmeans;
 /** A 1-D Gaussian mixture (amscr_gmm1d_new). @since 0.1 */
 typedef struct amscr_gmm1d amscr_gmm1d;
-/** A list of contours with their hierarchy (amscr_contours_from_mask). @since 0.2 */
+/** A list of contours with their hierarchy (amscr_contours_from_image). @since 0.2 */
 typedef struct amscr_contour_set amscr_contour_set;
 
 /**
@@ -352,6 +354,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_write_text(const amscr_cont
  * components are dropped; shapes touching the border are handled (the image is treated as
  * padded with background). The result is the sequence of boundary pixel centres (x = column,
  * y = row) with positive signed area (counter-clockwise in a y-up frame), no repeated point.
+ * Prefer amscr_contour_from_image (8/16 bits, sub-pixel; AMSCR_TRACE_PIXEL_CHAIN at level T + 0.5 is this call).
  *
  * @param[in] pixels  width*height bytes, rows `stride` bytes apart.
  * @param[in] width, height  1..AMSCR_MAX_IMAGE_SIDE, width*height <= AMSCR_MAX_IMAGE_PIXELS.
@@ -384,6 +387,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_from_mask(const uint8_t *pi
  * of their first pixel, so a parent comes before its children. A contour is kept when it has
  * at least 3 points, its polygon area (pixels^2) is >= min_area and its parent is kept;
  * contours of no area (single pixels, lines) are always dropped.
+ * Prefer amscr_contours_from_image (8/16 bits, sub-pixel; AMSCR_TRACE_PIXEL_CHAIN at level T + 0.5 is this call).
  *
  * @param[in] pixels, width, height, stride, threshold  as amscr_contour_from_mask.
  * @param[in] min_area  pixels^2, >= 0 and finite (0 keeps every contour with an area).
@@ -489,7 +493,7 @@ AMSCR_API double amscr_contour_set_area(const amscr_contour_set *s, size_t i);
  *                   pixels as amscr_contour_from_mask's threshold T); negative
  *                   (AMSCR_LEVEL_AUTO): halfway between the medians of the two classes
  *                   of Otsu's split.
- * @param[in] flags  0 (sub-pixel), AMSCR_TRACE_PIXEL_CHAIN, and/or AMSCR_TRACE_JOIN (since 0.5).
+ * @param[in] flags  0 (sub-pixel), AMSCR_TRACE_PIXEL_CHAIN, and/or AMSCR_TRACE_JOIN.
  * @param[out] out  new contour.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, empty image, bad stride, bits, level or
  *         flags); AMSCR_E_LIMIT; AMSCR_E_NOT_FOUND (no foreground, or foreground
@@ -1089,9 +1093,10 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_new(amscr_params **out);
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_new_registration(amscr_params **out);
 
 /**
- * @brief The retrieval preset, for amscr_db_retrieval_matrix: the defaults with reflections
- *        on, channel weight 1 (the shape channel alone) and re-ranking with k = 8 neighbours
- *        (10 iterations).
+ * @brief The retrieval preset, for amscr_db_retrieval_matrix and amscr_index_build: the
+ *        defaults with reflections on, channel weight 1 (the shape channel alone), affine-view
+ *        factor 2, and re-ranking with k = 8 neighbours (10 iterations) on the retrieval
+ *        distance's graph and the inner distance's (share 0.1, closing 0.04).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL out); AMSCR_E_NOMEM.
  * Ownership: caller frees *out with amscr_params_free.
  * Thread-safety: safe.
@@ -1417,7 +1422,7 @@ AMSCR_API int amscr_params_get_partial(const amscr_params *p);
  *        It applies when both descriptors keep their input points (amscr_descriptor_new keeps
  *        up to 4096 of them, 64 KiB, under affine invariance; descriptors in or loaded from a
  *        collection keep none), the target is closed and the invariance is affine. With the
- *        polish and the "despike" stage on (amscr_params_set_stage; opt-in since 0.5),
+ *        polish and the "despike" stage on (amscr_params_set_stage; off by default),
  *        amscr_descriptor_new also drops isolated stray points of contours of 32 or more
  *        points. The distance is not changed by the polish.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
@@ -1439,12 +1444,12 @@ AMSCR_API int amscr_params_get_polish(const amscr_params *p);
 /**
  * @brief Switches an optional stage of amscr_register on or off by name: "despike" (stray
  *        points dropped when a shape is prepared with the polish on), "recovery" (fragments
- *        placed as further starts when part of the target is missing), "polish" (as
- *        amscr_params_set_polish; both must be on), "order" and "even_spacing" (the polish's
- *        steps on markedly noisy points). Default in every preset: recovery and polish on;
- *        despike, order and even_spacing off (opt-in since 0.5: they changed no map of the
- *        traced-image benchmark; they help point lists with stray points or synthetic noise,
- *        docs/results-registration.md). A stage switched on still runs only when its
+ *        placed as further starts when part of the target is missing), "polish" (both this
+ *        switch and amscr_params_set_polish must be on; prefer amscr_params_set_polish, as
+ *        this one is on by default), "order" and "even_spacing" (the polish's steps on
+ *        markedly noisy points). Default in every preset: recovery and polish on; despike,
+ *        order and even_spacing off (switch them on for point lists with stray points or
+ *        synthetic noise; docs/method.md §11). A stage switched on still runs only when its
  *        condition holds (amscr_result_stage).
  * @param on  1 on, 0 off.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, unknown or mandatory stage, on not 0 or 1).
@@ -1548,10 +1553,10 @@ AMSCR_API double amscr_params_get_channel_affine_share(const amscr_params *p);
 
 /**
  * @brief Sets the half width of the channel's dynamic-programming band, as a fraction of N
- *        in (0, 0.5] (default 0.15: 19 samples at N = 128; 0.08 before 0.6): how far the
- *        correspondence may stray from the best cyclic shift, i.e. how much articulation
- *        (a part bent or stretched along the curve) the channel forgives. With the
- *        similarity frame and an affine share, the whitened frame has its own band
+ *        in (0, 0.5] (default 0.15: 19 samples at N = 128): how far the correspondence may
+ *        stray from the best cyclic shift, i.e. how much articulation (a part bent or
+ *        stretched along the curve) the channel forgives. With the similarity frame and an
+ *        affine share, the whitened frame has its own band
  *        (amscr_params_set_channel_affine_band).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
@@ -1572,11 +1577,9 @@ AMSCR_API double amscr_params_get_channel_band(const amscr_params *p);
 /**
  * @brief Sets the band of the channel's whitened frame when it is the second frame (the
  *        similarity frame with an affine share > 0), as a fraction of N in (0, 0.5]
- *        (default 0.08). That frame is there for affine views, not articulation: a band
- *        as wide as the similarity frame's changes no measured score there and costs
- *        time (docs/results-retrieval.md). Set it equal to amscr_params_set_channel_band's
- *        value for the settings before 0.6 (0.08 both). A collection file saved before 0.6
- *        loads with the two bands equal, as it was computed.
+ *        (default 0.08: that frame serves affine views rather than articulation, and a
+ *        channel distance's time grows with the band). A file that holds one band for both
+ *        frames loads with this one equal to amscr_params_set_channel_band's.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -1636,7 +1639,7 @@ AMSCR_API double amscr_params_get_channel_locality(const amscr_params *p);
  * @brief Sets the neighbours of the context re-ranking in amscr_db_retrieval_matrix,
  *        0..1000; 0 = no re-ranking (default 0; 8 in the retrieval preset). A collection of
  *        n shapes uses K = min(k, max(1, n / 2)): neighbourhoods that cover the collection
- *        carry no context and flatten every score (since 0.6; min(k, n) before).
+ *        carry no context and flatten every score.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -1677,10 +1680,10 @@ AMSCR_API unsigned amscr_params_get_rerank_iterations(const amscr_params *p);
  *        retrieval distance; with a share s > 0 it diffuses over (1 - s) times that graph
  *        plus s times the kNN graph of the inner distance (the shortest path inside the
  *        shape between two boundary points, which a part bent at a joint hardly changes),
- *        so neighbours both distances agree on reinforce each other. It costs under a tenth
- *        of the channel's time and changes nothing without re-ranking. An index holds both
- *        graphs (since 0.8; an index of 0.7 re-ranked on the first alone, its collection's
- *        share 0). Set 0 for the ranking before 0.7.
+ *        so neighbours both distances agree on reinforce each other. It adds one inner
+ *        distance per pair the channel compares (a small part of the channel's time) and
+ *        changes nothing without re-ranking. An index holds both graphs; an index file that
+ *        holds one graph loads with share 0.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (outside [0, 1), NaN).
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -1706,11 +1709,11 @@ AMSCR_API double amscr_params_get_rerank_inner_share(const amscr_params *p);
  *        parts and wider inlets stay. A cut that reaches the outline then changes the inner
  *        distance as little as it changes the shape. Only the inner-distance graph uses it
  *        (amscr_params_set_rerank_inner_share); a curve that bounds no area is taken as it
- *        is. The outline is made from the whole contour when a shape is prepared with c > 0
- *        (about 1 ms) and kept with it; a shape prepared with another value is closed from
- *        its N samples instead, which on a long slotted outline approximates it poorly.
- *        Set 0 for the ranking before 0.9. Collection and index files keep the value and the
- *        outlines; files written before 0.9 load with 0.
+ *        is. The outline (64 points, 1 KB) is made from the whole contour when a shape is
+ *        prepared with c > 0 and kept with it; a shape prepared with another value is closed
+ *        from its N samples instead, which on a long slotted outline approximates it poorly.
+ *        Collection and index files keep the value and the outlines; a file without them
+ *        loads with 0.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (outside [0, 1], NaN).
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -1735,9 +1738,9 @@ AMSCR_API double amscr_params_get_inner_closing(const amscr_params *p);
  *        min(m, f d_affine). An affine view of a shape (a photograph at an angle, a sheared or
  *        stretched copy) is far nearer in the whitened frame than in the similarity frame and
  *        is then ranked by the whitened frame; any other pair keeps the mix. 0 (the default)
- *        keeps the mix for every pair, the rule before 0.11; 2 in the retrieval preset. With
- *        one frame (share 0 or 1, or the affine frame) it changes nothing.
- *        Collection and index files keep the value; files written before 0.11 load with 0.
+ *        keeps the mix for every pair; 2 in the retrieval preset. With one frame (share 0 or
+ *        1, or the affine frame) it changes nothing. Collection and index files keep the
+ *        value; a file without it loads with 0.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (not 0 and outside [1, 100], NaN).
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -2363,6 +2366,7 @@ AMSCR_API void amscr_db_free(amscr_db *db);
 
 /**
  * @brief Prepares a contour with the db's params and stores it with a label.
+ * Prefer amscr_db_add_contours (many at once on the db's threads, all or nothing; n = 1 is this call).
  * @param[out] out_index  index of the new shape (may be NULL).
  * @return AMSCR_OK; as amscr_descriptor_new.
  * Ownership: none (the contour is not kept).
@@ -2490,6 +2494,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_cross_distances(const amscr_db *
  * @brief The n x n matrix of shape-channel distances (amscr_channel_distance; symmetric, zero
  *        diagonal, d(i, j) for i < j in both cells), on the db's threads; the result does not
  *        depend on the thread count. NaN on failure as amscr_db_query.
+ * Prefer amscr_db_retrieval_matrix (channel weight 1, rerank_k 0: this matrix over its median, the same ranking).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, open curves); AMSCR_E_CANCELLED; AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: const.
@@ -2517,9 +2522,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_retrieval_matrix(const amscr_db 
 
 /**
  * @brief Writes the prepared collection (versioned little-endian binary format with a
- *        checksum, 4 + 8 * (12 + 4N + 2Np) bytes per shape; version 5 since 0.6, 2 before,
- *        and every earlier version loads) to a temporary name in the same folder and renames
- *        it.
+ *        checksum, 4 + 8 * (12 + 4N + 2Np) bytes per shape, 1 KB more when the params close
+ *        the inner distance's silhouette) to a temporary name in the same folder and renames
+ *        it; amscr_db_load reads it and every earlier format version.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: const.
@@ -2528,7 +2533,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_retrieval_matrix(const amscr_db 
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_save(const amscr_db *db, const char *path);
 
 /**
- * @brief Reads a saved collection.
+ * @brief Reads a saved collection file of any format version (of an index file: its collection).
+ * Prefer amscr_index_load_with for an index file (this call reads only its collection).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_LIMIT (file too large);
  *         AMSCR_E_FORMAT (wrong magic, newer version, bad checksum, truncated); AMSCR_E_NOMEM.
  * Ownership: caller frees *out with amscr_db_free.
@@ -2549,6 +2555,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_save_memory(const amscr_db *db, 
 
 /**
  * @brief Deserializes a buffer made by amscr_db_save_memory (or a file's bytes).
+ * Prefer amscr_index_load_memory_with for an index's bytes (this call reads only its collection).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_FORMAT (as amscr_db_load); AMSCR_E_NOMEM.
  * Ownership: caller frees *out with amscr_db_free; buf is not kept.
  * Thread-safety: reentrant.
@@ -2559,12 +2566,13 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
 /**
  * @brief One query's retrieval scores against a collection: exactly the query's row of
  *        amscr_db_retrieval_matrix computed on the collection plus the query (the query last;
- *        its collection columns), without the collection's matrix in memory when the channel
- *        weight is 0 or 1: the collection's neighbour lists are built once for the call (as
- *        amscr_index_build) and the query's re-ranked row is computed from them. With a channel
- *        weight strictly between 0 and 1 the fusion's medians move with the query, and the call
- *        computes the matrix of the collection plus the query. To query a collection many
- *        times, build an amscr_index once instead.
+ *        its collection columns).
+ * Cost: with a channel weight strictly between 0 and 1 (the fusion's medians move with the
+ *       query), the matrix of the collection plus the query: (n + 1)^2 pair distances and
+ *       doubles; otherwise, with re-ranking, the collection's neighbour lists as
+ *       amscr_index_build with candidates 0 makes them, on every call: n^2 pair distances,
+ *       n^2 doubles of scratch; without re-ranking, n pair distances.
+ * Prefer amscr_index_query_scores on an index built once (candidates 0, channel weight 0 or 1: the same scores).
  * @param[in]  q  a shape prepared with params compatible with the collection's.
  * @param[in]  progress, user  optional progress callback (may be NULL).
  * @param[out] out_scores  n scores, lower is better (see amscr_db_retrieval_matrix).
@@ -2594,25 +2602,30 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_query_retrieval(const amscr_db *
 typedef struct amscr_index amscr_index;
 
 /**
- * @brief Builds the index of a collection (its params say the retrieval: channel weight,
- *        re-ranking k and iterations): a copy of the shapes, a signature per shape, and each
- *        shape's K (amscr_params_set_rerank_k: min(rerank_k, max(1, n / 2)); an index file of
- *        0.5 holds min(rerank_k, n)) nearest shapes under the base distance of
- *        amscr_db_retrieval_matrix (the fused distance before re-ranking), with the fusion's
- *        medians and the largest distance; when the params give the inner distance's graph a
- *        share (amscr_params_set_rerank_inner_share), also each shape's inner features (about
- *        17 KB in memory, 8.7 KB in the file) and its K nearest shapes under the inner
- *        distance. candidates 0 computes the whole base matrix (and inner matrix: the lists
- *        are exact: a query then gives exactly amscr_db_query_retrieval's scores);
- *        candidates M > 0 seeks each shape's neighbours among its min(M, 192)
- *        signature-nearest shapes only (O(n M) distances, for large collections; at least
- *        K - 1; fused medians estimated on 256 shapes; from 20,000 shapes each shortlist is
- *        sought among the shapes of the signature clusters nearest it, so it may miss a few
- *        of the nearest), then among its neighbours' neighbours; the inner distance's among
- *        the same shortlist and its base neighbours, then its inner neighbours' neighbours.
- *        Runs on the params' threads; the result does not depend on the thread count.
+ * @brief Builds the retrieval index of a collection for the retrieval its params say
+ *        (channel weight, re-ranking k and iterations, inner-distance share): a copy of the
+ *        shapes with their channel features and signatures, and each shape's K nearest shapes
+ *        (K as amscr_params_set_rerank_k) under the base distance of amscr_db_retrieval_matrix
+ *        (the fused distance before re-ranking), with the fusion's medians and the largest
+ *        distance; when the inner distance's graph has a share
+ *        (amscr_params_set_rerank_inner_share), also each shape's inner features and its K
+ *        nearest shapes under the inner distance.
+ *        candidates 0: every pair is matched and the lists are exact (a query with
+ *        candidates 0 then gives exactly amscr_db_query_retrieval's scores).
+ *        candidates M > 0, for large collections: each shape's lists are sought among a
+ *        shortlist of at most M (at least K - 1) signature-nearest shapes and then among its
+ *        neighbours' neighbours, so they may miss a few of the exact nearest; with a channel
+ *        weight strictly between 0 and 1 the fusion's medians come from a sample of the
+ *        shapes (docs/collections.md, "The index file").
+ * Cost: candidates 0: n^2 pair distances; M > 0: O(n (M + K^2)) pair distances.
+ * Memory: the index holds the collection's copy, the features, about 24 bytes a listed
+ *         neighbour and, with the inner graph, about 17 KB of inner features a shape; the
+ *         build's scratch is n^2 doubles with candidates 0, at most 12 n M bytes with M.
+ * Threads: amscr_params_set_num_threads of the db's params; the index is the same for any
+ *          thread count.
  * @param[in]  db  the collection (copied; may be freed afterwards).
- * @param[in]  candidates  0, or the shortlist size M.
+ * @param[in]  candidates  0, or the shortlist size M (AMSCR_INDEX_CANDIDATES is the
+ *                         recommended one).
  * @param[in]  progress, user  optional progress callback (may be NULL).
  * @param[out] out  the new index.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, open curves with a channel weight);
@@ -2770,13 +2783,12 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_set_group(amscr_index *x, siz
 AMSCR_API const char *amscr_index_group(const amscr_index *x, size_t i);
 
 /**
- * @brief Writes the index (the collection file format, version 9 since 0.8, 8 in 0.7, 6 in
- *        0.6, 4 in 0.5, 3 in 0.4: amscr_db_load of it gives the collection; versions 4 and up
- *        also store each shape's channel features, so a load does not rebuild them; 6 adds the
- *        whitened frame's band to the settings, 8 the inner distance's share, 9 the inner
- *        distance's graph: its lists and each shape's inner features) to a temporary name in
- *        the same folder and renames it. Every earlier version loads (one of 0.7 re-ranks on
- *        one graph, as it did).
+ * @brief Writes the index to a temporary name in the same folder and renames it: the
+ *        collection file format (amscr_db_load of it gives the collection) with an index
+ *        section holding the lists, each shape's channel features (so a load does not rebuild
+ *        them) and, with the inner graph, each shape's inner features (about 8.7 KB) and its
+ *        lists; amscr_index_load_with reads it and every earlier format version
+ *        (docs/collections.md).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none. Thread-safety: const.
  * @since 0.4
@@ -2794,13 +2806,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_save_memory(const amscr_index
                                                                size_t *out_len);
 
 /**
- * @brief Reads an index file (mapped read-only while it is read, where the system can map
- *        it: replace an index file by renaming, as amscr_index_save does, not by rewriting it
- *        in place). Index files of format 3 (0.4) load too, their channel features built from
- *        the shapes. A collection file without an index (amscr_db_save) and the index files of
- *        the tool before 0.4 are AMSCR_E_FORMAT with a detail saying to build the index again.
- * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_LIMIT; AMSCR_E_FORMAT (wrong
- *         magic, version, checksum, truncated or inconsistent content); AMSCR_E_NOMEM.
+ * @brief Reads an index file: amscr_index_load_with with flags 0.
+ * Prefer amscr_index_load_with (the same with flags 0; AMSCR_INDEX_LAZY for a few queries).
+ * @return as amscr_index_load_with.
  * Ownership: caller frees *out with amscr_index_free.
  * Thread-safety: reentrant.
  * @since 0.4
@@ -2808,26 +2816,35 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_save_memory(const amscr_index
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load(const char *path, amscr_index **out);
 
 /**
- * @brief Deserializes a buffer made by amscr_index_save_memory (or an index file's bytes).
- * @return as amscr_index_load (no AMSCR_E_IO).
+ * @brief Deserializes an index from memory: amscr_index_load_memory_with with flags 0.
+ * Prefer amscr_index_load_memory_with (the same with flags 0).
+ * @return as amscr_index_load_memory_with.
  * Ownership: caller frees *out with amscr_index_free; buf is not kept.
  * Thread-safety: reentrant.
  * @since 0.4
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out);
 
-/** Load flag: the shapes' channel features are not made ready at load (format 4: their
- *  spectra, from the stored heights; format 3: the features); each query computes those of the
- *  candidates it matches (for one or a few queries a load, e.g. a command-line search); without
- *  it a load computes every shape's once, on the params' threads (for many queries). A lazy load
+/** Load flag: the shapes' channel features are not made ready at load; each query computes
+ *  those of the candidates it matches (for one or a few queries a load, e.g. a command-line
+ *  search); without it a load makes every shape's ready once, on the params' threads (for many
+ *  queries: it costs an FFT a shape, or the features of a file without them). A lazy load
  *  of a file (amscr_index_load_with) also maps the file and decodes each prepared shape when it
  *  is first read (every shape is still checked at load, so the same files are refused). Scores
  *  are the same either way. @since 0.4 */
 #define AMSCR_INDEX_LAZY 1u
 
 /**
- * @brief amscr_index_load with flags (0 or AMSCR_INDEX_LAZY).
- * @return as amscr_index_load; AMSCR_E_INVALID_ARG for an unknown flag.
+ * @brief Reads an index file (amscr_index_save) with flags 0 or AMSCR_INDEX_LAZY. The file is
+ *        mapped read-only where the system can map it, while it is read (for the index's
+ *        lifetime with AMSCR_INDEX_LAZY): replace an index file by renaming, as
+ *        amscr_index_save does, not by rewriting it in place. Every earlier format version
+ *        loads; a file that lacks the channel features has them built from its shapes. A
+ *        collection file without an index (amscr_db_save) and index files of an older,
+ *        separate format are AMSCR_E_FORMAT with a detail saying to build the index again.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, an unknown flag); AMSCR_E_IO; AMSCR_E_LIMIT;
+ *         AMSCR_E_FORMAT (wrong magic, version, checksum, truncated or inconsistent
+ *         content); AMSCR_E_NOMEM.
  * Ownership: caller frees *out with amscr_index_free.
  * Thread-safety: reentrant.
  * @since 0.4
@@ -2835,8 +2852,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory(const void *buf, 
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index **out);
 
 /**
- * @brief amscr_index_load_memory with flags (0 or AMSCR_INDEX_LAZY).
- * @return as amscr_index_load_memory; AMSCR_E_INVALID_ARG for an unknown flag.
+ * @brief Deserializes a buffer made by amscr_index_save_memory (or an index file's bytes) with
+ *        flags 0 or AMSCR_INDEX_LAZY; formats as amscr_index_load_with.
+ * @return as amscr_index_load_with, without AMSCR_E_IO.
  * Ownership: caller frees *out with amscr_index_free; buf is not kept.
  * Thread-safety: reentrant.
  * @since 0.4
