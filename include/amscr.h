@@ -1781,7 +1781,7 @@ typedef enum amscr_ranking {
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_ranking(const amscr_params *p, amscr_ranking *out_ranking);
 
-/* ----------------------------------------------- every option by key (since 0.13) */
+/* ----------------------------------------------------------- every option by key */
 
 /**
  * Option keys of the keyed calls amscr_params_set_int / _set_real / _get_int / _get_real /
