@@ -10,7 +10,7 @@
 #include <time.h>
 
 #include "channel.h"
-#include "../tools/cli/collection.h"
+#include "collection.h"
 
 const raw_cfg RAW_DEFAULT = {128, 0.08, 1.0, 4.0, 1, 1};
 const post_cfg POST_DEFAULT = {0.2, 1.0, 8, 10, 0.0, 0, 0.0, 0, 0, 0, 0, 0.05};

@@ -10,7 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "../tools/cli/collection.h"
+#include "collection.h"
 
 static int fold_idx(const folds_data *fd, int which, size_t *idx)
 {

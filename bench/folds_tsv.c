@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "folds_tsv.h"
-#include "../tools/cli/collection.h"
+#include "collection.h"
 
 /* Fold (0 A, 1 B) of every class of the manifest from folds.tsv beside it; -1 without it. */
 int folds_tsv_read(const char *manifest, int32_t *fold_of_class, size_t cap)

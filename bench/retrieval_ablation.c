@@ -25,7 +25,7 @@
 #include "internal.h"
 #include "folds_tsv.h"
 #include "mcd_set.h"
-#include "../tools/cli/collection.h"
+#include "collection.h"
 
 enum { M_AMSCR, M_SIM, M_AFF, M_INNER, M_INNER_OPEN, NBASE };
 

@@ -40,7 +40,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "../tools/cli/image.h"
+#include "image.h"
 #include "folds_tsv.h"
 #include "inner.h"
 #include "internal.h"

@@ -9,8 +9,8 @@
  *   --refine R, --band B, --skip S, --loc L, --weight W (channel weight in the fusion; 0 = AMSCR
  *   only, -1 = channel only), --k K, --iters T, --both, --threads T, --fuse median|knn. */
 #include "channel.h"
-#include "../tools/cli/collection.h"
-#include "../tools/cli/image.h"
+#include "collection.h"
+#include "image.h"
 #include "mcd_set.h"
 
 #include <math.h>
