@@ -1,11 +1,10 @@
-/* folds_tsv.c — mpeg7-dev's class folds (folds.tsv beside its manifest), for the benchmarks
- * that score fold A and fold B as collections of their own, and the seeded shuffle of classes
- * that draws the probes' random class halves and subsets. */
+/* folds_tsv.c — mpeg7-dev's class folds (folds.tsv beside its manifest), for the ablation,
+ * which scores fold A and fold B as collections of their own. */
 #include <stdio.h>
 #include <string.h>
 
 #include "folds_tsv.h"
-#include "../tools/cli/collection.h"
+#include "collection.h"
 
 /* Fold (0 A, 1 B) of every class of the manifest from folds.tsv beside it; -1 without it. */
 int folds_tsv_read(const char *manifest, int32_t *fold_of_class, size_t cap)
@@ -33,18 +32,4 @@ int folds_tsv_read(const char *manifest, int32_t *fold_of_class, size_t cap)
     fclose(f);
     collection_free(&col);
     return 0;
-}
-
-void folds_shuffle(int *perm, int L, unsigned long long *seed)
-{
-    for (int c = 0; c < L; c++)
-        perm[c] = c;
-    for (int c = L - 1; c > 0; c--) {
-        *seed ^= *seed >> 12;
-        *seed ^= *seed << 25;
-        *seed ^= *seed >> 27;
-        int r = (int)((*seed * 2685821657736338717ull >> 33) % (unsigned long long)(c + 1)), t = perm[c];
-        perm[c] = perm[r];
-        perm[r] = t;
-    }
 }

@@ -1,4 +1,4 @@
-/* folds_tsv.h — mpeg7-dev's class folds and random class splits (folds_tsv.c). */
+/* folds_tsv.h — mpeg7-dev's class folds (folds_tsv.c). */
 #ifndef AMSCR_BENCH_FOLDS_TSV_H
 #define AMSCR_BENCH_FOLDS_TSV_H
 #include <stddef.h>
@@ -7,8 +7,5 @@
 /* fold_of_class[k] (0 fold A, 1 fold B) for every class k of the manifest (in the manifest's
  * class order, k < cap), from folds.tsv beside it: 0, or -1 without it. */
 int folds_tsv_read(const char *manifest, int32_t *fold_of_class, size_t cap);
-/* perm = a seeded random permutation of 0..L-1 (xorshift64*, Fisher-Yates): the random class
- * halves and subsets of the probes. */
-void folds_shuffle(int *perm, int L, unsigned long long *seed);
 
 #endif

@@ -6,8 +6,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "../tools/cli/collection.h"
-#include "../tools/cli/image.h"
+#include "collection.h"
+#include "image.h"
 
 /* xorshift64*: uniform in [0, 1) */
 static double urand(unsigned long long *s)

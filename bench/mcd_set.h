@@ -1,5 +1,5 @@
-/* mcd_set.h — the MCD-style affine set, shared by the benchmark, the experiment
- * driver and its test: one contour of every class of a labelled collection (its first listed
+/* mcd_set.h — the MCD-style affine set of the retrieval, index and signature benchmarks
+ * and the retrieval_mcd test: one contour of every class of a labelled collection (its first listed
  * shape) x MCD_COPIES random affine copies (any rotation, axis scales x0.5-2 log-uniform,
  * shear +-0.5, 0.5 % Gaussian noise of the RMS radius per coordinate), from a seeded
  * xorshift64* generator: the same set on every machine. */

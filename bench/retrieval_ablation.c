@@ -11,8 +11,7 @@
  * graph at the row's share: 0.1 in the default, 0.05 before 0.12). A row's time is the wall time of the base
  * matrices it needs plus its fusion and re-ranking (decode, trace and preparation are listed
  * once per set). With mpeg7-dev/folds.tsv, two more columns: each class fold of mpeg7-dev as its
- * own collection (sub-matrices of mpeg7-dev's base matrices; the generalization audit in
- * docs/results-retrieval.md). */
+ * own collection (sub-matrices of mpeg7-dev's base matrices; why the folds: docs/decisions.md). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,7 +24,7 @@
 #include "internal.h"
 #include "folds_tsv.h"
 #include "mcd_set.h"
-#include "../tools/cli/collection.h"
+#include "collection.h"
 
 enum { M_AMSCR, M_SIM, M_AFF, M_INNER, M_INNER_OPEN, NBASE };
 

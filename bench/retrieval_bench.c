@@ -20,10 +20,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "internal.h"
 #include "mcd_set.h"
-#include "../tools/cli/collection.h"
-#include "../tools/cli/shape_db.h"
+#include "collection.h"
+#include "load_db.h"
 
 static double now(void)
 {
@@ -130,7 +129,7 @@ static void time_tool(const char *manifest)
         die("params");
     double t0 = now();
     amscr_db *db = NULL;
-    if (load_db(p, &a, TOOL_THRESHOLD_DEFAULT, &db) != 0)
+    if (load_db(p, &a, 127 /* the tool's default threshold */, &db) != 0)
         die("load");
     double t1 = now();
     size_t n = a.n;

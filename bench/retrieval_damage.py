@@ -1,8 +1,7 @@
 #!/usr/bin/env python3
 """Collections of damaged silhouettes, made the way damage reaches users' images: a copy of a
 collection (manifest + images) where a share of each class's images is cut or bitten before it
-is traced. For `amscr eval` and the envelope benchmark (`amscr-retrieval-envelope OUT ...` reads
-OUT/NAME/manifest.tsv, so OUT mirrors the datasets folder: mpeg7-dev with its folds.tsv,
+is traced. For `amscr eval` (OUT mirrors the datasets folder: mpeg7-dev with its folds.tsv,
 kimia99, kimia216).
 
 Damage (one kind per damaged image, drawn with the seed):
@@ -16,7 +15,6 @@ Damage (one kind per damaged image, drawn with the seed):
 Usage: .venv/bin/python bench/retrieval_damage.py OUT [--data ../shared/datasets]
        [--share 0.5] [--seed 1] [--sets mpeg7-dev,kimia99,kimia216] [--kinds slots,bite,specks]
 then   build/tools/amscr eval OUT/mpeg7-dev/manifest.tsv            # the library's default
-       AMSCR_ENVELOPE_DUMP=D build/bench/amscr-retrieval-envelope OUT 0.08 --one-frame
 """
 import argparse
 import os

@@ -36,8 +36,8 @@
 #include "affine_warp.h"
 #include "channel.h"
 #include "mcd_set.h"
-#include "../tools/cli/collection.h"
-#include "../tools/cli/image.h"
+#include "collection.h"
+#include "image.h"
 
 enum { OLD_DIM = 24, TOP = 10, NM = 5, NVAR = 5, TIMED = 15 };
 static const size_t MS[NM] = {16, 32, 64, 128, 256};

@@ -7,7 +7,7 @@
 /* registration: the library's registration preset (N 256, 20 refinement iterations: measured
  * in docs/measurements.md). Retrieval (search/matrix/eval): the library's retrieval preset (the shape
  * channel in the similarity frame with 0.2 of the affine frame, re-ranking k 8, 10 iterations,
- * reflections on: docs/results-retrieval.md); the AMSCR distance in it (a channel weight
+ * reflections on: docs/decisions.md); the AMSCR distance in it (a channel weight
  * below 1) is the affine group without refinement, the paper's method. make_params adds the
  * options. */
 static amscr_status base_params(int registration, amscr_params **out)

@@ -1,4 +1,4 @@
-/* load_db.c — a collection's shapes decoded, traced and prepared on threads (see shape_db.h).
+/* load_db.c — a collection's shapes decoded, traced and prepared on threads (see load_db.h).
  *
  * Shapes are handed out in order, one at a time; every thread (the calling one too) decodes
  * and traces its shape and prepares it with amscr_descriptor_new, muted. The calling thread
@@ -6,13 +6,14 @@
  * is the one a loop over the shapes builds. After a failure no new shape is handed out; the
  * first failing shape in order is loaded again on the calling thread, which prints its error
  * as a single-threaded load would: the message does not depend on the thread count. */
-#include "shape_db.h"
+#include "load_db.h"
 
 #include <pthread.h>
 #include <stdlib.h>
 #include <unistd.h>
 
 #include "image.h"
+#include "util.h"
 
 typedef struct {
     const amscr_params *p;

@@ -6,11 +6,8 @@
 #include "amscr.h"
 #include "cli.h"
 #include "collection.h"
+#include "load_db.h"
 
-/* Loads every shape of collection c into a new db (params p), decoding, tracing and preparing
- * on the params' threads (load_db.c; the db is the one a loop over the shapes builds); on
- * failure prints the error naming the first bad file in order and returns -1. */
-int load_db(const amscr_params *p, const collection *c, int threshold, amscr_db **out);
 /* Images of a collection and of a query are traced as `amscr register` traces them: the other
  * large pieces near the largest component (a thin part low resolution or damage broke off) are
  * joined to its outline (AMSCR_TRACE_JOIN; sub-pixel tracing only). Called by search, matrix,
