@@ -2637,6 +2637,23 @@ typedef struct amscr_index amscr_index;
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_build(const amscr_db *db, size_t candidates,
                                                          amscr_progress_fn progress, void *user, amscr_index **out);
 
+/** The largest collection whose index amscr_index_default_candidates builds from every pair:
+ *  up to this size the exact build takes seconds; above it its cost grows as n^2 while a
+ *  shortlist build's grows as n. @since 0.13 */
+#define AMSCR_INDEX_EXACT_MAX 2000
+
+/**
+ * @brief The candidates argument an index of n shapes is built with by default (the tool's
+ *        `amscr index`, Python's amscr.Index): 0 (every pair: exact neighbour lists) for n up to
+ *        AMSCR_INDEX_EXACT_MAX shapes, AMSCR_INDEX_CANDIDATES above (O(n M) distances).
+ * @param[in] n  the collection's size.
+ * @return 0 or AMSCR_INDEX_CANDIDATES; never fails.
+ * Ownership: none.
+ * Thread-safety: pure.
+ * @since 0.13
+ */
+AMSCR_API size_t amscr_index_default_candidates(size_t n);
+
 /**
  * @brief Adds the shapes of a collection (labels kept, unnamed) to the index: each new shape's
  *        list from its base distances to every shape (or to its M signature-nearest, for an

@@ -111,6 +111,16 @@ static void exact_case_share(double w, unsigned k, double share)
 
 static void exact_case(double w, unsigned k) { exact_case_share(w, k, 0.05); }
 
+/* The build's default: every pair up to AMSCR_INDEX_EXACT_MAX shapes, the shortlist above. */
+START_TEST(default_candidates)
+{
+    ck_assert_uint_eq(amscr_index_default_candidates(0), 0);
+    ck_assert_uint_eq(amscr_index_default_candidates(AMSCR_INDEX_EXACT_MAX), 0);
+    ck_assert_uint_eq(amscr_index_default_candidates(AMSCR_INDEX_EXACT_MAX + 1), AMSCR_INDEX_CANDIDATES);
+    ck_assert_uint_eq(amscr_index_default_candidates(SIZE_MAX), AMSCR_INDEX_CANDIDATES);
+}
+END_TEST
+
 START_TEST(exact_channel_rerank) { exact_case(1.0, 8); }
 END_TEST
 START_TEST(exact_amscr_rerank) { exact_case(0.0, 5); }
@@ -944,6 +954,7 @@ Suite *amscr_suite_index(void)
     TCase *tc = tcase_create("index");
     tcase_set_timeout(tc, 600);
     tcase_add_test(tc, knn_select_is_the_sorted_prefix);
+    tcase_add_test(tc, default_candidates);
     tcase_add_test(tc, exact_channel_rerank);
     tcase_add_test(tc, exact_amscr_rerank);
     tcase_add_test(tc, exact_fused_rerank);

@@ -285,3 +285,8 @@ amscr_status amscr_index_set_class_name(amscr_index *x, int32_t label, const cha
     x->classes[label] = s;
     return AMSCR_OK;
 }
+
+size_t amscr_index_default_candidates(size_t n)
+{
+    return n <= AMSCR_INDEX_EXACT_MAX ? 0 : AMSCR_INDEX_CANDIDATES;
+}

@@ -11,7 +11,8 @@
 #include "index_tool.h"
 #include "shape_db.h"
 
-/* A new index of collection c: every pair, or each shape's --candidates M. */
+/* A new index of collection c: every pair, or each shape's --candidates M (default: the library's
+ * for the collection's size). */
 static int build(const opts *o, const collection *c, amscr_index **x)
 {
     amscr_params *p = NULL;
@@ -23,7 +24,8 @@ static int build(const opts *o, const collection *c, amscr_index **x)
     if (load_db(p, c, o->threshold, &db) == 0) {
         tool_progress pr;
         progress_init(&pr, "matching");
-        amscr_status st = amscr_index_build(db, o->candidates_set ? o->candidates : 0, progress_cb, &pr, x);
+        size_t m = o->candidates_set ? o->candidates : amscr_index_default_candidates(amscr_db_size(db));
+        amscr_status st = amscr_index_build(db, m, progress_cb, &pr, x);
         progress_end(&pr);
         if (st != AMSCR_OK)
             tool_lib_error(o->pos[0], st);

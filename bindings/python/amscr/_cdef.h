@@ -14,6 +14,7 @@
 #define AMSCR_TRACE_PIXEL_CHAIN 1
 #define AMSCR_TRACE_JOIN 2
 #define AMSCR_INDEX_CANDIDATES 256
+#define AMSCR_INDEX_EXACT_MAX 2000
 #define AMSCR_INDEX_LAZY 1
 
 typedef enum amscr_status {
@@ -297,6 +298,7 @@ amscr_status amscr_db_load_memory(const void *buf, size_t len, amscr_db **out);
 amscr_status amscr_db_query_retrieval(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress, void *user, double *out_scores, size_t n);
 typedef struct amscr_index amscr_index;
 amscr_status amscr_index_build(const amscr_db *db, size_t candidates, amscr_progress_fn progress, void *user, amscr_index **out);
+size_t amscr_index_default_candidates(size_t n);
 amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progress_fn progress, void *user);
 amscr_status amscr_index_query_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates, double *out_scores, size_t n);
 amscr_status amscr_index_query(const amscr_index *x, const amscr_descriptor *q, size_t candidates, size_t top, size_t *out_idx, double *out_scores, size_t *out_count);

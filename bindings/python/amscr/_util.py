@@ -218,6 +218,17 @@ def matrix_out(fn, *args) -> np.ndarray:
 ProgressArg = Union[bool, Callable[[int, int], Any], None]
 
 
+# progress=None (the default of long builds: Index) shows the bar only once the call has run this long
+AUTO_AFTER = 2.0
+
+
+def _stderr_is_terminal() -> bool:
+    try:
+        return sys.stderr.isatty()
+    except (AttributeError, ValueError):
+        return False
+
+
 class _ProgressState:
     """Per-call state of the C progress callback (see `progress_call`)."""
 
@@ -233,6 +244,11 @@ class _ProgressState:
 
     def update(self, done: int, total: int) -> int:
         p = self.progress
+        if p is None:  # 'auto': a bar once the call has run AUTO_AFTER seconds, on a terminal
+            p = self.progress = (True if time.monotonic() - self.started >= AUTO_AFTER and _stderr_is_terminal()
+                                 else None)
+            if p is None:
+                return 0
         if p is True:
             now = time.monotonic()
             if done >= total or now - self.last >= 0.1:

@@ -39,28 +39,32 @@ class Index:
     matrix. The ``amscr`` tool's ``index``, ``search`` and this class read and write the same
     files.
 
-    ``Index(collection, progress=False, candidates=0)`` builds the index of a
+    ``Index(collection, progress=None, candidates=None)`` builds the index of a
     :class:`Collection` on its threads (the collection is copied). ``candidates=0`` computes the
     whole base matrix (exact lists: a query then ranks exactly as ``collection.query``);
     ``candidates=M`` seeks each shape's neighbours among its M signature-nearest shapes only
-    (large collections). Thread-safety: any number of threads may query at once; :meth:`add`
+    (large collections); the default, None, is exact up to ``AMSCR_INDEX_EXACT_MAX`` (2,000)
+    shapes and ``AMSCR_INDEX_CANDIDATES`` above (C ``amscr_index_default_candidates``). Thread-safety: any number of threads may query at once; :meth:`add`
     waits for them.
 
     Args:
         collection: the shapes and their params (``Params.retrieval()`` for the project's
             retrieval).
-        progress: True for a progress bar on stderr, or a callable(done, total).
-        candidates: 0, or the shortlist size M of a large collection.
+        progress: True for a progress bar on stderr, False for none, a callable(done, total),
+            or None (default): a bar on a terminal's stderr once the build has run 2 s.
+        candidates: None (the default for the collection's size), 0 (every pair), or the
+            shortlist size M.
     Raises:
         InvalidArgumentError: open curves with a channel weight; CancelledError: cancelled.
     """
 
-    def __init__(self, collection: Collection, progress: ProgressArg = False, candidates: int = 0):
+    def __init__(self, collection: Collection, progress: ProgressArg = None, candidates: Optional[int] = None):
         if not isinstance(collection, Collection):
             raise TypeError('collection: expected an amscr.Collection, got %s' % type(collection).__name__)
         out = ffi.new('amscr_index **')
         with collection._lock.read():
-            progress_call(lib.amscr_index_build, (collection._db, int(candidates)), (out,), progress)
+            m = lib.amscr_index_default_candidates(len(collection)) if candidates is None else _candidates(candidates)
+            progress_call(lib.amscr_index_build, (collection._db, int(m)), (out,), progress)
             names = collection._label_names
         self._init(ffi.gc(out[0], lib.amscr_index_free))
         for code, name in enumerate(names or ()):
