@@ -2564,15 +2564,19 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_save_memory(const amscr_db *db, 
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, size_t len, amscr_db **out);
 
 /**
- * @brief One query's retrieval scores against a collection: exactly the query's row of
+ * @brief One query's retrieval scores against a collection: the query's row of
  *        amscr_db_retrieval_matrix computed on the collection plus the query (the query last;
- *        its collection columns).
- * Cost: with a channel weight strictly between 0 and 1 (the fusion's medians move with the
- *       query), the matrix of the collection plus the query: (n + 1)^2 pair distances and
- *       doubles; otherwise, with re-ranking, the collection's neighbour lists as
- *       amscr_index_build with candidates 0 makes them, on every call: n^2 pair distances,
- *       n^2 doubles of scratch; without re-ranking, n pair distances.
- * Prefer amscr_index_query_scores on an index built once (candidates 0, channel weight 0 or 1: the same scores).
+ *        its collection columns; to rounding, ~1e-12). With a channel weight strictly between
+ *        0 and 1 the fusion uses the collection's medians (those of the kept index's build),
+ *        not medians moved by the query.
+ * Cost: without re-ranking and fusion, n pair distances. Otherwise the collection keeps an
+ *       exact index for its queries: the first such call builds it (n^2 pair distances, as
+ *       amscr_index_build with candidates 0), the first call after shapes were added enters
+ *       them (n pair distances a new shape), and each call then costs n pair distances and
+ *       the re-ranking of one row, as amscr_index_query_scores with candidates 0.
+ * Memory: the kept index, about 50 KB a shape with the retrieval preset (channel and inner
+ *       features, signature, lists; not a copy of the shapes), until amscr_db_free.
+ * Prefer an amscr_index to save the preparation in a file or to query with a shortlist.
  * @param[in]  q  a shape prepared with params compatible with the collection's.
  * @param[in]  progress, user  optional progress callback (may be NULL).
  * @param[out] out_scores  n scores, lower is better (see amscr_db_retrieval_matrix).
@@ -2580,7 +2584,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, incompatible params, open curves with a
  *         channel weight); AMSCR_E_CANCELLED; AMSCR_E_NOMEM.
  * Ownership: none.
- * Thread-safety: const; runs on the db's threads.
+ * Thread-safety: const: concurrent queries are safe (the kept index is built or extended by
+ *       one of them under the collection's lock); runs on the db's threads.
  * @since 0.4
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_query_retrieval(const amscr_db *db, const amscr_descriptor *q,

@@ -94,7 +94,15 @@ static void exact_case_share(double w, unsigned k, double share)
     double ref[NSHAPES], got[NSHAPES], viax[NSHAPES];
     reference_row(db, q, ref);
     ck_assert_int_eq(amscr_db_query_retrieval(db, q, NULL, NULL, got, NSHAPES), AMSCR_OK);
-    assert_close(ref, got, NSHAPES, 1e-12);
+    /* fused weights: the collection's medians (its kept index), not moved by the query */
+    assert_close(ref, got, NSHAPES, w > 0.0 && w < 1.0 ? 1e-3 : 1e-12);
+    if (w > 0.0 && w < 1.0) {
+        amscr_index *x = NULL;
+        ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
+        ck_assert_int_eq(amscr_index_query_scores(x, q, 0, viax, NSHAPES), AMSCR_OK);
+        assert_close(viax, got, NSHAPES, 1e-12);
+        amscr_index_free(x);
+    }
     if (w <= 0.0 || w >= 1.0) { /* an index: the collection's graphs */
         amscr_index *x = NULL;
         ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
@@ -110,6 +118,38 @@ static void exact_case_share(double w, unsigned k, double share)
 }
 
 static void exact_case(double w, unsigned k) { exact_case_share(w, k, 0.05); }
+
+/* A collection's queries keep its index: after an add, the same scores as a new collection's. */
+static void kept_case(double w, unsigned k)
+{
+    amscr_params *p = params_of(w, k, 2);
+    amscr_db *db = db_of(p, NSHAPES - 5), *fresh = db_of(p, NSHAPES);
+    amscr_descriptor *q = shape(p, 1000);
+    double got[NSHAPES], ref[NSHAPES];
+    ck_assert_int_eq(amscr_db_query_retrieval(db, q, NULL, NULL, got, NSHAPES - 5), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_query_retrieval(db, q, NULL, NULL, ref, NSHAPES - 5), AMSCR_OK);
+    assert_close(ref, got, NSHAPES - 5, 0.0); /* the kept index: the same scores again */
+    for (unsigned i = NSHAPES - 5; i < NSHAPES; i++) {
+        amscr_descriptor *d = shape(p, i);
+        ck_assert_int_eq(amscr_db_add_descriptor(db, d, (int32_t)(i % 6), NULL), AMSCR_OK);
+        amscr_descriptor_free(d);
+        if (i == NSHAPES - 3) /* a query between adds: the index follows each */
+            ck_assert_int_eq(amscr_db_query_retrieval(db, q, NULL, NULL, got, i + 1), AMSCR_OK);
+    }
+    ck_assert_int_eq(amscr_db_query_retrieval(db, q, NULL, NULL, got, NSHAPES), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_query_retrieval(fresh, q, NULL, NULL, ref, NSHAPES), AMSCR_OK);
+    assert_close(ref, got, NSHAPES, 1e-12);
+    amscr_descriptor_free(q);
+    amscr_db_free(db);
+    amscr_db_free(fresh);
+    amscr_params_free(p);
+}
+
+START_TEST(kept_after_add) { kept_case(1.0, 8); }
+END_TEST
+
+START_TEST(kept_after_add_amscr) { kept_case(0.0, 5); }
+END_TEST
 
 /* The build's default: every pair up to AMSCR_INDEX_EXACT_MAX shapes, the shortlist above. */
 START_TEST(default_candidates)
@@ -955,6 +995,8 @@ Suite *amscr_suite_index(void)
     tcase_set_timeout(tc, 600);
     tcase_add_test(tc, knn_select_is_the_sorted_prefix);
     tcase_add_test(tc, default_candidates);
+    tcase_add_test(tc, kept_after_add);
+    tcase_add_test(tc, kept_after_add_amscr);
     tcase_add_test(tc, exact_channel_rerank);
     tcase_add_test(tc, exact_amscr_rerank);
     tcase_add_test(tc, exact_fused_rerank);

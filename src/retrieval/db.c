@@ -24,6 +24,11 @@ struct amscr_db {
     const unsigned char *src;
     size_t src_pos0, src_per, nsrc;
     pthread_mutex_t lock;
+    /* What one-vs-many retrieval keeps between queries (retrieval_query.c): owned, released by
+     * kept_free, taken under kept_lock (queries of a const collection prepare it once). */
+    void *kept;
+    void (*kept_free)(void *);
+    pthread_mutex_t kept_lock;
 };
 
 amscr_status amscr_db_new(const amscr_params *p, amscr_db **out)
@@ -37,6 +42,7 @@ amscr_status amscr_db_new(const amscr_params *p, amscr_db **out)
         db->params = *p;
     else
         amscr__params_defaults(&db->params);
+    pthread_mutex_init(&db->kept_lock, NULL);
     *out = db;
     return AMSCR_OK;
 }
@@ -45,10 +51,13 @@ void amscr_db_free(amscr_db *db)
 {
     if (!db)
         return;
+    if (db->kept) /* it may refer to the shapes */
+        db->kept_free(db->kept);
     for (size_t i = 0; i < db->n; i++)
         amscr_descriptor_free(db->d[i]);
     if (db->src)
         pthread_mutex_destroy(&db->lock);
+    pthread_mutex_destroy(&db->kept_lock);
     free(db->d);
     free(db->labels);
     free(db);
@@ -161,6 +170,19 @@ amscr_status amscr_db_add_descriptor(amscr_db *db, const amscr_descriptor *d, in
     if (st != AMSCR_OK)
         amscr_descriptor_free(copy);
     return st;
+}
+
+void **amscr__db_kept_lock(const amscr_db *db, void (*free_fn)(void *))
+{
+    amscr_db *m = (amscr_db *)(uintptr_t)db; /* the kept state of a const collection, under its lock */
+    pthread_mutex_lock(&m->kept_lock);
+    m->kept_free = free_fn;
+    return &m->kept;
+}
+
+void amscr__db_kept_unlock(const amscr_db *db)
+{
+    pthread_mutex_unlock(&((amscr_db *)(uintptr_t)db)->kept_lock);
 }
 
 size_t amscr_db_size(const amscr_db *db) { return db ? db->n : 0; }

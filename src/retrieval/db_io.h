@@ -84,6 +84,10 @@ amscr_status amscr__db_push(amscr_db *db, amscr_descriptor *d, int32_t label, si
 amscr_status amscr__db_prepare(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out);
 /* Room for `extra` more shapes, so that as many pushes cannot fail. */
 amscr_status amscr__db_reserve(amscr_db *db, size_t extra);
+/* The slot of what one-vs-many retrieval keeps between queries of db (retrieval_query.c), locked;
+ * amscr_db_free releases what it holds with free_fn. Unlock with amscr__db_kept_unlock. */
+void **amscr__db_kept_lock(const amscr_db *db, void (*free_fn)(void *));
+void amscr__db_kept_unlock(const amscr_db *db);
 
 /* Shape bytes [at, at + per) of a file with params prm decoded into *out (caller frees);
  * *label when label is not NULL. AMSCR_E_FORMAT when truncated, not finite or degenerate. */

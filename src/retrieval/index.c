@@ -107,7 +107,8 @@ amscr_status amscr__index_check_db(const amscr_db *db, const char *what)
     return AMSCR_OK;
 }
 
-amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
+/* An empty index for db's params and size: on db itself (borrow) or on a copy of it. */
+static amscr_status index_alloc(const amscr_db *db, int borrow, amscr_index **out)
 {
     amscr_index *x = calloc(1, sizeof *x);
     if (!x)
@@ -118,8 +119,13 @@ amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
     x->nf = amscr__index_frames(p);
     x->k = n > 0 ? amscr__rerank_k(p, n) : 0;
     x->k2 = amscr__index_k2(p, x->k);
-    amscr_status st = amscr_db_new(p, &x->db);
-    for (size_t i = 0; st == AMSCR_OK && i < n; i++)
+    x->db_borrowed = borrow;
+    amscr_status st = AMSCR_OK;
+    if (borrow)
+        x->db = (amscr_db *)(uintptr_t)db; /* never changed through x: see amscr__index_build_on */
+    else
+        st = amscr_db_new(p, &x->db);
+    for (size_t i = 0; !borrow && st == AMSCR_OK && i < n; i++)
         st = amscr_db_add_descriptor(x->db, amscr_db_descriptor(db, i), amscr_db_label(db, i), NULL);
     if (st == AMSCR_OK)
         st = amscr__index_reserve(x, n);
@@ -130,6 +136,10 @@ amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out)
     *out = x;
     return AMSCR_OK;
 }
+
+amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out) { return index_alloc(db, 0, out); }
+
+amscr_status amscr__index_alloc_on(const amscr_db *db, amscr_index **out) { return index_alloc(db, 1, out); }
 
 size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,
                               size_t *cand)
@@ -195,7 +205,8 @@ void amscr_index_free(amscr_index *x)
     free(x->in_idx);
     free(x->in_dist);
     amscr__index_reverse_free(x);
-    amscr_db_free(x->db);
+    if (!x->db_borrowed)
+        amscr_db_free(x->db);
     free(x);
 }
 

@@ -12,7 +12,8 @@
 #include "signature.h"
 
 struct amscr_index {
-    amscr_db *db;         /* the collection (owned) */
+    amscr_db *db;         /* the collection (owned, unless db_borrowed) */
+    int db_borrowed;      /* db is the caller's (a collection's kept index: retrieval_query.c) */
     size_t k;             /* neighbours a shape: amscr__rerank_k (a 0.5 file: min(rerank_k, n)) */
     size_t candidates;    /* the build's shortlist M (0: every shape, exact lists) */
     double dmax;          /* largest base distance of the collection */
@@ -72,6 +73,11 @@ typedef struct {
 
 /* An empty index of a copy of db (no lists yet). */
 amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out);
+amscr_status amscr__index_alloc_on(const amscr_db *db, amscr_index **out); /* on db itself */
+/* An index on db itself (not a copy; db must outlive it), its lists exact (candidates 0). */
+amscr_status amscr__index_build_on(const amscr_db *db, amscr_progress_fn progress, void *user, amscr_index **out);
+/* Shapes n0..n-1 of x->db, already in it, into x: features, lists, the lists they enter. */
+amscr_status amscr__index_extend(amscr_index *x, size_t n0, amscr_progress_fn progress, void *user);
 /* Grows the per-shape arrays to hold n rows. */
 amscr_status amscr__index_reserve(amscr_index *x, size_t n);
 /* Refined lists (*nidx, *ndist) replace (*idx, *dist), their first `keep` entries (the rows

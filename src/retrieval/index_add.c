@@ -139,10 +139,17 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
         st = amscr__index_reserve(x, n);
     for (size_t i = 0; st == AMSCR_OK && i < add; i++)
         st = amscr_db_add_descriptor(x->db, amscr_db_descriptor(shapes, i), amscr_db_label(shapes, i), NULL);
+    return st == AMSCR_OK ? amscr__index_extend(x, n0, progress, user) : st;
+}
+
+amscr_status amscr__index_extend(amscr_index *x, size_t n0, amscr_progress_fn progress, void *user)
+{
+    size_t n = amscr_db_size(x->db), add = n - n0;
+    amscr_status st = amscr__index_reserve(x, n);
     if (st == AMSCR_OK)
         st = amscr__index_features(x, n0, 0);
     add_ctx c = {x, {0}, n0, n, NULL, NULL, NULL, NULL};
-    amscr__base_init(&c.b, p, x->med_a, x->med_h);
+    amscr__base_init(&c.b, amscr_db_params(x->db), x->med_a, x->med_h);
     size_t batch = 4 * (size_t)c.b.threads; /* rows computed together (memory: batch x n) */
     c.cand = st == AMSCR_OK ? amscr__malloc_array(batch, n * sizeof *c.cand) : NULL;
     c.cd = st == AMSCR_OK ? amscr__malloc_array(batch, n * sizeof *c.cd) : NULL;

@@ -215,31 +215,17 @@ amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_pro
     return st;
 }
 
-amscr_status amscr_index_build(const amscr_db *db, size_t candidates, amscr_progress_fn progress, void *user,
-                               amscr_index **out)
+/* x's lists, from every pair (candidates 0) or each shape's shortlist; x freed on failure. */
+static amscr_status build_into(amscr_index *x, size_t candidates, amscr_progress_fn progress, void *user)
 {
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(db);
-    AMSCR_CHECK_NULL(out);
-    amscr_status st = amscr__index_check_db(db, "amscr_index_build");
-    if (st != AMSCR_OK)
-        return st;
-    amscr_index *x = NULL;
-    st = amscr__index_alloc(db, &x);
-    if (st != AMSCR_OK)
-        return st;
-    size_t n = amscr_db_size(db);
-    st = amscr__index_features(x, 0, 0);
-    if (st != AMSCR_OK) {
-        amscr_index_free(x);
-        return st;
-    }
+    size_t n = amscr_db_size(x->db);
+    amscr_status st = amscr__index_features(x, 0, 0);
     if (candidates > 0 && candidates + 1 < x->k)
         candidates = x->k - 1; /* a shortlist holds at least the K - 1 neighbours */
     x->candidates = candidates > 0 && n > 1 && candidates < n - 1 ? candidates : 0;
-    if (x->candidates == 0) {
+    if (st == AMSCR_OK && x->candidates == 0) {
         st = build_full(x, progress, user);
-    } else {
+    } else if (st == AMSCR_OK) {
         size_t mb = x->candidates < BUILD_SHORTLIST ? x->candidates : BUILD_SHORTLIST;
         st = sampled_medians(x);
         if (st == AMSCR_OK)
@@ -247,10 +233,37 @@ amscr_status amscr_index_build(const amscr_db *db, size_t candidates, amscr_prog
     }
     if (st == AMSCR_OK)
         st = amscr__index_reverse(x);
-    if (st != AMSCR_OK) {
+    if (st != AMSCR_OK)
         amscr_index_free(x);
-        return st;
-    }
-    *out = x;
-    return AMSCR_OK;
+    return st;
+}
+
+amscr_status amscr_index_build(const amscr_db *db, size_t candidates, amscr_progress_fn progress, void *user,
+                               amscr_index **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(db);
+    AMSCR_CHECK_NULL(out);
+    amscr_status st = amscr__index_check_db(db, "amscr_index_build");
+    amscr_index *x = NULL;
+    if (st == AMSCR_OK)
+        st = amscr__index_alloc(db, &x);
+    if (st == AMSCR_OK)
+        st = build_into(x, candidates, progress, user);
+    if (st == AMSCR_OK)
+        *out = x;
+    return st;
+}
+
+amscr_status amscr__index_build_on(const amscr_db *db, amscr_progress_fn progress, void *user, amscr_index **out)
+{
+    amscr_status st = amscr__index_check_db(db, "amscr_db_query_retrieval");
+    amscr_index *x = NULL;
+    if (st == AMSCR_OK)
+        st = amscr__index_alloc_on(db, &x);
+    if (st == AMSCR_OK)
+        st = build_into(x, 0, progress, user);
+    if (st == AMSCR_OK)
+        *out = x;
+    return st;
 }

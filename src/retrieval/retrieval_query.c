@@ -1,8 +1,10 @@
 /* retrieval_query.c — which scores a collection ranks its shapes by (amscr_params_ranking), and
- * one query's retrieval scores against a collection that keeps no index
- * (amscr_db_query_retrieval): the base distances alone without re-ranking, the collection's
- * neighbour lists built for the call (an exact index) with it, and the matrix of the collection
- * plus the query when the fusion's medians move with the query. */
+ * one query's retrieval scores against a collection (amscr_db_query_retrieval): the base
+ * distances alone when nothing of the collection's is needed, else from an exact index of the
+ * collection kept with it — built by the first such query, brought up to date by the first
+ * query after shapes were added (their rows and the lists they enter), so each query costs
+ * O(n) matches. */
+#include "db_io.h"
 #include "index.h"
 
 #include <stdlib.h>
@@ -17,26 +19,55 @@ amscr_status amscr_params_ranking(const amscr_params *p, amscr_ranking *out_rank
     return AMSCR_OK;
 }
 
-/* The last row of the retrieval matrix of db plus q. */
-static amscr_status query_by_matrix(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress,
-                                    void *user, double *out)
+/* The index a collection keeps for its queries, and the shapes it covers. */
+typedef struct {
+    amscr_index *x;
+    size_t n;
+} kept_index;
+
+static void kept_free(void *p)
+{
+    kept_index *k = p;
+    if (k)
+        amscr_index_free(k->x);
+    free(k);
+}
+
+/* k brought to db's size: the new shapes entered, or a rebuild when the lists' K changes with
+ * the size. On failure k holds no index. */
+static amscr_status kept_refresh(const amscr_db *db, kept_index *k, amscr_progress_fn progress, void *user)
 {
     size_t n = amscr_db_size(db);
-    amscr_db *all = NULL;
-    amscr_status st = amscr_db_new(amscr_db_params(db), &all);
-    for (size_t i = 0; st == AMSCR_OK && i < n; i++)
-        st = amscr_db_add_descriptor(all, amscr_db_descriptor(db, i), amscr_db_label(db, i), NULL);
-    if (st == AMSCR_OK)
-        st = amscr_db_add_descriptor(all, q, -1, NULL);
-    double *M = st == AMSCR_OK ? amscr__malloc_array((n + 1) * (n + 1), sizeof *M) : NULL;
-    if (st == AMSCR_OK && !M)
+    amscr_status st = AMSCR_OK;
+    if (k->x && k->n > 0 && amscr__rerank_k(amscr_db_params(db), n) == k->x->k)
+        st = amscr__index_extend(k->x, k->n, progress, user);
+    else {
+        amscr_index_free(k->x);
+        k->x = NULL;
+        st = amscr__index_build_on(db, progress, user, &k->x);
+    }
+    if (st != AMSCR_OK) {
+        amscr_index_free(k->x);
+        k->x = NULL;
+    }
+    k->n = st == AMSCR_OK ? n : 0;
+    return st;
+}
+
+/* The index db keeps for its queries, up to date (built or extended under the collection's lock). */
+static amscr_status kept(const amscr_db *db, amscr_progress_fn progress, void *user, const amscr_index **out)
+{
+    void **slot = amscr__db_kept_lock(db, kept_free);
+    kept_index *k = *slot;
+    amscr_status st = AMSCR_OK;
+    if (!k && (k = calloc(1, sizeof *k)) == NULL)
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_db_query_retrieval: out of memory");
-    if (st == AMSCR_OK)
-        st = amscr_db_retrieval_matrix(all, progress, user, M);
-    if (st == AMSCR_OK)
-        memcpy(out, M + n * (n + 1), n * sizeof *out);
-    free(M);
-    amscr_db_free(all);
+    else
+        *slot = k;
+    if (st == AMSCR_OK && (!k->x || k->n != amscr_db_size(db)))
+        st = kept_refresh(db, k, progress, user);
+    *out = st == AMSCR_OK ? k->x : NULL;
+    amscr__db_kept_unlock(db);
     return st;
 }
 
@@ -70,16 +101,10 @@ amscr_status amscr_db_query_retrieval(const amscr_db *db, const amscr_descriptor
         return AMSCR_E_INVALID_ARG;
     const amscr_params *p = amscr_db_params(db);
     double w = p->channel_weight;
-    /* fused weights: the medians move with the query: the whole matrix */
-    if (w > 0.0 && w < 1.0)
-        return query_by_matrix(db, q, progress, user, out_scores);
-    if (p->rerank_k == 0) /* the base distances alone: nothing of the collection's is needed */
+    if (p->rerank_k == 0 && !(w > 0.0 && w < 1.0)) /* the base distances alone: nothing of the collection's */
         return plain_row(db, q, progress, user, out_scores);
-    amscr_index *x = NULL;
-    amscr_status st = amscr_index_build(db, 0, progress, user, &x);
-    if (st == AMSCR_OK)
-        st = amscr_index_query_scores(x, q, 0, out_scores, n); /* every shape a candidate */
-    amscr_index_free(x);
-    return st;
+    const amscr_index *x = NULL;
+    amscr_status st = kept(db, progress, user, &x);
+    return st == AMSCR_OK ? amscr_index_query_scores(x, q, 0, out_scores, n) : st; /* every shape a candidate */
 }
 

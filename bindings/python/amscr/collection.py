@@ -219,12 +219,17 @@ class Collection:
         scores (C ``amscr_db_query_retrieval``: the query's row of :meth:`retrieval_matrix` on
         the collection plus the query, shape channel, fusion and re-ranking) when the params
         ask for retrieval (:attr:`Params.ranking` 'retrieval': ``channel_weight`` > 0 or
-        ``rerank_k`` > 0, e.g. :meth:`Params.retrieval`). To query a collection many times that
-        way, build an :class:`Index` once.
+        ``rerank_k`` > 0, e.g. :meth:`Params.retrieval`). Retrieval scores come from an exact
+        index of the collection that the first such query builds (every pair: O(n²) once) and
+        the collection keeps; a query after :meth:`add` first enters the new shapes (O(n) a
+        shape), and every query then costs O(n), as :meth:`Index.query` with ``candidates=0``.
+        With a ``channel_weight`` strictly between 0 and 1 the fusion uses the collection's
+        medians (those of the first query's build), not medians moved by the query.
 
         Args:
             shape: the query: (n, 2) points, an OpenCV (n, 1, 2) contour or a :class:`Shape`.
-            threads: threads for this call (None: the collection's).
+            threads: threads for this call (None: the collection's; retrieval scores always
+                use the collection's, with the index it keeps).
             progress: True for a progress bar on stderr, or a callable(done, total) (returning
                 True cancels with CancelledError; an exception it raises cancels and propagates).
             order: 'xy' (default) or 'rc' for (row, col) points (scikit-image).
@@ -238,9 +243,8 @@ class Collection:
             p = self.params
             q = as_shape(shape, p, 'shape', order)
             out = np.zeros(len(self), dtype=np.float64)
-            if p.ranking == 'retrieval':
-                src, _ = self._with_threads(threads)
-                progress_call(lib.amscr_db_query_retrieval, (src._db, q._d), (dbuf(out), len(out)), progress)
+            if p.ranking == 'retrieval':  # the collection's kept index (a copy would build its own)
+                progress_call(lib.amscr_db_query_retrieval, (self._db, q._d), (dbuf(out), len(out)), progress)
             elif threads is None or int(threads) == p.threads:
                 progress_call(lib.amscr_db_query, (self._db, q._d), (dbuf(out),), progress)
             else:
