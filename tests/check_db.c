@@ -1799,6 +1799,33 @@ END_TEST
 
 /* ----------------------------------------------------------------- suite */
 
+
+/* A saved file gets 0666 less the umask (not mkstemp's 0600); a replaced file keeps its mode. */
+START_TEST(saved_file_mode)
+{
+    char path[] = "/tmp/amscr_mode_XXXXXX";
+    int fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    remove(path);
+    amscr_db *db = NULL;
+    ck_assert_int_eq(amscr_db_new(NULL, &db), AMSCR_OK);
+    mode_t old = umask(027);
+    amscr_status st = amscr_db_save(db, path);
+    umask(old);
+    ck_assert_int_eq(st, AMSCR_OK);
+    struct stat sb;
+    ck_assert_int_eq(stat(path, &sb), 0);
+    ck_assert_uint_eq(sb.st_mode & 0777, 0640);
+    ck_assert_int_eq(chmod(path, 0664), 0);
+    ck_assert_int_eq(amscr_db_save(db, path), AMSCR_OK);
+    ck_assert_int_eq(stat(path, &sb), 0);
+    ck_assert_uint_eq(sb.st_mode & 0777, 0664);
+    remove(path);
+    amscr_db_free(db);
+}
+END_TEST
+
 Suite *amscr_suite_db(void)
 {
     Suite *s = suite_create("db");
@@ -1846,6 +1873,7 @@ Suite *amscr_suite_db(void)
     tcase_add_test(tc, crafted_files_valid_checksum);
     tcase_add_test(tc, crafted_scale_out_of_range);
     tcase_add_test(tc, load_bad_paths);
+    tcase_add_test(tc, saved_file_mode);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("null");

@@ -289,4 +289,7 @@ static inline size_t amscr__rerank_k(const amscr_params *p, size_t n)
 /* Thread count helper: 0 -> online cores. */
 unsigned amscr__resolve_threads(unsigned requested);
 
+/* The mode of a file written to path (file_mode.c): the replaced file's, else 0666 & ~umask. */
+unsigned amscr__file_mode(const char *path);
+
 #endif

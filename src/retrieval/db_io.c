@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <fcntl.h>
@@ -116,6 +117,7 @@ amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t 
     if (fd < 0) {
         st = amscr__fail(AMSCR_E_IO, "%s: cannot create a temporary file: %s", path, strerror(errno));
     } else {
+        (void)fchmod(fd, (mode_t)amscr__file_mode(path)); /* mkstemp made it 0600 (best effort) */
         FILE *f = fdopen(fd, "wb");
         int ok = f && fwrite(buf, 1, len, f) == len;
         if (f)

@@ -232,7 +232,7 @@ amscr_status amscr_contour_write_text(const amscr_contour *c, const char *path)
         return st;
     }
     /* mkstemp creates 0600; give the file ordinary permissions (best effort). */
-    (void)fchmod(fd, 0644);
+    (void)fchmod(fd, (mode_t)amscr__file_mode(path));
     FILE *f = fdopen(fd, "w");
     if (!f) {
         int e = errno;
