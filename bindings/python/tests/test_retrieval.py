@@ -58,6 +58,22 @@ def test_query_follows_the_ranking():
         np.testing.assert_allclose(coll.query(shapes[0]), full[-1, :-1], rtol=0, atol=1e-12)
 
 
+def test_query_keeps_the_collection_index_across_adds():
+    """Collection.query's retrieval scores come from an index the collection keeps: the same
+    scores on a second call, and after add() the scores of a collection made with every shape
+    (the kept index enters the new shapes)."""
+    params = amscr.Params.retrieval()
+    shapes = [blob(200, seed=s) for s in range(30)]
+    coll, whole = amscr.Collection(params), amscr.Collection(params)
+    coll.extend(shapes[1:25])
+    whole.extend(shapes[1:])
+    first = coll.query(shapes[0])
+    np.testing.assert_array_equal(coll.query(shapes[0]), first)
+    coll.extend(shapes[25:])
+    np.testing.assert_allclose(coll.query(shapes[0]), whole.query(shapes[0]), rtol=0, atol=1e-12)
+    assert coll.query(shapes[0]).shape == (29,)
+
+
 def test_channel_distance_is_zero_to_itself_and_invariant():
     a, b = blob(300, seed=1), blob(300, seed=2)
     assert amscr.channel_distance(a, a) == 0.0
