@@ -11,7 +11,7 @@ static const double default_scales[] = {1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 11.0, 16.0
 
 /* The retrieval options (0.2): off in the plain defaults (amscr_db_distance_matrix is the
  * AMSCR distance exactly as in 0.1); the channel's own settings are those measured in
- * docs/results-retrieval.md, so turning the channel on needs only a weight. */
+ * docs/decisions.md, so turning the channel on needs only a weight. */
 static void retrieval_defaults(amscr_params *p)
 {
     p->channel_weight = 0.0;
@@ -50,7 +50,7 @@ void amscr__params_defaults(amscr_params *p)
     /* Opt-in stages (amscr_params_set_stage): despike, order and even_spacing changed no map of
      * the 216 traced pairs of fold A of bench/registration_traced.py (either tracer; fold B
      * confirmed it), which chose this; they help point lists with stray points or synthetic
-     * noise (docs/results-registration.md, "0.5: the pipeline as stages"). */
+     * noise (docs/decisions.md). */
     p->stages_off = AMSCR__STAGE_BIT(AMSCR__STAGE_DESPIKE) | AMSCR__STAGE_BIT(AMSCR__STAGE_ORDER) |
                     AMSCR__STAGE_BIT(AMSCR__STAGE_EVEN);
     retrieval_defaults(p);

@@ -13,7 +13,7 @@
  * 800 times their distances from the curve, evenly sampled ones 1.7 to 2.6 times; points spaced
  * evenly along another version of the curve drift along it (Kuiper's test).
  *
- * Measured (docs/results-registration.md, 280 held-out pairs, after the order stage): 2 % noise
+ * Measured (docs/decisions.md; bench/registration_heldout.py, 280 held-out pairs, after the order stage): 2 % noise
  * within 2 %: 98.2 -> 99.6 %, median error 0.43 -> 0.27 %; 1 % noise median 0.22 -> 0.13 %. */
 #include "even.h"
 

@@ -17,7 +17,7 @@
  * neighbours' closest points put it (a running median; later rounds: its place in the round
  * before), ORDER_BAND sigmas either side.
  *
- * Measured (docs/results-registration.md, 280 held-out pairs at 2 % noise): median map error
+ * Measured (docs/decisions.md; bench/registration_heldout.py, 280 held-out pairs at 2 % noise): median map error
  * 0.57 -> 0.43 % of the size, 95th percentile 1.65 -> 1.21 %, within 2 %: 96.8 -> 98.2 %. It runs
  * only on markedly noisy curves (polish.c decides) and never on missing runs or fragments. */
 #include "ordered.h"

@@ -9,7 +9,7 @@
 /* Vertices of the polygon whose inner distances are taken, the offsets kept (the others
  * repeat them: ID(i, i + N - k) = ID(i - k, i)), and the frequencies kept along the contour
  * (0..N/4: the matrices are compared smoothed along the curve; the full spectrum scores the
- * same, at twice the cost: docs/results-retrieval.md). */
+ * same, at twice the cost: docs/decisions.md). */
 #define AMSCR__INNER_N AMSCR__OUTLINE_N
 #define AMSCR__INNER_K (AMSCR__INNER_N / 2)
 #define AMSCR__INNER_F (AMSCR__INNER_N / 4 + 1)
