@@ -151,6 +151,48 @@ END_TEST
 START_TEST(kept_after_add_amscr) { kept_case(0.0, 5); }
 END_TEST
 
+/* Threads querying a collection at once: one builds its kept index, all get the serial scores. */
+typedef struct {
+    const amscr_db *db;
+    const amscr_descriptor *q;
+    double out[NSHAPES];
+    amscr_status st;
+} kept_job;
+
+static void *kept_worker(void *arg)
+{
+    kept_job *j = arg;
+    j->st = amscr_db_query_retrieval(j->db, j->q, NULL, NULL, j->out, NSHAPES);
+    return NULL;
+}
+
+START_TEST(kept_concurrent)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_db *db = db_of(p, NSHAPES), *serial = db_of(p, NSHAPES);
+    amscr_descriptor *q = shape(p, 1000);
+    double ref[NSHAPES];
+    ck_assert_int_eq(amscr_db_query_retrieval(serial, q, NULL, NULL, ref, NSHAPES), AMSCR_OK);
+    enum { T = 4 };
+    kept_job jobs[T];
+    pthread_t tid[T];
+    for (int t = 0; t < T; t++) {
+        jobs[t].db = db;
+        jobs[t].q = q;
+        ck_assert_int_eq(pthread_create(&tid[t], NULL, kept_worker, &jobs[t]), 0);
+    }
+    for (int t = 0; t < T; t++) {
+        ck_assert_int_eq(pthread_join(tid[t], NULL), 0);
+        ck_assert_int_eq(jobs[t].st, AMSCR_OK);
+        assert_close(ref, jobs[t].out, NSHAPES, 0.0);
+    }
+    amscr_descriptor_free(q);
+    amscr_db_free(db);
+    amscr_db_free(serial);
+    amscr_params_free(p);
+}
+END_TEST
+
 /* The build's default: every pair up to AMSCR_INDEX_EXACT_MAX shapes, the shortlist above. */
 START_TEST(default_candidates)
 {
@@ -997,6 +1039,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, default_candidates);
     tcase_add_test(tc, kept_after_add);
     tcase_add_test(tc, kept_after_add_amscr);
+    tcase_add_test(tc, kept_concurrent);
     tcase_add_test(tc, exact_channel_rerank);
     tcase_add_test(tc, exact_amscr_rerank);
     tcase_add_test(tc, exact_fused_rerank);
