@@ -9,8 +9,10 @@
  * a continuous shift: the lowest AMSCR__CANDIDATES and, in the ranked search (refinement on),
  * when those are distinct maps that all score about as well as the winner (a shape with three
  * or more symmetries), every further one about as low, up to AMSCR__CANDIDATES_MAX — so that each
- * symmetry of a square or a regular star is ranked and listed as an alternative. Open curves have
- * one candidate per orientation (no shift).
+ * symmetry of a square or a regular star is ranked and listed as an alternative. The further
+ * minima of an orientation whose lowest ones did not score alike here are held: the polish,
+ * whose ranking judges them anew, asks for them when it finds them alike
+ * (amscr__search_held). Open curves have one candidate per orientation (no shift).
  *
  * One ranking rule picks the winner: the lowest score, ties broken by the lower distance, then
  * by the earlier candidate (orientations in order, each one's candidates best criterion first);
@@ -292,7 +294,7 @@ static int about_as_good(double crit, double best, double e)
  * criterion): where an orientation's lowest AMSCR__CANDIDATES minima are alike (each
  * about_as_good as the lowest of all), every further minimum of it that is about_as_good too, up
  * to AMSCR__CANDIDATES_MAX per orientation — the symmetries of a shape with more than three, which
- * the ranking takes when their base candidates score alike (further_alike). On return ws->P
+ * the ranking takes when their base candidates score alike (amscr__lowest_alike). On return ws->P
  * holds orientation `norient - 1`'s spectra; crit[i] is candidate i's criterion. */
 static size_t collect_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                              int prune, amscr_workspace *ws, start_t *out, double *crit, size_t *nbase)
@@ -413,21 +415,18 @@ static amscr_status score_starts(const amscr_params *prm, const amscr_descriptor
     return AMSCR_OK;
 }
 
-/* Whether the ranked search also scores orientation o's further minima: its lowest
- * AMSCR__CANDIDATES (among the first s->nbase) are distinct maps that all scored about as well as
- * the winner, by the alternatives' tests — a shape with three or more symmetries, which may have
- * more (the search's ambiguity is then at least AMSCR__ALT_RATIO already). */
-static int further_alike(const amscr_descriptor *f, const amscr__search *s, int o)
+int amscr__lowest_alike(const amscr_descriptor *f, double X[][6], const int *ro, const double *cost, size_t nbase,
+                        size_t best, int o)
 {
-    double best = s->score[s->best] + AMSCR__AMBIGUITY_FLOOR;
+    double c0 = cost[best] + AMSCR__AMBIGUITY_FLOOR;
     size_t k = 0;
-    for (size_t i = 0; i < s->nbase; i++) {
-        if (s->o[i] != o)
+    for (size_t i = 0; i < nbase; i++) {
+        if (ro[i] != o)
             continue;
-        if (!(best / (s->score[i] + AMSCR__AMBIGUITY_FLOOR) >= AMSCR__ALT_RATIO))
+        if (!(c0 / (cost[i] + AMSCR__AMBIGUITY_FLOOR) >= AMSCR__ALT_RATIO))
             return 0;
         for (size_t j = 0; j < i; j++)
-            if (s->o[j] == o && !(amscr__map_gap2(f, s->X[i], s->X[j]) > AMSCR__DISTINCT_GAP2))
+            if (ro[j] == o && !(amscr__map_gap2(f, X[i], X[j]) > AMSCR__DISTINCT_GAP2))
                 return 0;
         k++;
     }
@@ -454,13 +453,20 @@ amscr_status amscr__search_starts(const amscr_params *prm, const amscr_descripto
     s->prepared_o = (prm->reflections ? 2 : 1) - 1;
     s->best = 0;
     st = score_starts(prm, f, h, crit, 0, ws, s);
+    s->nheld = 0;
     if (st == AMSCR_OK && total > nbase) { /* the further minima of the orientations that need them */
-        int want[2] = {further_alike(f, s, 0), further_alike(f, s, 1)};
+        int want[2];
+        for (int o = 0; o < 2; o++)
+            want[o] = amscr__lowest_alike(f, s->X, s->o, s->score, s->nbase, s->best, o);
         for (size_t i = nbase; i < total; i++)
             if (want[starts[i].o]) {
                 s->s[s->count] = starts[i].s;
                 s->o[s->count] = starts[i].o;
                 crit[s->count++] = crit[i];
+            } else { /* held for the polish's ranking */
+                s->held_s[s->nheld] = starts[i].s;
+                s->held_o[s->nheld] = starts[i].o;
+                s->held_crit[s->nheld++] = crit[i];
             }
         st = score_starts(prm, f, h, crit, nbase, ws, s);
     }
@@ -477,10 +483,13 @@ static void keep_ranking(const amscr_descriptor *f, const amscr__search *s, matc
     m->ncand_base = ranked ? s->nbase : 0;
     m->nrank = m->ncand;
     m->rank_best = s->best;
+    m->rank_nbase = m->ncand_base;
     if (!m->ncand)
         return;
     memcpy(m->cand, s->X, s->count * sizeof s->X[0]);
+    memcpy(m->cand_o, s->o, s->count * sizeof s->o[0]);
     memcpy(m->rank_X, s->X, s->count * sizeof s->X[0]);
+    memcpy(m->rank_o, s->o, s->count * sizeof s->o[0]);
     memcpy(m->rank_cost, s->score, s->count * sizeof s->score[0]);
 }
 
@@ -495,6 +504,31 @@ amscr_status amscr__method_at(const amscr_params *prm, const amscr_descriptor *f
     if (!isfinite(m->dist))
         return amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
     return AMSCR_OK;
+}
+
+amscr_status amscr__search_held(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                amscr_workspace *ws, amscr__search *s, int o, double X[][6], size_t *out_n)
+{
+    double crit[2 * AMSCR__CANDIDATES_MAX];
+    size_t from = s->count, kept = 0;
+    for (size_t i = 0; i < s->nheld; i++) {
+        if (s->held_o[i] != o) {
+            s->held_s[kept] = s->held_s[i];
+            s->held_o[kept] = s->held_o[i];
+            s->held_crit[kept++] = s->held_crit[i];
+            continue;
+        }
+        s->s[s->count] = s->held_s[i];
+        s->o[s->count] = o;
+        crit[s->count++] = s->held_crit[i];
+    }
+    s->nheld = kept;
+    s->prepared_o = -1; /* later stages used ws->P (the way back of a symmetric match) */
+    amscr_status st = score_starts(prm, f, h, crit, from, ws, s);
+    *out_n = st == AMSCR_OK ? s->count - from : 0;
+    if (*out_n)
+        memcpy(X, s->X + from, *out_n * sizeof X[0]);
+    return st;
 }
 
 amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
