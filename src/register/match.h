@@ -193,10 +193,10 @@ typedef struct {
     size_t nbase; /* the first nbase: the lowest minima, the winner's pool; then the further ones */
     int kind;       /* how the candidates were scored (shift_search.c) */
     int prepared_o; /* the orientation whose spectra ws->P holds */
-    /* further minima held back unscored (their orientation's lowest ones did not score alike
-     * in the search): the polish's ranking may ask for them (amscr__search_held) */
-    double held_s[2 * (AMSCR__CANDIDATES_MAX - AMSCR__CANDIDATES)];
-    double held_crit[2 * (AMSCR__CANDIDATES_MAX - AMSCR__CANDIDATES)];
+    /* the further minima not ranked (integer shifts, orientations): their orientation's lowest
+     * ones did not score alike in the search; the polish's ranking may ask for them
+     * (amscr__search_held) */
+    size_t held_i[2 * (AMSCR__CANDIDATES_MAX - AMSCR__CANDIDATES)];
     int held_o[2 * (AMSCR__CANDIDATES_MAX - AMSCR__CANDIDATES)];
     size_t nheld;
 } amscr__search;
