@@ -36,10 +36,10 @@
 /* Candidate start shifts per orientation: a shape's criterion rarely has more than a few deep
  * minima (symmetries); the lowest three, which keep the right one among them at a small cost, are
  * the reported map's pool. With refinement on (the ranked search), when those three are distinct
- * maps that score alike, further minima about as low are ranked too (shift_search.c), so that a
- * shape with more symmetries than three (a square's four quarter turns, a regular star's fifths)
- * lists each as an alternative — up to AMSCR__CANDIDATES_MAX per orientation (a 12-fold
- * symmetry); they never become the reported map. */
+ * maps that score alike (in the search's ranking or the polish's), the further minima are ranked
+ * too (shift_search.c), so that a shape with more symmetries than three (a square's four quarter
+ * turns, a regular star's fifths) lists each as an alternative — up to AMSCR__CANDIDATES_MAX per
+ * orientation (a 12-fold symmetry); they never become the reported map. */
 #define AMSCR__CANDIDATES 3
 #define AMSCR__CANDIDATES_MAX 12
 
