@@ -2259,11 +2259,13 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_stage(const amscr_result *r,
  * @brief How many distinct maps fit about as well as the chosen one, the chosen one included
  *        (at least 1). Symmetric shapes have several, each listed once: a square or a 4-armed
  *        cross 4 (its quarter turns), an equilateral triangle 3, a regular 5-pointed star 5; with
- *        reflections on, their mirror maps too (8, 6, 10); an asymmetric shape 1. The start-point
- *        search ranks the lowest three minima of its criterion per orientation (the reported
- *        map is the best of them) and, when those are distinct maps that score alike, every
- *        further one about as low, up to 12 per orientation: a shape with more symmetries than
- *        that (a circle, an ellipse) lists 12 (24 with reflections).
+ *        reflections on, their mirror maps too (8, 6, 10); an n-fold shape n (2n with
+ *        reflections on when it is also mirror-symmetric); an asymmetric shape 1. The
+ *        start-point search ranks the lowest three minima of its criterion per orientation (the
+ *        reported map is the best of them) and, when those are distinct maps that score alike
+ *        (in the search's ranking or the polish's), every further local minimum, up to 12 per
+ *        orientation: a shape with more symmetries than that (a circle, an ellipse) lists 12
+ *        (24 with reflections).
  *        Alternative 0 is always the reported map (amscr_result_affine). Another map
  *        is listed when it moves the source samples by more than 10 % of the shape's RMS
  *        radius (RMS) from the chosen one and from every map listed before, and its ranking

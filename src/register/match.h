@@ -36,10 +36,10 @@
 /* Candidate start shifts per orientation: a shape's criterion rarely has more than a few deep
  * minima (symmetries); the lowest three, which keep the right one among them at a small cost, are
  * the reported map's pool. With refinement on (the ranked search), when those three are distinct
- * maps that score alike, further minima about as low are ranked too (shift_search.c), so that a
- * shape with more symmetries than three (a square's four quarter turns, a regular star's fifths)
- * lists each as an alternative — up to AMSCR__CANDIDATES_MAX per orientation (a 12-fold
- * symmetry); they never become the reported map. */
+ * maps that score alike (in the search's ranking or the polish's), the further minima are ranked
+ * too (shift_search.c), so that a shape with more symmetries than three (a square's four quarter
+ * turns, a regular star's fifths) lists each as an alternative — up to AMSCR__CANDIDATES_MAX per
+ * orientation (a 12-fold symmetry); they never become the reported map. */
 #define AMSCR__CANDIDATES 3
 #define AMSCR__CANDIDATES_MAX 12
 
@@ -104,13 +104,16 @@ typedef struct {
     double ambiguity;
     /* the search's scored start candidates (registration with refinement; else ncand 0) */
     double cand[2 * AMSCR__CANDIDATES_MAX][6];
+    int cand_o[2 * AMSCR__CANDIDATES_MAX]; /* their orientations */
     size_t ncand;
     size_t ncand_base; /* the first ncand_base of cand may win (the rest: further minima, listed only) */
     /* the last ranking of distinct starts (the search's, or the polish's when it re-ranked):
-     * their maps (normalized frames), their ranking costs and the winner (nrank 0: none) */
+     * their maps (normalized frames), orientations, ranking costs and the winner (nrank 0:
+     * none); the first rank_nbase are the lowest minima (they may win), further minima follow */
     double rank_X[1 + 2 * AMSCR__CANDIDATES_MAX][6];
+    int rank_o[1 + 2 * AMSCR__CANDIDATES_MAX];
     double rank_cost[1 + 2 * AMSCR__CANDIDATES_MAX];
-    size_t nrank, rank_best;
+    size_t nrank, rank_best, rank_nbase;
 } match_t;
 
 /* Most maps a result lists as alternatives: the chosen one and every distinct ranked start. */
@@ -190,6 +193,12 @@ typedef struct {
     size_t nbase; /* the first nbase: the lowest minima, the winner's pool; then the further ones */
     int kind;       /* how the candidates were scored (shift_search.c) */
     int prepared_o; /* the orientation whose spectra ws->P holds */
+    /* the further minima not ranked (integer shifts, orientations): their orientation's lowest
+     * ones did not score alike in the search; the polish's ranking may ask for them
+     * (amscr__search_held) */
+    size_t held_i[2 * (AMSCR__CANDIDATES_MAX - AMSCR__CANDIDATES)];
+    int held_o[2 * (AMSCR__CANDIDATES_MAX - AMSCR__CANDIDATES)];
+    size_t nheld;
 } amscr__search;
 /* The start-point search of f -> h: every candidate scored by one ranking rule into *s. */
 amscr_status amscr__search_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
@@ -198,6 +207,17 @@ amscr_status amscr__search_starts(const amscr_params *prm, const amscr_descripto
  * the ranked candidates). */
 amscr_status amscr__method_at(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                               amscr_workspace *ws, amscr__search *s, match_t *m);
+/* Whether the lowest minima of orientation o (among the first nbase of a ranking: maps X,
+ * orientations ro, costs cost, winner best) are AMSCR__CANDIDATES distinct maps that all score
+ * about as well as the winner, by the alternatives' tests: a shape with three or more
+ * symmetries, which may have more (its further minima are then ranked too). */
+int amscr__lowest_alike(const amscr_descriptor *f, double X[][6], const int *ro, const double *cost, size_t nbase,
+                        size_t best, int o);
+/* The further minima of orientation o the search held back, scored as the ranked ones were
+ * (the method and a short refinement): their maps (normalized frames) into X, their count
+ * into *out_n; they are no longer held. */
+amscr_status amscr__search_held(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                amscr_workspace *ws, amscr__search *s, int o, double X[][6], size_t *out_n);
 /* The best start point of f -> h (one ranking rule), run through the method and refined. */
 amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                               amscr_workspace *ws, match_t *m);
@@ -272,6 +292,12 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
 typedef struct amscr__polish_state amscr__polish_state;
 amscr_status amscr__polish_fit(const amscr_descriptor *f, const amscr_descriptor *h, int partial, match_t *m,
                                amscr__polish_state **out);
+/* Whether the match's ranking is the polish's (it re-ranked the search's distinct starts). */
+int amscr__polish_reranked(const amscr__polish_state *ps);
+/* The polish's ranking in m extended by further starts of orientation o (X, n, normalized
+ * frames): each that differs from every ranked map polished as the ranked starts were and
+ * appended (never the winner); the ambiguity takes them in. AMSCR_E_NOMEM when out of memory. */
+amscr_status amscr__polish_rank_more(amscr__polish_state *ps, double X[][6], size_t n, int o, match_t *m);
 /* Whether the order and even-spacing steps apply to the polished map (markedly noisier points,
  * no gap, not partial). */
 int amscr__polish_steps_apply(const amscr__polish_state *w);

@@ -22,7 +22,9 @@
  * candidates are polished alike and ranked by a two-way trimmed cost, so a noisy
  * symmetric-looking shape gets the start the points favour (the search's further minima of a
  * shape with more than three symmetries are polished and ranked too, for the alternatives, but
- * never become the reported map). When the rougher curve is markedly
+ * never become the reported map; where the polished ranking finds an orientation's lowest starts
+ * alike and the search did not, the stage asks the search for the further minima it held back and
+ * ranks them the same way: amscr__polish_rank_more). When the rougher curve is markedly
  * the noisier, the winner is refined by the order of its points (ordered.c), then by their even
  * spacing where the points bear that out (even.c). Runs on closed
  * curves under affine invariance when the params ask for it (the registration preset does);
@@ -427,10 +429,11 @@ static int has_gap(const curve_t *c)
  * apart (ambiguity at least AMBIGUOUS_SEARCH) — each candidate that differs from all before.
  * may_win[k]: start k may become the reported map (the search's further minima are polished and
  * ranked for the alternatives only). */
-static size_t polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6], unsigned char *may_win)
+static size_t polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6], int *so, unsigned char *may_win)
 {
     size_t count = 1;
     memcpy(S[0], m->X, sizeof S[0]);
+    so[0] = m->reflected;
     may_win[0] = 1;
     for (size_t c = 0; m->ambiguity >= AMBIGUOUS_SEARCH && c < m->ncand; c++) {
         int fresh = 1;
@@ -440,6 +443,7 @@ static size_t polish_starts(const amscr_descriptor *f, const match_t *m, double 
             fresh = amscr__map_gap2(f, m->cand[c], S[k]) > AMSCR__DISTINCT_GAP2;
         if (fresh) {
             may_win[count] = c < m->ncand_base;
+            so[count] = m->cand_o[c];
             memcpy(S[count++], m->cand[c], sizeof S[0]);
         }
     }
@@ -464,15 +468,22 @@ static double polished_ambiguity(const amscr_descriptor *f, double S[][6], const
 struct amscr__polish_state {
     polish_t w;
     const amscr_descriptor *f, *h;
-    double Y[6]; /* the polished map, a -> b in the curves' frames */
+    double Y[6];  /* the polished map, a -> b in the curves' frames */
+    int reranked; /* the match's ranking is the polish's */
 };
 
-/* The re-ranked starts as the match's ranking (the alternatives read it). */
-static void keep_ranking(double S[][6], const double *cost, size_t count, size_t best, match_t *m)
+/* The re-ranked starts as the match's ranking (the alternatives read it); the starts that may
+ * win come first (polish_starts), so they are its lowest minima. */
+static void keep_ranking(double S[][6], const int *so, const unsigned char *may_win, const double *cost, size_t count,
+                         size_t best, match_t *m)
 {
     m->nrank = count;
     m->rank_best = best;
+    m->rank_nbase = 0;
+    while (m->rank_nbase < count && may_win[m->rank_nbase])
+        m->rank_nbase++;
     memcpy(m->rank_X, S, count * sizeof S[0]);
+    memcpy(m->rank_o, so, count * sizeof *so);
     memcpy(m->rank_cost, cost, count * sizeof *cost);
 }
 
@@ -492,12 +503,13 @@ static size_t rank_starts(amscr__polish_state *ps, double S[][6], double Y[][6],
 }
 
 /* Polishes the winner on; returns whether it finished (ps->Y then holds it). */
-static int polish_winner(amscr__polish_state *ps, double S[][6], double Y[][6], const double *cost, size_t count,
-                         size_t best, match_t *m)
+static int polish_winner(amscr__polish_state *ps, double S[][6], const int *so, const unsigned char *may_win,
+                         double Y[][6], const double *cost, size_t count, size_t best, match_t *m)
 {
     if (count > 1) {
         m->ambiguity = polished_ambiguity(ps->f, S, cost, count, best);
-        keep_ranking(S, cost, count, best, m);
+        keep_ranking(S, so, may_win, cost, count, best, m);
+        ps->reranked = 1;
     }
     int done = polish_one(&ps->w, Y[best], POLISH_ITERS - SCORE_ITERS) < INFINITY;
     if (done) {
@@ -533,7 +545,8 @@ amscr_status amscr__polish_fit(const amscr_descriptor *f, const amscr_descriptor
     double S[1 + 2 * AMSCR__CANDIDATES_MAX][6], Y[1 + 2 * AMSCR__CANDIDATES_MAX][6],
         cost[1 + 2 * AMSCR__CANDIDATES_MAX];
     unsigned char may_win[1 + 2 * AMSCR__CANDIDATES_MAX];
-    size_t count = polish_starts(f, m, S, may_win), best = count;
+    int so[1 + 2 * AMSCR__CANDIDATES_MAX];
+    size_t count = polish_starts(f, m, S, so, may_win), best = count;
     int ready = polish_prepare(&ps->w, f, h, m->X, partial);
     if (ready > 0)
         best = rank_starts(ps, S, Y, cost, may_win, count);
@@ -541,7 +554,7 @@ amscr_status amscr__polish_fit(const amscr_descriptor *f, const amscr_descriptor
         amscr__polish_end(ps);
         return amscr__fail(AMSCR_E_NOMEM, "registration polish: out of memory");
     }
-    int done = best < count && polish_winner(ps, S, Y, cost, count, best, m);
+    int done = best < count && polish_winner(ps, S, so, may_win, Y, cost, count, best, m);
     if (ps->w.nomem) {
         amscr__polish_end(ps);
         return amscr__fail(AMSCR_E_NOMEM, "registration polish: out of memory");
@@ -551,6 +564,33 @@ amscr_status amscr__polish_fit(const amscr_descriptor *f, const amscr_descriptor
     else
         amscr__polish_end(ps);
     return AMSCR_OK;
+}
+
+int amscr__polish_reranked(const amscr__polish_state *ps) { return ps && ps->reranked; }
+
+amscr_status amscr__polish_rank_more(amscr__polish_state *ps, double X[][6], size_t n, int o, match_t *m)
+{
+    size_t best = m->rank_best;
+    for (size_t i = 0; i < n && m->nrank < 1 + 2 * AMSCR__CANDIDATES_MAX; i++) {
+        int fresh = 1;
+        for (int k = 0; k < 6; k++)
+            fresh = fresh && isfinite(X[i][k]);
+        for (size_t k = 0; k < m->nrank && fresh; k++)
+            fresh = amscr__map_gap2(ps->f, X[i], m->rank_X[k]) > AMSCR__DISTINCT_GAP2;
+        if (!fresh)
+            continue;
+        double Y[6], *S = m->rank_X[m->nrank];
+        to_frames(&ps->w, ps->f, ps->h, X[i], Y);
+        double cost = polish_one(&ps->w, Y, SCORE_ITERS);
+        from_frames(&ps->w, ps->f, ps->h, Y, S);
+        m->rank_o[m->nrank] = o;
+        m->rank_cost[m->nrank++] = cost;
+        if (amscr__map_gap2(ps->f, S, m->rank_X[best]) > AMSCR__DISTINCT_GAP2) { /* polished_ambiguity's term */
+            double r = (m->rank_cost[best] + AMSCR__AMBIGUITY_FLOOR) / (cost + AMSCR__AMBIGUITY_FLOOR);
+            m->ambiguity = r > m->ambiguity ? (r > 1.0 ? 1.0 : r) : m->ambiguity;
+        }
+    }
+    return ps->w.nomem ? amscr__fail(AMSCR_E_NOMEM, "registration polish: out of memory") : AMSCR_OK;
 }
 
 int amscr__polish_steps_apply(const amscr__polish_state *ps)

@@ -8,9 +8,13 @@
  * lowest few local minima of that criterion per orientation are the candidates, each refined to
  * a continuous shift: the lowest AMSCR__CANDIDATES and, in the ranked search (refinement on),
  * when those are distinct maps that all score about as well as the winner (a shape with three
- * or more symmetries), every further one about as low, up to AMSCR__CANDIDATES_MAX — so that each
- * symmetry of a square or a regular star is ranked and listed as an alternative. Open curves have
- * one candidate per orientation (no shift).
+ * or more symmetries), every further local minimum, up to AMSCR__CANDIDATES_MAX — so that each
+ * symmetry of a square or a regular star is ranked (the geometry judges it, not the criterion,
+ * which reads an imperfect symmetry's shift far worse than its map fits) and listed as an
+ * alternative. The further minima of an orientation whose lowest ones did not score alike here
+ * are held as integer shifts: the polish, whose ranking judges them anew, asks for them when it
+ * finds them alike (amscr__search_held). Open curves have one candidate per orientation (no
+ * shift).
  *
  * One ranking rule picks the winner: the lowest score, ties broken by the lower distance, then
  * by the earlier candidate (orientations in order, each one's candidates best criterion first);
@@ -30,12 +34,6 @@
 /* With refinement on, each candidate is scored after at most this many closest-point steps
  * (the winner then gets all of them). */
 #define AMSCR__SCORE_REFINE 2
-/* The ranked search takes a minimum beyond the lowest AMSCR__CANDIDATES when its residual is within
- * AMSCR__PRUNE_RATIO of the best one's plus this share of the smoothed target's energy (an RMS
- * misfit of 2 % of the RMS radius). The criterion sees a fractional shift through band-limited
- * interpolation, which blurs sharp corners: at the twelve equal minima of a clean 12-pointed star
- * it reads residuals up to 1.4e-4 of the energy where the best reads 0. */
-#define AMSCR__EXTRA_FLOOR (0.02 * 0.02)
 
 /* The search criterion: minus the explained part of the stacked smoothed least-squares
  * problem, -tr(C S^-1 C^T) with C = Σ_k R_k(s) (2x2) and S = Σ_k S_k over all scales (or the
@@ -262,50 +260,26 @@ typedef struct {
     double s;
 } start_t;
 
-/* The smoothed target's energy Σ_k |h_k|^2 without its mean (Parseval, the criterion's gains):
- * the residual at a shift is this plus the criterion (f is centred: its mean explains nothing). */
-static double smoothed_energy(const amscr_descriptor *f, const amscr_descriptor *h, int use_finest)
-{
-    size_t n = f->n;
-    const double *gain = use_finest ? f->gain + f->finest * n : f->gain + f->p * n;
-    const double *Hx = h->spec, *Hy = h->spec + 2 * n;
-    double e = 0.0;
-    for (size_t w = 1; w < n; w++)
-        e += gain[w] * (Hx[2 * w] * Hx[2 * w] + Hx[2 * w + 1] * Hx[2 * w + 1] + Hy[2 * w] * Hy[2 * w] +
-                        Hy[2 * w + 1] * Hy[2 * w + 1]);
-    return e / (double)n;
-}
-
-/* Whether a further minimum (beyond the lowest AMSCR__CANDIDATES of its orientation) of criterion
- * `crit` is about as low as the lowest criterion `best`: its residual (energy e plus the
- * criterion) within AMSCR__PRUNE_RATIO of the best residual, plus AMSCR__EXTRA_FLOOR of e. */
-static int about_as_good(double crit, double best, double e)
-{
-    double r = e + crit, r0 = e + best;
-    return r <= AMSCR__PRUNE_RATIO * (r0 > 0.0 ? r0 : 0.0) + AMSCR__EXTRA_FLOOR * e;
-}
-
 /* The candidates of f -> h, in ranking order of ties (orientation, then criterion). Closed
- * curves: per orientation the lowest local minima of the criterion refined to a continuous
- * shift; `prune` drops those far above the orientation's best (criterion ranking). Those are
- * the first *nbase; without `prune` (the ranked search) further ones follow (orientation, then
- * criterion): where an orientation's lowest AMSCR__CANDIDATES minima are alike (each
- * about_as_good as the lowest of all), every further minimum of it that is about_as_good too, up
- * to AMSCR__CANDIDATES_MAX per orientation — the symmetries of a shape with more than three, which
- * the ranking takes when their base candidates score alike (further_alike). On return ws->P
- * holds orientation `norient - 1`'s spectra; crit[i] is candidate i's criterion. */
+ * curves: per orientation the lowest AMSCR__CANDIDATES local minima of the criterion refined to
+ * a continuous shift; `prune` drops those far above the orientation's best (criterion ranking).
+ * Without `prune` (the ranked search) each orientation's further minima, up to
+ * AMSCR__CANDIDATES_MAX in all, lowest first, are held in s as integer shifts: the symmetries of
+ * a shape with more than three, refined and ranked only when the orientation's lowest minima
+ * score alike (score_held). On return ws->P holds orientation `norient - 1`'s spectra; crit[i]
+ * is candidate i's criterion. */
 static size_t collect_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                             int prune, amscr_workspace *ws, start_t *out, double *crit, size_t *nbase)
+                             int prune, amscr_workspace *ws, start_t *out, double *crit, amscr__search *s)
 {
     int norient = prm->reflections ? 2 : 1, use_finest = prm->method == AMSCR_METHOD_ACMA;
     size_t n = f->n, count = 0;
+    s->nheld = 0;
     if (!f->params.closed) {
         for (int o = 0; o < norient; o++) {
             out[count].o = o;
             out[count].s = 0.0;
             crit[count++] = 0.0;
         }
-        *nbase = count;
         return count;
     }
     double Si[4];
@@ -313,37 +287,24 @@ static size_t collect_starts(const amscr_params *prm, const amscr_descriptor *f,
     /* The residual is Σ_k |h_k|^2 + criterion; Σ_k |h_k|^2 is bounded by p |h|^2. The pruning
      * test allows a rounding-sized 1e-12 of it so that equal residuals always stay in. */
     double hk2 = (use_finest ? 1.0 : (double)f->p) * h->norm2;
-    size_t cap = prune ? AMSCR__CANDIDATES : AMSCR__CANDIDATES_MAX, nfur = 0;
-    start_t fur[2 * (AMSCR__CANDIDATES_MAX - AMSCR__CANDIDATES)];
-    double fur_crit[2 * (AMSCR__CANDIDATES_MAX - AMSCR__CANDIDATES)];
-    double best = INFINITY, e = prune ? 0.0 : smoothed_energy(f, h, use_finest);
+    size_t cap = prune ? AMSCR__CANDIDATES : AMSCR__CANDIDATES_MAX;
     for (int o = 0; o < norient; o++) {
         shift_criterion(f, h, o, use_finest, Si, ws);
         size_t cand[AMSCR__CANDIDATES_MAX];
-        size_t nc = integer_candidates(ws, n, cap, cand), first = count;
+        size_t nc = integer_candidates(ws, n, cap, cand);
         double r0 = ws->crit[cand[0]] + hk2;
         for (size_t c = 0; c < nc && c < AMSCR__CANDIDATES; c++) {
             if (prune && c > 0 && ws->crit[cand[c]] + hk2 > AMSCR__PRUNE_RATIO * r0 + 1e-12 * hk2)
                 break;
             out[count].o = o;
             out[count].s = refine_shift(f, use_finest, Si, ws, cand[c], &crit[count]);
-            best = fmin(best, crit[count++]);
+            count++;
         }
-        int alike = nc > AMSCR__CANDIDATES;
-        for (size_t i = first; alike && i < count; i++)
-            alike = about_as_good(crit[i], best, e);
-        for (size_t c = AMSCR__CANDIDATES; alike && c < nc; c++) {
-            fur[nfur].o = o;
-            fur[nfur].s = refine_shift(f, use_finest, Si, ws, cand[c], &fur_crit[nfur]);
-            nfur += about_as_good(fur_crit[nfur], best, e);
+        for (size_t c = AMSCR__CANDIDATES; c < nc; c++) {
+            s->held_i[s->nheld] = cand[c];
+            s->held_o[s->nheld++] = o;
         }
     }
-    *nbase = count;
-    for (size_t i = 0; i < nfur; i++) /* the first orientation's against the best of both */
-        if (about_as_good(fur_crit[i], best, e)) {
-            out[count] = fur[i];
-            crit[count++] = fur_crit[i];
-        }
     return count;
 }
 
@@ -413,21 +374,47 @@ static amscr_status score_starts(const amscr_params *prm, const amscr_descriptor
     return AMSCR_OK;
 }
 
-/* Whether the ranked search also scores orientation o's further minima: its lowest
- * AMSCR__CANDIDATES (among the first s->nbase) are distinct maps that all scored about as well as
- * the winner, by the alternatives' tests — a shape with three or more symmetries, which may have
- * more (the search's ambiguity is then at least AMSCR__ALT_RATIO already). */
-static int further_alike(const amscr_descriptor *f, const amscr__search *s, int o)
+/* The held further minima of orientation o refined to a continuous shift (its criterion
+ * computed again: ws->crit holds the last orientation's, and ws->P may hold anything after the
+ * search) and scored into s after its other candidates; they are no longer held. */
+static amscr_status score_held(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                               amscr_workspace *ws, amscr__search *s, int o)
 {
-    double best = s->score[s->best] + AMSCR__AMBIGUITY_FLOOR;
-    size_t k = 0;
-    for (size_t i = 0; i < s->nbase; i++) {
-        if (s->o[i] != o)
+    int use_finest = prm->method == AMSCR_METHOD_ACMA, ready = 0;
+    double Si[4], crit[2 * AMSCR__CANDIDATES_MAX];
+    size_t from = s->count, kept = 0;
+    crit_matrix(f, use_finest, prm->invariance != AMSCR_INVARIANCE_AFFINE, Si);
+    for (size_t i = 0; i < s->nheld; i++) {
+        if (s->held_o[i] != o) {
+            s->held_i[kept] = s->held_i[i];
+            s->held_o[kept++] = s->held_o[i];
             continue;
-        if (!(best / (s->score[i] + AMSCR__AMBIGUITY_FLOOR) >= AMSCR__ALT_RATIO))
+        }
+        if (!ready) {
+            shift_criterion(f, h, o, use_finest, Si, ws);
+            s->prepared_o = o;
+            ready = 1;
+        }
+        s->o[s->count] = o;
+        s->s[s->count] = refine_shift(f, use_finest, Si, ws, s->held_i[i], &crit[s->count]);
+        s->count++;
+    }
+    s->nheld = kept;
+    return score_starts(prm, f, h, crit, from, ws, s);
+}
+
+int amscr__lowest_alike(const amscr_descriptor *f, double X[][6], const int *ro, const double *cost, size_t nbase,
+                        size_t best, int o)
+{
+    double c0 = cost[best] + AMSCR__AMBIGUITY_FLOOR;
+    size_t k = 0;
+    for (size_t i = 0; i < nbase; i++) {
+        if (ro[i] != o)
+            continue;
+        if (!(c0 / (cost[i] + AMSCR__AMBIGUITY_FLOOR) >= AMSCR__ALT_RATIO))
             return 0;
         for (size_t j = 0; j < i; j++)
-            if (s->o[j] == o && !(amscr__map_gap2(f, s->X[i], s->X[j]) > AMSCR__DISTINCT_GAP2))
+            if (ro[j] == o && !(amscr__map_gap2(f, X[i], X[j]) > AMSCR__DISTINCT_GAP2))
                 return 0;
         k++;
     }
@@ -441,12 +428,11 @@ amscr_status amscr__search_starts(const amscr_params *prm, const amscr_descripto
     if (st != AMSCR_OK)
         return st;
     s->kind = !f->params.closed ? SCORE_METHOD : prm->refine > 0 ? SCORE_GEOMETRY : SCORE_CRITERION;
-    start_t starts[2 * AMSCR__CANDIDATES_MAX];
-    double crit[2 * AMSCR__CANDIDATES_MAX];
-    size_t nbase, total;
+    start_t starts[2 * AMSCR__CANDIDATES];
+    double crit[2 * AMSCR__CANDIDATES];
     STAGE_T0;
-    total = collect_starts(prm, f, h, s->kind == SCORE_CRITERION, ws, starts, crit, &nbase);
-    for (size_t i = 0; i < total; i++) {
+    size_t nbase = collect_starts(prm, f, h, s->kind == SCORE_CRITERION, ws, starts, crit, s);
+    for (size_t i = 0; i < nbase; i++) {
         s->s[i] = starts[i].s;
         s->o[i] = starts[i].o;
     }
@@ -454,16 +440,9 @@ amscr_status amscr__search_starts(const amscr_params *prm, const amscr_descripto
     s->prepared_o = (prm->reflections ? 2 : 1) - 1;
     s->best = 0;
     st = score_starts(prm, f, h, crit, 0, ws, s);
-    if (st == AMSCR_OK && total > nbase) { /* the further minima of the orientations that need them */
-        int want[2] = {further_alike(f, s, 0), further_alike(f, s, 1)};
-        for (size_t i = nbase; i < total; i++)
-            if (want[starts[i].o]) {
-                s->s[s->count] = starts[i].s;
-                s->o[s->count] = starts[i].o;
-                crit[s->count++] = crit[i];
-            }
-        st = score_starts(prm, f, h, crit, nbase, ws, s);
-    }
+    for (int o = 0; o < 2 && st == AMSCR_OK && s->nheld; o++) /* the further minima of a symmetric shape */
+        if (amscr__lowest_alike(f, s->X, s->o, s->score, s->nbase, s->best, o))
+            st = score_held(prm, f, h, ws, s, o);
     STAGE_MARK(ws, 0);
     return st;
 }
@@ -477,10 +456,13 @@ static void keep_ranking(const amscr_descriptor *f, const amscr__search *s, matc
     m->ncand_base = ranked ? s->nbase : 0;
     m->nrank = m->ncand;
     m->rank_best = s->best;
+    m->rank_nbase = m->ncand_base;
     if (!m->ncand)
         return;
     memcpy(m->cand, s->X, s->count * sizeof s->X[0]);
+    memcpy(m->cand_o, s->o, s->count * sizeof s->o[0]);
     memcpy(m->rank_X, s->X, s->count * sizeof s->X[0]);
+    memcpy(m->rank_o, s->o, s->count * sizeof s->o[0]);
     memcpy(m->rank_cost, s->score, s->count * sizeof s->score[0]);
 }
 
@@ -495,6 +477,17 @@ amscr_status amscr__method_at(const amscr_params *prm, const amscr_descriptor *f
     if (!isfinite(m->dist))
         return amscr__fail(AMSCR_E_NUMERIC, "registration: non-finite distance");
     return AMSCR_OK;
+}
+
+amscr_status amscr__search_held(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                amscr_workspace *ws, amscr__search *s, int o, double X[][6], size_t *out_n)
+{
+    size_t from = s->count;
+    amscr_status st = score_held(prm, f, h, ws, s, o);
+    *out_n = st == AMSCR_OK ? s->count - from : 0;
+    if (*out_n)
+        memcpy(X, s->X + from, *out_n * sizeof X[0]);
+    return st;
 }
 
 amscr_status amscr__match_dir(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,

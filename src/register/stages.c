@@ -90,7 +90,33 @@ static amscr_status run_symmetric(stage_ctx *c)
         c->r->m.dist = 0.5 * (c->r->m.dist + back.dist);
     return st;
 }
-static amscr_status run_polish(stage_ctx *c) { return amscr__polish_fit(c->f, c->h, c->prm->partial, &c->r->m, &c->pol); }
+/* The polish's ranking judges anew whether an orientation's lowest minima are alike (a shape with
+ * three or more symmetries): where it finds them alike and the search did not, the further
+ * minima the search held back are ranked too, so that each symmetry is listed. */
+static amscr_status rank_held(stage_ctx *c)
+{
+    match_t *m = &c->r->m;
+    for (int o = 0; o < 2; o++) {
+        double X[2 * AMSCR__CANDIDATES_MAX][6];
+        size_t n = 0;
+        if (!amscr__lowest_alike(c->f, m->rank_X, m->rank_o, m->rank_cost, m->rank_nbase, m->rank_best, o))
+            continue;
+        amscr_status st = amscr__search_held(c->prm, c->f, c->h, c->ws, &c->search, o, X, &n);
+        if (st != AMSCR_OK)
+            return st;
+        st = amscr__polish_rank_more(c->pol, X, n, o, m);
+        if (st != AMSCR_OK)
+            return st;
+    }
+    return AMSCR_OK;
+}
+static amscr_status run_polish(stage_ctx *c)
+{
+    amscr_status st = amscr__polish_fit(c->f, c->h, c->prm->partial, &c->r->m, &c->pol);
+    if (st != AMSCR_OK || c->prm->partial || !amscr__polish_reranked(c->pol) || !c->search.nheld)
+        return st;
+    return rank_held(c);
+}
 static amscr_status run_order(stage_ctx *c) { return amscr__polish_order(c->pol, &c->r->m); }
 static amscr_status run_even(stage_ctx *c) { return amscr__polish_even(c->pol, &c->r->m); }
 static amscr_status run_alternatives(stage_ctx *c)
