@@ -9,15 +9,9 @@
  * Gaussian noise of 1 % and 2 % of the RMS radius. Success: max error over the source points
  * below 2 % of the target's RMS radius (bench/registration_heldout.py's measure).
  *
- * Then traced pairs from 200 x 200 images (the shape ~140 px across; `amscr register`'s path:
- * sub-pixel tracing with AMSCR_TRACE_JOIN, the registration preset): the target drawn under a
- * random affine map (anisotropy up to 2, shear up to 0.5), clean or damaged in the image —
- * segmentation noise (the boundary moved by a smooth field of 1.5 % of the radius, 12 specks),
- * a bite (a disk of 0.3 x radius removed at the boundary), a touching disk of 0.3 x radius.
- * Library time per stage (tracing both, preparing both, the method's search and solves, the rest
- * of amscr_register: recovery, polish, alternatives, correspondences) and per pair; success: RMS
- * error below 2 % of the RMS radius.
- *
+ * Then pairs traced from 200 x 200 images as `amscr register` traces them, the target drawn under
+ * such a map and damaged in the image (segmentation noise, a bite, a touching disk): CPU time of
+ * the library per stage and per pair (traced_pairs).
  *   amscr-registration-bench [--pairs N] [--traced-pairs N] [--seed S]
  *
  * Not a test: it prints numbers (one thread, wall clock, median of the pairs). Run through
@@ -131,261 +125,6 @@ static amscr_contour *make_target(const amscr_contour *src, const double T[6], d
     return c;
 }
 
-/* ------------------------------------------------------------- traced 200-px pairs */
-
-#define TSIDE 200
-
-typedef struct {
-    double a[9], ph[9], limb_dir;
-    int limb;
-} blob;
-
-static double blob_radius(const blob *b, double th)
-{
-    double r = 1.0;
-    for (int k = 2; k <= 8; k++)
-        r += b->a[k] * cos(k * th + b->ph[k]);
-    return r;
-}
-
-/* Whether unit-frame point (x, y) is inside the blob. */
-static int blob_inside(const blob *b, double x, double y)
-{
-    if (hypot(x, y) < blob_radius(b, atan2(y, x)))
-        return 1;
-    double ux = cos(b->limb_dir), uy = sin(b->limb_dir), along = x * ux + y * uy;
-    return b->limb && along > 0.0 && along < 1.6 && fabs(-x * uy + y * ux) < 0.06;
-}
-
-/* The blob under linear map L (2x2) drawn into a TSIDE^2 mask, ~140 px across: pixel = s L u + o.
- * Fills T6 (unit frame -> pixels). */
-static void draw_blob(const blob *b, const double L[4], uint8_t *mask, double T6[6])
-{
-    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-    for (int t = 0; t < 1440 + 4; t++) {
-        double x, y;
-        if (t < 1440) {
-            double th = TWO_PI * t / 1440.0, r = blob_radius(b, th);
-            x = r * cos(th), y = r * sin(th);
-        } else if (b->limb) {
-            double ux = cos(b->limb_dir), uy = sin(b->limb_dir), w = (t & 1) ? 0.06 : -0.06;
-            x = 1.6 * ux - w * uy, y = 1.6 * uy + w * ux;
-        } else
-            continue;
-        double u = L[0] * x + L[1] * y, v = L[2] * x + L[3] * y;
-        lo[0] = fmin(lo[0], u), hi[0] = fmax(hi[0], u), lo[1] = fmin(lo[1], v), hi[1] = fmax(hi[1], v);
-    }
-    double sc = 140.0 / fmax(hi[0] - lo[0], hi[1] - lo[1]);
-    double ox = 0.5 * TSIDE - sc * 0.5 * (lo[0] + hi[0]), oy = 0.5 * TSIDE - sc * 0.5 * (lo[1] + hi[1]);
-    double T[6] = {sc * L[0], sc * L[1], ox, sc * L[2], sc * L[3], oy}, det = T[0] * T[4] - T[1] * T[3];
-    for (int y = 0; y < TSIDE; y++)
-        for (int x = 0; x < TSIDE; x++) {
-            double dx = x - ox, dy = y - oy; /* inverse map to the unit frame */
-            double ux = (T[4] * dx - T[1] * dy) / det, uy = (-T[3] * dx + T[0] * dy) / det;
-            mask[(size_t)y * TSIDE + x] = blob_inside(b, ux, uy) ? 255 : 0;
-        }
-    memcpy(T6, T, sizeof T);
-}
-
-/* Radius sqrt(area / pi) and centroid of a mask's foreground. */
-static double mask_radius(const uint8_t *m, double *cx, double *cy)
-{
-    double n = 0, sx = 0, sy = 0;
-    for (int y = 0; y < TSIDE; y++)
-        for (int x = 0; x < TSIDE; x++)
-            if (m[(size_t)y * TSIDE + x])
-                n++, sx += x, sy += y;
-    *cx = sx / n, *cy = sy / n;
-    return sqrt(n / 3.141592653589793);
-}
-
-static void disk(uint8_t *m, double cx, double cy, double r, uint8_t v)
-{
-    for (int y = 0; y < TSIDE; y++)
-        for (int x = 0; x < TSIDE; x++)
-            if (hypot(x - cx, y - cy) <= r)
-                m[(size_t)y * TSIDE + x] = v;
-}
-
-/* Damage 1 noise (a smooth field moving the boundary by ~1.5 % of R, 12 specks), 2 bite,
- * 3 touching disk, in the target mask. */
-static void damage(uint8_t *m, int kind)
-{
-    double cx, cy, R = mask_radius(m, &cx, &cy);
-    if (kind == 1) {
-        uint8_t *o = malloc((size_t)TSIDE * TSIDE);
-        memcpy(o, m, (size_t)TSIDE * TSIDE);
-        double a[4], ph[4], e = 0.015 * R;
-        for (int k = 0; k < 4; k++)
-            a[k] = gauss(), ph[k] = TWO_PI * uni();
-        for (int y = 1; y < TSIDE - 1; y++)
-            for (int x = 1; x < TSIDE - 1; x++) { /* shift the boundary by the field along the radius */
-                double th = atan2(y - cy, x - cx), f = 0.0;
-                for (int k = 0; k < 4; k++)
-                    f += a[k] * cos((5 + 3 * k) * th + ph[k]) * 0.5;
-                double d = e * f, ex = cos(th) * d, ey = sin(th) * d;
-                int sx = (int)lround(x - ex), sy = (int)lround(y - ey);
-                if (sx >= 0 && sx < TSIDE && sy >= 0 && sy < TSIDE)
-                    m[(size_t)y * TSIDE + x] = o[(size_t)sy * TSIDE + sx];
-            }
-        free(o);
-        for (int k = 0; k < 12; k++) {
-            double x = TSIDE * uni(), y = TSIDE * uni();
-            if (!m[(size_t)(int)y * TSIDE + (int)x] && hypot(x - cx, y - cy) > 1.5 * R)
-                disk(m, x, y, 1.0 + uni(), 255);
-        }
-        return;
-    }
-    /* a boundary point in a random direction from the centroid */
-    double th = TWO_PI * uni(), ux = cos(th), uy = sin(th), t = 0.0;
-    for (double s = 0.0; s < TSIDE; s += 0.5) {
-        int x = (int)lround(cx + s * ux), y = (int)lround(cy + s * uy);
-        if (x < 0 || y < 0 || x >= TSIDE || y >= TSIDE)
-            break;
-        if (m[(size_t)y * TSIDE + x])
-            t = s;
-    }
-    double bx = cx + t * ux, by = cy + t * uy, r = 0.3 * R;
-    if (kind == 2)
-        disk(m, bx, by, r, 0);
-    else
-        disk(m, bx + r * ux, by + r * uy, r, 255);
-}
-
-static int cmp_double(const void *a, const void *b);
-static double median(double *v, size_t n);
-
-/* RMS over the source contour of |M p - T p| over the RMS radius of T(src). */
-static double rms_error(const double M[6], const double T[6], const amscr_contour *src)
-{
-    const double *xy = amscr_contour_xy(src);
-    size_t n = amscr_contour_size(src);
-    double s = 0.0, *tp = malloc(2 * n * sizeof *tp);
-    for (size_t i = 0; i < n; i++) {
-        double a, b;
-        apply(M, xy[2 * i], xy[2 * i + 1], &a, &b);
-        apply(T, xy[2 * i], xy[2 * i + 1], &tp[2 * i], &tp[2 * i + 1]);
-        s += (a - tp[2 * i]) * (a - tp[2 * i]) + (b - tp[2 * i + 1]) * (b - tp[2 * i + 1]);
-    }
-    double e = sqrt(s / (double)n) / rms_radius(tp, n);
-    free(tp);
-    return e;
-}
-
-/* Thread CPU seconds: the machine may be shared, and every call here runs on this thread. */
-static double cpu_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-/* Seconds of amscr_register with the recovery and the polish as given; *r the result (or NULL). */
-static double cpu_register(amscr_params *p, int recovery, int polish, const amscr_descriptor *a,
-                           const amscr_descriptor *d, amscr_workspace *ws, amscr_result **r)
-{
-    amscr_result *own = NULL;
-    if (amscr_params_set_stage(p, "recovery", recovery) != AMSCR_OK || amscr_params_set_polish(p, polish) != AMSCR_OK)
-        return NAN;
-    double t0 = cpu_now();
-    amscr_status st = amscr_register(p, a, d, ws, r ? r : &own);
-    double t = cpu_now() - t0;
-    amscr_result_free(own);
-    return st == AMSCR_OK ? t : NAN;
-}
-
-/* The traced pairs' table: `pairs` per condition. */
-static void traced_pairs(size_t pairs)
-{
-    static const char *names[4] = {"clean", "seg. noise", "bite 0.3R", "touch 0.3R"};
-    enum { NT = 6 }; /* trace, prepare, register bare, the recovery, the polish, pair */
-    amscr_params *p = NULL;
-    amscr_workspace *ws = NULL;
-    if (amscr_params_new_registration(&p) != AMSCR_OK || amscr_workspace_new(&ws) != AMSCR_OK)
-        return;
-    printf("\ntraced pairs, %d x %d px images (shape ~140 px across), sub-pixel tracing with join, registration\n"
-           "preset, %zu pairs per condition, one thread, median (pair: [90th percentile, max]) CPU time of the\n"
-           "library calls; register bare: without the recovery and the polish; recovery, polish: what each adds:\n",
-           TSIDE, TSIDE, pairs);
-    printf("  %-11s %6s %8s %8s %8s %8s %8s %25s %7s %8s\n", "condition", "points", "trace", "prepare", "reg.bare",
-           "recovery", "polish", "pair [p90, max]", "recov.", "ok (RMS)");
-    uint8_t *ms = malloc((size_t)TSIDE * TSIDE), *mt = malloc((size_t)TSIDE * TSIDE);
-    for (int c = 0; c < 4; c++) {
-        double *v[NT];
-        for (int i = 0; i < NT; i++)
-            v[i] = calloc(pairs, sizeof(double));
-        size_t done = 0, ok = 0, npts = 0, recov = 0;
-        for (size_t k = 0; k < pairs; k++) {
-            blob b;
-            for (int j = 2; j <= 8; j++)
-                b.a[j] = (0.25 / j) * uni(), b.ph[j] = TWO_PI * uni();
-            b.limb = uni() < 0.5;
-            b.limb_dir = TWO_PI * uni();
-            double I[4] = {1, 0, 0, 1}, L[4], A6[6], Ts[6], Tt[6];
-            random_affine(A6);
-            L[0] = A6[0], L[1] = A6[1], L[2] = A6[3], L[3] = A6[4];
-            draw_blob(&b, I, ms, Ts);
-            draw_blob(&b, L, mt, Tt);
-            if (c > 0)
-                damage(mt, c);
-            amscr_contour *src = NULL, *tgt = NULL;
-            amscr_descriptor *a = NULL, *d = NULL;
-            amscr_result *r = NULL;
-            double t0 = cpu_now();
-            int good = amscr_contour_from_image(ms, TSIDE, TSIDE, TSIDE, 8, 127.5, AMSCR_TRACE_JOIN, &src) == AMSCR_OK &&
-                       amscr_contour_from_image(mt, TSIDE, TSIDE, TSIDE, 8, 127.5, AMSCR_TRACE_JOIN, &tgt) == AMSCR_OK;
-            double t1 = cpu_now();
-            good = good && amscr_descriptor_new(p, src, &a) == AMSCR_OK && amscr_descriptor_new(p, tgt, &d) == AMSCR_OK;
-            double t2 = cpu_now(), M[6], bare = NAN, norec = NAN, full = NAN;
-            if (good) {
-                bare = cpu_register(p, 0, 0, a, d, ws, NULL);
-                norec = cpu_register(p, 1, 0, a, d, ws, NULL);
-                full = cpu_register(p, 1, 1, a, d, ws, &r); /* the preset */
-            }
-            if (good && r && isfinite(bare + norec + full)) {
-                /* the true map source pixels -> target pixels: Tt Ts^-1 */
-                double det = Ts[0] * Ts[4] - Ts[1] * Ts[3], Si[6] = {Ts[4] / det, -Ts[1] / det, 0, -Ts[3] / det,
-                                                                      Ts[0] / det, 0};
-                Si[2] = -(Si[0] * Ts[2] + Si[1] * Ts[5]), Si[5] = -(Si[3] * Ts[2] + Si[4] * Ts[5]);
-                double T[6] = {Tt[0] * Si[0] + Tt[1] * Si[3], Tt[0] * Si[1] + Tt[1] * Si[4],
-                               Tt[0] * Si[2] + Tt[1] * Si[5] + Tt[2], Tt[3] * Si[0] + Tt[4] * Si[3],
-                               Tt[3] * Si[1] + Tt[4] * Si[4], Tt[3] * Si[2] + Tt[4] * Si[5] + Tt[5]};
-                ok += amscr_result_affine(r, M) == AMSCR_OK && rms_error(M, T, src) < 0.02;
-                for (size_t i = 0; i < amscr_result_num_stages(r); i++) {
-                    const char *nm = NULL;
-                    int ran = 0;
-                    if (amscr_result_stage(r, i, &nm, &ran) == AMSCR_OK && nm && !strcmp(nm, "recovery"))
-                        recov += (size_t)ran;
-                }
-                v[0][done] = t1 - t0, v[1][done] = t2 - t1, v[2][done] = bare, v[3][done] = norec - bare;
-                v[4][done] = full - norec, v[5][done] = t2 - t0 + full;
-                npts += amscr_contour_size(src) + amscr_contour_size(tgt);
-                done++;
-            }
-            amscr_result_free(r);
-            amscr_descriptor_free(a);
-            amscr_descriptor_free(d);
-            amscr_contour_free(src);
-            amscr_contour_free(tgt);
-        }
-        if (done) {
-            double q[NT];
-            for (int i = 0; i < NT; i++)
-                q[i] = median(v[i], done); /* sorts v[i] */
-            printf("  %-11s %6zu %5.2f ms %5.2f ms %5.2f ms %5.2f ms %5.2f ms %6.2f [%6.2f, %6.2f] ms %7zu %7.1f %%\n",
-                   names[c], npts / (2 * done), 1e3 * q[0], 1e3 * q[1], 1e3 * q[2], 1e3 * q[3], 1e3 * q[4],
-                   1e3 * q[5], 1e3 * v[5][(size_t)(0.9 * (double)(done - 1) + 0.5)], 1e3 * v[5][done - 1], recov,
-                   100.0 * (double)ok / (double)done);
-        }
-        for (int i = 0; i < NT; i++)
-            free(v[i]);
-    }
-    free(ms);
-    free(mt);
-    amscr_workspace_free(ws);
-    amscr_params_free(p);
-}
-
 static double map_error(const double M[6], const double T[6], const amscr_contour *src, double size)
 {
     const double *xy = amscr_contour_xy(src);
@@ -426,6 +165,159 @@ static double timed_register(amscr_params *p, int polish, const amscr_descriptor
     *ok = st == AMSCR_OK && amscr_result_affine(r, M) == AMSCR_OK && map_error(M, T, src, size) < 0.02;
     amscr_result_free(r);
     return t;
+}
+
+/* ------------------------------------------------------------- traced 200-px pairs */
+#define TSIDE 200
+typedef struct { double a[13], ph[13], dir; int limb; } blob; /* random_silhouette's; 9..12: noise */
+
+static int blob_inside(const blob *b, double x, double y)
+{
+    double r = 1.0, th = atan2(y, x), ux = cos(b->dir), uy = sin(b->dir), along = x * ux + y * uy;
+    for (int k = 2; k <= 12; k++)
+        r += b->a[k] * cos(k * th + b->ph[k]);
+    return hypot(x, y) < r || (b->limb && along > 0.0 && along < 1.6 && fabs(-x * uy + y * ux) < 0.06);
+}
+
+/* The blob under the linear map L drawn into a TSIDE^2 mask, fitted to 140 px; T: unit -> px. */
+static void draw_blob(const blob *b, const double L[4], uint8_t *m, double T[6])
+{
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (int y = -170; y <= 170; y++) /* the bounding box of its image, on a grid of the unit frame */
+        for (int x = -170; x <= 170; x++)
+            if (blob_inside(b, x / 100.0, y / 100.0))
+                for (int d = 0; d < 2; d++) {
+                    double u = L[2 * d] * x / 100.0 + L[2 * d + 1] * y / 100.0;
+                    lo[d] = fmin(lo[d], u), hi[d] = fmax(hi[d], u);
+                }
+    double sc = 140.0 / fmax(hi[0] - lo[0], hi[1] - lo[1]), det = L[0] * L[3] - L[1] * L[2];
+    T[0] = sc * L[0], T[1] = sc * L[1], T[2] = 0.5 * (TSIDE - sc * (lo[0] + hi[0]));
+    T[3] = sc * L[2], T[4] = sc * L[3], T[5] = 0.5 * (TSIDE - sc * (lo[1] + hi[1]));
+    for (int i = 0; i < TSIDE * TSIDE; i++) {
+        double dx = (i % TSIDE - T[2]) / sc, dy = (i / TSIDE - T[5]) / sc;
+        m[i] = blob_inside(b, (L[3] * dx - L[1] * dy) / det, (-L[2] * dx + L[0] * dy) / det) ? 255 : 0;
+    }
+}
+
+static void disk(uint8_t *m, double cx, double cy, double r, uint8_t v)
+{
+    for (int i = 0; i < TSIDE * TSIDE; i++)
+        m[i] = hypot(i % TSIDE - cx, i / TSIDE - cy) <= r ? v : m[i];
+}
+
+/* Damage 1: 12 specks (with the noise harmonics); 2: a bite, 3: a touching disk of 0.3 R
+ * (R = sqrt(area / pi)) at the boundary. */
+static void damage(uint8_t *m, int kind)
+{
+    double n = 0, cx = 0, cy = 0, th = TWO_PI * uni(), t = 0.0;
+    for (int i = 0; i < TSIDE * TSIDE; i++)
+        if (m[i])
+            n++, cx += i % TSIDE, cy += i / TSIDE;
+    cx /= n, cy /= n;
+    double R = sqrt(n / 3.141592653589793), ux = cos(th), uy = sin(th);
+    for (int k = 0; kind == 1 && k < 12; k++) {
+        double x = TSIDE * uni(), y = TSIDE * uni(), rs = 1.0 + uni();
+        disk(m, x, y, hypot(x - cx, y - cy) > 1.5 * R ? rs : -1.0, 255);
+    }
+    if (kind == 1)
+        return;
+    for (double r = 0.0; r < TSIDE; r += 0.5) { /* the outermost boundary point in direction th */
+        int x = (int)lround(cx + r * ux), y = (int)lround(cy + r * uy);
+        if (x >= 0 && y >= 0 && x < TSIDE && y < TSIDE && m[y * TSIDE + x])
+            t = r;
+    }
+    double r = 0.3 * R, off = kind == 2 ? 0.0 : r; /* a bite centred on the boundary, a disk touching it */
+    disk(m, cx + (t + off) * ux, cy + (t + off) * uy, r, kind == 2 ? 0 : 255);
+}
+
+static double cpu_now(void) /* thread CPU seconds: every call timed runs on this thread */
+{
+    struct timespec t;
+    return clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t) == 0 ? (double)t.tv_sec + 1e-9 * (double)t.tv_nsec : NAN;
+}
+
+/* Seconds of amscr_register with the recovery and the polish on or off; the result into *r. */
+static double cpu_register(amscr_params *p, int rec, int pol, const amscr_descriptor *a, const amscr_descriptor *d,
+                           amscr_workspace *ws, amscr_result **r)
+{
+    amscr_result_free(*r), *r = NULL;
+    double t0 = cpu_now();
+    int ok = amscr_params_set_stage(p, "recovery", rec) == AMSCR_OK && amscr_params_set_polish(p, pol) == AMSCR_OK &&
+             amscr_register(p, a, d, ws, r) == AMSCR_OK;
+    return ok ? cpu_now() - t0 : NAN;
+}
+
+/* The traced pairs' table, `pairs` a condition (the table of docs/measurements.md). */
+static void traced_pairs(size_t pairs)
+{
+    static const char *names[4] = {"clean", "seg. noise", "bite 0.3R", "touch 0.3R"};
+    amscr_params *p = NULL;
+    amscr_workspace *ws = NULL;
+    uint8_t *ms = malloc(TSIDE * TSIDE), *mt = malloc(TSIDE * TSIDE);
+    double *v = malloc(6 * pairs * sizeof *v); /* trace, prepare, bare, recovery, polish, pair */
+    if (amscr_params_new_registration(&p) != AMSCR_OK || amscr_workspace_new(&ws) != AMSCR_OK || !ms || !mt || !v)
+        return; /* (a benchmark: leaks on failure) */
+    printf("\npairs traced from %d px images (shape 140 px across), registration preset, %zu pairs a condition, one\n"
+           "thread, median (pair: [90th percentile, max]) CPU time of the library calls; bare: no recovery, no polish:\n",
+           TSIDE, pairs);
+    printf("  %-10s %6s %8s %8s %8s %8s %8s %24s %6s %7s\n", "condition", "points", "trace", "prepare", "bare",
+           "recovery", "polish", "pair [p90, max]", "recov", "ok");
+    for (int c = 0; c < 4; c++) {
+        size_t done = 0, ok = 0, npts = 0, recov = 0;
+        for (size_t k = 0; k < pairs; k++) {
+            blob b = {{0}, {0}, 0.0, 0};
+            for (int j = 2; j <= 8; j++)
+                b.a[j] = (0.25 / j) * uni(), b.ph[j] = TWO_PI * uni();
+            b.limb = uni() < 0.5, b.dir = TWO_PI * uni();
+            double I[4] = {1, 0, 0, 1}, A[6], Ts[6], Tt[6], M[6], t[6];
+            random_affine(A);
+            double L[4] = {A[0], A[1], A[3], A[4]};
+            draw_blob(&b, I, ms, Ts);
+            for (int j = 9; c == 1 && j <= 12; j++) /* the boundary moved by ~1.5 % of the radius */
+                b.a[j] = 0.0075 * gauss(), b.ph[j] = TWO_PI * uni();
+            draw_blob(&b, L, mt, Tt);
+            if (c > 0)
+                damage(mt, c);
+            amscr_contour *src = NULL, *tgt = NULL;
+            amscr_descriptor *a = NULL, *d = NULL;
+            amscr_result *r = NULL;
+            t[0] = cpu_now(); /* the library's calls: trace both, prepare both, register 3 ways */
+            int good = amscr_contour_from_image(ms, TSIDE, TSIDE, TSIDE, 8, 127.5, AMSCR_TRACE_JOIN, &src) == AMSCR_OK &&
+                       amscr_contour_from_image(mt, TSIDE, TSIDE, TSIDE, 8, 127.5, AMSCR_TRACE_JOIN, &tgt) == AMSCR_OK;
+            t[1] = cpu_now();
+            good = good && amscr_descriptor_new(p, src, &a) == AMSCR_OK && amscr_descriptor_new(p, tgt, &d) == AMSCR_OK;
+            t[2] = cpu_now();
+            for (int i = 0; i < 3; i++) /* bare, with the recovery, the preset (with the polish too) */
+                t[3 + i] = good ? cpu_register(p, i > 0, i > 1, a, d, ws, &r) : NAN;
+            if (isfinite(t[3] + t[4] + t[5]) && amscr_result_affine(r, M) == AMSCR_OK) {
+                /* the true map, source px -> target px: Tt Ts^-1 (Ts is a scaling and a shift) */
+                double s = Ts[0], T[6] = {Tt[0] / s, Tt[1] / s, Tt[2] - (Tt[0] * Ts[2] + Tt[1] * Ts[5]) / s,
+                                          Tt[3] / s, Tt[4] / s, Tt[5] - (Tt[3] * Ts[2] + Tt[4] * Ts[5]) / s};
+                double size = sqrt(fabs(T[0] * T[4] - T[1] * T[3])) * rms_radius(amscr_contour_xy(src), amscr_contour_size(src));
+                ok += map_error(M, T, src, size) < 0.02; /* size: the source's RMS radius times the map's scale */
+                const char *nm = NULL;
+                for (int i = 0, ran = 0; i < (int)amscr_result_num_stages(r); i++)
+                    if (amscr_result_stage(r, i, &nm, &ran) == AMSCR_OK && !strcmp(nm, "recovery"))
+                        recov += (size_t)ran;
+                double row[6] = {t[1] - t[0], t[2] - t[1], t[3], t[4] - t[3], t[5] - t[4], t[2] - t[0] + t[5]};
+                for (int i = 0; i < 6; i++)
+                    v[i * pairs + done] = row[i];
+                npts += amscr_contour_size(src) + amscr_contour_size(tgt), done++;
+            }
+            amscr_result_free(r), amscr_descriptor_free(a), amscr_descriptor_free(d);
+            amscr_contour_free(src), amscr_contour_free(tgt);
+        }
+        double q[6] = {0};
+        for (int i = 0; done && i < 6; i++)
+            q[i] = 1e3 * median(v + i * pairs, done); /* sorts that column */
+        if (done)
+            printf("  %-10s %6zu %5.2f ms %5.2f ms %5.2f ms %5.2f ms %5.2f ms %6.2f [%6.2f, %6.2f] ms %6zu %6.1f%%\n",
+                   names[c], npts / (2 * done), q[0], q[1], q[2], q[3], q[4], q[5],
+                   1e3 * v[5 * pairs + (size_t)(0.9 * (double)(done - 1) + 0.5)], 1e3 * v[5 * pairs + done - 1], recov,
+                   100.0 * (double)ok / (double)done);
+    }
+    free(ms), free(mt), free(v);
+    amscr_workspace_free(ws), amscr_params_free(p);
 }
 
 int main(int argc, char **argv)
