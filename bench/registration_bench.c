@@ -183,11 +183,11 @@ static int blob_inside(const blob *b, double x, double y)
 static void draw_blob(const blob *b, const double L[4], uint8_t *m, double T[6])
 {
     double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-    for (int y = -170; y <= 170; y++) /* the bounding box of its image, on a grid of the unit frame */
-        for (int x = -170; x <= 170; x++)
-            if (blob_inside(b, x / 100.0, y / 100.0))
+    for (int y = -85; y <= 85; y++) /* the bounding box of its image, on a grid of the unit frame */
+        for (int x = -85; x <= 85; x++)
+            if (blob_inside(b, x / 50.0, y / 50.0))
                 for (int d = 0; d < 2; d++) {
-                    double u = L[2 * d] * x / 100.0 + L[2 * d + 1] * y / 100.0;
+                    double u = L[2 * d] * x / 50.0 + L[2 * d + 1] * y / 50.0;
                     lo[d] = fmin(lo[d], u), hi[d] = fmax(hi[d], u);
                 }
     double sc = 140.0 / fmax(hi[0] - lo[0], hi[1] - lo[1]), det = L[0] * L[3] - L[1] * L[2];

@@ -259,7 +259,8 @@ double amscr__closest_on_closed(const double *E, size_t n, size_t b0, size_t w, 
 {
     double best = INFINITY;
     size_t cnt = 2 * w + 1 < n ? 2 * w + 1 : n;
-    size_t b = (b0 + n - (cnt == n ? 0 : w % n)) % n, first = n - b < cnt ? n - b : cnt;
+    size_t c0 = b0 < n ? b0 : b0 % n, back = cnt == n ? 0 : w; /* w < n here: no division */
+    size_t b = c0 >= back ? c0 - back : c0 + n - back, first = n - b < cnt ? n - b : cnt;
     closest_run(E, n, b, b + first, px, py, &best, qx, qy, seg); /* up to the wrap */
     closest_run(E, n, 0, cnt - first, px, py, &best, qx, qy, seg);
     return best;
