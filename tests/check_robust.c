@@ -103,7 +103,8 @@ static double confidence_of(const double *s, size_t n, double *out_amb)
     double c = amscr_result_confidence(r);
     *out_amb = amscr_result_ambiguity(r);
     ck_assert(c >= 0.0 && c <= 1.0);
-    ck_assert_double_eq_tol(c, (1.0 - *out_amb) * amscr_result_inlier_fraction(r), 1e-12);
+    double share = fmin(amscr_result_inlier_fraction(r), amscr_result_overlap(r)), fb = amscr_result_backward_error(r);
+    ck_assert_double_eq_tol(c, (1.0 - *out_amb) * share / (1.0 + (isnan(fb) ? 0.0 : pow(fb / 0.01, 2))), 1e-12);
     amscr_result_free(r);
     free(a);
     free(t);
@@ -235,6 +236,85 @@ START_TEST(touching_object_inliers)
 }
 END_TEST
 
+/* A 4-armed cross (arms 1 wide, reaching 3 from the centre; the target's first arm cut to
+ * `cut`), 40 points per edge, the target mapped by R(th) diag(s1, s2) plus (5, 5). */
+static amscr_contour *cross_contour(double cut, double th, double s1, double s2)
+{
+    const double v[24] = {1, -1, cut, -1, cut, 1, 1, 1, 1, 3, -1, 3, -1, 1, -3, 1, -3, -1, -1, -1, -1, -3, 1, -3};
+    double xy[2 * 12 * 40], c = cos(th), s = sin(th);
+    for (int i = 0; i < 12; i++)
+        for (int k = 0; k < 40; k++) {
+            int j = (i + 1) % 12;
+            double t = k / 40.0, x = (v[2 * i] + t * (v[2 * j] - v[2 * i])) * s1,
+                   y = (v[2 * i + 1] + t * (v[2 * j + 1] - v[2 * i + 1])) * s2;
+            xy[2 * (40 * i + k)] = c * x - s * y + 5.0;
+            xy[2 * (40 * i + k) + 1] = s * x + c * y + 5.0;
+        }
+    amscr_contour *ct = NULL;
+    ck_assert_int_eq(amscr_contour_new(xy, 12 * 40, &ct), AMSCR_OK);
+    return ct;
+}
+
+/* A cross whose target lost most of one arm (12 seeded views): every quarter turn fits the
+ * three whole arms, so the registration may answer one a quarter turn off (which turn wins is
+ * decided by rounding: the arms are exactly alike). When the way back lands on another turn,
+ * the forward-backward error is large and the confidence about 0 (either map may be the wrong
+ * one); when the way back agrees, the two compose to the identity (error about 0) and a right
+ * map keeps a high confidence. (Both directions may also agree on the same wrong turn: the
+ * check cannot see that.)
+ * An exact clean pair: overlap 1, no way back needed (NaN). */
+START_TEST(forward_backward_check)
+{
+    amscr_contour *cs = cross_contour(3.0, 0.0, 1.0, 1.0);
+    const double *sxy = amscr_contour_xy(cs);
+    size_t n = amscr_contour_size(cs), caught = 0, confirmed = 0;
+    for (int i = 0; i < 12; i++) {
+        double th = 0.37 + 2.39996 * i, s1 = 0.75 + 0.05 * (i % 7), s2 = 1.3 - 0.06 * (i % 5), cut = 1.4 + 0.07 * i;
+        amscr_contour *ct = cross_contour(cut, th, s1, s2);
+        amscr_result *r = NULL;
+        ck_assert_int_eq(amscr_register_contours(NULL, cs, ct, &r), AMSCR_OK);
+        double M[6], c = cos(th), s = sin(th);
+        double T[6] = {c * s1, -s * s2, 5.0, s * s1, c * s2, 5.0};
+        T[2] -= 5.0 * (T[0] + T[1]); /* the source is the cross shifted by (5, 5) too */
+        T[5] -= 5.0 * (T[3] + T[4]);
+        ck_assert_int_eq(amscr_result_affine(r, M), AMSCR_OK);
+        double err = amscr_test_max_map_error(M, T, sxy, n) / 3.0; /* of the arm's reach */
+        double conf = amscr_result_confidence(r), fb = amscr_result_backward_error(r);
+        double ov = amscr_result_overlap(r), inl = amscr_result_inlier_fraction(r);
+        printf("robust: bitten cross %d: error %.3f, confidence %.3f, overlap %.3f, inliers %.3f, fb %.3g\n", i, err,
+               conf, ov, inl, fb);
+        fflush(stdout);
+        ck_assert(ov > 0.7 && ov < 0.97);
+        if (!isnan(fb) && fb > 0.5) {
+            ck_assert_msg(conf < 0.05, "the way back disagrees: confidence %.3f", conf);
+            caught += err > 0.5;
+        }
+        if (!isnan(fb) && fb <= 0.5) { /* the way back agrees: exactly, on noise-free contours */
+            ck_assert_msg(fb < 1e-6, "the way back agrees: fb %.3g", fb);
+            if (err < 0.01) {
+                ck_assert_msg(conf > 0.5, "a right map confirmed: confidence %.3f", conf);
+                confirmed++;
+            }
+        }
+        double e = isnan(fb) ? 0.0 : fb / 0.01;
+        ck_assert_double_eq_tol(conf, (1.0 - amscr_result_ambiguity(r)) * fmin(ov, inl) / (1.0 + e * e), 1e-12);
+        amscr_result_free(r);
+        amscr_contour_free(ct);
+    }
+    ck_assert_msg(caught >= 2 && confirmed >= 1, "wrong maps caught %zu, right maps confirmed %zu", caught, confirmed);
+    /* an exact affine copy */
+    amscr_contour *ct = cross_contour(3.0, 0.3, 1.3, 0.8);
+    amscr_result *r = NULL;
+    ck_assert_int_eq(amscr_register_contours(NULL, cs, ct, &r), AMSCR_OK);
+    ck_assert_msg(amscr_result_overlap(r) > 0.995, "exact pair: overlap %.4f", amscr_result_overlap(r));
+    ck_assert(isnan(amscr_result_backward_error(r)));
+    ck_assert(isnan(amscr_result_overlap(NULL)) && isnan(amscr_result_backward_error(NULL)));
+    amscr_result_free(r);
+    amscr_contour_free(ct);
+    amscr_contour_free(cs);
+}
+END_TEST
+
 /* Bad input: partial needs an open source and a closed target; the flag is 0 or 1. */
 START_TEST(partial_errors)
 {
@@ -339,6 +419,7 @@ Suite *amscr_suite_robust(void)
     tcase_add_test(tc, missing_run_inliers_and_correspondences);
     tcase_add_test(tc, partial_errors);
     tcase_add_test(tc, touching_object_inliers);
+    tcase_add_test(tc, forward_backward_check);
     tcase_add_test(tc, kimia_fragments);
     tcase_add_test(tc, kimia_missing_10);
     tcase_add_test(tc, kimia_missing_20);

@@ -19,7 +19,8 @@
  *   ordered.c           the polish's order stage: a noisy curve's point order (ordered.h)
  *   even.c              the polish's even-spacing stage: points taken evenly along it (even.h)
  *   alternatives.c      the distinct maps that fit about as well as the chosen one
- *   correspond.c        confidence, inliers, the part covered, dense correspondences
+ *   correspond.c        inliers, the part covered, dense correspondences
+ *   check.c             the overlap, the forward-backward check and the confidence
  *   result.c            the result object and its getters
  * and workspace.c, the caller-owned scratch of all of the above. */
 #ifndef AMSCR_MATCH_H
@@ -129,6 +130,9 @@ struct amscr_result {
     double *corr;  /* 5n: source xy (input), target parameter, target xy (input) */
     double inlier; /* inlier fraction */
     double part[2];
+    double overlap; /* IoU of the two contours as regions under the map (check.c); NaN: not closed */
+    double fb;      /* forward-backward error (check.c); NaN when the way back did not run */
+    int backward;   /* this result is a forward-backward check's way back: no check of its own */
     unsigned char ran[AMSCR__NUM_STAGES]; /* which stages ran (stages.c) */
     /* the distinct maps that fit about as well (alternatives.c), input coordinates; 0 the chosen */
     double alt[AMSCR__MAX_ALTERNATIVES][6];
@@ -324,5 +328,24 @@ void amscr__alternatives(const amscr_descriptor *f, const amscr_descriptor *h, a
 /* correspond.c: the dense correspondences, inlier fraction and part of a finished result r of
  * f -> h (fills r->corr, r->ncorr, r->inlier, r->part). */
 amscr_status amscr__correspond(const amscr_descriptor *f, const amscr_descriptor *h, amscr_result *r);
+
+/* check.c (docs/method.md §11.5). A confidence at or above this is a confident answer: the
+ * limit the documentation tells callers to reject below (1 - AMSCR__ALT_RATIO). */
+#define AMSCR__CONFIDENT 0.25
+/* The way back runs for a confident map when less than this share of the shape (the smaller
+ * of the inlier fraction and the overlap) agrees: a clean match never pays for it. */
+#define AMSCR__CHECK_SHARE 0.85
+/* The forward-backward error that halves the confidence, in units of the RMS radius: half the
+ * 2 % accuracy the benchmarks call a success (the two maps then disagree by that accuracy's
+ * half each way). */
+#define AMSCR__FB_SCALE 0.01
+/* The intersection over union of the closed polygons P (n vertices) and Q (m), even-odd rule. */
+amscr_status amscr__overlap(const double *P, size_t n, const double *Q, size_t m, double *out);
+/* The overlap and, when it leaves doubt, the forward-backward error of a finished result r of
+ * f -> h (fills r->overlap, r->fb; a way back's own result, r->backward, only its overlap). */
+amscr_status amscr__check(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                          amscr_workspace *ws, amscr_result *r);
+/* (1 - ambiguity) x min(inlier fraction, overlap) / (1 + (fb / AMSCR__FB_SCALE)^2). */
+double amscr__confidence(const amscr_result *r);
 
 #endif
