@@ -14,9 +14,9 @@
 #include <string.h>
 
 /* Horizontal lines the overlap integrates over (the midpoint rule on equal strips of the union's
- * height): the error is a few 1e-4 of the area for 256-sample contours. A resolution, not a
+ * height): the error is about 1e-3 of the area for 256-sample contours. A resolution, not a
  * constant chosen on data. */
-#define AMSCR__OVERLAP_LINES 512
+#define AMSCR__OVERLAP_LINES 256
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -107,7 +107,66 @@ double amscr__confidence(const amscr_result *r)
 {
     double fb = isfinite(r->fb) ? r->fb / AMSCR__FB_SCALE : 0.0;
     double share = r->overlap < r->inlier ? r->overlap : r->inlier;
-    return (1.0 - r->m.ambiguity) * share / (1.0 + fb * fb);
+    double amb = r->amb_conv > r->m.ambiguity ? r->amb_conv : r->m.ambiguity;
+    return (1.0 - amb) * share / (1.0 + fb * fb);
+}
+
+/* The ambiguity near a symmetry of the source: the source registered onto itself ranks its
+ * own candidate turns; each refined to convergence that maps the source onto itself about as
+ * well as the identity (within the ambiguity's floor: a symmetry) gives the alternative
+ * X o S, which is refined on the target in turn. When part of the target is missing, the
+ * ranking's few refinement steps can leave such a turn far from its minimum, where converged it
+ * fits exactly as well (a 4-armed cross with an arm cut: every quarter turn). */
+static amscr_status symmetric_ambiguity(const amscr_params *prm, const amscr_descriptor *f,
+                                        const amscr_descriptor *h, amscr_workspace *ws, amscr_result *r)
+{
+    amscr_result *s = calloc(1, sizeof *s);
+    double (*S)[6] = amscr__malloc_array(AMSCR__MAX_ALTERNATIVES + 1, sizeof *S);
+    double *cost = amscr__malloc_array(AMSCR__MAX_ALTERNATIVES + 1, sizeof *cost);
+    amscr_status st = s && S && cost ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "symmetric ambiguity: out of memory");
+    amscr_params self = *prm; /* the source onto itself: a clean pair, the polish has nothing to add */
+    self.polish = 0;
+    if (st == AMSCR_OK) {
+        s->backward = 1;
+        st = amscr__run_stages(&self, f, f, ws, s);
+    }
+    size_t n = 1;
+    const double I[6] = {1, 0, 0, 0, 1, 0};
+    if (st == AMSCR_OK) {
+        const match_t *m = &s->m;
+        for (size_t k = 0; k < m->nrank && n <= AMSCR__MAX_ALTERNATIVES; k++)
+            if (amscr__map_gap2(f, m->rank_X[k], I) > AMSCR__DISTINCT_GAP2)
+                memcpy(S[n++], m->rank_X[k], sizeof S[0]);
+        memcpy(S[0], I, sizeof S[0]);
+        st = amscr__rank_converged(prm, f, f, S + 1, n - 1, cost + 1);
+    }
+    double amb = 0.0;
+    if (st == AMSCR_OK) {
+        size_t ns = 1; /* the symmetries, composed with the map */
+        memcpy(S[0], r->m.X, sizeof S[0]);
+        for (size_t k = 1; k < n; k++)
+            if (amscr__map_gap2(f, S[k], I) > AMSCR__DISTINCT_GAP2 &&
+                AMSCR__AMBIGUITY_FLOOR / (cost[k] + AMSCR__AMBIGUITY_FLOOR) >= AMSCR__ALT_RATIO)
+                amscr__affine_compose(r->m.X, S[k], S[ns++]);
+        if (ns > 1)
+            st = amscr__rank_converged(prm, f, h, S, ns, cost);
+        for (size_t k = 1; st == AMSCR_OK && k < ns; k++) {
+            if (!(amscr__map_gap2(f, S[k], S[0]) > AMSCR__DISTINCT_GAP2))
+                continue;
+            double q = (cost[0] + AMSCR__AMBIGUITY_FLOOR) / (cost[k] + AMSCR__AMBIGUITY_FLOOR);
+            amb = q > amb ? (q > 1.0 ? 1.0 : q) : amb;
+        }
+    }
+    if (st == AMSCR_OK)
+        r->amb_conv = amb;
+    else if (st != AMSCR_E_NOMEM) {
+        st = AMSCR_OK; /* no evidence either way */
+        amscr__clear_error();
+    }
+    amscr_result_free(s);
+    free(S);
+    free(cost);
+    return st;
 }
 
 amscr_status amscr__check(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
@@ -115,6 +174,7 @@ amscr_status amscr__check(const amscr_params *prm, const amscr_descriptor *f, co
 {
     r->fb = NAN;
     r->overlap = NAN;
+    r->amb_conv = NAN;
     if (prm->partial || !f->params.closed || !h->params.closed)
         return AMSCR_OK;
     amscr_status st = map_overlap(f, h, r);
@@ -123,6 +183,11 @@ amscr_status amscr__check(const amscr_params *prm, const amscr_descriptor *f, co
     /* the way back only when the cheap evidence leaves doubt: a map confident without it whose
      * boundary or region agree over less than AMSCR__CHECK_SHARE of the shape */
     double share = r->overlap < r->inlier ? r->overlap : r->inlier;
+    if (amscr__confidence(r) >= AMSCR__CONFIDENT && share < AMSCR__SYM_SHARE) {
+        st = symmetric_ambiguity(prm, f, h, ws, r);
+        if (st != AMSCR_OK)
+            return st;
+    }
     if (!(amscr__confidence(r) >= AMSCR__CONFIDENT && share < AMSCR__CHECK_SHARE))
         return AMSCR_OK;
     amscr_result *b = calloc(1, sizeof *b);

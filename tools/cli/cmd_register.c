@@ -28,7 +28,7 @@ typedef struct reg_report {
     int refl;
     const char *mname;
     /* confidence, the part of the target covered, dense correspondences */
-    double conf, amb, inl, overlap, fb, part[2];
+    double conf, amb, inl, overlap, fb, symamb, part[2];
     size_t ncorr;
     double *corr_param, *corr_xy; /* ncorr and 2 ncorr */
     /* the pipeline's stages and whether each ran; the maps that fit about as well (0.5) */
@@ -176,6 +176,7 @@ static int read_report(const amscr_result *res, const amscr_params *p, reg_repor
     r->inl = amscr_result_inlier_fraction(res);
     r->overlap = amscr_result_overlap(res);
     r->fb = amscr_result_backward_error(res);
+    r->symamb = amscr_result_symmetry_ambiguity(res);
     if (amscr_result_part(res, &r->part[0], &r->part[1]) != AMSCR_OK ||
         amscr_result_correspondences(res, NULL, NULL, NULL, &r->ncorr) != AMSCR_OK)
     {
@@ -244,6 +245,8 @@ static void json_confidence(sbuf *b, const opts *o, const reg_report *r)
     sb_json_num(b, r->overlap);
     sb_puts(b, ", \"backward_error\": ");
     sb_json_num(b, r->fb);
+    sb_puts(b, ", \"symmetry_ambiguity\": ");
+    sb_json_num(b, r->symamb);
     sb_printf(b, ", \"partial\": %s, \"part\": ", o->partial ? "true" : "false");
     sb_json_nums(b, r->part, NULL, 2);
     sb_puts(b, ", \"correspondences\": {\"param\": ");

@@ -268,6 +268,7 @@ double amscr_result_threshold(const amscr_result *r);
 double amscr_result_confidence(const amscr_result *r);
 double amscr_result_overlap(const amscr_result *r);
 double amscr_result_backward_error(const amscr_result *r);
+double amscr_result_symmetry_ambiguity(const amscr_result *r);
 double amscr_result_ambiguity(const amscr_result *r);
 double amscr_result_inlier_fraction(const amscr_result *r);
 amscr_status amscr_result_part(const amscr_result *r, double *out_start, double *out_end);
