@@ -2,11 +2,14 @@
  * §11.5): besides the ambiguity (alternatives.c) and the inlier fraction (correspond.c),
  *   the overlap   the intersection over union of the two closed contours as regions, the
  *                 source's under the map and the target's, computed from the polygons alone;
- *   the way back  when the overlap leaves doubt, the target registered onto the source on its
- *                 own: the two maps must compose to the identity. Their forward–backward error
- *                 is the RMS displacement of the source samples under the composition, in
- *                 units of the source's RMS radius (normalized frames).
- * The confidence combines them (amscr__confidence). */
+ *   a symmetry    when less than AMSCR__SYM_SHARE of the shape agrees, the source's own
+ *                 symmetries (the source registered onto itself) composed with the map and
+ *                 refined on the target: the ambiguity near a symmetry;
+ *   the way back  when less than AMSCR__CHECK_SHARE agrees, the target registered onto the
+ *                 source on its own: the two maps must compose to the identity. Their
+ *                 forward-backward error is the RMS displacement of the source samples under
+ *                 the composition, in units of the source's RMS radius (normalized frames).
+ * The confidence combines them (amscr__confidence). None of it changes the map. */
 #include "match.h"
 
 #include <math.h>
@@ -180,8 +183,10 @@ amscr_status amscr__check(const amscr_params *prm, const amscr_descriptor *f, co
     amscr_status st = map_overlap(f, h, r);
     if (st != AMSCR_OK || r->backward)
         return st;
-    /* the way back only when the cheap evidence leaves doubt: a map confident without it whose
-     * boundary or region agree over less than AMSCR__CHECK_SHARE of the shape */
+    /* the dearer evidence only where the cheap one leaves doubt: a map confident without it whose
+     * boundary or region agree over less than AMSCR__SYM_SHARE (the symmetry test; a clean
+     * registration of the source onto itself) or AMSCR__CHECK_SHARE (the way back: a
+     * registration of the damaged target) of the shape */
     double share = r->overlap < r->inlier ? r->overlap : r->inlier;
     if (amscr__confidence(r) >= AMSCR__CONFIDENT && share < AMSCR__SYM_SHARE) {
         st = symmetric_ambiguity(prm, f, h, ws, r);

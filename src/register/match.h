@@ -20,7 +20,7 @@
  *   even.c              the polish's even-spacing stage: points taken evenly along it (even.h)
  *   alternatives.c      the distinct maps that fit about as well as the chosen one
  *   correspond.c        inliers, the part covered, dense correspondences
- *   check.c             the overlap, the forward-backward check and the confidence
+ *   check.c             the overlap, the symmetry test, the forward-backward check, the confidence
  *   result.c            the result object and its getters
  * and workspace.c, the caller-owned scratch of all of the above. */
 #ifndef AMSCR_MATCH_H
