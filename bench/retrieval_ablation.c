@@ -43,7 +43,6 @@ typedef struct {
     double view;        /* the affine-view factor f (both frames): min(mix, f d_affine); 0: the mix */
     double inner;       /* with an inner distance: its graph's share of the re-ranking */
     int k;              /* re-ranking k (8 in the default) */
-    double reach;       /* PROBE: affinities below reach x the row's largest rank by the input distance */
 } row_t;
 
 static const row_t ROWS[] = {
@@ -72,11 +71,6 @@ static const row_t ROWS[] = {
     {"default without re-ranking", {0, 1, 1, 0}, 1, 0.2, 0, 2.0, 0, 8},
     {"default, re-ranking k 4", {0, 1, 1, 1}, 1, 0.2, 1, 2.0, 0.1, 4},
     {"default, re-ranking k 16", {0, 1, 1, 1}, 1, 0.2, 1, 2.0, 0.1, 16},
-    {"PROBE reach 0.01", {0, 1, 1, 1}, 1, 0.2, 1, 2.0, 0.1, 8, 0.01},
-    {"PROBE reach 0.02", {0, 1, 1, 1}, 1, 0.2, 1, 2.0, 0.1, 8, 0.02},
-    {"PROBE reach 0.03", {0, 1, 1, 1}, 1, 0.2, 1, 2.0, 0.1, 8, 0.03},
-    {"PROBE reach 0.05", {0, 1, 1, 1}, 1, 0.2, 1, 2.0, 0.1, 8, 0.05},
-    {"PROBE reach 0.03 one graph", {0, 1, 1, 0}, 1, 0.2, 1, 2.0, 0, 8, 0.03},
 };
 enum { DEFAULT_ROW = 15 };
 enum { NROWS = sizeof ROWS / sizeof ROWS[0] };
@@ -205,19 +199,9 @@ static void compose(const set_run *r, const row_t *w, double *out)
     free(H);
     size_t k = n < (size_t)w->k ? n : (size_t)w->k;
     const double *inner = w->use[M_INNER] ? r->base[M_INNER] : w->use[M_INNER_OPEN] ? r->base[M_INNER_OPEN] : NULL;
-    double *Hs = w->reach > 0 ? malloc(nn * sizeof *Hs) : NULL, hmax = 0;
-    for (size_t i = 0; Hs && i < n; i++)
-        for (size_t j = 0; j < n; j++) {
-            Hs[i * n + j] = i == j ? 0.0 : 0.5 * (out[i * n + j] + out[j * n + i]);
-            hmax = Hs[i * n + j] > hmax ? Hs[i * n + j] : hmax;
-        }
     if (w->rerank && (inner ? amscr__rerank_normalized2(out, inner, w->inner, n, k, 10, amscr__resolve_threads(0), out)
                             : amscr__rerank_normalized(out, n, k, 10, amscr__resolve_threads(0), out)) != AMSCR_OK)
         die("re-ranking");
-    for (size_t i = 0; Hs && i < nn; i++)
-        if (out[i] > 0.5 * (1.0 - w->reach) && out[i] < 0.5)
-            out[i] = 0.5 + 0.5 * Hs[i] / hmax;
-    free(Hs);
 }
 
 /* The standard error of a figure that is the mean of m units' scores u (times scale). */
