@@ -2159,16 +2159,71 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_mixture(const amscr_result *
 AMSCR_API double amscr_result_threshold(const amscr_result *r);
 
 /**
- * @brief How sure the registration is, in [0, 1]: (1 - ambiguity) x inlier fraction. Near 0:
- *        reject the map, because another, clearly different map explains the target almost
- *        as well (a symmetric shape, a fragment too short to place) or most source samples
- *        found no target boundary near them. It flags wrong maps, not small biases.
+ * @brief How sure the registration is, in [0, 1]: (1 - a) x min(inlier fraction, overlap) /
+ *        (1 + (e / 0.01)^2), a the larger of amscr_result_ambiguity and
+ *        amscr_result_symmetry_ambiguity (when measured), e the forward-backward error (0 when
+ *        the check did not run; amscr_result_backward_error). Near 0: reject the map, because
+ *        another, clearly different map explains the target almost as well (a symmetric shape,
+ *        a symmetric shape with a part missing, a fragment too short to place), most source
+ *        samples found no target boundary near them, the
+ *        registered regions overlap little, or the target registered back onto the source on
+ *        its own does not undo the map. Reject maps below 0.25. It flags wrong maps, not small
+ *        biases (a map 3 % of the size off can still read high). Before 0.14 the value was
+ *        (1 - ambiguity) x inlier fraction; partial matches keep that value.
  * @return the value; NaN for NULL.
  * Ownership: none.
  * Thread-safety: const.
  * @since 0.2
  */
 AMSCR_API double amscr_result_confidence(const amscr_result *r);
+
+/**
+ * @brief The overlap of the registered shapes as regions, in [0, 1]: the intersection over
+ *        union of the areas the two closed contours enclose (even-odd rule), the source's
+ *        under the map and the target's, computed from the sampled contours without images.
+ *        1 for a perfect match; about 1 - the damaged share of the area when part of the
+ *        target is missing or an object touches it; low for a wrong map.
+ * @return the value; NaN for NULL or a partial match (an open source encloses no region).
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API double amscr_result_overlap(const amscr_result *r);
+
+/**
+ * @brief The forward-backward error: when the map is confident but less than 85 % of the
+ *        shape agrees (the smaller of the inlier fraction and the overlap), the target is
+ *        registered onto the source on its own, as amscr_register would with the same
+ *        params; the two maps should compose to the identity. The value is the RMS
+ *        displacement of the source's samples under the composition, in units of the
+ *        source's RMS radius (in the affine-normalized frame): about 0 when the two agree,
+ *        0.01 halves the confidence. The map itself does not change.
+ * @return the value; NaN when the check did not run (a clean match, an unconfident map, a
+ *         partial match, the way back failing) or for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API double amscr_result_backward_error(const amscr_result *r);
+
+/**
+ * @brief The ambiguity near a symmetry of the source, in [0, 1]: when the map is confident but
+ *        less than 95 % of the shape agrees (the smaller of the inlier fraction and the
+ *        overlap), the source is registered onto itself; each of its own distinct maps that
+ *        maps it onto itself as well as the identity does (within the ambiguity's 0.5 % floor: a
+ *        symmetry S) gives the alternative map (chosen map) o S, refined on the target; the
+ *        value is the largest ratio of the chosen map's cost to such an alternative's, as in
+ *        amscr_result_ambiguity (both refined to convergence, the two-way trimmed
+ *        closest-point cost). 1: a symmetric turn of the source explains the damaged target
+ *        exactly as well (a 4-armed cross with one arm cut); 0: the source has no symmetry,
+ *        or none fits. The confidence uses the larger of the two ambiguities.
+ * @return the value; NaN when it was not measured (a clean match, an unconfident map, a partial
+ *         match) or for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API double amscr_result_symmetry_ambiguity(const amscr_result *r);
 
 /**
  * @brief Ambiguity in [0, 1]: the trimmed closest-point cost of the chosen map divided by that

@@ -266,6 +266,9 @@ amscr_status amscr_result_sse(const amscr_result *r, double *out, size_t *inout_
 amscr_status amscr_result_mixture(const amscr_result *r, double *out_weights, double *out_means, double *out_variances, size_t *inout_n);
 double amscr_result_threshold(const amscr_result *r);
 double amscr_result_confidence(const amscr_result *r);
+double amscr_result_overlap(const amscr_result *r);
+double amscr_result_backward_error(const amscr_result *r);
+double amscr_result_symmetry_ambiguity(const amscr_result *r);
 double amscr_result_ambiguity(const amscr_result *r);
 double amscr_result_inlier_fraction(const amscr_result *r);
 amscr_status amscr_result_part(const amscr_result *r, double *out_start, double *out_end);
