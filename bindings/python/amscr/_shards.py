@@ -249,7 +249,7 @@ class ShardedIndex:
         out = np.zeros((nq, n), dtype=np.float64)
         if nq == 0 or n == 0:
             return out
-        qf = self.client.scatter(q.to_bytes(), broadcast=True)
+        qf = self.client.scatter(q.to_bytes(), broadcast=True, hash=False)
         futs = [self.client.submit(_query_block, sh, qf, pure=False, workers=[self._workers[s]],
                                    allow_other_workers=True) for s, sh in enumerate(self._shards)]
         parts = self.client.gather(futs)
@@ -440,7 +440,7 @@ def build_index(client, collection: Collection, path: Optional[PathLike] = None,
     from .distributed import _block
     datas = [_block(collection, lo, hi, params.threads).to_bytes() for lo, hi in bounds]
     placed = [workers[s % len(workers)] for s in range(ns)]
-    rows = [client.scatter(datas[s], workers=[placed[s]]) for s in range(ns)]
+    rows = [client.scatter(datas[s], workers=[placed[s]], hash=False) for s in range(ns)]
     from .distributed import _threads_by_host
     th = _threads_by_host(client)
     idx = [client.submit(_shard_index, rows[s], th, pure=False, workers=[placed[s]], allow_other_workers=True)
