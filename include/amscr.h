@@ -3124,28 +3124,30 @@ typedef struct amscr_index_graph amscr_index_graph;
 
 /**
  * @brief The base distance (the retrieval matrix's distance before re-ranking, as an index
- *        lists it) and the inner distance of q to every shape of x, each pair computed as the
+ *        lists it) and the inner distance of q to shapes first.. of x, each pair computed as the
  *        cell of the two in the matrix of one collection (the lower index first): shapes of x
  *        below qpos come before q, the others after it. qpos SIZE_MAX: q is a query (after
  *        every shape, as amscr_index_query_scores with candidates 0 matches it); 0: q comes
  *        before every shape of x (x's block lies after q's in the whole collection); i: q is
- *        shape i of x itself (its own distance is 0).
+ *        shape i of x itself (its own distance is 0; first i + 1 gives the pairs of a block
+ *        with itself once).
  * @param[in]  x  an index (a shard), with a channel weight of 0 or 1 (a weight strictly between
  *                uses x's own medians: the whole collection's differ).
  * @param[in]  q  a shape prepared with params compatible with x's.
- * @param[out] out_base  n base distances.
+ * @param[in]  first  the first shape of x matched (0: all).
+ * @param[out] out_base  n base distances (of shapes first..first+n-1).
  * @param[out] out_inner  n inner distances, or NULL; zeros when the params give the inner graph
  *                        no share.
- * @param[in]  n  must equal amscr_index_size(x).
- * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, incompatible params); AMSCR_E_NOMEM.
- * Cost: n pair distances on the params' threads (the inner ones on the calling thread).
+ * @param[in]  n  must equal amscr_index_size(x) - first.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, first or n, incompatible params); AMSCR_E_NOMEM.
+ * Cost: n pair distances on the params' threads.
  * Ownership: none.
  * Thread-safety: const on x.
  * @since 0.14
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_pair_distances(const amscr_index *x, const amscr_descriptor *q,
-                                                                  size_t qpos, double *out_base, double *out_inner,
-                                                                  size_t n);
+                                                                  size_t qpos, size_t first, double *out_base,
+                                                                  double *out_inner, size_t n);
 
 /**
  * @brief The widths of a collection's neighbour lists: *out_k neighbours a shape under the base

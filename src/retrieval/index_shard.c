@@ -5,6 +5,7 @@
  * the single index's scores (the same diffusion, index_diffuse.c). */
 #include "db_io.h"
 #include "index.h"
+#include "rows.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -14,8 +15,45 @@ struct amscr_index_graph {
     amscr_index *x; /* lists and normalisers; its db holds n empty slots (no shapes) */
 };
 
-/* The inner distances of q to every shape of x, each pair with the lower index first. */
-static amscr_status pair_inner(const amscr_index *x, const amscr_descriptor *q, size_t qpos, double *out, size_t n)
+/* The inner distances of q (features f) to shapes first.. of x on threads, each pair with the lower
+ * index first. */
+typedef struct {
+    const amscr_index *x;
+    const amscr__inner *f;
+    size_t qpos, first;
+    int refl;
+    double *out;
+} inner_ctx;
+
+static amscr_status inner_init(void *ctx, void **scratch)
+{
+    (void)ctx;
+    amscr__inner_ws *ws = malloc(sizeof *ws);
+    if (!ws || amscr__inner_ws_init(ws) != AMSCR_OK) {
+        free(ws);
+        return AMSCR_E_NOMEM;
+    }
+    *scratch = ws;
+    return AMSCR_OK;
+}
+
+static void inner_fini(void *scratch)
+{
+    if (scratch)
+        amscr__inner_ws_free(scratch);
+    free(scratch);
+}
+
+static amscr_status inner_row(void *ctx, size_t j, void *scratch)
+{
+    inner_ctx *c = ctx;
+    c->out[j - c->first] = j < c->qpos ? amscr__inner_distance(&c->x->inner[j], c->f, c->refl, scratch)
+                                       : amscr__inner_distance(c->f, &c->x->inner[j], c->refl, scratch);
+    return AMSCR_OK;
+}
+
+static amscr_status pair_inner(const amscr_index *x, const amscr_descriptor *q, size_t qpos, size_t first,
+                               double *out)
 {
     amscr__inner_ws ws;
     amscr__inner *f = malloc(sizeof *f);
@@ -25,15 +63,16 @@ static amscr_status pair_inner(const amscr_index *x, const amscr_descriptor *q, 
     }
     const amscr_params *p = amscr_db_params(x->db);
     amscr_status st = amscr__inner_build_shape(q, p->inner_closing, f, &ws);
-    for (size_t j = 0; st == AMSCR_OK && j < n; j++)
-        out[j] = j < qpos ? amscr__inner_distance(&x->inner[j], f, p->reflections, &ws)
-                          : amscr__inner_distance(f, &x->inner[j], p->reflections, &ws);
     amscr__inner_ws_free(&ws);
+    inner_ctx c = {x, f, qpos, first, p->reflections, out};
+    amscr__rows_fn fn = {inner_init, inner_fini, inner_row, &c, "amscr_index_pair_distances"};
+    if (st == AMSCR_OK)
+        st = amscr__run_rows(&fn, first, amscr_db_size(x->db), amscr__resolve_threads(p->num_threads), NULL, NULL);
     free(f);
     return st;
 }
 
-amscr_status amscr_index_pair_distances(const amscr_index *x, const amscr_descriptor *q, size_t qpos,
+amscr_status amscr_index_pair_distances(const amscr_index *x, const amscr_descriptor *q, size_t qpos, size_t first,
                                         double *out_base, double *out_inner, size_t n)
 {
     amscr__clear_error();
@@ -43,24 +82,23 @@ amscr_status amscr_index_pair_distances(const amscr_index *x, const amscr_descri
     const amscr_params *p = amscr_db_params(x->db);
     if (!amscr__params_compatible(p, &q->params, "amscr_index_pair_distances"))
         return AMSCR_E_INVALID_ARG;
-    if (n != amscr_db_size(x->db))
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_pair_distances: the output holds %zu distances, the "
-                                                "index %zu shapes", n, amscr_db_size(x->db));
-    if (out_inner && x->k2 == 0 && n > 0 && amscr__index_k2(p, 1) > 0)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_pair_distances: the index keeps no inner features");
+    size_t size = amscr_db_size(x->db);
+    if (first > size || n != size - first)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_pair_distances: shapes %zu.. of %zu, the output holds "
+                                                "%zu distances", first, size, n);
     size_t *cand = amscr__malloc_array(n ? n : 1, sizeof *cand);
     if (!cand)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_index_pair_distances: out of memory");
     for (size_t j = 0; j < n; j++)
-        cand[j] = j;
+        cand[j] = first + j;
     amscr__base b;
     amscr__base_init(&b, p, x->med_a, x->med_h);
     amscr_status st = n > 0 ? amscr__base_row(&b, x->db, x->hf, q, qpos, cand, n, NULL, NULL, out_base) : AMSCR_OK;
     free(cand);
     if (st == AMSCR_OK && out_inner) {
-        if (x->k2 > 0)
-            st = pair_inner(x, q, qpos, out_inner, n);
-        else
+        if (x->k2 > 0 && n > 0)
+            st = pair_inner(x, q, qpos, first, out_inner);
+        else if (n > 0)
             memset(out_inner, 0, n * sizeof *out_inner);
     }
     return st;

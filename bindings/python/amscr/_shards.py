@@ -126,15 +126,24 @@ def _index_bytes(index: Index) -> bytes:
     return index.to_bytes()
 
 
-def _distances(index: Index, qdb, count: int, qpos_of) -> Tuple[np.ndarray, np.ndarray]:
-    """Base and inner distances (count x len(index)) of shapes 0..count-1 of C db qdb."""
+def _distances(index: Index, qdb, count: int, where: str) -> Tuple[np.ndarray, np.ndarray]:
+    """Base and inner distances (count x len(index)) of shapes 0..count-1 of C db qdb, which come
+    (`where`) 'after' every shape of the index (queries), 'before' them (an earlier block), or are
+    the index's own shapes ('diagonal': each pair computed once and mirrored)."""
+    diagonal = where == 'diagonal'
+    qpos = {'after': QPOS_AFTER, 'before': 0, 'diagonal': None}[where]
     m = len(index)
     D = np.zeros((count, m), dtype=np.float64)
     D2 = np.zeros((count, m), dtype=np.float64)
     with index._lock.read():
         for i in range(count):
-            _check(lib.amscr_index_pair_distances(index._x, lib.amscr_db_descriptor(qdb, i), qpos_of(i),
-                                                  dbuf(D[i]), dbuf(D2[i]), m))
+            first = i + 1 if diagonal else 0
+            _check(lib.amscr_index_pair_distances(index._x, lib.amscr_db_descriptor(qdb, i),
+                                                  i if diagonal else qpos, first,
+                                                  dbuf(D[i, first:]), dbuf(D2[i, first:]), m - first))
+    if diagonal:
+        D += D.T
+        D2 += D2.T
     return D, D2
 
 
@@ -160,7 +169,7 @@ def _pair_block(rows_data: bytes, index: Index, r0: int, c0: int, k: int, k2: in
     rows = index if same else Collection.from_bytes(rows_data)
     qdb = lib.amscr_index_db(index._x) if same else rows._db
     count = len(index) if same else len(rows)
-    D, D2 = _distances(index, qdb, count, (lambda i: i) if same else (lambda i: 0))
+    D, D2 = _distances(index, qdb, count, 'diagonal' if same else 'before')
     out: Dict[str, Any] = {'dmax': float(D.max(initial=0.0)), 'dmax2': float(D2.max(initial=0.0))}
     out['rows'] = (_best(D, c0, k, r0 if same else None), _best(D2, c0, k2, r0 if same else None))
     if not same:
@@ -171,7 +180,7 @@ def _pair_block(rows_data: bytes, index: Index, r0: int, c0: int, k: int, k2: in
 def _query_block(index: Index, qdata: bytes) -> Tuple[np.ndarray, np.ndarray]:
     """The queries' base and inner distances to every shape of a shard (queries after every shape)."""
     q = Collection.from_bytes(qdata)
-    return _distances(index, q._db, len(q), lambda i: QPOS_AFTER)
+    return _distances(index, q._db, len(q), 'after')
 
 
 # ========================================================================== client side
