@@ -1,6 +1,7 @@
 """amscr.distributed scaling on this machine: C batch (1, 2 threads) vs Dask 1 and 2 worker processes
 (threads_per_worker=1, 1 C thread per tile), interleaved, `reps` times; wall time (best) and CPU time
-(pairs per CPU-second of the computing processes, median)."""
+(pairs per CPU-second of the computing processes, median). `shards`: the index in shards
+(build_index) with 1, 2, 4 workers: build time, query rate, memory per worker."""
 import os, sys, time, statistics
 # run from the repository root: python3 bench/distributed_scaling.py [N_SHAPES] [REPS] (needs psutil, dask);
 # python3 bench/distributed_scaling.py shards [N_SHAPES] [REPS]: the index in shards (sharded() below)
@@ -76,17 +77,21 @@ def sharded(n, reps, nq=20):
     print('single index (2 C threads, every pair): build %.1fs' % (time.perf_counter() - t))
     ref = np.array([single.scores(q, candidates=0) for q in qs])
     rss = lambda: psutil.Process().memory_info().rss
-    print('%-10s %12s %16s %18s' % ('workers', 'build (best)', 'query/s (best)', 'RSS/worker (max)'))
+    print('%-10s %12s %16s %18s %14s %s' % ('workers', 'build (best)', 'query/s (best)', 'RSS/worker (max)',
+                                           'idle RSS', 'load avg'))
     for nw in (1, 2, 4):
         with LocalCluster(n_workers=nw, threads_per_worker=1, processes=True, dashboard_address=':0') as cl, Client(cl) as c:
-            builds, queries, mem = [], [], []
+            builds, queries, mem, loads = [], [], [], []
+            idle = max(c.run(rss).values())
             for rep in range(reps):
+                loads.append(os.getloadavg()[0])
                 t = time.perf_counter(); sx = ad.build_index(c, db); builds.append(time.perf_counter() - t)
                 t = time.perf_counter(); S = sx.scores_many(qs); queries.append(time.perf_counter() - t)
                 assert np.abs(S - ref).max() <= 1e-9
                 mem.append(max(c.run(rss).values()))
                 del sx
-            print('%-10d %11.1fs %16.1f %15.0f MB' % (nw, min(builds), nq / min(queries), max(mem) / 2**20), flush=True)
+            print('%-10d %11.1fs %16.1f %15.0f MB %11.0f MB %s' % (nw, min(builds), nq / min(queries), max(mem) / 2**20,
+                  idle / 2**20, ' '.join('%.1f' % x for x in loads)), flush=True)
 
 
 if __name__ == '__main__':
