@@ -47,6 +47,22 @@ QPOS_AFTER = 2 ** 64 - 1  # SIZE_MAX: the query after every shape
 PathLike = Union[str, 'os.PathLike[str]']
 
 
+def _register_sizeof() -> None:
+    """Tells Dask what a shard weighs (its shapes and features), so that its scheduler never
+    steals a shard's task to another worker, which would copy and rebuild the shard there."""
+    try:
+        from dask.sizeof import sizeof
+    except ImportError:  # pragma: no cover - amscr.distributed needs Dask anyway
+        return
+
+    @sizeof.register(Index)
+    def _index_size(x: Index) -> int:
+        return 64 * 1024 + len(x) * 40 * 1024
+
+
+_register_sizeof()
+
+
 class ShardSetError(AmscrError, ValueError):
     """A saved shard set that cannot be used: a shard file missing, foreign (another set's, or
     altered) or built with other options than the manifest's. The message names the file."""
@@ -259,8 +275,8 @@ class ShardedIndex:
         if nq == 0 or n == 0:
             return out
         qf = self.client.scatter(q.to_bytes(), broadcast=True, hash=False)
-        futs = [self.client.submit(_query_block, sh, qf, pure=False, workers=[self._workers[s]],
-                                   allow_other_workers=True) for s, sh in enumerate(self._shards)]
+        futs = [self.client.submit(_query_block, sh, qf, pure=False, workers=[self._workers[s]])
+                for s, sh in enumerate(self._shards)]
         parts = self.client.gather(futs)
         dq = np.concatenate([p[0] for p in parts], axis=1)
         dq2 = np.concatenate([p[1] for p in parts], axis=1)
@@ -433,8 +449,8 @@ def build_index(client, collection: Collection, path: Optional[PathLike] = None,
     Returns:
         a :class:`ShardedIndex` whose shards live on the workers.
     Raises:
-        InvalidArgumentError: a channel weight strictly between 0 and 1, open curves with a
-        channel weight, no workers.
+        InvalidArgumentError: an empty collection, a channel weight strictly between 0 and 1, open
+        curves with a channel weight, no workers, a bad shard count.
     Cost: every pair of shapes once (n (n - 1) / 2 pair distances, as the single index with
     candidates 0), spread over the blocks, plus a short shortlist build of each shard.
     """
@@ -444,7 +460,11 @@ def build_index(client, collection: Collection, path: Optional[PathLike] = None,
     _check_params(params)
     workers = _workers(client)
     n = len(collection)
-    ns = max(1, min(int(shards) if shards is not None else len(workers), max(n, 1)))
+    if n == 0:
+        raise InvalidArgumentError('amscr.distributed.build_index: the collection is empty')
+    if shards is not None and (isinstance(shards, bool) or int(shards) != shards or shards < 1):
+        raise InvalidArgumentError('amscr.distributed.build_index: shards must be a count >= 1, got %r' % (shards,))
+    ns = min(int(shards) if shards is not None else len(workers), n)
     bounds = _bounds(n, ns)
     from .distributed import _block
     datas = [_block(collection, lo, hi, params.threads).to_bytes() for lo, hi in bounds]
@@ -452,14 +472,14 @@ def build_index(client, collection: Collection, path: Optional[PathLike] = None,
     rows = [client.scatter(datas[s], workers=[placed[s]], hash=False) for s in range(ns)]
     from .distributed import _threads_by_host
     th = _threads_by_host(client)
-    idx = [client.submit(_shard_index, rows[s], th, pure=False, workers=[placed[s]], allow_other_workers=True)
+    idx = [client.submit(_shard_index, rows[s], th, pure=False, workers=[placed[s]])
            for s in range(ns)]
     k, k2 = widths(params, n)
     blocks = {}
     for s in range(ns):
         for t in range(s, ns):
             blocks[s, t] = client.submit(_pair_block, rows[s], idx[t], bounds[s][0], bounds[t][0], k, k2,
-                                         pure=False, workers=[placed[t]], allow_other_workers=True)
+                                         pure=False, workers=[placed[t]])
     got = dict(zip(blocks, client.gather(list(blocks.values()))))
     base = [[] for _ in range(ns)]
     inner = [[] for _ in range(ns)]
@@ -526,6 +546,6 @@ def load_index(client, path: PathLike) -> ShardedIndex:
                           lib.AMSCR_E_FORMAT) from None
     workers = _workers(client)
     placed = [workers[s % len(workers)] for s in range(len(entries))]
-    idx = [client.submit(_shard_from_file_bytes, datas[s], pure=False, workers=[placed[s]], allow_other_workers=True)
+    idx = [client.submit(_shard_from_file_bytes, datas[s], pure=False, workers=[placed[s]])
            for s in range(len(entries))]
     return ShardedIndex(client, idx, bounds, graph, params, placed)

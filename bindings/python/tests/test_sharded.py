@@ -182,3 +182,7 @@ def test_bad_input(client):
         ad.build_index(client, _collection(params, _shapes(40, 0)))
     with pytest.raises(TypeError):
         ad.build_index(client, [1, 2])
+    with pytest.raises(amscr.InvalidArgumentError, match='empty'):
+        ad.build_index(client, amscr.Collection(amscr.Params.retrieval()))
+    with pytest.raises(amscr.InvalidArgumentError, match='shards'):
+        ad.build_index(client, _collection(amscr.Params.retrieval(points=POINTS), _shapes(40, 0)), shards=0)
