@@ -3153,8 +3153,11 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_pair_distances(const amscr_in
  * @brief The widths of a collection's neighbour lists: *out_k neighbours a shape under the base
  *        distance (the re-ranking's k for n shapes, at most n / 2; 0 without re-ranking) and
  *        *out_k2 under the inner distance (*out_k when the params give the inner graph a share,
- *        else 0). Either pointer may be NULL.
- * Ownership: none. Thread-safety: pure.
+ *        else 0). Either pointer may be NULL; p NULL gives 0 and 0.
+ * @param[in]  p  the collection's params.
+ * @param[in]  n  the collection's size.
+ * Ownership: none.
+ * Thread-safety: pure.
  * @since 0.14
  */
 AMSCR_API void amscr_index_graph_widths(const amscr_params *p, size_t n, size_t *out_k, size_t *out_k2);
@@ -3171,8 +3174,8 @@ AMSCR_API void amscr_index_graph_widths(const amscr_params *p, size_t n, size_t 
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL; a row not itself first, an index >= n, a distance
  *         negative or not finite: the detail names the row); AMSCR_E_LIMIT (2^32 shapes or
  *         more); AMSCR_E_NOMEM.
- * Memory: about (k + k2) * 28 bytes a shape. Ownership: caller frees *out with
- *         amscr_index_graph_free; the lists are copied.
+ * Memory: about (k + k2) * 28 bytes a shape.
+ * Ownership: caller frees *out with amscr_index_graph_free; the lists are copied.
  * Thread-safety: pure.
  * @since 0.14
  */
@@ -3192,17 +3195,30 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_graph_new(const amscr_params 
  * @param[out] out_scores  n scores, lower is better.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, candidates not ascending or out of range, a
  *         distance not finite or negative); AMSCR_E_NOMEM.
- * Ownership: none. Thread-safety: const on g; runs on the calling thread.
+ * Ownership: none.
+ * Thread-safety: const on g; runs on the calling thread.
  * @since 0.14
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_graph_scores(const amscr_index_graph *g, const size_t *cand,
                                                                 const double *dq, const double *dq2, size_t m,
                                                                 double *out_scores, size_t n);
 
-/** @brief The graph's number of shapes (0 for NULL). Thread-safety: const. @since 0.14 */
+/**
+ * @brief The graph's number of shapes.
+ * @return n; 0 for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
 AMSCR_API size_t amscr_index_graph_size(const amscr_index_graph *g);
 
-/** @brief Frees a graph (NULL is a no-op). @since 0.14 */
+/**
+ * @brief Frees a graph.
+ * @param[in] g  the graph, or NULL (a no-op).
+ * Ownership: takes g.
+ * Thread-safety: exclusive on g.
+ * @since 0.14
+ */
 AMSCR_API void amscr_index_graph_free(amscr_index_graph *g);
 
 /**

@@ -127,6 +127,19 @@ def test_missing_foreign_or_other_options_shard_is_named(small, client, tmp_path
 
     (d / name).write_bytes(data)
     ad.load_index(client, d)  # whole again
+    graph = [n for n in os.listdir(d) if n.startswith('graph-')][0]
+    gdata = (d / graph).read_bytes()
+    (d / graph).write_bytes(gdata[:-10])
+    with pytest.raises(ad.ShardSetError, match='graph .*%s is foreign' % graph):
+        ad.load_index(client, d)
+    (d / graph).write_bytes(gdata)
+    manifest = (d / 'manifest.json').read_bytes()
+    for bad, what in ((manifest[:40], 'not a shard set manifest'),
+                      (manifest.replace(b'"version": 1', b'"version": 7'), 'version 7'),
+                      (manifest.replace(b'"shapes": %d' % len(coll), b'"shapes": 3'), 'do not cover')):
+        (d / 'manifest.json').write_bytes(bad)
+        with pytest.raises(amscr.FormatError, match=what):
+            ad.load_index(client, d)
     os.unlink(d / 'manifest.json')
     with pytest.raises(amscr.FileError, match='manifest.json is missing'):
         ad.load_index(client, d)
