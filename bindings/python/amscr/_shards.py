@@ -346,6 +346,21 @@ def _ours(f: str) -> bool:
             or (f.startswith('.amscr-tmp-')))
 
 
+def _umask() -> int:
+    """The process's umask, read without changing it where Linux tells it (os.umask changes it
+    for every thread while it is read)."""
+    try:
+        with open('/proc/self/status') as f:
+            for line in f:
+                if line.startswith('Umask:'):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 def _write_atomic(d: str, name: str, data: bytes) -> None:
     """Writes d/name by a temporary file in d, fsync and rename; mode 0666 less the umask."""
     fd, tmp = tempfile.mkstemp(prefix='.amscr-tmp-', dir=d)
@@ -355,9 +370,7 @@ def _write_atomic(d: str, name: str, data: bytes) -> None:
                 f.write(data)
                 f.flush()
                 os.fsync(f.fileno())
-            mask = os.umask(0)
-            os.umask(mask)
-            os.chmod(tmp, 0o666 & ~mask)
+            os.chmod(tmp, 0o666 & ~_umask())
             os.replace(tmp, os.path.join(d, name))
         except BaseException:
             os.unlink(tmp)
