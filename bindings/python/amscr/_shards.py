@@ -262,6 +262,22 @@ class ShardedIndex:
                 q.add(np.asarray(x, dtype=np.float64))
         return q
 
+    def _gather(self, futs: List[Any]) -> List[Any]:
+        """The results of one task a shard; a shard lost with its worker is a clear error."""
+        lost = [s for s, sh in enumerate(self._shards) if sh.status in ('lost', 'cancelled', 'error')]
+        try:
+            return self.client.gather(futs)
+        except AmscrError:
+            raise
+        except Exception as e:  # noqa: BLE001 - Dask's errors for lost data vary by version
+            lost = lost or [s for s, sh in enumerate(self._shards) if sh.status != 'finished']
+            if not lost:
+                raise
+            raise ShardSetError('amscr.distributed: shard%s %s lost with %s worker (%s: %s); load the saved set '
+                                'again (load_index) or build it again'
+                                % ('s' if len(lost) > 1 else '', ', '.join(map(str, lost)),
+                                   'their' if len(lost) > 1 else 'its', type(e).__name__, e), lib.AMSCR_E_STATE) from e
+
     def scores_many(self, queries: Sequence[Any]) -> np.ndarray:
         """The retrieval scores (len(queries), len(self)) of point arrays or :class:`amscr.Shape` s:
         each query matched with every shard's shapes on its worker, the rows merged on the client.
@@ -277,7 +293,7 @@ class ShardedIndex:
         qf = self.client.scatter(q.to_bytes(), broadcast=True, hash=False)
         futs = [self.client.submit(_query_block, sh, qf, pure=False, workers=[self._workers[s]])
                 for s, sh in enumerate(self._shards)]
-        parts = self.client.gather(futs)
+        parts = self._gather(futs)
         dq = np.concatenate([p[0] for p in parts], axis=1)
         dq2 = np.concatenate([p[1] for p in parts], axis=1)
         for i in range(nq):
@@ -315,7 +331,8 @@ class ShardedIndex:
         """
         d = os.fspath(path)
         os.makedirs(d, exist_ok=True)
-        datas = self.client.gather([self.client.submit(_index_bytes, sh, pure=False) for sh in self._shards])
+        datas = self._gather([self.client.submit(_index_bytes, sh, pure=False, workers=[self._workers[s]])
+                              for s, sh in enumerate(self._shards)])
         entries = []
         keep = {MANIFEST}
         for s, data in enumerate(datas):

@@ -3,7 +3,9 @@ split in shards answers as the single index (the top 10 of 2,000 procedural shap
 1e-9 with the inner distance's graph), a saved set loads back, a missing, foreign or differently
 built shard is an error naming its file, a write cut off never replaces a good set, files follow
 the umask. Skipped without Dask."""
+import contextlib
 import os
+import time
 
 import numpy as np
 import pytest
@@ -199,3 +201,16 @@ def test_bad_input(client):
         ad.build_index(client, amscr.Collection(amscr.Params.retrieval()))
     with pytest.raises(amscr.InvalidArgumentError, match='shards'):
         ad.build_index(client, _collection(amscr.Params.retrieval(points=POINTS), _shapes(40, 0)), shards=0)
+
+
+def test_shard_lost_with_its_worker_is_a_clear_error(client):
+    """Last in the file: it kills a worker of the module's cluster (its nanny starts another)."""
+    coll = _collection(amscr.Params.retrieval(points=POINTS, threads=1), _shapes(60, 0))
+    sx = ad.build_index(client, coll, shards=2)
+    sx.scores(_queries(1)[0])
+    with contextlib.suppress(Exception):  # the worker dies before it answers
+        client.run(os._exit, 1, workers=[sx._workers[1]])
+    with pytest.raises(ad.ShardSetError, match='shard 1 lost with its worker'):
+        for _ in range(50):  # until the scheduler has seen the worker go
+            sx.scores(_queries(1)[0])
+            time.sleep(0.2)
