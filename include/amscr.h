@@ -3162,6 +3162,120 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_precision_recall(const double
                                                                     const int32_t *labels, size_t nlevels,
                                                                     double *out_precision);
 
+/* ============================================================================
+ * An index split in shards: what amscr.distributed builds on (docs/collections.md,
+ * "An index in shards"). A collection of n shapes is cut into contiguous blocks; each block is an
+ * ordinary index (a shard, whose shapes carry their features); the whole collection's neighbour
+ * lists are computed from amscr_index_pair_distances over every pair of blocks and held, without
+ * any shape, by an amscr_index_graph. A query's distances to every shard's shapes
+ * (amscr_index_pair_distances with qpos SIZE_MAX), given to amscr_index_graph_scores, are the
+ * scores of the single index of the whole collection built with candidates 0 and queried with
+ * candidates 0 (to rounding), for a channel weight of 0 or 1.
+ * ============================================================================ */
+
+/** The neighbour lists of a whole collection without its shapes, and its largest distances:
+ *  turns a query's distances into its retrieval scores. @since 0.14 */
+typedef struct amscr_index_graph amscr_index_graph;
+
+/**
+ * @brief The base distance (the retrieval matrix's distance before re-ranking, as an index
+ *        lists it) and the inner distance of q to shapes first.. of x, each pair computed as the
+ *        cell of the two in the matrix of one collection (the lower index first): shapes of x
+ *        below qpos come before q, the others after it. qpos SIZE_MAX: q is a query (after
+ *        every shape, as amscr_index_query_scores with candidates 0 matches it); 0: q comes
+ *        before every shape of x (x's block lies after q's in the whole collection); i: q is
+ *        shape i of x itself (its own distance is 0; first i + 1 gives the pairs of a block
+ *        with itself once).
+ * @param[in]  x  an index (a shard), with a channel weight of 0 or 1 (a weight strictly between
+ *                uses x's own medians: the whole collection's differ).
+ * @param[in]  q  a shape prepared with params compatible with x's.
+ * @param[in]  first  the first shape of x matched (0: all).
+ * @param[out] out_base  n base distances (of shapes first..first+n-1).
+ * @param[out] out_inner  n inner distances, or NULL; zeros when the params give the inner graph
+ *                        no share.
+ * @param[in]  n  must equal amscr_index_size(x) - first.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, first or n, incompatible params); AMSCR_E_NOMEM.
+ * Cost: n pair distances on the params' threads.
+ * Ownership: none.
+ * Thread-safety: const on x.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_pair_distances(const amscr_index *x, const amscr_descriptor *q,
+                                                                  size_t qpos, size_t first, double *out_base,
+                                                                  double *out_inner, size_t n);
+
+/**
+ * @brief The widths of a collection's neighbour lists: *out_k neighbours a shape under the base
+ *        distance (the re-ranking's k for n shapes, at most n / 2; 0 without re-ranking) and
+ *        *out_k2 under the inner distance (*out_k when the params give the inner graph a share,
+ *        else 0). Either pointer may be NULL; p NULL gives 0 and 0.
+ * @param[in]  p  the collection's params.
+ * @param[in]  n  the collection's size.
+ * Ownership: none.
+ * Thread-safety: pure.
+ * @since 0.14
+ */
+AMSCR_API void amscr_index_graph_widths(const amscr_params *p, size_t n, size_t *out_k, size_t *out_k2);
+
+/**
+ * @brief A graph of n shapes from lists computed elsewhere (amscr_index_pair_distances over
+ *        every pair of blocks): row i of each list is shape i itself at distance 0, then its
+ *        k - 1 nearest other shapes by (distance, index), as amscr_index_build with candidates 0
+ *        lists them; dmax and dmax2 the largest base and inner distance of the collection.
+ * @param[in] p  the collection's params (copied).
+ * @param[in] nb_idx, nb_dist  n x k (amscr_index_graph_widths), row-major.
+ * @param[in] in_idx, in_dist  n x k2, or NULL when k2 is 0.
+ * @param[out] out  the new graph.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL; a row not itself first, an index >= n, a distance
+ *         negative or not finite: the detail names the row); AMSCR_E_LIMIT (2^32 shapes or
+ *         more); AMSCR_E_NOMEM.
+ * Memory: about (k + k2) * 28 bytes a shape.
+ * Ownership: caller frees *out with amscr_index_graph_free; the lists are copied.
+ * Thread-safety: pure.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_graph_new(const amscr_params *p, size_t n, const uint32_t *nb_idx,
+                                                             const double *nb_dist, const uint32_t *in_idx,
+                                                             const double *in_dist, double dmax, double dmax2,
+                                                             amscr_index_graph **out);
+
+/**
+ * @brief A query's retrieval scores against the graph's n shapes from its distances to the
+ *        candidates cand[0..m-1] (strictly ascending; the others score +inf unless the
+ *        re-ranking reaches them): the computation of amscr_index_query_scores after its
+ *        matching. With every shape a candidate and the distances of amscr_index_pair_distances
+ *        (qpos SIZE_MAX), the scores of the single index (see above).
+ * @param[in] dq   m base distances (finite, >= 0).
+ * @param[in] dq2  m inner distances, or NULL when the graph's k2 is 0.
+ * @param[out] out_scores  n scores, lower is better.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, candidates not ascending or out of range, a
+ *         distance not finite or negative); AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: const on g; runs on the calling thread.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_graph_scores(const amscr_index_graph *g, const size_t *cand,
+                                                                const double *dq, const double *dq2, size_t m,
+                                                                double *out_scores, size_t n);
+
+/**
+ * @brief The graph's number of shapes.
+ * @return n; 0 for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API size_t amscr_index_graph_size(const amscr_index_graph *g);
+
+/**
+ * @brief Frees a graph.
+ * @param[in] g  the graph, or NULL (a no-op).
+ * Ownership: takes g.
+ * Thread-safety: exclusive on g.
+ * @since 0.14
+ */
+AMSCR_API void amscr_index_graph_free(amscr_index_graph *g);
+
 /**
  * @brief Re-ranks a whole distance matrix by affinity diffusion on a k-nearest-neighbour
  *        tensor-product graph (Yang, Prasad, Latecki, CVPR 2012; docs/method.md). The output
