@@ -1,17 +1,19 @@
 /* amscr-registration-bench — speed (and, alongside, accuracy) of single registrations with the
- * registration preset, per stage: preparing both shapes, matching without the polish, matching
- * with it (the polish's cost is the difference).
+ * registration preset, per stage: tracing and preparing both shapes, registering without the
+ * recovery and the polish, what each adds, and the pair.
  *
  * Shapes: random smooth silhouettes (radius harmonics 2..8, some with a thin limb) drawn into a
  * 400 x 400 mask and traced (pixel contours of 600-1500 points, like the datasets'). Each is
  * registered onto a random affine image of itself (any rotation, anisotropy up to 2, shear up to
  * 0.5), resampled to 0.6-1.4 times the point count from a new start point, clean and with
- * Gaussian noise of 1 % and 2 % of the RMS radius. Success: max error over the source points
- * below 2 % of the target's RMS radius (bench/registration_heldout.py's measure).
+ * Gaussian noise of 1 % and 2 % of the RMS radius. Then pairs traced from 200 x 200 images as
+ * `amscr register` traces them, the target drawn under such a map, 140 px across, and damaged in
+ * the image (segmentation noise, a bite, a touching disk of 0.3 x the radius). Success: max error
+ * over the source points below 2 % of the target's RMS radius (registration_heldout.py's measure).
  *
  *   amscr-registration-bench [--pairs N] [--seed S]
  *
- * Not a test: it prints numbers (one thread, wall clock, median of the pairs). Run through
+ * Not a test: it prints numbers (one thread, CPU time, median of the pairs). Run through
  * `meson compile -C build bench` or `meson compile -C build bench-registration`. */
 #include <amscr.h>
 
@@ -26,32 +28,50 @@
 #define SIDE 400
 #define TWO_PI 6.283185307179586
 
-/* A random silhouette's pixel contour: a star-shaped blob, sometimes with a thin limb. */
-static amscr_contour *random_silhouette(void)
+/* A random star-shaped blob, sometimes with a thin limb; harmonics 9..12 (0 unless set): the
+ * traced pairs' segmentation noise. */
+typedef struct { double a[13], ph[13], dir; int limb; } blob;
+
+static blob random_blob(void)
 {
-    double a[9] = {0}, ph[9] = {0};
+    blob b = {{0}, {0}, 0.0, 0};
     for (int k = 2; k <= 8; k++) {
-        a[k] = (0.25 / k) * uni();
-        ph[k] = TWO_PI * uni();
+        b.a[k] = (0.25 / k) * uni();
+        b.ph[k] = TWO_PI * uni();
     }
-    int limb = uni() < 0.5;
-    double limb_dir = TWO_PI * uni();
-    uint8_t *mask = calloc((size_t)SIDE * SIDE, 1);
-    for (int y = 0; y < SIDE; y++)
-        for (int x = 0; x < SIDE; x++) {
-            double dx = (x - SIDE / 2) / (0.3 * SIDE), dy = (y - SIDE / 2) / (0.3 * SIDE);
+    b.limb = uni() < 0.5;
+    b.dir = TWO_PI * uni();
+    return b;
+}
+
+/* The blob into a side^2 mask: pixel (x, y) shows unit-frame point Li ((x, y) - o) / s. */
+static void draw(const blob *b, int side, const double Li[4], double ox, double oy, double s, uint8_t *mask)
+{
+    for (int y = 0; y < side; y++)
+        for (int x = 0; x < side; x++) {
+            double u = (x - ox) / s, v = (y - oy) / s, dx = Li[0] * u + Li[1] * v, dy = Li[2] * u + Li[3] * v;
             double th = atan2(dy, dx), r = 1.0, rho = hypot(dx, dy);
-            for (int k = 2; k <= 8; k++)
-                r += a[k] * cos(k * th + ph[k]);
+            for (int k = 2; k <= 12; k++)
+                r += b->a[k] * cos(k * th + b->ph[k]);
             int in = rho < r;
-            if (limb) { /* a bar 0.12 wide from the centre out to 1.6 */
-                double ux = cos(limb_dir), uy = sin(limb_dir), along = dx * ux + dy * uy;
+            if (b->limb) { /* a bar 0.12 wide from the centre out to 1.6 */
+                double ux = cos(b->dir), uy = sin(b->dir), along = dx * ux + dy * uy;
                 in |= along > 0.0 && along < 1.6 && fabs(-dx * uy + dy * ux) < 0.06;
             }
-            mask[(size_t)y * SIDE + x] = in ? 255 : 0;
+            mask[(size_t)y * side + x] = in ? 255 : 0;
         }
+}
+
+/* A random silhouette's pixel contour. */
+static amscr_contour *random_silhouette(void)
+{
+    blob b = random_blob();
+    double I[4] = {1, 0, 0, 1};
+    uint8_t *mask = calloc((size_t)SIDE * SIDE, 1);
     amscr_contour *c = NULL;
-    if (amscr_contour_from_mask(mask, SIDE, SIDE, SIDE, 128, &c) != AMSCR_OK)
+    if (mask)
+        draw(&b, SIDE, I, SIDE / 2, SIDE / 2, 0.3 * SIDE, mask);
+    if (!mask || amscr_contour_from_mask(mask, SIDE, SIDE, SIDE, 128, &c) != AMSCR_OK)
         c = NULL;
     free(mask);
     return c;
@@ -148,20 +168,105 @@ static double median(double *v, size_t n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-/* Registration of d_src onto d_tgt with polish on/off: seconds and success. */
-static double timed_register(amscr_params *p, int polish, const amscr_descriptor *a, const amscr_descriptor *b,
-                             const double T[6], const amscr_contour *src, double size, int *ok)
+#define TSIDE 200
+/* The blob under the linear map L into a TSIDE^2 mask, fitted to 140 px (T: unit frame -> px). */
+static void draw_fitted(const blob *b, const double L[4], uint8_t *m, double T[6])
+{
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}, det = L[0] * L[3] - L[1] * L[2];
+    double Li[4] = {L[3] / det, -L[1] / det, -L[2] / det, L[0] / det};
+    draw(b, TSIDE, Li, TSIDE / 2, TSIDE / 2, 20.0, m); /* at a scale that fits (L of det 1); its box: */
+    for (int i = 0; i < TSIDE * TSIDE; i++)
+        if (m[i])
+            lo[0] = fmin(lo[0], i % TSIDE), hi[0] = fmax(hi[0], i % TSIDE), lo[1] = fmin(lo[1], i / TSIDE),
+            hi[1] = fmax(hi[1], i / TSIDE);
+    double sc = 20.0 * 140.0 / fmax(hi[0] - lo[0], hi[1] - lo[1]), ox = TSIDE / 2 - (lo[0] + hi[0] - TSIDE) * sc / 40.0;
+    double oy = TSIDE / 2 - (lo[1] + hi[1] - TSIDE) * sc / 40.0, T6[6] = {sc * L[0], sc * L[1], ox, sc * L[2], sc * L[3], oy};
+    draw(b, TSIDE, Li, ox, oy, sc, m);
+    memcpy(T, T6, sizeof T6);
+}
+
+static void disk(uint8_t *m, double cx, double cy, double r, uint8_t v)
+{
+    for (int i = 0; i < TSIDE * TSIDE; i++)
+        m[i] = hypot(i % TSIDE - cx, i / TSIDE - cy) <= r ? v : m[i];
+}
+
+/* Damage 1: 12 specks (with the noise harmonics); 2: a bite, 3: a touching disk of 0.3 R
+ * (R = sqrt(area / pi)) at the boundary. */
+static void damage(uint8_t *m, int kind)
+{
+    double n = 0, cx = 0, cy = 0, th = TWO_PI * uni(), t = 0.0;
+    for (int i = 0; i < TSIDE * TSIDE; i++)
+        if (m[i])
+            n++, cx += i % TSIDE, cy += i / TSIDE;
+    cx /= n, cy /= n;
+    double R = sqrt(n / 3.141592653589793), ux = cos(th), uy = sin(th);
+    for (int k = 0; kind == 1 && k < 12; k++) {
+        double x = TSIDE * uni(), y = TSIDE * uni(), rs = 1.0 + uni();
+        disk(m, x, y, hypot(x - cx, y - cy) > 1.5 * R ? rs : -1.0, 255);
+    }
+    if (kind == 1)
+        return;
+    for (double r = 0.0; r < TSIDE; r += 0.5) { /* the outermost boundary point in direction th */
+        int x = (int)lround(cx + r * ux), y = (int)lround(cy + r * uy);
+        if (x >= 0 && y >= 0 && x < TSIDE && y < TSIDE && m[y * TSIDE + x])
+            t = r;
+    }
+    double r = 0.3 * R, off = kind == 2 ? 0.0 : r; /* a bite centred on the boundary, a disk touching it */
+    disk(m, cx + (t + off) * ux, cy + (t + off) * uy, r, kind == 2 ? 0 : 255);
+}
+
+/* Thread CPU seconds: every call timed runs on this thread (and the machine may be shared). */
+static double cpu_now(void)
+{
+    struct timespec t;
+    return clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t) == 0 ? (double)t.tv_sec + 1e-9 * (double)t.tv_nsec : NAN;
+}
+
+/* Traced pair `kind` (0 clean, 1 segmentation noise, 2 bite, 3 touching disk): the contours, the
+ * true map T (source px -> target px), the target's size; returns the tracing's CPU seconds. */
+static double traced_pair(int kind, amscr_contour **src, amscr_contour **tgt, double T[6], double *size)
+{
+    static uint8_t ms[TSIDE * TSIDE], mt[TSIDE * TSIDE];
+    blob b = random_blob();
+    double I[4] = {1, 0, 0, 1}, A[6], Ts[6], Tt[6];
+    random_affine(A);
+    double g = sqrt(fabs(A[0] * A[4] - A[1] * A[3])), L[4] = {A[0] / g, A[1] / g, A[3] / g, A[4] / g};
+    draw_fitted(&b, I, ms, Ts);
+    for (int j = 9; kind == 1 && j <= 12; j++) /* the boundary moved by ~1.5 % of the radius */
+        b.a[j] = 0.0075 * gauss(), b.ph[j] = TWO_PI * uni();
+    draw_fitted(&b, L, mt, Tt);
+    if (kind > 0)
+        damage(mt, kind);
+    double s = Ts[0], t0 = cpu_now(); /* Tt Ts^-1; Ts is a scaling and a shift */
+    double M[6] = {Tt[0] / s, Tt[1] / s, Tt[2] - (Tt[0] * Ts[2] + Tt[1] * Ts[5]) / s,
+                   Tt[3] / s, Tt[4] / s, Tt[5] - (Tt[3] * Ts[2] + Tt[4] * Ts[5]) / s};
+    memcpy(T, M, sizeof M);
+    if (amscr_contour_from_image(ms, TSIDE, TSIDE, TSIDE, 8, 127.5, AMSCR_TRACE_JOIN, src) != AMSCR_OK ||
+        amscr_contour_from_image(mt, TSIDE, TSIDE, TSIDE, 8, 127.5, AMSCR_TRACE_JOIN, tgt) != AMSCR_OK)
+        return NAN;
+    double t = cpu_now() - t0;
+    *size = sqrt(fabs(T[0] * T[4] - T[1] * T[3])) * rms_radius(amscr_contour_xy(*src), amscr_contour_size(*src));
+    return t;
+}
+
+/* amscr_register with the recovery and the polish on or off: CPU seconds (NaN on failure), and
+ * whether the map is within 2 % of T's. */
+static double timed_register(amscr_params *p, int rec, int pol, const amscr_descriptor *a, const amscr_descriptor *b,
+                             const double T[6], const amscr_contour *src, double size, int *ok, int *recovered)
 {
     amscr_result *r = NULL;
-    double M[6];
-    if (amscr_params_set_polish(p, polish) != AMSCR_OK)
-        return NAN;
-    double t0 = now();
-    amscr_status st = amscr_register(p, a, b, NULL, &r);
-    double t = now() - t0;
-    *ok = st == AMSCR_OK && amscr_result_affine(r, M) == AMSCR_OK && map_error(M, T, src, size) < 0.02;
+    double M[6], t0 = cpu_now();
+    int st = amscr_params_set_stage(p, "recovery", rec) == AMSCR_OK && amscr_params_set_polish(p, pol) == AMSCR_OK &&
+             amscr_register(p, a, b, NULL, &r) == AMSCR_OK;
+    double t = cpu_now() - t0;
+    *ok = st && amscr_result_affine(r, M) == AMSCR_OK && map_error(M, T, src, size) < 0.02;
+    const char *nm = NULL;
+    for (int i = 0, ran = 0; st && i < (int)amscr_result_num_stages(r); i++)
+        if (amscr_result_stage(r, i, &nm, &ran) == AMSCR_OK && !strcmp(nm, "recovery"))
+            *recovered = ran;
     amscr_result_free(r);
-    return t;
+    return st ? t : NAN;
 }
 
 int main(int argc, char **argv)
@@ -178,49 +283,62 @@ int main(int argc, char **argv)
             return 2;
         }
     }
+    uint64_t seed = rng_state;
     amscr_params *p = NULL;
-    if (amscr_params_new_registration(&p) != AMSCR_OK)
+    double *v = calloc(6 * (pairs ? pairs : 1), sizeof *v); /* trace, prepare, bare, no polish, preset, pair */
+    if (amscr_params_new_registration(&p) != AMSCR_OK || !v)
         return 1;
+    static const char *names[7] = {"0 % noise", "1 % noise", "2 % noise", "img clean", "img noise", "img bite",
+                                   "img touch"};
     const double noises[3] = {0.0, 0.01, 0.02};
-    printf("registration (preset: N 256, refine 20), %zu pairs per condition, one thread, median wall time:\n",
+    printf("registration (preset: N 256, refine 20), %zu pairs per condition, one thread, median CPU time; pair:\n"
+           "trace + prepare + register (preset) [90th percentile, max]; bare: register without the recovery and\n"
+           "the polish, which add the next two; recov.: pairs the recovery ran for; ok: within 2 %% (no polish,\n"
+           "preset). Point lists (n %% noise), then 200-px images (clean, segmentation noise, bite, touching disk):\n",
            pairs);
-    printf("  %-10s %8s %10s %12s %12s %8s %12s %12s\n", "condition", "points", "prepare", "no polish", "polished",
-           "polish", "ok no pol.", "ok polished");
-    for (int c = 0; c < 3; c++) {
-        double *tp = calloc(pairs, sizeof *tp), *t0 = calloc(pairs, sizeof *t0), *t1 = calloc(pairs, sizeof *t1);
-        size_t ok0 = 0, ok1 = 0, npts = 0, done = 0;
+    printf("  %-10s %6s %8s %8s %8s %8s %8s %24s %6s %7s %7s\n", "condition", "points", "trace", "prepare", "bare",
+           "recovery", "polish", "pair [p90, max]", "recov.", "ok", "ok pol.");
+    for (int c = 0; c < 7; c++) {
+        size_t ok0 = 0, ok1 = 0, npts = 0, done = 0, recov = 0;
+        if (c == 3)
+            rng_state = seed + 186; /* the images draw their own shapes */
         for (size_t k = 0; k < pairs; k++) {
-            double T[6], size;
-            amscr_contour *src = random_silhouette(), *tgt = NULL;
-            random_affine(T);
-            if (src)
-                tgt = make_target(src, T, noises[c], &size);
+            double T[6], size = 0.0, t[6] = {0.0};
+            amscr_contour *src = NULL, *tgt = NULL;
+            if (c < 3) {
+                src = random_silhouette();
+                random_affine(T);
+                if (src)
+                    tgt = make_target(src, T, noises[c], &size);
+            } else
+                t[0] = traced_pair(c - 3, &src, &tgt, T, &size);
             amscr_descriptor *a = NULL, *b = NULL;
-            double s = now();
+            double s = cpu_now();
+            int o[3] = {0}, rec = 0;
             int prepared = tgt && amscr_descriptor_new(p, src, &a) == AMSCR_OK && amscr_descriptor_new(p, tgt, &b) == AMSCR_OK;
-            tp[done] = now() - s;
-            int o0 = 0, o1 = 0;
-            if (prepared) {
-                t0[done] = timed_register(p, 0, a, b, T, src, size, &o0);
-                t1[done] = timed_register(p, 1, a, b, T, src, size, &o1);
-                ok0 += (size_t)o0, ok1 += (size_t)o1;
-                npts += amscr_contour_size(src) + amscr_contour_size(tgt);
-                done++;
+            t[1] = cpu_now() - s;
+            for (int i = 0; prepared && i < 3; i++) /* bare, with the recovery, the preset (with the polish) */
+                t[2 + i] = timed_register(p, i > 0, i > 1, a, b, T, src, size, &o[i], &rec);
+            t[5] = t[0] + t[1] + t[4];
+            if (prepared && isfinite(t[0] + t[2] + t[3] + t[4])) {
+                for (int i = 0; i < 6; i++)
+                    v[i * pairs + done] = t[i];
+                ok0 += (size_t)o[1], ok1 += (size_t)o[2], recov += (size_t)rec;
+                npts += amscr_contour_size(src) + amscr_contour_size(tgt), done++;
             }
-            amscr_descriptor_free(a);
-            amscr_descriptor_free(b);
-            amscr_contour_free(src);
-            amscr_contour_free(tgt);
+            amscr_descriptor_free(a), amscr_descriptor_free(b);
+            amscr_contour_free(src), amscr_contour_free(tgt);
         }
+        double q[6] = {0}; /* bare, recovery, polish: differences of the medians */
+        for (int i = 0; done && i < 6; i++)
+            q[i] = 1e3 * median(v + i * pairs, done); /* sorts that column */
         if (done)
-            printf("  %3.0f %% noise %8zu %8.2f ms %9.2f ms %9.2f ms %5.2f ms %11.1f %% %11.1f %%\n", 100.0 * noises[c],
-                   npts / (2 * done), 1e3 * median(tp, done), 1e3 * median(t0, done), 1e3 * median(t1, done),
-                   1e3 * (median(t1, done) - median(t0, done)), 100.0 * (double)ok0 / (double)done,
-                   100.0 * (double)ok1 / (double)done);
-        free(tp);
-        free(t0);
-        free(t1);
+            printf("  %-10s %6zu %5.2f ms %5.2f ms %5.2f ms %5.2f ms %5.2f ms %6.2f [%6.2f, %6.2f] ms %6zu %6.1f%% %6.1f%%\n",
+                   names[c], npts / (2 * done), q[0], q[1], q[2], q[3] - q[2], q[4] - q[3], q[5],
+                   1e3 * v[5 * pairs + (size_t)(0.9 * (double)(done - 1) + 0.5)], 1e3 * v[5 * pairs + done - 1], recov,
+                   100.0 * (double)ok0 / (double)done, 100.0 * (double)ok1 / (double)done);
     }
+    free(v);
     amscr_params_free(p);
     return 0;
 }

@@ -2634,6 +2634,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  * Memory: the kept index, about 50 KB a shape with the retrieval preset (channel and inner
  *       features, signature, lists; not a copy of the shapes), until amscr_db_free.
  * Prefer an amscr_index to save the preparation in a file or to query with a shortlist.
+ * The query is scored as a new shape even when it is a member's copy (no member rule:
+ * amscr_db_search_retrieval applies it).
  * @param[in]  q  a shape prepared with params compatible with the collection's.
  * @param[in]  progress, user  optional progress callback (may be NULL).
  * @param[out] out_scores  n scores, lower is better (see amscr_db_retrieval_matrix).
@@ -2648,6 +2650,27 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_query_retrieval(const amscr_db *db, const amscr_descriptor *q,
                                                                 amscr_progress_fn progress, void *user,
                                                                 double *out_scores, size_t n);
+
+/**
+ * @brief amscr_db_query_retrieval with the member rule (see amscr_index_search_scores): a
+ *        query whose prepared samples equal a shape's of the collection, bit for bit (a member
+ *        traced and prepared again), gets that shape's row of amscr_db_retrieval_matrix on the
+ *        collection itself (0 against itself; to rounding, ~1e-12), as `amscr search` shows it;
+ *        any other query gets amscr_db_query_retrieval's scores. The rule applies when the scores
+ *        depend on the collection (rerank_k > 0, or a channel weight strictly between 0 and 1);
+ *        the base distances alone are the same for a member's copy.
+ * Cost, memory, params as amscr_db_query_retrieval; the rule adds the query's signature and
+ *       a comparison with its 32 signature-nearest shapes.
+ * @param[out] out_scores  n scores, lower is better.
+ * @param[in]  n  must equal amscr_db_size(db).
+ * @return as amscr_db_query_retrieval.
+ * Ownership: none.
+ * Thread-safety: as amscr_db_query_retrieval.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_search_retrieval(const amscr_db *db, const amscr_descriptor *q,
+                                                                 amscr_progress_fn progress, void *user,
+                                                                 double *out_scores, size_t n);
 
 /* ============================================================================
  * Retrieval index: a collection with what one-vs-many retrieval needs
@@ -2744,7 +2767,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_add(amscr_index *x, const ams
  *        equal amscr_db_query_retrieval's (to rounding, ~1e-12); with a channel weight strictly
  *        between 0 and 1 the fusion uses the build's medians. candidates M matches the query
  *        with its M signature-nearest shapes only (at least K - 1); the others get +inf unless
- *        the re-ranking reaches them.
+ *        the re-ranking reaches them. The query is scored as a new shape even when it is a
+ *        member's copy (no member rule: amscr_index_search_scores applies it).
  * @param[in]  q  a shape prepared with params compatible with the index's.
  * @param[out] out_scores  n scores, lower is better.
  * @param[in]  n  must equal amscr_index_size(x).
@@ -2781,6 +2805,61 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_query(const amscr_index *x, c
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t candidates,
                                                                  double *out_scores, size_t n);
+
+/**
+ * @brief The member rule: the shape of the index whose prepared samples are the query's, bit
+ *        for bit (the same number of samples and the same sample points in input coordinates,
+ *        amscr_descriptor_input_points), e.g. a file of the collection traced and prepared
+ *        again with the index's params; the lowest index when the collection holds copies.
+ *        The search calls (amscr_index_search_scores, amscr_index_search,
+ *        amscr_db_search_retrieval; the tool's `amscr search`) score such a query as that
+ *        shape: its row of the collection's retrieval matrix (amscr_index_member_scores).
+ *        The query calls (amscr_index_query_scores, amscr_index_query,
+ *        amscr_db_query_retrieval) never apply it: they score every query as a new shape.
+ * Cost: the query's signature and a comparison with its 32 signature-nearest shapes (a lazy
+ *       load decodes at most those); no pair distance.
+ * @param[in]  q  a shape prepared with params compatible with the index's.
+ * @param[out] out_i  the shape's index, or SIZE_MAX when no shape has the query's samples.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, incompatible params); AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_find_member(const amscr_index *x, const amscr_descriptor *q,
+                                                               size_t *out_i);
+
+/**
+ * @brief The query's scores as a search shows them: amscr_index_member_scores of the shape
+ *        amscr_index_find_member finds (the member rule), else amscr_index_query_scores. The rule
+ *        applies when the scores depend on the collection (rerank_k > 0, or a channel weight
+ *        strictly between 0 and 1); the base distances alone (channel weight 0 or 1 without
+ *        re-ranking) are amscr_index_query_scores' for every query. So a member's copy ranks
+ *        the member first at 0 and the others as the member's own row, with every face (C, the
+ *        tool, Python's Index.query and Collection.query) giving the same scores.
+ * @param[in]  q  a shape prepared with params compatible with the index's.
+ * @param[in]  candidates  as amscr_index_query_scores.
+ * @param[out] out_scores  n scores, lower is better.
+ * @param[in]  n  must equal amscr_index_size(x).
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, incompatible params); AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: const; runs on the params' threads.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_search_scores(const amscr_index *x, const amscr_descriptor *q,
+                                                                 size_t candidates, double *out_scores, size_t n);
+
+/**
+ * @brief The `top` best shapes of amscr_index_search_scores, best first (ties by index).
+ * @param[out] out_idx, out_scores  room for `top` entries each.
+ * @param[out] out_count  min(top, n) entries written.
+ * @return as amscr_index_search_scores.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_search(const amscr_index *x, const amscr_descriptor *q,
+                                                          size_t candidates, size_t top, size_t *out_idx,
+                                                          double *out_scores, size_t *out_count);
 
 /**
  * @brief Shapes in the index (0 for NULL).

@@ -241,6 +241,107 @@ START_TEST(member_rows)
 }
 END_TEST
 
+/* The member rule (amscr_index_find_member and the search calls): a query prepared again from
+ * a member's points is that member (the lowest index of copies), and the search calls score it
+ * by the member's row of the collection's retrieval matrix (amscr_index_member_scores; the db's
+ * search its row of amscr_db_retrieval_matrix) when the scores re-rank or fuse, by the query's
+ * own scores otherwise (the channel alone); any other query gets the query calls' scores; the
+ * query calls never apply the rule; a lazy load finds the same member. */
+static void member_rule_case(double w, unsigned k, int applies)
+{
+    amscr_params *p = params_of(w, k, 2);
+    amscr_db *db = db_of(p, NSHAPES);
+    amscr_descriptor *dup = shape(p, 7), *q = NULL, *other = shape(p, 2000);
+    ck_assert_int_eq(amscr_db_add_descriptor(db, dup, 1, NULL), AMSCR_OK); /* shape NSHAPES: a copy of 7 */
+    const size_t n = NSHAPES + 1;
+    double *M = malloc(n * n * sizeof *M), got[NSHAPES + 1], want[NSHAPES + 1], mem[NSHAPES + 1];
+    amscr_index *x = NULL, *y = NULL;
+    void *buf = NULL;
+    size_t len = 0, i = 0, idx[5], cnt = 0;
+    ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_load_memory_with(buf, len, AMSCR_INDEX_LAZY, &y), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_retrieval_matrix(db, NULL, NULL, M), AMSCR_OK);
+    for (unsigned s = 3; s < NSHAPES; s += 4) {
+        q = shape(p, s); /* the member's points prepared again: its samples, bit for bit */
+        ck_assert_int_eq(amscr_index_find_member(x, q, &i), AMSCR_OK);
+        ck_assert_uint_eq(i, s);
+        ck_assert_int_eq(amscr_index_find_member(y, q, &i), AMSCR_OK);
+        ck_assert_uint_eq(i, s);
+        ck_assert_int_eq(amscr_index_query_scores(x, q, 0, want, n), AMSCR_OK);
+        ck_assert_int_eq(amscr_index_member_scores(x, s, 0, mem, n), AMSCR_OK);
+        if (applies)
+            memcpy(want, mem, sizeof want);
+        ck_assert_int_eq(amscr_index_search_scores(x, q, 0, got, n), AMSCR_OK);
+        ck_assert_mem_eq(got, want, sizeof got);
+        ck_assert_int_eq(amscr_index_search_scores(y, q, 0, got, n), AMSCR_OK);
+        assert_close(got, want, n, 1e-12);
+        ck_assert_int_eq(amscr_index_search(x, q, 0, 5, idx, got, &cnt), AMSCR_OK);
+        ck_assert_uint_eq(cnt, 5);
+        ck_assert_uint_eq(idx[0], s); /* first, at its own score */
+        ck_assert(got[0] == want[s]);
+        ck_assert_int_eq(amscr_db_search_retrieval(db, q, NULL, NULL, got, n), AMSCR_OK);
+        if (applies) {
+            assert_close(got, M + s * n, n, 1e-12); /* its row of the collection's matrix */
+            ck_assert(got[s] == 0.0);
+            ck_assert_int_eq(amscr_db_query_retrieval(db, q, NULL, NULL, want, n), AMSCR_OK);
+            double diff = 0.0; /* the query call scores it as a new shape: other scores */
+            for (size_t j = 0; j < n; j++)
+                diff = fmax(diff, fabs(want[j] - got[j]));
+            ck_assert_msg(diff > 1e-6, "the query call should not apply the member rule (%g)", diff);
+        } else {
+            ck_assert_int_eq(amscr_db_query_retrieval(db, q, NULL, NULL, want, n), AMSCR_OK);
+            ck_assert_mem_eq(got, want, sizeof got);
+        }
+        amscr_descriptor_free(q);
+    }
+    /* copies: the lowest index */
+    ck_assert_int_eq(amscr_index_find_member(x, dup, &i), AMSCR_OK);
+    ck_assert_uint_eq(i, 7);
+    /* not a member: the query calls' scores */
+    ck_assert_int_eq(amscr_index_find_member(x, other, &i), AMSCR_OK);
+    ck_assert_uint_eq(i, SIZE_MAX);
+    ck_assert_int_eq(amscr_index_query_scores(x, other, 0, want, n), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_search_scores(x, other, 0, got, n), AMSCR_OK);
+    ck_assert_mem_eq(got, want, sizeof got);
+    ck_assert_int_eq(amscr_db_query_retrieval(db, other, NULL, NULL, want, n), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_search_retrieval(db, other, NULL, NULL, got, n), AMSCR_OK);
+    ck_assert_mem_eq(got, want, sizeof got);
+    /* errors */
+    ck_assert_int_eq(amscr_index_find_member(NULL, other, &i), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_index_find_member(x, NULL, &i), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_index_find_member(x, other, NULL), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_index_search_scores(x, other, 0, got, n - 1), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_index_search(x, other, 0, 5, NULL, got, &cnt), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_db_search_retrieval(db, other, NULL, NULL, got, n + 1), AMSCR_E_INVALID_ARG);
+    amscr_params *p32 = params_of(w, k, 2);
+    ck_assert_int_eq(amscr_params_set_num_samples(p32, 32), AMSCR_OK);
+    amscr_descriptor *q32 = shape(p32, 3);
+    ck_assert_int_eq(amscr_index_find_member(x, q32, &i), AMSCR_E_INVALID_ARG);
+    ck_assert_uint_eq(i, SIZE_MAX);
+    ck_assert_int_eq(amscr_index_search_scores(x, q32, 0, got, n), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_db_search_retrieval(db, q32, NULL, NULL, got, n), AMSCR_E_INVALID_ARG);
+    amscr_descriptor_free(q32);
+    amscr_params_free(p32);
+    amscr_free(buf);
+    amscr_index_free(x);
+    amscr_index_free(y);
+    free(M);
+    amscr_descriptor_free(dup);
+    amscr_descriptor_free(other);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+
+START_TEST(member_rule_rerank) { member_rule_case(1.0, 8, 1); }
+END_TEST
+
+START_TEST(member_rule_fused) { member_rule_case(0.5, 0, 1); }
+END_TEST
+
+START_TEST(member_rule_channel_alone) { member_rule_case(1.0, 0, 0); }
+END_TEST
+
 static amscr_index *named_index(const amscr_params *p, size_t candidates)
 {
     amscr_db *db = db_of(p, NSHAPES);
@@ -1051,6 +1152,9 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, inner_lists);
     tcase_add_test(tc, inner_section);
     tcase_add_test(tc, member_rows);
+    tcase_add_test(tc, member_rule_rerank);
+    tcase_add_test(tc, member_rule_fused);
+    tcase_add_test(tc, member_rule_channel_alone);
     tcase_add_test(tc, round_trips);
     tcase_add_test(tc, lazy_load);
     tcase_add_test(tc, lazy_file_shapes);

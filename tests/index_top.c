@@ -1,7 +1,8 @@
 /* index_top.c — the C face of an index search, for the cross-face test
  * (bindings/python/tests/test_index_faces.py): loads an index file (amscr_index_load), prepares
  * the query (a text file of "x y" lines) with the index's params and prints its TOP best shapes
- * (amscr_index_query) as JSON: {"n": N, "results": [{"index": I, "file": NAME, "distance": D}]}.
+ * (amscr_index_search: a member's copy scored as the member) as JSON:
+ * {"n": N, "results": [{"index": I, "file": NAME, "distance": D}]}.
  *   index_top INDEX QUERY.txt [CANDIDATES (default 0: every shape)] [TOP (default 10)] */
 #include <stdio.h>
 #include <stdlib.h>
@@ -68,7 +69,7 @@ int main(int argc, char **argv)
     if (st == AMSCR_OK)
         st = amscr_descriptor_new(amscr_db_params(amscr_index_db(x)), c, &q);
     if (st == AMSCR_OK)
-        st = amscr_index_query(x, q, cand, top, idx, scores, &count);
+        st = amscr_index_search(x, q, cand, top, idx, scores, &count);
     if (st == AMSCR_OK) {
         printf("{\"n\": %zu, \"results\": [", amscr_index_size(x));
         for (size_t t = 0; t < count; t++) {

@@ -133,17 +133,17 @@ static void keep_placement(placement *best, size_t *nb, const placement *c)
         (*nb)++;
 }
 
-/* One closest-point pass: partners of X f_a on the dense target Hd (nd edges, closed) within
- * b[a] ± w; q, r2, b updated; returns the trimmed cost, *cut its cut-off. */
-static double pairs(const amscr_descriptor *f, const double *Hd, size_t nd, const double X[6], size_t w, double *q,
-                    double *r2, double *sorted, double *b, double *cut)
+/* One closest-point pass: partners of X f_a on the dense target Hd (nd edges, closed; lengths
+ * edges E) within b[a] ± w; q, r2, b updated; returns the trimmed cost, *cut its cut-off. */
+static double pairs(const amscr_descriptor *f, const double *Hd, const double *E, size_t nd, const double X[6],
+                    size_t w, double *q, double *r2, double *sorted, double *b, double *cut)
 {
     size_t n = f->n;
     for (size_t a = 0; a < n; a++) {
         double fx = f->base[2 * a], fy = f->base[2 * a + 1];
         double px = X[0] * fx + X[1] * fy + X[2], py = X[3] * fx + X[4] * fy + X[5];
         size_t seg = (size_t)b[a];
-        r2[a] = amscr__closest_on_polygon(Hd, nd, 1, seg, w, px, py, &q[2 * a], &q[2 * a + 1], &seg);
+        r2[a] = amscr__closest_on_closed(E, nd, seg, w, px, py, &q[2 * a], &q[2 * a + 1], &seg);
         b[a] = (double)seg;
         sorted[a] = r2[a];
     }
@@ -158,16 +158,17 @@ static double pairs(const amscr_descriptor *f, const double *Hd, size_t nd, cons
 
 /* Trimmed closest-point refinement of placement pl (X in/out); returns the trimmed cost.
  * b: the initial partners (dense edge per sample), updated. */
-static double refine_placement(const amscr_params *prm, const amscr_descriptor *f, const double *Hd, size_t nd,
-                               double X[6], double *b, double *q, double *r2, double *sorted, double *out_cut)
+static double refine_placement(const amscr_params *prm, const amscr_descriptor *f, const double *Hd,
+                               const double *E, size_t nd, double X[6], double *b, double *q, double *r2,
+                               double *sorted, double *out_cut)
 {
     size_t n = f->n, wide = AMSCR__DENSE * (n / PART_WINDOW_DIV), near = AMSCR__DENSE * PART_HINT;
-    double cut, cost = pairs(f, Hd, nd, X, wide, q, r2, sorted, b, &cut);
+    double cut, cost = pairs(f, Hd, E, nd, X, wide, q, r2, sorted, b, &cut);
     for (unsigned it = 0; it < PART_ITERS; it++) {
         double Xn[6], cutn;
         if (!amscr__plane_solve(prm, f->base, q, r2, b, Hd, nd, n, cut, Xn))
             break;
-        double costn = pairs(f, Hd, nd, Xn, it == 0 ? wide : near, q, r2, sorted, b, &cutn);
+        double costn = pairs(f, Hd, E, nd, Xn, it == 0 ? wide : near, q, r2, sorted, b, &cutn);
         int done = !(costn < cost * (1.0 - 1e-6));
         memcpy(X, Xn, 6 * sizeof *X);
         cost = costn;
@@ -273,7 +274,7 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
     amscr_status st = amscr__ws_reserve_refine(ws, n);
     if (st != AMSCR_OK)
         return st;
-    double *buf = amscr__malloc_array(6 * n + 2 * PART_K + 3 * PART_U, sizeof *buf);
+    double *buf = amscr__malloc_array((6 + 5 * AMSCR__DENSE) * n + 2 * PART_K + 3 * PART_U, sizeof *buf);
     double *b = amscr__malloc_array(n, sizeof *b);
     if (!buf || !b) {
         free(buf);
@@ -281,7 +282,7 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
         return amscr__fail(AMSCR_E_NOMEM, "partial registration: out of memory");
     }
     double *sm = buf, *cumF = sm + 2 * n, *cumH = cumF + n, *F = cumH + n, *Hu = F + 2 * PART_K,
-           *Hp = Hu + 2 * PART_U;
+           *Hp = Hu + 2 * PART_U, *E = Hp + PART_U;
     double LF, LH;
     st = partial_samples(f, h, sm, cumF, cumH, &LF, &LH, F, Hu, Hp);
     if (st != AMSCR_OK) {
@@ -293,12 +294,13 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
     size_t nb = search_placements(prm, F, Hu, phi_min, best);
     double *q = ws->rbuf, *r2 = q + 2 * n, *sorted = r2 + n, *Hd = q + 8 * n;
     size_t nd = amscr__densify(h->base, n, 1, Hd);
+    amscr__closed_edges(Hd, nd, E);
     size_t win = 0;
     double cut = 0.0;
     for (size_t c = 0; c < nb; c++) {
         memcpy(best[c].X0, best[c].X, sizeof best[c].X0);
         initial_partners(&best[c], cumF, LF, Hp, n, nd, b);
-        best[c].tcost = refine_placement(prm, f, Hd, nd, best[c].X, b, q, r2, sorted, &cut);
+        best[c].tcost = refine_placement(prm, f, Hd, E, nd, best[c].X, b, q, r2, sorted, &cut);
         if (best[c].tcost < best[win].tcost)
             win = c;
     }
@@ -315,7 +317,7 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
     if (win + 1 != nb) {
         memcpy(X, best[win].X0, sizeof X);
         initial_partners(&best[win], cumF, LF, Hp, n, nd, b);
-        cost = refine_placement(prm, f, Hd, nd, X, b, q, r2, sorted, &cut);
+        cost = refine_placement(prm, f, Hd, E, nd, X, b, q, r2, sorted, &cut);
     }
     double all = 0.0;
     for (size_t a = 0; a < n; a++)

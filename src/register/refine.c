@@ -51,8 +51,16 @@ static double closest_on_polygon(const double *H, size_t n, int closed, size_t b
     for (size_t i = 0; i < cnt; i++) {
         size_t c = b + 1 == n ? 0 : b + 1;
         double ax = H[2 * b], ay = H[2 * b + 1], ex = H[2 * c] - ax, ey = H[2 * c + 1] - ay;
-        double l2 = ex * ex + ey * ey, t = l2 > 0.0 ? ((px - ax) * ex + (py - ay) * ey) / l2 : 0.0;
-        t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+        double l2 = ex * ex + ey * ey, num = (px - ax) * ex + (py - ay) * ey, t;
+        /* num / l2 clamped to [0, 1], dividing only inside (most edges of a window project
+         * outside): the same t as the quotient's (num < 0 < l2 gives a negative one, num > l2
+         * one of at least 1; a NaN stays NaN) */
+        if (num < 0.0 || !(l2 > 0.0))
+            t = 0.0;
+        else if (num > l2)
+            t = 1.0;
+        else
+            t = num / l2;
         double cx = ax + t * ex, cy = ay + t * ey, d2 = (px - cx) * (px - cx) + (py - cy) * (py - cy);
         if (d2 < best) {
             best = d2;
@@ -206,6 +214,57 @@ double amscr__closest_on_polygon(const double *H, size_t n, int closed, size_t b
 }
 
 size_t amscr__densify(const double *H, size_t n, int closed, double *out) { return densify(H, n, closed, out); }
+
+void amscr__closed_edges(const double *H, size_t n, double *E)
+{
+    double *ax = E, *ay = E + n, *ex = E + 2 * n, *ey = E + 3 * n, *l2 = E + 4 * n;
+    for (size_t b = 0; b < n; b++) {
+        size_t c = b + 1 == n ? 0 : b + 1;
+        ax[b] = H[2 * b];
+        ay[b] = H[2 * b + 1];
+        ex[b] = H[2 * c] - ax[b];
+        ey[b] = H[2 * c + 1] - ay[b];
+        l2[b] = ex[b] * ex[b] + ey[b] * ey[b];
+    }
+}
+
+/* Edges b .. e - 1 (no wrap) of closest_on_polygon's search, from the edges E: its arithmetic,
+ * dividing only when the foot is inside the edge (num / l2 clamped to [0, 1] is 0 when
+ * num < 0 < l2 and 1 when num > l2 > 0; a NaN stays NaN), the first strictly lowest kept. */
+static void closest_run(const double *E, size_t n, size_t b, size_t e, double px, double py, double *best,
+                        double *qx, double *qy, size_t *seg)
+{
+    const double *AX = E, *AY = E + n, *EX = E + 2 * n, *EY = E + 3 * n, *L2 = E + 4 * n;
+    for (; b < e; b++) {
+        double ax = AX[b], ay = AY[b], ex = EX[b], ey = EY[b], l2 = L2[b];
+        double num = (px - ax) * ex + (py - ay) * ey, t;
+        if (num < 0.0 || !(l2 > 0.0))
+            t = 0.0;
+        else if (num > l2)
+            t = 1.0;
+        else
+            t = num / l2;
+        double cx = ax + t * ex, cy = ay + t * ey, d2 = (px - cx) * (px - cx) + (py - cy) * (py - cy);
+        if (d2 < *best) {
+            *best = d2;
+            *qx = cx;
+            *qy = cy;
+            *seg = b;
+        }
+    }
+}
+
+double amscr__closest_on_closed(const double *E, size_t n, size_t b0, size_t w, double px, double py, double *qx,
+                                double *qy, size_t *seg)
+{
+    double best = INFINITY;
+    size_t cnt = 2 * w + 1 < n ? 2 * w + 1 : n;
+    size_t c0 = b0 < n ? b0 : b0 % n, back = cnt == n ? 0 : w; /* w < n here: no division */
+    size_t b = c0 >= back ? c0 - back : c0 + n - back, first = n - b < cnt ? n - b : cnt;
+    closest_run(E, n, b, b + first, px, py, &best, qx, qy, seg); /* up to the wrap */
+    closest_run(E, n, 0, cnt - first, px, py, &best, qx, qy, seg);
+    return best;
+}
 
 /* Point-to-line weight of the pairs' tangential part: the solve minimizes
  * Σ (n·e)^2 + AMSCR__PLANE_MU |e|^2 over the kept pairs, e = X f - q and n the target's normal

@@ -90,6 +90,12 @@ int amscr__index_frames(const amscr_params *p);
 size_t amscr__index_k2(const amscr_params *p, size_t k);
 /* db can be indexed (closed curves for the channel, at most 2^32 - 1 shapes). */
 amscr_status amscr__index_check_db(const amscr_db *db, const char *what);
+/* The member rule of the search calls (index_query.c): whether p's scores depend on the
+ * collection (re-ranking or fusion), so a member's copy is scored as the member; and
+ * amscr_index_search_scores without its checks. */
+int amscr__member_rule_applies(const amscr_params *p);
+amscr_status amscr__index_search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates,
+                                        double *out);
 /* The candidates of shape-like q: every shape (m = 0 or >= n) or the m whose signatures are
  * nearest sig / lb (exclude: an index to leave out or SIZE_MAX), ascending; 0 when out of
  * memory. */

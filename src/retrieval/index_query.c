@@ -1,6 +1,8 @@
 /* index_query.c — one query against an index: its shortlist of candidate shapes (their
  * signatures nearest the query's), its base distances to them (index_pairs.c) and its inner
- * distances (with the inner graph), then its row of the retrieval scores (index_diffuse.c). */
+ * distances (with the inner graph), then its row of the retrieval scores (index_diffuse.c);
+ * and the search calls' member rule: a query whose prepared samples are a member's, bit for
+ * bit, is scored as that member (its row of the collection's retrieval matrix). */
 #include "index.h"
 
 #include <stdlib.h>
@@ -121,6 +123,111 @@ amscr_status amscr_index_query(const amscr_index *x, const amscr_descriptor *q, 
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_index_query: out of memory");
     if (st == AMSCR_OK)
         st = query_scores(x, q, SIZE_MAX, candidates, all);
+    if (st == AMSCR_OK && k > 0)
+        st = amscr_topk(all, n, k, SIZE_MAX, out_idx);
+    for (size_t t = 0; st == AMSCR_OK && t < k; t++)
+        out_scores[t] = all[out_idx[t]];
+    if (st == AMSCR_OK)
+        *out_count = k;
+    free(all);
+    return st;
+}
+
+/* Signature-nearest shapes among which the member rule looks for the query's copy: a copy's
+ * signature is the query's (distance 0), and copies tie by index, so the lowest-index copy is
+ * among them unless this many shapes have the query's very signature without its samples. */
+enum { MEMBER_SHORTLIST = 32 };
+
+/* Whether shape j of x has q's prepared samples, bit for bit (a lazy load decodes it here). */
+static int same_samples(const amscr_index *x, size_t j, const amscr_descriptor *q)
+{
+    const amscr_descriptor *d = amscr_db_descriptor(x->db, j);
+    return d && d->n == q->n && memcmp(d->input, q->input, 2 * q->n * sizeof *q->input) == 0;
+}
+
+/* The member rule's shape for q (compatible params checked) into *out, SIZE_MAX for none. */
+static amscr_status find_member(const amscr_index *x, const amscr_descriptor *q, size_t *out)
+{
+    size_t n = amscr_db_size(x->db), m = n < MEMBER_SHORTLIST ? n : MEMBER_SHORTLIST;
+    size_t cand[MEMBER_SHORTLIST];
+    *out = SIZE_MAX;
+    if (m == 0)
+        return AMSCR_OK;
+    float sig[AMSCR__SIG_DIM], lb[AMSCR__SIG_LB_DIM];
+    amscr__shape_signature(q, sig);
+    amscr__sig_bound_vector(sig, lb);
+    if (amscr__index_shortlist(x, sig, lb, m, SIZE_MAX, cand) != m)
+        return amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    for (size_t t = 0; t < m; t++) /* ascending index: the first copy is the lowest */
+        if (same_samples(x, cand[t], q)) {
+            *out = cand[t];
+            break;
+        }
+    return AMSCR_OK;
+}
+
+/* Whether a search scores a member's copy by the member's row: scores that depend on the
+ * collection (re-ranking, or a fusion of both distances), as amscr_db_query_retrieval's. */
+int amscr__member_rule_applies(const amscr_params *p)
+{
+    return p->rerank_k > 0 || (p->channel_weight > 0.0 && p->channel_weight < 1.0);
+}
+
+amscr_status amscr_index_find_member(const amscr_index *x, const amscr_descriptor *q, size_t *out_i)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    AMSCR_CHECK_NULL(q);
+    AMSCR_CHECK_NULL(out_i);
+    *out_i = SIZE_MAX;
+    amscr_status st = check_query(x, q, NULL, 0, "amscr_index_find_member");
+    return st == AMSCR_OK ? find_member(x, q, out_i) : st;
+}
+
+/* amscr_index_query_scores with the member rule. */
+static amscr_status search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates, double *out)
+{
+    size_t member = SIZE_MAX;
+    amscr_status st = amscr__member_rule_applies(amscr_db_params(x->db)) ? find_member(x, q, &member) : AMSCR_OK;
+    if (st != AMSCR_OK)
+        return st;
+    return member != SIZE_MAX ? query_scores(x, amscr_db_descriptor(x->db, member), member, candidates, out)
+                              : query_scores(x, q, SIZE_MAX, candidates, out);
+}
+
+amscr_status amscr_index_search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates,
+                                       double *out_scores, size_t n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    AMSCR_CHECK_NULL(q);
+    AMSCR_CHECK_NULL(out_scores);
+    amscr_status st = check_query(x, q, (size_t *)out_scores, n, "amscr_index_search_scores");
+    return st == AMSCR_OK ? search_scores(x, q, candidates, out_scores) : st;
+}
+
+amscr_status amscr__index_search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates,
+                                        double *out)
+{
+    return search_scores(x, q, candidates, out);
+}
+
+amscr_status amscr_index_search(const amscr_index *x, const amscr_descriptor *q, size_t candidates, size_t top,
+                                size_t *out_idx, double *out_scores, size_t *out_count)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    AMSCR_CHECK_NULL(q);
+    AMSCR_CHECK_NULL(out_idx);
+    AMSCR_CHECK_NULL(out_scores);
+    AMSCR_CHECK_NULL(out_count);
+    amscr_status st = check_query(x, q, NULL, 0, "amscr_index_search");
+    size_t n = amscr_db_size(x->db), k = top < n ? top : n;
+    double *all = st == AMSCR_OK ? amscr__malloc_array(n, sizeof *all) : NULL;
+    if (st == AMSCR_OK && !all)
+        st = amscr__fail(AMSCR_E_NOMEM, "amscr_index_search: out of memory");
+    if (st == AMSCR_OK)
+        st = search_scores(x, q, candidates, all);
     if (st == AMSCR_OK && k > 0)
         st = amscr_topk(all, n, k, SIZE_MAX, out_idx);
     for (size_t t = 0; st == AMSCR_OK && t < k; t++)

@@ -87,24 +87,37 @@ static amscr_status plain_row(const amscr_db *db, const amscr_descriptor *q, ams
     return st;
 }
 
-amscr_status amscr_db_query_retrieval(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress,
-                                      void *user, double *out_scores, size_t n)
+/* amscr_db_query_retrieval (member 0) or amscr_db_search_retrieval (member 1). */
+static amscr_status db_query(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress, void *user,
+                             double *out_scores, size_t n, int member, const char *what)
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(db);
     AMSCR_CHECK_NULL(q);
     AMSCR_CHECK_NULL(out_scores);
     if (n != amscr_db_size(db))
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_db_query_retrieval: the output holds %zu scores, the "
-                                                "collection %zu shapes", n, amscr_db_size(db));
-    if (!amscr__params_compatible(amscr_db_params(db), &q->params, "amscr_db_query_retrieval"))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: the output holds %zu scores, the collection %zu shapes", what,
+                           n, amscr_db_size(db));
+    if (!amscr__params_compatible(amscr_db_params(db), &q->params, what))
         return AMSCR_E_INVALID_ARG;
-    const amscr_params *p = amscr_db_params(db);
-    double w = p->channel_weight;
-    if (p->rerank_k == 0 && !(w > 0.0 && w < 1.0)) /* the base distances alone: nothing of the collection's */
+    if (!amscr__member_rule_applies(amscr_db_params(db))) /* the base distances alone: nothing of the collection's */
         return plain_row(db, q, progress, user, out_scores);
     const amscr_index *x = NULL;
     amscr_status st = kept(db, progress, user, &x);
-    return st == AMSCR_OK ? amscr_index_query_scores(x, q, 0, out_scores, n) : st; /* every shape a candidate */
+    if (st != AMSCR_OK)
+        return st;
+    return member ? amscr__index_search_scores(x, q, 0, out_scores) /* every shape a candidate */
+                  : amscr_index_query_scores(x, q, 0, out_scores, n);
 }
 
+amscr_status amscr_db_query_retrieval(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress,
+                                      void *user, double *out_scores, size_t n)
+{
+    return db_query(db, q, progress, user, out_scores, n, 0, "amscr_db_query_retrieval");
+}
+
+amscr_status amscr_db_search_retrieval(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress,
+                                       void *user, double *out_scores, size_t n)
+{
+    return db_query(db, q, progress, user, out_scores, n, 1, "amscr_db_search_retrieval");
+}

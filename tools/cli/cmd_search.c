@@ -4,7 +4,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "amscr.h"
 #include "cli.h"
@@ -17,74 +16,18 @@
 #include "shape_db.h"
 #include "sheet.h"
 
-/* The index of the collection's item that is the query's file (same device and inode), or
- * SIZE_MAX: a member query is ranked by its own row, so its score against itself is 0. */
-static size_t member_index(const collection *c, const char *qpath)
-{
-    struct stat q, m;
-    if (stat(qpath, &q) != 0)
-        return SIZE_MAX;
-    for (size_t i = 0; i < c->n; i++)
-        if (stat(c->items[i].path, &m) == 0 && m.st_dev == q.st_dev && m.st_ino == q.st_ino)
-            return i;
-    return SIZE_MAX;
-}
-
-/* Whether shape j of db has the query's prepared samples, bit for bit. */
-static int same_samples(const amscr_db *db, size_t j, const amscr_descriptor *dq)
-{
-    const amscr_descriptor *d = amscr_db_descriptor(db, j);
-    size_t ns = amscr_descriptor_num_samples(dq);
-    return d && amscr_descriptor_num_samples(d) == ns &&
-           memcmp(amscr_descriptor_input_points(d), amscr_descriptor_input_points(dq), 2 * ns * sizeof(double)) == 0;
-}
-
-/* The shape of db whose prepared samples are the query's, bit for bit, or SIZE_MAX: an index
- * keeps no paths, so a member query is known by its samples. */
-static size_t member_of(const amscr_db *db, const amscr_descriptor *dq)
-{
-    for (size_t j = 0; j < amscr_db_size(db); j++)
-        if (same_samples(db, j, dq))
-            return j;
-    return SIZE_MAX;
-}
-
-/* member_of among the shapes that the query's own scores (dist, n of them) rank first: a
- * member's copy is its own nearest shape (base distance 0, the same neighbours), so it ranks
- * there, and only those few shapes are read (a lazily loaded index decodes no other). */
-static size_t member_among_first(const amscr_db *db, const amscr_descriptor *dq, const double *dist, size_t n)
-{
-    enum { FIRST = 32 };
-    size_t idx[FIRST], k = n < FIRST ? n : FIRST;
-    if (k == 0 || amscr_topk(dist, n, k, SIZE_MAX, idx) != AMSCR_OK)
-        return member_of(db, dq);
-    for (size_t t = 0; t < k; t++)
-        if (same_samples(db, idx[t], dq))
-            return idx[t];
-    return SIZE_MAX;
-}
-
 /* The query's scores against every shape of db (n of them) into dist, as the db's params say:
- * the plain AMSCR distance (query -> shape), or its retrieval scores (amscr_db_query_retrieval);
- * a member query (shape `member`) gets its row of the collection's retrieval matrix. */
-static int query_distances(const amscr_db *db, const amscr_descriptor *dq, size_t member, const char *qpath,
-                           const char *cpath, double *dist)
+ * the plain AMSCR distance (query -> shape), or its retrieval scores with the library's member
+ * rule (amscr_db_search_retrieval: a member's copy gets the member's row of the collection's
+ * retrieval matrix). */
+static int query_distances(const amscr_db *db, const amscr_descriptor *dq, const char *qpath, double *dist)
 {
     size_t n = amscr_db_size(db);
     const amscr_params *p = amscr_db_params(db);
-    int channel_only = amscr_params_get_channel_weight(p) >= 1.0 && amscr_params_get_rerank_k(p) == 0;
-    if (member != SIZE_MAX && !retrieval_is_plain(p) && !channel_only) {
-        double *full = NULL;
-        if (compute_matrix(db, cpath, &full) != 0)
-            return -1;
-        memcpy(dist, full + member * n, n * sizeof *dist);
-        free(full);
-        return 0;
-    }
     tool_progress pr;
     progress_init(&pr, "matching");
     amscr_status st = retrieval_is_plain(p) ? amscr_db_query(db, dq, progress_cb, &pr, dist)
-                                            : amscr_db_query_retrieval(db, dq, progress_cb, &pr, dist, n);
+                                            : amscr_db_search_retrieval(db, dq, progress_cb, &pr, dist, n);
     progress_end(&pr);
     if (st != AMSCR_OK) {
         tool_lib_error(qpath, st);
@@ -93,20 +36,18 @@ static int query_distances(const amscr_db *db, const amscr_descriptor *dq, size_
     return 0;
 }
 
-/* The query's scores against an index: its stored lists (amscr_index_query_scores, or the
- * member's row) when the user's params are the index's; the collection's matrix (as a folder)
- * when --rerank/--no-rerank/--inner-share/--inner-closing differs from the build's (an index holds the build's
- * graphs); the plain distance without the channel. */
+/* The query's scores against an index: its stored lists with the library's member rule
+ * (amscr_index_search_scores) when the user's params are the index's; the collection's
+ * scores (as a folder) when --rerank/--no-rerank/--inner-share/--inner-closing differs from the
+ * build's (an index holds the build's graphs); the plain distance without the channel. */
 static int index_distances(const amscr_index *x, const amscr_params *p, const amscr_descriptor *dq, size_t cand,
                            const char *qpath, const char *cpath, double *dist)
 {
     const amscr_db *idb = amscr_index_db(x);
     const amscr_params *b = amscr_db_params(idb);
     size_t n = amscr_index_size(x);
-    /* the channel alone: the query's own distances, as a folder search */
-    int own = amscr_params_get_channel_weight(p) >= 1.0 && amscr_params_get_rerank_k(p) == 0;
     if (retrieval_is_plain(p))
-        return query_distances(idb, dq, SIZE_MAX, qpath, cpath, dist);
+        return query_distances(idb, dq, qpath, dist);
     double c = amscr_params_get_inner_closing(p), cb = amscr_params_get_inner_closing(b);
     if (c > 0.0 && c != cb && amscr_params_get_rerank_k(p) > 0 && amscr_params_get_rerank_inner_share(p) > 0.0) {
         /* the outlines come from the shapes' contours, which an index does not keep */
@@ -120,15 +61,11 @@ static int index_distances(const amscr_index *x, const amscr_params *p, const am
         amscr_params_get_rerank_inner_share(p) != amscr_params_get_rerank_inner_share(b) ||
         amscr_params_get_inner_closing(p) != amscr_params_get_inner_closing(b)) {
         amscr_db *db = NULL;
-        size_t member = own ? SIZE_MAX : member_of(idb, dq);
-        int r = index_db_with_params(x, p, cpath, &db) == 0 ? query_distances(db, dq, member, qpath, cpath, dist) : -1;
+        int r = index_db_with_params(x, p, cpath, &db) == 0 ? query_distances(db, dq, qpath, dist) : -1;
         amscr_db_free(db);
         return r;
     }
-    amscr_status st = amscr_index_query_scores(x, dq, cand, dist, n);
-    size_t member = st == AMSCR_OK && !own ? member_among_first(idb, dq, dist, n) : SIZE_MAX;
-    if (member != SIZE_MAX) /* a member: its row of the collection's matrix */
-        st = amscr_index_member_scores(x, member, cand, dist, n);
+    amscr_status st = amscr_index_search_scores(x, dq, cand, dist, n);
     if (st != AMSCR_OK) {
         tool_lib_error(qpath, st);
         return -1;
@@ -278,7 +215,7 @@ int cmd_search(opts *o)
         goto done;
     size_t cand = o->candidates && o->candidates < k ? k : o->candidates;
     if (x ? index_distances(x, p, dq, cand, qpath, cpath, dist) != 0
-          : query_distances(db, dq, member_index(&c, qpath), qpath, cpath, dist) != 0)
+          : query_distances(db, dq, qpath, dist) != 0)
         goto done;
     amscr_status st = amscr_topk(dist, n, k, SIZE_MAX, idx);
     if (st != AMSCR_OK) {

@@ -299,6 +299,7 @@ amscr_status amscr_db_load(const char *path, amscr_db **out);
 amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *out_len);
 amscr_status amscr_db_load_memory(const void *buf, size_t len, amscr_db **out);
 amscr_status amscr_db_query_retrieval(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress, void *user, double *out_scores, size_t n);
+amscr_status amscr_db_search_retrieval(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress, void *user, double *out_scores, size_t n);
 typedef struct amscr_index amscr_index;
 amscr_status amscr_index_build(const amscr_db *db, size_t candidates, amscr_progress_fn progress, void *user, amscr_index **out);
 size_t amscr_index_default_candidates(size_t n);
@@ -306,6 +307,9 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
 amscr_status amscr_index_query_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates, double *out_scores, size_t n);
 amscr_status amscr_index_query(const amscr_index *x, const amscr_descriptor *q, size_t candidates, size_t top, size_t *out_idx, double *out_scores, size_t *out_count);
 amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t candidates, double *out_scores, size_t n);
+amscr_status amscr_index_find_member(const amscr_index *x, const amscr_descriptor *q, size_t *out_i);
+amscr_status amscr_index_search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates, double *out_scores, size_t n);
+amscr_status amscr_index_search(const amscr_index *x, const amscr_descriptor *q, size_t candidates, size_t top, size_t *out_idx, double *out_scores, size_t *out_count);
 size_t amscr_index_size(const amscr_index *x);
 const amscr_db *amscr_index_db(const amscr_index *x);
 int32_t amscr_index_label(const amscr_index *x, size_t i);

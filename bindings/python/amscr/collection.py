@@ -216,7 +216,7 @@ class Collection:
               order: str = 'xy') -> np.ndarray:
         """Distances from `shape` to every shape of the collection, by the collection's own
         params: the plain AMSCR distance (query -> shape) with the defaults, and the retrieval
-        scores (C ``amscr_db_query_retrieval``: the query's row of :meth:`retrieval_matrix` on
+        scores (C ``amscr_db_search_retrieval``: the query's row of :meth:`retrieval_matrix` on
         the collection plus the query, shape channel, fusion and re-ranking) when the params
         ask for retrieval (:attr:`Params.ranking` 'retrieval': ``channel_weight`` > 0 or
         ``rerank_k`` > 0, e.g. :meth:`Params.retrieval`). Retrieval scores come from an exact
@@ -224,7 +224,11 @@ class Collection:
         the collection keeps; a query after :meth:`add` first enters the new shapes (O(n) a
         shape), and every query then costs O(n), as :meth:`Index.query` with ``candidates=0``.
         With a ``channel_weight`` strictly between 0 and 1 the fusion uses the collection's
-        medians (those of the first query's build), not medians moved by the query.
+        medians (those of the first query's build), not medians moved by the query. A query
+        whose prepared samples are a shape's of the collection, bit for bit (the member rule,
+        :meth:`Index.find_member`), gets that shape's row of the collection's own retrieval
+        matrix when the scores re-rank or fuse (C ``amscr_db_search_retrieval``), as
+        :meth:`Index.query` and ``amscr search`` give it.
 
         Args:
             shape: the query: (n, 2) points, an OpenCV (n, 1, 2) contour or a :class:`Shape`.
@@ -244,7 +248,7 @@ class Collection:
             q = as_shape(shape, p, 'shape', order)
             out = np.zeros(len(self), dtype=np.float64)
             if p.ranking == 'retrieval':  # the collection's kept index (a copy would build its own)
-                progress_call(lib.amscr_db_query_retrieval, (self._db, q._d), (dbuf(out), len(out)), progress)
+                progress_call(lib.amscr_db_search_retrieval, (self._db, q._d), (dbuf(out), len(out)), progress)
             elif threads is None or int(threads) == p.threads:
                 progress_call(lib.amscr_db_query, (self._db, q._d), (dbuf(out),), progress)
             else:

@@ -247,9 +247,31 @@ class Index:
         from .params import Params
         return Params._copy_of(lib.amscr_db_params(lib.amscr_index_db(self._x)))
 
+    def find_member(self, points: PointsLike, *, order: str = 'xy') -> Optional[int]:
+        """The member rule (C ``amscr_index_find_member``): the shape whose prepared samples are
+        the query's, bit for bit (e.g. a file of the collection traced again), the lowest index
+        when the collection holds copies; None when no shape is the query's copy.
+
+        Args:
+            points: the query: points or a :class:`Shape`.
+            order: 'xy' (default) or 'rc'.
+        Returns:
+            the shape's index, or None.
+        Raises:
+            InvalidArgumentError: bad points, or a Shape prepared with incompatible params.
+        """
+        with self._lock.read():
+            q = as_shape(points, self.collection_params(), 'points', order)
+            out = ffi.new('size_t *')
+            _check(lib.amscr_index_find_member(self._x, q._d, out))
+            return None if out[0] == ffi.cast('size_t', -1) else int(out[0])
+
     def scores(self, points: PointsLike, candidates: Optional[int] = None, *, order: str = 'xy') -> np.ndarray:
         """The query's retrieval score against every shape (lower is better): its row of
-        :meth:`Collection.retrieval_matrix` on the collection plus the query.
+        :meth:`Collection.retrieval_matrix` on the collection plus the query; a query that is a
+        member's copy (:meth:`find_member`) gets that member's row of the collection's own
+        retrieval matrix (0 against itself) when the scores re-rank or fuse, as ``amscr search``
+        shows it (C ``amscr_index_search_scores``).
 
         Args:
             points: the query: points or a :class:`Shape`.
@@ -266,12 +288,13 @@ class Index:
         with self._lock.read():
             q = as_shape(points, self.collection_params(), 'points', order)
             out = np.zeros(len(self), dtype=np.float64)
-            _check(lib.amscr_index_query_scores(self._x, q._d, _candidates(candidates), dbuf(out), len(out)))
+            _check(lib.amscr_index_search_scores(self._x, q._d, _candidates(candidates), dbuf(out), len(out)))
             return out
 
     def query(self, points: PointsLike, top: int = 10, candidates: Optional[int] = None, *,
               order: str = 'xy') -> Tuple[np.ndarray, np.ndarray]:
-        """The `top` best shapes for a query, best first (ties by index), as :meth:`scores`.
+        """The `top` best shapes for a query, best first (ties by index), as :meth:`scores` (a
+        member's copy scored as the member: C ``amscr_index_search``).
 
         Args:
             points: the query: points or a :class:`Shape`.
@@ -291,7 +314,7 @@ class Index:
             idx = np.zeros(max(top, 1), dtype=np.uintp)
             sc = np.zeros(max(top, 1), dtype=np.float64)
             cnt = ffi.new('size_t *')
-            _check(lib.amscr_index_query(self._x, q._d, _candidates(candidates), top,
+            _check(lib.amscr_index_search(self._x, q._d, _candidates(candidates), top,
                                          ffi.from_buffer('size_t[]', idx), dbuf(sc), cnt))
             k = int(cnt[0])
             return idx[:k].astype(np.int64), sc[:k].copy()

@@ -114,3 +114,55 @@ def dataset_manifest(tmp_path, name, step):
 @pytest.mark.parametrize('name,step', [('kimia216', 1), ('mpeg7-dev', 5)])
 def test_datasets(tmp_path, name, step):
     check_collection(tmp_path, dataset_manifest(tmp_path, name, step), queries=3, seed=216)
+
+
+def member_faces(tmp_path, collection, files):
+    """A member's file as the query (the member rule): `amscr search FILE` (the image itself and
+    its traced points), `amscr search` on the folder or manifest, Index.query / Index.scores,
+    Collection.query on the index's collection and the C face (amscr_index_search) give the
+    member first at 0 and the same scores: its row of the collection's retrieval matrix."""
+    idx_path = tmp_path / 'members.idx'
+    run(tool(), 'index', collection, '-o', idx_path)
+    index = amscr.Index.load(idx_path)
+    coll = index.collection
+    names = index.names
+    n = len(index)
+    assert coll.params.ranking == 'retrieval'
+    for f in files:
+        pts_file = tmp_path / (os.path.basename(f) + '.txt')
+        run(tool(), 'contour', f, '-o', pts_file)
+        q = np.loadtxt(pts_file)
+        member = index.find_member(q)
+        assert member is not None and names[member] == os.path.basename(f), f
+        row = index.scores(q, candidates=0)
+        assert row[member] == 0.0
+        # the query calls score it as a new shape; the search applies the member rule
+        new = np.zeros(n)
+        from amscr._lib import lib, ffi
+        assert lib.amscr_index_query_scores(index._x, amscr.Shape(q, coll.params)._d, 0,
+                                            ffi.cast('double *', new.ctypes.data), n) == 0
+        assert np.abs(new - row).max() > 1e-6, 'the member rule changed nothing: test the rule elsewhere'
+        np.testing.assert_allclose(coll.query(q), row, rtol=0, atol=1e-12)
+        pi, ps = index.query(q, top=TOP, candidates=0)
+        assert pi[0] == member and ps[0] == 0.0
+        py = [{'index': int(i), 'distance': float(s)} for i, s in zip(pi, ps)]
+        for query in (f, pts_file):
+            for target in (idx_path, collection):
+                t = json.loads(run(tool(), 'search', query, target, '--json', '--candidates', '0',
+                                   '--top', TOP))['results']
+                same(py, t, 'tool search %s in %s' % (query, target))
+        c = json.loads(run(index_top(), idx_path, pts_file, 0, TOP))['results']
+        same(py, c, 'C face, %s' % f)
+
+
+def test_member_query_examples(tmp_path):
+    folder = os.path.join(REPO, 'examples', 'collection')
+    files = sorted(os.path.join(folder, f) for f in os.listdir(folder) if f.endswith('.png'))
+    member_faces(tmp_path, folder, files[::4])
+
+
+def test_member_query_kimia216(tmp_path):
+    folder = os.path.join(DATASETS, 'kimia216')
+    if not os.path.isdir(folder):
+        pytest.skip('kimia216 not found (%s): the member-query test runs on examples/collection only' % folder)
+    member_faces(tmp_path, folder, [os.path.join(folder, f) for f in ('bird-1.png', 'Bone-7.png')])
