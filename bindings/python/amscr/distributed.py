@@ -25,8 +25,9 @@ How it runs:
   without ever materializing the full matrix. When the collection's params ask for retrieval
   (:attr:`amscr.Params.ranking`: channel weight > 0 or re-ranking on), a query's scores depend
   on the whole collection (the retrieval matrix's fusion and re-ranking), so a tile is a block
-  of queries against every shape, each scored by ``amscr_db_query_retrieval`` as
-  :meth:`amscr.Collection.query` does. Ranking is by (distance, index): the order of
+  of queries against every shape, each scored by ``amscr_db_search_retrieval`` as
+  :meth:`amscr.Collection.query` does (a query that is a copy of a member is scored as that
+  member: the member rule of the collections guide). Ranking is by (distance, index): the order of
   ``np.argsort(row, kind='stable')`` (NaN last), so ties go to the lower index.
 * ``client=None`` starts a local cluster (one single-threaded worker process per core), computes
   and closes it. With a client, :func:`distance_matrix` and :func:`cross_matrix` return a lazy
@@ -234,14 +235,14 @@ def _topk_tile(qpayload: _Payload, tpayload: _Payload, c0: int, c1: int, k: int,
 def _retrieval_tile(qpayload: _Payload, tpayload: _Payload, k: int, exclude: Optional[np.ndarray],
                     threads) -> Tuple[np.ndarray, np.ndarray]:
     """The k best of each query of a block by its retrieval scores against every target: the
-    scores of :meth:`Collection.query` (C ``amscr_db_query_retrieval``, one query at a time)."""
+    scores of :meth:`Collection.query` (C ``amscr_db_search_retrieval``, one query at a time)."""
     t = _tile_threads(threads)
     q, coll = qpayload.collection(t), tpayload.collection(t)
     D = np.empty((len(q), len(coll)), dtype=np.float64)
     with q._lock.read(), coll._lock.read():
         for i in range(len(q)):
-            _check(lib.amscr_db_query_retrieval(coll._db, lib.amscr_db_descriptor(q._db, i), ffi.NULL, ffi.NULL,
-                                                dbuf(D[i]), D.shape[1]))
+            _check(lib.amscr_db_search_retrieval(coll._db, lib.amscr_db_descriptor(q._db, i), ffi.NULL, ffi.NULL,
+                                                 dbuf(D[i]), D.shape[1]))
     return _tile_candidates(D, 0, k, exclude)
 
 
