@@ -66,6 +66,8 @@ import numpy as np
 import cv2
 
 import registration_heldout  # noqa: E402  (bench/: the ECC multi-start both benches use)
+import shapegen  # noqa: E402  (bench/: the procedural silhouettes)
+from registration_heldout import apply, compose, inv_affine, shape_size  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.join(HERE, '..')
@@ -82,24 +84,6 @@ CANVAS = 200
 SPAN = 140.0
 REDUCE = 4
 CONFIDENT = 0.25
-
-
-def shape_size(xy):
-    c = xy - xy.mean(axis=0)
-    return math.sqrt((c * c).sum(axis=1).mean())
-
-
-def apply(T, xy):
-    return xy @ T[:, :2].T + T[:, 2]
-
-
-def compose(P, Q):  # P after Q
-    return np.hstack([P[:, :2] @ Q[:, :2], P[:, :2] @ Q[:, 2:] + P[:, 2:]])
-
-
-def inv_affine(P):
-    A = np.linalg.inv(P[:, :2])
-    return np.hstack([A, -(A @ P[:, 2:])])
 
 
 def enclosed_area(xy):
@@ -127,8 +111,8 @@ def fit_map(xy):
 
 
 def load_source(path):
-    """The silhouette (foreground 255) scaled to SPAN px in a CANVAS image."""
-    img = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
+    """The silhouette (foreground 255; a file or an array) scaled to SPAN px in a CANVAS image."""
+    img = cv2.imread(path, cv2.IMREAD_GRAYSCALE) if isinstance(path, str) else path
     m = (img > 127).astype(np.uint8) * 255
     if np.mean(np.concatenate([m[0], m[-1], m[:, 0], m[:, -1]])) > 127:
         m = 255 - m
@@ -187,6 +171,61 @@ def damage(key, tgt, g, rng):
         u /= max(np.linalg.norm(u), 1e-12)
         return disk(tgt, p + 0.95 * r * u, r, 255)
     return tgt
+
+
+# ---- families: the conditions as the independent check states them, each swept over its levels
+def family_conditions(quick=False):
+    """(key, label, kind, level, success threshold %, seed index); --quick: the check's points."""
+    lv = [('clean', 0)] + [('noise', a) for a in (0.5, 1, 1.5, 2)] + \
+         [(k, r) for k in ('bite', 'touching') for r in (0.1, 0.2, 0.3, 0.4)] + \
+         [(k, px) for k in ('lowres', 'grey') for px in (30, 40, 60, 80)]
+    unit = {'clean': '', 'noise': ' %g %% R', 'bite': ' %g R', 'touching': ' %g R', 'lowres': ' %g px',
+            'grey': ' %g px'}
+    name = {'lowres': 'binary', 'grey': 'grey', 'touching': 'touching'}
+    return [('%s%g' % (k, v) if v else k, name.get(k, k) + (unit[k] % v if v else ''), k, v,
+             4.0 if k in ('lowres', 'grey') else 2.0, 100 + i) for i, (k, v) in enumerate(lv)
+            if not quick or (k, v) in (('clean', 0), ('noise', 1.5), ('bite', 0.3), ('touching', 0.3),
+                                       ('lowres', 40), ('grey', 40))]
+
+
+def largest_piece(img):
+    n, lab, stats, _ = cv2.connectedComponentsWithStats((img > 0).astype(np.uint8), connectivity=8)
+    if n <= 2:
+        return img
+    return np.where(lab == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA])), img, 0).astype(np.uint8)
+
+
+def family_target(src, f, kind, level, rng):
+    """(target, T) as the check builds them: the warped source thresholded at half level, then
+    noise: a smooth Gaussian field (correlation 2 % of R, amplitude `level` % of R) added to the
+    signed distance, and specks on 0.05 % of the pixels; bite: a disk of `level` R removed at a
+    random boundary point, the largest piece kept; touching: a disk of `level` R centred 0.8 x
+    its radius outside a random boundary point (along the ray from the centroid) added;
+    lowres / grey: the target alone reduced (area) so the shape spans `level` px, binary or grey.
+    R: the RMS radius of the true target contour."""
+    tgt, T = make_target(src, f, rng)
+    g = apply(T, f)
+    R = shape_size(g)
+    if kind == 'noise':
+        sd = (cv2.distanceTransform((tgt > 0).astype(np.uint8), cv2.DIST_L2, 5) -
+              cv2.distanceTransform((tgt == 0).astype(np.uint8), cv2.DIST_L2, 5))
+        field = cv2.GaussianBlur(rng.normal(0, 1, tgt.shape), (0, 0), 0.02 * R)
+        out = np.where(sd + field * (level / 100 * R / max(field.std(), 1e-12)) > 0, 255, 0).astype(np.uint8)
+        out.flat[rng.choice(out.size, int(round(0.0005 * out.size)), replace=False)] = 255
+        return out, T
+    if kind in ('bite', 'touching'):
+        p = g[rng.integers(len(g))]
+        if kind == 'bite':
+            return largest_piece(disk(tgt, p, level * R, 0)), T
+        u = (p - g.mean(axis=0)) / max(np.linalg.norm(p - g.mean(axis=0)), 1e-12)
+        return disk(tgt, p + 0.8 * level * R * u, level * R, 255), T
+    if kind in ('lowres', 'grey'):
+        side = int(round(CANVAS * level / SPAN))
+        r = CANVAS / side
+        small = cv2.resize(tgt, (side, side), interpolation=cv2.INTER_AREA)
+        S = np.array([[1.0 / r, 0, (1.0 / r - 1) / 2], [0, 1.0 / r, (1.0 / r - 1) / 2]])
+        return (np.where(small > 127, 255, 0).astype(np.uint8) if kind == 'lowres' else small), compose(S, T)
+    return tgt, T
 
 
 def set_low_px(px):
@@ -305,7 +344,7 @@ def reference_register(tool, tmp, src, tgt):
     return tool_register(tool, sp, tp, [])
 
 
-def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=None, use_ref=False):
+def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=None, use_ref=False, lib=True):
     """{method: (rms error %, max error %, confidence, ms)}."""
     if key in ('lowres', 'grey'):
         src, tgt = reduce(src, key == 'lowres'), reduce(tgt, key == 'lowres')
@@ -323,7 +362,7 @@ def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=
     if use_ref:
         M, conf, ms = reference_register(tool, tmp, src, tgt)
         out['ref'] = (*errors(M, T, f), conf, ms)
-    out['lib'] = (0.0, 0.0, 0.0, lib_register_ms(src, tgt, breakdown))
+    out['lib'] = (0.0, 0.0, 0.0, lib_register_ms(src, tgt, breakdown) if lib else math.nan)
     if use_ecc:
         t0 = time.perf_counter()
         W = ecc_register(src, tgt)
@@ -366,16 +405,43 @@ def print_table(title, res, conds, methods, measure=0):
         print(line)
 
 
+def family_table(res, conds, methods):
+    """One table a method: success and wrong + confident (RMS measure) per condition level, the
+    sets side by side; returns {method: {set: {key: [ok %, w+c %, pairs]}}}."""
+    sets = [(k, lab) for k, lab in (('A', 'fold A'), ('B', 'fold B'), ('P', 'procedural')) if res[k][conds[0][0]]['sub']]
+    out = {}
+    for m, lab in methods:
+        print('\n%s: ok %% / wrong + confident %% (RMS error < 2 %% of R, 4 %% at low resolution)' % lab)
+        print('%-20s' % 'condition' + ''.join(' | %-19s' % ('%s (%d)' % (sl, len(res[k][conds[0][0]][m])))
+                                             for k, sl in sets))
+        for c in conds:
+            line = '%-20s' % c[1]
+            for k, _ in sets:
+                sm = summary(res[k][c[0]][m], c[4])
+                out.setdefault(m, {}).setdefault(k, {})[c[0]] = [sm[0], sm[1], sm[4]]
+                line += ' | %6.1f / %5.1f     ' % (sm[0], sm[1]) if m != 'ecc' else ' | %6.1f / -         ' % sm[0]
+            print(line)
+    return out
+
+
 def main():
+    global CLOCK, SPAN, CANVAS
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    ap.add_argument('--data', default=os.path.join(ROOT, '..', 'shared', 'datasets', 'mpeg7-dev'))
-    ap.add_argument('--tool', default=os.path.join(ROOT, 'build', 'tools', 'amscr'))
+    ap.add_argument('--data', default=os.path.join(os.environ.get('AMSCR_DATASETS') or
+                                                   os.path.join(ROOT, '..', 'shared', 'datasets'), 'mpeg7-dev'))
+    ap.add_argument('--tool', default=os.environ.get('AMSCR_TOOL') or os.path.join(ROOT, 'build', 'tools', 'amscr'))
     ap.add_argument('--draws', type=int, default=2)
     ap.add_argument('--no-ecc', action='store_true')
     ap.add_argument('--no-chain', action='store_true', help='skip the --pixel-chain column')
     ap.add_argument('--conditions', '--only', dest='only', default='',
                     help='comma-separated condition keys: ' + ','.join(c[0] for c in CONDITIONS))
-    ap.add_argument('--fold', default='', choices=['', 'A', 'B'], help='one fold of folds.tsv only')
+    ap.add_argument('--fold', default='', choices=['', 'A', 'B', 'P'], help='one fold of folds.tsv (P: procedural) only')
+    ap.add_argument('--families', action='store_true',
+                    help="the check's conditions swept (shapes 200 px across): " +
+                         ','.join(c[0] for c in family_conditions()))
+    ap.add_argument('--quick', action='store_true', help='--families at the check\'s points only')
+    ap.add_argument('--procedural', type=int, default=None,
+                    help='add N seeded procedural silhouettes (bench/shapegen.py; default 35 with --families, else 0)')
     ap.add_argument('--breakdown', action='store_true',
                     help="the library's time split: traces, registration, without polish, without polish and refinement")
     ap.add_argument('--cpu-time', action='store_true',
@@ -389,37 +455,47 @@ def main():
     ap.add_argument('--json', default=None)
     a = ap.parse_args()
     if a.cpu_time:
-        global CLOCK
         CLOCK = time.process_time
     if a.low_px != SPAN / REDUCE:
         set_low_px(a.low_px)
-    if not os.path.isdir(a.data):
+    a.families = a.families or a.quick
+    if a.families:
+        SPAN, CANVAS = 200.0, 280
+    nproc = a.procedural if a.procedural is not None else (35 if a.families else 0)
+    classes = load_classes(a.data) if os.path.isdir(a.data) else []
+    if not classes and not nproc:
         print('registration_traced: no data at %s (skipped)' % a.data)
         return 0
-    use_ecc = not a.no_ecc
-    classes = load_classes(a.data)
     class_index = {c[0]: i for i, c in enumerate(classes)}  # the seeds do not depend on --fold
     if a.classes:
         classes = classes[:a.classes]
+    for i in range(nproc):
+        class_index['proc%02d' % i] = 1000 + i
+        classes.append(('proc%02d' % i, shapegen.silhouette(1, i), 'P'))
     if a.fold:
         classes = [c for c in classes if c[2] == a.fold]
+    use_ecc = not a.no_ecc
     use_chain = not a.no_chain
-    conds = [c for c in CONDITIONS if not a.only or c[0] in a.only.split(',')]
-    keys = [c[0] for c in conds]
-    res = {fold: {k: {m: [] for m, _ in METHODS + EXTRA} for k, _, _ in CONDITIONS} for fold in ('A', 'B', 'all')}
+    allconds = family_conditions(a.quick) if a.families else [(k, lab, k, None, thr, i) for i, (k, lab, thr) in enumerate(CONDITIONS)]
+    conds = [c for c in allconds if not a.only or c[0] in a.only.split(',')]
+    res = {fold: {c[0]: {m: [] for m, _ in METHODS + EXTRA} for c in conds} for fold in ('A', 'B', 'P', 'all')}
     rows = []
     split = {}  # condition -> [ms of the traces, register, no polish, no polish + no refine]
     with tempfile.TemporaryDirectory() as tmp:
         for ci, (cls, path, fold) in enumerate(classes):
             src = load_source(path)
             f = subpixel_contour(src)
-            for key in keys:
+            for key, _, kind, level, _, seed in conds:
                 for d in range(a.draws):
-                    rng = np.random.default_rng([class_index[cls], [c[0] for c in CONDITIONS].index(key), d, 2024])
-                    tgt, T = make_target(src, f, rng)
-                    tgt = damage(key, tgt, apply(T, f), rng)
+                    rng = np.random.default_rng([class_index[cls], seed, d, 2024])
+                    if a.families:
+                        tgt, T = family_target(src, f, kind, level, rng)
+                    else:
+                        tgt, T = make_target(src, f, rng)
+                        tgt = damage(key, tgt, apply(T, f), rng)
                     bd = [] if a.breakdown else None
-                    out = run_pair(a.tool, tmp, key, src, tgt, f, T, use_ecc, use_chain, bd, a.reference)
+                    out = run_pair(a.tool, tmp, key, src, tgt, f, T, use_ecc, use_chain, bd, a.reference,
+                                   lib=not a.families)
                     if bd:
                         split.setdefault(key, []).append(bd)
                     rows.append({'class': cls, 'fold': fold, 'condition': key, 'draw': d,
@@ -432,9 +508,18 @@ def main():
     print(file=sys.stderr)
     methods = [m for m in METHODS if (use_ecc or m[0] != 'ecc') and (use_chain or m[0] != 'chain')
                and (a.reference or m[0] != 'ref')]
+    if a.families:
+        table = family_table(res, conds, methods)
+        if a.json:
+            with open(a.json, 'w') as fp:
+                json.dump({'draws': a.draws, 'table': table, 'pairs': rows}, fp)
+        return 0
+    conds = [(c[0], c[1], c[4]) for c in conds]
+    keys = [c[0] for c in conds]
     for measure, what in ((0, 'RMS error (as the reference evaluation measures)'), (1, 'max error (stricter; the figures before 0.5)')):
         print('\n=== %s: success < 2 %% of the size (4 %% at low resolution) ===' % what)
-        for fold, title in (('A', 'fold 1 (folds.tsv A)'), ('B', 'fold 2 (folds.tsv B)'), ('all', 'both folds')):
+        for fold, title in (('A', 'fold 1 (folds.tsv A)'), ('B', 'fold 2 (folds.tsv B)'), ('P', 'procedural'),
+                            ('all', 'all shapes')):
             if any(res[fold][k]['sub'] for k in keys):
                 print_table('%s, %s' % (title, what.split(' (')[0]), res[fold], conds, methods, measure)
     if split:
