@@ -1,56 +1,56 @@
 #!/usr/bin/env python3
 """Registration from images: the amscr tool on traced PNG pairs against OpenCV's ECC.
 
-For each class of mpeg7-dev (one shape per class, the class's first file) and `--draws` seeded
-draws per condition: the silhouette scaled to 140 px in a 200 x 200 image (the source), a random
-affine map T (any rotation, axis scales x0.5-2, shear +-0.5; then scaled and shifted so the
-warped shape again spans 140 px of a 200 x 200 image) applied with cv2.warpAffine (the target),
-then the target damaged in the image:
+For each class of mpeg7-dev (one shape per class, the class's first file; folds.tsv's fold A / B)
+and `--procedural N` seeded silhouettes (bench/shapegen.py: thin limbs, near symmetries, holes,
+spikes, deep notches; "fold" P), `--draws` seeded draws per condition: the silhouette scaled to
+140 px in a 200 x 200 image (the source), a random affine map T (any rotation, axis scales
+x0.5-2, shear +-0.5; then scaled and shifted so the warped shape again spans 140 px of a 200 x 200
+image) applied with cv2.warpAffine (the target), then the target damaged in the image:
 
   clean      the warped silhouette (bilinear, thresholded at half level);
-  noise      segmentation noise: the boundary moved by a smooth random field of 1.5 % of the
-             shape's radius (RMS radius), plus 12 background specks (1-2 px disks);
+  noise      the boundary moved by a smooth random field of 1.5 % of the shape's RMS radius,
+             plus 12 background specks (1-2 px disks);
   bite       a disk of 0.3 x radius removed at a random boundary point;
   touching   such a disk added outside, touching the boundary at a random point;
-  lowres     source and target reduced 4x (cv2.INTER_AREA: the shape 35 px across; --low-px N for
-             another size) and thresholded;
+  lowres     source and target reduced 4x (area: the shape 35 px across; --low-px N) and thresholded;
   grey       the same reduction kept as 8-bit antialiased grey (area coverage).
 
-Both PNGs are registered by the tool, `amscr register SRC TGT --json` (the default sub-pixel
-tracer, and with --pixel-chain), and by cv2.findTransformECC (MOTION_AFFINE, 8 starting
-rotations with centroid and area matched, the best correlation kept) on the same images.
---reference adds the reference evaluation's calibration column: scikit-image find_contours point lists of
-both images through `amscr register` (no image decoding in the tool).
+--families (--quick: at the check's points only) builds the conditions as the independent check
+states them, each swept (family_target): shapes 200 px across in 280-px images; noise 0.5-2 % R
+(field correlation 2 % R, specks on 0.05 % of the pixels); bite / touching disks of 0.1-0.4 R
+(the bite's largest piece kept; the touching disk centred 0.8 radii outside); the target alone
+reduced to 30-80 px, binary / grey. One table a method: ok % / wrong + confident %, fold A, fold
+B and the procedural set side by side (RMS measure); --json OUT writes {draws, table, pairs}.
 
-Error, two measures over the clean source's sub-pixel contour f (in the source image's pixels),
-both as % of size(T(f)), the RMS radius about the centroid:
-  RMS  sqrt(mean_i |M(f_i) - T(f_i)|^2) -- the primary table, "as the reference evaluation measures": the evaluation
-       states "map error below 2 % of the shape's size; 4 % at low resolution" without saying
-       max or RMS, and gives a calibration (binary / grey 35-px images traced by scikit-image's
-       find_contours at half level, handed to the tool as point lists: 94.3 % / 92.9 %).
-       `--reference` (those point lists, 70 pairs each) gives 95.7 / 98.6 % under RMS and
-       80.0 / 97.1 % under max: on binary images, which tell the measures apart, RMS is one pair
-       from the reference figure and max ten pairs short -- so the reference figures are taken to be
-       RMS ones (docs/measurements.md);
-  max  max_i |M(f_i) - T(f_i)| -- the stricter second table, the measure of the figures before
-       0.5 (kept so they stay comparable).
-Success: error < 2 % (4 % for lowres and grey), under each measure. Wrong + confident (w+c): a
-failure the tool reports with confidence >= 0.25; ok+c: the share of the successes reported with
-confidence >= 0.25. ECC is scored by the same two measures (it reports no confidence).
-ms/pair: wall time per pair (the tool's includes process start and PNG decoding).
+Both PNGs are registered by the tool, `amscr register SRC TGT --json` (--tool, or $AMSCR_TOOL;
+the default sub-pixel tracer, and with --pixel-chain), and by cv2.findTransformECC (MOTION_AFFINE,
+8 starting rotations with centroid and area matched, the best correlation kept) on the same
+images. --reference adds the reference evaluation's calibration column: scikit-image
+find_contours point lists of both images through `amscr register`.
+
+Error, two measures over the clean source's sub-pixel contour f (source pixels), as % of R =
+size(T(f)), the RMS radius about the centroid:
+  RMS  sqrt(mean_i |M(f_i) - T(f_i)|^2) -- the primary table, as the reference evaluation measures
+       (it states "below 2 % of the shape's size; 4 % at low resolution" and a calibration, 35-px
+       binary / grey images traced by find_contours: 94.3 / 92.9 %; `--reference` gives 95.7 /
+       98.6 % under RMS, 80.0 / 97.1 % under max, so its figures are taken to be RMS ones);
+  max  max_i |M(f_i) - T(f_i)| -- the stricter second table, the measure of the figures before 0.5.
+Success: error < 2 % (4 % at low resolution). Wrong + confident (w+c): a failure the tool reports
+with confidence >= 0.25; ok+c: the share of the successes with confidence >= 0.25. ECC is scored
+by the same measures (it reports no confidence). ms: wall time per pair (the tool's includes
+process start and PNG decoding).
 
 Usage: nice .venv/bin/python bench/registration_traced.py [--data DIR] [--tool PATH] [--draws 2]
-       [--no-ecc] [--no-chain] [--reference] [--conditions clean,lowres,...] [--fold A|B] [--json OUT]
-       [--low-px 35]
---json OUT writes one row per pair, each method as [RMS %, max %, confidence, ms].
---conditions (alias --only) and --fold restrict the run (the tables then show what ran);
---no-chain skips the --pixel-chain column; --breakdown splits the library's time (the traces,
-the registration, without the polish, without the polish and the refinement); --cpu-time reports
-the library's time as this process's CPU time (with OPENBLAS_NUM_THREADS=1). "lib ms": the library alone in this process (the
-Python binding: both images traced by amscr.contour_from_mask(join=True) as the tool traces them,
-then amscr.register), the
-median over the condition's pairs; skipped when the amscr package is not importable.
-Deterministic: every draw is seeded by (class index, condition, draw).
+       [--no-ecc] [--no-chain] [--reference] [--conditions clean,lowres,...] [--fold A|B|P]
+       [--families | --quick] [--procedural N] [--json OUT] [--low-px 35]
+--json OUT writes one row per pair, each method as [RMS %, max %, confidence, ms]. --conditions
+(alias --only) and --fold restrict the run; --breakdown splits the library's time (the traces,
+the registration, without the polish, without the polish and the refinement); --cpu-time counts
+it as CPU time (with OPENBLAS_NUM_THREADS=1). "lib ms": the library alone in this process
+(amscr.contour_from_mask(join=True) on both images, as the tool traces, then amscr.register), the
+median over the condition's pairs; skipped with --families or without the amscr package.
+Deterministic: every draw is seeded by (shape index, condition, draw).
 """
 import argparse
 import json
@@ -92,10 +92,8 @@ def enclosed_area(xy):
 
 
 def subpixel_contour(img):
-    """The iso-line at half level of an 8-bit image enclosing the largest area -- the outer
-    boundary -- as (x, y) rows (skimage). (Before 0.5 the line with the most points was taken,
-    which for the pocket watch is a hole's jagged boundary: its targets were fitted to that hole
-    and overflowed the canvas, and its errors were measured on the hole.)"""
+    """The iso-line at half level of an 8-bit image enclosing the largest area (the outer boundary,
+    not a hole's) as (x, y) rows (skimage)."""
     from skimage import measure
     cs = measure.find_contours(np.pad(img.astype(float), 1), 127.5)
     c = max(cs, key=enclosed_area)[:, ::-1] - 1.0
@@ -229,8 +227,7 @@ def family_target(src, f, kind, level, rng):
 
 
 def set_low_px(px):
-    """The low-resolution conditions with the shape `px` pixels across (35 by default: the 4x
-    reduction; the reference evaluation states ~40): the reduced canvas and S_LOW."""
+    """The lowres / grey shapes `px` across (35: the 4x reduction): the reduced canvas and S_LOW."""
     global LOW_SIDE, S_LOW
     LOW_SIDE = int(round(CANVAS * px / SPAN))
     r = CANVAS / LOW_SIDE
@@ -258,8 +255,7 @@ def map_error(M, T, f):
 
 
 def rms_error(M, T, f):
-    """The measure as the reference evaluation states its figures: the RMS of |M f_i - T f_i| over the
-    contour, % of the size."""
+    """The primary measure: the RMS of |M f_i - T f_i| over the contour, % of the size."""
     if M is None:
         return math.inf
     d = apply(M, f) - apply(T, f)
@@ -336,8 +332,7 @@ MEASURES = [(0, 'RMS'), (1, 'max')]  # index into a record (rms %, max %, confid
 
 
 def reference_register(tool, tmp, src, tgt):
-    """The reference evaluation's calibration: both images traced by scikit-image's find_contours at half level
-    and handed to the tool as point lists."""
+    """The calibration: both images traced by find_contours, through the tool as point lists."""
     sp, tp = os.path.join(tmp, 'src.txt'), os.path.join(tmp, 'tgt.txt')
     np.savetxt(sp, subpixel_contour(src))
     np.savetxt(tp, subpixel_contour(tgt))
@@ -408,7 +403,7 @@ def print_table(title, res, conds, methods, measure=0):
 def family_table(res, conds, methods):
     """One table a method: success and wrong + confident (RMS measure) per condition level, the
     sets side by side; returns {method: {set: {key: [ok %, w+c %, pairs]}}}."""
-    sets = [(k, lab) for k, lab in (('A', 'fold A'), ('B', 'fold B'), ('P', 'procedural')) if res[k][conds[0][0]]['sub']]
+    sets = [(k, l) for k, l in (('A', 'fold A'), ('B', 'fold B'), ('P', 'procedural')) if res[k][conds[0][0]]['sub']]
     out = {}
     for m, lab in methods:
         print('\n%s: ok %% / wrong + confident %% (RMS error < 2 %% of R, 4 %% at low resolution)' % lab)
@@ -435,7 +430,7 @@ def main():
     ap.add_argument('--no-chain', action='store_true', help='skip the --pixel-chain column')
     ap.add_argument('--conditions', '--only', dest='only', default='',
                     help='comma-separated condition keys: ' + ','.join(c[0] for c in CONDITIONS))
-    ap.add_argument('--fold', default='', choices=['', 'A', 'B', 'P'], help='one fold of folds.tsv (P: procedural) only')
+    ap.add_argument('--fold', default='', choices=['', 'A', 'B', 'P'], help='one fold (P: procedural) only')
     ap.add_argument('--families', action='store_true',
                     help="the check's conditions swept (shapes 200 px across): " +
                          ','.join(c[0] for c in family_conditions()))
@@ -476,7 +471,8 @@ def main():
         classes = [c for c in classes if c[2] == a.fold]
     use_ecc = not a.no_ecc
     use_chain = not a.no_chain
-    allconds = family_conditions(a.quick) if a.families else [(k, lab, k, None, thr, i) for i, (k, lab, thr) in enumerate(CONDITIONS)]
+    allconds = (family_conditions(a.quick) if a.families else
+                [(k, lab, k, None, t, i) for i, (k, lab, t) in enumerate(CONDITIONS)])
     conds = [c for c in allconds if not a.only or c[0] in a.only.split(',')]
     res = {fold: {c[0]: {m: [] for m, _ in METHODS + EXTRA} for c in conds} for fold in ('A', 'B', 'P', 'all')}
     rows = []

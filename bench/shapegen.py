@@ -69,7 +69,7 @@ def silhouette(seed, i, size=200):
                 img[hole > 0], want = 0, want - 1
     x, y, w, h = cv2.boundingRect(img)
     s = size / max(w, h)
-    small = cv2.resize(img[y:y + h, x:x + w], (max(1, round(w * s)), max(1, round(h * s))), interpolation=cv2.INTER_AREA)
+    small = cv2.resize(img[y:y + h, x:x + w], (max(1, round(w * s)), max(1, round(h * s))), None, 0, 0, cv2.INTER_AREA)
     side = int(round(1.3 * size))
     out = np.zeros((side, side), np.uint8)
     oy, ox = (side - small.shape[0]) // 2, (side - small.shape[1]) // 2
