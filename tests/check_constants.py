@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """The "Constants chosen on data" table of docs/decisions.md against the source.
 
-Every code span `NAME = VALUE` in that table's rows names a constant of src/: a macro
-(`#define NAME EXPR`, every definition) or, when no macro has the name, an assignment
-(`NAME = EXPR;`, at least one). EXPR and VALUE are evaluated as arithmetic (other macros expanded,
+Every code span `NAME = VALUE` in the first cell (the value) of that table's rows names a
+constant of src/: a macro (`#define NAME EXPR`, every definition) or, when no macro has the
+name, an assignment (`NAME = EXPR;`, at least one). EXPR and VALUE are evaluated as arithmetic (other macros expanded,
 sqrt(x) allowed) and must agree to 1e-9. A constant renamed, removed or changed without its row
 fails here; so does a table whose rows name no constant at all.
 
@@ -14,7 +14,7 @@ import os
 import re
 import sys
 
-SPAN = re.compile(r'`([A-Za-z_][A-Za-z0-9_>.-]*)\s*=\s*([^`]+)`')
+SPAN = re.compile(r'`([A-Za-z_][A-Za-z0-9_]*)\s*=\s*([^`]+)`')
 DEFINE = re.compile(r'^\s*#\s*define\s+([A-Za-z_][A-Za-z0-9_]*)[ \t]+(.+?)\s*(?:/\*.*)?$', re.M)
 
 
@@ -65,7 +65,7 @@ def main(md_path, src):
     rows = table_rows(open(md_path, encoding='utf-8').read())
     bad, n = [], 0
     for row in rows:
-        for name, want in SPAN.findall(row):
+        for name, want in SPAN.findall(row.split('|')[1]):
             n += 1
             try:
                 w = value(want, macros)
