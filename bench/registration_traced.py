@@ -177,13 +177,11 @@ def family_conditions(quick=False):
     lv = [('clean', 0)] + [('noise', a) for a in (0.5, 1, 1.5, 2)] + \
          [(k, r) for k in ('bite', 'touching') for r in (0.1, 0.2, 0.3, 0.4)] + \
          [(k, px) for k in ('lowres', 'grey') for px in (30, 40, 60, 80)]
-    unit = {'clean': '', 'noise': ' %g %% R', 'bite': ' %g R', 'touching': ' %g R', 'lowres': ' %g px',
-            'grey': ' %g px'}
-    name = {'lowres': 'binary', 'grey': 'grey', 'touching': 'touching'}
-    return [('%s%g' % (k, v) if v else k, name.get(k, k) + (unit[k] % v if v else ''), k, v,
-             4.0 if k in ('lowres', 'grey') else 2.0, 100 + i) for i, (k, v) in enumerate(lv)
-            if not quick or (k, v) in (('clean', 0), ('noise', 1.5), ('bite', 0.3), ('touching', 0.3),
-                                       ('lowres', 40), ('grey', 40))]
+    fmt = {'clean': 'clean', 'noise': 'noise %g %% R', 'bite': 'bite %g R', 'touching': 'touching %g R',
+           'lowres': 'binary %g px', 'grey': 'grey %g px'}
+    quick_points = (('clean', 0), ('noise', 1.5), ('bite', 0.3), ('touching', 0.3), ('lowres', 40), ('grey', 40))
+    return [('%s%g' % (k, v) if v else k, fmt[k] % v if v else k, k, v, 4.0 if k in ('lowres', 'grey') else 2.0,
+             100 + i) for i, (k, v) in enumerate(lv) if not quick or (k, v) in quick_points]
 
 
 def largest_piece(img):
