@@ -11,7 +11,12 @@
  * graph at the row's share: 0.1 in the default, 0.05 before 0.12). A row's time is the wall time of the base
  * matrices it needs plus its fusion and re-ranking (decode, trace and preparation are listed
  * once per set). With mpeg7-dev/folds.tsv, two more columns: each class fold of mpeg7-dev as its
- * own collection (sub-matrices of mpeg7-dev's base matrices; why the folds: docs/decisions.md). */
+ * own collection (sub-matrices of mpeg7-dev's base matrices; why the folds: docs/decisions.md).
+ * With eth80-dev (objects seen in 41 views, a manifest with a `group` column), its column:
+ * leave one object out, 1-NN. Last, the mean of the four collections (mpeg7-dev as its folds'
+ * mean, Kimia as the two sums' mean share of the best, eth80-dev, the MCD-style set) and each
+ * figure's spread: the standard error of the default's figure over its units (classes; objects
+ * in eth80-dev), the margin within which a change may lower it. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,38 +42,47 @@ typedef struct {
     int rerank;         /* re-ranking k 8, 10 iterations */
     double view;        /* the affine-view factor f (both frames): min(mix, f d_affine); 0: the mix */
     double inner;       /* with an inner distance: its graph's share of the re-ranking */
+    int k;              /* re-ranking k (8 in the default) */
 } row_t;
 
 static const row_t ROWS[] = {
-    {"paper's method (AMSCR, affine, no re-ranking)", {1, 0, 0, 0}, 0, 0, 0, 0, 0},
-    {"AMSCR + re-ranking", {1, 0, 0, 0}, 0, 0, 1, 0, 0},
-    {"channel, similarity frame", {0, 1, 0, 0}, 1, 0, 0, 0, 0},
-    {"channel, affine frame (band 0.08)", {0, 0, 1, 0}, 1, 1, 0, 0, 0},
-    {"channel, both frames (0.8 / 0.2)", {0, 1, 1, 0}, 1, 0.2, 0, 0, 0},
-    {"AMSCR + channel fused (w 0.5)", {1, 1, 1, 0}, 0.5, 0.2, 0, 0, 0},
-    {"inner distance alone (closed silhouette)", {0, 0, 0, 1}, 1, 0, 0, 0, 0},
-    {"channel, similarity frame + re-ranking", {0, 1, 0, 0}, 1, 0, 1, 0, 0},
-    {"channel, affine frame (band 0.08) + re-ranking", {0, 0, 1, 0}, 1, 1, 1, 0, 0},
-    {"AMSCR + channel fused (w 0.5) + re-ranking", {1, 1, 1, 0}, 0.5, 0.2, 1, 0, 0},
-    {"channel, both frames + re-ranking on one graph (0.6's default)", {0, 1, 1, 0}, 1, 0.2, 1, 0, 0},
+    {"paper's method (AMSCR, affine, no re-ranking)", {1, 0, 0, 0}, 0, 0, 0, 0, 0, 8},
+    {"AMSCR + re-ranking", {1, 0, 0, 0}, 0, 0, 1, 0, 0, 8},
+    {"channel, similarity frame", {0, 1, 0, 0}, 1, 0, 0, 0, 0, 8},
+    {"channel, affine frame (band 0.08)", {0, 0, 1, 0}, 1, 1, 0, 0, 0, 8},
+    {"channel, both frames (0.8 / 0.2)", {0, 1, 1, 0}, 1, 0.2, 0, 0, 0, 8},
+    {"AMSCR + channel fused (w 0.5)", {1, 1, 1, 0}, 0.5, 0.2, 0, 0, 0, 8},
+    {"inner distance alone (closed silhouette)", {0, 0, 0, 1}, 1, 0, 0, 0, 0, 8},
+    {"channel, similarity frame + re-ranking", {0, 1, 0, 0}, 1, 0, 1, 0, 0, 8},
+    {"channel, affine frame (band 0.08) + re-ranking", {0, 0, 1, 0}, 1, 1, 1, 0, 0, 8},
+    {"AMSCR + channel fused (w 0.5) + re-ranking", {1, 1, 1, 0}, 0.5, 0.2, 1, 0, 0, 8},
+    {"channel, both frames + re-ranking on one graph (0.6's default)", {0, 1, 1, 0}, 1, 0.2, 1, 0, 0, 8},
     {"channel, both frames + two graphs, the silhouette as traced (0.8's default)", {0, 1, 1, 0, 1}, 1, 0.2, 1, 0,
-     0.05},
-    {"channel, both frames + re-ranking on two graphs (0.10's default)", {0, 1, 1, 1}, 1, 0.2, 1, 0, 0.05},
+     0.05, 8},
+    {"channel, both frames + re-ranking on two graphs (0.10's default)", {0, 1, 1, 1}, 1, 0.2, 1, 0, 0.05, 8},
     {"channel, both frames, affine views by the affine frame + two graphs (0.11's default)", {0, 1, 1, 1}, 1, 0.2,
-     1, 2.0, 0.05},
-    {"channel, similarity frame + re-ranking on two graphs (--fast)", {0, 1, 0, 1}, 1, 0, 1, 0, 0.1},
+     1, 2.0, 0.05, 8},
+    {"channel, similarity frame + re-ranking on two graphs (--fast)", {0, 1, 0, 1}, 1, 0, 1, 0, 0.1, 8},
     {"**default: channel, both frames, affine views by the affine frame + two graphs, the inner one at 0.1**",
-     {0, 1, 1, 1}, 1, 0.2, 1, 2.0, 0.1},
+     {0, 1, 1, 1}, 1, 0.2, 1, 2.0, 0.1, 8},
+    {"default without the affine-view rule", {0, 1, 1, 1}, 1, 0.2, 1, 0, 0.1, 8},
+    {"default without the inner graph", {0, 1, 1, 0}, 1, 0.2, 1, 2.0, 0, 8},
+    {"default, the inner distance on the silhouette as traced", {0, 1, 1, 0, 1}, 1, 0.2, 1, 2.0, 0.1, 8},
+    {"default without re-ranking", {0, 1, 1, 0}, 1, 0.2, 0, 2.0, 0, 8},
+    {"default, re-ranking k 4", {0, 1, 1, 1}, 1, 0.2, 1, 2.0, 0.1, 4},
+    {"default, re-ranking k 16", {0, 1, 1, 1}, 1, 0.2, 1, 2.0, 0.1, 16},
 };
+enum { DEFAULT_ROW = 15 };
 enum { NROWS = sizeof ROWS / sizeof ROWS[0] };
 
 typedef struct {
     const char *title;
-    int kind; /* 0 bull's eye %, 1 top-k sum */
+    int kind; /* 0 bull's eye %, 1 top-k sum, 2 leave one group out 1-NN % */
     shape_set s;
+    int32_t *groups; /* kind 2: each shape's group (object) */
     double t_load, t_prep, t_base[NBASE];
     double *base[NBASE];
-    double score[NROWS], secs[NROWS];
+    double score[NROWS], secs[NROWS], spread[NROWS];
 } set_run;
 
 static double now(void)
@@ -183,11 +197,65 @@ static void compose(const set_run *r, const row_t *w, double *out)
         }
     }
     free(H);
-    size_t k = n < 8 ? n : 8;
+    size_t k = n < (size_t)w->k ? n : (size_t)w->k;
     const double *inner = w->use[M_INNER] ? r->base[M_INNER] : w->use[M_INNER_OPEN] ? r->base[M_INNER_OPEN] : NULL;
     if (w->rerank && (inner ? amscr__rerank_normalized2(out, inner, w->inner, n, k, 10, amscr__resolve_threads(0), out)
                             : amscr__rerank_normalized(out, n, k, 10, amscr__resolve_threads(0), out)) != AMSCR_OK)
         die("re-ranking");
+}
+
+/* The standard error of a figure that is the mean of m units' scores u (times scale). */
+static double std_error(const double *u, size_t m, double scale)
+{
+    double mean = 0, ss = 0;
+    for (size_t i = 0; i < m; i++)
+        mean += u[i] / (double)m;
+    for (size_t i = 0; i < m; i++)
+        ss += (u[i] - mean) * (u[i] - mean);
+    return m > 1 ? scale * sqrt(ss / (double)(m - 1) / (double)m) : 0.0;
+}
+
+/* Row k's figure of r from D, and its spread over the units (classes, or groups for kind 2). */
+static void score_one(set_run *r, const double *D, int k)
+{
+    size_t n = r->s.n, m = 0;
+    const int32_t *units = r->kind == 2 ? r->groups : r->s.labels;
+    int32_t *cls = malloc(n * sizeof *cls), *lab = malloc(n * sizeof *lab);
+    double *u = malloc(n * sizeof *u);
+    if (!cls || !lab || !u)
+        die("memory");
+    m = n;
+    if (amscr_score_classes(units, n, cls, NULL, &m) != AMSCR_OK)
+        die("classes");
+    r->score[k] = 0;
+    if (r->kind == 1) { /* top-k sum; a class's hits with every other class's labels made unique */
+        size_t counts[16] = {0}, kmax = n > 100 ? 11 : 10;
+        for (size_t c = 0; c < m; c++) {
+            for (size_t i = 0; i < n; i++)
+                lab[i] = r->s.labels[i] == cls[c] ? cls[c] : -1 - (int32_t)i;
+            if (amscr_score_topk_table(D, n, lab, kmax, counts) != AMSCR_OK)
+                die("top-k");
+            u[c] = 0;
+            for (size_t q = 0; q < kmax; q++)
+                u[c] += (double)counts[q];
+            r->score[k] += u[c];
+        }
+        r->spread[k] = std_error(u, m, (double)m);
+    } else if (r->kind == 2) {
+        if (amscr_score_nn_groups(D, n, r->s.labels, r->groups, m, 0, &r->score[k], u, NULL) != AMSCR_OK)
+            die("groups");
+        r->score[k] *= 100.0;
+        r->spread[k] = std_error(u, m, 100.0);
+    } else {
+        if (amscr_score_bullseye(D, n, r->s.labels, 0, &r->score[k]) != AMSCR_OK ||
+            amscr_score_per_class(D, n, r->s.labels, m, u, NULL) != AMSCR_OK)
+            die("bull's eye");
+        r->score[k] *= 100.0;
+        r->spread[k] = std_error(u, m, 100.0);
+    }
+    free(cls);
+    free(lab);
+    free(u);
 }
 
 static void score_rows(set_run *r)
@@ -202,18 +270,7 @@ static void score_rows(set_run *r)
         r->secs[k] = now() - t0;
         for (int b = 0; b < NBASE; b++)
             r->secs[k] += ROWS[k].use[b] ? r->t_base[b] : 0.0;
-        r->score[k] = 0;
-        if (r->kind == 1) {
-            size_t counts[16] = {0}, kmax = n > 100 ? 11 : 10;
-            if (amscr_score_topk_table(D, n, r->s.labels, kmax, counts) != AMSCR_OK)
-                die("top-k");
-            for (size_t q = 0; q < kmax; q++)
-                r->score[k] += (double)counts[q];
-        } else if (amscr_score_bullseye(D, n, r->s.labels, 0, &r->score[k]) != AMSCR_OK) {
-            die("bull's eye");
-        } else {
-            r->score[k] *= 100.0;
-        }
+        score_one(r, D, k);
     }
     free(D);
 }
@@ -254,19 +311,46 @@ static void fold_set(const set_run *all, const int32_t *fold_of_class, int which
 
 int ablation_main(const char *dir);
 
+/* The groups of the manifest at path (its `group` column) into r->groups; -1 without them. */
+static int load_groups(const char *path, set_run *r)
+{
+    collection col;
+    if (collection_open(path, &col) != 0)
+        return -1;
+    int ok = col.ngroups > 1 && col.n == r->s.n && (r->groups = malloc(col.n * sizeof *r->groups)) != NULL;
+    for (size_t i = 0; ok && i < col.n; i++)
+        r->groups[i] = col.items[i].group;
+    collection_free(&col);
+    return ok ? 0 : -1;
+}
+
+/* Row k's mean of the four collections in % (mpeg7-dev's folds averaged, Kimia's sums as shares). */
+static double mean_of_four(const set_run *sets, const set_run *folds, int k)
+{
+    double m7 = 0.5 * (folds[0].score[k] + folds[1].score[k]);
+    double kim = 50.0 * (sets[2].score[k] / 990.0 + sets[3].score[k] / 2376.0);
+    return 0.25 * (m7 + sets[1].score[k] + kim + sets[4].score[k]);
+}
+
 int ablation_main(const char *dir)
 {
-    static set_run sets[4], folds[2];
+    enum { NSETS = 5 };
+    static set_run sets[NSETS], folds[2];
     static int32_t fold_of_class[4096];
-    int nfolds = 0;
-    const char *titles[4] = {"mpeg7-dev (bull's eye %)", "MCD-style (bull's eye %)", "Kimia-99 (top-10 sum /990)",
-                             "Kimia-216 (top-11 sum /2376)"};
-    const char *dirs[4] = {"mpeg7-dev", "mpeg7-dev", "kimia99", "kimia216"};
-    for (int k = 0; k < 4; k++) {
+    int nfolds = 0, nsets = NSETS;
+    const char *titles[NSETS] = {"mpeg7-dev (bull's eye %)", "MCD-style (bull's eye %)", "Kimia-99 (top-10 sum /990)",
+                                 "Kimia-216 (top-11 sum /2376)", "eth80-dev (one object out, 1-NN %)"};
+    const char *dirs[NSETS] = {"mpeg7-dev", "mpeg7-dev", "kimia99", "kimia216", "eth80-dev"};
+    for (int k = 0; k < nsets; k++) {
         sets[k].title = titles[k];
-        sets[k].kind = k >= 2;
+        sets[k].kind = k == 4 ? 2 : k >= 2;
         char path[4096];
         snprintf(path, sizeof path, "%s/%s/manifest.tsv", dir, dirs[k]);
+        if (access(path, R_OK) != 0 && k == 4) { /* the column is left out without the set */
+            fprintf(stderr, "amscr-retrieval-bench: %s not found: no eth80-dev column\n", path);
+            nsets = 4;
+            break;
+        }
         if (access(path, R_OK) != 0) {
             fprintf(stderr, "amscr-retrieval-bench: %s not found\n", path);
             return 77;
@@ -274,6 +358,10 @@ int ablation_main(const char *dir)
         double t0 = now();
         if ((k == 1 ? shape_set_mcd(path, MCD_SEED, &sets[k].s) : shape_set_load(path, &sets[k].s)) != 0)
             return 1;
+        if (k == 4 && load_groups(path, &sets[k]) != 0) {
+            fprintf(stderr, "amscr-retrieval-bench: %s: no `group` column\n", path);
+            return 1;
+        }
         sets[k].t_load = now() - t0;
         compute_bases(&sets[k]);
         score_rows(&sets[k]);
@@ -289,6 +377,7 @@ int ablation_main(const char *dir)
         free_bases(&sets[k]);
         fprintf(stderr, "ablation: %s done\n", dirs[k]);
     }
+    int mean4 = nsets == NSETS && nfolds == 2;
     double la[3] = {-1, -1, -1};
     FILE *f = fopen("/proc/loadavg", "r");
     if (f) {
@@ -300,32 +389,41 @@ int ablation_main(const char *dir)
            "Score, then wall seconds of the matrices the row needs plus its fusion and re-ranking.\n\n",
            sysconf(_SC_NPROCESSORS_ONLN), la[0], la[1], la[2]);
     printf("| setting |");
-    for (int k = 0; k < 4; k++)
+    for (int k = 0; k < nsets; k++)
         printf(" %s | s |", sets[k].title);
     for (int w = 0; w < nfolds; w++)
         printf(" %s |", folds[w].title);
-    printf("\n|---|");
-    for (int k = 0; k < 4; k++)
+    printf(mean4 ? " mean of four (%%) |\n|---|" : "\n|---|");
+    for (int k = 0; k < nsets; k++)
         printf("---|---|");
-    for (int w = 0; w < nfolds; w++)
+    for (int w = 0; w < nfolds + mean4; w++)
         printf("---|");
     printf("\n");
     for (int r = 0; r < NROWS; r++) {
         printf("| %s |", ROWS[r].name);
-        for (int k = 0; k < 4; k++)
-            printf(sets[k].kind ? " %.0f | %.1f |" : " %.2f | %.1f |", sets[k].score[r], sets[k].secs[r]);
+        for (int k = 0; k < nsets; k++)
+            printf(sets[k].kind == 1 ? " %.0f | %.1f |" : " %.2f | %.1f |", sets[k].score[r], sets[k].secs[r]);
         for (int w = 0; w < nfolds; w++)
             printf(" %.2f |", folds[w].score[r]);
+        if (mean4)
+            printf(" %.2f |", mean_of_four(sets, folds, r));
         printf("\n");
     }
     printf("| (decode + trace, prepare: s) |");
-    for (int k = 0; k < 4; k++)
+    for (int k = 0; k < nsets; k++)
         printf(" %.1f + %.1f | |", sets[k].t_load, sets[k].t_prep);
-    for (int w = 0; w < nfolds; w++)
+    for (int w = 0; w < nfolds + mean4; w++)
         printf(" |");
-    printf("\n");
-    for (int k = 0; k < 4; k++)
+    printf("\n| (spread of the default: standard error over classes, objects in eth80-dev) |");
+    for (int k = 0; k < nsets; k++)
+        printf(sets[k].kind == 1 ? " ±%.1f | |" : " ±%.2f | |", sets[k].spread[DEFAULT_ROW]);
+    for (int w = 0; w < nfolds; w++)
+        printf(" ±%.2f |", folds[w].spread[DEFAULT_ROW]);
+    printf(mean4 ? " |\n" : "\n");
+    for (int k = 0; k < nsets; k++) {
         shape_set_free(&sets[k].s);
+        free(sets[k].groups);
+    }
     for (int w = 0; w < nfolds; w++)
         shape_set_free(&folds[w].s);
     return 0;

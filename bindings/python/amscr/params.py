@@ -142,7 +142,8 @@ class Params:
                                  "frame of the shape channel: 'similarity' (default) or 'affine' (whitened)")
     channel_affine_share = _Option('channel_affine_share', _FLOAT,
                                    'with the similarity frame: the share, 0..1, of the channel computed in the '
-                                   'affine frame (default 0.2; 0 = one frame, less time)')
+                                   'affine frame (default 0.2; 0 = the similarity frame alone, proportions kept, '
+                                   'less time; 1 = the affine frame alone)')
     channel_band = _Option('channel_band', _FLOAT,
                            "half width of the channel's dynamic-programming band, fraction of N in (0, 0.5] "
                            '(default 0.15; 0.08 before 0.6)')
