@@ -2,11 +2,11 @@
 """Registration from images: the amscr tool on traced PNG pairs against OpenCV's ECC.
 
 For each class of mpeg7-dev (one shape per class, the class's first file; folds.tsv's fold A / B)
-and `--procedural N` seeded silhouettes (bench/shapegen.py: thin limbs, near symmetries, holes,
-spikes, deep notches; "fold" P), `--draws` seeded draws per condition: the silhouette scaled to
-140 px in a 200 x 200 image (the source), a random affine map T (any rotation, axis scales
-x0.5-2, shear +-0.5; then scaled and shifted so the warped shape again spans 140 px of a 200 x 200
-image) applied with cv2.warpAffine (the target), then the target damaged in the image:
+and `--procedural N` seeded silhouettes (bindings/python/tests/shapegen.py: thin limbs, near
+symmetries, holes, spikes, deep notches; "fold" P), `--draws` seeded draws per condition: the
+silhouette 140 px across in a 200 x 200 image (the source), a random affine map T (any rotation,
+axis scales x0.5-2, shear +-0.5; then scaled and shifted so the warped shape again spans 140 px)
+applied with cv2.warpAffine (the target), then the target damaged in the image:
 
   clean      the warped silhouette (bilinear, thresholded at half level);
   noise      the boundary moved by a smooth random field of 1.5 % of the shape's RMS radius,
@@ -29,28 +29,15 @@ the default sub-pixel tracer, and with --pixel-chain), and by cv2.findTransformE
 images. --reference adds the reference evaluation's calibration column: scikit-image
 find_contours point lists of both images through `amscr register`.
 
-Error, two measures over the clean source's sub-pixel contour f (source pixels), as % of R =
-size(T(f)), the RMS radius about the centroid:
-  RMS  sqrt(mean_i |M(f_i) - T(f_i)|^2) -- the primary table, as the reference evaluation measures
-       (it states "below 2 % of the shape's size; 4 % at low resolution" and a calibration, 35-px
-       binary / grey images traced by find_contours: 94.3 / 92.9 %; `--reference` gives 95.7 /
-       98.6 % under RMS, 80.0 / 97.1 % under max, so its figures are taken to be RMS ones);
-  max  max_i |M(f_i) - T(f_i)| -- the stricter second table, the measure of the figures before 0.5.
-Success: error < 2 % (4 % at low resolution). Wrong + confident (w+c): a failure the tool reports
-with confidence >= 0.25; ok+c: the share of the successes with confidence >= 0.25. ECC is scored
-by the same measures (it reports no confidence). ms: wall time per pair (the tool's includes
-process start and PNG decoding).
-
-Usage: nice .venv/bin/python bench/registration_traced.py [--data DIR] [--tool PATH] [--draws 2]
-       [--no-ecc] [--no-chain] [--reference] [--conditions clean,lowres,...] [--fold A|B|P]
-       [--families | --quick] [--procedural N] [--json OUT] [--low-px 35]
---json OUT writes one row per pair, each method as [RMS %, max %, confidence, ms]. --conditions
-(alias --only) and --fold restrict the run; --breakdown splits the library's time (the traces,
-the registration, without the polish, without the polish and the refinement); --cpu-time counts
-it as CPU time (with OPENBLAS_NUM_THREADS=1). "lib ms": the library alone in this process
-(amscr.contour_from_mask(join=True) on both images, as the tool traces, then amscr.register), the
-median over the condition's pairs; skipped with --families or without the amscr package.
-Deterministic: every draw is seeded by (shape index, condition, draw).
+Error over the clean source's sub-pixel contour f, % of R = size(T(f)) (the RMS radius): the RMS
+of |M(f_i) - T(f_i)| (the primary table: the reference evaluation's figures, by its calibration,
+are RMS ones; docs/measurements.md) and the max (stricter, the figures before 0.5). Success: < 2 %
+(4 % at low resolution). Wrong + confident (w+c): a failure reported with confidence >= 0.25;
+ok+c: the successes' share with confidence >= 0.25. ms: wall time a pair (the tool's with process
+start and PNG decoding). --json OUT: a row a pair, each method [RMS %, max %, confidence, ms].
+"lib ms": the library alone in this process (amscr.contour_from_mask(join=True), amscr.register),
+the median; skipped with --families or without the amscr package. Every draw is seeded by (shape
+index, condition, draw). Usage: nice .venv/bin/python bench/registration_traced.py --help
 """
 import argparse
 import json
@@ -66,7 +53,8 @@ import numpy as np
 import cv2
 
 import registration_heldout  # noqa: E402  (bench/: the ECC multi-start both benches use)
-import shapegen  # noqa: E402  (bench/: the procedural silhouettes)
+sys.path.insert(1, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'bindings', 'python', 'tests'))
+import shapegen  # noqa: E402  (the procedural silhouettes, shared with the tests)
 from registration_heldout import apply, compose, inv_affine, shape_size  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -114,9 +102,7 @@ def load_source(path):
     m = (img > 127).astype(np.uint8) * 255
     if np.mean(np.concatenate([m[0], m[-1], m[:, 0], m[:, -1]])) > 127:
         m = 255 - m
-    n, lab, stats, _ = cv2.connectedComponentsWithStats(m, connectivity=8)
-    big = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
-    m = np.where(lab == big, 255, 0).astype(np.uint8)
+    m = largest_piece(m)
     ys, xs = np.nonzero(m)
     P = fit_map(np.column_stack([xs, ys]).astype(float))
     src = cv2.warpAffine(m, P, (CANVAS, CANVAS), flags=cv2.INTER_AREA if P[0, 0] < 1 else cv2.INTER_LINEAR)
@@ -217,19 +203,23 @@ def family_target(src, f, kind, level, rng):
         return disk(tgt, p + 0.8 * level * R * u, level * R, 255), T
     if kind in ('lowres', 'grey'):
         side = int(round(CANVAS * level / SPAN))
-        r = CANVAS / side
         small = cv2.resize(tgt, (side, side), interpolation=cv2.INTER_AREA)
-        S = np.array([[1.0 / r, 0, (1.0 / r - 1) / 2], [0, 1.0 / r, (1.0 / r - 1) / 2]])
-        return (np.where(small > 127, 255, 0).astype(np.uint8) if kind == 'lowres' else small), compose(S, T)
+        small = np.where(small > 127, 255, 0).astype(np.uint8) if kind == 'lowres' else small
+        return small, compose(low_map(side), T)
     return tgt, T
+
+
+def low_map(side):
+    """Pixel centres of the CANVAS image -> those of its area reduction to side x side."""
+    r = CANVAS / side
+    return np.array([[1.0 / r, 0, (1.0 / r - 1) / 2], [0, 1.0 / r, (1.0 / r - 1) / 2]])
 
 
 def set_low_px(px):
     """The lowres / grey shapes `px` across (35: the 4x reduction): the reduced canvas and S_LOW."""
     global LOW_SIDE, S_LOW
     LOW_SIDE = int(round(CANVAS * px / SPAN))
-    r = CANVAS / LOW_SIDE
-    S_LOW = np.array([[1.0 / r, 0, (1.0 / r - 1) / 2], [0, 1.0 / r, (1.0 / r - 1) / 2]])
+    S_LOW = low_map(LOW_SIDE)
 
 
 LOW_SIDE = CANVAS // REDUCE
@@ -240,8 +230,7 @@ def reduce(img, binary):
     return np.where(small > 127, 255, 0).astype(np.uint8) if binary else small
 
 
-# low-res pixel x = (x - 1.5) / 4 for a 4x area reduction (pixel centres)
-S_LOW = np.array([[1.0 / REDUCE, 0, -(REDUCE - 1) / 2 / REDUCE], [0, 1.0 / REDUCE, -(REDUCE - 1) / 2 / REDUCE]])
+S_LOW = low_map(LOW_SIDE)  # low-res pixel x = (x - 1.5) / 4 for a 4x area reduction
 
 
 def map_error(M, T, f):
@@ -429,22 +418,14 @@ def main():
     ap.add_argument('--conditions', '--only', dest='only', default='',
                     help='comma-separated condition keys: ' + ','.join(c[0] for c in CONDITIONS))
     ap.add_argument('--fold', default='', choices=['', 'A', 'B', 'P'], help='one fold (P: procedural) only')
-    ap.add_argument('--families', action='store_true',
-                    help="the check's conditions swept (shapes 200 px across): " +
-                         ','.join(c[0] for c in family_conditions()))
+    ap.add_argument('--families', action='store_true', help="the check's conditions swept (see above)")
     ap.add_argument('--quick', action='store_true', help='--families at the check\'s points only')
-    ap.add_argument('--procedural', type=int, default=None,
-                    help='add N seeded procedural silhouettes (bench/shapegen.py; default 35 with --families, else 0)')
-    ap.add_argument('--breakdown', action='store_true',
-                    help="the library's time split: traces, registration, without polish, without polish and refinement")
-    ap.add_argument('--cpu-time', action='store_true',
-                    help="lib ms as the process's CPU time, not wall time (steadier on a shared machine; "
-                         "run with OPENBLAS_NUM_THREADS=1, or BLAS threads that spin are counted)")
-    ap.add_argument('--reference', action='store_true',
-                    help="add the reference evaluation's calibration: scikit-image find_contours point lists through the tool")
+    ap.add_argument('--procedural', type=int, default=None, help='N procedural shapes (35 with --families, else 0)')
+    ap.add_argument('--breakdown', action='store_true', help="lib ms split: traces, register, no polish, no refine")
+    ap.add_argument('--cpu-time', action='store_true', help="lib ms as CPU time (with OPENBLAS_NUM_THREADS=1)")
+    ap.add_argument('--reference', action='store_true', help="add the calibration: find_contours lists to the tool")
     ap.add_argument('--classes', type=int, default=0, help='the first N classes only (0: all)')
-    ap.add_argument('--low-px', type=float, default=SPAN / REDUCE,
-                    help='the shape\'s size across in the lowres and grey conditions (default 35: a 4x reduction)')
+    ap.add_argument('--low-px', type=float, default=SPAN / REDUCE, help='lowres / grey: the shape N px across')
     ap.add_argument('--json', default=None)
     a = ap.parse_args()
     if a.cpu_time:

@@ -1,7 +1,7 @@
-"""The registration bench's procedural silhouettes (bench/shapegen.py) and damage families
-(bench/registration_traced.py --families): seeded, one piece each, and the damage as stated --
-a bite leaves one piece, a touching disk adds area, a low-resolution target spans its pixels.
-Skipped without OpenCV or scikit-image."""
+"""The registration bench's procedural silhouettes (shapegen.py, beside this file) and damage
+families (bench/registration_traced.py --families): seeded, one piece each, and the damage as
+stated -- a bite leaves one piece, a touching disk adds area, a low-resolution target spans its
+pixels. Skipped without OpenCV or scikit-image."""
 import os
 import sys
 
@@ -11,7 +11,7 @@ import pytest
 cv2 = pytest.importorskip('cv2')
 pytest.importorskip('skimage')
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'bench'))
-import shapegen  # noqa: E402
+import shapegen  # noqa: E402  (beside this file)
 
 N = 35  # the bench's procedural set: silhouette(1, i), i < 35
 
