@@ -1,8 +1,10 @@
 """amscr.distributed scaling on this machine: C batch (1, 2 threads) vs Dask 1 and 2 worker processes
 (threads_per_worker=1, 1 C thread per tile), interleaved, `reps` times; wall time (best) and CPU time
-(pairs per CPU-second of the computing processes, median)."""
+(pairs per CPU-second of the computing processes, median). `shards`: the index in shards
+(build_index) with 1, 2, 4 workers: build time, query rate, memory per worker."""
 import os, sys, time, statistics
-# run from the repository root: python3 bench/distributed_scaling.py [N_SHAPES] [REPS] (needs psutil, dask)
+# run from the repository root: python3 bench/distributed_scaling.py [N_SHAPES] [REPS] (needs psutil, dask);
+# python3 bench/distributed_scaling.py shards [N_SHAPES] [REPS]: the index in shards (sharded() below)
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'bindings', 'python')); sys.path.insert(0, os.path.join(ROOT, 'bindings', 'python', 'tests'))
 os.environ.setdefault('AMSCR_LIBRARY', os.path.join(ROOT, 'build', 'libamscr.so.0'))
@@ -13,9 +15,9 @@ from distributed import Client, LocalCluster
 def wcpu():
     t = psutil.Process().cpu_times(); return t.user + t.system
 
-if __name__ == '__main__':
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 1000
-    reps = int(sys.argv[2]) if len(sys.argv) > 2 else 3
+def matrix(argv):
+    n = int(argv[1]) if len(argv) > 1 else 1000
+    reps = int(argv[2]) if len(argv) > 2 else 3
     db = amscr.Collection(threads=1)
     for i in range(n):
         db.add(blob(400, seed=i, phase=0.01 * i), label=i % 20)
@@ -58,3 +60,42 @@ if __name__ == '__main__':
                                                   ' '.join('%.1f' % x[2] for x in v)))
     for c in clients.values(): c.close()
     for cl in clusters.values(): cl.close()
+
+
+def sharded(n, reps, nq=20):
+    """amscr.distributed.build_index with 1, 2, 4 worker processes (one thread each): build, a batch
+    of nq queries, the largest worker's memory (RSS after the build and the queries); the scores
+    checked against the single index. Run: python3 bench/distributed_scaling.py shards N [REPS]."""
+    params = amscr.Params.retrieval(threads=1)  # the preset: N = 128, the inner distance's graph
+    shapes = [blob(400, seed=i, phase=0.01 * i) for i in range(n)]
+    db = amscr.Collection(params)
+    db.extend(shapes, [i % 20 for i in range(n)])
+    db2 = amscr.Collection(params.copy(threads=2))
+    db2.extend(shapes, [i % 20 for i in range(n)])
+    qs = [blob(400, seed=100000 + i, phase=0.37 * i) for i in range(nq)]
+    t = time.perf_counter(); single = amscr.Index(db2, candidates=0)
+    print('single index (2 C threads, every pair): build %.1fs' % (time.perf_counter() - t))
+    ref = np.array([single.scores(q, candidates=0) for q in qs])
+    rss = lambda: psutil.Process().memory_info().rss
+    print('%-10s %12s %16s %18s %14s %s' % ('workers', 'build (best)', 'query/s (best)', 'RSS/worker (max)',
+                                           'idle RSS', 'load avg'))
+    for nw in (1, 2, 4):
+        with LocalCluster(n_workers=nw, threads_per_worker=1, processes=True, dashboard_address=':0') as cl, Client(cl) as c:
+            builds, queries, mem, loads = [], [], [], []
+            idle = max(c.run(rss).values())
+            for rep in range(reps):
+                loads.append(os.getloadavg()[0])
+                t = time.perf_counter(); sx = ad.build_index(c, db); builds.append(time.perf_counter() - t)
+                t = time.perf_counter(); S = sx.scores_many(qs); queries.append(time.perf_counter() - t)
+                assert np.abs(S - ref).max() <= 1e-9
+                mem.append(max(c.run(rss).values()))
+                del sx
+            print('%-10d %11.1fs %16.1f %15.0f MB %11.0f MB %s' % (nw, min(builds), nq / min(queries), max(mem) / 2**20,
+                  idle / 2**20, ' '.join('%.1f' % x for x in loads)), flush=True)
+
+
+if __name__ == '__main__':
+    if sys.argv[1:2] == ['shards']:
+        sharded(int(sys.argv[2]) if len(sys.argv) > 2 else 1000, int(sys.argv[3]) if len(sys.argv) > 3 else 1)
+    else:
+        matrix(sys.argv)

@@ -2159,16 +2159,71 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_mixture(const amscr_result *
 AMSCR_API double amscr_result_threshold(const amscr_result *r);
 
 /**
- * @brief How sure the registration is, in [0, 1]: (1 - ambiguity) x inlier fraction. Near 0:
- *        reject the map, because another, clearly different map explains the target almost
- *        as well (a symmetric shape, a fragment too short to place) or most source samples
- *        found no target boundary near them. It flags wrong maps, not small biases.
+ * @brief How sure the registration is, in [0, 1]: (1 - a) x min(inlier fraction, overlap) /
+ *        (1 + (e / 0.01)^2), a the larger of amscr_result_ambiguity and
+ *        amscr_result_symmetry_ambiguity (when measured), e the forward-backward error (0 when
+ *        the check did not run; amscr_result_backward_error). Near 0: reject the map, because
+ *        another, clearly different map explains the target almost as well (a symmetric shape,
+ *        a symmetric shape with a part missing, a fragment too short to place), most source
+ *        samples found no target boundary near them, the
+ *        registered regions overlap little, or the target registered back onto the source on
+ *        its own does not undo the map. Reject maps below 0.25. It flags wrong maps, not small
+ *        biases (a map 3 % of the size off can still read high). Before 0.14 the value was
+ *        (1 - ambiguity) x inlier fraction; partial matches keep that value.
  * @return the value; NaN for NULL.
  * Ownership: none.
  * Thread-safety: const.
  * @since 0.2
  */
 AMSCR_API double amscr_result_confidence(const amscr_result *r);
+
+/**
+ * @brief The overlap of the registered shapes as regions, in [0, 1]: the intersection over
+ *        union of the areas the two closed contours enclose (even-odd rule), the source's
+ *        under the map and the target's, computed from the sampled contours without images.
+ *        1 for a perfect match; about 1 - the damaged share of the area when part of the
+ *        target is missing or an object touches it; low for a wrong map.
+ * @return the value; NaN for NULL or a partial match (an open source encloses no region).
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API double amscr_result_overlap(const amscr_result *r);
+
+/**
+ * @brief The forward-backward error: when the map is confident but less than 85 % of the
+ *        shape agrees (the smaller of the inlier fraction and the overlap), the target is
+ *        registered onto the source on its own, as amscr_register would with the same
+ *        params; the two maps should compose to the identity. The value is the RMS
+ *        displacement of the source's samples under the composition, in units of the
+ *        source's RMS radius (in the affine-normalized frame): about 0 when the two agree,
+ *        0.01 halves the confidence. The map itself does not change.
+ * @return the value; NaN when the check did not run (a clean match, an unconfident map, a
+ *         partial match, the way back failing) or for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API double amscr_result_backward_error(const amscr_result *r);
+
+/**
+ * @brief The ambiguity near a symmetry of the source, in [0, 1]: when the map is confident but
+ *        less than 95 % of the shape agrees (the smaller of the inlier fraction and the
+ *        overlap), the source is registered onto itself; each of its own distinct maps that
+ *        maps it onto itself as well as the identity does (within the ambiguity's 0.5 % floor: a
+ *        symmetry S) gives the alternative map (chosen map) o S, refined on the target; the
+ *        value is the largest ratio of the chosen map's cost to such an alternative's, as in
+ *        amscr_result_ambiguity (both refined to convergence, the two-way trimmed
+ *        closest-point cost). 1: a symmetric turn of the source explains the damaged target
+ *        exactly as well (a 4-armed cross with one arm cut); 0: the source has no symmetry,
+ *        or none fits. The confidence uses the larger of the two ambiguities.
+ * @return the value; NaN when it was not measured (a clean match, an unconfident map, a partial
+ *         match) or for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API double amscr_result_symmetry_ambiguity(const amscr_result *r);
 
 /**
  * @brief Ambiguity in [0, 1]: the trimmed closest-point cost of the chosen map divided by that
@@ -3106,6 +3161,120 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_nn_groups(const double *dist,
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_precision_recall(const double *dist, size_t n,
                                                                     const int32_t *labels, size_t nlevels,
                                                                     double *out_precision);
+
+/* ============================================================================
+ * An index split in shards: what amscr.distributed builds on (docs/collections.md,
+ * "An index in shards"). A collection of n shapes is cut into contiguous blocks; each block is an
+ * ordinary index (a shard, whose shapes carry their features); the whole collection's neighbour
+ * lists are computed from amscr_index_pair_distances over every pair of blocks and held, without
+ * any shape, by an amscr_index_graph. A query's distances to every shard's shapes
+ * (amscr_index_pair_distances with qpos SIZE_MAX), given to amscr_index_graph_scores, are the
+ * scores of the single index of the whole collection built with candidates 0 and queried with
+ * candidates 0 (to rounding), for a channel weight of 0 or 1.
+ * ============================================================================ */
+
+/** The neighbour lists of a whole collection without its shapes, and its largest distances:
+ *  turns a query's distances into its retrieval scores. @since 0.14 */
+typedef struct amscr_index_graph amscr_index_graph;
+
+/**
+ * @brief The base distance (the retrieval matrix's distance before re-ranking, as an index
+ *        lists it) and the inner distance of q to shapes first.. of x, each pair computed as the
+ *        cell of the two in the matrix of one collection (the lower index first): shapes of x
+ *        below qpos come before q, the others after it. qpos SIZE_MAX: q is a query (after
+ *        every shape, as amscr_index_query_scores with candidates 0 matches it); 0: q comes
+ *        before every shape of x (x's block lies after q's in the whole collection); i: q is
+ *        shape i of x itself (its own distance is 0; first i + 1 gives the pairs of a block
+ *        with itself once).
+ * @param[in]  x  an index (a shard), with a channel weight of 0 or 1 (a weight strictly between
+ *                uses x's own medians: the whole collection's differ).
+ * @param[in]  q  a shape prepared with params compatible with x's.
+ * @param[in]  first  the first shape of x matched (0: all).
+ * @param[out] out_base  n base distances (of shapes first..first+n-1).
+ * @param[out] out_inner  n inner distances, or NULL; zeros when the params give the inner graph
+ *                        no share.
+ * @param[in]  n  must equal amscr_index_size(x) - first.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, first or n, incompatible params); AMSCR_E_NOMEM.
+ * Cost: n pair distances on the params' threads.
+ * Ownership: none.
+ * Thread-safety: const on x.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_pair_distances(const amscr_index *x, const amscr_descriptor *q,
+                                                                  size_t qpos, size_t first, double *out_base,
+                                                                  double *out_inner, size_t n);
+
+/**
+ * @brief The widths of a collection's neighbour lists: *out_k neighbours a shape under the base
+ *        distance (the re-ranking's k for n shapes, at most n / 2; 0 without re-ranking) and
+ *        *out_k2 under the inner distance (*out_k when the params give the inner graph a share,
+ *        else 0). Either pointer may be NULL; p NULL gives 0 and 0.
+ * @param[in]  p  the collection's params.
+ * @param[in]  n  the collection's size.
+ * Ownership: none.
+ * Thread-safety: pure.
+ * @since 0.14
+ */
+AMSCR_API void amscr_index_graph_widths(const amscr_params *p, size_t n, size_t *out_k, size_t *out_k2);
+
+/**
+ * @brief A graph of n shapes from lists computed elsewhere (amscr_index_pair_distances over
+ *        every pair of blocks): row i of each list is shape i itself at distance 0, then its
+ *        k - 1 nearest other shapes by (distance, index), as amscr_index_build with candidates 0
+ *        lists them; dmax and dmax2 the largest base and inner distance of the collection.
+ * @param[in] p  the collection's params (copied).
+ * @param[in] nb_idx, nb_dist  n x k (amscr_index_graph_widths), row-major.
+ * @param[in] in_idx, in_dist  n x k2, or NULL when k2 is 0.
+ * @param[out] out  the new graph.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL; a row not itself first, an index >= n, a distance
+ *         negative or not finite: the detail names the row); AMSCR_E_LIMIT (2^32 shapes or
+ *         more); AMSCR_E_NOMEM.
+ * Memory: about (k + k2) * 28 bytes a shape.
+ * Ownership: caller frees *out with amscr_index_graph_free; the lists are copied.
+ * Thread-safety: pure.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_graph_new(const amscr_params *p, size_t n, const uint32_t *nb_idx,
+                                                             const double *nb_dist, const uint32_t *in_idx,
+                                                             const double *in_dist, double dmax, double dmax2,
+                                                             amscr_index_graph **out);
+
+/**
+ * @brief A query's retrieval scores against the graph's n shapes from its distances to the
+ *        candidates cand[0..m-1] (strictly ascending; the others score +inf unless the
+ *        re-ranking reaches them): the computation of amscr_index_query_scores after its
+ *        matching. With every shape a candidate and the distances of amscr_index_pair_distances
+ *        (qpos SIZE_MAX), the scores of the single index (see above).
+ * @param[in] dq   m base distances (finite, >= 0).
+ * @param[in] dq2  m inner distances, or NULL when the graph's k2 is 0.
+ * @param[out] out_scores  n scores, lower is better.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, candidates not ascending or out of range, a
+ *         distance not finite or negative); AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: const on g; runs on the calling thread.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_graph_scores(const amscr_index_graph *g, const size_t *cand,
+                                                                const double *dq, const double *dq2, size_t m,
+                                                                double *out_scores, size_t n);
+
+/**
+ * @brief The graph's number of shapes.
+ * @return n; 0 for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API size_t amscr_index_graph_size(const amscr_index_graph *g);
+
+/**
+ * @brief Frees a graph.
+ * @param[in] g  the graph, or NULL (a no-op).
+ * Ownership: takes g.
+ * Thread-safety: exclusive on g.
+ * @since 0.14
+ */
+AMSCR_API void amscr_index_graph_free(amscr_index_graph *g);
 
 /**
  * @brief Re-ranks a whole distance matrix by affinity diffusion on a k-nearest-neighbour

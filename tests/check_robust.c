@@ -103,7 +103,9 @@ static double confidence_of(const double *s, size_t n, double *out_amb)
     double c = amscr_result_confidence(r);
     *out_amb = amscr_result_ambiguity(r);
     ck_assert(c >= 0.0 && c <= 1.0);
-    ck_assert_double_eq_tol(c, (1.0 - *out_amb) * amscr_result_inlier_fraction(r), 1e-12);
+    double share = fmin(amscr_result_inlier_fraction(r), amscr_result_overlap(r)), fb = amscr_result_backward_error(r);
+    double sa = amscr_result_symmetry_ambiguity(r), amb = isnan(sa) ? *out_amb : fmax(sa, *out_amb);
+    ck_assert_double_eq_tol(c, (1.0 - amb) * share / (1.0 + (isnan(fb) ? 0.0 : pow(fb / 0.01, 2))), 1e-12);
     amscr_result_free(r);
     free(a);
     free(t);
@@ -235,6 +237,102 @@ START_TEST(touching_object_inliers)
 }
 END_TEST
 
+/* A 4-armed cross (arms 1 wide, reaching 3 from the centre; the target's first arm cut to
+ * `cut`), 40 points per edge, the target mapped by R(th) diag(s1, s2) plus (5, 5). */
+static amscr_contour *cross_contour(double cut, double th, double s1, double s2)
+{
+    const double v[24] = {1, -1, cut, -1, cut, 1, 1, 1, 1, 3, -1, 3, -1, 1, -3, 1, -3, -1, -1, -1, -1, -3, 1, -3};
+    double xy[2 * 12 * 40], c = cos(th), s = sin(th);
+    for (int i = 0; i < 12; i++)
+        for (int k = 0; k < 40; k++) {
+            int j = (i + 1) % 12;
+            double t = k / 40.0, x = (v[2 * i] + t * (v[2 * j] - v[2 * i])) * s1,
+                   y = (v[2 * i + 1] + t * (v[2 * j + 1] - v[2 * i + 1])) * s2;
+            xy[2 * (40 * i + k)] = c * x - s * y + 5.0;
+            xy[2 * (40 * i + k) + 1] = s * x + c * y + 5.0;
+        }
+    amscr_contour *ct = NULL;
+    ck_assert_int_eq(amscr_contour_new(xy, 12 * 40, &ct), AMSCR_OK);
+    return ct;
+}
+
+/* A cross whose target lost part of one arm (12 seeded views): every quarter turn of the source
+ * fits the three whole arms alike, so the registration may answer one a quarter turn off (which
+ * turn wins is decided by rounding: the arms are exactly alike) and the search's ranking, a few
+ * refinement steps from each start, does not show it (ambiguity below 0.3). The source's own
+ * symmetries composed with the map, refined on the target, do: every view, right or wrong, is
+ * reported ambiguous. */
+START_TEST(symmetric_shape_with_a_bite)
+{
+    amscr_contour *cs = cross_contour(3.0, 0.0, 1.0, 1.0);
+    const double *sxy = amscr_contour_xy(cs);
+    size_t n = amscr_contour_size(cs), wrong = 0;
+    for (int i = 0; i < 12; i++) {
+        double th = 0.37 + 2.39996 * i, s1 = 0.75 + 0.05 * (i % 7), s2 = 1.3 - 0.06 * (i % 5), cut = 1.4 + 0.07 * i;
+        amscr_contour *ct = cross_contour(cut, th, s1, s2);
+        amscr_result *r = NULL;
+        ck_assert_int_eq(amscr_register_contours(NULL, cs, ct, &r), AMSCR_OK);
+        double M[6], c = cos(th), s = sin(th);
+        double T[6] = {c * s1, -s * s2, 5.0, s * s1, c * s2, 5.0};
+        T[2] -= 5.0 * (T[0] + T[1]); /* the source is the cross shifted by (5, 5) too */
+        T[5] -= 5.0 * (T[3] + T[4]);
+        ck_assert_int_eq(amscr_result_affine(r, M), AMSCR_OK);
+        double err = amscr_test_max_map_error(M, T, sxy, n) / 3.0; /* of the arm's reach */
+        double conf = amscr_result_confidence(r), sa = amscr_result_symmetry_ambiguity(r);
+        double ov = amscr_result_overlap(r), inl = amscr_result_inlier_fraction(r);
+        printf("robust: bitten cross %d: error %.3f, confidence %.3f, ambiguity %.3f, near a symmetry %.3f, "
+               "overlap %.3f, inliers %.3f\n",
+               i, err, conf, amscr_result_ambiguity(r), sa, ov, inl);
+        fflush(stdout);
+        ck_assert(ov > 0.7 && ov < 0.97);
+        ck_assert_msg(sa > 0.75 && conf < 0.25, "bitten cross %d: near a symmetry %.3f, confidence %.3f", i, sa, conf);
+        ck_assert_double_eq_tol(conf, (1.0 - fmax(sa, amscr_result_ambiguity(r))) * fmin(ov, inl), 1e-12);
+        wrong += err > 0.5;
+        amscr_result_free(r);
+        amscr_contour_free(ct);
+    }
+    ck_assert_msg(wrong >= 3, "%zu of 12 views a quarter turn off", wrong); /* the case it is for */
+    /* an exact affine copy: the overlap 1, nothing in doubt, nothing measured */
+    amscr_contour *ct = cross_contour(3.0, 0.3, 1.3, 0.8);
+    amscr_result *r = NULL;
+    ck_assert_int_eq(amscr_register_contours(NULL, cs, ct, &r), AMSCR_OK);
+    ck_assert_msg(amscr_result_overlap(r) > 0.995, "exact pair: overlap %.4f", amscr_result_overlap(r));
+    ck_assert(isnan(amscr_result_backward_error(r)) && isnan(amscr_result_symmetry_ambiguity(r)));
+    ck_assert(isnan(amscr_result_overlap(NULL)) && isnan(amscr_result_backward_error(NULL)) &&
+              isnan(amscr_result_symmetry_ambiguity(NULL)));
+    amscr_result_free(r);
+    amscr_contour_free(ct);
+    amscr_contour_free(cs);
+}
+END_TEST
+
+/* An asymmetric shape, its exact affine copy with a fifth of the boundary cut away (the
+ * contour closes across the gap): the map is right, the way back runs (less than 85 % agrees)
+ * and composes with it to the identity, no symmetry fits, and the confidence stays high. */
+START_TEST(forward_backward_exact_pair)
+{
+    enum { N = 400, DROP = 80 };
+    double src[2 * N], tgt[2 * N], T[6], size;
+    make_pair(7, N, src, tgt, T, &size);
+    amscr_result *r = NULL;
+    double err = reg_error(src, N, tgt + 2 * DROP, N - DROP, T, size, 0, &r);
+    double fb = amscr_result_backward_error(r), sa = amscr_result_symmetry_ambiguity(r);
+    double conf = amscr_result_confidence(r), inl = amscr_result_inlier_fraction(r), ov = amscr_result_overlap(r);
+    printf("robust: 20 %% cut: error %.4f %%, forward-backward %.3g, near a symmetry %.3f, inliers %.3f, overlap "
+           "%.3f, confidence %.3f\n",
+           100.0 * err, fb, sa, inl, ov, conf);
+    fflush(stdout);
+    ck_assert_msg(err < 0.01, "error %.3f %%", 100.0 * err);
+    ck_assert_msg(fmin(inl, ov) < 0.85 && fb < 1e-3, "forward-backward %.3g (inliers %.3f, overlap %.3f)", fb, inl,
+                  ov);
+    ck_assert_msg(sa < 0.5, "near a symmetry %.3f", sa);
+    ck_assert_msg(conf > 0.5, "confidence %.3f", conf);
+    double e = fb / 0.01;
+    ck_assert_double_eq_tol(conf, (1.0 - fmax(sa, amscr_result_ambiguity(r))) * fmin(ov, inl) / (1.0 + e * e), 1e-12);
+    amscr_result_free(r);
+}
+END_TEST
+
 /* Bad input: partial needs an open source and a closed target; the flag is 0 or 1. */
 START_TEST(partial_errors)
 {
@@ -339,6 +437,8 @@ Suite *amscr_suite_robust(void)
     tcase_add_test(tc, missing_run_inliers_and_correspondences);
     tcase_add_test(tc, partial_errors);
     tcase_add_test(tc, touching_object_inliers);
+    tcase_add_test(tc, symmetric_shape_with_a_bite);
+    tcase_add_test(tc, forward_backward_exact_pair);
     tcase_add_test(tc, kimia_fragments);
     tcase_add_test(tc, kimia_missing_10);
     tcase_add_test(tc, kimia_missing_20);

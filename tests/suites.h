@@ -30,6 +30,7 @@ Suite *amscr_suite_ordered(void);
 Suite *amscr_suite_despike(void);
 Suite *amscr_suite_even(void);
 Suite *amscr_suite_index(void);
+Suite *amscr_suite_shards(void);
 Suite *amscr_suite_signature(void);
 Suite *amscr_suite_protocols(void);
 Suite *amscr_suite_subpixel(void);

@@ -19,7 +19,8 @@
  *   ordered.c           the polish's order stage: a noisy curve's point order (ordered.h)
  *   even.c              the polish's even-spacing stage: points taken evenly along it (even.h)
  *   alternatives.c      the distinct maps that fit about as well as the chosen one
- *   correspond.c        confidence, inliers, the part covered, dense correspondences
+ *   correspond.c        inliers, the part covered, dense correspondences
+ *   check.c             the overlap, the symmetry test, the forward-backward check, the confidence
  *   result.c            the result object and its getters
  * and workspace.c, the caller-owned scratch of all of the above. */
 #ifndef AMSCR_MATCH_H
@@ -129,6 +130,10 @@ struct amscr_result {
     double *corr;  /* 5n: source xy (input), target parameter, target xy (input) */
     double inlier; /* inlier fraction */
     double part[2];
+    double overlap; /* IoU of the two contours as regions under the map (check.c); NaN: not closed */
+    double fb;      /* forward-backward error (check.c); NaN when the way back did not run */
+    double amb_conv; /* the ambiguity near a symmetry of the source (check.c); NaN: not run */
+    int backward;   /* this result is a forward-backward check's way back: no check of its own */
     unsigned char ran[AMSCR__NUM_STAGES]; /* which stages ran (stages.c) */
     /* the distinct maps that fit about as well (alternatives.c), input coordinates; 0 the chosen */
     double alt[AMSCR__MAX_ALTERNATIVES][6];
@@ -265,6 +270,10 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
  * closed target; ws->rbuf keeps the pairs. */
 amscr_status amscr__refine_adaptive(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                     amscr_workspace *ws, match_t *m);
+/* recover.c: each of the count maps X refined to convergence (the adaptive refinement, in place)
+ * and scored by the recovery's two-way trimmed cost into cost. */
+amscr_status amscr__rank_converged(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                   double X[][6], size_t count, double *cost);
 /* Mean squared displacement between the maps X1 and X2 over the samples of f's base level. */
 double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6]);
 /* A candidate map differing from the chosen one by more than this RMS displacement (10 % of
@@ -324,5 +333,28 @@ void amscr__alternatives(const amscr_descriptor *f, const amscr_descriptor *h, a
 /* correspond.c: the dense correspondences, inlier fraction and part of a finished result r of
  * f -> h (fills r->corr, r->ncorr, r->inlier, r->part). */
 amscr_status amscr__correspond(const amscr_descriptor *f, const amscr_descriptor *h, amscr_result *r);
+
+/* check.c (docs/method.md §11.5). A confidence at or above this is a confident answer: the
+ * limit the documentation tells callers to reject below (1 - AMSCR__ALT_RATIO). */
+#define AMSCR__CONFIDENT 0.25
+/* The way back runs for a confident map when less than this share of the shape (the smaller
+ * of the inlier fraction and the overlap) agrees: a clean match never pays for it. */
+#define AMSCR__CHECK_SHARE 0.85
+/* The source's symmetries are tried as alternatives (check.c) for a confident map when less than
+ * this share of the shape agrees: a bite of 0.3 x the radius leaves about 0.9 of it. */
+#define AMSCR__SYM_SHARE 0.95
+/* The forward-backward error that halves the confidence, in units of the RMS radius: half the
+ * 2 % accuracy the benchmarks call a success (the two maps then disagree by that accuracy's
+ * half each way). */
+#define AMSCR__FB_SCALE 0.01
+/* The intersection over union of the closed polygons P (n vertices) and Q (m), even-odd rule. */
+amscr_status amscr__overlap(const double *P, size_t n, const double *Q, size_t m, double *out);
+/* The overlap and, when it leaves doubt, the forward-backward error of a finished result r of
+ * f -> h (fills r->overlap, r->fb; a way back's own result, r->backward, only its overlap). */
+amscr_status amscr__check(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                          amscr_workspace *ws, amscr_result *r);
+/* (1 - max(ambiguity, the ambiguity near a symmetry)) x min(inlier fraction, overlap)
+ * / (1 + (fb / AMSCR__FB_SCALE)^2). */
+double amscr__confidence(const amscr_result *r);
 
 #endif

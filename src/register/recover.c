@@ -338,3 +338,20 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
     scratch_free(&s);
     return st;
 }
+
+amscr_status amscr__rank_converged(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                   double X[][6], size_t count, double *cost)
+{
+    if (f->n != h->n || !h->params.closed)
+        return AMSCR_OK;
+    scratch_t s = {0};
+    amscr_status st = scratch_new(f, h, &s);
+    if (st != AMSCR_OK)
+        return st;
+    for (size_t k = 0; k < count; k++) {
+        refine_adaptive(prm, f, &s, X[k]);
+        cost[k] = two_way_cost(f, h, &s, X[k]);
+    }
+    scratch_free(&s);
+    return AMSCR_OK;
+}

@@ -84,6 +84,25 @@ amscr_status amscr__db_reserve(amscr_db *db, size_t extra)
     return AMSCR_OK;
 }
 
+amscr_status amscr__db_new_slots(const amscr_params *p, size_t n, amscr_db **out)
+{
+    amscr_db *db = NULL;
+    amscr_status st = amscr_db_new(p, &db);
+    if (st == AMSCR_OK && n > 0)
+        st = amscr__db_reserve(db, n);
+    if (st != AMSCR_OK) {
+        amscr_db_free(db);
+        return st;
+    }
+    for (size_t i = 0; i < n; i++) {
+        db->d[i] = NULL;
+        db->labels[i] = -1;
+    }
+    db->n = n;
+    *out = db;
+    return AMSCR_OK;
+}
+
 amscr_status amscr__db_push(amscr_db *db, amscr_descriptor *d, int32_t label, size_t *out_index)
 {
     amscr_status st = amscr__db_reserve(db, 1);

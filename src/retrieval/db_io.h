@@ -84,6 +84,9 @@ amscr_status amscr__db_push(amscr_db *db, amscr_descriptor *d, int32_t label, si
 amscr_status amscr__db_prepare(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out);
 /* Room for `extra` more shapes, so that as many pushes cannot fail. */
 amscr_status amscr__db_reserve(amscr_db *db, size_t extra);
+/* A collection of n empty slots (no shapes, labels -1) with params p: the size of a graph that
+ * holds lists without shapes (index_shard.c); never handed to a caller. */
+amscr_status amscr__db_new_slots(const amscr_params *p, size_t n, amscr_db **out);
 /* The slot of what one-vs-many retrieval keeps between queries of db (retrieval_query.c), locked;
  * amscr_db_free releases what it holds with free_fn. Unlock with amscr__db_kept_unlock. */
 void **amscr__db_kept_lock(const amscr_db *db, void (*free_fn)(void *));

@@ -28,7 +28,7 @@ typedef struct reg_report {
     int refl;
     const char *mname;
     /* confidence, the part of the target covered, dense correspondences */
-    double conf, amb, inl, part[2];
+    double conf, amb, inl, overlap, fb, symamb, part[2];
     size_t ncorr;
     double *corr_param, *corr_xy; /* ncorr and 2 ncorr */
     /* the pipeline's stages and whether each ran; the maps that fit about as well (0.5) */
@@ -174,6 +174,9 @@ static int read_report(const amscr_result *res, const amscr_params *p, reg_repor
     r->conf = amscr_result_confidence(res);
     r->amb = amscr_result_ambiguity(res);
     r->inl = amscr_result_inlier_fraction(res);
+    r->overlap = amscr_result_overlap(res);
+    r->fb = amscr_result_backward_error(res);
+    r->symamb = amscr_result_symmetry_ambiguity(res);
     if (amscr_result_part(res, &r->part[0], &r->part[1]) != AMSCR_OK ||
         amscr_result_correspondences(res, NULL, NULL, NULL, &r->ncorr) != AMSCR_OK)
     {
@@ -238,6 +241,12 @@ static void json_confidence(sbuf *b, const opts *o, const reg_report *r)
     sb_json_num(b, r->amb);
     sb_puts(b, ", \"inlier_fraction\": ");
     sb_json_num(b, r->inl);
+    sb_puts(b, ", \"overlap\": ");
+    sb_json_num(b, r->overlap);
+    sb_puts(b, ", \"backward_error\": ");
+    sb_json_num(b, r->fb);
+    sb_puts(b, ", \"symmetry_ambiguity\": ");
+    sb_json_num(b, r->symamb);
     sb_printf(b, ", \"partial\": %s, \"part\": ", o->partial ? "true" : "false");
     sb_json_nums(b, r->part, NULL, 2);
     sb_puts(b, ", \"correspondences\": {\"param\": ");

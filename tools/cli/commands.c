@@ -70,8 +70,11 @@ static const char HELP_REGISTER[] =
     "  --component N           use contour N of 'amscr contour --all' of each image\n"
     "                          (default: the largest outer contour); --min-area A as there\n"
     "\n"
-    "Every result prints its confidence in [0, 1] ((1 - ambiguity) x inlier fraction;\n"
-    "reject maps below about 0.25) and, with --json, the matched target boundary\n"
+    "Every result prints its confidence in [0, 1] ((1 - ambiguity) x the smaller of the\n"
+    "inlier fraction and the overlap, lowered when a symmetric turn of the source fits as\n"
+    "well or the target registered back onto the source does not undo the map; reject\n"
+    "maps below 0.25) and, with --json, the overlap, the forward-backward error, the\n"
+    "symmetry ambiguity and the matched target boundary\n"
     "parameter and point of every source sample (\"correspondences\").\n";
 
 static const char HELP_SEARCH[] =

@@ -266,6 +266,9 @@ amscr_status amscr_result_sse(const amscr_result *r, double *out, size_t *inout_
 amscr_status amscr_result_mixture(const amscr_result *r, double *out_weights, double *out_means, double *out_variances, size_t *inout_n);
 double amscr_result_threshold(const amscr_result *r);
 double amscr_result_confidence(const amscr_result *r);
+double amscr_result_overlap(const amscr_result *r);
+double amscr_result_backward_error(const amscr_result *r);
+double amscr_result_symmetry_ambiguity(const amscr_result *r);
 double amscr_result_ambiguity(const amscr_result *r);
 double amscr_result_inlier_fraction(const amscr_result *r);
 amscr_status amscr_result_part(const amscr_result *r, double *out_start, double *out_end);
@@ -331,4 +334,11 @@ amscr_status amscr_score_per_class(const double *dist, size_t n, const int32_t *
 amscr_status amscr_score_nn_random_split(const double *dist, size_t n, const int32_t *labels, size_t train, size_t splits, uint64_t seed, size_t nclasses, double *out_mean, double *out_std, double *out_accuracies, double *out_class_accuracy);
 amscr_status amscr_score_nn_groups(const double *dist, size_t n, const int32_t *labels, const int32_t *groups, size_t ngroups, size_t nclasses, double *out_accuracy, double *out_group_accuracy, double *out_class_accuracy);
 amscr_status amscr_score_precision_recall(const double *dist, size_t n, const int32_t *labels, size_t nlevels, double *out_precision);
+typedef struct amscr_index_graph amscr_index_graph;
+amscr_status amscr_index_pair_distances(const amscr_index *x, const amscr_descriptor *q, size_t qpos, size_t first, double *out_base, double *out_inner, size_t n);
+void amscr_index_graph_widths(const amscr_params *p, size_t n, size_t *out_k, size_t *out_k2);
+amscr_status amscr_index_graph_new(const amscr_params *p, size_t n, const uint32_t *nb_idx, const double *nb_dist, const uint32_t *in_idx, const double *in_dist, double dmax, double dmax2, amscr_index_graph **out);
+amscr_status amscr_index_graph_scores(const amscr_index_graph *g, const size_t *cand, const double *dq, const double *dq2, size_t m, double *out_scores, size_t n);
+size_t amscr_index_graph_size(const amscr_index_graph *g);
+void amscr_index_graph_free(amscr_index_graph *g);
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);

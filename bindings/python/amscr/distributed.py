@@ -70,7 +70,8 @@ from .collection import Collection
 from .errors import AmscrError, FormatError, _check
 from .shape import Shape
 
-__all__ = ['distance_matrix', 'cross_matrix', 'topk', 'tile_size', 'LostTilesError']
+__all__ = ['distance_matrix', 'cross_matrix', 'topk', 'tile_size', 'LostTilesError', 'build_index', 'load_index',
+           'ShardedIndex', 'ShardSetError']
 
 TILE_MIN, TILE_MAX = 64, 2048
 TILES_PER_THREAD = 8  # enough tiles that the last round leaves few threads idle
@@ -652,3 +653,6 @@ def topk(queries: Union[Collection, Iterable[Any], bytes], collection: Union[Col
         jobs = {i: (lambda attempt, i=i: submit_row(i, attempt)) for i in range(len(row_b))}
         _drain(c, jobs, progress, put, [tpay, qpays])
     return indices, distances
+
+
+from ._shards import ShardedIndex, ShardSetError, build_index, load_index  # noqa: E402  (an index in shards)

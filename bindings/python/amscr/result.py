@@ -66,11 +66,21 @@ class Registration:
         shift: start shift (source sample a <-> target sample (a + shift) mod N).
         reflected: True when the match used the mirrored target.
         method: the method used.
-        confidence: how sure the map is, in [0, 1] ((1 - ambiguity) x inlier_fraction; see the
-            docs/measurements.md, "Confidence", for what a low value means).
+        confidence: how sure the map is, in [0, 1]: (1 - max(ambiguity, symmetry_ambiguity))
+            x min(inlier_fraction, overlap) / (1 + (backward_error / 0.01)^2) (a value not
+            measured, NaN, counts as no evidence against the map); reject maps below 0.25.
         ambiguity: cost of the chosen map over that of the best clearly different candidate
             (1: a symmetric shape or a fragment that fits several places).
         inlier_fraction: share of source samples within 5 % of the target's size of its boundary.
+        overlap: intersection over union of the two contours as regions under the map (NaN for
+            a partial match).
+        backward_error: when the map is confident but less than 85 % of the shape agrees, the
+            target registered onto the source on its own and composed with the map: the RMS
+            displacement of the source samples, in units of its RMS radius (about 0 when the
+            two maps agree); NaN when the check did not run.
+        symmetry_ambiguity: when the map is confident but less than 95 % of the shape agrees,
+            the ambiguity against the source's own symmetries composed with the map (1: a
+            symmetric turn fits the damaged target as well); NaN when not measured.
         part: (start, end) fractions of the target's boundary the source's first and last samples
             fall on (where a fragment lies, with partial=True).
         stages: dict {stage name: whether it ran}, in pipeline order (despike, search, method,
@@ -115,6 +125,9 @@ class Registration:
         self.confidence = float(lib.amscr_result_confidence(r))
         self.ambiguity = float(lib.amscr_result_ambiguity(r))
         self.inlier_fraction = float(lib.amscr_result_inlier_fraction(r))
+        self.overlap = float(lib.amscr_result_overlap(r))
+        self.backward_error = float(lib.amscr_result_backward_error(r))
+        self.symmetry_ambiguity = float(lib.amscr_result_symmetry_ambiguity(r))
         part = ffi.new('double[2]')
         _check(lib.amscr_result_part(r, part, part + 1))
         self.part = (float(part[0]), float(part[1]))

@@ -375,3 +375,32 @@ def test_loaded_collection_keeps_int_labels(collection, tmp_path):
         db.add(blob(200), label='name')
     db.add(blob(200), label=7)
     assert db.labels[-1] == 7
+
+
+def _cross(cut=3.0):
+    """A 4-armed cross (arms 1 wide reaching 3 from the centre, the first cut to `cut`)."""
+    v = np.array([(1, -1), (cut, -1), (cut, 1), (1, 1), (1, 3), (-1, 3), (-1, 1), (-3, 1), (-3, -1), (-1, -1),
+                  (-1, -3), (1, -3)], float)
+    t = (np.arange(40) / 40)[:, None]
+    return np.vstack([a + (b - a) * t for a, b in zip(v, np.roll(v, -1, axis=0))])
+
+
+def test_confidence_evidence_on_an_exact_pair_and_a_bitten_cross(pair):
+    """An exact affine copy: overlap ~1, nothing in doubt (no way back, no symmetry tried), a
+    high confidence. A cross with an arm cut: every quarter turn fits the three whole arms, so
+    the map, right or wrong, is reported ambiguous near the source's symmetry (confidence < 0.25).
+    The exact copy cut by a fifth: the way back runs and composes with the map to the identity."""
+    src, tgt = pair
+    r = amscr.register(src, tgt)
+    assert r.overlap > 0.99 and np.isnan(r.backward_error) and np.isnan(r.symmetry_ambiguity)
+    assert r.confidence > 0.9
+    A = np.array([[0.9, -0.5], [0.4, 1.2]])
+    r = amscr.register(_cross(), _cross(1.6) @ A.T + 5)
+    assert r.symmetry_ambiguity > 0.75 and r.confidence < 0.25
+    share = min(r.inlier_fraction, r.overlap)
+    assert r.confidence == pytest.approx((1 - max(r.ambiguity, r.symmetry_ambiguity)) * share, abs=1e-12)
+    cut = len(tgt) // 5
+    r = amscr.register(src, tgt[cut:])
+    np.testing.assert_allclose(r.A, A_TRUE, atol=0.01)
+    assert min(r.inlier_fraction, r.overlap) < 0.85 and r.backward_error < 1e-3
+    assert r.confidence > 0.5

@@ -1,0 +1,581 @@
+"""An index split in shards over a Dask cluster (``amscr.distributed.build_index``).
+
+The collection is cut into contiguous blocks; block s is an ordinary index (:class:`amscr.Index`,
+a *shard*) built and held by one worker. The whole collection's neighbour lists are global: every
+pair of blocks (s <= t) is matched once on the worker holding shard t (C
+``amscr_index_pair_distances``, each pair computed as its cell of the whole collection's matrix),
+each block keeps its rows' and columns' best candidates, and the client merges them into the
+lists the single index would hold (``amscr_index_build`` with candidates 0). The lists, without
+any shape, make the *graph* (C ``amscr_index_graph``). A query is matched with every shard's
+shapes on its worker (fan-out); the client gathers its distances and diffuses them on the graph
+(merge, ``amscr_index_graph_scores``): the scores are those of ``amscr.Index(collection,
+candidates=0).scores(query, candidates=0)``.
+
+A saved set is a directory: ``manifest.json`` (written last, by an atomic rename: the commit
+point), one ``shard-SSS-CHECKSUM.amscr-index`` per shard (an ordinary index file that ``amscr
+search`` and :meth:`amscr.Index.load` read alone; its own lists come from a short shortlist build
+and serve only such a use) and ``graph-CHECKSUM.npz`` (the global lists). Each file is named by
+its SHA-256; the manifest holds the checksums, each shard's first shape and count, and the
+options (:class:`amscr.Params`).
+"""
+from __future__ import annotations
+
+import errno
+import hashlib
+import io
+import json
+import os
+import tempfile
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from ._lib import ffi, lib
+from ._util import dbuf
+from .collection import Collection
+from .errors import AmscrError, FileError, FormatError, InvalidArgumentError, _check
+from .index import Index
+from .params import Params, _params_from_dict
+from .shape import Shape
+
+FORMAT = 'amscr-sharded-index'
+VERSION = 1
+MANIFEST = 'manifest.json'
+SHARD_LIST = 16  # the shortlist of a shard's own (local) lists: they serve only the shard opened alone
+QPOS_AFTER = 2 ** 64 - 1  # SIZE_MAX: the query after every shape
+
+PathLike = Union[str, 'os.PathLike[str]']
+
+
+def _register_sizeof() -> None:
+    """Tells Dask what a shard weighs (its shapes and features), so that its scheduler never
+    steals a shard's task to another worker, which would copy and rebuild the shard there."""
+    try:
+        from dask.sizeof import sizeof
+    except ImportError:  # pragma: no cover - amscr.distributed needs Dask anyway
+        return
+
+    @sizeof.register(Index)
+    def _index_size(x: Index) -> int:
+        return 64 * 1024 + len(x) * 40 * 1024
+
+
+_register_sizeof()
+
+
+class ShardSetError(AmscrError, ValueError):
+    """A saved shard set that cannot be used: a shard file missing, foreign (another set's, or
+    altered) or built with other options than the manifest's. The message names the file."""
+
+
+# ========================================================================== the graph (client)
+class _Graph:
+    """The whole collection's lists without its shapes (C ``amscr_index_graph``)."""
+
+    def __init__(self, params: Params, n: int, nb_idx, nb_dist, in_idx, in_dist, dmax: float, dmax2: float):
+        k, k2 = widths(params, n)
+        self.arrays = {'nb_idx': np.ascontiguousarray(nb_idx, dtype=np.uint32).reshape(n, k),
+                       'nb_dist': np.ascontiguousarray(nb_dist, dtype=np.float64).reshape(n, k),
+                       'in_idx': np.ascontiguousarray(in_idx, dtype=np.uint32).reshape(n, k2),
+                       'in_dist': np.ascontiguousarray(in_dist, dtype=np.float64).reshape(n, k2),
+                       'dmax': np.float64(dmax), 'dmax2': np.float64(dmax2)}
+        a = self.arrays
+        out = ffi.new('amscr_index_graph **')
+        nul = ffi.NULL
+        _check(lib.amscr_index_graph_new(params._p, n, ffi.from_buffer('uint32_t[]', a['nb_idx']) if k else nul,
+                                         dbuf(a['nb_dist'].ravel()) if k else nul,
+                                         ffi.from_buffer('uint32_t[]', a['in_idx']) if k2 else nul,
+                                         dbuf(a['in_dist'].ravel()) if k2 else nul, float(dmax), float(dmax2), out))
+        self._g = ffi.gc(out[0], lib.amscr_index_graph_free)
+        self.n, self.k2 = n, k2
+
+    def scores(self, dq: np.ndarray, dq2: np.ndarray) -> np.ndarray:
+        n = self.n
+        cand = np.arange(n, dtype=np.uintp)
+        out = np.zeros(n, dtype=np.float64)
+        dq = np.ascontiguousarray(dq, dtype=np.float64)
+        dq2 = np.ascontiguousarray(dq2, dtype=np.float64)
+        _check(lib.amscr_index_graph_scores(self._g, ffi.from_buffer('size_t[]', cand), dbuf(dq),
+                                            dbuf(dq2) if self.k2 else ffi.NULL, n, dbuf(out), n))
+        return out
+
+    def to_bytes(self) -> bytes:
+        buf = io.BytesIO()
+        np.savez(buf, **self.arrays)
+        return buf.getvalue()
+
+    @classmethod
+    def from_bytes(cls, params: Params, n: int, data: bytes) -> '_Graph':
+        with np.load(io.BytesIO(data), allow_pickle=False) as z:
+            return cls(params, n, z['nb_idx'], z['nb_dist'], z['in_idx'], z['in_dist'], float(z['dmax']),
+                       float(z['dmax2']))
+
+
+def widths(params: Params, n: int) -> Tuple[int, int]:
+    """(k, k2): the base and inner lists' entries a shape for n shapes (C ``amscr_index_graph_widths``)."""
+    k, k2 = ffi.new('size_t *'), ffi.new('size_t *')
+    lib.amscr_index_graph_widths(params._p, n, k, k2)
+    return int(k[0]), int(k2[0])
+
+
+# ========================================================================== worker side
+def _threads(threads) -> int:
+    from .distributed import _tile_threads
+    return _tile_threads(threads)
+
+
+def _shard_index(data: bytes, threads) -> Index:
+    """Shard from its collection's bytes: an ordinary index (local lists from a short shortlist)."""
+    coll = Collection.from_bytes(data)
+    t = _threads(threads)
+    if coll.params.threads != t:
+        from .distributed import _block
+        coll = _block(coll, 0, len(coll), t)
+    return Index(coll, progress=False, candidates=SHARD_LIST if len(coll) > SHARD_LIST + 1 else 0)
+
+
+def _shard_from_file_bytes(data: bytes) -> Index:
+    return Index.from_bytes(data)  # computes on the threads the shard was built with
+
+
+def _index_bytes(index: Index) -> bytes:
+    return index.to_bytes()
+
+
+def _distances(index: Index, qdb, count: int, where: str) -> Tuple[np.ndarray, np.ndarray]:
+    """Base and inner distances (count x len(index)) of shapes 0..count-1 of C db qdb, which come
+    (`where`) 'after' every shape of the index (queries), 'before' them (an earlier block), or are
+    the index's own shapes ('diagonal': each pair computed once and mirrored)."""
+    diagonal = where == 'diagonal'
+    qpos = {'after': QPOS_AFTER, 'before': 0, 'diagonal': None}[where]
+    m = len(index)
+    D = np.zeros((count, m), dtype=np.float64)
+    D2 = np.zeros((count, m), dtype=np.float64)
+    with index._lock.read():
+        for i in range(count):
+            first = i + 1 if diagonal else 0
+            _check(lib.amscr_index_pair_distances(index._x, lib.amscr_db_descriptor(qdb, i),
+                                                  i if diagonal else qpos, first,
+                                                  dbuf(D[i, first:]), dbuf(D2[i, first:]), m - first))
+    if diagonal:
+        D += D.T
+        D2 += D2.T
+    return D, D2
+
+
+def _best(D: np.ndarray, cols0: int, k: int, self0: Optional[int]) -> Tuple[np.ndarray, np.ndarray]:
+    """Each row's k best (distance, column) among D's columns (numbered from cols0), a row's own
+    column (self0 + row) left out."""
+    m, c = D.shape
+    cols = np.broadcast_to(np.arange(cols0, cols0 + c, dtype=np.int64), (m, c))
+    key = D.copy()
+    if self0 is not None:
+        r = np.arange(m)
+        key[r, self0 + r - cols0] = np.inf
+    order = np.lexsort((cols, key), axis=-1)[:, :k]
+    idx = np.take_along_axis(cols, order, 1)
+    dist = np.take_along_axis(key, order, 1)
+    return idx, dist
+
+
+def _pair_block(rows_data: bytes, index: Index, r0: int, c0: int, k: int, k2: int) -> Dict[str, Any]:
+    """Block (rows of shard s, columns of shard t), s <= t, on shard t's worker: each row's and
+    (s < t) each column's best candidates under both distances, and the block's largest ones."""
+    same = r0 == c0
+    rows = index if same else Collection.from_bytes(rows_data)
+    qdb = lib.amscr_index_db(index._x) if same else rows._db
+    count = len(index) if same else len(rows)
+    D, D2 = _distances(index, qdb, count, 'diagonal' if same else 'before')
+    out: Dict[str, Any] = {'dmax': float(D.max(initial=0.0)), 'dmax2': float(D2.max(initial=0.0))}
+    out['rows'] = (_best(D, c0, k, r0 if same else None), _best(D2, c0, k2, r0 if same else None))
+    if not same:
+        out['cols'] = (_best(D.T, r0, k, None), _best(D2.T, r0, k2, None))
+    return out
+
+
+def _query_block(index: Index, qdata: bytes) -> Tuple[np.ndarray, np.ndarray]:
+    """The queries' base and inner distances to every shape of a shard (queries after every shape)."""
+    q = Collection.from_bytes(qdata)
+    return _distances(index, q._db, len(q), 'after')
+
+
+# ========================================================================== client side
+def _merge_lists(parts: List[Tuple[np.ndarray, np.ndarray]], r0: int, n: int, k: int) -> Tuple[np.ndarray, np.ndarray]:
+    """Lists of rows r0..r0+n-1 from their candidates: itself first, then k - 1 by (distance, index)."""
+    idx = np.zeros((n, k), dtype=np.uint32)
+    dist = np.zeros((n, k), dtype=np.float64)
+    if k == 0:
+        return idx, dist
+    ci = np.concatenate([p[0] for p in parts], axis=1)
+    cd = np.concatenate([p[1] for p in parts], axis=1)
+    order = np.lexsort((ci, cd), axis=-1)[:, :k - 1]
+    idx[:, 0] = np.arange(r0, r0 + n)
+    idx[:, 1:] = np.take_along_axis(ci, order, 1)
+    dist[:, 1:] = np.take_along_axis(cd, order, 1)
+    return idx, dist
+
+
+def _bounds(n: int, shards: int) -> List[Tuple[int, int]]:
+    b = [n * s // shards for s in range(shards + 1)]
+    return [(b[s], b[s + 1]) for s in range(shards)]
+
+
+def _check_params(params: Params) -> None:
+    w = params.channel_weight
+    if 0.0 < w < 1.0:
+        raise InvalidArgumentError('amscr.distributed.build_index: a channel weight strictly between 0 and 1 '
+                                   '(%g) fuses by medians of the whole collection, which shards do not share; '
+                                   'use 0 or 1' % w)
+
+
+class ShardedIndex:
+    """An index split in shards held by the workers of a Dask cluster (see
+    :func:`amscr.distributed.build_index`). Its scores equal the single index's
+    (``amscr.Index(collection, candidates=0)`` queried with ``candidates=0``), to rounding.
+
+    Attributes:
+        bounds: each shard's (first, end) shapes in the whole collection.
+        params: the options (:class:`amscr.Params`).
+    """
+
+    def __init__(self, client, shards: List[Any], bounds: List[Tuple[int, int]], graph: _Graph, params: Params,
+                 workers: List[str]):
+        self.client = client
+        self._shards = shards  # futures of Index, one a shard
+        self.bounds = bounds
+        self._graph = graph
+        self.params = params
+        self._workers = workers
+
+    def __len__(self) -> int:
+        return self.bounds[-1][1] if self.bounds else 0
+
+    def __repr__(self) -> str:
+        return 'ShardedIndex(%d shapes, %d shards)' % (len(self), len(self.bounds))
+
+    def _queries(self, queries: Sequence[Any]) -> Collection:
+        q = Collection(self.params)
+        for x in queries:
+            if isinstance(x, Shape):
+                q.add(x)
+            else:
+                q.add(np.asarray(x, dtype=np.float64))
+        return q
+
+    def _gather(self, futs: List[Any]) -> List[Any]:
+        """The results of one task a shard; a shard lost with its worker is a clear error."""
+        lost = [s for s, sh in enumerate(self._shards) if sh.status in ('lost', 'cancelled', 'error')]
+        try:
+            return self.client.gather(futs)
+        except AmscrError:
+            raise
+        except Exception as e:  # noqa: BLE001 - Dask's errors for lost data vary by version
+            lost = lost or [s for s, sh in enumerate(self._shards) if sh.status != 'finished']
+            if not lost:
+                raise
+            raise ShardSetError('amscr.distributed: shard%s %s lost with %s worker (%s: %s); load the saved set '
+                                'again (load_index) or build it again'
+                                % ('s' if len(lost) > 1 else '', ', '.join(map(str, lost)),
+                                   'their' if len(lost) > 1 else 'its', type(e).__name__, e), lib.AMSCR_E_STATE) from e
+
+    def scores_many(self, queries: Sequence[Any]) -> np.ndarray:
+        """The retrieval scores (len(queries), len(self)) of point arrays or :class:`amscr.Shape` s:
+        each query matched with every shard's shapes on its worker, the rows merged on the client.
+
+        Raises:
+            InvalidArgumentError: bad points.
+        """
+        q = self._queries(queries)
+        nq, n = len(q), len(self)
+        out = np.zeros((nq, n), dtype=np.float64)
+        if nq == 0 or n == 0:
+            return out
+        qf = self.client.scatter(q.to_bytes(), broadcast=True, hash=False)
+        futs = [self.client.submit(_query_block, sh, qf, pure=False, workers=[self._workers[s]])
+                for s, sh in enumerate(self._shards)]
+        parts = self._gather(futs)
+        dq = np.concatenate([p[0] for p in parts], axis=1)
+        dq2 = np.concatenate([p[1] for p in parts], axis=1)
+        for i in range(nq):
+            out[i] = self._graph.scores(dq[i], dq2[i])
+        return out
+
+    def scores(self, points: Any) -> np.ndarray:
+        """One query's scores against every shape (lower is better)."""
+        return self.scores_many([points])[0]
+
+    def query(self, points: Any, top: int = 10) -> Tuple[np.ndarray, np.ndarray]:
+        """The `top` best shapes, best first (ties by index), as :meth:`amscr.Index.query`."""
+        idx, sc = self.query_many([points], top)
+        return idx[0], sc[0]
+
+    def query_many(self, queries: Sequence[Any], top: int = 10) -> Tuple[np.ndarray, np.ndarray]:
+        """(indices, scores), each (len(queries), min(top, len(self))), best first, ties by index."""
+        top = int(top)
+        if top < 0:
+            raise InvalidArgumentError('top: %d is negative' % top)
+        S = self.scores_many(queries)
+        k = min(top, S.shape[1])
+        order = np.argsort(S, axis=1, kind='stable')[:, :k]
+        return order.astype(np.int64), np.take_along_axis(S, order, 1)
+
+    # -- persistence ------------------------------------------------------------------
+    def save(self, path: PathLike) -> None:
+        """Writes the set into directory `path` (created if needed): the shard files and the
+        graph first, each under a temporary name renamed into place, then the manifest by an
+        atomic rename, then the files of the set it replaces are removed. A write cut off (the
+        process killed, the disk full) leaves the previous set whole. Files follow the umask.
+
+        Raises:
+            FileError: a file cannot be written (the previous set, if any, is kept).
+        """
+        d = os.fspath(path)
+        os.makedirs(d, exist_ok=True)
+        datas = self._gather([self.client.submit(_index_bytes, sh, pure=False, workers=[self._workers[s]])
+                              for s, sh in enumerate(self._shards)])
+        entries = []
+        keep = {MANIFEST}
+        for s, data in enumerate(datas):
+            sha = hashlib.sha256(data).hexdigest()
+            name = 'shard-%03d-%s.amscr-index' % (s, sha[:16])
+            _write_atomic(d, name, data)
+            keep.add(name)
+            entries.append({'file': name, 'sha256': sha, 'first': self.bounds[s][0], 'count':
+                            self.bounds[s][1] - self.bounds[s][0]})
+        gdata = self._graph.to_bytes()
+        gsha = hashlib.sha256(gdata).hexdigest()
+        gname = 'graph-%s.npz' % gsha[:16]
+        _write_atomic(d, gname, gdata)
+        keep.add(gname)
+        manifest = {'format': FORMAT, 'version': VERSION, 'shapes': len(self), 'params': self.params._plain_dict(),
+                    'shards': entries, 'graph': {'file': gname, 'sha256': gsha}}
+        _write_atomic(d, MANIFEST, (json.dumps(manifest, indent=1, sort_keys=True) + '\n').encode())
+        for f in os.listdir(d):  # the replaced set's files and leftovers of cut-off writes
+            if f not in keep and (_ours(f)):
+                try:
+                    os.unlink(os.path.join(d, f))
+                except OSError:
+                    pass
+
+
+def _ours(f: str) -> bool:
+    return ((f.startswith('shard-') and f.endswith('.amscr-index')) or (f.startswith('graph-') and f.endswith('.npz'))
+            or (f.startswith('.amscr-tmp-')))
+
+
+def _umask() -> int:
+    """The process's umask, read without changing it where Linux tells it (os.umask changes it
+    for every thread while it is read)."""
+    try:
+        with open('/proc/self/status') as f:
+            for line in f:
+                if line.startswith('Umask:'):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _write_atomic(d: str, name: str, data: bytes) -> None:
+    """Writes d/name by a temporary file in d, fsync and rename; mode 0666 less the umask."""
+    fd, tmp = tempfile.mkstemp(prefix='.amscr-tmp-', dir=d)
+    try:
+        try:
+            with os.fdopen(fd, 'wb') as f:
+                f.write(data)
+                f.flush()
+                os.fsync(f.fileno())
+            os.chmod(tmp, 0o666 & ~_umask())
+            os.replace(tmp, os.path.join(d, name))
+        except BaseException:
+            os.unlink(tmp)
+            raise
+    except OSError as e:
+        raise FileError('amscr.distributed: cannot write %s: %s' % (os.path.join(d, name), e.strerror or e),
+                        lib.AMSCR_E_IO) from e
+    try:
+        dfd = os.open(d, os.O_RDONLY)
+        try:
+            os.fsync(dfd)
+        finally:
+            os.close(dfd)
+    except OSError:  # pragma: no cover - a file system without directory fsync
+        pass
+
+
+def _read_manifest(d: str) -> Dict[str, Any]:
+    p = os.path.join(d, MANIFEST)
+    try:
+        with open(p, 'rb') as f:
+            m = json.loads(f.read().decode('utf-8'))
+    except FileNotFoundError:
+        raise FileError('amscr.distributed.load_index: no shard set in %s (%s is missing)' % (d, MANIFEST),
+                        lib.AMSCR_E_IO) from None
+    except (ValueError, UnicodeDecodeError) as e:
+        raise FormatError('amscr.distributed.load_index: %s is not a shard set manifest: %s' % (p, e),
+                          lib.AMSCR_E_FORMAT) from None
+    if not isinstance(m, dict) or m.get('format') != FORMAT:
+        raise FormatError('amscr.distributed.load_index: %s is not a shard set manifest' % p, lib.AMSCR_E_FORMAT)
+    if m.get('version') != VERSION:
+        raise FormatError('amscr.distributed.load_index: %s is of version %r; this amscr reads version %d'
+                          % (p, m.get('version'), VERSION), lib.AMSCR_E_FORMAT)
+    return m
+
+
+def _differing(a: Dict[str, Any], b: Dict[str, Any]) -> List[str]:
+    skip = {'threads'}
+    return ['%s %r (the manifest: %r)' % (key, b.get(key), a.get(key)) for key in sorted(set(a) | set(b))
+            if key not in skip and a.get(key) != b.get(key)]
+
+
+def _read_shard(d: str, s: int, entry: Dict[str, Any], params: Params) -> bytes:
+    """Shard s's bytes, checked against the manifest (ShardSetError naming the file otherwise)."""
+    name = str(entry.get('file'))
+    p = os.path.join(d, name)
+    try:
+        with open(p, 'rb') as f:
+            data = f.read()
+    except FileNotFoundError:
+        raise ShardSetError('amscr.distributed.load_index: shard %d of %s, %s, is missing' % (s, d, name),
+                            lib.AMSCR_E_IO) from None
+    except OSError as e:
+        raise FileError('amscr.distributed.load_index: cannot read shard %d, %s: %s' % (s, p, e.strerror),
+                        lib.AMSCR_E_IO) from None
+    if hashlib.sha256(data).hexdigest() == entry.get('sha256'):
+        return data
+    try:  # tell what differs
+        x = Index.from_bytes(data)
+    except AmscrError:
+        raise ShardSetError('amscr.distributed.load_index: shard %d, %s, is not an index file (its checksum '
+                            'differs from the manifest\'s)' % (s, p), lib.AMSCR_E_FORMAT) from None
+    diff = _differing(params._plain_dict(), x.collection_params()._plain_dict())
+    if diff:
+        raise ShardSetError('amscr.distributed.load_index: shard %d, %s, was built with other options than the '
+                            'set: %s' % (s, p, '; '.join(diff)), lib.AMSCR_E_FORMAT)
+    raise ShardSetError('amscr.distributed.load_index: shard %d, %s, is foreign to this set (%d shapes, the '
+                        'manifest %s; its checksum differs from the manifest\'s: another set\'s shard, or '
+                        'altered)' % (s, p, len(x), entry.get('count')), lib.AMSCR_E_FORMAT)
+
+
+def _workers(client) -> List[str]:
+    w = sorted(client.nthreads())
+    if not w:
+        raise InvalidArgumentError('amscr.distributed: the cluster has no workers')
+    return w
+
+
+def build_index(client, collection: Collection, path: Optional[PathLike] = None, *,
+                shards: Optional[int] = None) -> ShardedIndex:
+    """Builds an index of `collection` split in shards over the workers of `client`.
+
+    Args:
+        client: a ``distributed.Client``.
+        collection: the shapes and their params (``Params.retrieval()``: a channel weight of 0
+            or 1).
+        path: a directory to save the set into (:meth:`ShardedIndex.save`), or None.
+        shards: how many shards (default: one a worker; at most one a shape).
+    Returns:
+        a :class:`ShardedIndex` whose shards live on the workers.
+    Raises:
+        InvalidArgumentError: an empty collection, a channel weight strictly between 0 and 1, open
+        curves with a channel weight, no workers, a bad shard count.
+    Cost: every pair of shapes once (n (n - 1) / 2 pair distances, as the single index with
+    candidates 0), spread over the blocks, plus a short shortlist build of each shard.
+    """
+    if not isinstance(collection, Collection):
+        raise TypeError('collection: expected an amscr.Collection, got %s' % type(collection).__name__)
+    params = collection.params
+    _check_params(params)
+    workers = _workers(client)
+    n = len(collection)
+    if n == 0:
+        raise InvalidArgumentError('amscr.distributed.build_index: the collection is empty')
+    if shards is not None and (isinstance(shards, bool) or int(shards) != shards or shards < 1):
+        raise InvalidArgumentError('amscr.distributed.build_index: shards must be a count >= 1, got %r' % (shards,))
+    ns = min(int(shards) if shards is not None else len(workers), n)
+    bounds = _bounds(n, ns)
+    from .distributed import _block
+    datas = [_block(collection, lo, hi, params.threads).to_bytes() for lo, hi in bounds]
+    placed = [workers[s % len(workers)] for s in range(ns)]
+    rows = [client.scatter(datas[s], workers=[placed[s]], hash=False) for s in range(ns)]
+    from .distributed import _threads_by_host
+    th = _threads_by_host(client)
+    idx = [client.submit(_shard_index, rows[s], th, pure=False, workers=[placed[s]])
+           for s in range(ns)]
+    k, k2 = widths(params, n)
+    blocks = {}
+    for s in range(ns):
+        for t in range(s, ns):
+            blocks[s, t] = client.submit(_pair_block, rows[s], idx[t], bounds[s][0], bounds[t][0], k, k2,
+                                         pure=False, workers=[placed[t]])
+    got = dict(zip(blocks, client.gather(list(blocks.values()))))
+    base = [[] for _ in range(ns)]
+    inner = [[] for _ in range(ns)]
+    dmax = dmax2 = 0.0
+    for (s, t), r in got.items():
+        dmax, dmax2 = max(dmax, r['dmax']), max(dmax2, r['dmax2'])
+        base[s].append(r['rows'][0])
+        inner[s].append(r['rows'][1])
+        if s != t:
+            base[t].append(r['cols'][0])
+            inner[t].append(r['cols'][1])
+    nb = [_merge_lists(base[s], lo, hi - lo, k) for s, (lo, hi) in enumerate(bounds)]
+    nb_idx = np.concatenate([x[0] for x in nb]) if n else np.zeros((0, k), np.uint32)
+    nb_dist = np.concatenate([x[1] for x in nb]) if n else np.zeros((0, k))
+    ni = [_merge_lists(inner[s], lo, hi - lo, k2) for s, (lo, hi) in enumerate(bounds)]
+    in_idx = np.concatenate([x[0] for x in ni]) if n else np.zeros((0, k2), np.uint32)
+    in_dist = np.concatenate([x[1] for x in ni]) if n else np.zeros((0, k2))
+    graph = _Graph(params, n, nb_idx, nb_dist, in_idx, in_dist, dmax, dmax2 if k2 else 0.0)
+    for f in rows:
+        f.release()
+    sx = ShardedIndex(client, idx, bounds, graph, params, placed)
+    if path is not None:
+        sx.save(path)
+    return sx
+
+
+def load_index(client, path: PathLike) -> ShardedIndex:
+    """Reads a set saved by :meth:`ShardedIndex.save` and places its shards on the workers.
+
+    Raises:
+        FileError: no manifest (or unreadable files); FormatError: not a manifest, a corrupt graph;
+        ShardSetError: a shard missing, foreign or built with other options (the message names
+        the file).
+    """
+    d = os.fspath(path)
+    m = _read_manifest(d)
+    try:
+        params = _params_from_dict(m['params'])
+        n = int(m['shapes'])
+        entries = list(m['shards'])
+        bounds = [(int(e['first']), int(e['first']) + int(e['count'])) for e in entries]
+        gentry = m['graph']
+    except (KeyError, TypeError, ValueError) as e:
+        raise FormatError('amscr.distributed.load_index: %s: a malformed manifest (%s)' % (os.path.join(d, MANIFEST), e),
+                          lib.AMSCR_E_FORMAT) from None
+    if [b[0] for b in bounds] != [0] + [b[1] for b in bounds[:-1]] or (bounds and bounds[-1][1] != n):
+        raise FormatError('amscr.distributed.load_index: %s: shards do not cover the %d shapes in order'
+                          % (os.path.join(d, MANIFEST), n), lib.AMSCR_E_FORMAT)
+    gp = os.path.join(d, str(gentry.get('file')))
+    try:
+        with open(gp, 'rb') as f:
+            gdata = f.read()
+    except FileNotFoundError:
+        raise ShardSetError('amscr.distributed.load_index: the graph of %s, %s, is missing' % (d, gentry.get('file')),
+                            lib.AMSCR_E_IO) from None
+    if hashlib.sha256(gdata).hexdigest() != gentry.get('sha256'):
+        raise ShardSetError('amscr.distributed.load_index: the graph %s is foreign to this set (its checksum '
+                            'differs from the manifest\'s)' % gp, lib.AMSCR_E_FORMAT)
+    datas = [_read_shard(d, s, e, params) for s, e in enumerate(entries)]
+    try:
+        graph = _Graph.from_bytes(params, n, gdata)
+    except (KeyError, ValueError, OSError) as e:
+        raise FormatError('amscr.distributed.load_index: the graph %s is corrupt: %s' % (gp, e),
+                          lib.AMSCR_E_FORMAT) from None
+    workers = _workers(client)
+    placed = [workers[s % len(workers)] for s in range(len(entries))]
+    idx = [client.submit(_shard_from_file_bytes, datas[s], pure=False, workers=[placed[s]])
+           for s in range(len(entries))]
+    return ShardedIndex(client, idx, bounds, graph, params, placed)

@@ -1,0 +1,216 @@
+"""amscr.distributed.build_index on a real LocalCluster (4 worker processes on loopback): an index
+split in shards answers as the single index (the top 10 of 2,000 procedural shapes, the scores to
+1e-9 with the inner distance's graph), a saved set loads back, a missing, foreign or differently
+built shard is an error naming its file, a write cut off never replaces a good set, files follow
+the umask. Skipped without Dask."""
+import contextlib
+import os
+import time
+
+import numpy as np
+import pytest
+
+distributed = pytest.importorskip(
+    'distributed', reason='Dask is not installed: pip install "dask[distributed]>=2023" to run these tests')
+
+import amscr  # noqa: E402
+import amscr.distributed as ad  # noqa: E402
+from amscr import _shards  # noqa: E402
+from helpers import blob  # noqa: E402
+
+POINTS = 32  # small N keeps the file fast; the sharding does not depend on N
+N_LARGE = 2000
+N_SMALL = 160
+N_QUERIES = 100
+
+
+def _shapes(n, seed0):
+    out = [blob(120, seed=seed0 + i, phase=0.1 * i) for i in range(n - 8)]
+    return out + [out[3 * i] for i in range(8)]  # exact duplicates: tied distances in the lists
+
+
+def _collection(params, shapes):
+    c = amscr.Collection(params)
+    c.extend(shapes, [i % 20 for i in range(len(shapes))])
+    return c
+
+
+@pytest.fixture(scope='module')
+def client():
+    with distributed.LocalCluster(n_workers=4, threads_per_worker=1, processes=True, dashboard_address=':0') as cl, \
+            distributed.Client(cl) as c:
+        yield c
+
+
+@pytest.fixture(scope='module')
+def small(client):
+    """A set with the retrieval preset's inner-distance graph, and its single index."""
+    params = amscr.Params.retrieval(points=POINTS, threads=1)
+    coll = _collection(params, _shapes(N_SMALL, 0))
+    return ad.build_index(client, coll, shards=3), amscr.Index(coll, candidates=0), coll
+
+
+def _queries(n, seed0=50000):
+    return [blob(120, seed=seed0 + i, phase=0.37 * i) for i in range(n)]
+
+
+def test_top10_equals_single_index_on_2000_shapes(client):
+    params = amscr.Params.retrieval(points=POINTS, rerank_inner_share=0.0, threads=0)
+    coll = _collection(params, _shapes(N_LARGE, 0))
+    single = amscr.Index(coll, candidates=0)
+    sx = ad.build_index(client, coll)
+    assert len(sx) == N_LARGE and len(sx.bounds) == 4
+    qs = _queries(N_QUERIES)
+    idx, sc = sx.query_many(qs, 10)
+    same = 0
+    for i, q in enumerate(qs):
+        ref_idx, ref_sc = single.query(q, 10, candidates=0)
+        same += np.array_equal(idx[i], ref_idx)
+        np.testing.assert_allclose(sc[i], ref_sc, rtol=0, atol=1e-9)
+    assert same >= 0.99 * N_QUERIES
+
+
+def test_scores_equal_with_the_inner_graph(small):
+    sx, single, _ = small
+    qs = _queries(12)
+    S = sx.scores_many(qs)
+    for i, q in enumerate(qs):
+        np.testing.assert_allclose(S[i], single.scores(q, candidates=0), rtol=0, atol=1e-9)
+    m_idx, m_sc = sx.query(qs[0], 5)
+    r_idx, r_sc = single.query(qs[0], 5, candidates=0)
+    assert np.array_equal(m_idx, r_idx)
+
+
+def test_save_load_round_trip(small, client, tmp_path):
+    sx, single, _ = small
+    sx.save(tmp_path / 'set')
+    names = sorted(os.listdir(tmp_path / 'set'))
+    assert 'manifest.json' in names and sum(n.startswith('shard-') for n in names) == 3
+    loaded = ad.load_index(client, tmp_path / 'set')
+    assert loaded.bounds == sx.bounds
+    qs = _queries(3, 7000)
+    np.testing.assert_array_equal(loaded.scores_many(qs), sx.scores_many(qs))
+    # each shard is an ordinary index file
+    shard = amscr.Index.load(tmp_path / 'set' / [n for n in names if n.startswith('shard-001')][0])
+    assert len(shard) == sx.bounds[1][1] - sx.bounds[1][0]
+
+
+def _shard_file(d, s):
+    return [n for n in os.listdir(d) if n.startswith('shard-%03d-' % s)][0]
+
+
+def test_missing_foreign_or_other_options_shard_is_named(small, client, tmp_path):
+    sx, _, coll = small
+    d = tmp_path / 'set'
+    sx.save(d)
+    name = _shard_file(d, 1)
+    data = (d / name).read_bytes()
+
+    os.unlink(d / name)
+    with pytest.raises(ad.ShardSetError, match='shard 1 .*%s.* missing' % name):
+        ad.load_index(client, d)
+
+    lo, hi = sx.bounds[1]
+    other = amscr.Collection(coll.params)
+    other.extend(_shapes(hi - lo, 900), [0] * (hi - lo))
+    (d / name).write_bytes(amscr.Index(other, candidates=0).to_bytes())
+    with pytest.raises(ad.ShardSetError, match='shard 1, .*%s, is foreign' % name):
+        ad.load_index(client, d)
+
+    part = amscr.Collection(coll.params.copy(rerank_k=5))
+    part.extend(_shapes(hi - lo, 0)[:hi - lo], [0] * (hi - lo))
+    (d / name).write_bytes(amscr.Index(part, candidates=0).to_bytes())
+    with pytest.raises(ad.ShardSetError, match='%s, was built with other options.*rerank_k 5' % name):
+        ad.load_index(client, d)
+
+    (d / name).write_bytes(data[:len(data) // 2])
+    with pytest.raises(ad.ShardSetError, match='%s, is not an index file' % name):
+        ad.load_index(client, d)
+
+    (d / name).write_bytes(data)
+    ad.load_index(client, d)  # whole again
+    graph = [n for n in os.listdir(d) if n.startswith('graph-')][0]
+    gdata = (d / graph).read_bytes()
+    (d / graph).write_bytes(gdata[:-10])
+    with pytest.raises(ad.ShardSetError, match='graph .*%s is foreign' % graph):
+        ad.load_index(client, d)
+    (d / graph).write_bytes(gdata)
+    manifest = (d / 'manifest.json').read_bytes()
+    for bad, what in ((manifest[:40], 'not a shard set manifest'),
+                      (manifest.replace(b'"version": 1', b'"version": 7'), 'version 7'),
+                      (manifest.replace(b'"shapes": %d' % len(coll), b'"shapes": 3'), 'do not cover')):
+        (d / 'manifest.json').write_bytes(bad)
+        with pytest.raises(amscr.FormatError, match=what):
+            ad.load_index(client, d)
+    os.unlink(d / 'manifest.json')
+    with pytest.raises(amscr.FileError, match='manifest.json is missing'):
+        ad.load_index(client, d)
+
+
+def test_cut_off_write_keeps_the_good_set(small, client, tmp_path, monkeypatch):
+    sx, _, coll = small
+    d = tmp_path / 'set'
+    sx.save(d)
+    before = sorted(os.listdir(d))
+    qs = _queries(2, 8000)
+    want = sx.scores_many(qs)
+    other = ad.build_index(client, _collection(coll.params, _shapes(N_SMALL, 300)), shards=3)
+
+    real_fsync, calls = os.fsync, []
+
+    def full_disk(fd):  # the disk fills on the 4th file: the 3 shards are written, the graph is not
+        calls.append(fd)
+        if len(calls) > 3 * 2:  # each file: its own fsync and its directory's
+            raise OSError(28, 'No space left on device')
+        real_fsync(fd)
+
+    monkeypatch.setattr(os, 'fsync', full_disk)
+    with pytest.raises(amscr.FileError, match='No space left'):
+        other.save(d)
+    monkeypatch.setattr(os, 'fsync', real_fsync)
+    assert not [n for n in os.listdir(d) if n.startswith('.amscr-tmp-')]
+    np.testing.assert_array_equal(ad.load_index(client, d).scores_many(qs), want)
+
+    # killed mid-write: a temporary file left behind; the set still loads, the next save clears it
+    (d / '.amscr-tmp-killed').write_bytes(b'half a shard')
+    np.testing.assert_array_equal(ad.load_index(client, d).scores_many(qs), want)
+    other.save(d)
+    after = sorted(os.listdir(d))
+    assert '.amscr-tmp-killed' not in after and not set(before) - {'manifest.json'} & set(after)
+    assert not np.array_equal(ad.load_index(client, d).scores_many(qs), want)
+
+
+def test_files_follow_the_umask(small, tmp_path):
+    sx = small[0]
+    old = os.umask(0o027)
+    try:
+        sx.save(tmp_path / 'set')
+    finally:
+        os.umask(old)
+    for n in os.listdir(tmp_path / 'set'):
+        assert os.stat(tmp_path / 'set' / n).st_mode & 0o777 == 0o640, n
+
+
+def test_bad_input(client):
+    params = amscr.Params.retrieval(points=POINTS, channel_weight=0.5)
+    with pytest.raises(amscr.InvalidArgumentError, match='between 0 and 1'):
+        ad.build_index(client, _collection(params, _shapes(40, 0)))
+    with pytest.raises(TypeError):
+        ad.build_index(client, [1, 2])
+    with pytest.raises(amscr.InvalidArgumentError, match='empty'):
+        ad.build_index(client, amscr.Collection(amscr.Params.retrieval()))
+    with pytest.raises(amscr.InvalidArgumentError, match='shards'):
+        ad.build_index(client, _collection(amscr.Params.retrieval(points=POINTS), _shapes(40, 0)), shards=0)
+
+
+def test_shard_lost_with_its_worker_is_a_clear_error(client):
+    """Last in the file: it kills a worker of the module's cluster (its nanny starts another)."""
+    coll = _collection(amscr.Params.retrieval(points=POINTS, threads=1), _shapes(60, 0))
+    sx = ad.build_index(client, coll, shards=2)
+    sx.scores(_queries(1)[0])
+    with contextlib.suppress(Exception):  # the worker dies before it answers
+        client.run(os._exit, 1, workers=[sx._workers[1]])
+    with pytest.raises(ad.ShardSetError, match='shard 1 lost with its worker'):
+        for _ in range(50):  # until the scheduler has seen the worker go
+            sx.scores(_queries(1)[0])
+            time.sleep(0.2)

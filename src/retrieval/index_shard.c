@@ -1,0 +1,227 @@
+/* index_shard.c — what an index split in shards needs of the library (Python's
+ * amscr.distributed.build_index): the pair distances of a shape to each shape of an index (a
+ * shard), each computed as the cell of the whole collection's matrix, and the neighbour graph of
+ * the whole collection without its shapes, which turns a query's distances to every shard into
+ * the single index's scores (the same diffusion, index_diffuse.c). */
+#include "db_io.h"
+#include "index.h"
+#include "rows.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct amscr_index_graph {
+    amscr_index *x; /* lists and normalisers; its db holds n empty slots (no shapes) */
+};
+
+/* The inner distances of q (features f) to shapes first.. of x on threads, each pair with the lower
+ * index first. */
+typedef struct {
+    const amscr_index *x;
+    const amscr__inner *f;
+    size_t qpos, first;
+    int refl;
+    double *out;
+} inner_ctx;
+
+static amscr_status inner_init(void *ctx, void **scratch)
+{
+    (void)ctx;
+    amscr__inner_ws *ws = malloc(sizeof *ws);
+    if (!ws || amscr__inner_ws_init(ws) != AMSCR_OK) {
+        free(ws);
+        return AMSCR_E_NOMEM;
+    }
+    *scratch = ws;
+    return AMSCR_OK;
+}
+
+static void inner_fini(void *scratch)
+{
+    if (scratch)
+        amscr__inner_ws_free(scratch);
+    free(scratch);
+}
+
+static amscr_status inner_row(void *ctx, size_t j, void *scratch)
+{
+    inner_ctx *c = ctx;
+    c->out[j - c->first] = j < c->qpos ? amscr__inner_distance(&c->x->inner[j], c->f, c->refl, scratch)
+                                       : amscr__inner_distance(c->f, &c->x->inner[j], c->refl, scratch);
+    return AMSCR_OK;
+}
+
+static amscr_status pair_inner(const amscr_index *x, const amscr_descriptor *q, size_t qpos, size_t first,
+                               double *out)
+{
+    amscr__inner_ws ws;
+    amscr__inner *f = malloc(sizeof *f);
+    if (!f || amscr__inner_ws_init(&ws) != AMSCR_OK) {
+        free(f);
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_index_pair_distances: out of memory");
+    }
+    const amscr_params *p = amscr_db_params(x->db);
+    amscr_status st = amscr__inner_build_shape(q, p->inner_closing, f, &ws);
+    amscr__inner_ws_free(&ws);
+    inner_ctx c = {x, f, qpos, first, p->reflections, out};
+    amscr__rows_fn fn = {inner_init, inner_fini, inner_row, &c, "amscr_index_pair_distances"};
+    if (st == AMSCR_OK)
+        st = amscr__run_rows(&fn, first, amscr_db_size(x->db), amscr__resolve_threads(p->num_threads), NULL, NULL);
+    free(f);
+    return st;
+}
+
+amscr_status amscr_index_pair_distances(const amscr_index *x, const amscr_descriptor *q, size_t qpos, size_t first,
+                                        double *out_base, double *out_inner, size_t n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    AMSCR_CHECK_NULL(q);
+    AMSCR_CHECK_NULL(out_base);
+    const amscr_params *p = amscr_db_params(x->db);
+    if (!amscr__params_compatible(p, &q->params, "amscr_index_pair_distances"))
+        return AMSCR_E_INVALID_ARG;
+    size_t size = amscr_db_size(x->db);
+    if (first > size || n != size - first)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_pair_distances: shapes %zu.. of %zu, the output holds "
+                                                "%zu distances", first, size, n);
+    size_t *cand = amscr__malloc_array(n ? n : 1, sizeof *cand);
+    if (!cand)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_index_pair_distances: out of memory");
+    for (size_t j = 0; j < n; j++)
+        cand[j] = first + j;
+    amscr__base b;
+    amscr__base_init(&b, p, x->med_a, x->med_h);
+    amscr_status st = n > 0 ? amscr__base_row(&b, x->db, x->hf, q, qpos, cand, n, NULL, NULL, out_base) : AMSCR_OK;
+    free(cand);
+    if (st == AMSCR_OK && out_inner) {
+        if (x->k2 > 0 && n > 0)
+            st = pair_inner(x, q, qpos, first, out_inner);
+        else if (n > 0)
+            memset(out_inner, 0, n * sizeof *out_inner);
+    }
+    return st;
+}
+
+void amscr_index_graph_widths(const amscr_params *p, size_t n, size_t *out_k, size_t *out_k2)
+{
+    size_t k = p && n > 0 ? amscr__rerank_k(p, n) : 0;
+    if (out_k)
+        *out_k = k;
+    if (out_k2)
+        *out_k2 = p ? amscr__index_k2(p, k) : 0;
+}
+
+/* Row i of a list (k entries): itself first, the others below n, distances finite and >= 0. */
+static int bad_row(const uint32_t *idx, const double *dist, size_t i, size_t k, size_t n)
+{
+    if (k > 0 && idx[0] != i)
+        return 1;
+    for (size_t t = 0; t < k; t++)
+        if (idx[t] >= n || !(dist[t] >= 0.0) || !isfinite(dist[t]))
+            return 1;
+    return 0;
+}
+
+static amscr_status copy_lists(const uint32_t *idx, const double *dist, size_t n, size_t k, uint32_t **oi,
+                               double **od)
+{
+    *oi = amscr__malloc_array(n ? n : 1, (k ? k : 1) * sizeof **oi);
+    *od = amscr__malloc_array(n ? n : 1, (k ? k : 1) * sizeof **od);
+    if (!*oi || !*od)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_index_graph_new: out of memory");
+    if (n * k > 0) {
+        memcpy(*oi, idx, n * k * sizeof **oi);
+        memcpy(*od, dist, n * k * sizeof **od);
+    }
+    return AMSCR_OK;
+}
+
+amscr_status amscr_index_graph_new(const amscr_params *p, size_t n, const uint32_t *nb_idx, const double *nb_dist,
+                                   const uint32_t *in_idx, const double *in_dist, double dmax, double dmax2,
+                                   amscr_index_graph **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(p);
+    AMSCR_CHECK_NULL(out);
+    *out = NULL;
+    size_t k, k2;
+    amscr_index_graph_widths(p, n, &k, &k2);
+    if (n > UINT32_MAX)
+        return amscr__fail(AMSCR_E_LIMIT, "amscr_index_graph_new: %zu shapes exceed 2^32 - 1", n);
+    if ((k > 0 && (!nb_idx || !nb_dist)) || (k2 > 0 && (!in_idx || !in_dist)))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_new: NULL lists (%zu shapes, %zu and %zu "
+                                                "neighbours a shape)", n, k, k2);
+    if (!(dmax >= 0.0) || !isfinite(dmax) || !(dmax2 >= 0.0) || !isfinite(dmax2))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_new: largest distances %g, %g", dmax, dmax2);
+    for (size_t i = 0; i < n; i++) {
+        if (bad_row(nb_idx + i * k, nb_dist + i * k, i, k, n))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_new: row %zu of the base lists is not "
+                                                    "itself first, then shapes below %zu at distances >= 0", i, n);
+        if (k2 > 0 && bad_row(in_idx + i * k2, in_dist + i * k2, i, k2, n))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_new: row %zu of the inner lists is not "
+                                                    "itself first, then shapes below %zu at distances >= 0", i, n);
+    }
+    amscr_index_graph *g = calloc(1, sizeof *g);
+    amscr_index *x = calloc(1, sizeof *x);
+    amscr_status st = g && x ? amscr__db_new_slots(p, n, &x->db)
+                             : amscr__fail(AMSCR_E_NOMEM, "amscr_index_graph_new: out of memory");
+    if (g)
+        g->x = x;
+    if (st == AMSCR_OK) {
+        x->sig_dim = AMSCR__SIG_DIM;
+        x->k = k;
+        x->k2 = k2;
+        x->dmax = dmax;
+        x->dmax2 = k2 > 0 ? dmax2 : 0.0;
+        st = copy_lists(nb_idx, nb_dist, n, k, &x->nb_idx, &x->nb_dist);
+    }
+    if (st == AMSCR_OK && k2 > 0)
+        st = copy_lists(in_idx, in_dist, n, k2, &x->in_idx, &x->in_dist);
+    if (st == AMSCR_OK)
+        st = amscr__index_reverse(x);
+    if (st != AMSCR_OK) {
+        amscr_index_graph_free(g);
+        if (!g)
+            amscr_index_free(x);
+        return st;
+    }
+    *out = g;
+    return AMSCR_OK;
+}
+
+amscr_status amscr_index_graph_scores(const amscr_index_graph *g, const size_t *cand, const double *dq,
+                                      const double *dq2, size_t m, double *out_scores, size_t n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(g);
+    AMSCR_CHECK_NULL(out_scores);
+    const amscr_index *x = g->x;
+    size_t size = amscr_db_size(x->db);
+    if (n != size)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_scores: the output holds %zu scores, the graph "
+                                                "%zu shapes", n, size);
+    if (m > 0 && (!cand || !dq || (x->k2 > 0 && !dq2)))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_scores: NULL candidates or distances%s",
+                           x->k2 > 0 ? " (this graph needs the inner distances too)" : "");
+    for (size_t t = 0; t < m; t++) {
+        if (cand[t] >= size || (t > 0 && cand[t] <= cand[t - 1]))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_scores: candidate %zu (%zu) is not below "
+                                                    "%zu and above the one before", t, cand[t], size);
+        if (!(dq[t] >= 0.0) || !isfinite(dq[t]) || (x->k2 > 0 && (!(dq2[t] >= 0.0) || !isfinite(dq2[t]))))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_scores: candidate %zu's distance is not "
+                                                    "finite and >= 0", t);
+    }
+    return amscr__index_scores(x, size, cand, dq, x->k2 > 0 ? dq2 : NULL, m, out_scores);
+}
+
+size_t amscr_index_graph_size(const amscr_index_graph *g) { return g ? amscr_db_size(g->x->db) : 0; }
+
+void amscr_index_graph_free(amscr_index_graph *g)
+{
+    if (!g)
+        return;
+    amscr_index_free(g->x);
+    free(g);
+}
