@@ -1,33 +1,20 @@
 #!/usr/bin/env python3
 """Registration from images: the amscr tool on traced PNG pairs against OpenCV's ECC.
 
-For each class of mpeg7-dev (one shape per class, the class's first file; folds.tsv's fold A / B)
-and `--procedural N` seeded silhouettes (bindings/python/tests/shapegen.py: thin limbs, near
-symmetries, holes, spikes, deep notches; "fold" P), `--draws` seeded draws per condition: the
-silhouette 140 px across in a 200 x 200 image (the source), a random affine map T (any rotation,
-axis scales x0.5-2, shear +-0.5; then scaled and shifted so the warped shape again spans 140 px)
-applied with cv2.warpAffine (the target), then the target damaged in the image:
-
-  clean      the warped silhouette (bilinear, thresholded at half level);
-  noise      the boundary moved by a smooth random field of 1.5 % of the shape's RMS radius,
-             plus 12 background specks (1-2 px disks);
-  bite       a disk of 0.3 x radius removed at a random boundary point;
-  touching   such a disk added outside, touching the boundary at a random point;
-  lowres     source and target reduced 4x (area: the shape 35 px across; --low-px N) and thresholded;
-  grey       the same reduction kept as 8-bit antialiased grey (area coverage).
-
---families (--quick: at the check's points only) builds the conditions as the independent check
-states them, each swept (family_target): shapes 200 px across in 280-px images; noise 0.5-2 % R
-(field correlation 2 % R, specks on 0.05 % of the pixels); bite / touching disks of 0.1-0.4 R
-(the bite's largest piece kept; the touching disk centred 0.8 radii outside); the target alone
-reduced to 30-80 px, binary / grey. One table a method: ok % / wrong + confident %, fold A, fold
-B and the procedural set side by side (RMS measure); --json OUT writes {draws, table, pairs}.
-
-Both PNGs are registered by the tool, `amscr register SRC TGT --json` (--tool, or $AMSCR_TOOL;
-the default sub-pixel tracer, and with --pixel-chain), and by cv2.findTransformECC (MOTION_AFFINE,
-8 starting rotations with centroid and area matched, the best correlation kept) on the same
-images. --reference adds the reference evaluation's calibration column: scikit-image
-find_contours point lists of both images through `amscr register`.
+For each class of mpeg7-dev (one shape a class, its first file; folds.tsv's fold A / B) and
+`--procedural N` seeded silhouettes (bindings/python/tests/shapegen.py; "fold" P), `--draws`
+seeded draws a condition: the silhouette 140 px across in a 200-px image (the source), a random
+affine map T (any rotation, axis scales x0.5-2, shear +-0.5; then scaled and shifted so the shape
+again spans 140 px) applied with cv2.warpAffine (the target), the target damaged in the image:
+clean (thresholded at half level); noise (the boundary moved by a smooth field of 1.5 % of the RMS
+radius, 12 specks of 1-2 px); bite (a disk of 0.3 x the radius removed at a boundary point);
+touching (such a disk added outside); lowres / grey (both images reduced 4x by area, --low-px N,
+thresholded / grey). --families (--quick: the check's points only) builds the check's conditions,
+each swept (family_target): one table a method, ok % / w+c %, fold A, fold B and the procedural
+set side by side (RMS measure); --json OUT writes {draws, table, pairs}. The pairs are registered
+by the tool, `amscr register SRC TGT --json` (--tool or $AMSCR_TOOL; also --pixel-chain), and by
+cv2.findTransformECC (MOTION_AFFINE, 8 starting rotations, centroid and area matched, the best
+correlation kept); --reference: find_contours point lists of both images through the tool.
 
 Error over the clean source's sub-pixel contour f, % of R = size(T(f)) (the RMS radius): the RMS
 of |M(f_i) - T(f_i)| (the primary table: the reference evaluation's figures, by its calibration,
@@ -75,8 +62,7 @@ CONFIDENT = 0.25
 
 
 def enclosed_area(xy):
-    x, y = xy[:, 0], xy[:, 1]
-    return 0.5 * abs(float(np.dot(x, np.roll(y, 1)) - np.dot(y, np.roll(x, 1))))
+    return abs(float(cv2.contourArea(xy.astype(np.float32))))
 
 
 def subpixel_contour(img):
@@ -203,9 +189,7 @@ def family_target(src, f, kind, level, rng):
         return disk(tgt, p + 0.8 * level * R * u, level * R, 255), T
     if kind in ('lowres', 'grey'):
         side = int(round(CANVAS * level / SPAN))
-        small = cv2.resize(tgt, (side, side), interpolation=cv2.INTER_AREA)
-        small = np.where(small > 127, 255, 0).astype(np.uint8) if kind == 'lowres' else small
-        return small, compose(low_map(side), T)
+        return reduce(tgt, kind == 'lowres', side), compose(low_map(side), T)
     return tgt, T
 
 
@@ -225,32 +209,21 @@ def set_low_px(px):
 LOW_SIDE = CANVAS // REDUCE
 
 
-def reduce(img, binary):
-    small = cv2.resize(img, (LOW_SIDE, LOW_SIDE), interpolation=cv2.INTER_AREA)
+def reduce(img, binary, side=None):
+    small = cv2.resize(img, (side or LOW_SIDE,) * 2, interpolation=cv2.INTER_AREA)
     return np.where(small > 127, 255, 0).astype(np.uint8) if binary else small
 
 
 S_LOW = low_map(LOW_SIDE)  # low-res pixel x = (x - 1.5) / 4 for a 4x area reduction
 
 
-def map_error(M, T, f):
-    """The stricter measure: the largest |M f_i - T f_i| over the contour, % of the size."""
-    if M is None:
-        return math.inf
-    d = apply(M, f) - apply(T, f)
-    return 100 * float(np.sqrt((d * d).sum(axis=1)).max() / shape_size(apply(T, f)))
-
-
-def rms_error(M, T, f):
-    """The primary measure: the RMS of |M f_i - T f_i| over the contour, % of the size."""
-    if M is None:
-        return math.inf
-    d = apply(M, f) - apply(T, f)
-    return 100 * float(np.sqrt((d * d).sum(axis=1).mean()) / shape_size(apply(T, f)))
-
-
 def errors(M, T, f):
-    return rms_error(M, T, f), map_error(M, T, f)
+    """The RMS (the primary measure) and the largest of |M f_i - T f_i| over the contour, % of the
+    size; inf when the registration failed."""
+    if M is None:
+        return math.inf, math.inf
+    d = np.sqrt(((apply(M, f) - apply(T, f)) ** 2).sum(axis=1)) / shape_size(apply(T, f))
+    return 100 * float(np.sqrt((d * d).mean())), 100 * float(d.max())
 
 
 CLOCK = time.perf_counter  # --cpu-time: time.process_time
@@ -292,9 +265,7 @@ def tool_register(tool, sp, tp, extra):
 
 def ecc_register(a8, b8):
     """W with b(W x) ~ a(x): source pixels -> target pixels; None when every start fails."""
-    sigma = 0.01 * max(a8.shape)
-    a = cv2.GaussianBlur(a8.astype(np.float32) / 255, (0, 0), sigma)
-    b = cv2.GaussianBlur(b8.astype(np.float32) / 255, (0, 0), sigma)
+    a, b = (cv2.GaussianBlur(x.astype(np.float32) / 255, (0, 0), 0.01 * max(a8.shape)) for x in (a8, b8))
     return registration_heldout.ecc_multistart(a, b, cv2)
 
 
@@ -318,14 +289,6 @@ EXTRA = [('lib', 'library alone')]  # timing only
 MEASURES = [(0, 'RMS'), (1, 'max')]  # index into a record (rms %, max %, confidence, ms)
 
 
-def reference_register(tool, tmp, src, tgt):
-    """The calibration: both images traced by find_contours, through the tool as point lists."""
-    sp, tp = os.path.join(tmp, 'src.txt'), os.path.join(tmp, 'tgt.txt')
-    np.savetxt(sp, subpixel_contour(src))
-    np.savetxt(tp, subpixel_contour(tgt))
-    return tool_register(tool, sp, tp, [])
-
-
 def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=None, use_ref=False, lib=True):
     """{method: (rms error %, max error %, confidence, ms)}."""
     if key in ('lowres', 'grey'):
@@ -333,16 +296,14 @@ def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=
         T = compose(S_LOW, compose(T, inv_affine(S_LOW)))
         f = apply(S_LOW, f)
     sp, tp = os.path.join(tmp, 'src.png'), os.path.join(tmp, 'tgt.png')
-    cv2.imwrite(sp, src)
-    cv2.imwrite(tp, tgt)
+    cv2.imwrite(sp, src), cv2.imwrite(tp, tgt)
     out = {}
-    for m, extra in (('sub', []), ('chain', ['--pixel-chain'])):
-        if m == 'chain' and not use_chain:
-            continue
+    for m, extra in [('sub', [])] + ([('chain', ['--pixel-chain'])] if use_chain else []):
         M, conf, ms = tool_register(tool, sp, tp, extra)
         out[m] = (*errors(M, T, f), conf, ms)
-    if use_ref:
-        M, conf, ms = reference_register(tool, tmp, src, tgt)
+    if use_ref:  # the calibration: both images traced by find_contours, to the tool as point lists
+        np.savetxt(sp + '.txt', subpixel_contour(src)), np.savetxt(tp + '.txt', subpixel_contour(tgt))
+        M, conf, ms = tool_register(tool, sp + '.txt', tp + '.txt', [])
         out['ref'] = (*errors(M, T, f), conf, ms)
     out['lib'] = (0.0, 0.0, 0.0, lib_register_ms(src, tgt, breakdown) if lib else math.nan)
     if use_ecc:
@@ -357,8 +318,7 @@ def summary(recs, thr, measure=0):
     >= CONFIDENT %) under the measure (0: RMS, 1: max)."""
     if not recs:
         return None
-    err = np.array([r[measure] for r in recs])
-    conf = np.array([r[2] for r in recs])
+    err, conf = np.array([r[measure] for r in recs]), np.array([r[2] for r in recs])
     ok = err < thr
     wrong_conf = (~ok) & (conf >= CONFIDENT)
     good_conf = 100 * float(np.mean(conf[ok] >= CONFIDENT)) if ok.any() else math.nan
@@ -368,10 +328,7 @@ def summary(recs, thr, measure=0):
 
 def print_table(title, res, conds, methods, measure=0):
     print('\n%s' % title)
-    head = '%-44s' % 'condition'
-    for _, lab in methods:
-        head += ' | %-38s' % lab
-    print(head)
+    print('%-44s' % 'condition' + ''.join(' | %-38s' % lab for _, lab in methods))
     print('%-44s' % '' + ''.join(' | %-38s' % 'ok %   w+c %  ok+c %  med err %  ms' for _ in methods))
     for key, lab, thr in conds:
         line = '%-44s' % ('%s (%d pairs)' % (lab, len(res[key]['sub'])))
