@@ -1,56 +1,30 @@
 #!/usr/bin/env python3
 """Registration from images: the amscr tool on traced PNG pairs against OpenCV's ECC.
 
-For each class of mpeg7-dev (one shape per class, the class's first file) and `--draws` seeded
-draws per condition: the silhouette scaled to 140 px in a 200 x 200 image (the source), a random
-affine map T (any rotation, axis scales x0.5-2, shear +-0.5; then scaled and shifted so the
-warped shape again spans 140 px of a 200 x 200 image) applied with cv2.warpAffine (the target),
-then the target damaged in the image:
+For each class of mpeg7-dev (one shape a class, its first file; folds.tsv's fold A / B) and
+`--procedural N` seeded silhouettes (bindings/python/tests/shapegen.py; "fold" P), `--draws`
+seeded draws a condition: the silhouette 140 px across in a 200-px image (the source), a random
+affine map T (any rotation, axis scales x0.5-2, shear +-0.5; then scaled and shifted so the shape
+again spans 140 px) applied with cv2.warpAffine (the target), the target damaged in the image:
+clean (thresholded at half level); noise (the boundary moved by a smooth field of 1.5 % of the RMS
+radius, 12 specks of 1-2 px); bite (a disk of 0.3 x the radius removed at a boundary point);
+touching (such a disk added outside); lowres / grey (both images reduced 4x by area, --low-px N,
+thresholded / grey). --families (--quick: the check's points only) builds the check's conditions,
+each swept (family_target): one table a method, ok % / w+c %, fold A, fold B and the procedural
+set side by side (RMS measure); --json OUT writes {draws, table, pairs}. The pairs are registered
+by the tool, `amscr register SRC TGT --json` (--tool or $AMSCR_TOOL; also --pixel-chain), and by
+cv2.findTransformECC (MOTION_AFFINE, 8 starting rotations, centroid and area matched, the best
+correlation kept); --reference: find_contours point lists of both images through the tool.
 
-  clean      the warped silhouette (bilinear, thresholded at half level);
-  noise      segmentation noise: the boundary moved by a smooth random field of 1.5 % of the
-             shape's radius (RMS radius), plus 12 background specks (1-2 px disks);
-  bite       a disk of 0.3 x radius removed at a random boundary point;
-  touching   such a disk added outside, touching the boundary at a random point;
-  lowres     source and target reduced 4x (cv2.INTER_AREA: the shape 35 px across; --low-px N for
-             another size) and thresholded;
-  grey       the same reduction kept as 8-bit antialiased grey (area coverage).
-
-Both PNGs are registered by the tool, `amscr register SRC TGT --json` (the default sub-pixel
-tracer, and with --pixel-chain), and by cv2.findTransformECC (MOTION_AFFINE, 8 starting
-rotations with centroid and area matched, the best correlation kept) on the same images.
---reference adds the reference evaluation's calibration column: scikit-image find_contours point lists of
-both images through `amscr register` (no image decoding in the tool).
-
-Error, two measures over the clean source's sub-pixel contour f (in the source image's pixels),
-both as % of size(T(f)), the RMS radius about the centroid:
-  RMS  sqrt(mean_i |M(f_i) - T(f_i)|^2) -- the primary table, "as the reference evaluation measures": the evaluation
-       states "map error below 2 % of the shape's size; 4 % at low resolution" without saying
-       max or RMS, and gives a calibration (binary / grey 35-px images traced by scikit-image's
-       find_contours at half level, handed to the tool as point lists: 94.3 % / 92.9 %).
-       `--reference` (those point lists, 70 pairs each) gives 95.7 / 98.6 % under RMS and
-       80.0 / 97.1 % under max: on binary images, which tell the measures apart, RMS is one pair
-       from the reference figure and max ten pairs short -- so the reference figures are taken to be
-       RMS ones (docs/measurements.md);
-  max  max_i |M(f_i) - T(f_i)| -- the stricter second table, the measure of the figures before
-       0.5 (kept so they stay comparable).
-Success: error < 2 % (4 % for lowres and grey), under each measure. Wrong + confident (w+c): a
-failure the tool reports with confidence >= 0.25; ok+c: the share of the successes reported with
-confidence >= 0.25. ECC is scored by the same two measures (it reports no confidence).
-ms/pair: wall time per pair (the tool's includes process start and PNG decoding).
-
-Usage: nice .venv/bin/python bench/registration_traced.py [--data DIR] [--tool PATH] [--draws 2]
-       [--no-ecc] [--no-chain] [--reference] [--conditions clean,lowres,...] [--fold A|B] [--json OUT]
-       [--low-px 35]
---json OUT writes one row per pair, each method as [RMS %, max %, confidence, ms].
---conditions (alias --only) and --fold restrict the run (the tables then show what ran);
---no-chain skips the --pixel-chain column; --breakdown splits the library's time (the traces,
-the registration, without the polish, without the polish and the refinement); --cpu-time reports
-the library's time as this process's CPU time (with OPENBLAS_NUM_THREADS=1). "lib ms": the library alone in this process (the
-Python binding: both images traced by amscr.contour_from_mask(join=True) as the tool traces them,
-then amscr.register), the
-median over the condition's pairs; skipped when the amscr package is not importable.
-Deterministic: every draw is seeded by (class index, condition, draw).
+Error over the clean source's sub-pixel contour f, % of R = size(T(f)) (the RMS radius): the RMS
+of |M(f_i) - T(f_i)| (the primary table: the reference evaluation's figures, by its calibration,
+are RMS ones; docs/measurements.md) and the max (stricter, the figures before 0.5). Success: < 2 %
+(4 % at low resolution). Wrong + confident (w+c): a failure reported with confidence >= 0.25;
+ok+c: the successes' share with confidence >= 0.25. ms: wall time a pair (the tool's with process
+start and PNG decoding). --json OUT: a row a pair, each method [RMS %, max %, confidence, ms].
+"lib ms": the library alone in this process (amscr.contour_from_mask(join=True), amscr.register),
+the median; skipped with --families or without the amscr package. Every draw is seeded by (shape
+index, condition, draw). Usage: nice .venv/bin/python bench/registration_traced.py --help
 """
 import argparse
 import json
@@ -66,6 +40,9 @@ import numpy as np
 import cv2
 
 import registration_heldout  # noqa: E402  (bench/: the ECC multi-start both benches use)
+sys.path.insert(1, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'bindings', 'python', 'tests'))
+import shapegen  # noqa: E402  (the procedural silhouettes, shared with the tests)
+from registration_heldout import apply, compose, inv_affine, shape_size  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.join(HERE, '..')
@@ -84,34 +61,13 @@ REDUCE = 4
 CONFIDENT = 0.25
 
 
-def shape_size(xy):
-    c = xy - xy.mean(axis=0)
-    return math.sqrt((c * c).sum(axis=1).mean())
-
-
-def apply(T, xy):
-    return xy @ T[:, :2].T + T[:, 2]
-
-
-def compose(P, Q):  # P after Q
-    return np.hstack([P[:, :2] @ Q[:, :2], P[:, :2] @ Q[:, 2:] + P[:, 2:]])
-
-
-def inv_affine(P):
-    A = np.linalg.inv(P[:, :2])
-    return np.hstack([A, -(A @ P[:, 2:])])
-
-
 def enclosed_area(xy):
-    x, y = xy[:, 0], xy[:, 1]
-    return 0.5 * abs(float(np.dot(x, np.roll(y, 1)) - np.dot(y, np.roll(x, 1))))
+    return abs(float(cv2.contourArea(xy.astype(np.float32))))
 
 
 def subpixel_contour(img):
-    """The iso-line at half level of an 8-bit image enclosing the largest area -- the outer
-    boundary -- as (x, y) rows (skimage). (Before 0.5 the line with the most points was taken,
-    which for the pocket watch is a hole's jagged boundary: its targets were fitted to that hole
-    and overflowed the canvas, and its errors were measured on the hole.)"""
+    """The iso-line at half level of an 8-bit image enclosing the largest area (the outer boundary,
+    not a hole's) as (x, y) rows (skimage)."""
     from skimage import measure
     cs = measure.find_contours(np.pad(img.astype(float), 1), 127.5)
     c = max(cs, key=enclosed_area)[:, ::-1] - 1.0
@@ -127,14 +83,12 @@ def fit_map(xy):
 
 
 def load_source(path):
-    """The silhouette (foreground 255) scaled to SPAN px in a CANVAS image."""
-    img = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
+    """The silhouette (foreground 255; a file or an array) scaled to SPAN px in a CANVAS image."""
+    img = cv2.imread(path, cv2.IMREAD_GRAYSCALE) if isinstance(path, str) else path
     m = (img > 127).astype(np.uint8) * 255
     if np.mean(np.concatenate([m[0], m[-1], m[:, 0], m[:, -1]])) > 127:
         m = 255 - m
-    n, lab, stats, _ = cv2.connectedComponentsWithStats(m, connectivity=8)
-    big = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
-    m = np.where(lab == big, 255, 0).astype(np.uint8)
+    m = largest_piece(m)
     ys, xs = np.nonzero(m)
     P = fit_map(np.column_stack([xs, ys]).astype(float))
     src = cv2.warpAffine(m, P, (CANVAS, CANVAS), flags=cv2.INTER_AREA if P[0, 0] < 1 else cv2.INTER_LINEAR)
@@ -189,46 +143,87 @@ def damage(key, tgt, g, rng):
     return tgt
 
 
+# ---- families: the conditions as the independent check states them, each swept over its levels
+def family_conditions(quick=False):
+    """(key, label, kind, level, success threshold %, seed index); --quick: the check's points."""
+    lv = [('clean', 0)] + [('noise', a) for a in (0.5, 1, 1.5, 2)] + \
+         [(k, r) for k in ('bite', 'touching') for r in (0.1, 0.2, 0.3, 0.4)] + \
+         [(k, px) for k in ('lowres', 'grey') for px in (30, 40, 60, 80)]
+    fmt = {'clean': 'clean', 'noise': 'noise %g %% R', 'bite': 'bite %g R', 'touching': 'touching %g R',
+           'lowres': 'binary %g px', 'grey': 'grey %g px'}
+    quick_points = (('clean', 0), ('noise', 1.5), ('bite', 0.3), ('touching', 0.3), ('lowres', 40), ('grey', 40))
+    return [('%s%g' % (k, v) if v else k, fmt[k] % v if v else k, k, v, 4.0 if k in ('lowres', 'grey') else 2.0,
+             100 + i) for i, (k, v) in enumerate(lv) if not quick or (k, v) in quick_points]
+
+
+def largest_piece(img):
+    n, lab, stats, _ = cv2.connectedComponentsWithStats((img > 0).astype(np.uint8), connectivity=8)
+    if n <= 2:
+        return img
+    return np.where(lab == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA])), img, 0).astype(np.uint8)
+
+
+def family_target(src, f, kind, level, rng):
+    """(target, T) as the check builds them: the warped source thresholded at half level, then
+    noise: a smooth Gaussian field (correlation 2 % of R, amplitude `level` % of R) added to the
+    signed distance, and specks on 0.05 % of the pixels; bite: a disk of `level` R removed at a
+    random boundary point, the largest piece kept; touching: a disk of `level` R centred 0.8 x
+    its radius outside a random boundary point (along the ray from the centroid) added;
+    lowres / grey: the target alone reduced (area) so the shape spans `level` px, binary or grey.
+    R: the RMS radius of the true target contour."""
+    tgt, T = make_target(src, f, rng)
+    g = apply(T, f)
+    R = shape_size(g)
+    if kind == 'noise':
+        sd = (cv2.distanceTransform((tgt > 0).astype(np.uint8), cv2.DIST_L2, 5) -
+              cv2.distanceTransform((tgt == 0).astype(np.uint8), cv2.DIST_L2, 5))
+        field = cv2.GaussianBlur(rng.normal(0, 1, tgt.shape), (0, 0), 0.02 * R)
+        out = np.where(sd + field * (level / 100 * R / max(field.std(), 1e-12)) > 0, 255, 0).astype(np.uint8)
+        out.flat[rng.choice(out.size, int(round(0.0005 * out.size)), replace=False)] = 255
+        return out, T
+    if kind in ('bite', 'touching'):
+        p = g[rng.integers(len(g))]
+        if kind == 'bite':
+            return largest_piece(disk(tgt, p, level * R, 0)), T
+        u = (p - g.mean(axis=0)) / max(np.linalg.norm(p - g.mean(axis=0)), 1e-12)
+        return disk(tgt, p + 0.8 * level * R * u, level * R, 255), T
+    if kind in ('lowres', 'grey'):
+        side = int(round(CANVAS * level / SPAN))
+        return reduce(tgt, kind == 'lowres', side), compose(low_map(side), T)
+    return tgt, T
+
+
+def low_map(side):
+    """Pixel centres of the CANVAS image -> those of its area reduction to side x side."""
+    r = CANVAS / side
+    return np.array([[1.0 / r, 0, (1.0 / r - 1) / 2], [0, 1.0 / r, (1.0 / r - 1) / 2]])
+
+
 def set_low_px(px):
-    """The low-resolution conditions with the shape `px` pixels across (35 by default: the 4x
-    reduction; the reference evaluation states ~40): the reduced canvas and S_LOW."""
+    """The lowres / grey shapes `px` across (35: the 4x reduction): the reduced canvas and S_LOW."""
     global LOW_SIDE, S_LOW
     LOW_SIDE = int(round(CANVAS * px / SPAN))
-    r = CANVAS / LOW_SIDE
-    S_LOW = np.array([[1.0 / r, 0, (1.0 / r - 1) / 2], [0, 1.0 / r, (1.0 / r - 1) / 2]])
+    S_LOW = low_map(LOW_SIDE)
 
 
 LOW_SIDE = CANVAS // REDUCE
 
 
-def reduce(img, binary):
-    small = cv2.resize(img, (LOW_SIDE, LOW_SIDE), interpolation=cv2.INTER_AREA)
+def reduce(img, binary, side=None):
+    small = cv2.resize(img, (side or LOW_SIDE,) * 2, interpolation=cv2.INTER_AREA)
     return np.where(small > 127, 255, 0).astype(np.uint8) if binary else small
 
 
-# low-res pixel x = (x - 1.5) / 4 for a 4x area reduction (pixel centres)
-S_LOW = np.array([[1.0 / REDUCE, 0, -(REDUCE - 1) / 2 / REDUCE], [0, 1.0 / REDUCE, -(REDUCE - 1) / 2 / REDUCE]])
-
-
-def map_error(M, T, f):
-    """The stricter measure: the largest |M f_i - T f_i| over the contour, % of the size."""
-    if M is None:
-        return math.inf
-    d = apply(M, f) - apply(T, f)
-    return 100 * float(np.sqrt((d * d).sum(axis=1)).max() / shape_size(apply(T, f)))
-
-
-def rms_error(M, T, f):
-    """The measure as the reference evaluation states its figures: the RMS of |M f_i - T f_i| over the
-    contour, % of the size."""
-    if M is None:
-        return math.inf
-    d = apply(M, f) - apply(T, f)
-    return 100 * float(np.sqrt((d * d).sum(axis=1).mean()) / shape_size(apply(T, f)))
+S_LOW = low_map(LOW_SIDE)  # low-res pixel x = (x - 1.5) / 4 for a 4x area reduction
 
 
 def errors(M, T, f):
-    return rms_error(M, T, f), map_error(M, T, f)
+    """The RMS (the primary measure) and the largest of |M f_i - T f_i| over the contour, % of the
+    size; inf when the registration failed."""
+    if M is None:
+        return math.inf, math.inf
+    d = np.sqrt(((apply(M, f) - apply(T, f)) ** 2).sum(axis=1)) / shape_size(apply(T, f))
+    return 100 * float(np.sqrt((d * d).mean())), 100 * float(d.max())
 
 
 CLOCK = time.perf_counter  # --cpu-time: time.process_time
@@ -270,9 +265,7 @@ def tool_register(tool, sp, tp, extra):
 
 def ecc_register(a8, b8):
     """W with b(W x) ~ a(x): source pixels -> target pixels; None when every start fails."""
-    sigma = 0.01 * max(a8.shape)
-    a = cv2.GaussianBlur(a8.astype(np.float32) / 255, (0, 0), sigma)
-    b = cv2.GaussianBlur(b8.astype(np.float32) / 255, (0, 0), sigma)
+    a, b = (cv2.GaussianBlur(x.astype(np.float32) / 255, (0, 0), 0.01 * max(a8.shape)) for x in (a8, b8))
     return registration_heldout.ecc_multistart(a, b, cv2)
 
 
@@ -296,34 +289,23 @@ EXTRA = [('lib', 'library alone')]  # timing only
 MEASURES = [(0, 'RMS'), (1, 'max')]  # index into a record (rms %, max %, confidence, ms)
 
 
-def reference_register(tool, tmp, src, tgt):
-    """The reference evaluation's calibration: both images traced by scikit-image's find_contours at half level
-    and handed to the tool as point lists."""
-    sp, tp = os.path.join(tmp, 'src.txt'), os.path.join(tmp, 'tgt.txt')
-    np.savetxt(sp, subpixel_contour(src))
-    np.savetxt(tp, subpixel_contour(tgt))
-    return tool_register(tool, sp, tp, [])
-
-
-def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=None, use_ref=False):
+def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=None, use_ref=False, lib=True):
     """{method: (rms error %, max error %, confidence, ms)}."""
     if key in ('lowres', 'grey'):
         src, tgt = reduce(src, key == 'lowres'), reduce(tgt, key == 'lowres')
         T = compose(S_LOW, compose(T, inv_affine(S_LOW)))
         f = apply(S_LOW, f)
     sp, tp = os.path.join(tmp, 'src.png'), os.path.join(tmp, 'tgt.png')
-    cv2.imwrite(sp, src)
-    cv2.imwrite(tp, tgt)
+    cv2.imwrite(sp, src), cv2.imwrite(tp, tgt)
     out = {}
-    for m, extra in (('sub', []), ('chain', ['--pixel-chain'])):
-        if m == 'chain' and not use_chain:
-            continue
+    for m, extra in [('sub', [])] + ([('chain', ['--pixel-chain'])] if use_chain else []):
         M, conf, ms = tool_register(tool, sp, tp, extra)
         out[m] = (*errors(M, T, f), conf, ms)
-    if use_ref:
-        M, conf, ms = reference_register(tool, tmp, src, tgt)
+    if use_ref:  # the calibration: both images traced by find_contours, to the tool as point lists
+        np.savetxt(sp + '.txt', subpixel_contour(src)), np.savetxt(tp + '.txt', subpixel_contour(tgt))
+        M, conf, ms = tool_register(tool, sp + '.txt', tp + '.txt', [])
         out['ref'] = (*errors(M, T, f), conf, ms)
-    out['lib'] = (0.0, 0.0, 0.0, lib_register_ms(src, tgt, breakdown))
+    out['lib'] = (0.0, 0.0, 0.0, lib_register_ms(src, tgt, breakdown) if lib else math.nan)
     if use_ecc:
         t0 = time.perf_counter()
         W = ecc_register(src, tgt)
@@ -336,8 +318,7 @@ def summary(recs, thr, measure=0):
     >= CONFIDENT %) under the measure (0: RMS, 1: max)."""
     if not recs:
         return None
-    err = np.array([r[measure] for r in recs])
-    conf = np.array([r[2] for r in recs])
+    err, conf = np.array([r[measure] for r in recs]), np.array([r[2] for r in recs])
     ok = err < thr
     wrong_conf = (~ok) & (conf >= CONFIDENT)
     good_conf = 100 * float(np.mean(conf[ok] >= CONFIDENT)) if ok.any() else math.nan
@@ -347,10 +328,7 @@ def summary(recs, thr, measure=0):
 
 def print_table(title, res, conds, methods, measure=0):
     print('\n%s' % title)
-    head = '%-44s' % 'condition'
-    for _, lab in methods:
-        head += ' | %-38s' % lab
-    print(head)
+    print('%-44s' % 'condition' + ''.join(' | %-38s' % lab for _, lab in methods))
     print('%-44s' % '' + ''.join(' | %-38s' % 'ok %   w+c %  ok+c %  med err %  ms' for _ in methods))
     for key, lab, thr in conds:
         line = '%-44s' % ('%s (%d pairs)' % (lab, len(res[key]['sub'])))
@@ -366,60 +344,90 @@ def print_table(title, res, conds, methods, measure=0):
         print(line)
 
 
+def family_table(res, conds, methods):
+    """One table a method: success and wrong + confident (RMS measure) per condition level, the
+    sets side by side; returns {method: {set: {key: [ok %, w+c %, pairs]}}}."""
+    sets = [(k, l) for k, l in (('A', 'fold A'), ('B', 'fold B'), ('P', 'procedural')) if res[k][conds[0][0]]['sub']]
+    out = {}
+    for m, lab in methods:
+        print('\n%s: ok %% / wrong + confident %% (RMS error < 2 %% of R, 4 %% at low resolution)' % lab)
+        print('%-20s' % 'condition' + ''.join(' | %-19s' % ('%s (%d)' % (sl, len(res[k][conds[0][0]][m])))
+                                             for k, sl in sets))
+        for c in conds:
+            line = '%-20s' % c[1]
+            for k, _ in sets:
+                sm = summary(res[k][c[0]][m], c[4])
+                out.setdefault(m, {}).setdefault(k, {})[c[0]] = [sm[0], sm[1], sm[4]]
+                line += ' | %6.1f / %5.1f     ' % (sm[0], sm[1]) if m != 'ecc' else ' | %6.1f / -         ' % sm[0]
+            print(line)
+    return out
+
+
 def main():
+    global CLOCK, SPAN, CANVAS
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    ap.add_argument('--data', default=os.path.join(ROOT, '..', 'shared', 'datasets', 'mpeg7-dev'))
-    ap.add_argument('--tool', default=os.path.join(ROOT, 'build', 'tools', 'amscr'))
+    ap.add_argument('--data', default=os.path.join(os.environ.get('AMSCR_DATASETS') or
+                                                   os.path.join(ROOT, '..', 'shared', 'datasets'), 'mpeg7-dev'))
+    ap.add_argument('--tool', default=os.environ.get('AMSCR_TOOL') or os.path.join(ROOT, 'build', 'tools', 'amscr'))
     ap.add_argument('--draws', type=int, default=2)
     ap.add_argument('--no-ecc', action='store_true')
     ap.add_argument('--no-chain', action='store_true', help='skip the --pixel-chain column')
     ap.add_argument('--conditions', '--only', dest='only', default='',
                     help='comma-separated condition keys: ' + ','.join(c[0] for c in CONDITIONS))
-    ap.add_argument('--fold', default='', choices=['', 'A', 'B'], help='one fold of folds.tsv only')
-    ap.add_argument('--breakdown', action='store_true',
-                    help="the library's time split: traces, registration, without polish, without polish and refinement")
-    ap.add_argument('--cpu-time', action='store_true',
-                    help="lib ms as the process's CPU time, not wall time (steadier on a shared machine; "
-                         "run with OPENBLAS_NUM_THREADS=1, or BLAS threads that spin are counted)")
-    ap.add_argument('--reference', action='store_true',
-                    help="add the reference evaluation's calibration: scikit-image find_contours point lists through the tool")
+    ap.add_argument('--fold', default='', choices=['', 'A', 'B', 'P'], help='one fold (P: procedural) only')
+    ap.add_argument('--families', action='store_true', help="the check's conditions swept (see above)")
+    ap.add_argument('--quick', action='store_true', help='--families at the check\'s points only')
+    ap.add_argument('--procedural', type=int, default=None, help='N procedural shapes (35 with --families, else 0)')
+    ap.add_argument('--breakdown', action='store_true', help="lib ms split: traces, register, no polish, no refine")
+    ap.add_argument('--cpu-time', action='store_true', help="lib ms as CPU time (with OPENBLAS_NUM_THREADS=1)")
+    ap.add_argument('--reference', action='store_true', help="add the calibration: find_contours lists to the tool")
     ap.add_argument('--classes', type=int, default=0, help='the first N classes only (0: all)')
-    ap.add_argument('--low-px', type=float, default=SPAN / REDUCE,
-                    help='the shape\'s size across in the lowres and grey conditions (default 35: a 4x reduction)')
+    ap.add_argument('--low-px', type=float, default=SPAN / REDUCE, help='lowres / grey: the shape N px across')
     ap.add_argument('--json', default=None)
     a = ap.parse_args()
     if a.cpu_time:
-        global CLOCK
         CLOCK = time.process_time
     if a.low_px != SPAN / REDUCE:
         set_low_px(a.low_px)
-    if not os.path.isdir(a.data):
+    a.families = a.families or a.quick
+    if a.families:
+        SPAN, CANVAS = 200.0, 280
+    nproc = a.procedural if a.procedural is not None else (35 if a.families else 0)
+    classes = load_classes(a.data) if os.path.isdir(a.data) else []
+    if not classes and not nproc:
         print('registration_traced: no data at %s (skipped)' % a.data)
         return 0
-    use_ecc = not a.no_ecc
-    classes = load_classes(a.data)
     class_index = {c[0]: i for i, c in enumerate(classes)}  # the seeds do not depend on --fold
     if a.classes:
         classes = classes[:a.classes]
+    for i in range(nproc):
+        class_index['proc%02d' % i] = 1000 + i
+        classes.append(('proc%02d' % i, shapegen.silhouette(1, i), 'P'))
     if a.fold:
         classes = [c for c in classes if c[2] == a.fold]
+    use_ecc = not a.no_ecc
     use_chain = not a.no_chain
-    conds = [c for c in CONDITIONS if not a.only or c[0] in a.only.split(',')]
-    keys = [c[0] for c in conds]
-    res = {fold: {k: {m: [] for m, _ in METHODS + EXTRA} for k, _, _ in CONDITIONS} for fold in ('A', 'B', 'all')}
+    allconds = (family_conditions(a.quick) if a.families else
+                [(k, lab, k, None, t, i) for i, (k, lab, t) in enumerate(CONDITIONS)])
+    conds = [c for c in allconds if not a.only or c[0] in a.only.split(',')]
+    res = {fold: {c[0]: {m: [] for m, _ in METHODS + EXTRA} for c in conds} for fold in ('A', 'B', 'P', 'all')}
     rows = []
     split = {}  # condition -> [ms of the traces, register, no polish, no polish + no refine]
     with tempfile.TemporaryDirectory() as tmp:
         for ci, (cls, path, fold) in enumerate(classes):
             src = load_source(path)
             f = subpixel_contour(src)
-            for key in keys:
+            for key, _, kind, level, _, seed in conds:
                 for d in range(a.draws):
-                    rng = np.random.default_rng([class_index[cls], [c[0] for c in CONDITIONS].index(key), d, 2024])
-                    tgt, T = make_target(src, f, rng)
-                    tgt = damage(key, tgt, apply(T, f), rng)
+                    rng = np.random.default_rng([class_index[cls], seed, d, 2024])
+                    if a.families:
+                        tgt, T = family_target(src, f, kind, level, rng)
+                    else:
+                        tgt, T = make_target(src, f, rng)
+                        tgt = damage(key, tgt, apply(T, f), rng)
                     bd = [] if a.breakdown else None
-                    out = run_pair(a.tool, tmp, key, src, tgt, f, T, use_ecc, use_chain, bd, a.reference)
+                    out = run_pair(a.tool, tmp, key, src, tgt, f, T, use_ecc, use_chain, bd, a.reference,
+                                   lib=not a.families)
                     if bd:
                         split.setdefault(key, []).append(bd)
                     rows.append({'class': cls, 'fold': fold, 'condition': key, 'draw': d,
@@ -432,9 +440,18 @@ def main():
     print(file=sys.stderr)
     methods = [m for m in METHODS if (use_ecc or m[0] != 'ecc') and (use_chain or m[0] != 'chain')
                and (a.reference or m[0] != 'ref')]
+    if a.families:
+        table = family_table(res, conds, methods)
+        if a.json:
+            with open(a.json, 'w') as fp:
+                json.dump({'draws': a.draws, 'table': table, 'pairs': rows}, fp)
+        return 0
+    conds = [(c[0], c[1], c[4]) for c in conds]
+    keys = [c[0] for c in conds]
     for measure, what in ((0, 'RMS error (as the reference evaluation measures)'), (1, 'max error (stricter; the figures before 0.5)')):
         print('\n=== %s: success < 2 %% of the size (4 %% at low resolution) ===' % what)
-        for fold, title in (('A', 'fold 1 (folds.tsv A)'), ('B', 'fold 2 (folds.tsv B)'), ('all', 'both folds')):
+        for fold, title in (('A', 'fold 1 (folds.tsv A)'), ('B', 'fold 2 (folds.tsv B)'), ('P', 'procedural'),
+                            ('all', 'all shapes')):
             if any(res[fold][k]['sub'] for k in keys):
                 print_table('%s, %s' % (title, what.split(' (')[0]), res[fold], conds, methods, measure)
     if split:
