@@ -448,9 +448,15 @@ START_TEST(stored_features)
     void *buf = NULL;
     size_t len = 0, l3 = 0;
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    ck_assert_int_eq(((unsigned char *)buf)[8], 13);
+    ck_assert_int_eq(((unsigned char *)buf)[8], 14);
     ck_assert_int_eq(x->nf, 2);
-    unsigned char *v3 = as_version3(x, buf, len, &l3);
+    void *b13 = NULL; /* the format of 0.11 to 0.13, which older files are made from */
+    size_t l13 = 0;
+    ck_assert_int_eq(amscr__index_write(x, 13, &b13, &l13), AMSCR_OK);
+    ck_assert_int_eq(((unsigned char *)b13)[8], 13);
+    ck_assert_uint_gt(l13, len);
+    unsigned char *v3 = as_version3(x, b13, l13, &l3);
+    free(b13);
     for (unsigned lazy = 0; lazy < 2; lazy++) {
         ck_assert_int_eq(amscr_index_load_memory_with(v3, l3, lazy ? AMSCR_INDEX_LAZY : 0u, &y), AMSCR_OK);
         same_query(x, y, q, 0);
@@ -589,9 +595,32 @@ START_TEST(inner_section)
     size_t k2 = x->k2, fk = AMSCR__INNER_F * AMSCR__INNER_K, len = 0;
     void *buf = NULL;
     ck_assert_uint_gt(k2, 0);
+    /* version 14: the lists alone, the features computed at load */
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    size_t sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * 8 * (2 * fk + 1), at = len - 8 - sec;
+    size_t sec = 4 + 8 + NSHAPES * k2 * 12, at = len - 8 - sec;
     unsigned char *b = malloc(len);
+    memcpy(b, buf, len);
+    ck_assert_uint_eq(b[at], k2);
+    b[at] = 0; /* no inner graph, the params give one */
+    reseal(b, len, 14);
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "inner graph") != NULL);
+    memcpy(b, buf, len);
+    b[at + 12] = 1; /* shape 0's inner list not starting with itself */
+    reseal(b, len, 14);
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "inner neighbour") != NULL);
+    ck_assert_int_eq(amscr_index_load_memory(buf, len, &y), AMSCR_OK);
+    for (size_t i = 0; i < NSHAPES; i++) /* the features recomputed: the build's, bit for bit */
+        ck_assert(memcmp(&y->inner[i], &x->inner[i], sizeof x->inner[i]) == 0);
+    amscr_index_free(y);
+    y = NULL;
+    free(b);
+    amscr_free(buf);
+    /* version 13 (0.11 to 0.13): the features stored */
+    ck_assert_int_eq(amscr__index_write(x, 13, &buf, &len), AMSCR_OK);
+    sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * 8 * (2 * fk + 1), at = len - 8 - sec;
+    b = malloc(len);
     memcpy(b, buf, len);
     ck_assert_uint_eq(b[at], k2);
     b[at] = 0; /* no inner graph, the params give one */
@@ -622,7 +651,7 @@ START_TEST(inner_section)
     ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.0), AMSCR_OK);
     x = named_index(p, 0);
     ck_assert_uint_eq(x->k2, 0);
-    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    ck_assert_int_eq(amscr__index_write(x, 13, &buf, &len), AMSCR_OK);
     v8 = as_version8(x, buf, len, 4, &l8);
     ck_assert_int_eq(amscr_index_load_memory(v8, l8, &y), AMSCR_OK);
     amscr_descriptor *q = shape(p, 2000);
@@ -633,6 +662,63 @@ START_TEST(inner_section)
     amscr_free(buf);
     amscr_index_free(x);
     amscr_index_free(y);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* An index holds its shapes as compact records (their input samples and outline): each decodes
+ * to the prepared shape it was built from, bit for bit; a version 13 file (0.11 to 0.13, full
+ * records and the inner features) loads, eagerly and lazily, to the same scores and saves as the
+ * build's version 14 bytes; every cut of a version 14 file is refused. */
+START_TEST(compact_shapes)
+{
+    amscr_params *p = params_of(0.5, 8, 2); /* fused: a query reads the candidates' prepared shapes */
+    amscr_db *db = db_of(p, NSHAPES);
+    amscr_index *x = NULL, *y = NULL;
+    ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
+    size_t N = amscr_params_get_num_samples(p), np = amscr_db_params(amscr_index_db(x))->num_scales;
+    for (size_t i = 0; i < NSHAPES; i++) {
+        const amscr_descriptor *a = amscr_db_descriptor(db, i), *b = amscr_db_descriptor(amscr_index_db(x), i);
+        ck_assert_ptr_nonnull(b);
+        ck_assert(a != b);
+        ck_assert(memcmp(a->input, b->input, 2 * N * sizeof(double)) == 0);
+        ck_assert(memcmp(a->base, b->base, 2 * N * sizeof(double)) == 0);
+        ck_assert(memcmp(a->scaled, b->scaled, 2 * N * np * sizeof(double)) == 0);
+        ck_assert(memcmp(a->fwd, b->fwd, sizeof a->fwd) == 0 && memcmp(a->inv, b->inv, sizeof a->inv) == 0);
+        ck_assert(a->outline && b->outline && memcmp(a->outline, b->outline, 2 * AMSCR__OUTLINE_N * 8) == 0);
+        ck_assert_int_eq(amscr_db_label(amscr_index_db(x), i), amscr_db_label(db, i));
+    }
+    amscr_db_free(db);
+    amscr_descriptor *q = shape(p, 2000);
+    void *buf = NULL, *b13 = NULL, *b2 = NULL;
+    size_t len = 0, l13 = 0, len2 = 0;
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    ck_assert_int_eq(amscr__index_write(x, 13, &b13, &l13), AMSCR_OK);
+    ck_assert_uint_lt(len, l13);
+    for (unsigned lazy = 0; lazy < 2; lazy++) {
+        ck_assert_int_eq(amscr_index_load_memory_with(b13, l13, lazy ? AMSCR_INDEX_LAZY : 0u, &y), AMSCR_OK);
+        same_query(x, y, q, 0);
+        same_query(x, y, q, 6);
+        ck_assert_int_eq(amscr_index_save_memory(y, &b2, &len2), AMSCR_OK);
+        ck_assert_uint_eq(len2, len);
+        ck_assert(memcmp(b2, buf, len) == 0);
+        amscr_free(b2);
+        amscr_index_free(y);
+        ck_assert_int_eq(amscr_index_load_memory_with(buf, len, lazy ? AMSCR_INDEX_LAZY : 0u, &y), AMSCR_OK);
+        same_query(x, y, q, 0);
+        same_query(x, y, q, 6);
+        amscr_index_free(y);
+        y = NULL;
+    }
+    for (size_t cut = 0; cut < len; cut += cut < 256 ? 1 : 997) { /* a file cut short anywhere */
+        ck_assert_int_ne(amscr_index_load_memory(buf, cut, &y), AMSCR_OK);
+        ck_assert_ptr_null(y);
+        ck_assert(strlen(amscr_last_error_detail()) > 0);
+    }
+    amscr_descriptor_free(q);
+    free(b13);
+    amscr_free(buf);
+    amscr_index_free(x);
     amscr_params_free(p);
 }
 END_TEST
@@ -1052,6 +1138,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, inner_section);
     tcase_add_test(tc, member_rows);
     tcase_add_test(tc, round_trips);
+    tcase_add_test(tc, compact_shapes);
     tcase_add_test(tc, lazy_load);
     tcase_add_test(tc, lazy_file_shapes);
     tcase_add_test(tc, stored_features);

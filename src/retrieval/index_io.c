@@ -91,8 +91,9 @@ static amscr_status write_features(const amscr_index *x, amscr__wbuf *w)
     return st;
 }
 
-/* The inner distance's graph (version 9). */
-static void write_inner(const amscr_index *x, amscr__wbuf *w)
+/* The inner distance's graph (version 9; from version 14 without the features: a load computes
+ * them from the shapes' outlines). */
+static void write_inner(const amscr_index *x, uint32_t version, amscr__wbuf *w)
 {
     size_t n = amscr_db_size(x->db), k2 = x->k2;
     amscr__w_u32(w, (uint32_t)k2);
@@ -103,30 +104,26 @@ static void write_inner(const amscr_index *x, amscr__wbuf *w)
         amscr__w_u32(w, x->in_idx[i]);
         amscr__w_f64(w, x->in_dist[i]);
     }
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < n && !amscr__db_compact(version); i++) {
         amscr__w_f64s(w, &x->inner[i].re[0][0], AMSCR__INNER_F * AMSCR__INNER_K);
         amscr__w_f64s(w, &x->inner[i].im[0][0], AMSCR__INNER_F * AMSCR__INNER_K);
         amscr__w_f64(w, x->inner[i].norm2);
     }
 }
 
-amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_t *out_len)
+amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **out_buf, size_t *out_len)
 {
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(x);
-    AMSCR_CHECK_NULL(out_buf);
-    AMSCR_CHECK_NULL(out_len);
-    amscr_status st = amscr__db_decode_all(x->db); /* a lazy load's shapes */
+    amscr_status st = amscr__db_compact(version) ? AMSCR_OK : amscr__db_decode_all(x->db);
     if (st != AMSCR_OK)
         return st;
-    amscr__wbuf w = {NULL, 0, 0, 0};
-    amscr__db_write(x->db, AMSCR__DB_VERSION_INDEX_VIEW, &w);
+    amscr__wbuf w = {NULL, 0, 0, 0}; /* compact records: a lazy load's shapes are not decoded */
+    amscr__db_write(x->db, version, &w);
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
     write_section(x, &w);
     st = write_features(x, &w);
     if (st == AMSCR_OK)
-        write_inner(x, &w);
+        write_inner(x, version, &w);
     if (st != AMSCR_OK) {
         free(w.buf);
         return st;
@@ -135,7 +132,7 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
         uint64_t sec = (uint64_t)(w.len - at - 8);
         for (int i = 0; i < 8; i++)
             w.buf[at + (size_t)i] = (unsigned char)(sec >> (8 * i));
-        amscr__w_u64(&w, amscr__db_checksum(AMSCR__DB_VERSION_INDEX_VIEW, w.buf, w.len));
+        amscr__w_u64(&w, amscr__db_checksum(version, w.buf, w.len));
     }
     if (w.oom) {
         free(w.buf);
@@ -144,6 +141,15 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
     *out_buf = w.buf;
     *out_len = w.len;
     return AMSCR_OK;
+}
+
+amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_t *out_len)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    AMSCR_CHECK_NULL(out_buf);
+    AMSCR_CHECK_NULL(out_len);
+    return amscr__index_write(x, AMSCR__DB_VERSION_NEWEST, out_buf, out_len);
 }
 
 amscr_status amscr_index_save(const amscr_index *x, const char *path)
@@ -282,8 +288,9 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
     return AMSCR_OK;
 }
 
-/* The inner distance's graph of a version 9 file (its K2 must be the params'). */
-static amscr_status read_inner(amscr__rbuf *r, amscr_index *x)
+/* The inner distance's graph of a file of version 9 to 13 (its K2 must be the params'); from
+ * version 14 its lists only, the features computed from the shapes. */
+static amscr_status read_inner(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
     size_t n = amscr_db_size(x->db), fk = AMSCR__INNER_F * AMSCR__INNER_K;
     uint32_t k2 = amscr__r_u32(r);
@@ -295,13 +302,17 @@ static amscr_status read_inner(amscr__rbuf *r, amscr_index *x)
     x->dmax2 = amscr__r_f64(r);
     if (r->bad || !(x->dmax2 >= 0.0) || !isfinite(x->dmax2))
         return amscr__fail(AMSCR_E_FORMAT, "index file: bad largest inner distance");
-    size_t per = 12 * (size_t)k2 + 8 * (2 * fk + 1);
+    int compact = amscr__db_compact(version);
+    size_t per = 12 * (size_t)k2 + (compact ? 0 : 8 * (2 * fk + 1));
     if ((r->len - r->pos) / per < n)
         return amscr__fail(AMSCR_E_FORMAT, "index file: the inner graph is truncated");
     amscr_status st = read_list(r, n, k2, x->in_idx, x->in_dist, "inner ");
     amscr__inner_ws ws;
     if (st != AMSCR_OK)
         return st;
+    if (compact) /* bit for bit the build's: the same outlines, the same code */
+        return amscr__inner_features(x->db, 0, amscr__resolve_threads(amscr_db_params(x->db)->num_threads),
+                                     x->inner);
     if (amscr__inner_ws_init(&ws) != AMSCR_OK)
         return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
     for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
@@ -322,7 +333,7 @@ static amscr_status read_rest(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
     amscr_status st = amscr__db_has_features(version) ? read_features(r, x) : AMSCR_OK;
     if (st == AMSCR_OK && version >= AMSCR__DB_VERSION_INDEX_GRAPHS)
-        st = read_inner(r, x);
+        st = read_inner(r, x, version);
     else if (st == AMSCR_OK && x->k2 > 0)
         st = amscr__fail(AMSCR_E_FORMAT, "index file: format %u has no inner graph, its params give one",
                          (unsigned)version);
@@ -347,7 +358,10 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int
     size_t pos = 0;
     uint32_t version = 0;
     int lazy = map && (flags & AMSCR_INDEX_LAZY); /* the shapes decoded from the kept mapping when needed */
-    amscr_status st = amscr__db_parse(buf, len, lazy, &db, &pos, &version);
+    const unsigned char *b = buf;
+    uint32_t v0 = len >= 12 ? (uint32_t)b[8] | (uint32_t)b[9] << 8 | (uint32_t)b[10] << 16 | (uint32_t)b[11] << 24 : 0;
+    /* compact records stay records (checked now, decoded when read) */
+    amscr_status st = amscr__db_parse(buf, len, lazy || amscr__db_compact(v0), &db, &pos, &version);
     if (st != AMSCR_OK)
         return st;
     amscr_index *x = calloc(1, sizeof *x);
@@ -382,6 +396,8 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int
         st = read_rest(&r, x, version);
     if (st == AMSCR_OK)
         st = amscr__index_features(x, 0, 1);
+    if (st == AMSCR_OK && !x->map) /* the shapes held as compact records: a copy of the file's, or made */
+        st = amscr__db_compact(version) ? amscr__db_own_source(x->db) : amscr__index_compact_db(x);
     if (st != AMSCR_OK) {
         amscr__index_detach_map(x); /* the caller unmaps */
         amscr_index_free(x);

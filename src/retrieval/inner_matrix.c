@@ -3,6 +3,7 @@
  * threads (rows.c: every cell computed by the same code, so the result does not depend on the
  * thread count), mirrored into a symmetric matrix with a zero diagonal. */
 #include "channel.h" /* amscr__mirror_upper */
+#include "db_io.h"   /* amscr__db_descriptor_peek */
 #include "inner.h"
 #include "rows.h"
 
@@ -27,10 +28,13 @@ static amscr_status job_init(void *ctx, void **ws)
 static amscr_status feature_row(void *ctx, size_t i, void *ws)
 {
     const inner_job *m = ctx;
-    const amscr_descriptor *d = amscr_db_descriptor(m->db, i);
+    amscr_descriptor *tmp = NULL; /* a lazy collection's shape, decoded for this row only */
+    const amscr_descriptor *d = amscr__db_descriptor_peek(m->db, i, &tmp);
     if (!d)
         return amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
-    return amscr__inner_build_shape(d, amscr_db_params(m->db)->inner_closing, &m->f[i], ws);
+    amscr_status st = amscr__inner_build_shape(d, amscr_db_params(m->db)->inner_closing, &m->f[i], ws);
+    amscr_descriptor_free(tmp);
+    return st;
 }
 
 /* Rows a task takes, and the columns each row takes at a time: a column group's features
