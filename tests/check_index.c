@@ -4,11 +4,17 @@
  * member rows; file and memory round trips; damaged files; add; thread-count independence. */
 #include <amscr.h>
 #include <check.h>
+#include <dirent.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <signal.h>
+#include <unistd.h>
 
 #include "db_io.h"
 #include "index.h"
@@ -723,6 +729,78 @@ START_TEST(compact_shapes)
 }
 END_TEST
 
+/* The file's bytes at path (*len; caller frees). */
+static unsigned char *file_bytes(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    ck_assert_ptr_nonnull(f);
+    unsigned char *b = malloc(1 << 22);
+    *len = fread(b, 1, 1 << 22, f);
+    fclose(f);
+    return b;
+}
+
+/* A save cut off, by a full disk (the file-size limit: writes fail) or by the process killed
+ * mid-write (SIGXFSZ's default), never replaces the good file, whose mode stays; the failed
+ * save reports an I/O error. */
+START_TEST(cut_off_save)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_index *x = named_index(p, 0);
+    char path[] = "/tmp/amscr_cut_XXXXXX";
+    int fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    ck_assert_int_eq(amscr_index_save(x, path), AMSCR_OK);
+    ck_assert_int_eq(chmod(path, 0644), 0);
+    size_t l0 = 0, l1 = 0;
+    unsigned char *b0 = file_bytes(path, &l0);
+    ck_assert_uint_gt(l0, 8192);
+    for (int killed = 0; killed < 2; killed++) {
+        pid_t pid = fork();
+        ck_assert_int_ge(pid, 0);
+        if (pid == 0) { /* the child: writes beyond 4 KB fail, or kill it */
+            signal(SIGXFSZ, killed ? SIG_DFL : SIG_IGN);
+            struct rlimit rl = {4096, 4096};
+            setrlimit(RLIMIT_FSIZE, &rl);
+            amscr_status st = amscr_index_save(x, path);
+            _exit(st == AMSCR_E_IO ? 3 : 4);
+        }
+        int ws = 0;
+        ck_assert_int_eq(waitpid(pid, &ws, 0), pid);
+        if (killed)
+            ck_assert(WIFSIGNALED(ws) && WTERMSIG(ws) == SIGXFSZ);
+        else
+            ck_assert(WIFEXITED(ws) && WEXITSTATUS(ws) == 3);
+        unsigned char *b1 = file_bytes(path, &l1);
+        ck_assert_uint_eq(l1, l0);
+        ck_assert(memcmp(b0, b1, l0) == 0);
+        free(b1);
+        struct stat sb;
+        ck_assert_int_eq(stat(path, &sb), 0);
+        ck_assert_uint_eq(sb.st_mode & 0777, 0644);
+        amscr_index *y = NULL;
+        ck_assert_int_eq(amscr_index_load(path, &y), AMSCR_OK);
+        amscr_index_free(y);
+    }
+    free(b0);
+    remove(path);
+    char tmpl[64];
+    snprintf(tmpl, sizeof tmpl, "%s.tmp.", path + 5);
+    DIR *dir = opendir("/tmp"); /* the killed save's temporary file: cleaned up here */
+    for (struct dirent *e = dir ? readdir(dir) : NULL; e; e = readdir(dir))
+        if (strncmp(e->d_name, tmpl, strlen(tmpl)) == 0) {
+            char t[300];
+            snprintf(t, sizeof t, "/tmp/%s", e->d_name);
+            remove(t);
+        }
+    if (dir)
+        closedir(dir);
+    amscr_index_free(x);
+    amscr_params_free(p);
+}
+END_TEST
+
 START_TEST(round_trips)
 {
     amscr_params *p = params_of(1.0, 8, 2);
@@ -1139,6 +1217,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, member_rows);
     tcase_add_test(tc, round_trips);
     tcase_add_test(tc, compact_shapes);
+    tcase_add_test(tc, cut_off_save);
     tcase_add_test(tc, lazy_load);
     tcase_add_test(tc, lazy_file_shapes);
     tcase_add_test(tc, stored_features);

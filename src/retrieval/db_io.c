@@ -144,6 +144,7 @@ amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t 
         (void)fchmod(fd, (mode_t)amscr__file_mode(path)); /* mkstemp made it 0600 (best effort) */
         FILE *f = fdopen(fd, "wb");
         int ok = f && fwrite(buf, 1, len, f) == len;
+        ok = ok && fflush(f) == 0 && fsync(fd) == 0; /* on the disk before it takes the name */
         if (f)
             ok = (fclose(f) == 0) && ok;
         else

@@ -396,8 +396,8 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int
         st = read_rest(&r, x, version);
     if (st == AMSCR_OK)
         st = amscr__index_features(x, 0, 1);
-    if (st == AMSCR_OK && !x->map) /* the shapes held as compact records: a copy of the file's, or made */
-        st = amscr__db_compact(version) ? amscr__db_own_source(x->db) : amscr__index_compact_db(x);
+    if (st == AMSCR_OK && !x->map) /* the shapes kept as the file's compact records (an older file's decoded) */
+        st = amscr__db_own_source(x->db);
     if (st != AMSCR_OK) {
         amscr__index_detach_map(x); /* the caller unmaps */
         amscr_index_free(x);
