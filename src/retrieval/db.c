@@ -281,6 +281,26 @@ const unsigned char *amscr__db_record(const amscr_db *db, size_t i)
     return i < db->nsrc && db->src_compact ? db->src + db->src_pos0 + i * db->src_per : NULL;
 }
 
+int amscr__db_shallow(const amscr_db *db, size_t i, amscr_descriptor *sd, double *input, double *outline)
+{
+    const unsigned char *rec = amscr__db_record(db, i);
+    if (!rec)
+        return 0;
+    size_t N = db->params.num_samples;
+    amscr__rbuf r = {rec, db->src_per, 4, 0};
+    memset(sd, 0, sizeof *sd);
+    sd->params = db->params;
+    sd->n = N;
+    sd->p = db->params.num_scales;
+    sd->input = input;
+    int ok = amscr__r_f64s(&r, input, 2 * N);
+    if (ok && r.pos < r.len) {
+        sd->outline = outline;
+        ok = amscr__r_f64s(&r, outline, 2 * AMSCR__OUTLINE_N);
+    }
+    return ok;
+}
+
 amscr_status amscr__db_own_source(amscr_db *db)
 {
     if (!db->src || db->src_owned || !db->src_compact)

@@ -311,13 +311,17 @@ static int level_ok(const double *xy, size_t n)
 static void check_shape(const shapes_job *j, uint64_t i, double *scratch)
 {
     size_t N = j->prm->num_samples, p = j->prm->num_scales, at = j->pos0 + (size_t)i * j->per;
-    if (j->compact) { /* what a decode would find: decoded and dropped */
-        amscr_descriptor *d = NULL;
-        j->bad[i] = (unsigned char)decode_shape(j->p, at, j->per, 1, j->prm, &j->label[i], &d);
-        amscr_descriptor_free(d);
+    amscr__rbuf r = {j->p, at + j->per, at, 0};
+    if (j->compact) { /* finite samples with extent (a prepared shape's smoothed levels then have it) */
+        j->label[i] = (int32_t)amscr__r_u32(&r);
+        if (!amscr__r_f64s(&r, scratch, 2 * N))
+            j->bad[i] = 1;
+        else if (!level_ok(scratch, N))
+            j->bad[i] = 2;
+        else if (outline_kept(j->per, 1, j->prm) && !amscr__r_f64s(&r, scratch, 2 * AMSCR__OUTLINE_N))
+            j->bad[i] = 1;
         return;
     }
-    amscr__rbuf r = {j->p, at + j->per, at, 0};
     j->label[i] = (int32_t)amscr__r_u32(&r);
     if (!amscr__r_f64s(&r, scratch, 12) || !amscr__r_f64s(&r, scratch, 2 * N)) {
         j->bad[i] = 1;

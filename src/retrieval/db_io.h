@@ -18,8 +18,7 @@
  * with the inner distance's closing after the share (AMSCR__RETRIEVAL_BLOCK_V4); 12 and 13
  * (0.11): 10 and 11 with the channel's affine-view factor after the closing
  * (AMSCR__RETRIEVAL_BLOCK_V5); 14 (0.14): 13 with compact shape records (a shape's input samples
- * and outline only: the rest recomputed, amscr__descriptor_rebuild) and an index section without
- * the inner features (recomputed from the outlines at load). Every version loads. */
+ * and outline only: the rest recomputed, amscr__descriptor_rebuild). Every version loads. */
 #define AMSCR__DB_VERSION_PLAIN 2u
 #define AMSCR__DB_VERSION_INDEX 3u
 #define AMSCR__DB_VERSION_FEATURES 4u
@@ -122,6 +121,11 @@ const amscr_descriptor *amscr__db_descriptor_peek(const amscr_db *db, size_t i, 
 /* Shape i's compact record (amscr__db_shape_bytes of AMSCR__DB_VERSION_INDEX_COMPACT bytes) when
  * a lazy collection holds it as one, else NULL. */
 const unsigned char *amscr__db_record(const amscr_db *db, size_t i);
+/* Shape i's input samples (2N into input) and outline (2 AMSCR__OUTLINE_N into outline, when
+ * its record has one) read from its compact record into a shallow descriptor sd (params, n, p,
+ * input, outline; the rest NULL: for amscr__inner_vertices, nothing that reads the prepared
+ * levels); 0 when shape i is not held as a compact record. */
+int amscr__db_shallow(const amscr_db *db, size_t i, amscr_descriptor *sd, double *input, double *outline);
 /* A lazy collection of compact records read from a caller's buffer takes a copy of them (its
  * source then outlives the buffer); nothing for any other collection. */
 amscr_status amscr__db_own_source(amscr_db *db);

@@ -91,9 +91,8 @@ static amscr_status write_features(const amscr_index *x, amscr__wbuf *w)
     return st;
 }
 
-/* The inner distance's graph (version 9; from version 14 without the features: a load computes
- * them from the shapes' outlines). */
-static void write_inner(const amscr_index *x, uint32_t version, amscr__wbuf *w)
+/* The inner distance's graph (version 9). */
+static void write_inner(const amscr_index *x, amscr__wbuf *w)
 {
     size_t n = amscr_db_size(x->db), k2 = x->k2;
     amscr__w_u32(w, (uint32_t)k2);
@@ -104,7 +103,7 @@ static void write_inner(const amscr_index *x, uint32_t version, amscr__wbuf *w)
         amscr__w_u32(w, x->in_idx[i]);
         amscr__w_f64(w, x->in_dist[i]);
     }
-    for (size_t i = 0; i < n && !amscr__db_compact(version); i++) {
+    for (size_t i = 0; i < n; i++) {
         amscr__w_f64s(w, &x->inner[i].re[0][0], AMSCR__INNER_F * AMSCR__INNER_K);
         amscr__w_f64s(w, &x->inner[i].im[0][0], AMSCR__INNER_F * AMSCR__INNER_K);
         amscr__w_f64(w, x->inner[i].norm2);
@@ -123,7 +122,7 @@ amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **o
     write_section(x, &w);
     st = write_features(x, &w);
     if (st == AMSCR_OK)
-        write_inner(x, version, &w);
+        write_inner(x, &w);
     if (st != AMSCR_OK) {
         free(w.buf);
         return st;
@@ -288,9 +287,8 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
     return AMSCR_OK;
 }
 
-/* The inner distance's graph of a file of version 9 to 13 (its K2 must be the params'); from
- * version 14 its lists only, the features computed from the shapes. */
-static amscr_status read_inner(amscr__rbuf *r, amscr_index *x, uint32_t version)
+/* The inner distance's graph of a file of version 9 or later (its K2 must be the params'). */
+static amscr_status read_inner(amscr__rbuf *r, amscr_index *x)
 {
     size_t n = amscr_db_size(x->db), fk = AMSCR__INNER_F * AMSCR__INNER_K;
     uint32_t k2 = amscr__r_u32(r);
@@ -302,17 +300,13 @@ static amscr_status read_inner(amscr__rbuf *r, amscr_index *x, uint32_t version)
     x->dmax2 = amscr__r_f64(r);
     if (r->bad || !(x->dmax2 >= 0.0) || !isfinite(x->dmax2))
         return amscr__fail(AMSCR_E_FORMAT, "index file: bad largest inner distance");
-    int compact = amscr__db_compact(version);
-    size_t per = 12 * (size_t)k2 + (compact ? 0 : 8 * (2 * fk + 1));
+    size_t per = 12 * (size_t)k2 + 8 * (2 * fk + 1);
     if ((r->len - r->pos) / per < n)
         return amscr__fail(AMSCR_E_FORMAT, "index file: the inner graph is truncated");
     amscr_status st = read_list(r, n, k2, x->in_idx, x->in_dist, "inner ");
     amscr__inner_ws ws;
     if (st != AMSCR_OK)
         return st;
-    if (compact) /* bit for bit the build's: the same outlines, the same code */
-        return amscr__inner_features(x->db, 0, amscr__resolve_threads(amscr_db_params(x->db)->num_threads),
-                                     x->inner);
     if (amscr__inner_ws_init(&ws) != AMSCR_OK)
         return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
     for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
@@ -333,7 +327,7 @@ static amscr_status read_rest(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
     amscr_status st = amscr__db_has_features(version) ? read_features(r, x) : AMSCR_OK;
     if (st == AMSCR_OK && version >= AMSCR__DB_VERSION_INDEX_GRAPHS)
-        st = read_inner(r, x, version);
+        st = read_inner(r, x);
     else if (st == AMSCR_OK && x->k2 > 0)
         st = amscr__fail(AMSCR_E_FORMAT, "index file: format %u has no inner graph, its params give one",
                          (unsigned)version);
