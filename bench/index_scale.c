@@ -35,6 +35,7 @@
 
 #include "affine_warp.h"
 #include "amscr.h"
+#include "db_io.h"
 #include "index.h"
 #include "mcd_set.h"
 
@@ -194,9 +195,11 @@ static void list_recall(const amscr_db *db, const amscr_index *full)
     }
 }
 
-/* Bytes a shape of x holds: channel features, signature with its bound vector, lists and reverse. */
-static void index_bytes(const amscr_index *x, double b[3])
+/* Bytes a shape of x holds: channel features, signature with its bound vector, lists and reverse,
+ * and its shape as the index keeps it (a compact record: input samples and outline). */
+static void index_bytes(const amscr_index *x, double b[4])
 {
+    b[3] = (double)amscr__db_shape_bytes(AMSCR__DB_VERSION_NEWEST, amscr_db_params(x->db));
     size_t n = amscr_db_size(x->db), hf = 0;
     for (size_t i = 0; i < n * (size_t)x->nf; i++)
         hf += 2 * (x->hf[i].n * AMSCR__HF_BINS + AMSCR__HF_BINS * 2 * x->hf[i].nfreq * sizeof(double));
@@ -293,7 +296,7 @@ static void part_scale(const amscr_params *p, const shape_set *s, size_t n)
     for (size_t i = 0; i < n; i++)
         add(db, warped(p, s->c[i % s->n], &seed), s->labels[i % s->n]);
     size_t M = AMSCR_INDEX_CANDIDATES;
-    double before = rss_mb(), tb[2], tl, mb, times[NQ_SCALE], ctimes[NQ_SCALE], ib[3], sc[3];
+    double before = rss_mb(), tb[2], tl, mb, times[NQ_SCALE], ctimes[NQ_SCALE], ib[4], sc[3];
     double prepared = (before - empty) * 1e6 / (double)n;
     amscr_index *x = build(db, M, tb);
     double per_shape = (rss_mb() - before) * 1e3 / (double)n, peak = max_rss_mb();
@@ -309,9 +312,9 @@ static void part_scale(const amscr_params *p, const shape_set *s, size_t n)
         amscr_descriptor_free(d);
     }
     search_cost(x, BUILD_M, sc);
-    printf("| warped copies | %zu | %zu | %.1f s (%.1f) | %.0f MB | %.1f KB | %.0f + %.0f + %.0f B | %.0f B | "
+    printf("| warped copies | %zu | %zu | %.1f s (%.1f) | %.0f MB | %.1f KB | %.0f + %.0f + %.0f + %.0f B | %.0f B | "
            "%.2f s, %.0f MB | %.1f ms (%.1f) | %.3f / %.3f ms, %.1f %% |\n", n, M, tb[0], tb[1], peak, per_shape,
-           ib[0], ib[1], ib[2], prepared, tl, mb, 1e3 * median(times, NQ_SCALE), 1e3 * median(ctimes, NQ_SCALE), sc[0],
+           ib[0], ib[1], ib[2], ib[3], prepared, tl, mb, 1e3 * median(times, NQ_SCALE), 1e3 * median(ctimes, NQ_SCALE), sc[0],
            sc[1], sc[2]);
     fflush(stdout);
     amscr_index_free(x);
@@ -339,7 +342,7 @@ int main(int argc, char **argv)
         printf("\n");
     }
     printf("| collection | shapes | M | build | max RSS | RSS growth a shape | index a shape: features + signature + "
-           "lists | prepared shape | load, file | query (median of %d) | build shortlist (%d) a row: exact / "
+           "lists + shape record | prepared shape | load, file | query (median of %d) | build shortlist (%d) a row: exact / "
            "quantizer, recall |\n|---|---|---|---|---|---|---|---|---|---|---|\n", NQ_SCALE, BUILD_M);
     for (int a = 2; a < argc || a == 2; a++) {
         size_t sizes[2] = {1000, 10000};

@@ -694,6 +694,25 @@ START_TEST(compact_shapes)
         ck_assert(a->outline && b->outline && memcmp(a->outline, b->outline, 2 * AMSCR__OUTLINE_N * 8) == 0);
         ck_assert_int_eq(amscr_db_label(amscr_index_db(x), i), amscr_db_label(db, i));
     }
+    /* shapes added: kept as compact records too, the same index as one built on all of them */
+    amscr_db *half = NULL, *rest = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &half), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_new(p, &rest), AMSCR_OK);
+    for (size_t i = 0; i < NSHAPES; i++)
+        ck_assert_int_eq(amscr_db_add_descriptor(i < NSHAPES - 4 ? half : rest, amscr_db_descriptor(db, i),
+                                                 amscr_db_label(db, i), NULL), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_build(half, 0, NULL, NULL, &y), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_add(y, rest, NULL, NULL), AMSCR_OK);
+    ck_assert_ptr_nonnull(amscr__db_record(amscr_index_db(y), NSHAPES - 1));
+    for (size_t i = 0; i < NSHAPES; i++) {
+        const amscr_descriptor *a = amscr_db_descriptor(db, i), *b = amscr_db_descriptor(amscr_index_db(y), i);
+        ck_assert(memcmp(a->scaled, b->scaled, 2 * N * np * sizeof(double)) == 0);
+        ck_assert_int_eq(amscr_db_label(amscr_index_db(y), i), amscr_db_label(db, i));
+    }
+    amscr_index_free(y);
+    y = NULL;
+    amscr_db_free(half);
+    amscr_db_free(rest);
     amscr_db_free(db);
     amscr_descriptor *q = shape(p, 2000);
     void *buf = NULL, *b13 = NULL, *b2 = NULL;

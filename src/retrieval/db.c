@@ -25,6 +25,7 @@ struct amscr_db {
     size_t src_pos0, src_per, nsrc;
     int src_compact;          /* src holds compact records (db_io.h) */
     unsigned char *src_owned; /* src when the collection owns it (amscr__db_compact_copy) */
+    int compact_owned;        /* its shapes are kept as compact records it owns (added ones too) */
     pthread_mutex_t lock;
     /* What one-vs-many retrieval keeps between queries (retrieval_query.c): owned, released by
      * kept_free, taken under kept_lock (queries of a const collection prepare it once). */
@@ -228,6 +229,7 @@ amscr_status amscr__db_compact_copy(const amscr_db *db, amscr_db **out)
         return st;
     }
     c->src_owned = w.buf;
+    c->compact_owned = 1;
     amscr__db_set_source(c, w.buf, 0, per, 1, n);
     *out = c;
     return AMSCR_OK;
@@ -299,6 +301,29 @@ int amscr__db_shallow(const amscr_db *db, size_t i, amscr_descriptor *sd, double
         ok = amscr__r_f64s(&r, outline, 2 * AMSCR__OUTLINE_N);
     }
     return ok;
+}
+
+amscr_status amscr__db_compact_tail(amscr_db *db)
+{
+    if (!db->compact_owned || db->nsrc == db->n)
+        return AMSCR_OK;
+    size_t per = db->src_per, n = db->n;
+    unsigned char *grown = n <= SIZE_MAX / per ? realloc(db->src_owned, n * per) : NULL;
+    if (!grown)
+        return AMSCR_OK; /* the shapes stay decoded */
+    amscr__wbuf w = {grown, db->nsrc * per, n * per, 0};
+    for (size_t i = db->nsrc; i < n && !w.oom; i++)
+        if (!amscr__db_write_compact(db->d[i], db->labels[i], &db->params, &w))
+            w.oom = 1;
+    db->src = db->src_owned = grown;
+    if (w.oom || w.len != n * per)
+        return AMSCR_OK; /* as above: the records past nsrc are not read */
+    for (size_t i = db->nsrc; i < n; i++) {
+        amscr_descriptor_free(db->d[i]);
+        db->d[i] = NULL;
+    }
+    db->nsrc = n;
+    return AMSCR_OK;
 }
 
 amscr_status amscr__db_own_source(amscr_db *db)

@@ -126,6 +126,10 @@ const unsigned char *amscr__db_record(const amscr_db *db, size_t i);
  * input, outline; the rest NULL: for amscr__inner_vertices, nothing that reads the prepared
  * levels); 0 when shape i is not held as a compact record. */
 int amscr__db_shallow(const amscr_db *db, size_t i, amscr_descriptor *sd, double *input, double *outline);
+/* A collection made by amscr__db_compact_copy keeps the shapes added since as compact records
+ * too (their decoded copies freed); nothing for any other (or when out of memory: they stay
+ * decoded). Exclusive on db. */
+amscr_status amscr__db_compact_tail(amscr_db *db);
 /* A lazy collection of compact records read from a caller's buffer takes a copy of them (its
  * source then outlives the buffer); nothing for any other collection. */
 amscr_status amscr__db_own_source(amscr_db *db);
