@@ -1,6 +1,8 @@
-/* index_io.c — the index file: a collection file (db_io.c) of version 13 (11 in 0.9, 9 in 0.8, 8
- * in 0.7, 6 in 0.6, 4 in 0.5, 3 in 0.4) whose index section follows the shapes, so amscr_db_load of an index file
- * gives its collection.
+/* index_io.c — the index file: a collection file (db_io.c) of version 14 (13 in 0.11 to 0.13, 11
+ * in 0.9, 9 in 0.8, 8 in 0.7, 6 in 0.6, 4 in 0.5, 3 in 0.4) whose index section follows the
+ * shapes, so amscr_db_load of an index file gives its collection. From version 14 the shapes are
+ * compact records (their input samples and outline: db_io.h), which the index keeps as they are
+ * (decoded when read); the section is version 13's.
  * Little-endian:
  *   u64 section length (the bytes up to the trailing checksum), then
  *   u32 sig_dim, u32 4 (bytes of a signature value), u64 k, u64 candidates (0: full lists),
