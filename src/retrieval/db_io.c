@@ -89,7 +89,12 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
             amscr_descriptor_free(tmp);
             continue;
         }
-        const amscr_descriptor *d = amscr_db_descriptor(db, i);
+        amscr_descriptor *tmp = NULL; /* a lazy collection's shape decoded for its record only */
+        const amscr_descriptor *d = amscr__db_descriptor_peek(db, i, &tmp);
+        if (!d) {
+            w->oom = 1; /* only out of memory: the shapes were checked */
+            continue;
+        }
         amscr__w_u32(w, (uint32_t)amscr_db_label(db, i));
         amscr__w_f64s(w, d->fwd, 6);
         amscr__w_f64s(w, d->inv, 6);
@@ -97,12 +102,11 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
         amscr__w_f64s(w, d->base, 2 * N);
         amscr__w_f64s(w, d->scaled, 2 * N * p);
         double V[2 * AMSCR__OUTLINE_N];
-        if (!amscr__db_has_outline(version, prm))
-            continue;
-        if (amscr__inner_vertices(d, prm->inner_closing, V) == AMSCR_OK)
+        if (amscr__db_has_outline(version, prm) && amscr__inner_vertices(d, prm->inner_closing, V) == AMSCR_OK)
             amscr__w_f64s(w, V, 2 * AMSCR__OUTLINE_N);
-        else
+        else if (amscr__db_has_outline(version, prm))
             w->oom = 1; /* only out of memory: a prepared shape's samples always resample */
+        amscr_descriptor_free(tmp);
     }
 }
 
@@ -112,10 +116,7 @@ amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *ou
     AMSCR_CHECK_NULL(db);
     AMSCR_CHECK_NULL(out_buf);
     AMSCR_CHECK_NULL(out_len);
-    amscr_status st = amscr__db_decode_all(db); /* a lazy load's shapes */
-    if (st != AMSCR_OK)
-        return st;
-    amscr__wbuf w = {NULL, 0, 0, 0};
+    amscr__wbuf w = {NULL, 0, 0, 0}; /* a lazy load's shapes decoded one by one, none kept */
     amscr__db_write(db, AMSCR__DB_VERSION_PLAIN_VIEW, &w);
     if (!w.oom)
         amscr__w_u64(&w, amscr__fnv1a(w.buf, w.len));

@@ -114,10 +114,8 @@ static void write_inner(const amscr_index *x, amscr__wbuf *w)
 
 amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **out_buf, size_t *out_len)
 {
-    amscr_status st = amscr__db_compact(version) ? AMSCR_OK : amscr__db_decode_all(x->db);
-    if (st != AMSCR_OK)
-        return st;
-    amscr__wbuf w = {NULL, 0, 0, 0}; /* compact records: a lazy load's shapes are not decoded */
+    amscr_status st = AMSCR_OK;
+    amscr__wbuf w = {NULL, 0, 0, 0}; /* a lazy load's shapes: none decoded and kept (db_io.c) */
     amscr__db_write(x->db, version, &w);
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
