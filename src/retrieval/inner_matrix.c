@@ -28,18 +28,18 @@ static amscr_status job_init(void *ctx, void **ws)
 static amscr_status feature_row(void *ctx, size_t i, void *ws)
 {
     const inner_job *m = ctx;
-    amscr_descriptor sd, *tmp = NULL; /* a compact record's samples and outline read, else a lazy */
-    double *in = amscr__malloc_array(2 * amscr_db_params(m->db)->num_samples + 2 * AMSCR__OUTLINE_N, sizeof *in);
-    if (!in)                          /* collection's shape decoded for this row only */
-        return amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
     size_t N = amscr_db_params(m->db)->num_samples;
-    const amscr_descriptor *d = amscr__db_shallow(m->db, i, &sd, in, in + 2 * N) ? &sd
-                                                                                  : amscr__db_descriptor_peek(m->db, i, &tmp);
-    if (!d)
-        free(in);
-    if (!d)
-        return amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
-    amscr_status st = amscr__inner_build_shape(d, amscr_db_params(m->db)->inner_closing, &m->f[i], ws);
+    double *in = amscr__malloc_array(2 * N + 2 * AMSCR__OUTLINE_N, sizeof *in);
+    if (!in)
+        return amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
+    /* a compact record's samples and outline read as they are, else a lazy collection's shape
+     * decoded for this row only */
+    amscr_descriptor sd, *tmp = NULL;
+    const amscr_descriptor *d = &sd;
+    if (!amscr__db_shallow(m->db, i, &sd, in, in + 2 * N))
+        d = amscr__db_descriptor_peek(m->db, i, &tmp);
+    amscr_status st = d ? amscr__inner_build_shape(d, amscr_db_params(m->db)->inner_closing, &m->f[i], ws)
+                        : amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
     amscr_descriptor_free(tmp);
     free(in);
     return st;
