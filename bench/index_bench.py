@@ -8,6 +8,7 @@ matching the candidates, re-ranking). Prints the times and whether each size's t
 0.1 s at 1400 shapes, 0.5 s at 10,000 (the median of the queries).
 
     python3 bench/index_bench.py --tool build/tools/amscr [--shapes 1400,10000] [--work build/bench-index]
+    python3 bench/index_bench.py --rss-index m7.idx [--rss-copies 4]   # amscr.Index's memory (psutil)
 """
 import argparse
 import math
@@ -104,15 +105,45 @@ def one_size(args, shapes):
                                       "meets" if med <= goal else "MISSES", goal))
 
 
+def python_rss(args):
+    """amscr.Index(collection) in Python: the process's RSS before and after the build, a shape,
+    and the saved file's bytes a shape (the mpeg7-dev index of --rss-index, its shapes --rss-copies
+    times)."""
+    import gc
+    import psutil
+    import amscr
+    proc = psutil.Process()
+    src = amscr.Index.load(args.rss_index).collection
+    coll = amscr.Collection(src.params)
+    for _ in range(args.rss_copies):
+        coll._add_copies(src, range(len(src)))
+    del src
+    gc.collect()
+    n, r0 = len(coll), proc.memory_info().rss
+    x = amscr.Index(coll, candidates=256, progress=False)
+    r1 = proc.memory_info().rss
+    path = os.path.join(args.work, "rss.idx")
+    os.makedirs(args.work, exist_ok=True)
+    x.save(path)
+    print("amscr.Index(collection) of %d shapes: RSS %.0f -> %.0f MB, %.1f KB a shape; file %.1f KB a shape"
+          % (n, r0 / 1e6, r1 / 1e6, (r1 - r0) / n / 1e3, os.path.getsize(path) / n / 1e3))
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--tool", required=True)
+    ap.add_argument("--rss-index", help="an index file: measure amscr.Index(collection)'s memory instead")
+    ap.add_argument("--rss-copies", type=int, default=4)
+    ap.add_argument("--tool")
     ap.add_argument("--shapes", default="1400,10000", help="collection sizes, comma-separated")
     ap.add_argument("--work", default=os.path.join("build", "bench-index"))
     ap.add_argument("--build-candidates", default="8",
                     help="index --candidates (neighbours sought among each shape's M nearest signatures)")
     ap.add_argument("--queries", type=int, default=5)
     args = ap.parse_args()
+    if args.rss_index:
+        return python_rss(args)
+    if not args.tool:
+        ap.error("--tool is required")
     for shapes in (int(v) for v in str(args.shapes).split(",") if v.strip()):
         one_size(args, shapes)
 

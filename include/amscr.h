@@ -2703,7 +2703,10 @@ typedef struct amscr_index amscr_index;
  *        weight strictly between 0 and 1 the fusion's medians come from a sample of the
  *        shapes (docs/collections.md, "The index file").
  * Cost: candidates 0: n^2 pair distances; M > 0: O(n (M + K^2)) pair distances.
- * Memory: the index holds the collection's copy, the features, about 24 bytes a listed
+ * Memory: the index holds a compact copy of the shapes (since 0.14: each shape's input samples
+ *         and outline, ~3 KB at the defaults; a prepared shape is recomputed from them, bit for
+ *         bit, when first read, e.g. through amscr_index_db, and then kept), the features (~34 KB a
+ *         shape at the defaults), about 24 bytes a listed
  *         neighbour and, with the inner graph, about 17 KB of inner features a shape; the
  *         build's scratch is n^2 doubles with candidates 0, at most 12 n M bytes with M.
  * Threads: amscr_params_set_num_threads of the db's params; the index is the same for any

@@ -4,11 +4,17 @@
  * member rows; file and memory round trips; damaged files; add; thread-count independence. */
 #include <amscr.h>
 #include <check.h>
+#include <dirent.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <signal.h>
+#include <unistd.h>
 
 #include "db_io.h"
 #include "index.h"
@@ -549,9 +555,15 @@ START_TEST(stored_features)
     void *buf = NULL;
     size_t len = 0, l3 = 0;
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    ck_assert_int_eq(((unsigned char *)buf)[8], 13);
+    ck_assert_int_eq(((unsigned char *)buf)[8], 14);
     ck_assert_int_eq(x->nf, 2);
-    unsigned char *v3 = as_version3(x, buf, len, &l3);
+    void *b13 = NULL; /* the format of 0.11 to 0.13, which older files are made from */
+    size_t l13 = 0;
+    ck_assert_int_eq(amscr__index_write(x, 13, &b13, &l13), AMSCR_OK);
+    ck_assert_int_eq(((unsigned char *)b13)[8], 13);
+    ck_assert_uint_gt(l13, len);
+    unsigned char *v3 = as_version3(x, b13, l13, &l3);
+    free(b13);
     for (unsigned lazy = 0; lazy < 2; lazy++) {
         ck_assert_int_eq(amscr_index_load_memory_with(v3, l3, lazy ? AMSCR_INDEX_LAZY : 0u, &y), AMSCR_OK);
         same_query(x, y, q, 0);
@@ -690,9 +702,32 @@ START_TEST(inner_section)
     size_t k2 = x->k2, fk = AMSCR__INNER_F * AMSCR__INNER_K, len = 0;
     void *buf = NULL;
     ck_assert_uint_gt(k2, 0);
+    /* version 14 (compact shapes) */
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
     size_t sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * 8 * (2 * fk + 1), at = len - 8 - sec;
     unsigned char *b = malloc(len);
+    memcpy(b, buf, len);
+    ck_assert_uint_eq(b[at], k2);
+    b[at] = 0; /* no inner graph, the params give one */
+    reseal(b, len, 14);
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "inner graph") != NULL);
+    memcpy(b, buf, len);
+    b[at + 12] = 1; /* shape 0's inner list not starting with itself */
+    reseal(b, len, 14);
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "inner neighbour") != NULL);
+    ck_assert_int_eq(amscr_index_load_memory(buf, len, &y), AMSCR_OK);
+    for (size_t i = 0; i < NSHAPES; i++) /* the features: the build's, bit for bit */
+        ck_assert(memcmp(&y->inner[i], &x->inner[i], sizeof x->inner[i]) == 0);
+    amscr_index_free(y);
+    y = NULL;
+    free(b);
+    amscr_free(buf);
+    /* version 13 (0.11 to 0.13): the features stored */
+    ck_assert_int_eq(amscr__index_write(x, 13, &buf, &len), AMSCR_OK);
+    sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * 8 * (2 * fk + 1), at = len - 8 - sec;
+    b = malloc(len);
     memcpy(b, buf, len);
     ck_assert_uint_eq(b[at], k2);
     b[at] = 0; /* no inner graph, the params give one */
@@ -723,7 +758,7 @@ START_TEST(inner_section)
     ck_assert_int_eq(amscr_params_set_rerank_inner_share(p, 0.0), AMSCR_OK);
     x = named_index(p, 0);
     ck_assert_uint_eq(x->k2, 0);
-    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    ck_assert_int_eq(amscr__index_write(x, 13, &buf, &len), AMSCR_OK);
     v8 = as_version8(x, buf, len, 4, &l8);
     ck_assert_int_eq(amscr_index_load_memory(v8, l8, &y), AMSCR_OK);
     amscr_descriptor *q = shape(p, 2000);
@@ -734,6 +769,154 @@ START_TEST(inner_section)
     amscr_free(buf);
     amscr_index_free(x);
     amscr_index_free(y);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* An index holds its shapes as compact records (their input samples and outline): each decodes
+ * to the prepared shape it was built from, bit for bit; a version 13 file (0.11 to 0.13, full
+ * records and the inner features) loads, eagerly and lazily, to the same scores and saves as the
+ * build's version 14 bytes; every cut of a version 14 file is refused. */
+START_TEST(compact_shapes)
+{
+    amscr_params *p = params_of(0.5, 8, 2); /* fused: a query reads the candidates' prepared shapes */
+    amscr_db *db = db_of(p, NSHAPES);
+    amscr_index *x = NULL, *y = NULL;
+    ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
+    size_t N = amscr_params_get_num_samples(p), np = amscr_db_params(amscr_index_db(x))->num_scales;
+    for (size_t i = 0; i < NSHAPES; i++) {
+        const amscr_descriptor *a = amscr_db_descriptor(db, i), *b = amscr_db_descriptor(amscr_index_db(x), i);
+        ck_assert_ptr_nonnull(b);
+        ck_assert(a != b);
+        ck_assert(memcmp(a->input, b->input, 2 * N * sizeof(double)) == 0);
+        ck_assert(memcmp(a->base, b->base, 2 * N * sizeof(double)) == 0);
+        ck_assert(memcmp(a->scaled, b->scaled, 2 * N * np * sizeof(double)) == 0);
+        ck_assert(memcmp(a->fwd, b->fwd, sizeof a->fwd) == 0 && memcmp(a->inv, b->inv, sizeof a->inv) == 0);
+        ck_assert(a->outline && b->outline && memcmp(a->outline, b->outline, 2 * AMSCR__OUTLINE_N * 8) == 0);
+        ck_assert_int_eq(amscr_db_label(amscr_index_db(x), i), amscr_db_label(db, i));
+    }
+    /* shapes added: kept as compact records too, the same index as one built on all of them */
+    amscr_db *half = NULL, *rest = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &half), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_new(p, &rest), AMSCR_OK);
+    for (size_t i = 0; i < NSHAPES; i++)
+        ck_assert_int_eq(amscr_db_add_descriptor(i < NSHAPES - 4 ? half : rest, amscr_db_descriptor(db, i),
+                                                 amscr_db_label(db, i), NULL), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_build(half, 0, NULL, NULL, &y), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_add(y, rest, NULL, NULL), AMSCR_OK);
+    ck_assert_ptr_nonnull(amscr__db_record(amscr_index_db(y), NSHAPES - 1));
+    for (size_t i = 0; i < NSHAPES; i++) {
+        const amscr_descriptor *a = amscr_db_descriptor(db, i), *b = amscr_db_descriptor(amscr_index_db(y), i);
+        ck_assert(memcmp(a->scaled, b->scaled, 2 * N * np * sizeof(double)) == 0);
+        ck_assert_int_eq(amscr_db_label(amscr_index_db(y), i), amscr_db_label(db, i));
+    }
+    amscr_index_free(y);
+    y = NULL;
+    amscr_db_free(half);
+    amscr_db_free(rest);
+    amscr_db_free(db);
+    amscr_descriptor *q = shape(p, 2000);
+    void *buf = NULL, *b13 = NULL, *b2 = NULL;
+    size_t len = 0, l13 = 0, len2 = 0;
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    ck_assert_int_eq(amscr__index_write(x, 13, &b13, &l13), AMSCR_OK);
+    ck_assert_uint_lt(len, l13);
+    for (unsigned lazy = 0; lazy < 2; lazy++) {
+        ck_assert_int_eq(amscr_index_load_memory_with(b13, l13, lazy ? AMSCR_INDEX_LAZY : 0u, &y), AMSCR_OK);
+        same_query(x, y, q, 0);
+        same_query(x, y, q, 6);
+        ck_assert_int_eq(amscr_index_save_memory(y, &b2, &len2), AMSCR_OK);
+        ck_assert_uint_eq(len2, len);
+        ck_assert(memcmp(b2, buf, len) == 0);
+        amscr_free(b2);
+        amscr_index_free(y);
+        ck_assert_int_eq(amscr_index_load_memory_with(buf, len, lazy ? AMSCR_INDEX_LAZY : 0u, &y), AMSCR_OK);
+        same_query(x, y, q, 0);
+        same_query(x, y, q, 6);
+        amscr_index_free(y);
+        y = NULL;
+    }
+    for (size_t cut = 0; cut < len; cut += cut < 256 ? 1 : 997) { /* a file cut short anywhere */
+        ck_assert_int_ne(amscr_index_load_memory(buf, cut, &y), AMSCR_OK);
+        ck_assert_ptr_null(y);
+        ck_assert(strlen(amscr_last_error_detail()) > 0);
+    }
+    amscr_descriptor_free(q);
+    free(b13);
+    amscr_free(buf);
+    amscr_index_free(x);
+    amscr_params_free(p);
+}
+END_TEST
+
+/* The file's bytes at path (*len; caller frees). */
+static unsigned char *file_bytes(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    ck_assert_ptr_nonnull(f);
+    unsigned char *b = malloc(1 << 22);
+    *len = fread(b, 1, 1 << 22, f);
+    fclose(f);
+    return b;
+}
+
+/* A save cut off, by a full disk (the file-size limit: writes fail) or by the process killed
+ * mid-write (SIGXFSZ's default), never replaces the good file, whose mode stays; the failed
+ * save reports an I/O error. */
+START_TEST(cut_off_save)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_index *x = named_index(p, 0);
+    char path[] = "/tmp/amscr_cut_XXXXXX";
+    int fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    ck_assert_int_eq(amscr_index_save(x, path), AMSCR_OK);
+    ck_assert_int_eq(chmod(path, 0644), 0);
+    size_t l0 = 0, l1 = 0;
+    unsigned char *b0 = file_bytes(path, &l0);
+    ck_assert_uint_gt(l0, 8192);
+    for (int killed = 0; killed < 2; killed++) {
+        pid_t pid = fork();
+        ck_assert_int_ge(pid, 0);
+        if (pid == 0) { /* the child: writes beyond 4 KB fail, or kill it */
+            signal(SIGXFSZ, killed ? SIG_DFL : SIG_IGN);
+            struct rlimit rl = {4096, 4096};
+            setrlimit(RLIMIT_FSIZE, &rl);
+            amscr_status st = amscr_index_save(x, path);
+            _exit(st == AMSCR_E_IO ? 3 : 4);
+        }
+        int ws = 0;
+        ck_assert_int_eq(waitpid(pid, &ws, 0), pid);
+        if (killed)
+            ck_assert(WIFSIGNALED(ws) && WTERMSIG(ws) == SIGXFSZ);
+        else
+            ck_assert(WIFEXITED(ws) && WEXITSTATUS(ws) == 3);
+        unsigned char *b1 = file_bytes(path, &l1);
+        ck_assert_uint_eq(l1, l0);
+        ck_assert(memcmp(b0, b1, l0) == 0);
+        free(b1);
+        struct stat sb;
+        ck_assert_int_eq(stat(path, &sb), 0);
+        ck_assert_uint_eq(sb.st_mode & 0777, 0644);
+        amscr_index *y = NULL;
+        ck_assert_int_eq(amscr_index_load(path, &y), AMSCR_OK);
+        amscr_index_free(y);
+    }
+    free(b0);
+    remove(path);
+    char tmpl[64];
+    snprintf(tmpl, sizeof tmpl, "%s.tmp.", path + 5);
+    DIR *dir = opendir("/tmp"); /* the killed save's temporary file: cleaned up here */
+    for (struct dirent *e = dir ? readdir(dir) : NULL; e; e = readdir(dir))
+        if (strncmp(e->d_name, tmpl, strlen(tmpl)) == 0) {
+            char t[300];
+            snprintf(t, sizeof t, "/tmp/%s", e->d_name);
+            remove(t);
+        }
+    if (dir)
+        closedir(dir);
+    amscr_index_free(x);
     amscr_params_free(p);
 }
 END_TEST
@@ -1156,6 +1339,8 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, member_rule_fused);
     tcase_add_test(tc, member_rule_channel_alone);
     tcase_add_test(tc, round_trips);
+    tcase_add_test(tc, compact_shapes);
+    tcase_add_test(tc, cut_off_save);
     tcase_add_test(tc, lazy_load);
     tcase_add_test(tc, lazy_file_shapes);
     tcase_add_test(tc, stored_features);

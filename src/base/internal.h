@@ -217,6 +217,10 @@ struct amscr_descriptor {
 /* Builds the derived arrays of a descriptor whose params, n, p, input, base, scaled, fwd,
  * inv are set (used by amscr_descriptor_new and by db load). */
 amscr_status amscr__descriptor_finish(amscr_descriptor *d);
+/* The normalized and smoothed samples of a descriptor whose params, n, p and input are set
+ * (base, scaled, fwd, inv), then its derived arrays: bit for bit what amscr_descriptor_new
+ * computed from the same input (a compact record keeps only the input: db_io.c). */
+amscr_status amscr__descriptor_rebuild(amscr_descriptor *d);
 /* Allocates an empty descriptor for n samples and p scales (arrays uninitialized). */
 amscr_status amscr__descriptor_alloc(size_t n, size_t p, amscr_descriptor **out);
 /* Non-zero when two params describe compatible prepared shapes (N, scales, closed,

@@ -23,6 +23,9 @@ struct amscr_db {
      * under lock (a const collection stays safe for concurrent readers). */
     const unsigned char *src;
     size_t src_pos0, src_per, nsrc;
+    int src_compact;          /* src holds compact records (db_io.h) */
+    unsigned char *src_owned; /* src when the collection owns it (amscr__db_compact_copy) */
+    int compact_owned;        /* its shapes are kept as compact records it owns (added ones too) */
     pthread_mutex_t lock;
     /* What one-vs-many retrieval keeps between queries (retrieval_query.c): owned, released by
      * kept_free, taken under kept_lock (queries of a const collection prepare it once). */
@@ -60,6 +63,7 @@ void amscr_db_free(amscr_db *db)
     pthread_mutex_destroy(&db->kept_lock);
     free(db->d);
     free(db->labels);
+    free(db->src_owned);
     free(db);
 }
 
@@ -206,13 +210,48 @@ void amscr__db_kept_unlock(const amscr_db *db)
 
 size_t amscr_db_size(const amscr_db *db) { return db ? db->n : 0; }
 int32_t amscr_db_label(const amscr_db *db, size_t i) { return (db && i < db->n) ? db->labels[i] : 0; }
-void amscr__db_set_source(amscr_db *db, const unsigned char *src, size_t pos0, size_t per, size_t count)
+void amscr__db_set_source(amscr_db *db, const unsigned char *src, size_t pos0, size_t per, int compact, size_t count)
 {
     pthread_mutex_init(&db->lock, NULL);
     db->src = src;
     db->src_pos0 = pos0;
     db->src_per = per;
+    db->src_compact = compact;
     db->nsrc = count;
+}
+
+amscr_status amscr__db_compact_copy(const amscr_db *db, amscr_db **out)
+{
+    const amscr_params *p = &db->params;
+    size_t n = db->n, per = (size_t)amscr__db_shape_bytes(AMSCR__DB_VERSION_INDEX_COMPACT, p);
+    amscr_db *c = NULL;
+    amscr_status st = amscr_db_new(p, &c);
+    if (st == AMSCR_OK)
+        st = amscr__db_reserve(c, n);
+    amscr__wbuf w = {NULL, 0, 0, 0};
+    w.buf = st == AMSCR_OK && n > 0 ? amscr__malloc_array(n, per) : NULL; /* its size: never grown */
+    w.cap = w.buf ? n * per : 0;
+    for (size_t i = 0; st == AMSCR_OK && i < n && !w.oom; i++) {
+        amscr_descriptor *tmp = NULL;
+        const amscr_descriptor *d = amscr__db_descriptor_peek(db, i, &tmp);
+        if (!d || !amscr__db_write_compact(d, db->labels[i], p, &w))
+            w.oom = 1;
+        amscr_descriptor_free(tmp);
+        if (!w.oom)
+            st = amscr__db_push(c, NULL, db->labels[i], NULL);
+    }
+    if (st == AMSCR_OK && (w.oom || w.len != n * per))
+        st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    if (st != AMSCR_OK) {
+        free(w.buf);
+        amscr_db_free(c);
+        return st;
+    }
+    c->src_owned = w.buf;
+    c->compact_owned = 1;
+    amscr__db_set_source(c, w.buf, 0, per, 1, n);
+    *out = c;
+    return AMSCR_OK;
 }
 
 /* Shape i, decoded from the source when it is not yet (NULL: out of memory). Decoded outside
@@ -228,8 +267,8 @@ static amscr_descriptor *db_get(const amscr_db *db, size_t i)
     if (d)
         return d;
     amscr_descriptor *mine = NULL;
-    if (amscr__db_decode(db->src, db->src_pos0 + i * db->src_per, db->src_per, &db->params, NULL, &mine) !=
-        AMSCR_OK)
+    if (amscr__db_decode(db->src, db->src_pos0 + i * db->src_per, db->src_per, db->src_compact, &db->params, NULL,
+                         &mine) != AMSCR_OK)
         return NULL;
     pthread_mutex_lock(&m->lock);
     if (!m->d[i])
@@ -239,6 +278,85 @@ static amscr_descriptor *db_get(const amscr_db *db, size_t i)
     d = m->d[i];
     pthread_mutex_unlock(&m->lock);
     return d;
+}
+
+const amscr_descriptor *amscr__db_descriptor_peek(const amscr_db *db, size_t i, amscr_descriptor **tmp)
+{
+    *tmp = NULL;
+    if (i >= db->nsrc)
+        return db->d[i];
+    amscr_db *m = (amscr_db *)(uintptr_t)db;
+    pthread_mutex_lock(&m->lock);
+    amscr_descriptor *d = m->d[i];
+    pthread_mutex_unlock(&m->lock);
+    if (d)
+        return d;
+    if (amscr__db_decode(db->src, db->src_pos0 + i * db->src_per, db->src_per, db->src_compact, &db->params, NULL,
+                         tmp) != AMSCR_OK)
+        return NULL;
+    return *tmp;
+}
+
+const unsigned char *amscr__db_record(const amscr_db *db, size_t i)
+{
+    return i < db->nsrc && db->src_compact ? db->src + db->src_pos0 + i * db->src_per : NULL;
+}
+
+int amscr__db_shallow(const amscr_db *db, size_t i, amscr_descriptor *sd, double *input, double *outline)
+{
+    const unsigned char *rec = amscr__db_record(db, i);
+    if (!rec)
+        return 0;
+    size_t N = db->params.num_samples;
+    amscr__rbuf r = {rec, db->src_per, 4, 0};
+    memset(sd, 0, sizeof *sd);
+    sd->params = db->params;
+    sd->n = N;
+    sd->p = db->params.num_scales;
+    sd->input = input;
+    int ok = amscr__r_f64s(&r, input, 2 * N);
+    if (ok && r.pos < r.len) {
+        sd->outline = outline;
+        ok = amscr__r_f64s(&r, outline, 2 * AMSCR__OUTLINE_N);
+    }
+    return ok;
+}
+
+amscr_status amscr__db_compact_tail(amscr_db *db)
+{
+    if (!db->compact_owned || db->nsrc == db->n)
+        return AMSCR_OK;
+    size_t per = db->src_per, n = db->n;
+    unsigned char *grown = n <= SIZE_MAX / per ? realloc(db->src_owned, n * per) : NULL;
+    if (!grown)
+        return AMSCR_OK; /* the shapes stay decoded */
+    amscr__wbuf w = {grown, db->nsrc * per, n * per, 0};
+    for (size_t i = db->nsrc; i < n && !w.oom; i++)
+        if (!amscr__db_write_compact(db->d[i], db->labels[i], &db->params, &w))
+            w.oom = 1;
+    db->src = db->src_owned = grown;
+    if (w.oom || w.len != n * per)
+        return AMSCR_OK; /* as above: the records past nsrc are not read */
+    for (size_t i = db->nsrc; i < n; i++) {
+        amscr_descriptor_free(db->d[i]);
+        db->d[i] = NULL;
+    }
+    db->nsrc = n;
+    return AMSCR_OK;
+}
+
+amscr_status amscr__db_own_source(amscr_db *db)
+{
+    if (!db->src || db->src_owned || !db->src_compact)
+        return AMSCR_OK;
+    unsigned char *own = db->nsrc > 0 ? amscr__malloc_array(db->nsrc, db->src_per) : NULL;
+    if (db->nsrc > 0 && !own)
+        return amscr__fail(AMSCR_E_NOMEM, "collection: out of memory");
+    if (own)
+        memcpy(own, db->src + db->src_pos0, db->nsrc * db->src_per);
+    db->src = db->src_owned = own;
+    db->src_pos0 = 0;
+    return AMSCR_OK;
 }
 
 amscr_status amscr__db_decode_all(const amscr_db *db)

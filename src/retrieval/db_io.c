@@ -49,6 +49,19 @@ static void w_params(amscr__wbuf *w, const amscr_params *p)
     amscr__w_f64(w, p->penalty);
 }
 
+int amscr__db_write_compact(const amscr_descriptor *d, int32_t label, const amscr_params *prm, amscr__wbuf *w)
+{
+    amscr__w_u32(w, (uint32_t)label);
+    amscr__w_f64s(w, d->input, 2 * prm->num_samples);
+    if (!amscr__db_has_outline(AMSCR__DB_VERSION_INDEX_COMPACT, prm))
+        return 1;
+    double V[2 * AMSCR__OUTLINE_N];
+    if (amscr__inner_vertices(d, prm->inner_closing, V) != AMSCR_OK)
+        return 0; /* only out of memory: a prepared shape's samples always resample */
+    amscr__w_f64s(w, V, 2 * AMSCR__OUTLINE_N);
+    return 1;
+}
+
 void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
 {
     const amscr_params *prm = amscr_db_params(db);
@@ -65,7 +78,23 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
     amscr__w_u64(w, N);
     amscr__w_u64(w, p);
     for (size_t i = 0; i < n; i++) {
-        const amscr_descriptor *d = amscr_db_descriptor(db, i);
+        if (amscr__db_compact(version)) { /* a record kept as one copied, else encoded (nothing decoded kept) */
+            const unsigned char *rec = amscr__db_record(db, i);
+            amscr_descriptor *tmp = NULL;
+            const amscr_descriptor *d = rec ? NULL : amscr__db_descriptor_peek(db, i, &tmp);
+            if (rec)
+                amscr__w_bytes(w, rec, (size_t)amscr__db_shape_bytes(version, prm));
+            else if (!d || !amscr__db_write_compact(d, amscr_db_label(db, i), prm, w))
+                w->oom = 1;
+            amscr_descriptor_free(tmp);
+            continue;
+        }
+        amscr_descriptor *tmp = NULL; /* a lazy collection's shape decoded for its record only */
+        const amscr_descriptor *d = amscr__db_descriptor_peek(db, i, &tmp);
+        if (!d) {
+            w->oom = 1; /* only out of memory: the shapes were checked */
+            continue;
+        }
         amscr__w_u32(w, (uint32_t)amscr_db_label(db, i));
         amscr__w_f64s(w, d->fwd, 6);
         amscr__w_f64s(w, d->inv, 6);
@@ -73,12 +102,11 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
         amscr__w_f64s(w, d->base, 2 * N);
         amscr__w_f64s(w, d->scaled, 2 * N * p);
         double V[2 * AMSCR__OUTLINE_N];
-        if (!amscr__db_has_outline(version, prm))
-            continue;
-        if (amscr__inner_vertices(d, prm->inner_closing, V) == AMSCR_OK)
+        if (amscr__db_has_outline(version, prm) && amscr__inner_vertices(d, prm->inner_closing, V) == AMSCR_OK)
             amscr__w_f64s(w, V, 2 * AMSCR__OUTLINE_N);
-        else
+        else if (amscr__db_has_outline(version, prm))
             w->oom = 1; /* only out of memory: a prepared shape's samples always resample */
+        amscr_descriptor_free(tmp);
     }
 }
 
@@ -88,10 +116,7 @@ amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *ou
     AMSCR_CHECK_NULL(db);
     AMSCR_CHECK_NULL(out_buf);
     AMSCR_CHECK_NULL(out_len);
-    amscr_status st = amscr__db_decode_all(db); /* a lazy load's shapes */
-    if (st != AMSCR_OK)
-        return st;
-    amscr__wbuf w = {NULL, 0, 0, 0};
+    amscr__wbuf w = {NULL, 0, 0, 0}; /* a lazy load's shapes decoded one by one, none kept */
     amscr__db_write(db, AMSCR__DB_VERSION_PLAIN_VIEW, &w);
     if (!w.oom)
         amscr__w_u64(&w, amscr__fnv1a(w.buf, w.len));
@@ -120,6 +145,7 @@ amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t 
         (void)fchmod(fd, (mode_t)amscr__file_mode(path)); /* mkstemp made it 0600 (best effort) */
         FILE *f = fdopen(fd, "wb");
         int ok = f && fwrite(buf, 1, len, f) == len;
+        ok = ok && fflush(f) == 0 && fsync(fd) == 0; /* on the disk before it takes the name */
         if (f)
             ok = (fclose(f) == 0) && ok;
         else
@@ -198,17 +224,19 @@ static amscr_status r_params(amscr__rbuf *r, uint32_t version, amscr_params *prm
 
 /* Whether shape records of `per` bytes (params prm) end with an outline: longer than a record
  * without one. */
-static int outline_kept(size_t per, const amscr_params *prm)
+static int outline_kept(size_t per, int compact, const amscr_params *prm)
 {
-    return per > amscr__db_shape_bytes(AMSCR__DB_VERSION_PLAIN, prm);
+    return per > amscr__db_shape_bytes(compact ? AMSCR__DB_VERSION_INDEX_COMPACT : AMSCR__DB_VERSION_PLAIN,
+                                       &(amscr_params){.num_samples = prm->num_samples,
+                                                       .num_scales = prm->num_scales});
 }
 
 /* Shape bytes at `at` decoded: 0, or 1 truncated / not finite, 2 degenerate, 3 out of memory. */
-static int decode_shape(const unsigned char *p, size_t at, size_t per, const amscr_params *prm, int32_t *label,
-                        amscr_descriptor **out)
+static int decode_shape(const unsigned char *p, size_t at, size_t per, int compact, const amscr_params *prm,
+                        int32_t *label, amscr_descriptor **out)
 {
     size_t N = prm->num_samples, np = prm->num_scales;
-    int outline = outline_kept(per, prm);
+    int outline = outline_kept(per, compact, prm);
     amscr__rbuf r = {p, at + per, at, 0};
     *label = (int32_t)amscr__r_u32(&r);
     amscr_descriptor *d = NULL;
@@ -216,15 +244,17 @@ static int decode_shape(const unsigned char *p, size_t at, size_t per, const ams
         return 3;
     d->params = *prm;
     int bad = 0;
-    if (!amscr__r_f64s(&r, d->fwd, 6) || !amscr__r_f64s(&r, d->inv, 6) || !amscr__r_f64s(&r, d->input, 2 * N) ||
-        !amscr__r_f64s(&r, d->base, 2 * N) || !amscr__r_f64s(&r, d->scaled, 2 * N * np))
+    if (compact ? !amscr__r_f64s(&r, d->input, 2 * N)
+                : (!amscr__r_f64s(&r, d->fwd, 6) || !amscr__r_f64s(&r, d->inv, 6) ||
+                   !amscr__r_f64s(&r, d->input, 2 * N) || !amscr__r_f64s(&r, d->base, 2 * N) ||
+                   !amscr__r_f64s(&r, d->scaled, 2 * N * np)))
         bad = 1;
     else if (outline && !(d->outline = amscr__malloc_array(2 * AMSCR__OUTLINE_N, sizeof *d->outline)))
         bad = 3;
     else if (outline && !amscr__r_f64s(&r, d->outline, 2 * AMSCR__OUTLINE_N))
         bad = 1;
     else {
-        amscr_status st = amscr__descriptor_finish(d);
+        amscr_status st = compact ? amscr__descriptor_rebuild(d) : amscr__descriptor_finish(d);
         bad = st == AMSCR_OK ? 0 : st == AMSCR_E_DEGENERATE ? 2 : 3;
     }
     if (bad) {
@@ -235,11 +265,11 @@ static int decode_shape(const unsigned char *p, size_t at, size_t per, const ams
     return 0;
 }
 
-amscr_status amscr__db_decode(const unsigned char *p, size_t at, size_t per, const amscr_params *prm, int32_t *label,
-                              amscr_descriptor **out)
+amscr_status amscr__db_decode(const unsigned char *p, size_t at, size_t per, int compact, const amscr_params *prm,
+                              int32_t *label, amscr_descriptor **out)
 {
     int32_t lab = 0;
-    int bad = decode_shape(p, at, per, prm, &lab, out);
+    int bad = decode_shape(p, at, per, compact, prm, &lab, out);
     if (bad == 1)
         return amscr__fail(AMSCR_E_FORMAT, "collection: a shape is truncated or has non-finite values");
     if (bad == 2)
@@ -258,6 +288,7 @@ amscr_status amscr__db_decode(const unsigned char *p, size_t at, size_t per, con
 typedef struct {
     const unsigned char *p;
     size_t pos0, per;
+    int compact;
     const amscr_params *prm;
     uint64_t count;
     amscr_descriptor **d; /* count entries, NULL until decoded */
@@ -282,6 +313,16 @@ static void check_shape(const shapes_job *j, uint64_t i, double *scratch)
 {
     size_t N = j->prm->num_samples, p = j->prm->num_scales, at = j->pos0 + (size_t)i * j->per;
     amscr__rbuf r = {j->p, at + j->per, at, 0};
+    if (j->compact) { /* finite samples with extent (a prepared shape's smoothed levels then have it) */
+        j->label[i] = (int32_t)amscr__r_u32(&r);
+        if (!amscr__r_f64s(&r, scratch, 2 * N))
+            j->bad[i] = 1;
+        else if (!level_ok(scratch, N))
+            j->bad[i] = 2;
+        else if (outline_kept(j->per, 1, j->prm) && !amscr__r_f64s(&r, scratch, 2 * AMSCR__OUTLINE_N))
+            j->bad[i] = 1;
+        return;
+    }
     j->label[i] = (int32_t)amscr__r_u32(&r);
     if (!amscr__r_f64s(&r, scratch, 12) || !amscr__r_f64s(&r, scratch, 2 * N)) {
         j->bad[i] = 1;
@@ -295,14 +336,14 @@ static void check_shape(const shapes_job *j, uint64_t i, double *scratch)
         if (!level_ok(scratch, N))
             j->bad[i] = 2;
     }
-    if (outline_kept(j->per, j->prm) && !amscr__r_f64s(&r, scratch, 2 * AMSCR__OUTLINE_N))
+    if (outline_kept(j->per, 0, j->prm) && !amscr__r_f64s(&r, scratch, 2 * AMSCR__OUTLINE_N))
         j->bad[i] = 1;
 }
 
 static void read_shape(const shapes_job *j, uint64_t i)
 {
-    j->bad[i] = (unsigned char)decode_shape(j->p, j->pos0 + (size_t)i * j->per, j->per, j->prm, &j->label[i],
-                                            &j->d[i]);
+    j->bad[i] = (unsigned char)decode_shape(j->p, j->pos0 + (size_t)i * j->per, j->per, j->compact, j->prm,
+                                            &j->label[i], &j->d[i]);
 }
 
 static void *shapes_worker(void *arg)
@@ -355,7 +396,7 @@ static amscr_status r_shapes(amscr__rbuf *r, uint32_t version, const amscr_param
                              amscr_db *db)
 {
     size_t per = (size_t)amscr__db_shape_bytes(version, prm);
-    shapes_job j = {r->p, r->pos, per, prm, count, NULL, NULL, NULL, lazy, 0, 1};
+    shapes_job j = {r->p, r->pos, per, amscr__db_compact(version), prm, count, NULL, NULL, NULL, lazy, 0, 1};
     j.d = amscr__calloc_array(count ? count : 1, sizeof *j.d);
     j.label = amscr__malloc_array(count ? count : 1, sizeof *j.label);
     j.bad = amscr__calloc_array(count ? count : 1, 1);
@@ -376,7 +417,7 @@ static amscr_status r_shapes(amscr__rbuf *r, uint32_t version, const amscr_param
             j.d[i] = NULL; /* the collection's now */
     }
     if (st == AMSCR_OK && lazy)
-        amscr__db_set_source(db, r->p, r->pos, j.per, (size_t)count);
+        amscr__db_set_source(db, r->p, r->pos, j.per, j.compact, (size_t)count);
     for (uint64_t i = 0; j.d && i < count; i++)
         amscr_descriptor_free(j.d[i]);
     r->pos += st == AMSCR_OK ? (size_t)count * j.per : 0;

@@ -17,7 +17,8 @@
  * the inner distance's graph (its lists and the shapes' inner features); 10 and 11 (0.9): 7 and 9
  * with the inner distance's closing after the share (AMSCR__RETRIEVAL_BLOCK_V4); 12 and 13
  * (0.11): 10 and 11 with the channel's affine-view factor after the closing
- * (AMSCR__RETRIEVAL_BLOCK_V5). Every version loads. */
+ * (AMSCR__RETRIEVAL_BLOCK_V5); 14 (0.14): 13 with compact shape records (a shape's input samples
+ * and outline only: the rest recomputed, amscr__descriptor_rebuild). Every version loads. */
 #define AMSCR__DB_VERSION_PLAIN 2u
 #define AMSCR__DB_VERSION_INDEX 3u
 #define AMSCR__DB_VERSION_FEATURES 4u
@@ -30,7 +31,8 @@
 #define AMSCR__DB_VERSION_INDEX_CLOSING 11u
 #define AMSCR__DB_VERSION_PLAIN_VIEW 12u
 #define AMSCR__DB_VERSION_INDEX_VIEW 13u
-#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_VIEW
+#define AMSCR__DB_VERSION_INDEX_COMPACT 14u
+#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_COMPACT
 
 /* Whether a file of `version` is an index file (an index section after the shapes). */
 static inline int amscr__db_is_index(uint32_t version)
@@ -38,7 +40,7 @@ static inline int amscr__db_is_index(uint32_t version)
     return version == AMSCR__DB_VERSION_INDEX || version == AMSCR__DB_VERSION_FEATURES ||
            version == AMSCR__DB_VERSION_INDEX_BANDS || version == AMSCR__DB_VERSION_INDEX_INNER ||
            version == AMSCR__DB_VERSION_INDEX_GRAPHS || version == AMSCR__DB_VERSION_INDEX_CLOSING ||
-           version == AMSCR__DB_VERSION_INDEX_VIEW;
+           version == AMSCR__DB_VERSION_INDEX_VIEW || version == AMSCR__DB_VERSION_INDEX_COMPACT;
 }
 
 /* Whether an index file of `version` stores the shapes' channel features. */
@@ -46,7 +48,8 @@ static inline int amscr__db_has_features(uint32_t version)
 {
     return version == AMSCR__DB_VERSION_FEATURES || version == AMSCR__DB_VERSION_INDEX_BANDS ||
            version == AMSCR__DB_VERSION_INDEX_INNER || version == AMSCR__DB_VERSION_INDEX_GRAPHS ||
-           version == AMSCR__DB_VERSION_INDEX_CLOSING || version == AMSCR__DB_VERSION_INDEX_VIEW;
+           version == AMSCR__DB_VERSION_INDEX_CLOSING || version == AMSCR__DB_VERSION_INDEX_VIEW ||
+           version == AMSCR__DB_VERSION_INDEX_COMPACT;
 }
 
 /* The bytes of the retrieval block in a file of `version` (0: none). */
@@ -67,11 +70,18 @@ static inline int amscr__db_has_outline(uint32_t version, const amscr_params *p)
     return version >= AMSCR__DB_VERSION_PLAIN_CLOSING && p->closed && p->inner_closing > 0.0;
 }
 
+/* Whether the shapes of a file of `version` are compact records: i32 label, f64 input[2N] and
+ * (amscr__db_has_outline) f64 outline[2 AMSCR__OUTLINE_N]; the rest of the prepared shape is
+ * recomputed from the input (amscr__descriptor_rebuild, bit for bit). */
+static inline int amscr__db_compact(uint32_t version) { return version >= AMSCR__DB_VERSION_INDEX_COMPACT; }
+
 /* The bytes of one shape in a file of `version` with params p (db_io.c's layout). */
 static inline uint64_t amscr__db_shape_bytes(uint32_t version, const amscr_params *p)
 {
     uint64_t N = p->num_samples, np = p->num_scales;
     uint64_t outline = amscr__db_has_outline(version, p) ? 2 * AMSCR__OUTLINE_N : 0;
+    if (amscr__db_compact(version))
+        return 4 + 8 * (2 * N + outline);
     return 4 + 8 * (12 + 4 * N + 2 * N * np + outline);
 }
 
@@ -93,13 +103,39 @@ void **amscr__db_kept_lock(const amscr_db *db, void (*free_fn)(void *));
 void amscr__db_kept_unlock(const amscr_db *db);
 
 /* Shape bytes [at, at + per) of a file with params prm decoded into *out (caller frees);
- * *label when label is not NULL. AMSCR_E_FORMAT when truncated, not finite or degenerate. */
-amscr_status amscr__db_decode(const unsigned char *p, size_t at, size_t per, const amscr_params *prm, int32_t *label,
-                              amscr_descriptor **out);
-/* A lazy collection (db.c): its count shapes, at pos0 + i * per of src (which outlives it),
- * are decoded when first asked for; amscr__db_decode_all decodes every one (the batch calls'
- * and a save's). */
-void amscr__db_set_source(amscr_db *db, const unsigned char *src, size_t pos0, size_t per, size_t count);
+ * *label when label is not NULL; compact: a compact record (amscr__db_compact). AMSCR_E_FORMAT
+ * when truncated, not finite or degenerate. */
+amscr_status amscr__db_decode(const unsigned char *p, size_t at, size_t per, int compact, const amscr_params *prm,
+                              int32_t *label, amscr_descriptor **out);
+/* A lazy collection (db.c): its count shapes, at pos0 + i * per of src (which outlives it;
+ * compact records when compact), are decoded when first asked for; amscr__db_decode_all
+ * decodes every one (the batch calls' and a save's). */
+void amscr__db_set_source(amscr_db *db, const unsigned char *src, size_t pos0, size_t per, int compact, size_t count);
+/* One shape of d as a compact record (amscr__db_compact) into w; 0 when its outline cannot be
+ * made (out of memory). */
+int amscr__db_write_compact(const amscr_descriptor *d, int32_t label, const amscr_params *prm, amscr__wbuf *w);
+/* A copy of db whose shapes are held as compact records (~3 KB a shape at the defaults, decoded
+ * when first read), its labels and params db's. */
+amscr_status amscr__db_compact_copy(const amscr_db *db, amscr_db **out);
+/* Shape i of db as the collection gives it (kept), or, when a lazy collection has not decoded it
+ * yet, decoded into *tmp for the caller to free (the collection keeps nothing). NULL: out of
+ * memory or a bad record. */
+const amscr_descriptor *amscr__db_descriptor_peek(const amscr_db *db, size_t i, amscr_descriptor **tmp);
+/* Shape i's compact record (amscr__db_shape_bytes of AMSCR__DB_VERSION_INDEX_COMPACT bytes) when
+ * a lazy collection holds it as one, else NULL. */
+const unsigned char *amscr__db_record(const amscr_db *db, size_t i);
+/* Shape i's input samples (2N into input) and outline (2 AMSCR__OUTLINE_N into outline, when
+ * its record has one) read from its compact record into a shallow descriptor sd (params, n, p,
+ * input, outline; the rest NULL: for amscr__inner_vertices, nothing that reads the prepared
+ * levels); 0 when shape i is not held as a compact record. */
+int amscr__db_shallow(const amscr_db *db, size_t i, amscr_descriptor *sd, double *input, double *outline);
+/* A collection made by amscr__db_compact_copy keeps the shapes added since as compact records
+ * too (their decoded copies freed); nothing for any other (or when out of memory: they stay
+ * decoded). Exclusive on db. */
+amscr_status amscr__db_compact_tail(amscr_db *db);
+/* A lazy collection of compact records read from a caller's buffer takes a copy of them (its
+ * source then outlives the buffer); nothing for any other collection. */
+amscr_status amscr__db_own_source(amscr_db *db);
 amscr_status amscr__db_decode_all(const amscr_db *db);
 
 /* Writes the collection part of a file of `version`: magic, version, params, retrieval

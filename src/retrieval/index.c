@@ -139,6 +139,19 @@ static amscr_status index_alloc(const amscr_db *db, int borrow, amscr_index **ou
 
 amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out) { return index_alloc(db, 0, out); }
 
+amscr_status amscr__index_compact_db(amscr_index *x)
+{
+    amscr_db *c = NULL;
+    amscr_status st = amscr__db_compact_copy(x->db, &c);
+    if (st != AMSCR_OK)
+        return st;
+    if (!x->db_borrowed)
+        amscr_db_free(x->db);
+    x->db = c;
+    x->db_borrowed = 0;
+    return AMSCR_OK;
+}
+
 amscr_status amscr__index_alloc_on(const amscr_db *db, amscr_index **out) { return index_alloc(db, 1, out); }
 
 size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,

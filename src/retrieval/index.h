@@ -74,6 +74,9 @@ typedef struct {
 /* An empty index of a copy of db (no lists yet). */
 amscr_status amscr__index_alloc(const amscr_db *db, amscr_index **out);
 amscr_status amscr__index_alloc_on(const amscr_db *db, amscr_index **out); /* on db itself */
+/* x's collection replaced by a copy of it held as compact records (amscr__db_compact_copy: its
+ * shapes decoded when read); x owns it. */
+amscr_status amscr__index_compact_db(amscr_index *x);
 /* An index on db itself (not a copy; db must outlive it), its lists exact (candidates 0). */
 amscr_status amscr__index_build_on(const amscr_db *db, amscr_progress_fn progress, void *user, amscr_index **out);
 /* Shapes n0..n-1 of x->db, already in it, into x: features, lists, the lists they enter. */
@@ -170,6 +173,9 @@ amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t
 
 /* -------------------------------------------------------------------- loading (index_io.c) */
 
+/* x as an index file of `version` (13: the format of 0.11 to 0.13, full shape records and the
+ * inner features; 14: amscr_index_save_memory's) into *out_buf (caller frees with free). */
+amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **out_buf, size_t *out_len);
 /* An index file's bytes buf (len) mapped with mmap: loaded as amscr_index_load_with loads a
  * file (AMSCR_INDEX_LAZY: the index keeps the mapping, its shapes decoded from it when needed);
  * the mapping is the callee's either way (unmapped when not kept). */

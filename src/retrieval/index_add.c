@@ -2,6 +2,7 @@
  * every shape (or its shortlist, for an index built with one), and the older lists it enters.
  * With a full index and channel weight 0 or 1 the lists equal a rebuild's; with fused
  * weights the fusion keeps the build's medians. */
+#include "db_io.h"
 #include "index.h"
 
 #include <stdlib.h>
@@ -139,7 +140,9 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
         st = amscr__index_reserve(x, n);
     for (size_t i = 0; st == AMSCR_OK && i < add; i++)
         st = amscr_db_add_descriptor(x->db, amscr_db_descriptor(shapes, i), amscr_db_label(shapes, i), NULL);
-    return st == AMSCR_OK ? amscr__index_extend(x, n0, progress, user) : st;
+    if (st == AMSCR_OK)
+        st = amscr__index_extend(x, n0, progress, user);
+    return st == AMSCR_OK ? amscr__db_compact_tail(x->db) : st; /* kept as the others are */
 }
 
 amscr_status amscr__index_extend(amscr_index *x, size_t n0, amscr_progress_fn progress, void *user)

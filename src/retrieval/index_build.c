@@ -246,10 +246,12 @@ amscr_status amscr_index_build(const amscr_db *db, size_t candidates, amscr_prog
     AMSCR_CHECK_NULL(out);
     amscr_status st = amscr__index_check_db(db, "amscr_index_build");
     amscr_index *x = NULL;
-    if (st == AMSCR_OK)
-        st = amscr__index_alloc(db, &x);
+    if (st == AMSCR_OK) /* built on db's own shapes, then given its compact copy of them */
+        st = amscr__index_alloc_on(db, &x);
     if (st == AMSCR_OK)
         st = build_into(x, candidates, progress, user);
+    if (st == AMSCR_OK && (st = amscr__index_compact_db(x)) != AMSCR_OK)
+        amscr_index_free(x);
     if (st == AMSCR_OK)
         *out = x;
     return st;

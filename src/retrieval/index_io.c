@@ -1,6 +1,8 @@
-/* index_io.c — the index file: a collection file (db_io.c) of version 13 (11 in 0.9, 9 in 0.8, 8
- * in 0.7, 6 in 0.6, 4 in 0.5, 3 in 0.4) whose index section follows the shapes, so amscr_db_load of an index file
- * gives its collection.
+/* index_io.c — the index file: a collection file (db_io.c) of version 14 (13 in 0.11 to 0.13, 11
+ * in 0.9, 9 in 0.8, 8 in 0.7, 6 in 0.6, 4 in 0.5, 3 in 0.4) whose index section follows the
+ * shapes, so amscr_db_load of an index file gives its collection. From version 14 the shapes are
+ * compact records (their input samples and outline: db_io.h), which the index keeps as they are
+ * (decoded when read); the section is version 13's.
  * Little-endian:
  *   u64 section length (the bytes up to the trailing checksum), then
  *   u32 sig_dim, u32 4 (bytes of a signature value), u64 k, u64 candidates (0: full lists),
@@ -110,17 +112,11 @@ static void write_inner(const amscr_index *x, amscr__wbuf *w)
     }
 }
 
-amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_t *out_len)
+amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **out_buf, size_t *out_len)
 {
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(x);
-    AMSCR_CHECK_NULL(out_buf);
-    AMSCR_CHECK_NULL(out_len);
-    amscr_status st = amscr__db_decode_all(x->db); /* a lazy load's shapes */
-    if (st != AMSCR_OK)
-        return st;
-    amscr__wbuf w = {NULL, 0, 0, 0};
-    amscr__db_write(x->db, AMSCR__DB_VERSION_INDEX_VIEW, &w);
+    amscr_status st = AMSCR_OK;
+    amscr__wbuf w = {NULL, 0, 0, 0}; /* a lazy load's shapes: none decoded and kept (db_io.c) */
+    amscr__db_write(x->db, version, &w);
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
     write_section(x, &w);
@@ -135,7 +131,7 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
         uint64_t sec = (uint64_t)(w.len - at - 8);
         for (int i = 0; i < 8; i++)
             w.buf[at + (size_t)i] = (unsigned char)(sec >> (8 * i));
-        amscr__w_u64(&w, amscr__db_checksum(AMSCR__DB_VERSION_INDEX_VIEW, w.buf, w.len));
+        amscr__w_u64(&w, amscr__db_checksum(version, w.buf, w.len));
     }
     if (w.oom) {
         free(w.buf);
@@ -144,6 +140,15 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
     *out_buf = w.buf;
     *out_len = w.len;
     return AMSCR_OK;
+}
+
+amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_t *out_len)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    AMSCR_CHECK_NULL(out_buf);
+    AMSCR_CHECK_NULL(out_len);
+    return amscr__index_write(x, AMSCR__DB_VERSION_NEWEST, out_buf, out_len);
 }
 
 amscr_status amscr_index_save(const amscr_index *x, const char *path)
@@ -282,7 +287,7 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
     return AMSCR_OK;
 }
 
-/* The inner distance's graph of a version 9 file (its K2 must be the params'). */
+/* The inner distance's graph of a file of version 9 or later (its K2 must be the params'). */
 static amscr_status read_inner(amscr__rbuf *r, amscr_index *x)
 {
     size_t n = amscr_db_size(x->db), fk = AMSCR__INNER_F * AMSCR__INNER_K;
@@ -347,7 +352,10 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int
     size_t pos = 0;
     uint32_t version = 0;
     int lazy = map && (flags & AMSCR_INDEX_LAZY); /* the shapes decoded from the kept mapping when needed */
-    amscr_status st = amscr__db_parse(buf, len, lazy, &db, &pos, &version);
+    const unsigned char *b = buf;
+    uint32_t v0 = len >= 12 ? (uint32_t)b[8] | (uint32_t)b[9] << 8 | (uint32_t)b[10] << 16 | (uint32_t)b[11] << 24 : 0;
+    /* compact records stay records (checked now, decoded when read) */
+    amscr_status st = amscr__db_parse(buf, len, lazy || amscr__db_compact(v0), &db, &pos, &version);
     if (st != AMSCR_OK)
         return st;
     amscr_index *x = calloc(1, sizeof *x);
@@ -382,6 +390,8 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int
         st = read_rest(&r, x, version);
     if (st == AMSCR_OK)
         st = amscr__index_features(x, 0, 1);
+    if (st == AMSCR_OK && !x->map) /* the shapes kept as the file's compact records (an older file's decoded) */
+        st = amscr__db_own_source(x->db);
     if (st != AMSCR_OK) {
         amscr__index_detach_map(x); /* the caller unmaps */
         amscr_index_free(x);

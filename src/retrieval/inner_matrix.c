@@ -3,6 +3,7 @@
  * threads (rows.c: every cell computed by the same code, so the result does not depend on the
  * thread count), mirrored into a symmetric matrix with a zero diagonal. */
 #include "channel.h" /* amscr__mirror_upper */
+#include "db_io.h"   /* amscr__db_descriptor_peek */
 #include "inner.h"
 #include "rows.h"
 
@@ -27,10 +28,21 @@ static amscr_status job_init(void *ctx, void **ws)
 static amscr_status feature_row(void *ctx, size_t i, void *ws)
 {
     const inner_job *m = ctx;
-    const amscr_descriptor *d = amscr_db_descriptor(m->db, i);
-    if (!d)
-        return amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
-    return amscr__inner_build_shape(d, amscr_db_params(m->db)->inner_closing, &m->f[i], ws);
+    size_t N = amscr_db_params(m->db)->num_samples;
+    double *in = amscr__malloc_array(2 * N + 2 * AMSCR__OUTLINE_N, sizeof *in);
+    if (!in)
+        return amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
+    /* a compact record's samples and outline read as they are, else a lazy collection's shape
+     * decoded for this row only */
+    amscr_descriptor sd, *tmp = NULL;
+    const amscr_descriptor *d = &sd;
+    if (!amscr__db_shallow(m->db, i, &sd, in, in + 2 * N))
+        d = amscr__db_descriptor_peek(m->db, i, &tmp);
+    amscr_status st = d ? amscr__inner_build_shape(d, amscr_db_params(m->db)->inner_closing, &m->f[i], ws)
+                        : amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
+    amscr_descriptor_free(tmp);
+    free(in);
+    return st;
 }
 
 /* Rows a task takes, and the columns each row takes at a time: a column group's features

@@ -239,6 +239,18 @@ static amscr_status keep_outline(amscr_descriptor *d, const double *pts, size_t 
     return st == AMSCR_E_NOMEM ? amscr__fail(st, "descriptor: out of memory") : st;
 }
 
+amscr_status amscr__descriptor_rebuild(amscr_descriptor *d)
+{
+    const amscr_params *p = &d->params;
+    size_t N = d->n;
+    amscr_status st = p->invariance == AMSCR_INVARIANCE_AFFINE
+                          ? amscr__whiten(d->input, N, d->base, d->fwd, d->inv)
+                          : normalize_similarity(d->input, N, d->base, d->fwd, d->inv);
+    for (size_t k = 0; st == AMSCR_OK && k < d->p; k++)
+        st = amscr__smooth(d->base, N, p->closed, p->scales[k], d->scaled + 2 * N * k);
+    return st == AMSCR_OK ? amscr__descriptor_finish(d) : st;
+}
+
 amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c, amscr_descriptor **out)
 {
     amscr__clear_error();
@@ -280,16 +292,8 @@ amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c,
         st = amscr__parametrize(pts, m, closed, p->parametrization, p->presmooth, p->arclength_passes, M, N,
                                 d->input);
     }
-    if (st == AMSCR_OK) {
-        if (p->invariance == AMSCR_INVARIANCE_AFFINE)
-            st = amscr__whiten(d->input, N, d->base, d->fwd, d->inv);
-        else
-            st = normalize_similarity(d->input, N, d->base, d->fwd, d->inv);
-    }
-    for (size_t k = 0; st == AMSCR_OK && k < d->p; k++)
-        st = amscr__smooth(d->base, N, closed, p->scales[k], d->scaled + 2 * N * k);
     if (st == AMSCR_OK)
-        st = amscr__descriptor_finish(d);
+        st = amscr__descriptor_rebuild(d);
     if (st == AMSCR_OK && closed && p->inner_closing > 0.0)
         st = keep_outline(d, pts, m);
     if (st == AMSCR_OK && p->invariance == AMSCR_INVARIANCE_AFFINE)

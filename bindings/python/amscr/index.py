@@ -40,7 +40,9 @@ class Index:
     files.
 
     ``Index(collection, progress=None, candidates=None)`` builds the index of a
-    :class:`Collection` on its threads (the collection is copied). ``candidates=0`` computes the
+    :class:`Collection` on its threads from the collection's own shapes; the index keeps a compact
+    copy of them (each shape's input samples and outline, ~3 KB at the defaults, the prepared
+    shape recomputed when read), not a second collection. ``candidates=0`` computes the
     whole base matrix (exact lists: a query then ranks exactly as ``collection.query``);
     ``candidates=M`` seeks each shape's neighbours among its M signature-nearest shapes only
     (large collections); the default, None, is exact up to ``AMSCR_INDEX_EXACT_MAX`` (2,000)
