@@ -358,8 +358,10 @@ static void format_text(sbuf *b, const opts *o, const amscr_contour *src, const 
     sb_puts(b, "   (scale:residual, * = kept)\n");
     sb_printf(b, "shift       %zu (of %zu samples)\n", r->shift, r->N);
     sb_printf(b, "reflected   %s\n", r->refl ? "yes" : "no");
-    sb_printf(b, "confidence  %.3f (ambiguity %.3f, inliers %.1f %%)%s\n", r->conf, r->amb, 100.0 * r->inl,
-              r->conf < 0.25 ? "  LOW: the map may be wrong" : "");
+    sb_printf(b, "confidence  %.3f (ambiguity %.3f, inliers %.1f %%", r->conf, r->amb, 100.0 * r->inl);
+    if (isfinite(r->overlap))
+        sb_printf(b, ", overlap %.1f %%", 100.0 * r->overlap);
+    sb_printf(b, ")%s\n", r->conf < 0.25 ? "  LOW: the map may be wrong" : "");
     if (o->partial)
         sb_printf(b, "part        %.4f .. %.4f of the target's boundary\n", r->part[0], r->part[1]);
     if (r->nalt > 1)
