@@ -13,7 +13,8 @@
  * once per set). With mpeg7-dev/folds.tsv, two more columns: each class fold of mpeg7-dev as its
  * own collection (sub-matrices of mpeg7-dev's base matrices; why the folds: docs/decisions.md).
  * With eth80-dev (objects seen in 41 views, a manifest with a `group` column), its column:
- * leave one object out, 1-NN. Last, the mean of the four collections (mpeg7-dev as its folds'
+ * leave one object out, 1-NN, each object's rows from the fusion and re-ranking graph of the others alone
+ * (as amscr_db_retrieval_matrix_heldout; one re-ranking per object). Last, the mean of the four collections (mpeg7-dev as its folds'
  * mean, Kimia as the two sums' mean share of the best, eth80-dev, the MCD-style set) and each
  * figure's spread: the standard error of the default's figure over its units (classes; objects
  * in eth80-dev), the margin within which a change may lower it. */
