@@ -13,7 +13,8 @@
  * once per set). With mpeg7-dev/folds.tsv, two more columns: each class fold of mpeg7-dev as its
  * own collection (sub-matrices of mpeg7-dev's base matrices; why the folds: docs/decisions.md).
  * With eth80-dev (objects seen in 41 views, a manifest with a `group` column), its column:
- * leave one object out, 1-NN. Last, the mean of the four collections (mpeg7-dev as its folds'
+ * leave one object out, 1-NN, each object's rows from the fusion and re-ranking graph of the others alone
+ * (as amscr_db_retrieval_matrix_heldout; one re-ranking per object). Last, the mean of the four collections (mpeg7-dev as its folds'
  * mean, Kimia as the two sums' mean share of the best, eth80-dev, the MCD-style set) and each
  * figure's spread: the standard error of the default's figure over its units (classes; objects
  * in eth80-dev), the margin within which a change may lower it. */
@@ -104,16 +105,17 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static double offdiag_median(const double *M, size_t n)
+/* The median off-diagonal value among the shapes not held out (held: NULL for none). */
+static double offdiag_median(const double *M, size_t n, const unsigned char *held)
 {
-    size_t m = n * n - n, k = 0;
-    double *v = malloc(m * sizeof *v);
+    size_t m = 0;
+    double *v = malloc(n * n * sizeof *v);
     if (!v)
         die("memory");
     for (size_t i = 0; i < n; i++)
         for (size_t j = 0; j < n; j++)
-            if (i != j)
-                v[k++] = M[i * n + j];
+            if (i != j && !(held && (held[i] || held[j])))
+                v[m++] = M[i * n + j];
     qsort(v, m, sizeof *v, cmp_double);
     double med = v[m / 2];
     free(v);
@@ -158,8 +160,9 @@ static void compute_bases(set_run *r)
     amscr_params_free(p);
 }
 
-/* Row w of the table into out (n x n), as amscr_db_retrieval_matrix composes it. */
-static void compose(const set_run *r, const row_t *w, double *out)
+/* Row w of the table into out (n x n), as amscr_db_retrieval_matrix composes it; with held
+ * (kind 2: one object out), as amscr_db_retrieval_matrix_heldout composes the held-out rows. */
+static void compose(const set_run *r, const row_t *w, const unsigned char *held, double *out)
 {
     size_t n = r->s.n, nn = n * n;
     double *H = malloc(nn * sizeof *H);
@@ -191,7 +194,7 @@ static void compose(const set_run *r, const row_t *w, double *out)
             }
         }
         if (ch) {
-            double sa = (1.0 - w->weight) / offdiag_median(out, n), sh = w->weight / offdiag_median(H, n);
+            double sa = (1.0 - w->weight) / offdiag_median(out, n, held), sh = w->weight / offdiag_median(H, n, held);
             for (size_t i = 0; i < nn; i++)
                 out[i] = sa * out[i] + sh * H[i];
         }
@@ -199,8 +202,12 @@ static void compose(const set_run *r, const row_t *w, double *out)
     free(H);
     size_t k = n < (size_t)w->k ? n : (size_t)w->k;
     const double *inner = w->use[M_INNER] ? r->base[M_INNER] : w->use[M_INNER_OPEN] ? r->base[M_INNER_OPEN] : NULL;
-    if (w->rerank && (inner ? amscr__rerank_normalized2(out, inner, w->inner, n, k, 10, amscr__resolve_threads(0), out)
-                            : amscr__rerank_normalized(out, n, k, 10, amscr__resolve_threads(0), out)) != AMSCR_OK)
+    const double *d[2] = {out, inner}, sh[2] = {0.0, w->inner};
+    if (w->rerank && held && amscr__rerank_held(d, sh, inner ? 2 : 1, n, k, 10, amscr__resolve_threads(0), held, out))
+        die("re-ranking");
+    if (w->rerank && !held &&
+        (inner ? amscr__rerank_normalized2(out, inner, w->inner, n, k, 10, amscr__resolve_threads(0), out)
+               : amscr__rerank_normalized(out, n, k, 10, amscr__resolve_threads(0), out)) != AMSCR_OK)
         die("re-ranking");
 }
 
@@ -261,18 +268,37 @@ static void score_one(set_run *r, const double *D, int k)
 static void score_rows(set_run *r)
 {
     size_t n = r->s.n;
-    double *D = malloc(n * n * sizeof *D);
-    if (!D)
+    double *D = malloc(n * n * sizeof *D), *G = malloc(n * n * sizeof *G);
+    unsigned char *held = calloc(n, 1);
+    if (!D || !G || !held)
         die("memory");
     for (int k = 0; k < NROWS; k++) {
         double t0 = now();
-        compose(r, &ROWS[k], D);
+        compose(r, &ROWS[k], NULL, D);
+        /* one object out: each object's rows from the fusion and graph of the others alone */
+        const row_t *w = &ROWS[k];
+        int fused = w->use[M_AMSCR] && (w->use[M_SIM] || w->use[M_AFF]);
+        for (size_t i = 0; r->kind == 2 && (w->rerank || fused) && i < n; i++) {
+            size_t first = 0;
+            while (r->groups[first] != r->groups[i])
+                first++;
+            if (first < i)
+                continue; /* the object's rows are done */
+            for (size_t j = 0; j < n; j++)
+                held[j] = r->groups[j] == r->groups[i];
+            compose(r, &ROWS[k], held, G);
+            for (size_t j = 0; j < n; j++)
+                if (held[j])
+                    memcpy(D + j * n, G + j * n, n * sizeof *D);
+        }
         r->secs[k] = now() - t0;
         for (int b = 0; b < NBASE; b++)
             r->secs[k] += ROWS[k].use[b] ? r->t_base[b] : 0.0;
         score_one(r, D, k);
     }
     free(D);
+    free(G);
+    free(held);
 }
 
 static void free_bases(set_run *r)

@@ -2578,6 +2578,33 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_retrieval_matrix(const amscr_db 
                                                                  void *user, double *out_dist);
 
 /**
+ * @brief The retrieval matrix with each group held out in turn (leave one group out, e.g. one
+ *        ETH-80 object): row i holds shape i's scores as a new query against the collection
+ *        without i's group. For each group, the fusion's medians and the re-ranking's kNN graph
+ *        are those of the other groups alone (the group's shapes are in no neighbour list but
+ *        their own, which holds the shape itself then its nearest among the other groups); the
+ *        pair distances are computed once. Row i then ranks the other groups' shapes as
+ *        amscr_db_retrieval_matrix does (values in [0, 1] with re-ranking, the fused distance
+ *        without), its own group's entries are +infinity and its diagonal 0; amscr_score_nn_groups
+ *        on it is the leave-one-group-out accuracy of a collection that never saw the group.
+ *        A query does not enter the other shapes' lists here (amscr_index_query_scores lets it
+ *        enter those it is nearer to than their K-th neighbour). Cost: the pair matrices once,
+ *        then one re-ranking of the n shapes per group (n x n doubles, a few times over).
+ * @param[in]  groups  n group ids (at least 2 distinct values; any int32 values).
+ * @param[in]  n       the collection's size (amscr_db_size).
+ * @param[out] out_dist  n x n, row-major.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n not the size, one group, open curves with a
+ *         channel weight); AMSCR_E_LIMIT (n > 65536); AMSCR_E_CANCELLED; AMSCR_E_NUMERIC;
+ *         AMSCR_E_NOMEM. NaN on failure as amscr_db_query.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_retrieval_matrix_heldout(const amscr_db *db, const int32_t *groups,
+                                                                         size_t n, amscr_progress_fn progress,
+                                                                         void *user, double *out_dist);
+
+/**
  * @brief Writes the prepared collection (versioned little-endian binary format with a
  *        checksum, 4 + 8 * (12 + 4N + 2Np) bytes per shape, 1 KB more when the params close
  *        the inner distance's silhouette) to a temporary name in the same folder and renames

@@ -202,6 +202,27 @@ START_TEST(test_matrices)
                             if (k / 3 != i / 3)
                                 ck_assert_msg(R[i * 6 + j] < R[i * 6 + k], "%d: %d vs %d", i, j, k);
                 }
+            /* each group (one shape of each family) held out: its own entries +infinity, the
+             * others in [0, 1], the family's other shapes first */
+            int32_t grp[6] = {0, 1, 2, 0, 1, 2};
+            double Hd[36];
+            ck_assert_int_eq(amscr_db_retrieval_matrix_heldout(db, grp, 6, NULL, NULL, Hd), AMSCR_OK);
+            for (int i = 0; i < 6; i++)
+                for (int j = 0; j < 6; j++) {
+                    if (i == j)
+                        ck_assert(Hd[i * 6 + j] == 0.0);
+                    else if (grp[i] == grp[j])
+                        ck_assert(isinf(Hd[i * 6 + j]) && Hd[i * 6 + j] > 0);
+                    else
+                        ck_assert(Hd[i * 6 + j] >= 0.0 && Hd[i * 6 + j] <= 1.0);
+                    for (int k = 0; k < 6; k++)
+                        if (j != i && grp[j] != grp[i] && i / 3 == j / 3 && k / 3 != i / 3)
+                            ck_assert_msg(Hd[i * 6 + j] < Hd[i * 6 + k], "held out %d: %d vs %d", i, j, k);
+                }
+            ck_assert_int_eq(amscr_db_retrieval_matrix_heldout(db, grp, 5, NULL, NULL, Hd), AMSCR_E_INVALID_ARG);
+            ck_assert_int_eq(amscr_db_retrieval_matrix_heldout(db, NULL, 6, NULL, NULL, Hd), AMSCR_E_INVALID_ARG);
+            int32_t one[6] = {7, 7, 7, 7, 7, 7};
+            ck_assert_int_eq(amscr_db_retrieval_matrix_heldout(db, one, 6, NULL, NULL, Hd), AMSCR_E_INVALID_ARG);
             /* AMSCR and the channel fused half and half, without re-ranking: symmetric, finite,
              * zero diagonal */
             amscr_params *q = NULL;
@@ -275,6 +296,10 @@ START_TEST(test_bad_input)
         ck_assert_int_eq(amscr_db_add_descriptor(db, f, i, NULL), AMSCR_OK);
     double m9[9];
     ck_assert_int_eq(amscr_db_channel_matrix(db, cancel_cb, NULL, m9), AMSCR_E_CANCELLED);
+    for (int i = 0; i < 9; i++)
+        ck_assert(isnan(m9[i]));
+    int32_t g3[3] = {0, 1, 1};
+    ck_assert_int_eq(amscr_db_retrieval_matrix_heldout(db, g3, 3, cancel_cb, NULL, m9), AMSCR_E_CANCELLED);
     for (int i = 0; i < 9; i++)
         ck_assert(isnan(m9[i]));
     amscr_db_free(db);

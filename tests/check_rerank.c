@@ -155,6 +155,77 @@ START_TEST(test_graphs)
 }
 END_TEST
 
+/* 1 when row a of A (na wide) and row b of B (nb wide) order m shapes alike: columns cols[t]
+ * of A, bcols[t] of B. */
+static int same_order(const double *A, int na, int a, const double *B, int nb, int b, const int *cols, const int *bcols,
+                      int m)
+{
+    for (int s = 0; s < m; s++)
+        for (int t = 0; t < m; t++)
+            if ((A[a * na + cols[s]] < A[a * na + cols[t]]) != (B[b * nb + bcols[s]] < B[b * nb + bcols[t]]))
+                return 0;
+    return 1;
+}
+
+/* Held-out shapes: with none it is the plain re-ranking; the others' rows order the others as
+ * the re-ranking of the others alone; a held-out row orders the others the same whatever the
+ * other held-out shapes are (here: with shape 3 dropped from the matrix). */
+START_TEST(test_held)
+{
+    enum { N = 14 };
+    double A[N * N], B[N * N], R1[N * N], R2[N * N], S[N * N], T[N * N];
+    random_matrix(A, N, 4);
+    random_matrix(B, N, 5);
+    unsigned char none[N] = {0}, held[N] = {0}, held2[N - 1] = {0};
+    const double *two[2] = {A, B};
+    double sh[2] = {0.0, 0.2};
+    ck_assert_int_eq(amscr__rerank_graphs(two, sh, 2, N, 4, 10, 1, R1), AMSCR_OK);
+    ck_assert_int_eq(amscr__rerank_held(two, sh, 2, N, 4, 10, 2, none, R2), AMSCR_OK);
+    for (int i = 0; i < N * N; i++)
+        ck_assert(R1[i] == R2[i]);
+    int others[N], m = 0, others2[N];
+    for (int i = 0; i < N; i++) {
+        held[i] = i % 3 == 0; /* 0, 3, 6, 9, 12 */
+        if (!held[i])
+            others[m++] = i;
+    }
+    ck_assert_int_eq(amscr__rerank_held(two, sh, 2, N, 4, 10, 1, held, R2), AMSCR_OK);
+    /* the others alone: their submatrices */
+    double SA[N * N], SB[N * N];
+    for (int s = 0; s < m; s++)
+        for (int t = 0; t < m; t++) {
+            SA[s * m + t] = A[others[s] * N + others[t]];
+            SB[s * m + t] = B[others[s] * N + others[t]];
+        }
+    const double *sub[2] = {SA, SB};
+    ck_assert_int_eq(amscr__rerank_graphs(sub, sh, 2, (size_t)m, 4, 10, 1, S), AMSCR_OK);
+    for (int s = 0; s < m; s++)
+        others2[s] = s;
+    for (int s = 0; s < m; s++)
+        ck_assert(same_order(R2, N, others[s], S, m, s, others, others2, m));
+    /* shape 3 dropped: the matrix without row and column 3 */
+    double DA[(N - 1) * (N - 1)], DB[(N - 1) * (N - 1)];
+    for (int i = 0, u = 0; i < N; i++) {
+        if (i == 3)
+            continue;
+        held2[u] = held[i];
+        for (int j = 0, v = 0; j < N; j++)
+            if (j != 3) {
+                DA[u * (N - 1) + v] = A[i * N + j];
+                DB[u * (N - 1) + v++] = B[i * N + j];
+            }
+        u++;
+    }
+    const double *drop[2] = {DA, DB};
+    ck_assert_int_eq(amscr__rerank_held(drop, sh, 2, N - 1, 4, 10, 1, held2, T), AMSCR_OK);
+    for (int s = 0; s < m; s++)
+        others2[s] = others[s] - (others[s] > 3);
+    ck_assert(same_order(R2, N, 0, T, N - 1, 0, others, others2, m));
+    ck_assert(same_order(R2, N, 12, T, N - 1, 11, others, others2, m));
+    ck_assert_int_eq(amscr__rerank_held(two, sh, 2, N, 4, 10, 1, NULL, R2), AMSCR_E_INVALID_ARG);
+}
+END_TEST
+
 Suite *amscr_suite_rerank(void)
 {
     Suite *s = suite_create("rerank");
@@ -163,6 +234,7 @@ Suite *amscr_suite_rerank(void)
     tcase_add_test(tc, test_blocks_and_unreached);
     tcase_add_test(tc, test_invalid);
     tcase_add_test(tc, test_graphs);
+    tcase_add_test(tc, test_held);
     suite_add_tcase(s, tc);
     return s;
 }

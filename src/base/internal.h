@@ -259,6 +259,13 @@ amscr_status amscr__rerank_normalized2(const double *dist, const double *dist2, 
 enum { AMSCR__RERANK_GRAPHS = 4 };
 amscr_status amscr__rerank_graphs(const double *const *dist, const double *share, int graphs, size_t n, size_t k,
                                   unsigned iterations, unsigned threads, double *out_dist);
+/* The same with the shapes held[i] != 0 held out of the graph: no list holds them but their own,
+ * and their own lists are themselves then their nearest among the others (not held out). The
+ * others' rows are then the re-ranking of the others alone, and a held-out row's entries of the
+ * others are its diffusion as a query into their graph (the other held-out shapes change them
+ * only by the row's scale, never their order). */
+amscr_status amscr__rerank_held(const double *const *dist, const double *share, int graphs, size_t n, size_t k,
+                                unsigned iterations, unsigned threads, const unsigned char *held, double *out_dist);
 
 /* The retrieval settings in the saved collection (format versions 2 and up, retrieval_io.c):
  * little-endian f64 channel_weight, u32 channel_invariance, f64 channel_affine_share,

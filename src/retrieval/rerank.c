@@ -33,10 +33,12 @@ static amscr_status check_args(const double *dist, size_t n, size_t k, unsigned 
  * entries a row: k neighbours of each graph); row (0..n-1) and nb (k) the neighbour
  * selection's scratch. */
 typedef struct {
-    double *D, *D2, *Q, *T, *sc, *pw;
+    double *D, *D2, *Q, *T, *sc, *pw, *cd;
     size_t *pj, *row;
     uint32_t *nb;
     size_t kk;
+    const unsigned char *held; /* shapes out of every list but their own (NULL: none) */
+    size_t nrow;               /* with held: the shapes not held out, in row[0..nrow-1] */
 } rerank_buf;
 
 static void buf_free(rerank_buf *b)
@@ -50,6 +52,7 @@ static void buf_free(rerank_buf *b)
     free(b->pj);
     free(b->row);
     free(b->nb);
+    free(b->cd);
 }
 
 static int buf_alloc(rerank_buf *b, size_t n, size_t k, int graphs)
@@ -65,7 +68,8 @@ static int buf_alloc(rerank_buf *b, size_t n, size_t k, int graphs)
     b->pj = amscr__malloc_array(n * b->kk, sizeof *b->pj);
     b->row = amscr__malloc_array(n, sizeof *b->row);
     b->nb = amscr__malloc_array(k, sizeof *b->nb);
-    if (b->D && (graphs < 2 || b->D2) && b->Q && b->T && b->sc && b->pw && b->pj && b->row && b->nb)
+    b->cd = amscr__malloc_array(n, sizeof *b->cd);
+    if (b->D && (graphs < 2 || b->D2) && b->Q && b->T && b->sc && b->pw && b->pj && b->row && b->nb && b->cd)
         return 1;
     buf_free(b);
     return 0;
@@ -90,11 +94,18 @@ static double symmetrize(const double *dist, size_t n, double *D)
 static amscr_status knn_graph(rerank_buf *b, const double *D, size_t n, size_t k, size_t off, double mass,
                               double dmax)
 {
-    size_t kk = b->kk;
+    size_t kk = b->kk, m = 0;
     for (size_t j = 0; j < n; j++)
-        b->row[j] = j;
+        if (!b->held || !b->held[j])
+            b->row[m++] = j;
     for (size_t i = 0; i < n; i++) {
-        amscr_status st = amscr__knn_select(i, b->row, D + i * n, n, k, b->nb, b->pw + i * kk + off);
+        const double *cd = D + i * n; /* every shape a candidate: the row itself */
+        if (b->held) {                /* the shapes not held out (and the row itself, first) */
+            for (size_t t = 0; t < m; t++)
+                b->cd[t] = D[i * n + b->row[t]];
+            cd = b->cd;
+        }
+        amscr_status st = amscr__knn_select(i, b->row, cd, m, k, b->nb, b->pw + i * kk + off);
         if (st != AMSCR_OK)
             return st;
         for (size_t t = 0; t < k; t++)
@@ -213,7 +224,8 @@ static double first_mass(const double *share, int graphs)
 /* dist[0] and the graphs' distances dist[1..graphs-1], each entering with share[g] of every
  * row's mass (graph 0 with the rest; share[0] is not read). */
 static amscr_status rerank(const double *const *dist, const double *share, int graphs, size_t n, size_t k,
-                           unsigned iterations, unsigned threads, int norm, double *out_dist, const char *what)
+                           unsigned iterations, unsigned threads, int norm, const unsigned char *held,
+                           double *out_dist, const char *what)
 {
     amscr__clear_error();
     amscr_status st = AMSCR_OK;
@@ -224,6 +236,7 @@ static amscr_status rerank(const double *const *dist, const double *share, int g
     rerank_buf b;
     if (!buf_alloc(&b, n, k, graphs))
         return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", what);
+    b.held = held;
     double dmax = symmetrize(dist[0], n, b.D);
     st = knn_graph(&b, b.D, n, k, 0, first_mass(share, graphs), dmax);
     for (int g = 1; g < graphs && st == AMSCR_OK; g++) /* b.D2 is reused graph by graph */
@@ -239,14 +252,14 @@ static amscr_status rerank(const double *const *dist, const double *share, int g
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist)
 {
     double share = 1.0;
-    return rerank(&dist, &share, 1, n, k, iterations, 1, NORM_ROW_MAX, out_dist, "amscr_rerank_diffusion");
+    return rerank(&dist, &share, 1, n, k, iterations, 1, NORM_ROW_MAX, NULL, out_dist, "amscr_rerank_diffusion");
 }
 
 amscr_status amscr__rerank_normalized(const double *dist, size_t n, size_t k, unsigned iterations, unsigned threads,
                                       double *out_dist)
 {
     double share = 1.0;
-    return rerank(&dist, &share, 1, n, k, iterations, threads, NORM_UNIT, out_dist, "re-ranking");
+    return rerank(&dist, &share, 1, n, k, iterations, threads, NORM_UNIT, NULL, out_dist, "re-ranking");
 }
 
 amscr_status amscr__rerank_normalized2(const double *dist, const double *dist2, double share, size_t n, size_t k,
@@ -254,7 +267,7 @@ amscr_status amscr__rerank_normalized2(const double *dist, const double *dist2, 
 {
     const double *d[2] = {dist, dist2};
     double sh[2] = {1.0 - share, share};
-    return rerank(d, sh, dist2 ? 2 : 1, n, k, iterations, threads, NORM_UNIT, out_dist, "re-ranking");
+    return rerank(d, sh, dist2 ? 2 : 1, n, k, iterations, threads, NORM_UNIT, NULL, out_dist, "re-ranking");
 }
 
 amscr_status amscr__rerank_graphs(const double *const *dist, const double *share, int graphs, size_t n, size_t k,
@@ -262,5 +275,13 @@ amscr_status amscr__rerank_graphs(const double *const *dist, const double *share
 {
     if (!dist || !share || graphs < 1 || graphs > AMSCR__RERANK_GRAPHS)
         return amscr__fail(AMSCR_E_INVALID_ARG, "re-ranking: 1 to %d graphs", AMSCR__RERANK_GRAPHS);
-    return rerank(dist, share, graphs, n, k, iterations, threads, NORM_UNIT, out_dist, "re-ranking");
+    return rerank(dist, share, graphs, n, k, iterations, threads, NORM_UNIT, NULL, out_dist, "re-ranking");
+}
+
+amscr_status amscr__rerank_held(const double *const *dist, const double *share, int graphs, size_t n, size_t k,
+                                unsigned iterations, unsigned threads, const unsigned char *held, double *out_dist)
+{
+    if (!dist || !share || !held || graphs < 1 || graphs > AMSCR__RERANK_GRAPHS)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "re-ranking: 1 to %d graphs", AMSCR__RERANK_GRAPHS);
+    return rerank(dist, share, graphs, n, k, iterations, threads, NORM_UNIT, held, out_dist, "re-ranking");
 }

@@ -158,11 +158,11 @@ def test_ablation_rows(where, flags, published, tmp_path):
 
 
 # eth80-dev (objects of ETH-80 seen in 41 views; docs/measurements.md "Retrieval"): leave one object
-# out, 1-NN, through `amscr eval MANIFEST --protocol groups` at the defaults, on every fourth view of
-# each object (views 1, 5, ..., 41: 440 shapes, a few seconds; the whole set's figure is the
-# ablation table's). No setting of the default was chosen on it. Asserted not to fall more than
+# out (out of the collection's fusion and re-ranking graph too), 1-NN, through `amscr eval MANIFEST
+# --protocol groups` at the defaults, on every fourth view of each object (views 1, 5, ..., 41: 440
+# shapes, a few seconds; the whole set's figure is the ablation table's). No setting of the default was chosen on it. Asserted not to fall more than
 # half a point (two of its 440 queries) below the published figure.
-ETH80_EVERY_FOURTH_VIEW = 78.64
+ETH80_EVERY_FOURTH_VIEW = 73.86
 
 
 def test_eth80_dev_one_object_out(tmp_path):

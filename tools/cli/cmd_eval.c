@@ -49,6 +49,41 @@ static int32_t *collection_labels(const collection *c, size_t **sizes)
     return l;
 }
 
+/* The matrix of the groups protocol: each group's shapes as new queries against the collection
+ * without the group (amscr_db_retrieval_matrix_heldout: its fusion and re-ranking graph held
+ * out too); the distance matrix as is when nothing of the collection's enters the ranking. */
+static int heldout_matrix(const amscr_db *db, const collection *c, const char *what, double **out)
+{
+    size_t n = c->n;
+    if (retrieval_is_plain(amscr_db_params(db)))
+        return compute_matrix(db, what, out);
+    if (n > SIZE_MAX / n / sizeof(double)) {
+        tool_error(what, "too many shapes for a matrix (%zu)", n);
+        return -1;
+    }
+    double *d = xmalloc_array(n * n, sizeof(double));
+    int32_t *g = xmalloc_array(n, sizeof(int32_t));
+    if (d == NULL || g == NULL) {
+        free(d);
+        free(g);
+        return -1;
+    }
+    for (size_t i = 0; i < n; i++)
+        g[i] = c->items[i].group;
+    tool_progress pr;
+    progress_init(&pr, "matching");
+    amscr_status st = amscr_db_retrieval_matrix_heldout(db, g, n, progress_cb, &pr, d);
+    progress_end(&pr);
+    free(g);
+    if (st != AMSCR_OK) {
+        tool_lib_error(what, st);
+        free(d);
+        return -1;
+    }
+    *out = d;
+    return 0;
+}
+
 /* Leave one group out (amscr_score_nn_groups). */
 static amscr_status compute_groups(const double *d, const collection *c, eval_scores *s)
 {
@@ -334,7 +369,7 @@ int cmd_eval(opts *o)
         goto done;
     }
     s.t1 = now_seconds();
-    if (compute_matrix(db, cpath, &d) != 0)
+    if ((pr == PROTO_GROUPS ? heldout_matrix(db, &c, cpath, &d) : compute_matrix(db, cpath, &d)) != 0)
         goto done;
     s.t2 = now_seconds();
     s.ranks = o->ranks ? o->ranks : TOOL_RANKS_DEFAULT;

@@ -294,6 +294,7 @@ amscr_status amscr_db_distance_matrix(const amscr_db *db, amscr_progress_fn prog
 amscr_status amscr_db_cross_distances(const amscr_db *queries, const amscr_db *targets, amscr_progress_fn progress, void *user, double *out_dist);
 amscr_status amscr_db_channel_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out_dist);
 amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out_dist);
+amscr_status amscr_db_retrieval_matrix_heldout(const amscr_db *db, const int32_t *groups, size_t n, amscr_progress_fn progress, void *user, double *out_dist);
 amscr_status amscr_db_save(const amscr_db *db, const char *path);
 amscr_status amscr_db_load(const char *path, amscr_db **out);
 amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *out_len);

@@ -8,7 +8,7 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ProgressArg, RWLock, as_points, bad, dbuf, new_object, progress_call, saved_bytes
+from ._util import ProgressArg, RWLock, as_points, bad, dbuf, factorize, new_object, progress_call, saved_bytes
 from .contour import contour_new
 from .errors import _check
 from .params import Params, make_params
@@ -309,6 +309,35 @@ class Collection:
             by `progress`.
         """
         return self._matrix(lib.amscr_db_retrieval_matrix, threads, progress)
+
+    def retrieval_matrix_heldout(self, groups: Sequence[Any], threads: Optional[int] = None,
+                                 progress: ProgressArg = False) -> np.ndarray:
+        """The retrieval matrix with each group held out in turn (C
+        ``amscr_db_retrieval_matrix_heldout``; ``amscr eval --protocol groups``): row i holds
+        shape i's scores as a new query against the collection without i's group, whose fusion
+        medians and re-ranking graph are computed without the group. Its own group's entries
+        are +inf (diagonal 0). :func:`amscr.nn_groups` on it is the leave-one-group-out
+        accuracy of a collection that never saw the group (on :meth:`retrieval_matrix` the
+        group's own shapes shape its neighbours' graph, which flatters or hurts the figure).
+
+        Args:
+            groups: n group names or ids (at least two distinct), e.g. the object of each view.
+            threads: threads for this call (None: the collection's).
+            progress: as in :meth:`query`.
+        Returns:
+            (n, n) float array for ranking.
+        Raises:
+            InvalidArgumentError: not one group per shape, a single group, open curves with a
+            channel weight; CancelledError: cancelled by `progress`.
+        """
+        with self._lock.read():
+            src, _ = self._with_threads(threads)
+            n = len(self)
+            codes = factorize(groups, n, 'groups')
+            out = np.zeros((n, n), dtype=np.float64)
+            progress_call(lib.amscr_db_retrieval_matrix_heldout, (src._db, ffi.from_buffer('int32_t[]', codes), n),
+                          (dbuf(out),), progress)
+            return out
 
     def _matrix(self, fn: Any, threads: Optional[int], progress: ProgressArg) -> np.ndarray:
         with self._lock.read():

@@ -242,6 +242,10 @@ def nn_groups(D: ArrayLike, labels: ArrayLike, groups: ArrayLike) -> GroupScores
     """Leave one group out (ETH-80: one object out): the shapes of each group are classified by
     their nearest shape among the other groups, never one of their own group.
 
+    For the retrieval scores, give it :meth:`Collection.retrieval_matrix_heldout` (each group
+    out of the fusion and the re-ranking graph, as ``amscr eval --protocol groups`` does): on
+    :meth:`Collection.retrieval_matrix` the group's own shapes are in the graph that ranks it.
+
     Args:
         D: (n, n) distance matrix (rows = queries), n >= 2.
         labels: n class labels (ints or names).

@@ -160,6 +160,40 @@ def test_retrieval_matrix_fuses_and_reranks():
     assert n == 30
 
 
+def test_retrieval_matrix_heldout():
+    """Each group held out: its rows are the fusion with the other groups' medians (no
+    re-ranking), its own group's entries +inf; with re-ranking, scores in [0, 1] that
+    nn_groups reads."""
+    p = amscr.Params.retrieval(points=64)
+    fused_db = _collection(p.copy(rerank_k=0, channel_weight=0.5))
+    n = len(fused_db)
+    groups = np.arange(n) % 4  # one copy of each class in each group
+    H = fused_db.retrieval_matrix_heldout(groups)
+    D = fused_db.distance_matrix()
+    S = 0.5 * (D + D.T)
+    np.fill_diagonal(S, 0.0)
+    C = fused_db.channel_matrix()
+    for g in range(4):
+        out = groups != g
+        off = np.outer(out, out) & ~np.eye(n, dtype=bool)
+        ms, mc = np.sort(S[off])[off.sum() // 2], np.sort(C[off])[off.sum() // 2]
+        for i in np.flatnonzero(~out):
+            np.testing.assert_allclose(H[i, out], 0.5 * S[i, out] / ms + 0.5 * C[i, out] / mc, rtol=1e-12)
+            sib = ~out
+            sib[i] = False
+            assert H[i, i] == 0.0 and np.all(np.isposinf(H[i, sib]))
+    db = _collection(p, copies=10)
+    groups = np.arange(len(db)) % 5
+    R = db.retrieval_matrix_heldout(['g%d' % g for g in groups])
+    own = groups[:, None] == groups[None, :]
+    assert np.all((R[~own] >= 0.0) & (R[~own] <= 1.0)) and np.all(np.diag(R) == 0.0)
+    assert amscr.nn_groups(R, db.label_codes, groups).accuracy == 1.0
+    with pytest.raises(amscr.InvalidArgumentError, match='at least 2 groups'):
+        db.retrieval_matrix_heldout([1] * len(db))
+    with pytest.raises(amscr.InvalidArgumentError):
+        db.retrieval_matrix_heldout([1, 2])
+
+
 def test_open_curves_need_weight_zero():
     db = amscr.Collection(amscr.Params.retrieval(closed=False, points=64))
     db.add(blob(200, seed=1)[:150])
