@@ -302,5 +302,13 @@ unsigned amscr__resolve_threads(unsigned requested);
 
 /* The mode of a file written to path (file_mode.c): the replaced file's, else 0666 & ~umask. */
 unsigned amscr__file_mode(const char *path);
+/* Whole files (file_io.c). buf written to path through a temporary name and a rename. */
+amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t len);
+/* The whole file at path (caller frees *out). */
+amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out_len);
+/* The whole file at path mapped read-only (*mapped = 1; no copy, the page cache's pages), or
+ * read as amscr__file_read where it cannot be mapped; release with amscr__file_unmap. */
+amscr_status amscr__file_map(const char *path, unsigned char **out, size_t *out_len, int *mapped);
+void amscr__file_unmap(unsigned char *buf, size_t len, int mapped);
 
 #endif

@@ -15,6 +15,7 @@
  *   recover.c           part of the target missing: source fragments placed as further starts
  *   final_solve.c       the reported solve by LAPACKE QR; the distance
  *   polish.c            the reported map polished on the input points (amscr_register only)
+ *   polish_rank.c       the starts the polish tries, their ambiguity and ranking in the match
  *   nearest.c           closest points on the input polylines, for the polish (nearest.h)
  *   ordered.c           the polish's order stage: a noisy curve's point order (ordered.h)
  *   even.c              the polish's even-spacing stage: points taken evenly along it (even.h)
@@ -321,6 +322,19 @@ amscr_status amscr__polish_order(amscr__polish_state *w, match_t *m);
 /* The polished map refined by the even spacing of those points (even.c), into m->X. */
 amscr_status amscr__polish_even(amscr__polish_state *w, match_t *m);
 void amscr__polish_end(amscr__polish_state *w);
+/* polish_rank.c: the polish's start maps into S (normalized frames) with their orientations so:
+ * m's chosen map first, then, when the search could not tell its candidates apart, each
+ * candidate that differs from all before; may_win[k]: start k may become the reported map (the
+ * search's further minima are ranked for the alternatives only). Returns their count. */
+size_t amscr__polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6], int *so,
+                            unsigned char *may_win);
+/* The ambiguity of start `best` among the count polished starts S (costs cost): its cost over
+ * the best cost of a clearly different map (1: as good; 0: none). */
+double amscr__polished_ambiguity(const amscr_descriptor *f, double S[][6], const double *cost, size_t count,
+                                 size_t best);
+/* The polished starts (S, so, may_win, cost; best the winner) as m's ranking (m->rank_*). */
+void amscr__polish_keep_ranking(double S[][6], const int *so, const unsigned char *may_win, const double *cost,
+                                size_t count, size_t best, match_t *m);
 
 /* stages.c: the stages of amscr_register on the checked pair, in pipeline order, into r (r->m,
  * r->ran). The caller fills the result's maps afterwards. */

@@ -59,10 +59,6 @@
 #define MAX_AREA_CHANGE 2.0
 /* Each direction of the ranking cost keeps this share of its pairs (recover.c's rule). */
 #define RANK_KEEP 0.7
-/* The search's other candidates are polished too when its ambiguity is at least this: another
- * start scored within a factor 2 of the chosen one (near-symmetric shapes, where noise decides;
- * measured on the held-out pairs: 0.6-1.0 for those, below 0.35 for every other pair). */
-#define AMBIGUOUS_SEARCH 0.5
 /* An edge longer than GAP_RATIO times the curve's median edge is a gap (the chord that closes a
  * contour across a missing run), not boundary: nothing is paired onto it. */
 #define GAP_RATIO 8.0
@@ -425,45 +421,6 @@ static int has_gap(const curve_t *c)
     return 0;
 }
 
-/* The start maps: the chosen one first, then — when the search could not tell its candidates
- * apart (ambiguity at least AMBIGUOUS_SEARCH) — each candidate that differs from all before.
- * may_win[k]: start k may become the reported map (the search's further minima are polished and
- * ranked for the alternatives only). */
-static size_t polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6], int *so, unsigned char *may_win)
-{
-    size_t count = 1;
-    memcpy(S[0], m->X, sizeof S[0]);
-    so[0] = m->reflected;
-    may_win[0] = 1;
-    for (size_t c = 0; m->ambiguity >= AMBIGUOUS_SEARCH && c < m->ncand; c++) {
-        int fresh = 1;
-        for (int k = 0; k < 6; k++)
-            fresh = fresh && isfinite(m->cand[c][k]);
-        for (size_t k = 0; k < count && fresh; k++)
-            fresh = amscr__map_gap2(f, m->cand[c], S[k]) > AMSCR__DISTINCT_GAP2;
-        if (fresh) {
-            may_win[count] = c < m->ncand_base;
-            so[count] = m->cand_o[c];
-            memcpy(S[count++], m->cand[c], sizeof S[0]);
-        }
-    }
-    return count;
-}
-
-/* The ambiguity of start `best` among the polished starts S (costs cost): its cost over the
- * best cost of a clearly different map (1: as good; 0: none). */
-static double polished_ambiguity(const amscr_descriptor *f, double S[][6], const double *cost, size_t count,
-                                 size_t best)
-{
-    double amb = 0.0;
-    for (size_t k = 0; k < count; k++)
-        if (k != best && amscr__map_gap2(f, S[k], S[best]) > AMSCR__DISTINCT_GAP2) {
-            double r = (cost[best] + AMSCR__AMBIGUITY_FLOOR) / (cost[k] + AMSCR__AMBIGUITY_FLOOR);
-            amb = r > amb ? (r > 1.0 ? 1.0 : r) : amb;
-        }
-    return amb;
-}
-
 /* The polish between its fit and its order and even-spacing steps. */
 struct amscr__polish_state {
     polish_t w;
@@ -471,21 +428,6 @@ struct amscr__polish_state {
     double Y[6];  /* the polished map, a -> b in the curves' frames */
     int reranked; /* the match's ranking is the polish's */
 };
-
-/* The re-ranked starts as the match's ranking (the alternatives read it); the starts that may
- * win come first (polish_starts), so they are its lowest minima. */
-static void keep_ranking(double S[][6], const int *so, const unsigned char *may_win, const double *cost, size_t count,
-                         size_t best, match_t *m)
-{
-    m->nrank = count;
-    m->rank_best = best;
-    m->rank_nbase = 0;
-    while (m->rank_nbase < count && may_win[m->rank_nbase])
-        m->rank_nbase++;
-    memcpy(m->rank_X, S, count * sizeof S[0]);
-    memcpy(m->rank_o, so, count * sizeof *so);
-    memcpy(m->rank_cost, cost, count * sizeof *cost);
-}
 
 /* Every start a few steps, ranked; the index of the best that may win (count when none finished). */
 static size_t rank_starts(amscr__polish_state *ps, double S[][6], double Y[][6], double *cost,
@@ -507,8 +449,8 @@ static int polish_winner(amscr__polish_state *ps, double S[][6], const int *so, 
                          double Y[][6], const double *cost, size_t count, size_t best, match_t *m)
 {
     if (count > 1) {
-        m->ambiguity = polished_ambiguity(ps->f, S, cost, count, best);
-        keep_ranking(S, so, may_win, cost, count, best, m);
+        m->ambiguity = amscr__polished_ambiguity(ps->f, S, cost, count, best);
+        amscr__polish_keep_ranking(S, so, may_win, cost, count, best, m);
         ps->reranked = 1;
     }
     int done = polish_one(&ps->w, Y[best], POLISH_ITERS - SCORE_ITERS) < INFINITY;
@@ -546,7 +488,7 @@ amscr_status amscr__polish_fit(const amscr_descriptor *f, const amscr_descriptor
         cost[1 + 2 * AMSCR__CANDIDATES_MAX];
     unsigned char may_win[1 + 2 * AMSCR__CANDIDATES_MAX];
     int so[1 + 2 * AMSCR__CANDIDATES_MAX];
-    size_t count = polish_starts(f, m, S, so, may_win), best = count;
+    size_t count = amscr__polish_starts(f, m, S, so, may_win), best = count;
     int ready = polish_prepare(&ps->w, f, h, m->X, partial);
     if (ready > 0)
         best = rank_starts(ps, S, Y, cost, may_win, count);
@@ -585,7 +527,8 @@ amscr_status amscr__polish_rank_more(amscr__polish_state *ps, double X[][6], siz
         from_frames(&ps->w, ps->f, ps->h, Y, S);
         m->rank_o[m->nrank] = o;
         m->rank_cost[m->nrank++] = cost;
-        if (amscr__map_gap2(ps->f, S, m->rank_X[best]) > AMSCR__DISTINCT_GAP2) { /* polished_ambiguity's term */
+        /* amscr__polished_ambiguity's term */
+        if (amscr__map_gap2(ps->f, S, m->rank_X[best]) > AMSCR__DISTINCT_GAP2) {
             double r = (m->rank_cost[best] + AMSCR__AMBIGUITY_FLOOR) / (cost + AMSCR__AMBIGUITY_FLOOR);
             m->ambiguity = r > m->ambiguity ? (r > 1.0 ? 1.0 : r) : m->ambiguity;
         }

@@ -146,13 +146,5 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w);
  * checked but not decoded; *out decodes them from buf (which must outlive it) when asked for. */
 amscr_status amscr__db_parse(const unsigned char *buf, size_t len, int lazy, amscr_db **out, size_t *out_pos,
                              uint32_t *out_version);
-/* buf written to path through a temporary name and a rename. */
-amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t len);
-/* The whole file at path (caller frees *out). */
-amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out_len);
-/* The whole file at path mapped read-only (*mapped = 1; no copy, the page cache's pages), or
- * read as amscr__file_read where it cannot be mapped; release with amscr__file_unmap. */
-amscr_status amscr__file_map(const char *path, unsigned char **out, size_t *out_len, int *mapped);
-void amscr__file_unmap(unsigned char *buf, size_t len, int mapped);
 
 #endif
