@@ -107,32 +107,6 @@ amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t ca
     return query_scores(x, amscr_db_descriptor(x->db, i), i, candidates, out_scores);
 }
 
-amscr_status amscr_index_query(const amscr_index *x, const amscr_descriptor *q, size_t candidates, size_t top,
-                               size_t *out_idx, double *out_scores, size_t *out_count)
-{
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(x);
-    AMSCR_CHECK_NULL(q);
-    AMSCR_CHECK_NULL(out_idx);
-    AMSCR_CHECK_NULL(out_scores);
-    AMSCR_CHECK_NULL(out_count);
-    amscr_status st = check_query(x, q, NULL, 0, "amscr_index_query");
-    size_t n = amscr_db_size(x->db), k = top < n ? top : n;
-    double *all = st == AMSCR_OK ? amscr__malloc_array(n, sizeof *all) : NULL;
-    if (st == AMSCR_OK && !all)
-        st = amscr__fail(AMSCR_E_NOMEM, "amscr_index_query: out of memory");
-    if (st == AMSCR_OK)
-        st = query_scores(x, q, SIZE_MAX, candidates, all);
-    if (st == AMSCR_OK && k > 0)
-        st = amscr_topk(all, n, k, SIZE_MAX, out_idx);
-    for (size_t t = 0; st == AMSCR_OK && t < k; t++)
-        out_scores[t] = all[out_idx[t]];
-    if (st == AMSCR_OK)
-        *out_count = k;
-    free(all);
-    return st;
-}
-
 /* Signature-nearest shapes among which the member rule looks for the query's copy: a copy's
  * signature is the query's (distance 0), and copies tie by index, so the lowest-index copy is
  * among them unless this many shapes have the query's very signature without its samples. */
@@ -212,8 +186,10 @@ amscr_status amscr__index_search_scores(const amscr_index *x, const amscr_descri
     return search_scores(x, q, candidates, out);
 }
 
-amscr_status amscr_index_search(const amscr_index *x, const amscr_descriptor *q, size_t candidates, size_t top,
-                                size_t *out_idx, double *out_scores, size_t *out_count)
+/* The top best of the query's scores (the member rule when `member`): the body of
+ * amscr_index_query and amscr_index_search. */
+static amscr_status best_hits(const amscr_index *x, const amscr_descriptor *q, size_t candidates, size_t top,
+                              int member, size_t *out_idx, double *out_scores, size_t *out_count, const char *fn)
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
@@ -221,13 +197,13 @@ amscr_status amscr_index_search(const amscr_index *x, const amscr_descriptor *q,
     AMSCR_CHECK_NULL(out_idx);
     AMSCR_CHECK_NULL(out_scores);
     AMSCR_CHECK_NULL(out_count);
-    amscr_status st = check_query(x, q, NULL, 0, "amscr_index_search");
+    amscr_status st = check_query(x, q, NULL, 0, fn);
     size_t n = amscr_db_size(x->db), k = top < n ? top : n;
     double *all = st == AMSCR_OK ? amscr__malloc_array(n, sizeof *all) : NULL;
     if (st == AMSCR_OK && !all)
-        st = amscr__fail(AMSCR_E_NOMEM, "amscr_index_search: out of memory");
+        st = amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", fn);
     if (st == AMSCR_OK)
-        st = search_scores(x, q, candidates, all);
+        st = member ? search_scores(x, q, candidates, all) : query_scores(x, q, SIZE_MAX, candidates, all);
     if (st == AMSCR_OK && k > 0)
         st = amscr_topk(all, n, k, SIZE_MAX, out_idx);
     for (size_t t = 0; st == AMSCR_OK && t < k; t++)
@@ -236,4 +212,16 @@ amscr_status amscr_index_search(const amscr_index *x, const amscr_descriptor *q,
         *out_count = k;
     free(all);
     return st;
+}
+
+amscr_status amscr_index_query(const amscr_index *x, const amscr_descriptor *q, size_t candidates, size_t top,
+                               size_t *out_idx, double *out_scores, size_t *out_count)
+{
+    return best_hits(x, q, candidates, top, 0, out_idx, out_scores, out_count, "amscr_index_query");
+}
+
+amscr_status amscr_index_search(const amscr_index *x, const amscr_descriptor *q, size_t candidates, size_t top,
+                                size_t *out_idx, double *out_scores, size_t *out_count)
+{
+    return best_hits(x, q, candidates, top, 1, out_idx, out_scores, out_count, "amscr_index_search");
 }
