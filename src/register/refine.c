@@ -35,6 +35,16 @@
  * already exact, and closest-point steps smaller than half of it are noise: both would only
  * let the map slide along the curve, which closest-point costs do not see. */
 #define AMSCR__REFINE_FLOOR 1e-8
+/* The foot's position num / l2 on an edge, clamped to [0, 1], dividing only inside (most edges
+ * of a window project outside): the quotient's clamp (num < 0 < l2 gives a negative one,
+ * num > l2 one of at least 1; a NaN stays NaN). */
+static inline double edge_foot(double num, double l2)
+{
+    if (num < 0.0 || !(l2 > 0.0))
+        return 0.0;
+    return num > l2 ? 1.0 : num / l2;
+}
+
 /* Closest point to (px, py) on the polygon H (n vertices; closed: with the closing edge),
  * edges b0-w .. b0+w; *seg receives the edge index. */
 static double closest_on_polygon(const double *H, size_t n, int closed, size_t b0, size_t w, double px, double py,
@@ -52,15 +62,7 @@ static double closest_on_polygon(const double *H, size_t n, int closed, size_t b
         size_t c = b + 1 == n ? 0 : b + 1;
         double ax = H[2 * b], ay = H[2 * b + 1], ex = H[2 * c] - ax, ey = H[2 * c + 1] - ay;
         double l2 = ex * ex + ey * ey, num = (px - ax) * ex + (py - ay) * ey, t;
-        /* num / l2 clamped to [0, 1], dividing only inside (most edges of a window project
-         * outside): the same t as the quotient's (num < 0 < l2 gives a negative one, num > l2
-         * one of at least 1; a NaN stays NaN) */
-        if (num < 0.0 || !(l2 > 0.0))
-            t = 0.0;
-        else if (num > l2)
-            t = 1.0;
-        else
-            t = num / l2;
+        t = edge_foot(num, l2);
         double cx = ax + t * ex, cy = ay + t * ey, d2 = (px - cx) * (px - cx) + (py - cy) * (py - cy);
         if (d2 < best) {
             best = d2;
@@ -237,13 +239,7 @@ static void closest_run(const double *E, size_t n, size_t b, size_t e, double px
     const double *AX = E, *AY = E + n, *EX = E + 2 * n, *EY = E + 3 * n, *L2 = E + 4 * n;
     for (; b < e; b++) {
         double ax = AX[b], ay = AY[b], ex = EX[b], ey = EY[b], l2 = L2[b];
-        double num = (px - ax) * ex + (py - ay) * ey, t;
-        if (num < 0.0 || !(l2 > 0.0))
-            t = 0.0;
-        else if (num > l2)
-            t = 1.0;
-        else
-            t = num / l2;
+        double num = (px - ax) * ex + (py - ay) * ey, t = edge_foot(num, l2);
         double cx = ax + t * ex, cy = ay + t * ey, d2 = (px - cx) * (px - cx) + (py - cy) * (py - cy);
         if (d2 < *best) {
             *best = d2;
