@@ -555,7 +555,7 @@ START_TEST(stored_features)
     void *buf = NULL;
     size_t len = 0, l3 = 0;
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    ck_assert_int_eq(((unsigned char *)buf)[8], 14);
+    ck_assert_int_eq(((unsigned char *)buf)[8], 15);
     ck_assert_int_eq(x->nf, 2);
     void *b13 = NULL; /* the format of 0.11 to 0.13, which older files are made from */
     size_t l13 = 0;
@@ -702,26 +702,53 @@ START_TEST(inner_section)
     size_t k2 = x->k2, fk = AMSCR__INNER_F * AMSCR__INNER_K, len = 0;
     void *buf = NULL;
     ck_assert_uint_gt(k2, 0);
-    /* version 14 (compact shapes) */
+    /* version 15 (compact shapes, the inner features in float32) */
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    size_t sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * 8 * (2 * fk + 1), at = len - 8 - sec;
+    size_t sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * (4 * 2 * fk + 8), at = len - 8 - sec;
     unsigned char *b = malloc(len);
     memcpy(b, buf, len);
+    ck_assert_uint_eq(b[8], 15);
     ck_assert_uint_eq(b[at], k2);
     b[at] = 0; /* no inner graph, the params give one */
-    reseal(b, len, 14);
+    reseal(b, len, 15);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner graph") != NULL);
     memcpy(b, buf, len);
     b[at + 12] = 1; /* shape 0's inner list not starting with itself */
-    reseal(b, len, 14);
+    reseal(b, len, 15);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner neighbour") != NULL);
+    memcpy(b, buf, len);
+    float fnan = NAN;
+    memcpy(b + at + 12 + NSHAPES * k2 * 12 + 4 * 3, &fnan, 4); /* shape 0's fourth real part */
+    reseal(b, len, 15);
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);
+    ck_assert_ptr_null(y);
     ck_assert_int_eq(amscr_index_load_memory(buf, len, &y), AMSCR_OK);
     for (size_t i = 0; i < NSHAPES; i++) /* the features: the build's, bit for bit */
         ck_assert(memcmp(&y->inner[i], &x->inner[i], sizeof x->inner[i]) == 0);
     amscr_index_free(y);
     y = NULL;
+    free(b);
+    amscr_free(buf);
+    /* version 14 (0.14's first builds: the inner features in f64): the same features, bit for bit,
+     * and a value beyond float32's range refused */
+    ck_assert_int_eq(amscr__index_write(x, 14, &buf, &len), AMSCR_OK);
+    sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * 8 * (2 * fk + 1), at = len - 8 - sec;
+    ck_assert_int_eq(amscr_index_load_memory(buf, len, &y), AMSCR_OK);
+    for (size_t i = 0; i < NSHAPES; i++)
+        ck_assert(memcmp(&y->inner[i], &x->inner[i], sizeof x->inner[i]) == 0);
+    amscr_index_free(y);
+    y = NULL;
+    b = malloc(len);
+    memcpy(b, buf, len);
+    double huge = 1e300;
+    memcpy(b + at + 12 + NSHAPES * k2 * 12, &huge, 8); /* shape 0's first real part */
+    reseal(b, len, 14);
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);
+    ck_assert_ptr_null(y);
     free(b);
     amscr_free(buf);
     /* version 13 (0.11 to 0.13): the features stored */
@@ -776,7 +803,7 @@ END_TEST
 /* An index holds its shapes as compact records (their input samples and outline): each decodes
  * to the prepared shape it was built from, bit for bit; a version 13 file (0.11 to 0.13, full
  * records and the inner features) loads, eagerly and lazily, to the same scores and saves as the
- * build's version 14 bytes; every cut of a version 14 file is refused. */
+ * build's version 15 bytes; every cut of a version 15 file is refused. */
 START_TEST(compact_shapes)
 {
     amscr_params *p = params_of(0.5, 8, 2); /* fused: a query reads the candidates' prepared shapes */

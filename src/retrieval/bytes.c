@@ -57,6 +57,15 @@ void amscr__w_f64s(amscr__wbuf *w, const double *d, size_t n)
         amscr__w_f64(w, d[i]);
 }
 
+void amscr__w_f32s(amscr__wbuf *w, const float *d, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        uint32_t v;
+        memcpy(&v, &d[i], 4);
+        amscr__w_u32(w, v);
+    }
+}
+
 void amscr__w_str(amscr__wbuf *w, const char *s)
 {
     if (!s) {
@@ -139,6 +148,20 @@ int amscr__r_f64s(amscr__rbuf *r, double *d, size_t n)
     }
     r->pos += 8 * n;
     r->bad = inf != 0;
+    return !r->bad;
+}
+
+int amscr__r_f32s(amscr__rbuf *r, float *d, size_t n)
+{
+    if (r->bad || (r->len - r->pos) / 4 < n) {
+        r->bad = 1;
+        return 0;
+    }
+    for (size_t i = 0; i < n && !r->bad; i++) {
+        uint32_t v = amscr__r_u32(r);
+        r->bad |= (v >> 23 & 0xff) == 0xff; /* NaN or infinite */
+        memcpy(&d[i], &v, 4);
+    }
     return !r->bad;
 }
 

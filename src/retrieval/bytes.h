@@ -17,6 +17,8 @@ void amscr__w_u32(amscr__wbuf *w, uint32_t v);
 void amscr__w_u64(amscr__wbuf *w, uint64_t v);
 void amscr__w_f64(amscr__wbuf *w, double d);
 void amscr__w_f64s(amscr__wbuf *w, const double *d, size_t n);
+/* n floats, 4 bytes each (IEEE single, little-endian). */
+void amscr__w_f32s(amscr__wbuf *w, const float *d, size_t n);
 /* A string: u32 length, then its bytes (NULL: length 0xffffffff, no bytes). */
 void amscr__w_str(amscr__wbuf *w, const char *s);
 
@@ -31,6 +33,8 @@ uint64_t amscr__r_u64(amscr__rbuf *r);
 double amscr__r_f64(amscr__rbuf *r);
 /* n finite doubles into d; 0 (and r->bad) when short or one is not finite. */
 int amscr__r_f64s(amscr__rbuf *r, double *d, size_t n);
+/* n finite floats (4 bytes each) into d; 0 (and r->bad) when short or one is not finite. */
+int amscr__r_f32s(amscr__rbuf *r, float *d, size_t n);
 /* A string written by amscr__w_str into a new malloc'ed one (*out NULL for a NULL string);
  * 0 when short, not NUL-free or out of memory (*oom set). */
 int amscr__r_str(amscr__rbuf *r, char **out, int *oom);

@@ -80,7 +80,7 @@ static void heights(const double *P, size_t n, double locality, uint8_t *seq, do
 /* The kept frequencies of every bin column's DFT into spec (AMSCR__HF_SPEC(nfreq) values):
  * bin b's real parts at spec + 2 b P, its imaginary parts at spec + (2 b + 1) P, P =
  * AMSCR__HF_PAD(nfreq), the padding zero. */
-static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, double *spec, amscr__fft_plan *plan,
+static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, float *spec, amscr__fft_plan *plan,
                            double *z)
 {
     const size_t D = AMSCR__HF_BINS, P = AMSCR__HF_PAD(nfreq);
@@ -92,8 +92,8 @@ static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, double *
         }
         amscr__fft(plan, z, 0);
         for (size_t f = 0; f < nfreq; f++) {
-            spec[2 * b * P + f] = z[2 * f];
-            spec[(2 * b + 1) * P + f] = z[2 * f + 1];
+            spec[2 * b * P + f] = (float)z[2 * f];
+            spec[(2 * b + 1) * P + f] = (float)z[2 * f + 1];
         }
     }
     return AMSCR_OK;
@@ -115,7 +115,7 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
     amscr_status st = AMSCR_OK;
     for (int o = 0; o < 2; o++) {
         out->seq[o] = amscr__malloc_array(n * D, sizeof(uint8_t));
-        out->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(out->nfreq), sizeof(double));
+        out->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(out->nfreq), sizeof(float));
         if (!out->seq[o] || !out->spec[o])
             st = AMSCR_E_NOMEM;
     }
@@ -151,7 +151,7 @@ amscr_status amscr__hf_spectra(amscr__hf *h, amscr__hf_ws *ws)
     int have_plan = own && amscr__fft_plan_init(&plan, h->n) == 0;
     amscr_status st = z && (have_plan || !own) ? AMSCR_OK : AMSCR_E_NOMEM;
     for (int o = 0; o < 2 && st == AMSCR_OK; o++) {
-        h->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(h->nfreq), sizeof(double));
+        h->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(h->nfreq), sizeof(float));
         if (h->spec[o])
             spectra(h->seq[o], h->n, h->nfreq, h->spec[o], own ? &plan : &ws->plan, z);
         else
@@ -206,12 +206,12 @@ static void cross_spectra(const amscr__hf *a, const amscr__hf *b, int both, doub
     for (size_t f0 = 0; f0 < F; f0 += 4) {
         double re[2][4] = {{0.0}}, im[2][4] = {{0.0}};
         for (size_t bin = 0; bin < D; bin++) {
-            const double *ar = a->spec[0] + 2 * bin * P + f0, *ai = ar + P;
+            const float *ar = a->spec[0] + 2 * bin * P + f0, *ai = ar + P;
             for (int o = 0; o < (both ? 2 : 1); o++) {
-                const double *br = b->spec[o] + 2 * bin * P + f0, *bi = br + P;
+                const float *br = b->spec[o] + 2 * bin * P + f0, *bi = br + P;
                 for (size_t t = 0; t < 4; t++) {
-                    re[o][t] += ar[t] * br[t] + ai[t] * bi[t];
-                    im[o][t] += ar[t] * bi[t] - ai[t] * br[t];
+                    re[o][t] += (double)ar[t] * br[t] + (double)ai[t] * bi[t];
+                    im[o][t] += (double)ar[t] * bi[t] - (double)ai[t] * br[t];
                 }
             }
         }

@@ -26,7 +26,8 @@ typedef struct {
     size_t n;
     size_t nfreq;    /* frequencies kept of each bin's DFT: AMSCR__HF_FREQS(n) + 1 */
     uint8_t *seq[2]; /* n * AMSCR__HF_BINS, weighted heights, quantized: 128 + QUANT * h */
-    double *spec[2]; /* AMSCR__HF_SPEC(nfreq): per bin nfreq real parts, then imaginary, padded */
+    float *spec[2]; /* AMSCR__HF_SPEC(nfreq): per bin nfreq real parts, then imaginary, padded
+                     * (float32: the shift search's correlations, summed in double) */
 } amscr__hf;
 
 typedef struct {

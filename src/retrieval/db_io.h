@@ -32,7 +32,9 @@
 #define AMSCR__DB_VERSION_PLAIN_VIEW 12u
 #define AMSCR__DB_VERSION_INDEX_VIEW 13u
 #define AMSCR__DB_VERSION_INDEX_COMPACT 14u
-#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_COMPACT
+/* Version 15: version 14 with the inner features in float32 (index_io.c). */
+#define AMSCR__DB_VERSION_INDEX_F32 15u
+#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_F32
 
 /* Whether a file of `version` is an index file (an index section after the shapes). */
 static inline int amscr__db_is_index(uint32_t version)
@@ -40,7 +42,8 @@ static inline int amscr__db_is_index(uint32_t version)
     return version == AMSCR__DB_VERSION_INDEX || version == AMSCR__DB_VERSION_FEATURES ||
            version == AMSCR__DB_VERSION_INDEX_BANDS || version == AMSCR__DB_VERSION_INDEX_INNER ||
            version == AMSCR__DB_VERSION_INDEX_GRAPHS || version == AMSCR__DB_VERSION_INDEX_CLOSING ||
-           version == AMSCR__DB_VERSION_INDEX_VIEW || version == AMSCR__DB_VERSION_INDEX_COMPACT;
+           version == AMSCR__DB_VERSION_INDEX_VIEW || version == AMSCR__DB_VERSION_INDEX_COMPACT ||
+           version == AMSCR__DB_VERSION_INDEX_F32;
 }
 
 /* Whether an index file of `version` stores the shapes' channel features. */
@@ -49,7 +52,7 @@ static inline int amscr__db_has_features(uint32_t version)
     return version == AMSCR__DB_VERSION_FEATURES || version == AMSCR__DB_VERSION_INDEX_BANDS ||
            version == AMSCR__DB_VERSION_INDEX_INNER || version == AMSCR__DB_VERSION_INDEX_GRAPHS ||
            version == AMSCR__DB_VERSION_INDEX_CLOSING || version == AMSCR__DB_VERSION_INDEX_VIEW ||
-           version == AMSCR__DB_VERSION_INDEX_COMPACT;
+           version == AMSCR__DB_VERSION_INDEX_COMPACT || version == AMSCR__DB_VERSION_INDEX_F32;
 }
 
 /* The bytes of the retrieval block in a file of `version` (0: none). */

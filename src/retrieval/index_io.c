@@ -1,4 +1,4 @@
-/* index_io.c — the index file: a collection file (db_io.c) of version 14 (13 in 0.11 to 0.13, 11
+/* index_io.c — the index file: a collection file (db_io.c) of version 15 (14 in 0.14's first builds, 13 in 0.11 to 0.13, 11
  * in 0.9, 9 in 0.8, 8 in 0.7, 6 in 0.6, 4 in 0.5, 3 in 0.4) whose index section follows the
  * shapes, so amscr_db_load of an index file gives its collection. From version 14 the shapes are
  * compact records (their input samples and outline: db_io.h), which the index keeps as they are
@@ -18,7 +18,8 @@
  *   versions 9, 11 and 13: then the inner distance's graph: u32 K2 (0: none; else K, when the params give it a
  *     share), f64 its largest distance, n x K2 x (u32 neighbour, f64 distance) as the lists above,
  *     and per shape its inner features (inner.h): F K f64 re, F K f64 im, f64 norm2 (8.7 KB a
- *     shape; the reversed orientation's twist is recomputed).
+ *     shape; the reversed orientation's twist is recomputed); from version 15 re and im are F K
+ *     f32 each (4.4 KB a shape: the features are float32 in memory too).
  * Every count is bounded by the bytes left before anything is allocated; F, N and B must be the
  * params' (any byte is a valid height). The features' spectra are not stored: a load computes
  * them from the heights (an FFT, a fifth of building the features), or, with AMSCR_INDEX_LAZY,
@@ -30,6 +31,7 @@
 #include "db_io.h"
 #include "index.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -94,8 +96,9 @@ static amscr_status write_features(const amscr_index *x, amscr__wbuf *w)
 }
 
 /* The inner distance's graph (version 9). */
-static void write_inner(const amscr_index *x, amscr__wbuf *w)
+static void write_inner(const amscr_index *x, uint32_t version, amscr__wbuf *w)
 {
+    size_t fk = AMSCR__INNER_F * AMSCR__INNER_K;
     size_t n = amscr_db_size(x->db), k2 = x->k2;
     amscr__w_u32(w, (uint32_t)k2);
     if (k2 == 0)
@@ -106,9 +109,17 @@ static void write_inner(const amscr_index *x, amscr__wbuf *w)
         amscr__w_f64(w, x->in_dist[i]);
     }
     for (size_t i = 0; i < n; i++) {
-        amscr__w_f64s(w, &x->inner[i].re[0][0], AMSCR__INNER_F * AMSCR__INNER_K);
-        amscr__w_f64s(w, &x->inner[i].im[0][0], AMSCR__INNER_F * AMSCR__INNER_K);
-        amscr__w_f64(w, x->inner[i].norm2);
+        const amscr__inner *f = &x->inner[i];
+        if (version >= AMSCR__DB_VERSION_INDEX_F32) {
+            amscr__w_f32s(w, &f->re[0][0], fk);
+            amscr__w_f32s(w, &f->im[0][0], fk);
+        } else {
+            for (size_t j = 0; j < fk; j++)
+                amscr__w_f64(w, (&f->re[0][0])[j]);
+            for (size_t j = 0; j < fk; j++)
+                amscr__w_f64(w, (&f->im[0][0])[j]);
+        }
+        amscr__w_f64(w, f->norm2);
     }
 }
 
@@ -122,7 +133,7 @@ amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **o
     write_section(x, &w);
     st = write_features(x, &w);
     if (st == AMSCR_OK)
-        write_inner(x, &w);
+        write_inner(x, version, &w);
     if (st != AMSCR_OK) {
         free(w.buf);
         return st;
@@ -287,9 +298,25 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
     return AMSCR_OK;
 }
 
-/* The inner distance's graph of a file of version 9 or later (its K2 must be the params'). */
-static amscr_status read_inner(amscr__rbuf *r, amscr_index *x)
+/* n finite doubles of a file before version 15 into floats (0 and r->bad: short, not finite or
+ * beyond float's range). */
+static int read_f64_as_f32(amscr__rbuf *r, float *d, size_t n)
 {
+    for (size_t i = 0; i < n; i++) {
+        double v = 0.0;
+        if (!amscr__r_f64s(r, &v, 1) || !(fabs(v) <= FLT_MAX)) {
+            r->bad = 1;
+            return 0;
+        }
+        d[i] = (float)v;
+    }
+    return 1;
+}
+
+/* The inner distance's graph of a file of version 9 or later (its K2 must be the params'). */
+static amscr_status read_inner(amscr__rbuf *r, amscr_index *x, uint32_t version)
+{
+    int f32 = version >= AMSCR__DB_VERSION_INDEX_F32;
     size_t n = amscr_db_size(x->db), fk = AMSCR__INNER_F * AMSCR__INNER_K;
     uint32_t k2 = amscr__r_u32(r);
     if (r->bad || k2 != x->k2)
@@ -300,7 +327,7 @@ static amscr_status read_inner(amscr__rbuf *r, amscr_index *x)
     x->dmax2 = amscr__r_f64(r);
     if (r->bad || !(x->dmax2 >= 0.0) || !isfinite(x->dmax2))
         return amscr__fail(AMSCR_E_FORMAT, "index file: bad largest inner distance");
-    size_t per = 12 * (size_t)k2 + 8 * (2 * fk + 1);
+    size_t per = 12 * (size_t)k2 + (f32 ? 4 : 8) * 2 * fk + 8;
     if ((r->len - r->pos) / per < n)
         return amscr__fail(AMSCR_E_FORMAT, "index file: the inner graph is truncated");
     amscr_status st = read_list(r, n, k2, x->in_idx, x->in_dist, "inner ");
@@ -311,8 +338,9 @@ static amscr_status read_inner(amscr__rbuf *r, amscr_index *x)
         return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
     for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
         amscr__inner *f = &x->inner[i];
-        if (!amscr__r_f64s(r, &f->re[0][0], fk) || !amscr__r_f64s(r, &f->im[0][0], fk) ||
-            !amscr__r_f64s(r, &f->norm2, 1) || !(f->norm2 >= 0.0))
+        int ok = f32 ? amscr__r_f32s(r, &f->re[0][0], fk) && amscr__r_f32s(r, &f->im[0][0], fk)
+                     : read_f64_as_f32(r, &f->re[0][0], fk) && read_f64_as_f32(r, &f->im[0][0], fk);
+        if (!ok || !amscr__r_f64s(r, &f->norm2, 1) || !(f->norm2 >= 0.0))
             st = amscr__fail(AMSCR_E_FORMAT, "index file: shape %zu's inner features are invalid", i);
         else
             amscr__inner_twist(f, &ws);
@@ -327,7 +355,7 @@ static amscr_status read_rest(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
     amscr_status st = amscr__db_has_features(version) ? read_features(r, x) : AMSCR_OK;
     if (st == AMSCR_OK && version >= AMSCR__DB_VERSION_INDEX_GRAPHS)
-        st = read_inner(r, x);
+        st = read_inner(r, x, version);
     else if (st == AMSCR_OK && x->k2 > 0)
         st = amscr__fail(AMSCR_E_FORMAT, "index file: format %u has no inner graph, its params give one",
                          (unsigned)version);

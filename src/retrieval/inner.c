@@ -114,8 +114,8 @@ static void twist(amscr__inner *f, const double *cs)
         for (size_t q = 0; q < AMSCR__INNER_F; q++) {
             const double *c = cs + 2 * ((q * (k + 1)) % N);
             double br = f->re[q][k], bi = f->im[q][k];
-            f->tre[q][k] = br * c[0] - bi * c[1];
-            f->tim[q][k] = br * c[1] + bi * c[0];
+            f->tre[q][k] = (float)(br * c[0] - bi * c[1]);
+            f->tim[q][k] = (float)(br * c[1] + bi * c[0]);
         }
 }
 
@@ -134,10 +134,10 @@ static amscr_status from_vertices(amscr__inner *out, amscr__inner_ws *ws)
         }
         amscr__fft(&ws->plan, ws->z, 0);
         for (size_t f = 0; f < AMSCR__INNER_F; f++) {
-            double br = ws->z[2 * f], bi = ws->z[2 * f + 1];
+            double br = (float)ws->z[2 * f], bi = (float)ws->z[2 * f + 1];
             out->norm2 += (f == 0 || 2 * f == N ? 1.0 : 2.0) * (br * br + bi * bi) / (double)N;
-            out->re[f][k] = br;
-            out->im[f][k] = bi;
+            out->re[f][k] = (float)br;
+            out->im[f][k] = (float)bi;
         }
     }
     twist(out, ws->cs);

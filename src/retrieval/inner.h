@@ -19,10 +19,10 @@
  * whole matrix (2 for offsets below N/2, 1 for N/2): the DFT of every column at the kept
  * frequencies, as re[f][k] + i im[f][k] (columns contiguous: the pair loop runs along k), the
  * same turned by e^{-2 pi i f (k + 1) / N} (tre, tim: the reversed orientation's shift of
- * column k), and the sum of squares of the columns so low-passed. */
+ * column k), and the sum of squares of the columns so low-passed (of the values as stored). */
 typedef struct {
-    double re[AMSCR__INNER_F][AMSCR__INNER_K], im[AMSCR__INNER_F][AMSCR__INNER_K];
-    double tre[AMSCR__INNER_F][AMSCR__INNER_K], tim[AMSCR__INNER_F][AMSCR__INNER_K];
+    float re[AMSCR__INNER_F][AMSCR__INNER_K], im[AMSCR__INNER_F][AMSCR__INNER_K]; /* float32: summed in double */
+    float tre[AMSCR__INNER_F][AMSCR__INNER_K], tim[AMSCR__INNER_F][AMSCR__INNER_K];
     double norm2;
 } amscr__inner;
 
