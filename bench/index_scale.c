@@ -202,7 +202,7 @@ static void index_bytes(const amscr_index *x, double b[4])
     b[3] = (double)amscr__db_shape_bytes(AMSCR__DB_VERSION_NEWEST, amscr_db_params(x->db));
     size_t n = amscr_db_size(x->db), hf = 0;
     for (size_t i = 0; i < n * (size_t)x->nf; i++)
-        hf += 2 * (x->hf[i].n * AMSCR__HF_BINS + AMSCR__HF_BINS * 2 * x->hf[i].nfreq * sizeof(double));
+        hf += 2 * (x->hf[i].n * AMSCR__HF_BINS + AMSCR__HF_SPEC(x->hf[i].nfreq) * sizeof *x->hf[i].spec[0]);
     b[0] = (double)hf / (double)n;
     b[1] = (double)(x->sig_dim + AMSCR__SIG_LB_DIM) * sizeof(float);
     b[2] = (double)(x->k + x->k2) * (sizeof(uint32_t) + sizeof(double)) + (x->rev ? (double)(x->k + x->k2) * 4 + 8
