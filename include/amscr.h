@@ -3248,11 +3248,13 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_precision_recall(const double
  * An index split in shards: what amscr.distributed builds on (docs/collections.md,
  * "An index in shards"). A collection of n shapes is cut into contiguous blocks; each block is an
  * ordinary index (a shard, whose shapes carry their features); the whole collection's neighbour
- * lists are computed from amscr_index_pair_distances over every pair of blocks and held, without
- * any shape, by an amscr_index_graph. A query's distances to every shard's shapes
- * (amscr_index_pair_distances with qpos SIZE_MAX), given to amscr_index_graph_scores, are the
- * scores of the single index of the whole collection built with candidates 0 and queried with
- * candidates 0 (to rounding), for a channel weight of 0 or 1.
+ * lists are computed from amscr_index_pair_distances over every pair of blocks (or, for a
+ * shortlist build, from amscr_index_pair_distances_at over the pairs of the global signature
+ * shortlists, amscr_signature_shortlists) and held, without any shape, by an amscr_index_graph.
+ * A query's distances to every shard's shapes (amscr_index_pair_distances with qpos SIZE_MAX),
+ * given to amscr_index_graph_scores, are the scores of the single index of the whole collection
+ * built with candidates 0 and queried with candidates 0 (to rounding), for a channel weight of 0
+ * or 1; the same holds with a shortlist M for build and query alike.
  * ============================================================================ */
 
 /** The neighbour lists of a whole collection without its shapes, and its largest distances:
@@ -3339,6 +3341,25 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_graph_new(const amscr_params 
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_graph_scores(const amscr_index_graph *g, const size_t *cand,
                                                                 const double *dq, const double *dq2, size_t m,
                                                                 double *out_scores, size_t n);
+
+/**
+ * @brief The scores of shape i of the graph's collection as the query (the member rule:
+ *        amscr_index_member_scores of the single index): its base distances dq to candidates
+ *        cand[0..m-1] (strictly ascending, i left out; every other shape, or its M
+ *        signature-nearest for candidates M), each computed as the pair's cell
+ *        (amscr_index_pair_distances_at with qpos i relative to each shard: SIZE_MAX for a shard
+ *        before i's, 0 after, i's own index in its shard).
+ * @param[out] out_scores  n scores (its own 0).
+ * @param[in]  n  must equal the graph's size.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, i or n, candidates not ascending, out of range or
+ *         i, a distance not finite and >= 0); AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_graph_member_scores(const amscr_index_graph *g, size_t i,
+                                                                       const size_t *cand, const double *dq, size_t m,
+                                                                       double *out_scores, size_t n);
 
 /**
  * @brief The graph's number of shapes.

@@ -336,6 +336,31 @@ amscr_status amscr_index_graph_scores(const amscr_index_graph *g, const size_t *
     return amscr__index_scores(x, size, cand, dq, x->k2 > 0 ? dq2 : NULL, m, out_scores);
 }
 
+amscr_status amscr_index_graph_member_scores(const amscr_index_graph *g, size_t i, const size_t *cand,
+                                             const double *dq, size_t m, double *out_scores, size_t n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(g);
+    AMSCR_CHECK_NULL(out_scores);
+    const amscr_index *x = g->x;
+    size_t size = amscr_db_size(x->db);
+    if (n != size || i >= size)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_member_scores: shape %zu, %zu scores, the graph "
+                                                "%zu shapes", i, n, size);
+    if (m > 0 && (!cand || !dq))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_member_scores: NULL candidates or distances");
+    for (size_t t = 0; t < m; t++) {
+        if (cand[t] >= size || cand[t] == i || (t > 0 && cand[t] <= cand[t - 1]))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_member_scores: candidate %zu (%zu) is not "
+                                                    "below %zu, above the one before and not the shape", t, cand[t],
+                               size);
+        if (!(dq[t] >= 0.0) || !isfinite(dq[t]))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_member_scores: candidate %zu's distance is "
+                                                    "not finite and >= 0", t);
+    }
+    return amscr__index_scores(x, i, cand, dq, NULL, m, out_scores);
+}
+
 size_t amscr_index_graph_size(const amscr_index_graph *g) { return g ? amscr_db_size(g->x->db) : 0; }
 
 void amscr_index_graph_free(amscr_index_graph *g)

@@ -1,15 +1,21 @@
 """An index split in shards over a Dask cluster (``amscr.distributed.build_index``).
 
 The collection is cut into contiguous blocks; block s is an ordinary index (:class:`amscr.Index`,
-a *shard*) built and held by one worker. The whole collection's neighbour lists are global: every
-pair of blocks (s <= t) is matched once on the worker holding shard t (C
-``amscr_index_pair_distances``, each pair computed as its cell of the whole collection's matrix),
-each block keeps its rows' and columns' best candidates, and the client merges them into the
-lists the single index would hold (``amscr_index_build`` with candidates 0). The lists, without
-any shape, make the *graph* (C ``amscr_index_graph``). A query is matched with every shard's
-shapes on its worker (fan-out); the client gathers its distances and diffuses them on the graph
-(merge, ``amscr_index_graph_scores``): the scores are those of ``amscr.Index(collection,
-candidates=0).scores(query, candidates=0)``.
+a *shard*) built and held by one worker. The whole collection's neighbour lists are global, those
+of ``amscr.Index(collection, candidates=M)``. M 0 (every pair): every pair of blocks (s <= t) is
+matched once on the worker holding shard t (C ``amscr_index_pair_distances``, each pair computed
+as its cell of the whole collection's matrix), each block keeps its rows' and columns' best
+candidates, and the client merges them. M > 0 (the default above 2,000 shapes): the client
+gathers the signatures (C ``amscr_index_signatures``), the workers find each shape's
+signature-nearest shapes of the whole collection (``amscr_signature_shortlists``), and the rounds
+of the single shortlist build (the shortlists' pairs, the neighbours' neighbours, the inner lists)
+are matched on the worker holding each pair's later shape (``amscr_index_pair_distances_at``). The
+lists, without any shape, make the *graph* (C ``amscr_index_graph``). A query is matched with
+every shard's shapes, or with its share of the query's M signature-nearest, on its worker
+(fan-out); the client gathers its distances and diffuses them on the graph (merge,
+``amscr_index_graph_scores``; a member's copy by the member rule,
+``amscr_index_graph_member_scores``): the scores are those of ``amscr.Index(collection,
+candidates=M).scores(query, candidates=M)``.
 
 A saved set is a directory: ``manifest.json`` (written last, by an atomic rename: the commit
 point), one ``shard-SSS-CHECKSUM.amscr-index`` per shard (an ordinary index file that ``amscr
@@ -100,6 +106,16 @@ class _Graph:
         _check(lib.amscr_index_graph_scores(self._g, ffi.from_buffer('size_t[]', cand) if m else ffi.NULL,
                                             dbuf(dq) if m else ffi.NULL,
                                             dbuf(dq2) if self.k2 and m else ffi.NULL, m, dbuf(out), n))
+        return out
+
+    def member_scores(self, i: int, dq: np.ndarray, cand: np.ndarray) -> np.ndarray:
+        """Shape i's scores (the member rule) from its base distances dq to shapes cand."""
+        out = np.zeros(self.n, dtype=np.float64)
+        cand = np.ascontiguousarray(cand, dtype=np.uintp)
+        dq = np.ascontiguousarray(dq, dtype=np.float64)
+        m = len(cand)
+        _check(lib.amscr_index_graph_member_scores(self._g, i, ffi.from_buffer('size_t[]', cand) if m else ffi.NULL,
+                                                   dbuf(dq) if m else ffi.NULL, m, dbuf(out), self.n))
         return out
 
     def to_bytes(self) -> bytes:
@@ -196,6 +212,18 @@ def _pair_block(rows_data: bytes, index: Index, r0: int, c0: int, k: int, k2: in
     return out
 
 
+def _members(index: Index, qdata: bytes) -> List[int]:
+    """Each query's member in a shard (C ``amscr_index_find_member``), -1 for none."""
+    q = Collection.from_bytes(qdata)
+    out = ffi.new('size_t *')
+    res = []
+    with index._lock.read():
+        for i in range(len(q)):
+            _check(lib.amscr_index_find_member(index._x, lib.amscr_db_descriptor(q._db, i), out))
+            res.append(-1 if out[0] == ffi.cast('size_t', -1) else int(out[0]))
+    return res
+
+
 def _signatures(index: Index) -> np.ndarray:
     """A shard's signatures (len x amscr_signature_size floats, C ``amscr_index_signatures``)."""
     d = int(lib.amscr_signature_size())
@@ -224,7 +252,8 @@ def _pairs_at(rows_data: Optional[bytes], index: Index, a: np.ndarray, b: np.nda
               base: bool, inner: bool) -> Tuple[np.ndarray, np.ndarray]:
     """Distances of pairs (a[t], b[t]) on shard b's worker: a local to the rows' block (rows_data's
     collection, or the shard itself when rows_data is None: then a < b and qpos is a), b local to
-    the shard, a ascending. qpos: QPOS_AFTER (queries), 0 (an earlier block) or None (the shard's own)."""
+    the shard, a ascending. qpos: QPOS_AFTER (queries), 0 (an earlier block), None (the shard's own)
+    or an array (each pair's)."""
     m = len(a)
     D = np.zeros(m, dtype=np.float64)
     D2 = np.zeros(m, dtype=np.float64)
@@ -237,12 +266,13 @@ def _pairs_at(rows_data: Optional[bytes], index: Index, a: np.ndarray, b: np.nda
         ends = np.r_[starts[1:], m]
         for lo, hi in zip(starts, ends):
             i = int(a[lo])
+            qp = i if qpos is None else int(qpos[lo]) if isinstance(qpos, np.ndarray) else qpos
             order = np.argsort(b[lo:hi], kind='stable')
             cand = np.ascontiguousarray(b[lo:hi][order], dtype=np.uintp)
             db_ = np.zeros(hi - lo)
             di_ = np.zeros(hi - lo)
             _check(lib.amscr_index_pair_distances_at(index._x, lib.amscr_db_descriptor(qdb, i),
-                                                     i if qpos is None else qpos, ffi.from_buffer('size_t[]', cand),
+                                                     qp, ffi.from_buffer('size_t[]', cand),
                                                      hi - lo, dbuf(db_) if base else ffi.NULL,
                                                      dbuf(di_) if inner else ffi.NULL))
             D[lo:hi][order] = db_
@@ -250,11 +280,12 @@ def _pairs_at(rows_data: Optional[bytes], index: Index, a: np.ndarray, b: np.nda
     return D, D2
 
 
-def _query_block(index: Index, qdata: bytes, a=None, b=None):
+def _query_block(index: Index, qdata: bytes, a=None, b=None, qpos=None):
     """The queries' base and inner distances to every shape of a shard (queries after every shape),
-    or (a, b given) to shapes b[t] of the shard for query a[t] only."""
+    or (a, b given) to shapes b[t] of the shard for query a[t] only (qpos: each pair's position of
+    the query, for members; then base distances only)."""
     if a is not None:
-        return _pairs_at(qdata, index, a, b, QPOS_AFTER, True, True)
+        return _pairs_at(qdata, index, a, b, QPOS_AFTER if qpos is None else qpos, True, qpos is None)
     q = Collection.from_bytes(qdata)
     return _distances(index, q._db, len(q), 'after')
 
@@ -487,10 +518,11 @@ class ShardedIndex:
         return k - 1 if c + 1 < k else c
 
     def scores_many(self, queries: Sequence[Any], candidates: Optional[int] = None) -> np.ndarray:
-        """The retrieval scores (len(queries), len(self)) of point arrays or :class:`amscr.Shape` s:
-        each query matched on the workers with every shard's shapes (candidates 0) or with its
-        share of the query's M signature-nearest shapes of the whole collection (candidates M;
-        None: the build's M), the rows merged on the client.
+        """The retrieval scores (len(queries), len(self)) of point arrays or :class:`amscr.Shape` s,
+        as :meth:`amscr.Index.scores` gives them: each query matched on the workers with every
+        shard's shapes (candidates 0) or with its share of the query's M signature-nearest shapes
+        of the whole collection (candidates M; None: the build's M), the rows merged on the
+        client. A member's copy is scored as that member (the member rule).
 
         Raises:
             InvalidArgumentError: bad points, a negative candidates.
@@ -502,33 +534,68 @@ class ShardedIndex:
         if nq == 0 or n == 0:
             return out
         qf = self.client.scatter(q.to_bytes(), broadcast=True, hash=False)
-        if want == 0:
+        member = np.full(nq, -1, dtype=np.int64)
+        if self.params.rerank_k > 0:  # the rule matters only with re-ranking (weights are 0 or 1 here)
+            for s, found in enumerate(self._gather([self.client.submit(_members, sh, qf, pure=False,
+                                                                       workers=[self._workers[s]])
+                                                    for s, sh in enumerate(self._shards)])):
+                f = np.asarray(found, dtype=np.int64)
+                member = np.where((member < 0) & (f >= 0), f + self.bounds[s][0], member)
+        new = np.flatnonzero(member < 0)
+        mem = np.flatnonzero(member >= 0)
+        if want == 0 and len(new):
             futs = [self.client.submit(_query_block, sh, qf, pure=False, workers=[self._workers[s]])
                     for s, sh in enumerate(self._shards)]
             parts = self._gather(futs)
             dq = np.concatenate([p[0] for p in parts], axis=1)
             dq2 = np.concatenate([p[1] for p in parts], axis=1)
-            for i in range(nq):
+            for i in new:
                 out[i] = self._graph.scores(dq[i], dq2[i])
+            new = new[:0]
+        # the rest: each query's candidates (ascending) and, for a member, its position
+        C: List[np.ndarray] = [np.zeros(0, dtype=np.int64)] * nq
+        if want > 0 and len(new):
+            d = int(lib.amscr_signature_size())
+            qs = np.zeros((len(new), d), dtype=np.float32)
+            for r, i in enumerate(new):
+                _check(lib.amscr_shape_signature(lib.amscr_db_descriptor(q._db, int(i)),
+                                                 ffi.from_buffer('float[]', qs[r]), d))
+            for r, c in zip(new, _shortlists(self._signatures(), qs, QPOS_AFTER, want, self.params.threads)):
+                C[r] = c
+        for i in mem:
+            j = int(member[i])
+            C[i] = np.r_[np.arange(j), np.arange(j + 1, n)] if want == 0 else \
+                _shortlists(self._signatures(), self._signatures()[j:j + 1], j, want, self.params.threads)[0]
+        todo = np.r_[new, mem].astype(np.int64)
+        if len(todo) == 0:
             return out
-        d = int(lib.amscr_signature_size())
-        qs = np.zeros((nq, d), dtype=np.float32)
-        for i in range(nq):
-            _check(lib.amscr_shape_signature(lib.amscr_db_descriptor(q._db, i), ffi.from_buffer('float[]', qs[i]), d))
-        C = _shortlists(self._signatures(), qs, QPOS_AFTER, want, self.params.threads)  # ascending
-        a = np.repeat(np.arange(nq, dtype=np.int64), want)
-        b = C.ravel()
+        a = np.concatenate([np.full(len(C[i]), i, dtype=np.int64) for i in todo])
+        b = np.concatenate([C[i] for i in todo])
         starts = np.array([lo for lo, _ in self.bounds], dtype=np.int64)
         sb = np.searchsorted(starts, b, 'right') - 1
-        sels = [np.flatnonzero(sb == s) for s in range(len(self._shards))]
-        futs = [self.client.submit(_query_block, sh, qf, a[sels[s]], b[sels[s]] - starts[s], pure=False,
-                                   workers=[self._workers[s]]) for s, sh in enumerate(self._shards)]
         D, D2 = np.zeros(len(b)), np.zeros(len(b))
-        for sel, (x, x2) in zip(sels, self._gather(futs)):
-            D[sel], D2[sel] = x, x2
-        D, D2 = D.reshape(nq, want), D2.reshape(nq, want)
-        for i in range(nq):
-            out[i] = self._graph.scores(D[i], D2[i], C[i])
+        for is_member in (False, True):
+            rows = (member[a] >= 0) == is_member
+            sels = [np.flatnonzero(rows & (sb == s)) for s in range(len(self._shards))]
+            futs = []
+            for s, sh in enumerate(self._shards):
+                qp = None
+                if is_member:  # the member's position relative to this shard's block
+                    j = member[a[sels[s]]]
+                    lo, hi = self.bounds[s]
+                    qp = np.where(j < lo, 0, j - lo).astype(np.uint64)
+                    qp[j >= hi] = QPOS_AFTER
+                futs.append(self.client.submit(_query_block, sh, qf, a[sels[s]], b[sels[s]] - starts[s], qp,
+                                               pure=False, workers=[self._workers[s]]))
+            for sel, (x, x2) in zip(sels, self._gather(futs)):
+                D[sel], D2[sel] = x, x2
+        pos = 0
+        for i in todo:
+            c = C[i]
+            d, d2 = D[pos:pos + len(c)], D2[pos:pos + len(c)]
+            pos += len(c)
+            out[i] = self._graph.member_scores(int(member[i]), d, c) if member[i] >= 0 else \
+                self._graph.scores(d, d2, c)
         return out
 
     def scores(self, points: Any, candidates: Optional[int] = None) -> np.ndarray:
