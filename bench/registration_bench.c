@@ -156,12 +156,6 @@ static double map_error(const double M[6], const double T[6], const amscr_contou
     return worst / size;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 static double median(double *v, size_t n)
 {
     qsort(v, n, sizeof *v, cmp_double);
