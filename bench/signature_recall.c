@@ -43,7 +43,6 @@ static const char *const SIG_NAME = "height-bins, share 0.2 (channel's)";
 typedef struct {
     size_t n;
     amscr_descriptor **d;
-    int32_t *label;
     amscr__hf *hf[2]; /* similarity, whitened frame */
     double *sig; /* n x DIM */
 } prepared;
@@ -56,17 +55,15 @@ static amscr_descriptor *prepare_one(const amscr_params *p, const amscr_contour 
     return d;
 }
 
-static void prepare_set(const amscr_params *p, amscr_contour *const *c, const int32_t *label, size_t n, prepared *s)
+static void prepare_set(const amscr_params *p, amscr_contour *const *c, size_t n, prepared *s)
 {
     s->n = n;
     s->d = xmalloc(n * sizeof *s->d);
-    s->label = xmalloc(n * sizeof *s->label);
     for (int f = 0; f < 2; f++)
         s->hf[f] = xmalloc(n * sizeof *s->hf[f]);
     s->sig = xmalloc(n * DIM * sizeof(double));
     for (size_t i = 0; i < n; i++) {
         s->d[i] = prepare_one(p, c[i]);
-        s->label[i] = label[i];
         for (int f = 0; f < 2; f++)
             if (amscr__hf_of_descriptor(p, f ? AMSCR_INVARIANCE_AFFINE : AMSCR_INVARIANCE_SIMILARITY, s->d[i],
                                         &s->hf[f][i]) != AMSCR_OK)
@@ -83,7 +80,6 @@ static void prepared_free(prepared *s)
         amscr__hf_free(&s->hf[1][i]);
     }
     free(s->d);
-    free(s->label);
     free(s->hf[0]);
     free(s->hf[1]);
     free(s->sig);
@@ -101,11 +97,6 @@ static double two_frames(const amscr_params *p, const amscr__hf *a0, const amscr
     amscr__hf_cfg_from(p, a0->n, 1, &cfg[1]);
     double s = amscr_params_get_channel_affine_share(p);
     return (1.0 - s) * amscr__hf_distance(a0, b0, &cfg[0], ws) + s * amscr__hf_distance(a1, b1, &cfg[1], ws);
-}
-
-static double exact(const amscr_params *p, const prepared *c, size_t i, const prepared *q, size_t k, amscr__hf_ws *ws)
-{
-    return two_frames(p, &c->hf[0][i], &c->hf[1][i], &q->hf[0][k], &q->hf[1][k], ws);
 }
 
 /* A channel workspace with room for both frames' bands. */
@@ -155,7 +146,7 @@ static void recall(const amscr_params *p, const prepared *c, const prepared *q, 
     memset(t, 0, sizeof *t);
     for (size_t k = 0; k < q->n; k++) {
         for (size_t i = 0; i < n; i++)
-            e[i] = exact(p, c, i, q, k, &ws);
+            e[i] = two_frames(p, &c->hf[0][i], &c->hf[1][i], &q->hf[0][k], &q->hf[1][k], &ws);
         if (k == 0) { /* the exact distance is the library's */
             double ref;
             if (amscr_channel_distance(p, c->d[1], q->d[0], &ref) != AMSCR_OK || fabs(ref - e[1]) > 1e-9 * (1 + ref))
@@ -167,13 +158,6 @@ static void recall(const amscr_params *p, const prepared *c, const prepared *q, 
     free(e);
     free(sd);
     free(rank);
-}
-
-static double cpu(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* The CPU time (1 thread, median over TIMED queries) of a query's parts: t[0] the fixed part
@@ -189,7 +173,7 @@ static void query_parts(const amscr_params *p, const prepared *c, amscr_contour 
     nq = nq < TIMED ? nq : TIMED;
     for (size_t k = 0; k < nq; k++) {
         amscr__hf h[2], b[2];
-        double t0 = cpu(), acc = 0.0;
+        double t0 = cpu_now(), acc = 0.0;
         amscr_descriptor *dq = prepare_one(p, qc[k]);
         for (int f = 0; f < 2; f++)
             if (amscr__hf_of_descriptor(p, f ? AMSCR_INVARIANCE_AFFINE : AMSCR_INVARIANCE_SIMILARITY, dq, &h[f]))
@@ -199,10 +183,10 @@ static void query_parts(const amscr_params *p, const prepared *c, amscr_contour 
             sd[j] = amscr__affine_signature_distance(qs, c->sig + j * DIM);
         if (amscr_topk(sd, n, m, SIZE_MAX, cand) != AMSCR_OK)
             die("top-k");
-        double t1 = cpu();
+        double t1 = cpu_now();
         for (size_t j = 0; j < m; j++)
             acc += two_frames(p, &c->hf[0][cand[j]], &c->hf[1][cand[j]], &h[0], &h[1], &ws);
-        double t2 = cpu();
+        double t2 = cpu_now();
         for (size_t j = 0; j < 16; j++)
             for (int f = 0; f < 2; f++) {
                 if (amscr__hf_of_descriptor(p, f ? AMSCR_INVARIANCE_AFFINE : AMSCR_INVARIANCE_SIMILARITY,
@@ -210,7 +194,7 @@ static void query_parts(const amscr_params *p, const prepared *c, amscr_contour 
                     die("height functions");
                 amscr__hf_free(&b[f]);
             }
-        double t3 = cpu();
+        double t3 = cpu_now();
         ms[0][k] = 1e3 * (t1 - t0);
         ms[1][k] = 1e3 * (t2 - t1) / (double)m + 0.0 * acc;
         ms[2][k] = 1e3 * (t3 - t2) / 16.0;
@@ -291,12 +275,12 @@ static void run_set(const amscr_params *p, const char *name, const shape_set *s,
                     int timing)
 {
     prepared c;
-    prepare_set(p, s->c, s->labels, s->n, &c);
+    prepare_set(p, s->c, s->n, &c);
     for (char which = 'A'; which <= 'B'; which++) {
         shape_set qs;
         make_queries(s, fold, which - 'A', nq, 0x9E3779B97F4A7C15ull + (unsigned long long)which, &qs);
         prepared q;
-        prepare_set(p, qs.c, qs.labels, qs.n, &q);
+        prepare_set(p, qs.c, qs.n, &q);
         tally t;
         recall(p, &c, &q, &t);
         printf("| %s | %c | %s |", name, which, SIG_NAME);
