@@ -10,12 +10,11 @@ new point count (Euclidean resampling to 0.6-1.4 times the count), then the cond
   boundary missing (one contiguous run of the target's points dropped, the rest still closed);
   an open fragment of 70 % / 50 % of the source's boundary against the whole target (--partial).
 
-Success: max_i |M(f_i) - T(f_i)| / size(T(f)) < 2 %, over the source's own points (the fragment's,
-for the partial conditions), size = RMS radius about the centroid (tests/testutil.c's definition).
+Success: max_i |M(f_i) - T(f_i)| / size(T(f)) < 2 % over the source's (the fragment's) points,
+size = RMS radius about the centroid.
 
-ECC (optional, --ecc; needs opencv-python-headless): cv2.findTransformECC with MOTION_AFFINE on
-rendered, blurred masks (the fragment closed by its chord), from 8 starting rotations with
-centroid and area matched, the best correlation kept.
+ECC (--ecc; opencv-python-headless): cv2.findTransformECC, MOTION_AFFINE, on rendered, blurred
+masks, from 8 starting rotations (centroid and area matched), the best correlation kept.
 
 Usage: nice python3 bench/registration_heldout.py [--data DIR] [--ecc] [--draws 2] [--stray F] [--only KEYS]
 Deterministic: every draw is seeded by (condition, class index, draw).

@@ -20,6 +20,8 @@
 #include "mcd_set.h"
 #include "collection.h"
 
+void die(const char *what); /* retrieval_bench.c */
+
 enum { M_AMSCR, M_SIM, M_AFF, M_INNER, M_INNER_OPEN, NBASE };
 
 typedef struct {
@@ -73,12 +75,6 @@ typedef struct {
     double *base[NBASE];
     double score[NROWS], secs[NROWS], spread[NROWS];
 } set_run;
-
-static void die(const char *what)
-{
-    fprintf(stderr, "amscr-retrieval-bench ablation: %s: %s\n", what, amscr_last_error_detail());
-    exit(1);
-}
 
 /* The median off-diagonal value among the shapes not held out (held: NULL for none). */
 static double offdiag_median(const double *M, size_t n, const unsigned char *held)

@@ -20,7 +20,8 @@
 #include "collection.h"
 #include "load_db.h"
 
-static void die(const char *what)
+void die(const char *what); /* retrieval_ablation.c's too */
+void die(const char *what)
 {
     fprintf(stderr, "amscr-retrieval-bench: %s: %s\n", what, amscr_last_error_detail());
     exit(1);

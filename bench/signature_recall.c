@@ -38,8 +38,6 @@ static void *xmalloc(size_t n)
 /* The library's signature (affine_signature.h); the variants measured against it: docs/decisions.md. */
 static const char *const SIG_NAME = "height-bins, share 0.2 (channel's)";
 
-/* ------------------------------------------------------------ prepared sets */
-
 typedef struct {
     size_t n;
     amscr_descriptor **d;
@@ -84,8 +82,6 @@ static void prepared_free(prepared *s)
     free(s->hf[1]);
     free(s->sig);
 }
-
-/* ------------------------------------------------------------ measuring */
 
 /* The channel distance of collection shape i and query q (shape i first), as
  * amscr_channel_distance with the retrieval preset. */
@@ -222,17 +218,6 @@ static void print_times(const char *name, const amscr_params *p, const prepared 
     printf("\n");
 }
 
-/* ------------------------------------------------------------ collections and folds */
-
-/* A random affine copy of c (affine_warp.h). */
-static amscr_contour *warp(const amscr_contour *c, unsigned long long *seed)
-{
-    amscr_contour *ct = warp_affine(c, seed);
-    if (!ct)
-        die("affine copy");
-    return ct;
-}
-
 /* nq random affine copies of shapes of s whose class is in fold `which` (0 A, 1 B). */
 static void make_queries(const shape_set *s, const int32_t *fold, int which, size_t nq, unsigned long long seed,
                          shape_set *q)
@@ -248,7 +233,8 @@ static void make_queries(const shape_set *s, const int32_t *fold, int which, siz
     q->labels = xmalloc(nq * sizeof *q->labels);
     for (size_t k = 0; k < nq; k++) {
         size_t i = pool[(size_t)(warp_urand(&seed) * (double)np) % np];
-        q->c[k] = warp(s->c[i], &seed);
+        if (!(q->c[k] = warp_affine(s->c[i], &seed)))
+            die("affine copy");
         q->labels[k] = s->labels[i];
     }
     free(pool);
@@ -266,7 +252,8 @@ static void make_mixed(const shape_set *s, shape_set *out)
         if (amscr_contour_new(amscr_contour_xy(s->c[i]), amscr_contour_size(s->c[i]), &copy) != AMSCR_OK)
             die("copy");
         out->c[i] = copy;
-        out->c[s->n + i] = warp(s->c[i], &seed);
+        if (!(out->c[s->n + i] = warp_affine(s->c[i], &seed)))
+            die("affine copy");
         out->labels[i] = out->labels[s->n + i] = s->labels[i];
     }
 }
