@@ -1,4 +1,4 @@
-/* affine_warp.c — the index benches' affine-warped copies (affine_warp.h). */
+/* affine_warp.c — the benches' affine-warped copies and their generator (affine_warp.h). */
 #include "affine_warp.h"
 
 #include <math.h>

@@ -1,8 +1,7 @@
 /* affine_warp.h — the seeded affine-warped, noisy copy of a contour that the index benches
- * (index_scale.c, signature_recall.c) draw their collections and queries from: any rotation,
- * axis scales x0.5-2 log-uniform, shear +-0.5, Gaussian noise 0.5 % of the RMS radius per
- * coordinate (mcd_set.h's distortion), from a xorshift64* generator: the same copies on every
- * machine. */
+ * (index_scale.c, signature_recall.c) draw collections and queries from, and its xorshift64*
+ * generator (mcd_set.c's too): any rotation, axis scales x0.5-2 log-uniform, shear +-0.5,
+ * Gaussian noise 0.5 % of the RMS radius per coordinate: the same copies on every machine. */
 #ifndef AMSCR_BENCH_AFFINE_WARP_H
 #define AMSCR_BENCH_AFFINE_WARP_H
 

@@ -3,7 +3,7 @@
  * Prints shapes/s, pairs/s, seconds for all threads and for one thread, per-stage timings,
  * and checks that both matrices are bit-identical.
  *
- *   amscr-bench [--shapes N] [--classes C] [--one-thread-rows R] [--reflections 0|1]
+ *   amscr-bench [--shapes N] [--classes C]
  *
  * Not a test: it prints numbers. Run through `meson compile -C build bench`. */
 #include <amscr.h>
@@ -47,16 +47,14 @@ static void make_shape(const double *a, const double *b, size_t n, double *xy)
 int main(int argc, char **argv)
 {
     size_t nshapes = 1400, nclasses = 70;
-    int reflections = 1;
+    const int reflections = 1;
     for (int i = 1; i + 1 < argc; i += 2) {
         if (!strcmp(argv[i], "--shapes"))
             nshapes = (size_t)atol(argv[i + 1]);
         else if (!strcmp(argv[i], "--classes"))
             nclasses = (size_t)atol(argv[i + 1]);
-        else if (!strcmp(argv[i], "--reflections"))
-            reflections = atoi(argv[i + 1]);
         else {
-            fprintf(stderr, "usage: amscr-bench [--shapes N] [--classes C] [--reflections 0|1]\n");
+            fprintf(stderr, "usage: amscr-bench [--shapes N] [--classes C]\n");
             return 2;
         }
     }

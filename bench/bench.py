@@ -25,19 +25,15 @@ ap.add_argument('--index-shapes', default='1400,10000', help='shapes of the synt
 ap.add_argument('--index-work', default=os.path.join('build', 'bench-index'))
 args, rest = ap.parse_known_args()
 
-sys.stdout.flush()
-rc = subprocess.call([args.bench, '--shapes', args.shapes] + rest)
-if rc != 0:
-    sys.exit(rc)
+cmds = [[args.bench, '--shapes', args.shapes] + rest]
 if args.registration_bench:
-    sys.stdout.flush()
-    rc = subprocess.call([args.registration_bench])
-    if rc != 0:
-        sys.exit(rc)
+    cmds.append([args.registration_bench])
 if args.tool and args.index_shapes != '0':
+    cmds.append([sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), 'index_bench.py'),
+                 '--tool', args.tool, '--shapes', args.index_shapes, '--work', args.index_work])
+for cmd in cmds:
     sys.stdout.flush()
-    rc = subprocess.call([sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), 'index_bench.py'),
-                          '--tool', args.tool, '--shapes', args.index_shapes, '--work', args.index_work])
+    rc = subprocess.call(cmd)
     if rc != 0:
         sys.exit(rc)
 if not args.tool or not args.datasets or not os.path.isdir(args.datasets):

@@ -1,4 +1,4 @@
-/* bench_util.h — the benchmarks' wall clock and seeded random numbers (splitmix64; one
+/* bench_util.h — the benchmarks' clocks, qsort comparison and seeded random numbers (splitmix64; one
  * generator per program: each benchmark is single-threaded where it draws). */
 #ifndef AMSCR_BENCH_UTIL_H
 #define AMSCR_BENCH_UTIL_H
@@ -12,6 +12,20 @@ static inline double now(void)
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Thread CPU seconds: every call timed runs on this thread (and the machine may be shared). */
+static inline double cpu_now(void)
+{
+    struct timespec t;
+    return clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t) == 0 ? (double)t.tv_sec + 1e-9 * (double)t.tv_nsec : NAN;
+}
+
+/* qsort order of doubles. */
+static inline int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
 }
 
 static uint64_t rng_state;

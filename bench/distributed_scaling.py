@@ -62,10 +62,12 @@ def matrix(argv):
     for cl in clusters.values(): cl.close()
 
 
-def sharded(n, reps, nq=20):
-    """amscr.distributed.build_index with 1, 2, 4 worker processes (one thread each): build, a batch
-    of nq queries, the largest worker's memory (RSS after the build and the queries); the scores
-    checked against the single index. Run: python3 bench/distributed_scaling.py shards N [REPS]."""
+def sharded(n, reps, nq=20, workers=(1, 2, 4)):
+    """amscr.distributed.build_index with 1, 2, 4 worker processes (one thread each): build (every pair,
+    candidates 0, then the default: a global signature shortlist above 2,000 shapes), a batch of nq
+    queries, the largest worker's memory (RSS after the builds and the queries); the scores checked
+    against the single index built and queried alike. Run: python3 bench/distributed_scaling.py shards
+    N [REPS] [WORKERS, e.g. 4]."""
     params = amscr.Params.retrieval(threads=1)  # the preset: N = 128, the inner distance's graph
     shapes = [blob(400, seed=i, phase=0.01 * i) for i in range(n)]
     db = amscr.Collection(params)
@@ -73,29 +75,35 @@ def sharded(n, reps, nq=20):
     db2 = amscr.Collection(params.copy(threads=2))
     db2.extend(shapes, [i % 20 for i in range(n)])
     qs = [blob(400, seed=100000 + i, phase=0.37 * i) for i in range(nq)]
-    t = time.perf_counter(); single = amscr.Index(db2, candidates=0)
-    print('single index (2 C threads, every pair): build %.1fs' % (time.perf_counter() - t))
-    ref = np.array([single.scores(q, candidates=0) for q in qs])
+    M = amscr.lib.amscr_index_default_candidates(n)
+    ref = {}
+    for m in sorted({0, M}):
+        t = time.perf_counter(); single = amscr.Index(db2, candidates=m)
+        print('single index (2 C threads, candidates %d): build %.1fs' % (m, time.perf_counter() - t))
+        ref[m] = np.array([single.scores(q, candidates=m) for q in qs])
     rss = lambda: psutil.Process().memory_info().rss
-    print('%-10s %12s %16s %18s %14s %s' % ('workers', 'build (best)', 'query/s (best)', 'RSS/worker (max)',
-                                           'idle RSS', 'load avg'))
-    for nw in (1, 2, 4):
+    print('%-10s %10s %12s %10s %16s %18s %14s %s' % ('workers', 'candidates', 'build (best)', 'pairs', 'query/s (best)',
+                                                    'RSS/worker (max)', 'idle RSS', 'load avg'))
+    for nw in workers:
         with LocalCluster(n_workers=nw, threads_per_worker=1, processes=True, dashboard_address=':0') as cl, Client(cl) as c:
-            builds, queries, mem, loads = [], [], [], []
             idle = max(c.run(rss).values())
-            for rep in range(reps):
-                loads.append(os.getloadavg()[0])
-                t = time.perf_counter(); sx = ad.build_index(c, db); builds.append(time.perf_counter() - t)
-                t = time.perf_counter(); S = sx.scores_many(qs); queries.append(time.perf_counter() - t)
-                assert np.abs(S - ref).max() <= 1e-9
-                mem.append(max(c.run(rss).values()))
-                del sx
-            print('%-10d %11.1fs %16.1f %15.0f MB %11.0f MB %s' % (nw, min(builds), nq / min(queries), max(mem) / 2**20,
-                  idle / 2**20, ' '.join('%.1f' % x for x in loads)), flush=True)
+            for m in sorted({0, M}):
+                builds, queries, mem, loads = [], [], [], []
+                for rep in range(reps):
+                    loads.append(os.getloadavg()[0])
+                    t = time.perf_counter(); sx = ad.build_index(c, db, candidates=m); builds.append(time.perf_counter() - t)
+                    t = time.perf_counter(); S = sx.scores_many(qs); queries.append(time.perf_counter() - t)
+                    assert np.array_equal(np.isinf(S), np.isinf(ref[m])) and np.abs(S - ref[m])[np.isfinite(S)].max() <= 1e-9
+                    mem.append(max(c.run(rss).values()))
+                    pairs = sx.pairs
+                    del sx
+                print('%-10d %10d %11.1fs %10d %16.1f %15.0f MB %11.0f MB %s' % (nw, m, min(builds), pairs, nq / min(queries),
+                      max(mem) / 2**20, idle / 2**20, ' '.join('%.1f' % x for x in loads)), flush=True)
 
 
 if __name__ == '__main__':
     if sys.argv[1:2] == ['shards']:
-        sharded(int(sys.argv[2]) if len(sys.argv) > 2 else 1000, int(sys.argv[3]) if len(sys.argv) > 3 else 1)
+        sharded(int(sys.argv[2]) if len(sys.argv) > 2 else 1000, int(sys.argv[3]) if len(sys.argv) > 3 else 1,
+                workers=tuple(int(w) for w in sys.argv[4:]) or (1, 2, 4))
     else:
         matrix(sys.argv)

@@ -6,35 +6,27 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "affine_warp.h"
 #include "collection.h"
 #include "image.h"
 
-/* xorshift64*: uniform in [0, 1) */
-static double urand(unsigned long long *s)
-{
-    *s ^= *s >> 12;
-    *s ^= *s << 25;
-    *s ^= *s >> 27;
-    return (double)((*s * 2685821657736338717ull) >> 11) / 9007199254740992.0;
-}
-
+/* Standard normal from affine_warp.h's xorshift64* generator. */
 static double nrand(unsigned long long *s)
 {
-    double u = urand(s), v = urand(s);
+    double u = warp_urand(s), v = warp_urand(s);
     if (u < 1e-300)
         u = 1e-300;
     return sqrt(-2.0 * log(u)) * cos(6.283185307179586 * v);
 }
 
-/* A random affine copy of c: A = R(theta) diag(sx, sy) [[1 sh] [0 1]], theta any, sx, sy
- * log-uniform in 0.5..2, sh in -0.5..0.5, then noise 0.5 % of the RMS radius. NULL on failure. */
+/* A random affine copy of c (mcd_set.h), A = R(theta) diag(sx, sy) [[1 sh] [0 1]]; NULL on failure. */
 static amscr_contour *affine_copy(const amscr_contour *c, unsigned long long *seed)
 {
     size_t n = amscr_contour_size(c);
     const double *xy = amscr_contour_xy(c);
-    double th = 6.283185307179586 * urand(seed);
-    double sx = exp(log(0.5) + log(4.0) * urand(seed)), sy = exp(log(0.5) + log(4.0) * urand(seed));
-    double sh = -0.5 + urand(seed);
+    double th = 6.283185307179586 * warp_urand(seed);
+    double sx = exp(log(0.5) + log(4.0) * warp_urand(seed)), sy = exp(log(0.5) + log(4.0) * warp_urand(seed));
+    double sh = -0.5 + warp_urand(seed);
     double cs = cos(th), sn = sin(th);
     double a = cs * sx, b = cs * sx * sh - sn * sy, c2 = sn * sx, d = sn * sx * sh + cs * sy;
     double *out = malloc(2 * n * sizeof *out);

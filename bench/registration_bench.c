@@ -1,20 +1,11 @@
 /* amscr-registration-bench — speed (and, alongside, accuracy) of single registrations with the
- * registration preset, per stage: tracing and preparing both shapes, registering without the
- * recovery and the polish, what each adds, and the pair.
+ * registration preset, per stage: random smooth silhouettes (radius harmonics, some with a thin
+ * limb) traced from a 400 x 400 mask, registered onto random affine images of themselves, clean
+ * and noisy; then pairs traced from 200 x 200 images as `amscr register` traces them, damaged in
+ * the image (docs/measurements.md). Success: max error over the source points below 2 % of the
+ * target's RMS radius. One thread, CPU time, median of the pairs; not a test.
  *
- * Shapes: random smooth silhouettes (radius harmonics 2..8, some with a thin limb) drawn into a
- * 400 x 400 mask and traced (pixel contours of 600-1500 points, like the datasets'). Each is
- * registered onto a random affine image of itself (any rotation, anisotropy up to 2, shear up to
- * 0.5), resampled to 0.6-1.4 times the point count from a new start point, clean and with
- * Gaussian noise of 1 % and 2 % of the RMS radius. Then pairs traced from 200 x 200 images as
- * `amscr register` traces them, the target drawn under such a map, 140 px across, and damaged in
- * the image (segmentation noise, a bite, a touching disk of 0.3 x the radius). Success: max error
- * over the source points below 2 % of the target's RMS radius (registration_heldout.py's measure).
- *
- *   amscr-registration-bench [--pairs N] [--seed S]
- *
- * Not a test: it prints numbers (one thread, CPU time, median of the pairs). Run through
- * `meson compile -C build bench` or `meson compile -C build bench-registration`. */
+ *   amscr-registration-bench [--pairs N] [--seed S] */
 #include <amscr.h>
 
 #include "bench_util.h"
@@ -156,12 +147,6 @@ static double map_error(const double M[6], const double T[6], const amscr_contou
     return worst / size;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 static double median(double *v, size_t n)
 {
     qsort(v, n, sizeof *v, cmp_double);
@@ -214,13 +199,6 @@ static void damage(uint8_t *m, int kind)
     }
     double r = 0.3 * R, off = kind == 2 ? 0.0 : r; /* a bite centred on the boundary, a disk touching it */
     disk(m, cx + (t + off) * ux, cy + (t + off) * uy, r, kind == 2 ? 0 : 255);
-}
-
-/* Thread CPU seconds: every call timed runs on this thread (and the machine may be shared). */
-static double cpu_now(void)
-{
-    struct timespec t;
-    return clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t) == 0 ? (double)t.tv_sec + 1e-9 * (double)t.tv_nsec : NAN;
 }
 
 /* Traced pair `kind` (0 clean, 1 segmentation noise, 2 bite, 3 touching disk): the contours, the

@@ -1,15 +1,12 @@
 #!/usr/bin/env python3
 """Registration of noisy contours whose points were taken evenly along ANOTHER version of the curve.
 
-The even-spacing stage (src/register/even.c) reads a noisy curve's point index as arc length along the
-other curve, the one it is registered to. That holds when both come from the same polyline (the
-held-out pairs: the target is the moved pixel contour resampled evenly); a target resampled along
-a smoothed contour or a 4-connected (crack-following) trace of the same shape is spaced along a
-curve whose arc length differs locally by a few percent, and the stage must then stay out (its
-whiteness test). This bench measures that: for each of the first 35 classes and DRAWS seeded
-draws, the traced pixel contour f, a random affine map T (registration_heldout.py's), the target
-resampled to 0.6-1.4 times the point count along T(g) with g = f ('plain'), f smoothed by a
-Gaussian of 2 points ('smooth') or f's 4-connected staircase ('four'), plus Gaussian noise.
+The even-spacing stage reads a noisy curve's point index as arc length along the curve it is
+registered to: true on the same polyline, not along a smoothed or 4-connected trace (the stage must
+then stay out). For each of the first 35 classes and DRAWS seeded draws: the traced pixel contour
+f, a random affine map T (registration_heldout.py's), the target resampled to 0.6-1.4 times the
+point count along T(g), g = f ('plain'), f smoothed by a Gaussian of 2 points ('smooth') or f's
+4-connected staircase ('four'), plus Gaussian noise.
 Success: max_i |M(f_i) - T(f_i)| < 2 % of the RMS radius (registration_heldout.py's measure).
 
 Usage: python3 bench/registration_convention.py [--curve plain|smooth|four] [--noise 0.02] [--draws 4]

@@ -10,18 +10,16 @@ new point count (Euclidean resampling to 0.6-1.4 times the count), then the cond
   boundary missing (one contiguous run of the target's points dropped, the rest still closed);
   an open fragment of 70 % / 50 % of the source's boundary against the whole target (--partial).
 
-Success: max_i |M(f_i) - T(f_i)| / size(T(f)) < 2 %, over the source's own points (the fragment's,
-for the partial conditions), size = RMS radius about the centroid (tests/testutil.c's definition).
+Success: max_i |M(f_i) - T(f_i)| / size(T(f)) < 2 % over the source's (the fragment's) points,
+size = RMS radius about the centroid.
 
-ECC (optional, --ecc; needs opencv-python-headless): cv2.findTransformECC with MOTION_AFFINE on
-rendered, blurred masks (the fragment closed by its chord), from 8 starting rotations with
-centroid and area matched, the best correlation kept.
+ECC (--ecc; opencv-python-headless): cv2.findTransformECC, MOTION_AFFINE, on rendered, blurred
+masks, from 8 starting rotations (centroid and area matched), the best correlation kept.
 
-Usage: nice python3 bench/registration_heldout.py [--data DIR] [--ecc] [--draws 2] [--stray F] [--json OUT]
+Usage: nice python3 bench/registration_heldout.py [--data DIR] [--ecc] [--draws 2] [--stray F] [--only KEYS]
 Deterministic: every draw is seeded by (condition, class index, draw).
 """
 import argparse
-import json
 import math
 import os
 import sys
@@ -137,16 +135,10 @@ def error_summary(errs):
         n, 100 * np.mean(e < 2), e[n // 2], e[9 * n // 10], e[95 * n // 100])
 
 
-def amscr_register(src, tgt, partial, mode):
+def amscr_register(src, tgt, partial):
     """The recovered 2x3 map, or None when the call fails."""
     try:
-        if partial:
-            if mode == 'partial':
-                r = amscr.register(src, tgt, partial=True)
-            else:  # today's main: both curves open
-                r = amscr.register(src, tgt, closed=False)
-        else:
-            r = amscr.register(src, tgt)
+        r = amscr.register(src, tgt, partial=True) if partial else amscr.register(src, tgt)
     except amscr.AmscrError:
         return None, None
     return np.hstack([r.A, r.B[:, None]]), r
@@ -233,16 +225,12 @@ def main():
     ap.add_argument('--classes', type=int, default=35)
     ap.add_argument('--draws', type=int, default=2)
     ap.add_argument('--ecc', action='store_true', help='also run OpenCV ECC (slow)')
-    ap.add_argument('--mode', choices=['partial', 'open'], default='partial',
-                    help='fragments: the partial option (default) or both curves open (0.1 behaviour)')
     ap.add_argument('--only', help='comma-separated condition keys')
     ap.add_argument('--stray', type=float, default=0.0,
                     help='share of the SOURCE points moved to random places in its bounding box (stray points); '
                          'the error is still measured on the clean source')
     ap.add_argument('--tracer', choices=['pixel-chain', 'subpixel'], default='pixel-chain',
                     help='how the source silhouettes are traced (the published table: pixel-chain)')
-    ap.add_argument('--json', help='write per-case results here')
-    ap.add_argument('-v', '--verbose', action='store_true')
     args = ap.parse_args()
     if not os.path.exists(os.path.join(args.data, 'manifest.tsv')):
         print('no manifest in %s: skipped' % args.data)
@@ -255,23 +243,22 @@ def main():
             print('opencv not installed: ECC column skipped')
     shapes = load_shapes(args.data, args.classes, args.tracer == 'subpixel')
     conds = [c for c in CONDITIONS if not args.only or c[0] in args.only.split(',')]
-    rows, cases = [], []
+    rows = []
     for ci, (key, label, amount, goal) in enumerate(CONDITIONS):
         if (key, label, amount, goal) not in conds:
             continue
         ok_a = ok_e = total = 0
         t_reg = 0.0
         conf_ok, conf_bad = [], []
-        for si, (cls, f) in enumerate(shapes):
+        for si, (_, f) in enumerate(shapes):
             for d in range(args.draws):
                 rng = np.random.default_rng([14, ci, si, d])
                 src, tgt, T, size, partial = make_case(f, key, amount, rng)
                 seen = with_strays(src, args.stray, np.random.default_rng([15, ci, si, d]))
                 t0 = time.perf_counter()
-                M, res = amscr_register(seen, tgt, partial, args.mode)
+                M, res = amscr_register(seen, tgt, partial)
                 t_reg += time.perf_counter() - t0
                 ea = map_error(M, T, src, size) if M is not None else math.inf
-                ee = None
                 if cv2 is not None:
                     W = ecc_register(src, tgt, cv2)
                     ee = map_error(W, T, src, size) if W is not None else math.inf
@@ -281,10 +268,6 @@ def main():
                 conf = getattr(res, 'confidence', None) if res is not None else None
                 if conf is not None:
                     (conf_ok if ea < 0.02 else conf_bad).append(conf)
-                cases.append(dict(cond=key, cls=cls, draw=d, amscr=ea, ecc=ee, confidence=conf))
-                if args.verbose and ea >= 0.02:
-                    print('  %s %s draw %d: amscr error %.2f %%%s' % (key, cls, d, 100 * ea,
-                          '' if conf is None else ', confidence %.3f' % conf))
         rows.append((label, 100.0 * ok_a / total, 100.0 * ok_e / total if cv2 is not None else None, goal,
                      1e3 * t_reg / total, conf_ok, conf_bad))
         sys.stdout.flush()
@@ -297,9 +280,6 @@ def main():
         for label, _, _, _, _, good, bad in rows:
             print('  %-14s %s / %s' % (label, '%.3f' % np.median(good) if good else '-',
                                       '%.3f' % np.median(bad) if bad else '-'))
-    if args.json:
-        with open(args.json, 'w') as fp:
-            json.dump(cases, fp, indent=0)
     return 0
 
 

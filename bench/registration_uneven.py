@@ -1,10 +1,9 @@
 #!/usr/bin/env python3
 """Registration of noisy contours sampled UNEVENLY along the curve (the order stage).
 
-For each of the first 35 classes of a manifest (one shape per class) and 4 seeded draws: the traced
-pixel contour f, a random affine map T (registration_heldout.py's), the target T(f) resampled to
-0.6-1.4 times the point count with a density DENSITY times higher on alternating quarter arcs (a
-pen that slowed down, say), from a new start point, plus Gaussian noise of NOISE x the RMS radius.
+For each of the first 35 classes (one shape each) and 4 seeded draws: the traced pixel contour f, a
+random affine map T (registration_heldout.py's), T(f) resampled to 0.6-1.4 times the point count,
+DENSITY times denser on alternating quarter arcs, new start point, Gaussian noise NOISE x RMS radius.
 Success: max_i |M(f_i) - T(f_i)| < 2 % of the RMS radius (registration_heldout.py's measure).
 
 Usage: python3 bench/registration_uneven.py [--density 6] [--noise 0.02] [--data DIR]

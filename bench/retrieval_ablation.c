@@ -1,23 +1,10 @@
-/* retrieval_ablation.c — the ablation table of the retrieval default (run by
- * `amscr-retrieval-bench ablation DATASETS`): on each set the three base matrices are computed
- * once through the library — the AMSCR distance (the paper's method: affine group, no
- * refinement, mirror images), the shape channel in the similarity frame (band 0.15) and in the
- * affine (whitened) frame (its own band, 0.08) — plus the inner distance of the re-ranking's
- * second graph (inside each silhouette closed at 0.04 sqrt(area), the default, and on the
- * silhouette as traced, 0.8's), and every row is composed from them exactly as amscr_db_retrieval_matrix
- * composes them (channel frames mixed 0.8 / 0.2, a pair the affine frame finds twice as near as
- * the mix taken at twice its affine distance in the default's row, fusion = each matrix over its median
- * off-diagonal value, re-ranking k 8, 10 iterations, on one graph or with the inner distance's
- * graph at the row's share: 0.1 in the default, 0.05 before 0.12). A row's time is the wall time of the base
- * matrices it needs plus its fusion and re-ranking (decode, trace and preparation are listed
- * once per set). With mpeg7-dev/folds.tsv, two more columns: each class fold of mpeg7-dev as its
- * own collection (sub-matrices of mpeg7-dev's base matrices; why the folds: docs/decisions.md).
- * With eth80-dev (objects seen in 41 views, a manifest with a `group` column), its column:
- * leave one object out, 1-NN, each object's rows from the fusion and re-ranking graph of the others alone
- * (as amscr_db_retrieval_matrix_heldout; one re-ranking per object). Last, the mean of the four collections (mpeg7-dev as its folds'
- * mean, Kimia as the two sums' mean share of the best, eth80-dev, the MCD-style set) and each
- * figure's spread: the standard error of the default's figure over its units (classes; objects
- * in eth80-dev), the margin within which a change may lower it. */
+/* retrieval_ablation.c — the ablation table of the retrieval default (`amscr-retrieval-bench
+ * ablation DATASETS`; the sets, rows and columns: docs/measurements.md, "One default for
+ * articulated and affine-distorted collections"). On each set the base matrices (AMSCR, the
+ * channel's similarity and affine frames, the inner distance closed and as traced) are computed
+ * once through the library and every row is composed from them as amscr_db_retrieval_matrix
+ * composes them (eth80-dev's held-out rows as amscr_db_retrieval_matrix_heldout). A row's
+ * time: the base matrices it needs plus its fusion and re-ranking. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,12 +12,15 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "bench_util.h"
 #include "channel.h"
 #include "inner.h"
 #include "internal.h"
 #include "folds_tsv.h"
 #include "mcd_set.h"
 #include "collection.h"
+
+void die(const char *what); /* retrieval_bench.c */
 
 enum { M_AMSCR, M_SIM, M_AFF, M_INNER, M_INNER_OPEN, NBASE };
 
@@ -85,25 +75,6 @@ typedef struct {
     double *base[NBASE];
     double score[NROWS], secs[NROWS], spread[NROWS];
 } set_run;
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void die(const char *what)
-{
-    fprintf(stderr, "amscr-retrieval-bench ablation: %s: %s\n", what, amscr_last_error_detail());
-    exit(1);
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 /* The median off-diagonal value among the shapes not held out (held: NULL for none). */
 static double offdiag_median(const double *M, size_t n, const unsigned char *held)

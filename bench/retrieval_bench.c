@@ -1,18 +1,13 @@
-/* retrieval_bench.c — the default retrieval pipeline measured:
+/* retrieval_bench.c — the default retrieval pipeline measured (docs/measurements.md):
  *
- *   amscr-retrieval-bench timing DATASETS    the retrieval preset and its fast setting (affine
- *       share 0) on a 1400-shape MPEG-7-size collection (mpeg7-dev loaded twice; without it
- *       the MCD-style set of kimia216 repeated): per-stage wall times and pairs/s, the shapes
- *       loaded and prepared on one thread; then the tool's path (amscr eval: the tool's loader,
- *       decoding, tracing and preparing on the threads, then the same matrix)
- *   amscr-retrieval-bench ablation DATASETS  the ablation table (markdown): each channel alone,
- *       fused, with and without re-ranking, the paper's method, on mpeg7-dev, the MCD-style set,
- *       Kimia-99 and Kimia-216, with times
- *   amscr-retrieval-bench mcd-check MANIFEST the MCD-style set built from MANIFEST must reach
- *       >= 99 % bull's eye with the retrieval preset (exit 0, 1 below, 77 = skipped: no data)
+ *   amscr-retrieval-bench timing DATASETS    the retrieval preset and its fast setting on 1400
+ *       shapes (mpeg7-dev twice; without it kimia216's MCD-style set repeated): per-stage wall
+ *       times, pairs/s; then the tool's path (amscr eval's loader and the same matrix)
+ *   amscr-retrieval-bench ablation DATASETS  the ablation table (retrieval_ablation.c)
+ *   amscr-retrieval-bench mcd-check MANIFEST the MCD-style set from MANIFEST must reach >= 99 %
+ *       bull's eye with the retrieval preset (exit 0, 1 below, 77 = skipped: no data)
  *
- * DATASETS holds kimia99/, kimia216/, mpeg7-dev/ (manifest.tsv each). Deterministic output
- * except the times. */
+ * DATASETS holds kimia99/, kimia216/, mpeg7-dev/ (manifest.tsv each). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,18 +15,13 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "bench_util.h"
 #include "mcd_set.h"
 #include "collection.h"
 #include "load_db.h"
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void die(const char *what)
+void die(const char *what); /* retrieval_ablation.c's too */
+void die(const char *what)
 {
     fprintf(stderr, "amscr-retrieval-bench: %s: %s\n", what, amscr_last_error_detail());
     exit(1);

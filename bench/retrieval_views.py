@@ -12,10 +12,11 @@ The draw is seeded: the same set on every machine for one seed.
 
 Rows: the retrieval preset's fused channel before re-ranking, re-ranked on one graph (the
 inner-distance share 0) and at each --shares value (the library's retrieval_matrix). Scores:
-1-NN accuracy with the query's own object left out (amscr.nn_groups).
+1-NN accuracy with the query's own object left out of the collection and its re-ranking graph
+(Collection.retrieval_matrix_heldout, amscr.nn_groups).
 
 Usage: .venv/bin/python bench/retrieval_views.py [--data ../shared/datasets] [--seeds 1,2,3]
-       [--fold A|B] [--objects 4] [--views 10] [--shares 0.05]          # ~1.5 min a seed
+       [--fold A|B] [--objects 4] [--views 10] [--shares 0.1]           # ~1.5 min a seed
        [--classes 8] [--k 16,41]    # ETH-80's shape: 8 classes drawn per seed, x 10 objects x 41 views
        [--join]                     # views traced as the tool's retrieval commands trace them
        [--options '{"channel_affine_view": 0}' ...]   # a column for each set of Params options
@@ -102,7 +103,7 @@ def build(by, objects, views, seed, join=False):
 def accuracy(shapes, cls, grp, **options):
     col = amscr.Collection(amscr.Params.retrieval(**options))
     col.extend(shapes, cls)
-    return 100.0 * amscr.nn_groups(col.retrieval_matrix(), cls, grp).accuracy
+    return 100.0 * amscr.nn_groups(col.retrieval_matrix_heldout(grp), cls, grp).accuracy
 
 
 def main(argv=None):
@@ -112,7 +113,7 @@ def main(argv=None):
     ap.add_argument('--fold', default='', choices=['', 'A', 'B'])
     ap.add_argument('--objects', type=int, default=4)
     ap.add_argument('--views', type=int, default=10)
-    ap.add_argument('--shares', default='0.05')
+    ap.add_argument('--shares', default='0.1')
     ap.add_argument('--classes', type=int, default=0, help="that many classes drawn with each seed (0: all)")
     ap.add_argument('--k', default='', help="re-ranking k values for more columns (the preset otherwise)")
     ap.add_argument('--join', action='store_true', help="trace as the tool's retrieval commands: broken pieces joined")

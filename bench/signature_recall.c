@@ -1,31 +1,10 @@
-/* signature_recall.c — the recall of an index query's signature shortlist (docs/collections.md,
- * "the index file"): how many of the exact nearest shapes the M signature-nearest keep.
+/* signature_recall.c — the recall of an index query's signature shortlist: % of the exact top 10
+ * (the retrieval preset's base distance before re-ranking, checked against
+ * amscr_channel_distance) inside the M signature-nearest, and % of first hits, for seeded affine
+ * queries per fold of mpeg7-dev/folds.tsv on mpeg7-dev, the MCD-style set and mpeg7-dev + affine
+ * copies; then the CPU time of one query at 1400 shapes (docs/measurements.md, "Shortlist recall").
  *
- *   amscr-signature-recall DATASETS [QUERIES]
- *
- * Collections (retrieval preset), from DATASETS/mpeg7-dev (manifest.tsv, folds.tsv):
- *   mpeg7-dev  the 700 shapes;
- *   mixed      mpeg7-dev + one random affine copy of every shape (1400);
- *   synthetic  the MCD-style affine set: the first shape of every class x 14 affine copies (490).
- * Queries: QUERIES (default 100) per fold of mpeg7-dev/folds.tsv (fold A chooses, fold B
- * confirms), each a random affine copy (any rotation, axis scales x0.5-2 log-uniform, shear
- * +-0.5, 0.5 % noise) of a random collection shape of a class of the fold; seeded, the same on
- * every machine.
- *
- * Exact ranking: the retrieval preset's base distance before re-ranking, i.e. the shape
- * channel (weight 1: similarity frame + 0.2 of the whitened frame), collection shape first as
- * an index query computes it (checked against amscr_channel_distance). An index query's
- * re-ranked row depends on the shortlist only through these base distances (its own K nearest
- * and the shapes it enters the neighbour lists of); the diffusion reaches the other shapes
- * through the stored lists whether they were shortlisted or not.
- *
- * For every signature and M in {16, 32, 64, 128, 256}: % of the exact top 10 inside the M
- * signature-nearest, % of queries whose exact first hit is inside; then (1400 shapes) the CPU
- * time of one query at M on 1 thread, from the medians over 15 queries of its parts: the
- * fixed part (prepare the query, its height functions, its signature, the n signature
- * distances, the top M) plus M candidate matches (two frames) from stored height functions,
- * and with each candidate's height functions built per query (as amscr_channel_distance and
- * today's index query do). Deterministic except the times. */
+ *   amscr-signature-recall DATASETS [QUERIES]     (QUERIES per fold, default 100) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,12 +13,12 @@
 
 #include "affine_signature.h"
 #include "affine_warp.h"
+#include "bench_util.h"
 #include "channel.h"
+#include "folds_tsv.h"
 #include "mcd_set.h"
-#include "collection.h"
-#include "image.h"
 
-enum { OLD_DIM = 24, TOP = 10, NM = 5, NVAR = 5, TIMED = 15 };
+enum { DIM = AMSCR__AFFINE_SIG_DIM, TOP = 10, NM = 5, TIMED = 15 };
 static const size_t MS[NM] = {16, 32, 64, 128, 256};
 
 static void die(const char *what)
@@ -56,127 +35,14 @@ static void *xmalloc(size_t n)
     return p;
 }
 
-/* ------------------------------------------------------------ signatures */
-
-/* The signature of tools/cli/index_file.c (index_signature), copied: harmonics 1..24 of the
- * radius function of the whitened samples (the retrieval preset's affine invariance) over
- * its mean; squared Euclidean distance. */
-static void sig_old(const amscr_descriptor *d, double *out)
-{
-    size_t n = amscr_descriptor_num_samples(d);
-    int affine = amscr_params_get_invariance(amscr_descriptor_params(d)) == AMSCR_INVARIANCE_AFFINE;
-    const double *p = affine ? amscr_descriptor_base_points(d) : amscr_descriptor_input_points(d);
-    double cx = 0.0, cy = 0.0, mean = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        cx += p[2 * i] / (double)n;
-        cy += p[2 * i + 1] / (double)n;
-    }
-    for (size_t i = 0; i < n; i++)
-        mean += hypot(p[2 * i] - cx, p[2 * i + 1] - cy) / (double)n;
-    for (size_t h = 1; h <= OLD_DIM; h++) {
-        double re = 0.0, im = 0.0, w = 2.0 * 3.14159265358979323846 * (double)h / (double)n;
-        for (size_t i = 0; i < n; i++) {
-            double r = mean > 0.0 ? hypot(p[2 * i] - cx, p[2 * i + 1] - cy) / mean : 0.0;
-            re += r * cos(w * (double)i);
-            im -= r * sin(w * (double)i);
-        }
-        out[h - 1] = hypot(re, im) / (double)n;
-    }
-}
-
-static double dist_old(const double *a, const double *b)
-{
-    double s = 0.0;
-    for (size_t t = 0; t < OLD_DIM; t++)
-        s += (a[t] - b[t]) * (a[t] - b[t]);
-    return s;
-}
-
-typedef struct {
-    const char *name;
-    size_t dim;
-    double share; /* the whitened frame's share (new signature), < 0: the descriptor's */
-} variant;
-
-static const variant VARS[NVAR] = {
-    {"similarity (old)", OLD_DIM, 0.0},
-    {"height-bins, share 0.2 (channel's)", AMSCR__AFFINE_SIG_DIM, -1.0},
-    {"height-bins, share 0.5", AMSCR__AFFINE_SIG_DIM, 0.5},
-    {"height-bins, whitened only", AMSCR__AFFINE_SIG_DIM, 1.0},
-    {"height-bins 0.5 + old, each over its median", OLD_DIM + AMSCR__AFFINE_SIG_DIM, 0.5},
-};
-
-/* The combined variant's scales: the median signature distance of each part over the
- * collection (set by set_medians). */
-static double med_old = 1.0, med_hf = 1.0;
-
-static void sig_of(int v, const amscr_descriptor *d, double *out)
-{
-    if (v == NVAR - 1) {
-        sig_old(d, out);
-        amscr__affine_signature_share(d, VARS[v].share, out + OLD_DIM);
-    } else if (v == 0)
-        sig_old(d, out);
-    else if (VARS[v].share < 0.0)
-        amscr__affine_signature(d, out);
-    else
-        amscr__affine_signature_share(d, VARS[v].share, out);
-}
-
-static double sig_dist(int v, const double *a, const double *b)
-{
-    if (v == NVAR - 1)
-        return sqrt(dist_old(a, b)) / med_old + amscr__affine_signature_distance(a + OLD_DIM, b + OLD_DIM) / med_hf;
-    return v == 0 ? dist_old(a, b) : amscr__affine_signature_distance(a, b);
-}
-
-static int cmp_dbl(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* med_old, med_hf from the pairs (i, i + 1 + k * 7) of the n signatures of the combined
- * variant in sig. */
-static void set_medians(const double *sig, size_t n)
-{
-    size_t dim = VARS[NVAR - 1].dim, m = 0, cap = 8 * n;
-    double *a = xmalloc(cap * sizeof *a), *b = xmalloc(cap * sizeof *b);
-    for (size_t i = 0; i < n; i++)
-        for (size_t k = 0; k < 8; k++) {
-            size_t j = (i + 1 + 7 * k) % n;
-            if (j == i)
-                continue;
-            a[m] = sqrt(dist_old(sig + i * dim, sig + j * dim));
-            b[m++] = amscr__affine_signature_distance(sig + i * dim + OLD_DIM, sig + j * dim + OLD_DIM);
-        }
-    qsort(a, m, sizeof *a, cmp_dbl);
-    qsort(b, m, sizeof *b, cmp_dbl);
-    med_old = a[m / 2] > 0 ? a[m / 2] : 1.0;
-    med_hf = b[m / 2] > 0 ? b[m / 2] : 1.0;
-    free(a);
-    free(b);
-}
-
-/* ------------------------------------------------------------ affine copies */
-
-/* A random affine copy of c (affine_warp.h). */
-static amscr_contour *warp(const amscr_contour *c, unsigned long long *seed)
-{
-    amscr_contour *ct = warp_affine(c, seed);
-    if (!ct)
-        die("affine copy");
-    return ct;
-}
-
-/* ------------------------------------------------------------ prepared sets */
+/* The library's signature (affine_signature.h); the variants measured against it: docs/decisions.md. */
+static const char *const SIG_NAME = "height-bins, share 0.2 (channel's)";
 
 typedef struct {
     size_t n;
     amscr_descriptor **d;
-    int32_t *label;
     amscr__hf *hf[2]; /* similarity, whitened frame */
-    double *sig[NVAR];
+    double *sig; /* n x DIM */
 } prepared;
 
 static amscr_descriptor *prepare_one(const amscr_params *p, const amscr_contour *c)
@@ -187,24 +53,20 @@ static amscr_descriptor *prepare_one(const amscr_params *p, const amscr_contour 
     return d;
 }
 
-static void prepare_set(const amscr_params *p, amscr_contour *const *c, const int32_t *label, size_t n, prepared *s)
+static void prepare_set(const amscr_params *p, amscr_contour *const *c, size_t n, prepared *s)
 {
     s->n = n;
     s->d = xmalloc(n * sizeof *s->d);
-    s->label = xmalloc(n * sizeof *s->label);
     for (int f = 0; f < 2; f++)
         s->hf[f] = xmalloc(n * sizeof *s->hf[f]);
-    for (int v = 0; v < NVAR; v++)
-        s->sig[v] = xmalloc(n * VARS[v].dim * sizeof(double));
+    s->sig = xmalloc(n * DIM * sizeof(double));
     for (size_t i = 0; i < n; i++) {
         s->d[i] = prepare_one(p, c[i]);
-        s->label[i] = label[i];
         for (int f = 0; f < 2; f++)
             if (amscr__hf_of_descriptor(p, f ? AMSCR_INVARIANCE_AFFINE : AMSCR_INVARIANCE_SIMILARITY, s->d[i],
                                         &s->hf[f][i]) != AMSCR_OK)
                 die("height functions");
-        for (int v = 0; v < NVAR; v++)
-            sig_of(v, s->d[i], s->sig[v] + i * VARS[v].dim);
+        amscr__affine_signature(s->d[i], s->sig + i * DIM);
     }
 }
 
@@ -216,14 +78,10 @@ static void prepared_free(prepared *s)
         amscr__hf_free(&s->hf[1][i]);
     }
     free(s->d);
-    free(s->label);
     free(s->hf[0]);
     free(s->hf[1]);
-    for (int v = 0; v < NVAR; v++)
-        free(s->sig[v]);
+    free(s->sig);
 }
-
-/* ------------------------------------------------------------ measuring */
 
 /* The channel distance of collection shape i and query q (shape i first), as
  * amscr_channel_distance with the retrieval preset. */
@@ -237,11 +95,6 @@ static double two_frames(const amscr_params *p, const amscr__hf *a0, const amscr
     return (1.0 - s) * amscr__hf_distance(a0, b0, &cfg[0], ws) + s * amscr__hf_distance(a1, b1, &cfg[1], ws);
 }
 
-static double exact(const amscr_params *p, const prepared *c, size_t i, const prepared *q, size_t k, amscr__hf_ws *ws)
-{
-    return two_frames(p, &c->hf[0][i], &c->hf[1][i], &q->hf[0][k], &q->hf[1][k], ws);
-}
-
 /* A channel workspace with room for both frames' bands. */
 static void ws_init(const amscr_params *p, size_t n, amscr__hf_ws *ws)
 {
@@ -253,8 +106,8 @@ static void ws_init(const amscr_params *p, size_t n, amscr__hf_ws *ws)
 }
 
 typedef struct {
-    size_t top[NVAR][NM];   /* exact top-10 members inside the shortlist */
-    size_t first[NVAR][NM]; /* queries whose exact first hit is inside */
+    size_t top[NM];   /* exact top-10 members inside the shortlist */
+    size_t first[NM]; /* queries whose exact first hit is inside */
     size_t nq;
 } tally;
 
@@ -265,19 +118,16 @@ static void count(const prepared *c, const prepared *q, size_t k, const double *
     size_t n = c->n, best[TOP];
     if (amscr_topk(e, n, TOP, SIZE_MAX, best) != AMSCR_OK)
         die("top-k");
-    for (int v = 0; v < NVAR; v++) {
-        size_t dim = VARS[v].dim;
-        for (size_t j = 0; j < n; j++)
-            sd[j] = sig_dist(v, q->sig[v] + k * dim, c->sig[v] + j * dim);
-        if (amscr_topk(sd, n, n, SIZE_MAX, rank) != AMSCR_OK)
-            die("top-k");
-        for (size_t j = 0; j < n; j++) /* rank[] -> the position of every shape */
-            sd[rank[j]] = (double)j;
-        for (int m = 0; m < NM; m++) {
-            for (size_t r = 0; r < TOP; r++)
-                t->top[v][m] += sd[best[r]] < (double)MS[m];
-            t->first[v][m] += sd[best[0]] < (double)MS[m];
-        }
+    for (size_t j = 0; j < n; j++)
+        sd[j] = amscr__affine_signature_distance(q->sig + k * DIM, c->sig + j * DIM);
+    if (amscr_topk(sd, n, n, SIZE_MAX, rank) != AMSCR_OK)
+        die("top-k");
+    for (size_t j = 0; j < n; j++) /* rank[] -> the position of every shape */
+        sd[rank[j]] = (double)j;
+    for (int m = 0; m < NM; m++) {
+        for (size_t r = 0; r < TOP; r++)
+            t->top[m] += sd[best[r]] < (double)MS[m];
+        t->first[m] += sd[best[0]] < (double)MS[m];
     }
     t->nq++;
 }
@@ -292,7 +142,7 @@ static void recall(const amscr_params *p, const prepared *c, const prepared *q, 
     memset(t, 0, sizeof *t);
     for (size_t k = 0; k < q->n; k++) {
         for (size_t i = 0; i < n; i++)
-            e[i] = exact(p, c, i, q, k, &ws);
+            e[i] = two_frames(p, &c->hf[0][i], &c->hf[1][i], &q->hf[0][k], &q->hf[1][k], &ws);
         if (k == 0) { /* the exact distance is the library's */
             double ref;
             if (amscr_channel_distance(p, c->d[1], q->d[0], &ref) != AMSCR_OK || fabs(ref - e[1]) > 1e-9 * (1 + ref))
@@ -306,41 +156,33 @@ static void recall(const amscr_params *p, const prepared *c, const prepared *q, 
     free(rank);
 }
 
-static double cpu(void)
+/* The CPU time (1 thread, median over TIMED queries) of a query's parts: t[0] the fixed part
+ * (prepare, the query's height functions in both frames, its signature, the n signature
+ * distances, the top 256), t[1] one candidate's match from stored height functions (two
+ * frames), t[2] building one candidate's height functions (two frames). */
+static void query_parts(const amscr_params *p, const prepared *c, amscr_contour *const *qc, size_t nq, double t[3])
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* The CPU time (1 thread, median over TIMED queries) of a query's parts with signature v:
- * t[0] the fixed part (prepare, the query's height functions in both frames, its signature,
- * the n signature distances, the top 256), t[1] one candidate's match from stored height
- * functions (two frames), t[2] building one candidate's height functions (two frames). */
-static void query_parts(const amscr_params *p, const prepared *c, amscr_contour *const *qc, size_t nq, int v,
-                        double t[3])
-{
-    size_t n = c->n, dim = VARS[v].dim, *cand = xmalloc(n * sizeof *cand), m = n < 256 ? n : 256;
-    double *sd = xmalloc(n * sizeof *sd), *qs = xmalloc(dim * sizeof *qs), ms[3][TIMED];
+    size_t n = c->n, *cand = xmalloc(n * sizeof *cand), m = n < 256 ? n : 256;
+    double *sd = xmalloc(n * sizeof *sd), qs[DIM], ms[3][TIMED];
     amscr__hf_ws ws;
     ws_init(p, c->d[0]->n, &ws);
     nq = nq < TIMED ? nq : TIMED;
     for (size_t k = 0; k < nq; k++) {
         amscr__hf h[2], b[2];
-        double t0 = cpu(), acc = 0.0;
+        double t0 = cpu_now(), acc = 0.0;
         amscr_descriptor *dq = prepare_one(p, qc[k]);
         for (int f = 0; f < 2; f++)
             if (amscr__hf_of_descriptor(p, f ? AMSCR_INVARIANCE_AFFINE : AMSCR_INVARIANCE_SIMILARITY, dq, &h[f]))
                 die("height functions");
-        sig_of(v, dq, qs);
+        amscr__affine_signature(dq, qs);
         for (size_t j = 0; j < n; j++)
-            sd[j] = sig_dist(v, qs, c->sig[v] + j * dim);
+            sd[j] = amscr__affine_signature_distance(qs, c->sig + j * DIM);
         if (amscr_topk(sd, n, m, SIZE_MAX, cand) != AMSCR_OK)
             die("top-k");
-        double t1 = cpu();
+        double t1 = cpu_now();
         for (size_t j = 0; j < m; j++)
             acc += two_frames(p, &c->hf[0][cand[j]], &c->hf[1][cand[j]], &h[0], &h[1], &ws);
-        double t2 = cpu();
+        double t2 = cpu_now();
         for (size_t j = 0; j < 16; j++)
             for (int f = 0; f < 2; f++) {
                 if (amscr__hf_of_descriptor(p, f ? AMSCR_INVARIANCE_AFFINE : AMSCR_INVARIANCE_SIMILARITY,
@@ -348,7 +190,7 @@ static void query_parts(const amscr_params *p, const prepared *c, amscr_contour 
                     die("height functions");
                 amscr__hf_free(&b[f]);
             }
-        double t3 = cpu();
+        double t3 = cpu_now();
         ms[0][k] = 1e3 * (t1 - t0);
         ms[1][k] = 1e3 * (t2 - t1) / (double)m + 0.0 * acc;
         ms[2][k] = 1e3 * (t3 - t2) / 16.0;
@@ -357,59 +199,27 @@ static void query_parts(const amscr_params *p, const prepared *c, amscr_contour 
         amscr_descriptor_free(dq);
     }
     for (int r = 0; r < 3; r++) {
-        for (size_t a = 1; a < nq; a++) /* insertion sort */
-            for (size_t z = a; z > 0 && ms[r][z - 1] > ms[r][z]; z--) {
-                double x = ms[r][z];
-                ms[r][z] = ms[r][z - 1];
-                ms[r][z - 1] = x;
-            }
+        qsort(ms[r], nq, sizeof ms[r][0], cmp_double);
         t[r] = nq ? ms[r][nq / 2] : 0.0;
     }
     amscr__hf_ws_free(&ws);
     free(cand);
     free(sd);
-    free(qs);
 }
 
 static void print_times(const char *name, const amscr_params *p, const prepared *c, const shape_set *qs)
 {
-    for (int v = 0; v < NVAR; v++) {
-        double t[3];
-        query_parts(p, c, qs->c, qs->n, v, t);
-        printf("| %s | time | %s: query ms (stored height functions / built per candidate); fixed %.2f ms, "
-               "%.1f + %.1f us per candidate |", name, VARS[v].name, t[0], 1e3 * t[1], 1e3 * t[2]);
-        for (int m = 0; m < NM; m++)
-            printf(" %.1f / %.0f |", t[0] + (double)MS[m] * t[1], t[0] + (double)MS[m] * (t[1] + t[2]));
-        printf("\n");
-    }
+    double t[3];
+    query_parts(p, c, qs->c, qs->n, t);
+    printf("| %s | time | %s: query ms (stored height functions / built per candidate); fixed %.2f ms, "
+           "%.1f + %.1f us per candidate |", name, SIG_NAME, t[0], 1e3 * t[1], 1e3 * t[2]);
+    for (int m = 0; m < NM; m++)
+        printf(" %.1f / %.0f |", t[0] + (double)MS[m] * t[1], t[0] + (double)MS[m] * (t[1] + t[2]));
+    printf("\n");
 }
 
-/* ------------------------------------------------------------ collections and folds */
-
-/* The fold ('A', 'B', or 0) of every class of col, from folds.tsv. */
-static char *class_folds(const char *folds_path, const collection *col)
-{
-    char *fold = calloc(col->nclasses ? col->nclasses : 1, 1), line[512];
-    FILE *f = fopen(folds_path, "r");
-    if (!fold || !f) {
-        fprintf(stderr, "amscr-signature-recall: cannot read %s\n", folds_path);
-        exit(1);
-    }
-    while (fgets(line, sizeof line, f)) {
-        char *tab = strchr(line, '\t');
-        if (!tab)
-            continue;
-        *tab = '\0';
-        for (size_t k = 0; k < col->nclasses; k++)
-            if (strcmp(col->classes[k], line) == 0)
-                fold[k] = tab[1];
-    }
-    fclose(f);
-    return fold;
-}
-
-/* nq random affine copies of shapes of s whose class is in fold `which`. */
-static void make_queries(const shape_set *s, const char *fold, char which, size_t nq, unsigned long long seed,
+/* nq random affine copies of shapes of s whose class is in fold `which` (0 A, 1 B). */
+static void make_queries(const shape_set *s, const int32_t *fold, int which, size_t nq, unsigned long long seed,
                          shape_set *q)
 {
     size_t *pool = xmalloc(s->n * sizeof *pool), np = 0;
@@ -423,7 +233,8 @@ static void make_queries(const shape_set *s, const char *fold, char which, size_
     q->labels = xmalloc(nq * sizeof *q->labels);
     for (size_t k = 0; k < nq; k++) {
         size_t i = pool[(size_t)(warp_urand(&seed) * (double)np) % np];
-        q->c[k] = warp(s->c[i], &seed);
+        if (!(q->c[k] = warp_affine(s->c[i], &seed)))
+            die("affine copy");
         q->labels[k] = s->labels[i];
     }
     free(pool);
@@ -441,36 +252,29 @@ static void make_mixed(const shape_set *s, shape_set *out)
         if (amscr_contour_new(amscr_contour_xy(s->c[i]), amscr_contour_size(s->c[i]), &copy) != AMSCR_OK)
             die("copy");
         out->c[i] = copy;
-        out->c[s->n + i] = warp(s->c[i], &seed);
+        if (!(out->c[s->n + i] = warp_affine(s->c[i], &seed)))
+            die("affine copy");
         out->labels[i] = out->labels[s->n + i] = s->labels[i];
     }
 }
 
-static void print_rows(const char *set, char fold, const tally *t)
-{
-    for (int v = 0; v < NVAR; v++) {
-        printf("| %s | %c | %s |", set, fold, VARS[v].name);
-        for (int m = 0; m < NM; m++)
-            printf(" %.1f / %.0f |", 100.0 * (double)t->top[v][m] / (double)(TOP * t->nq),
-                   100.0 * (double)t->first[v][m] / (double)t->nq);
-        printf("\n");
-    }
-}
-
-static void run_set(const amscr_params *p, const char *name, const shape_set *s, const char *fold, size_t nq,
+static void run_set(const amscr_params *p, const char *name, const shape_set *s, const int32_t *fold, size_t nq,
                     int timing)
 {
     prepared c;
-    prepare_set(p, s->c, s->labels, s->n, &c);
-    set_medians(c.sig[NVAR - 1], c.n);
+    prepare_set(p, s->c, s->n, &c);
     for (char which = 'A'; which <= 'B'; which++) {
         shape_set qs;
-        make_queries(s, fold, which, nq, 0x9E3779B97F4A7C15ull + (unsigned long long)which, &qs);
+        make_queries(s, fold, which - 'A', nq, 0x9E3779B97F4A7C15ull + (unsigned long long)which, &qs);
         prepared q;
-        prepare_set(p, qs.c, qs.labels, qs.n, &q);
+        prepare_set(p, qs.c, qs.n, &q);
         tally t;
         recall(p, &c, &q, &t);
-        print_rows(name, which, &t);
+        printf("| %s | %c | %s |", name, which, SIG_NAME);
+        for (int m = 0; m < NM; m++)
+            printf(" %.1f / %.0f |", 100.0 * (double)t.top[m] / (double)(TOP * t.nq),
+                   100.0 * (double)t.first[m] / (double)t.nq);
+        printf("\n");
         fflush(stdout);
         if (timing && which == 'A')
             print_times(name, p, &c, &qs);
@@ -487,18 +291,16 @@ int main(int argc, char **argv)
         return 2;
     }
     size_t nq = argc == 3 ? (size_t)strtoul(argv[2], NULL, 10) : 100;
-    char manifest[4096], folds[4096];
+    char manifest[4096];
     snprintf(manifest, sizeof manifest, "%s/mpeg7-dev/manifest.tsv", argv[1]);
-    snprintf(folds, sizeof folds, "%s/mpeg7-dev/folds.tsv", argv[1]);
-    collection col;
     shape_set base, mixed, synth;
     amscr_params *p = NULL;
-    if (collection_open(manifest, &col) != 0 || shape_set_load(manifest, &base) != 0 ||
-        shape_set_mcd(manifest, MCD_SEED, &synth) != 0)
+    int32_t fold[256];
+    if (shape_set_load(manifest, &base) != 0 || shape_set_mcd(manifest, MCD_SEED, &synth) != 0 ||
+        folds_tsv_read(manifest, fold, 256) != 0)
         return 77;
     if (amscr_params_new_retrieval(&p) != AMSCR_OK || amscr_params_set_num_threads(p, 1) != AMSCR_OK)
         die("params");
-    char *fold = class_folds(folds, &col);
     make_mixed(&base, &mixed);
     printf("Shortlist recall: %% of the exact top %d inside the M signature-nearest / %% of queries whose exact "
            "first hit is inside; %zu affine queries per fold\n\n", TOP, nq);
@@ -506,19 +308,12 @@ int main(int argc, char **argv)
     for (int m = 0; m < NM; m++)
         printf(" M = %zu |", MS[m]);
     printf("\n|---|---|---|---|---|---|---|---|\n");
-    const char *only = getenv("SIG_ONLY"); /* a set's first letter: m(peg7), s(ynthetic), x (mixed) */
-    int timing = getenv("SIG_NO_TIMING") == NULL;
-    if (!only || *only == 'm')
-        run_set(p, "mpeg7-dev (700)", &base, fold, nq, 0);
-    if (!only || *only == 's')
-        run_set(p, "synthetic affine (490)", &synth, fold, nq, 0);
-    if (!only || *only == 'x')
-        run_set(p, "mpeg7-dev + affine copies (1400)", &mixed, fold, nq, timing);
-    free(fold);
+    run_set(p, "mpeg7-dev (700)", &base, fold, nq, 0);
+    run_set(p, "synthetic affine (490)", &synth, fold, nq, 0);
+    run_set(p, "mpeg7-dev + affine copies (1400)", &mixed, fold, nq, 1);
     amscr_params_free(p);
     shape_set_free(&base);
     shape_set_free(&mixed);
     shape_set_free(&synth);
-    collection_free(&col);
     return 0;
 }

@@ -98,7 +98,7 @@ extern "C" {
 
 /** Compile-time version; amscr_version_number() gives the runtime one. */
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 13
+#define AMSCR_VERSION_MINOR 14
 #define AMSCR_VERSION_PATCH 0
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
@@ -3275,11 +3275,13 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_precision_recall(const double
  * An index split in shards: what amscr.distributed builds on (docs/collections.md,
  * "An index in shards"). A collection of n shapes is cut into contiguous blocks; each block is an
  * ordinary index (a shard, whose shapes carry their features); the whole collection's neighbour
- * lists are computed from amscr_index_pair_distances over every pair of blocks and held, without
- * any shape, by an amscr_index_graph. A query's distances to every shard's shapes
- * (amscr_index_pair_distances with qpos SIZE_MAX), given to amscr_index_graph_scores, are the
- * scores of the single index of the whole collection built with candidates 0 and queried with
- * candidates 0 (to rounding), for a channel weight of 0 or 1.
+ * lists are computed from amscr_index_pair_distances over every pair of blocks (or, for a
+ * shortlist build, from amscr_index_pair_distances_at over the pairs of the global signature
+ * shortlists, amscr_signature_shortlists) and held, without any shape, by an amscr_index_graph.
+ * A query's distances to every shard's shapes (amscr_index_pair_distances with qpos SIZE_MAX),
+ * given to amscr_index_graph_scores, are the scores of the single index of the whole collection
+ * built with candidates 0 and queried with candidates 0 (to rounding), for a channel weight of 0
+ * or 1; the same holds with a shortlist M for build and query alike.
  * ============================================================================ */
 
 /** The neighbour lists of a whole collection without its shapes, and its largest distances:
@@ -3368,6 +3370,25 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_graph_scores(const amscr_inde
                                                                 double *out_scores, size_t n);
 
 /**
+ * @brief The scores of shape i of the graph's collection as the query (the member rule:
+ *        amscr_index_member_scores of the single index): its base distances dq to candidates
+ *        cand[0..m-1] (strictly ascending, i left out; every other shape, or its M
+ *        signature-nearest for candidates M), each computed as the pair's cell
+ *        (amscr_index_pair_distances_at with qpos i relative to each shard: SIZE_MAX for a shard
+ *        before i's, 0 after, i's own index in its shard).
+ * @param[out] out_scores  n scores (its own 0).
+ * @param[in]  n  must equal the graph's size.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, i or n, candidates not ascending, out of range or
+ *         i, a distance not finite and >= 0); AMSCR_E_NOMEM.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_graph_member_scores(const amscr_index_graph *g, size_t i,
+                                                                       const size_t *cand, const double *dq, size_t m,
+                                                                       double *out_scores, size_t n);
+
+/**
  * @brief The graph's number of shapes.
  * @return n; 0 for NULL.
  * Ownership: none.
@@ -3384,6 +3405,92 @@ AMSCR_API size_t amscr_index_graph_size(const amscr_index_graph *g);
  * @since 0.14
  */
 AMSCR_API void amscr_index_graph_free(amscr_index_graph *g);
+
+/**
+ * @brief The base and inner distances of q to the chosen shapes cand[0..m-1] of x (a shard),
+ *        each pair computed as amscr_index_pair_distances computes it (qpos as there): the
+ *        pairs of a shortlist build in shards.
+ * @param[in]  cand  m shape indices of x, strictly ascending.
+ * @param[out] out_base, out_inner  m distances each; either may be NULL (not computed), not
+ *                                  both when m > 0; inner zeros when the params give the inner
+ *                                  graph no share.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, cand not ascending or out of range, incompatible
+ *         params); AMSCR_E_NOMEM.
+ * Cost: m pair distances on the params' threads.
+ * Ownership: none.
+ * Thread-safety: const on x.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_pair_distances_at(const amscr_index *x, const amscr_descriptor *q,
+                                                                     size_t qpos, const size_t *cand, size_t m,
+                                                                     double *out_base, double *out_inner);
+
+/**
+ * @brief The floats of one shape signature (the compact summary whose distances choose an
+ *        index's shortlists; amscr_index_signatures, amscr_shape_signature).
+ * @return the count (fixed for a library version).
+ * Ownership: none.
+ * Thread-safety: pure.
+ * @since 0.14
+ */
+AMSCR_API size_t amscr_signature_size(void);
+
+/**
+ * @brief The stored signatures of x's shapes, in order (amscr_signature_size() floats each).
+ * @param[out] out  n floats.
+ * @param[in]  n  must equal amscr_index_size(x) * amscr_signature_size().
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n).
+ * Ownership: none.
+ * Thread-safety: const on x.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_signatures(const amscr_index *x, float *out, size_t n);
+
+/**
+ * @brief A prepared shape's signature, as an index computes a query's or a member's.
+ * @param[out] out  n floats.
+ * @param[in]  n  must equal amscr_signature_size().
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n).
+ * Ownership: none.
+ * Thread-safety: const on q.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_shape_signature(const amscr_descriptor *q, float *out, size_t n);
+
+/**
+ * @brief The shortlist width M' an index of n shapes built with `candidates` (amscr_index_build)
+ *        seeks each shape's neighbours in: 0 when that build matches every pair (candidates 0
+ *        or >= n - 1), else at most the build's cap (192) and at least K - 1.
+ * @param[in] p  the collection's params (NULL gives 0).
+ * @return M' or 0; never fails.
+ * Ownership: none.
+ * Thread-safety: pure.
+ * @since 0.14
+ */
+AMSCR_API size_t amscr_index_build_shortlist(const amscr_params *p, size_t n, size_t candidates);
+
+/**
+ * @brief Shortlists by signature: for each query r (signature qsigs + r * amscr_signature_size()),
+ *        the m shapes of sigs (n signatures) whose signatures are nearest, by (distance, index),
+ *        ascending by index, leaving out shape first + r (first SIZE_MAX: none left out, e.g. a
+ *        new query); exactly the shortlists of amscr_index_build and amscr_index_query_scores
+ *        (below the 20,000 shapes from which a build finds them through a coarse quantizer).
+ * @param[in]  sigs  n signatures (amscr_index_signatures of the shards, concatenated).
+ * @param[in]  qsigs  nq signatures (a block of sigs for a build's rows, first its first shape).
+ * @param[in]  m  1 .. n (n - 1 when first is not SIZE_MAX).
+ * @param[in]  threads  as amscr_params_set_num_threads (0: every core).
+ * @param[out] out  nq x m shape indices.
+ * @param[in]  out_len  must equal nq * m.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, m, first, out_len, a signature not finite);
+ *         AMSCR_E_NOMEM.
+ * Cost: O(nq n) signature bounds, then a few full signature distances a query.
+ * Ownership: none.
+ * Thread-safety: safe.
+ * @since 0.14
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_signature_shortlists(const float *sigs, size_t n, const float *qsigs,
+                                                                  size_t nq, size_t first, size_t m, unsigned threads,
+                                                                  size_t *out, size_t out_len);
 
 /**
  * @brief Re-ranks a whole distance matrix by affinity diffusion on a k-nearest-neighbour

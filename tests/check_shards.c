@@ -1,7 +1,8 @@
 /* check_shards.c — an index split in shards (amscr_index_pair_distances, amscr_index_graph_*):
  * lists merged from the pair distances of two blocks equal the single index's, and a query's
  * scores from its distances to the blocks equal amscr_index_query_scores with every shape a
- * candidate; bad lists and arguments are errors. */
+ * candidate, and a member's (the member rule) amscr_index_member_scores; the signatures and
+ * shortlists of a shortlist build in shards; bad lists and arguments are errors. */
 #include <amscr.h>
 #include <check.h>
 #include <math.h>
@@ -133,6 +134,22 @@ static void sharded_case(double share)
             ck_assert_double_eq_tol(got[j], want[j], 1e-9);
         amscr_descriptor_free(q);
     }
+    for (size_t i = 3; i < n; i += 15) { /* the member rule: shape i's row (3 in block 0, 18 in block 1) */
+        double dq[NSHAPES], got[NSHAPES], want[NSHAPES];
+        size_t mc[NSHAPES], m = 0;
+        for (size_t j = 0; j < n; j++)
+            if (j != i) {
+                mc[m] = j;
+                dq[m++] = D[i * n + j];
+            }
+        ck_assert_int_eq(amscr_index_graph_member_scores(g, i, mc, dq, m, got, n), AMSCR_OK);
+        ck_assert_int_eq(amscr_index_member_scores(x, i, 0, want, n), AMSCR_OK);
+        for (size_t j = 0; j < n; j++)
+            ck_assert_double_eq_tol(got[j], want[j], 1e-9);
+        ck_assert_int_eq(amscr_index_graph_member_scores(g, i, cand, dq, n, got, n), AMSCR_E_INVALID_ARG); /* i in */
+        ck_assert_int_eq(amscr_index_graph_member_scores(g, n, mc, dq, m, got, n), AMSCR_E_INVALID_ARG);
+        ck_assert_int_eq(amscr_index_graph_member_scores(g, i, mc, dq, m, got, n - 1), AMSCR_E_INVALID_ARG);
+    }
     amscr_index_graph_free(g);
     free(ni);
     free(nd);
@@ -153,6 +170,72 @@ START_TEST(two_blocks_inner) { sharded_case(0.1); }
 END_TEST
 
 START_TEST(two_blocks_one_graph) { sharded_case(0.0); }
+END_TEST
+
+/* amscr_index_pair_distances_at equals amscr_index_pair_distances on its shapes; the signatures
+ * of an index are its shapes' (amscr_shape_signature) and their shortlists those the index
+ * ranks by; bad arguments are errors. */
+START_TEST(shortlists_and_chosen_pairs)
+{
+    amscr_params *p = params_of(0.1);
+    amscr_db *db = db_of(p, 0, NSHAPES);
+    amscr_index *x = NULL;
+    ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
+    size_t d = amscr_signature_size(), n = NSHAPES;
+    ck_assert_uint_gt(d, 0);
+    float *sigs = malloc(n * d * sizeof *sigs), *one = malloc(d * sizeof *one);
+    ck_assert_ptr_nonnull(sigs);
+    ck_assert_ptr_nonnull(one);
+    ck_assert_int_eq(amscr_index_signatures(x, sigs, n * d), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_signatures(x, sigs, n * d - 1), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_shape_signature(amscr_db_descriptor(db, 5), one, d), AMSCR_OK);
+    ck_assert_mem_eq(one, sigs + 5 * d, d * sizeof *one);
+    ck_assert_int_eq(amscr_shape_signature(amscr_db_descriptor(db, 5), one, d + 1), AMSCR_E_INVALID_ARG);
+    /* shape 5's 4 nearest, itself left out; as a new query (first SIZE_MAX) it is its own nearest */
+    size_t sl[4], sq[4];
+    ck_assert_int_eq(amscr_signature_shortlists(sigs, n, sigs + 5 * d, 1, 5, 4, 1, sl, 4), AMSCR_OK);
+    ck_assert_int_eq(amscr_signature_shortlists(sigs, n, sigs + 5 * d, 1, SIZE_MAX, 4, 2, sq, 4), AMSCR_OK);
+    int self = 0;
+    for (size_t t = 0; t < 4; t++) {
+        ck_assert(sl[t] != 5 && sl[t] < n && (t == 0 || sl[t] > sl[t - 1]));
+        self += sq[t] == 5;
+    }
+    ck_assert_int_eq(self, 1);
+    ck_assert_int_eq(amscr_signature_shortlists(sigs, n, sigs, 1, 0, n, 1, sl, n), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_signature_shortlists(sigs, n, sigs, 1, 0, 4, 1, sl, 3), AMSCR_E_INVALID_ARG);
+    sigs[3] = NAN;
+    ck_assert_int_eq(amscr_signature_shortlists(sigs, n, sigs + 5 * d, 1, 5, 4, 1, sl, 4), AMSCR_E_INVALID_ARG);
+    /* the chosen pairs of shape 3 (as itself) equal its row's cells */
+    double all[NSHAPES], all2[NSHAPES], at[3], at2[3];
+    size_t cand[3] = {4, 9, 20};
+    const amscr_descriptor *q = amscr_db_descriptor(db, 3);
+    ck_assert_int_eq(amscr_index_pair_distances(x, q, 3, 4, all + 4, all2 + 4, n - 4), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_pair_distances_at(x, q, 3, cand, 3, at, at2), AMSCR_OK);
+    for (size_t t = 0; t < 3; t++) {
+        ck_assert_double_eq(at[t], all[cand[t]]);
+        ck_assert_double_eq(at2[t], all2[cand[t]]);
+    }
+    ck_assert_int_eq(amscr_index_pair_distances_at(x, q, 3, cand, 3, NULL, at2), AMSCR_OK);
+    ck_assert_double_eq(at2[2], all2[20]);
+    size_t bad[2] = {9, 4}, out_of[1] = {NSHAPES};
+    ck_assert_int_eq(amscr_index_pair_distances_at(x, q, 3, bad, 2, at, at2), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_index_pair_distances_at(x, q, 3, out_of, 1, at, at2), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_index_pair_distances_at(x, q, 3, cand, 3, NULL, NULL), AMSCR_E_INVALID_ARG);
+    /* the build's shortlist width: 0 for every pair, the cap 192, at least K - 1 */
+    size_t k = 0;
+    amscr_index_graph_widths(p, 5000, &k, NULL);
+    ck_assert_uint_eq(amscr_index_build_shortlist(p, 5000, 0), 0);
+    ck_assert_uint_eq(amscr_index_build_shortlist(p, 5000, 256), 192);
+    ck_assert_uint_eq(amscr_index_build_shortlist(p, 5000, 100), 100);
+    ck_assert_uint_eq(amscr_index_build_shortlist(p, 5000, 1), k - 1);
+    ck_assert_uint_eq(amscr_index_build_shortlist(p, 100, 256), 0);
+    ck_assert_uint_eq(amscr_index_build_shortlist(NULL, 5000, 256), 0);
+    free(sigs);
+    free(one);
+    amscr_index_free(x);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
 END_TEST
 
 START_TEST(bad_graphs)
@@ -218,6 +301,7 @@ Suite *amscr_suite_shards(void)
     tcase_add_test(tc, two_blocks_inner);
     tcase_add_test(tc, two_blocks_one_graph);
     tcase_add_test(tc, bad_graphs);
+    tcase_add_test(tc, shortlists_and_chosen_pairs);
     suite_add_tcase(s, tc);
     return s;
 }

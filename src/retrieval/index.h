@@ -11,6 +11,9 @@
 #include "rows.h"
 #include "signature.h"
 
+/* The shortlist a build seeks each shape's neighbours in (index_build.c tells why 192). */
+#define AMSCR__INDEX_BUILD_SHORTLIST 192
+
 struct amscr_index {
     amscr_db *db;         /* the collection (owned, unless db_borrowed) */
     int db_borrowed;      /* db is the caller's (a collection's kept index: retrieval_query.c) */

@@ -17,7 +17,7 @@ enum { MEDIAN_SAMPLE = 256 };
  * 256 without it (99.5 %), at 85 % of the build's CPU (160 kept 99.5 % but let an index query
  * keep only 98.8 % of the exact top 10; docs/measurements.md, "The index: build, query,
  * recall"). */
-enum { BUILD_SHORTLIST = 192 };
+enum { BUILD_SHORTLIST = AMSCR__INDEX_BUILD_SHORTLIST };
 /* From this many shapes a build finds the shortlists among the lists of a coarse quantizer
  * (signature.h) instead of scanning every shape's lower bound. */
 enum { IVF_MIN_SHAPES = 20000 };

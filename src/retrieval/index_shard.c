@@ -20,7 +20,8 @@ struct amscr_index_graph {
 typedef struct {
     const amscr_index *x;
     const amscr__inner *f;
-    size_t qpos, first;
+    size_t qpos;
+    const size_t *cand; /* the shapes of x matched, ascending */
     int refl;
     double *out;
 } inner_ctx;
@@ -47,13 +48,14 @@ static void inner_fini(void *scratch)
 static amscr_status inner_row(void *ctx, size_t j, void *scratch)
 {
     inner_ctx *c = ctx;
-    c->out[j - c->first] = j < c->qpos ? amscr__inner_distance(&c->x->inner[j], c->f, c->refl, scratch)
-                                       : amscr__inner_distance(c->f, &c->x->inner[j], c->refl, scratch);
+    size_t i = c->cand[j];
+    c->out[j] = i < c->qpos ? amscr__inner_distance(&c->x->inner[i], c->f, c->refl, scratch)
+                            : amscr__inner_distance(c->f, &c->x->inner[i], c->refl, scratch);
     return AMSCR_OK;
 }
 
-static amscr_status pair_inner(const amscr_index *x, const amscr_descriptor *q, size_t qpos, size_t first,
-                               double *out)
+static amscr_status pair_inner(const amscr_index *x, const amscr_descriptor *q, size_t qpos, const size_t *cand,
+                               size_t m, double *out)
 {
     amscr__inner_ws ws;
     amscr__inner *f = malloc(sizeof *f);
@@ -64,11 +66,31 @@ static amscr_status pair_inner(const amscr_index *x, const amscr_descriptor *q, 
     const amscr_params *p = amscr_db_params(x->db);
     amscr_status st = amscr__inner_build_shape(q, p->inner_closing, f, &ws);
     amscr__inner_ws_free(&ws);
-    inner_ctx c = {x, f, qpos, first, p->reflections, out};
+    inner_ctx c = {x, f, qpos, cand, p->reflections, out};
     amscr__rows_fn fn = {inner_init, inner_fini, inner_row, &c, "amscr_index_pair_distances"};
     if (st == AMSCR_OK)
-        st = amscr__run_rows(&fn, first, amscr_db_size(x->db), amscr__resolve_threads(p->num_threads), NULL, NULL);
+        st = amscr__run_rows(&fn, 0, m, amscr__resolve_threads(p->num_threads), NULL, NULL);
     free(f);
+    return st;
+}
+
+/* The base (out_base may be NULL) and inner distances of q to shapes cand[0..m-1] of x. */
+static amscr_status pairs_of(const amscr_index *x, const amscr_descriptor *q, size_t qpos, const size_t *cand,
+                             size_t m, double *out_base, double *out_inner)
+{
+    const amscr_params *p = amscr_db_params(x->db);
+    amscr_status st = AMSCR_OK;
+    if (out_base && m > 0) {
+        amscr__base b;
+        amscr__base_init(&b, p, x->med_a, x->med_h);
+        st = amscr__base_row(&b, x->db, x->hf, q, qpos, cand, m, NULL, NULL, out_base);
+    }
+    if (st == AMSCR_OK && out_inner) {
+        if (x->k2 > 0 && m > 0)
+            st = pair_inner(x, q, qpos, cand, m, out_inner);
+        else if (m > 0)
+            memset(out_inner, 0, m * sizeof *out_inner);
+    }
     return st;
 }
 
@@ -91,17 +113,115 @@ amscr_status amscr_index_pair_distances(const amscr_index *x, const amscr_descri
         return amscr__fail(AMSCR_E_NOMEM, "amscr_index_pair_distances: out of memory");
     for (size_t j = 0; j < n; j++)
         cand[j] = first + j;
-    amscr__base b;
-    amscr__base_init(&b, p, x->med_a, x->med_h);
-    amscr_status st = n > 0 ? amscr__base_row(&b, x->db, x->hf, q, qpos, cand, n, NULL, NULL, out_base) : AMSCR_OK;
+    amscr_status st = pairs_of(x, q, qpos, cand, n, out_base, out_inner);
     free(cand);
-    if (st == AMSCR_OK && out_inner) {
-        if (x->k2 > 0 && n > 0)
-            st = pair_inner(x, q, qpos, first, out_inner);
-        else if (n > 0)
-            memset(out_inner, 0, n * sizeof *out_inner);
-    }
     return st;
+}
+
+amscr_status amscr_index_pair_distances_at(const amscr_index *x, const amscr_descriptor *q, size_t qpos,
+                                           const size_t *cand, size_t m, double *out_base, double *out_inner)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    AMSCR_CHECK_NULL(q);
+    if (!amscr__params_compatible(amscr_db_params(x->db), &q->params, "amscr_index_pair_distances_at"))
+        return AMSCR_E_INVALID_ARG;
+    size_t size = amscr_db_size(x->db);
+    if (m > 0 && (!cand || (!out_base && !out_inner)))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_pair_distances_at: NULL shapes or outputs");
+    for (size_t t = 0; t < m; t++)
+        if (cand[t] >= size || (t > 0 && cand[t] <= cand[t - 1]))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_pair_distances_at: shape %zu (%zu) is not below "
+                                                    "%zu and above the one before", t, cand[t], size);
+    return pairs_of(x, q, qpos, cand, m, out_base, out_inner);
+}
+
+/* ------------------------------------------------ signatures and shortlists */
+
+size_t amscr_signature_size(void) { return AMSCR__SIG_DIM; }
+
+amscr_status amscr_index_signatures(const amscr_index *x, float *out, size_t n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    size_t size = amscr_db_size(x->db);
+    if (n != size * AMSCR__SIG_DIM || (n > 0 && (!out || !x->sig || x->sig_dim != AMSCR__SIG_DIM)))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_signatures: the output holds %zu floats, %zu shapes "
+                                                "need %zu", n, size, size * (size_t)AMSCR__SIG_DIM);
+    if (n > 0)
+        memcpy(out, x->sig, n * sizeof *out);
+    return AMSCR_OK;
+}
+
+amscr_status amscr_shape_signature(const amscr_descriptor *q, float *out, size_t n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(q);
+    AMSCR_CHECK_NULL(out);
+    if (n != AMSCR__SIG_DIM)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_shape_signature: the output holds %zu floats, a signature "
+                                                "%d", n, (int)AMSCR__SIG_DIM);
+    amscr__shape_signature(q, out);
+    return AMSCR_OK;
+}
+
+size_t amscr_index_build_shortlist(const amscr_params *p, size_t n, size_t candidates)
+{
+    size_t k = 0;
+    amscr_index_graph_widths(p, n, &k, NULL);
+    if (candidates > 0 && candidates + 1 < k)
+        candidates = k - 1;
+    if (!p || candidates == 0 || n <= 1 || candidates >= n - 1)
+        return 0;
+    size_t mb = candidates < AMSCR__INDEX_BUILD_SHORTLIST ? candidates : AMSCR__INDEX_BUILD_SHORTLIST;
+    return mb + 1 < k ? k - 1 : mb;
+}
+
+typedef struct {
+    const float *sigs, *lbs, *qsigs;
+    size_t n, first, m;
+    size_t *out;
+} near_ctx;
+
+static amscr_status near_row(void *ctx, size_t r, void *scratch)
+{
+    (void)scratch;
+    near_ctx *c = ctx;
+    float lb[AMSCR__SIG_LB_DIM];
+    const float *sig = c->qsigs + r * AMSCR__SIG_DIM;
+    amscr__sig_bound_vector(sig, lb);
+    size_t got = amscr__sig_nearest(c->sigs, c->lbs, c->n, sig, lb, c->m, c->first == SIZE_MAX ? SIZE_MAX : c->first + r,
+                                    c->out + r * c->m);
+    return got == c->m ? AMSCR_OK : AMSCR_E_NOMEM;
+}
+
+amscr_status amscr_signature_shortlists(const float *sigs, size_t n, const float *qsigs, size_t nq, size_t first,
+                                        size_t m, unsigned threads, size_t *out, size_t out_len)
+{
+    amscr__clear_error();
+    size_t avail = first == SIZE_MAX ? n : n - 1;
+    if ((n > 0 && !sigs) || (nq > 0 && (!qsigs || !out)) || (first != SIZE_MAX && (first > n || nq > n - first)) ||
+        m == 0 || m > avail || out_len != nq * m)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_signature_shortlists: %zu nearest of %zu signatures for %zu "
+                                                "queries from %zu, the output holds %zu", m, n, nq, first, out_len);
+    for (size_t t = 0; t < n * AMSCR__SIG_DIM; t++)
+        if (!isfinite(sigs[t]))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_signature_shortlists: signature %zu is not finite",
+                               t / AMSCR__SIG_DIM);
+    for (size_t t = 0; t < nq * AMSCR__SIG_DIM; t++)
+        if (!isfinite(qsigs[t]))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_signature_shortlists: query %zu is not finite",
+                               t / AMSCR__SIG_DIM);
+    float *lbs = amscr__malloc_array(n ? n : 1, AMSCR__SIG_LB_DIM * sizeof *lbs);
+    if (!lbs)
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_signature_shortlists: out of memory");
+    for (size_t j = 0; j < n; j++)
+        amscr__sig_bound_vector(sigs + j * AMSCR__SIG_DIM, lbs + j * AMSCR__SIG_LB_DIM);
+    near_ctx c = {sigs, lbs, qsigs, n, first, m, out};
+    amscr__rows_fn fn = {NULL, NULL, near_row, &c, "amscr_signature_shortlists"};
+    amscr_status st = amscr__run_rows(&fn, 0, nq, amscr__resolve_threads(threads), NULL, NULL);
+    free(lbs);
+    return st == AMSCR_E_NOMEM ? amscr__fail(AMSCR_E_NOMEM, "amscr_signature_shortlists: out of memory") : st;
 }
 
 void amscr_index_graph_widths(const amscr_params *p, size_t n, size_t *out_k, size_t *out_k2)
@@ -214,6 +334,31 @@ amscr_status amscr_index_graph_scores(const amscr_index_graph *g, const size_t *
                                                     "finite and >= 0", t);
     }
     return amscr__index_scores(x, size, cand, dq, x->k2 > 0 ? dq2 : NULL, m, out_scores);
+}
+
+amscr_status amscr_index_graph_member_scores(const amscr_index_graph *g, size_t i, const size_t *cand,
+                                             const double *dq, size_t m, double *out_scores, size_t n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(g);
+    AMSCR_CHECK_NULL(out_scores);
+    const amscr_index *x = g->x;
+    size_t size = amscr_db_size(x->db);
+    if (n != size || i >= size)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_member_scores: shape %zu, %zu scores, the graph "
+                                                "%zu shapes", i, n, size);
+    if (m > 0 && (!cand || !dq))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_member_scores: NULL candidates or distances");
+    for (size_t t = 0; t < m; t++) {
+        if (cand[t] >= size || cand[t] == i || (t > 0 && cand[t] <= cand[t - 1]))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_member_scores: candidate %zu (%zu) is not "
+                                                    "below %zu, above the one before and not the shape", t, cand[t],
+                               size);
+        if (!(dq[t] >= 0.0) || !isfinite(dq[t]))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_graph_member_scores: candidate %zu's distance is "
+                                                    "not finite and >= 0", t);
+    }
+    return amscr__index_scores(x, i, cand, dq, NULL, m, out_scores);
 }
 
 size_t amscr_index_graph_size(const amscr_index_graph *g) { return g ? amscr_db_size(g->x->db) : 0; }

@@ -2,9 +2,9 @@
 /* Regenerate with: python3 scripts/gen_cdef.py -o bindings/python/amscr/_cdef.h */
 
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 13
+#define AMSCR_VERSION_MINOR 14
 #define AMSCR_VERSION_PATCH 0
-#define AMSCR_VERSION_NUMBER 1300
+#define AMSCR_VERSION_NUMBER 1400
 #define AMSCR_MAX_IMAGE_SIDE 32768
 #define AMSCR_MAX_IMAGE_PIXELS 268435456
 #define AMSCR_MAX_POINTS 16777216
@@ -344,6 +344,13 @@ amscr_status amscr_index_pair_distances(const amscr_index *x, const amscr_descri
 void amscr_index_graph_widths(const amscr_params *p, size_t n, size_t *out_k, size_t *out_k2);
 amscr_status amscr_index_graph_new(const amscr_params *p, size_t n, const uint32_t *nb_idx, const double *nb_dist, const uint32_t *in_idx, const double *in_dist, double dmax, double dmax2, amscr_index_graph **out);
 amscr_status amscr_index_graph_scores(const amscr_index_graph *g, const size_t *cand, const double *dq, const double *dq2, size_t m, double *out_scores, size_t n);
+amscr_status amscr_index_graph_member_scores(const amscr_index_graph *g, size_t i, const size_t *cand, const double *dq, size_t m, double *out_scores, size_t n);
 size_t amscr_index_graph_size(const amscr_index_graph *g);
 void amscr_index_graph_free(amscr_index_graph *g);
+amscr_status amscr_index_pair_distances_at(const amscr_index *x, const amscr_descriptor *q, size_t qpos, const size_t *cand, size_t m, double *out_base, double *out_inner);
+size_t amscr_signature_size(void);
+amscr_status amscr_index_signatures(const amscr_index *x, float *out, size_t n);
+amscr_status amscr_shape_signature(const amscr_descriptor *q, float *out, size_t n);
+size_t amscr_index_build_shortlist(const amscr_params *p, size_t n, size_t candidates);
+amscr_status amscr_signature_shortlists(const float *sigs, size_t n, const float *qsigs, size_t nq, size_t first, size_t m, unsigned threads, size_t *out, size_t out_len);
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);

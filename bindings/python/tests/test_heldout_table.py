@@ -40,7 +40,7 @@ def test_heldout_condition_as_published(heldout, key):
         for d in range(2):
             rng = np.random.default_rng([14, ci, si, d])
             src, tgt, T, size, partial = bench.make_case(f, key, amount, rng)
-            M, r = bench.amscr_register(src, tgt, partial, 'partial')
+            M, r = bench.amscr_register(src, tgt, partial)
             err = bench.map_error(M, T, src, size) if M is not None else np.inf
             if err < 0.02:
                 ok += 1

@@ -1,6 +1,7 @@
 """amscr.distributed.build_index on a real LocalCluster (4 worker processes on loopback): an index
-split in shards answers as the single index (the top 10 of 2,000 procedural shapes, the scores to
-1e-9 with the inner distance's graph), a saved set loads back, a missing, foreign or differently
+split in shards answers as the single index (the top 10 of 2,000 procedural shapes with every pair,
+of 2,100 with the global signature shortlists, the scores to 1e-9 with the inner distance's graph),
+a saved set loads back, a missing, foreign or differently
 built shard is an error naming its file, a write cut off never replaces a good set, files follow
 the umask. Skipped without Dask."""
 import contextlib
@@ -68,6 +69,61 @@ def test_top10_equals_single_index_on_2000_shapes(client):
         same += np.array_equal(idx[i], ref_idx)
         np.testing.assert_allclose(sc[i], ref_sc, rtol=0, atol=1e-9)
     assert same >= 0.99 * N_QUERIES
+
+
+def test_global_shortlists_equal_single_index_above_2000_shapes(client):
+    """Above 2,000 shapes both build with the default shortlist (256): each shape's candidates are
+    its signature-nearest of the whole collection, so the lists and a query's scores (candidates
+    256) are the single index's."""
+    n = N_LARGE + 100
+    params = amscr.Params.retrieval(points=POINTS, rerank_inner_share=0.0, threads=0)
+    coll = _collection(params, _shapes(n, 0))
+    single = amscr.Index(coll)
+    sx = ad.build_index(client, coll)
+    assert sx.candidates == 256 and len(sx.bounds) == 4
+    assert sx.pairs < n * (n - 1) // 2 // 4  # not every pair: about n (192 + K^2) / 2
+    qs = _queries(N_QUERIES)
+    idx, sc = sx.query_many(qs, 10)
+    same = 0
+    for i, q in enumerate(qs):
+        ref_idx, ref_sc = single.query(q, 10, candidates=256)
+        same += np.array_equal(idx[i], ref_idx)
+        np.testing.assert_allclose(sc[i], ref_sc, rtol=0, atol=1e-9)
+    assert same >= 0.99 * N_QUERIES
+    # every shape a candidate on the same lists
+    np.testing.assert_allclose(sx.scores(qs[0], candidates=0), single.scores(qs[0], candidates=0), rtol=0, atol=1e-9)
+
+
+def test_shortlist_build_with_the_inner_graph_member_rule_saved_and_loaded(client, tmp_path):
+    params = amscr.Params.retrieval(points=POINTS, threads=1)
+    coll = _collection(params, _shapes(N_SMALL, 100))
+    single = amscr.Index(coll, candidates=40)
+    sx = ad.build_index(client, coll, shards=3, candidates=40)
+    assert sx.candidates == 40 and sx.pairs < N_SMALL * (N_SMALL - 1) // 2
+    qs = _queries(8, 9000)
+    S = sx.scores_many(qs)
+    for i, q in enumerate(qs):
+        ref = single.scores(q, candidates=40)
+        assert np.array_equal(np.isinf(S[i]), np.isinf(ref))
+        np.testing.assert_allclose(S[i][np.isfinite(ref)], ref[np.isfinite(ref)], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(sx.scores(qs[0], candidates=0), single.scores(qs[0], candidates=0), rtol=0, atol=1e-9)
+    # the member rule: a member's copy is scored as that member (the lowest index of copies: 159 is 21's)
+    shapes = _shapes(N_SMALL, 100)
+    members = [shapes[i] for i in (0, 57, 100, 159)]
+    assert [single.find_member(q) for q in members] == [0, 57, 100, 21]
+    for m in (40, 0):
+        Sm = sx.scores_many(members, candidates=m)
+        for i, q in enumerate(members):
+            ref = single.scores(q, candidates=m)
+            assert np.array_equal(np.isinf(Sm[i]), np.isinf(ref))
+            np.testing.assert_allclose(Sm[i][np.isfinite(ref)], ref[np.isfinite(ref)], rtol=0, atol=1e-9)
+        assert Sm[3][21] == 0.0  # its own score
+    sx.save(tmp_path / 'set')
+    loaded = ad.load_index(client, tmp_path / 'set')
+    assert loaded.candidates == 40
+    np.testing.assert_array_equal(loaded.scores_many(qs[:3]), S[:3])
+    with pytest.raises(amscr.InvalidArgumentError, match='candidates'):
+        ad.build_index(client, coll, candidates=-1)
 
 
 def test_scores_equal_with_the_inner_graph(small):
