@@ -41,6 +41,12 @@
 #define PART_HINT 3
 #define PART_TRIM 0.9
 #define PART_ITERS 20
+/* A placement whose refinement changed the map's area (|det|) by more than this factor, or its
+ * sign, has collapsed the fragment onto a straight or flat piece of the target (a tiny one-way
+ * cost, the wrong place): it wins only when every placement did (measured on the fragments of
+ * bench/registration_heldout.py --sets: the right placements change by at most ~15 %, the
+ * collapsed ones by 10-1000x). As the polish's MAX_AREA_CHANGE. */
+#define PART_AREA_CHANGE 2.0
 
 typedef struct {
     size_t s;  /* start index in the uniform target */
@@ -180,6 +186,13 @@ static double refine_placement(const amscr_params *prm, const amscr_descriptor *
     return cost;
 }
 
+/* Whether the refined map X kept the area of the search's fit X0 (within PART_AREA_CHANGE). */
+static int kept_area(const double X0[6], const double X[6])
+{
+    double ratio = (X[0] * X[4] - X[1] * X[3]) / (X0[0] * X0[4] - X0[1] * X0[3]);
+    return ratio >= 1.0 / PART_AREA_CHANGE && ratio <= PART_AREA_CHANGE;
+}
+
 /* Partners (dense target edges) of the samples under placement pl: sample a at fragment
  * position u_a -> uniform target index s ± phi U u_a -> its dense edge. */
 static void initial_partners(const placement *pl, const double *cumF, double LF, const double *Hp, size_t n,
@@ -296,14 +309,21 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
     size_t nd = amscr__densify(h->base, n, 1, Hd);
     amscr__closed_edges(Hd, nd, E);
     size_t win = 0;
+    int kept[PART_KEEP], any_kept = 0;
     double cut = 0.0;
     for (size_t c = 0; c < nb; c++) {
         memcpy(best[c].X0, best[c].X, sizeof best[c].X0);
         initial_partners(&best[c], cumF, LF, Hp, n, nd, b);
         best[c].tcost = refine_placement(prm, f, Hd, E, nd, best[c].X, b, q, r2, sorted, &cut);
-        if (best[c].tcost < best[win].tcost)
-            win = c;
+        kept[c] = kept_area(best[c].X0, best[c].X);
+        any_kept |= kept[c];
     }
+    for (size_t c = 1; c < nb; c++) /* the lowest cost among the placements that kept their area */
+        if ((kept[c] || !any_kept) && (!(kept[win] || !any_kept) || best[c].tcost < best[win].tcost))
+            win = c;
+    for (size_t c = 0; c < nb && any_kept; c++) /* a collapsed placement is no alternative either */
+        if (!kept[c])
+            best[c].tcost = INFINITY;
     if (nb == 0) {
         free(buf);
         free(b);
