@@ -41,9 +41,12 @@
  * maps that score alike (in the search's ranking or the polish's), the further minima are ranked
  * too (shift_search.c), so that a shape with more symmetries than three (a square's four quarter
  * turns, a regular star's fifths) lists each as an alternative — up to AMSCR__CANDIDATES_MAX per
- * orientation (a 12-fold symmetry); they never become the reported map. */
+ * orientation (a 12-fold symmetry). One of them becomes the reported map only when it scores
+ * clearly better than the best of the lowest three: its cost below AMSCR__HELD_WIN times theirs (a near-symmetric shape whose right turn the criterion ranks
+ * fourth or later, measured on bench/registration_heldout.py --sets). */
 #define AMSCR__CANDIDATES 3
 #define AMSCR__CANDIDATES_MAX 12
+#define AMSCR__HELD_WIN 0.5
 
 /* Per-stage timing, compiled only into the benchmark's copy of the library
  * (-DAMSCR_STAGE_TIMING): the product's hot path has no clock calls. */
@@ -217,6 +220,9 @@ amscr_status amscr__method_at(const amscr_params *prm, const amscr_descriptor *f
  * orientations ro, costs cost, winner best) are AMSCR__CANDIDATES distinct maps that all score
  * about as well as the winner, by the alternatives' tests: a shape with three or more
  * symmetries, which may have more (its further minima are then ranked too). */
+/* Whether a further minimum of cost `cost` beats the best of the lowest minima (cost `best`):
+ * AMSCR__HELD_WIN. */
+int amscr__held_wins(double cost, double best);
 int amscr__lowest_alike(const amscr_descriptor *f, double X[][6], const int *ro, const double *cost, size_t nbase,
                         size_t best, int o);
 /* The further minima of orientation o the search held back, scored as the ranked ones were

@@ -441,7 +441,11 @@ static size_t rank_starts(amscr__polish_state *ps, double S[][6], double Y[][6],
         if (may_win[k] && cost[k] < (best < count ? cost[best] : INFINITY))
             best = k;
     }
-    return best;
+    size_t held = best; /* a further minimum wins only when clearly better (AMSCR__HELD_WIN) */
+    for (size_t k = 0; k < count && best < count; k++)
+        if (!may_win[k] && amscr__held_wins(cost[k], cost[best]) && cost[k] < cost[held])
+            held = k;
+    return held;
 }
 
 /* Polishes the winner on; returns whether it finished (ps->Y then holds it). */
@@ -532,6 +536,18 @@ amscr_status amscr__polish_rank_more(amscr__polish_state *ps, double X[][6], siz
             double r = (m->rank_cost[best] + AMSCR__AMBIGUITY_FLOOR) / (cost + AMSCR__AMBIGUITY_FLOOR);
             m->ambiguity = r > m->ambiguity ? (r > 1.0 ? 1.0 : r) : m->ambiguity;
         }
+        if (amscr__held_wins(cost, m->rank_cost[best]) &&
+            polish_one(&ps->w, Y, POLISH_ITERS - SCORE_ITERS) < INFINITY) { /* clearly better: it wins */
+            best = m->nrank - 1;
+            memcpy(ps->Y, Y, sizeof ps->Y);
+            from_frames(&ps->w, ps->f, ps->h, Y, S);
+            memcpy(m->X, S, sizeof m->X);
+            m->reflected = o;
+        }
+    }
+    if (best != m->rank_best) {
+        m->rank_best = best;
+        m->ambiguity = amscr__polished_ambiguity(ps->f, m->rank_X, m->rank_cost, m->nrank, best);
     }
     return ps->w.nomem ? amscr__fail(AMSCR_E_NOMEM, "registration polish: out of memory") : AMSCR_OK;
 }

@@ -368,10 +368,16 @@ static amscr_status score_starts(const amscr_params *prm, const amscr_descriptor
         s->dist[i] = dist;
         /* the one ranking rule: lower score, then lower distance, then the earlier candidate */
         double bs = s->score[s->best], bd = s->dist[s->best];
-        if (i == 0 || (i < s->nbase && (score < bs || (score == bs && dist < bd))))
+        if (i == 0 || (i < s->nbase && (score < bs || (score == bs && dist < bd))) ||
+            (i >= s->nbase && amscr__held_wins(score, bs)))
             s->best = i;
     }
     return AMSCR_OK;
+}
+
+int amscr__held_wins(double cost, double best)
+{
+    return cost < AMSCR__HELD_WIN * best;
 }
 
 /* The held further minima of orientation o refined to a continuous shift (its criterion
