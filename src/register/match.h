@@ -46,7 +46,7 @@
  * fourth or later, measured on bench/registration_heldout.py --sets). */
 #define AMSCR__CANDIDATES 3
 #define AMSCR__CANDIDATES_MAX 12
-#define AMSCR__HELD_WIN 0.5
+#define AMSCR__HELD_WIN 0.9
 
 /* Per-stage timing, compiled only into the benchmark's copy of the library
  * (-DAMSCR_STAGE_TIMING): the product's hot path has no clock calls. */
