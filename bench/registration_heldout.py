@@ -20,10 +20,11 @@ masks, from 8 starting rotations (centroid and area matched), the best correlati
 procedural silhouettes (bindings/python/tests/shapegen.py, set 1, 200 px, traced the same way) side
 by side: ok % under the max rule above and under the check's rule (RMS of the error over the
 source's points < 2 % of the size), and wrong + confident (an RMS failure with confidence >= 0.25).
---stages NAME,... switches optional stages on (order, even_spacing, ...).
+--stages NAME,... switches optional stages on (order, even_spacing, ...); --reversed gives the
+fragments' points in the other order (against the target's way round).
 
 Usage: nice python3 bench/registration_heldout.py [--data DIR] [--ecc] [--draws 2] [--stray F] [--only KEYS]
-       [--sets A,B,P] [--stages NAMES]
+       [--sets A,B,P] [--stages NAMES] [--reversed]
 Deterministic: every draw is seeded by (condition, class index, draw); procedural shape i has index 1000 + i.
 """
 import argparse
@@ -261,6 +262,8 @@ def sets_table(args, conds):
             for d in range(args.draws):
                 rng = np.random.default_rng([14, ci, si, d])
                 src, tgt, T, size, partial = make_case(f, key, amount, rng)
+                if partial and args.reversed:
+                    src = src[::-1].copy()
                 t0 = time.perf_counter()
                 M, r = amscr_register(src, tgt, partial, stages)
                 ms = 1e3 * (time.perf_counter() - t0)
@@ -303,6 +306,7 @@ def main():
     ap.add_argument('--sets', help="comma-separated sets side by side: A, B (folds.tsv), P (procedural)")
     ap.add_argument('--stages', default='', help='comma-separated optional stages switched on (--sets)')
     ap.add_argument('--failures', action='store_true', help='list the RMS failures (--sets)')
+    ap.add_argument('--reversed', action='store_true', help="fragments given against the target's way (--sets)")
     args = ap.parse_args()
     if not os.path.exists(os.path.join(args.data, 'manifest.tsv')):
         print('no manifest in %s: skipped' % args.data)

@@ -301,9 +301,11 @@ double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const doub
 amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                   amscr_workspace *ws, match_t *m);
 /* The same with the fragment's share of the target's affine length searched from phi_min up (a
- * caller that knows the fragment is long: fewer placements to try). */
+ * caller that knows the fragment is long: fewer placements to try); either_way: the fragment's
+ * points may run either way along the target (the caller's fragment; 0: a piece of a prepared
+ * closed source, which runs the target's way). */
 amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                      double phi_min, amscr_workspace *ws, match_t *m);
+                                      double phi_min, int either_way, amscr_workspace *ws, match_t *m);
 
 /* polish.c: m's map polished on the input points the descriptors kept (f->raw, h->raw; a closed
  * target, affine invariance): the chosen map and the search's other distinct candidates,
