@@ -111,7 +111,7 @@ typedef struct {
     double cand[2 * AMSCR__CANDIDATES_MAX][6];
     int cand_o[2 * AMSCR__CANDIDATES_MAX]; /* their orientations */
     size_t ncand;
-    size_t ncand_base; /* the first ncand_base of cand may win (the rest: further minima, listed only) */
+    size_t ncand_base; /* the first ncand_base of cand may win (the rest: further minima, AMSCR__HELD_WIN) */
     /* the last ranking of distinct starts (the search's, or the polish's when it re-ranked):
      * their maps (normalized frames), orientations, ranking costs and the winner (nrank 0:
      * none); the first rank_nbase are the lowest minima (they may win), further minima follow */
@@ -320,7 +320,8 @@ amscr_status amscr__polish_fit(const amscr_descriptor *f, const amscr_descriptor
 int amscr__polish_reranked(const amscr__polish_state *ps);
 /* The polish's ranking in m extended by further starts of orientation o (X, n, normalized
  * frames): each that differs from every ranked map polished as the ranked starts were and
- * appended (never the winner); the ambiguity takes them in. AMSCR_E_NOMEM when out of memory. */
+ * appended; one clearly better than the winner (AMSCR__HELD_WIN) is polished on and becomes it
+ * (m->X, the polish's map for its later steps); the ambiguity takes them in. AMSCR_E_NOMEM when out of memory. */
 amscr_status amscr__polish_rank_more(amscr__polish_state *ps, double X[][6], size_t n, int o, match_t *m);
 /* Whether the order and even-spacing steps apply to the polished map (markedly noisier points,
  * no gap, not partial). */
@@ -332,8 +333,9 @@ amscr_status amscr__polish_even(amscr__polish_state *w, match_t *m);
 void amscr__polish_end(amscr__polish_state *w);
 /* polish_rank.c: the polish's start maps into S (normalized frames) with their orientations so:
  * m's chosen map first, then, when the search could not tell its candidates apart, each
- * candidate that differs from all before; may_win[k]: start k may become the reported map (the
- * search's further minima are ranked for the alternatives only). Returns their count. */
+ * candidate that differs from all before; may_win[k]: start k may become the reported map by
+ * the lowest cost (the search's further minima: only when clearly better, AMSCR__HELD_WIN).
+ * Returns their count. */
 size_t amscr__polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6], int *so,
                             unsigned char *may_win);
 /* The ambiguity of start `best` among the count polished starts S (costs cost): its cost over

@@ -21,8 +21,8 @@
  * When the start-point search could not tell its candidates apart, the other distinct
  * candidates are polished alike and ranked by a two-way trimmed cost, so a noisy
  * symmetric-looking shape gets the start the points favour (the search's further minima of a
- * shape with more than three symmetries are polished and ranked too, for the alternatives, but
- * never become the reported map; where the polished ranking finds an orientation's lowest starts
+ * shape with more than three symmetries are polished and ranked too, for the alternatives, and
+ * become the reported map only when clearly better, AMSCR__HELD_WIN; where the polished ranking finds an orientation's lowest starts
  * alike and the search did not, the stage asks the search for the further minima it held back and
  * ranks them the same way: amscr__polish_rank_more). When the rougher curve is markedly
  * the noisier, the winner is refined by the order of its points (ordered.c), then by their even

@@ -18,7 +18,8 @@
  *
  * One ranking rule picks the winner: the lowest score, ties broken by the lower distance, then
  * by the earlier candidate (orientations in order, each one's candidates best criterion first);
- * the further minima are scored and ranked alike (the alternatives, the ambiguity) but never win.
+ * the further minima are scored and ranked alike (the alternatives, the ambiguity) and win only
+ * when clearly better (AMSCR__HELD_WIN: below 0.9x the best score).
  * The score is the cheapest quantity that judges the start point (see score_start). The winner
  * gets the whole method and the refinement.
  */
@@ -346,7 +347,7 @@ static double ambiguity_of(const amscr_descriptor *f, const double X[][6], const
 
 /* Candidates from..s->count-1 scored (the cheap kinds need no run of the method) into s; the
  * winner by the one ranking rule among the first s->nbase (the further minima are ranked for the
- * alternatives and the ambiguity only: the reported map is the best of the lowest minima). */
+ * alternatives and the ambiguity, and win only when clearly better: amscr__held_wins). */
 static amscr_status score_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                  const double *crit, size_t from, amscr_workspace *ws, amscr__search *s)
 {
