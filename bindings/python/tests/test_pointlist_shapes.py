@@ -61,6 +61,21 @@ def test_procedural_fragments_of_70_percent():
     assert not failed, failed
 
 
+def test_fragment_points_in_either_order():
+    """An open fragment has no orientation of its own: given against the target's way round it
+    registers as well, with a map that keeps the orientation (before: 0 of 10, mirrored maps)."""
+    failed = []
+    for i in range(5):
+        f = amscr.contour_from_mask(shapegen.silhouette(1, i), subpixel=False)
+        for d in range(2):
+            src, tgt, T, size, _ = bench.make_case(f, 'frag70', 0.7, np.random.default_rng([14, 6, 1000 + i, d]))
+            r = amscr.register(src[::-1].copy(), tgt, partial=True)
+            err = bench.map_error(np.hstack([r.A, r.B[:, None]]), T, src, size, rms=True)
+            if err >= 0.02 or r.reflected or np.linalg.det(r.A) <= 0:
+                failed.append((i, d, round(100 * err, 1), r.reflected))
+    assert not failed, failed
+
+
 # Near-symmetric stars broken by a small harmonic (shapegen shapes 6 and 1): pairs whose right
 # turn the criterion ranked below its three lowest minima (shape 6: clean, 5 % missing, 1 %
 # noise), or which the ranking's trimmed cost could not tell from a wrong turn (shape 1, 1 %
