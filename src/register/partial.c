@@ -45,13 +45,14 @@
  * sign, has collapsed the fragment onto a straight or flat piece of the target (a tiny one-way
  * cost, the wrong place): it wins only when every placement did (measured on the fragments of
  * bench/registration_heldout.py --sets: the right placements change by at most ~15 %, the
- * collapsed ones by 10-1000x). As the polish's MAX_AREA_CHANGE. */
+ * collapsed ones by 10-1000x). As the polish's MAX_AREA_CHANGE. The caller's fragments only
+ * (either_way): on the recovery's pieces of a closed source it lost traced bite pairs. */
 #define PART_AREA_CHANGE 2.0
 
 typedef struct {
     size_t s;  /* start index in the uniform target */
     double phi;
-    int o;     /* 1: the target traversed backwards (mirror, reflections on) */
+    int o;     /* 1: the target traversed backwards (a mirror, or the fragment run the other way) */
     double cost;
     double X[6];  /* the search's fit, then the refined map */
     double X0[6]; /* the search's fit */
@@ -330,7 +331,7 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
         memcpy(best[c].X0, best[c].X, sizeof best[c].X0);
         initial_partners(&best[c], cumF, LF, Hp, n, nd, b);
         best[c].tcost = refine_placement(prm, f, Hd, E, nd, best[c].X, b, q, r2, sorted, &cut);
-        kept[c] = kept_area(best[c].X0, best[c].X);
+        kept[c] = !either_way || kept_area(best[c].X0, best[c].X);
         any_kept |= kept[c];
     }
     for (size_t c = 1; c < nb; c++) /* the lowest cost among the placements that kept their area */
