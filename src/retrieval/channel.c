@@ -77,14 +77,15 @@ static void heights(const double *P, size_t n, double locality, uint8_t *seq, do
     }
 }
 
-/* The kept frequencies of every bin column's DFT into spec (AMSCR__HF_SPEC(nfreq) values):
- * bin b's real parts at spec + 2 b P, its imaginary parts at spec + (2 b + 1) P, P =
- * AMSCR__HF_PAD(nfreq), the padding zero. */
-static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, float *spec, amscr__fft_plan *plan,
-                           double *z)
+/* The kept frequencies of every bin column's DFT into spec (AMSCR__HF_SPEC(nfreq) values, in
+ * units of *scale: the largest magnitude / AMSCR__HF_SPEC_Q, rounded to the nearest): bin b's
+ * real parts at spec + 2 b P, its imaginary parts at spec + (2 b + 1) P, P =
+ * AMSCR__HF_PAD(nfreq), the padding zero. tmp: AMSCR__HF_SPEC(nfreq) doubles. */
+static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, int16_t *spec, double *scale,
+                           amscr__fft_plan *plan, double *z, double *tmp)
 {
-    const size_t D = AMSCR__HF_BINS, P = AMSCR__HF_PAD(nfreq);
-    memset(spec, 0, AMSCR__HF_SPEC(nfreq) * sizeof *spec);
+    const size_t D = AMSCR__HF_BINS, P = AMSCR__HF_PAD(nfreq), S = AMSCR__HF_SPEC(nfreq);
+    memset(tmp, 0, S * sizeof *tmp);
     for (size_t b = 0; b < D; b++) {
         for (size_t i = 0; i < n; i++) {
             z[2 * i] = (double)seq[i * D + b] - 128.0;
@@ -92,9 +93,17 @@ static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, float *s
         }
         amscr__fft(plan, z, 0);
         for (size_t f = 0; f < nfreq; f++) {
-            spec[2 * b * P + f] = (float)z[2 * f];
-            spec[(2 * b + 1) * P + f] = (float)z[2 * f + 1];
+            tmp[2 * b * P + f] = z[2 * f];
+            tmp[(2 * b + 1) * P + f] = z[2 * f + 1];
         }
+    }
+    double top = 0.0;
+    for (size_t t = 0; t < S; t++)
+        top = fabs(tmp[t]) > top ? fabs(tmp[t]) : top;
+    *scale = top / AMSCR__HF_SPEC_Q;
+    for (size_t t = 0; t < S; t++) {
+        double q = top > 0.0 ? tmp[t] / *scale : 0.0;
+        spec[t] = (int16_t)(q > AMSCR__HF_SPEC_Q ? AMSCR__HF_SPEC_Q : q < -AMSCR__HF_SPEC_Q ? -AMSCR__HF_SPEC_Q : lround(q));
     }
     return AMSCR_OK;
 }
@@ -107,7 +116,8 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
         return amscr__fail(AMSCR_E_INVALID_ARG, "shape channel: N = %zu is below %zu", n, D + 1);
     out->n = n;
     out->nfreq = AMSCR__HF_FREQS(n) + 1;
-    double *mir = amscr__malloc_array(2 * n, sizeof *mir), *z = amscr__malloc_array(2 * n, sizeof *z);
+    double *mir = amscr__malloc_array(2 * n, sizeof *mir);
+    double *z = amscr__malloc_array(2 * n + AMSCR__HF_SPEC(out->nfreq), sizeof *z);
     double *acc = amscr__malloc_array(D, sizeof *acc);
     size_t *cnt = amscr__malloc_array(D, sizeof *cnt);
     amscr__fft_plan plan;
@@ -115,7 +125,7 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
     amscr_status st = AMSCR_OK;
     for (int o = 0; o < 2; o++) {
         out->seq[o] = amscr__malloc_array(n * D, sizeof(uint8_t));
-        out->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(out->nfreq), sizeof(float));
+        out->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(out->nfreq), sizeof(int16_t));
         if (!out->seq[o] || !out->spec[o])
             st = AMSCR_E_NOMEM;
     }
@@ -130,7 +140,7 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
         heights(base, n, locality, out->seq[0], acc, cnt);
         heights(mir, n, locality, out->seq[1], acc, cnt);
         for (int o = 0; o < 2; o++)
-            spectra(out->seq[o], n, out->nfreq, out->spec[o], &plan, z);
+            spectra(out->seq[o], n, out->nfreq, out->spec[o], &out->scale[o], &plan, z, z + 2 * n);
     }
     if (have_plan)
         amscr__fft_plan_free(&plan);
@@ -147,13 +157,15 @@ amscr_status amscr__hf_spectra(amscr__hf *h, amscr__hf_ws *ws)
 {
     amscr__fft_plan plan;
     int own = !ws || ws->n != h->n || !ws->have_plan;
-    double *z = own ? amscr__malloc_array(2 * h->n, sizeof *z) : ws->z;
+    double *z = own ? amscr__malloc_array(2 * h->n + AMSCR__HF_SPEC(h->nfreq), sizeof *z) : ws->z;
     int have_plan = own && amscr__fft_plan_init(&plan, h->n) == 0;
     amscr_status st = z && (have_plan || !own) ? AMSCR_OK : AMSCR_E_NOMEM;
     for (int o = 0; o < 2 && st == AMSCR_OK; o++) {
-        h->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(h->nfreq), sizeof(float));
+        if (h->spec[o] || !h->seq[o])
+            continue; /* kept, or an orientation not held */
+        h->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(h->nfreq), sizeof(int16_t));
         if (h->spec[o])
-            spectra(h->seq[o], h->n, h->nfreq, h->spec[o], own ? &plan : &ws->plan, z);
+            spectra(h->seq[o], h->n, h->nfreq, h->spec[o], &h->scale[o], own ? &plan : &ws->plan, z, z + 2 * h->n);
         else
             st = AMSCR_E_NOMEM;
     }
@@ -169,7 +181,7 @@ amscr_status amscr__hf_ws_init(amscr__hf_ws *ws, size_t n, size_t band)
     memset(ws, 0, sizeof *ws);
     size_t W = 2 * band + 1;
     ws->n = n;
-    ws->z = amscr__malloc_array(2 * n, sizeof *ws->z);
+    ws->z = amscr__malloc_array(2 * n + AMSCR__HF_SPEC(AMSCR__HF_FREQS(n) + 1), sizeof *ws->z); /* + spectra()'s */
     ws->acc = amscr__malloc_array(4 * (AMSCR__HF_FREQS(n) + 1), sizeof *ws->acc);
     ws->row = amscr__malloc_array(4 * W, sizeof *ws->row);
     ws->start = amscr__malloc_array(4 * W, sizeof *ws->start);
@@ -199,16 +211,18 @@ void amscr__hf_ws_free(amscr__hf_ws *ws)
 
 /* The low-passed cross-spectra conj(A) B summed over the bins, for orientation 0 of b and,
  * when `both`, orientation 1: acc[4 f + 2 o] real, acc[4 f + 2 o + 1] imaginary part. Four
- * frequencies at a time side by side (vector registers), each summed over the bins in order. */
+ * frequencies at a time side by side (vector registers), each summed over the bins in order:
+ * products of the int16 values, exact in double whatever the order, then scaled. */
 static void cross_spectra(const amscr__hf *a, const amscr__hf *b, int both, double *restrict acc)
 {
     const size_t D = AMSCR__HF_BINS, F = a->nfreq, P = AMSCR__HF_PAD(F);
+    const double sc[2] = {a->scale[0] * b->scale[0], a->scale[0] * b->scale[1]};
     for (size_t f0 = 0; f0 < F; f0 += 4) {
         double re[2][4] = {{0.0}}, im[2][4] = {{0.0}};
         for (size_t bin = 0; bin < D; bin++) {
-            const float *ar = a->spec[0] + 2 * bin * P + f0, *ai = ar + P;
+            const int16_t *ar = a->spec[0] + 2 * bin * P + f0, *ai = ar + P;
             for (int o = 0; o < (both ? 2 : 1); o++) {
-                const float *br = b->spec[o] + 2 * bin * P + f0, *bi = br + P;
+                const int16_t *br = b->spec[o] + 2 * bin * P + f0, *bi = br + P;
                 for (size_t t = 0; t < 4; t++) {
                     re[o][t] += (double)ar[t] * br[t] + (double)ai[t] * bi[t];
                     im[o][t] += (double)ar[t] * bi[t] - (double)ai[t] * br[t];
@@ -217,8 +231,8 @@ static void cross_spectra(const amscr__hf *a, const amscr__hf *b, int both, doub
         }
         for (size_t t = 0; t < 4 && f0 + t < F; t++)
             for (int o = 0; o < 2; o++) {
-                acc[4 * (f0 + t) + 2 * (size_t)o] = re[o][t];
-                acc[4 * (f0 + t) + 2 * (size_t)o + 1] = im[o][t];
+                acc[4 * (f0 + t) + 2 * (size_t)o] = re[o][t] * sc[o];
+                acc[4 * (f0 + t) + 2 * (size_t)o + 1] = im[o][t] * sc[o];
             }
     }
 }

@@ -26,9 +26,15 @@ typedef struct {
     size_t n;
     size_t nfreq;    /* frequencies kept of each bin's DFT: AMSCR__HF_FREQS(n) + 1 */
     uint8_t *seq[2]; /* n * AMSCR__HF_BINS, weighted heights, quantized: 128 + QUANT * h */
-    float *spec[2]; /* AMSCR__HF_SPEC(nfreq): per bin nfreq real parts, then imaginary, padded
-                     * (float32: the shift search's correlations, summed in double) */
+    int16_t *spec[2]; /* AMSCR__HF_SPEC(nfreq): per bin nfreq real parts, then imaginary, padded,
+                       * in units of scale[o] (amscr__hf_quantize: the shift search's correlations,
+                       * summed exactly in double, then scaled) */
+    double scale[2];
 } amscr__hf;
+
+/* The largest magnitude of an orientation's spectra held as this int16 (the scale is that
+ * magnitude / AMSCR__HF_SPEC_Q): a spectrum value is off by at most half a step. */
+#define AMSCR__HF_SPEC_Q 32767.0
 
 typedef struct {
     size_t band;           /* half width of the DP band, samples */
