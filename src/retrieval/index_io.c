@@ -110,15 +110,23 @@ static void write_inner(const amscr_index *x, uint32_t version, amscr__wbuf *w)
     }
     for (size_t i = 0; i < n; i++) {
         const amscr__inner *f = &x->inner[i];
-        if (version >= AMSCR__DB_VERSION_INDEX_F32) {
-            amscr__w_f32s(w, &f->re[0][0], fk);
-            amscr__w_f32s(w, &f->im[0][0], fk);
-        } else {
-            for (size_t j = 0; j < fk; j++)
-                amscr__w_f64(w, (&f->re[0][0])[j]);
-            for (size_t j = 0; j < fk; j++)
-                amscr__w_f64(w, (&f->im[0][0])[j]);
+        const int16_t *v = &f->re[0][0];
+        if (version >= AMSCR__DB_VERSION_INDEX_I16) {
+            amscr__w_f64(w, f->scale);
+            for (size_t j = 0; j < 2 * fk; j++) { /* re, then im */
+                uint16_t u = (uint16_t)v[j];
+                unsigned char b2[2] = {(unsigned char)(u & 0xff), (unsigned char)(u >> 8)};
+                amscr__w_bytes(w, b2, 2);
+            }
+            continue;
         }
+        for (size_t j = 0; j < 2 * fk; j++) /* the values as they are held: exact in float32 and f64 */
+            if (version >= AMSCR__DB_VERSION_INDEX_F32) {
+                float u = (float)(v[j] * f->scale);
+                amscr__w_f32s(w, &u, 1);
+            } else {
+                amscr__w_f64(w, v[j] * f->scale);
+            }
         amscr__w_f64(w, f->norm2);
     }
 }
@@ -298,25 +306,11 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
     return AMSCR_OK;
 }
 
-/* n finite doubles of a file before version 15 into floats (0 and r->bad: short, not finite or
- * beyond float's range). */
-static int read_f64_as_f32(amscr__rbuf *r, float *d, size_t n)
-{
-    for (size_t i = 0; i < n; i++) {
-        double v = 0.0;
-        if (!amscr__r_f64s(r, &v, 1) || !(fabs(v) <= FLT_MAX)) {
-            r->bad = 1;
-            return 0;
-        }
-        d[i] = (float)v;
-    }
-    return 1;
-}
-
-/* The inner distance's graph of a file of version 9 or later (its K2 must be the params'). */
+/* The inner distance's graph of a file of version 9 or later (its K2 must be the params'): the
+ * features of a file before version 16 (float32 or double values) rounded as a build rounds them. */
 static amscr_status read_inner(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
-    int f32 = version >= AMSCR__DB_VERSION_INDEX_F32;
+    int f32 = version >= AMSCR__DB_VERSION_INDEX_F32, i16 = version >= AMSCR__DB_VERSION_INDEX_I16;
     size_t n = amscr_db_size(x->db), fk = AMSCR__INNER_F * AMSCR__INNER_K;
     uint32_t k2 = amscr__r_u32(r);
     if (r->bad || k2 != x->k2)
@@ -327,25 +321,41 @@ static amscr_status read_inner(amscr__rbuf *r, amscr_index *x, uint32_t version)
     x->dmax2 = amscr__r_f64(r);
     if (r->bad || !(x->dmax2 >= 0.0) || !isfinite(x->dmax2))
         return amscr__fail(AMSCR_E_FORMAT, "index file: bad largest inner distance");
-    size_t per = 12 * (size_t)k2 + (f32 ? 4 : 8) * 2 * fk + 8;
+    size_t per = 12 * (size_t)k2 + (i16 ? 2 * 2 * fk + 8 : (f32 ? 4 : 8) * 2 * fk + 8);
     if ((r->len - r->pos) / per < n)
         return amscr__fail(AMSCR_E_FORMAT, "index file: the inner graph is truncated");
     amscr_status st = read_list(r, n, k2, x->in_idx, x->in_dist, "inner ");
-    amscr__inner_ws ws;
-    if (st != AMSCR_OK)
-        return st;
-    if (amscr__inner_ws_init(&ws) != AMSCR_OK)
-        return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
+    double(*v)[AMSCR__INNER_F][AMSCR__INNER_K] = malloc(2 * sizeof *v);
+    if (st == AMSCR_OK && !v)
+        st = amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
     for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
         amscr__inner *f = &x->inner[i];
-        int ok = f32 ? amscr__r_f32s(r, &f->re[0][0], fk) && amscr__r_f32s(r, &f->im[0][0], fk)
-                     : read_f64_as_f32(r, &f->re[0][0], fk) && read_f64_as_f32(r, &f->im[0][0], fk);
-        if (!ok || !amscr__r_f64s(r, &f->norm2, 1) || !(f->norm2 >= 0.0))
+        int ok = 1;
+        if (i16) {
+            double scale = amscr__r_f64(r), sum = 0.0;
+            int16_t *q = &f->re[0][0];
+            for (size_t j = 0; j < 2 * fk; j++, r->pos += 2)
+                q[j] = (int16_t)(uint16_t)(r->p[r->pos] | (unsigned)r->p[r->pos + 1] << 8);
+            for (size_t j = 0; j < 2 * fk; j++) /* the norm as a build computes it */
+                sum += ((j % fk) / AMSCR__INNER_K == 0 ? 1.0 : 2.0) * ((double)q[j] * q[j]);
+            ok = !r->bad && scale >= 0.0 && scale <= FLT_MAX;
+            f->scale = scale;
+            f->norm2 = sum * scale * scale / (double)AMSCR__INNER_N;
+        } else {
+            double *d = &v[0][0][0], norm2 = 0.0;
+            for (size_t j = 0; j < 2 * fk && ok; j++) {
+                float u = 0.0f;
+                ok = f32 ? amscr__r_f32s(r, &u, 1) : amscr__r_f64s(r, &d[j], 1);
+                if (f32)
+                    d[j] = u;
+                ok = ok && fabs(d[j]) <= FLT_MAX;
+            }
+            ok = ok && amscr__r_f64s(r, &norm2, 1) && norm2 >= 0.0 && amscr__inner_quantize(f, &v[0][0][0]);
+        }
+        if (!ok)
             st = amscr__fail(AMSCR_E_FORMAT, "index file: shape %zu's inner features are invalid", i);
-        else
-            amscr__inner_twist(f, &ws);
     }
-    amscr__inner_ws_free(&ws);
+    free(v);
     return st;
 }
 
