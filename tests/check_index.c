@@ -235,6 +235,8 @@ START_TEST(member_rows)
     amscr_index *x = NULL;
     ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
     ck_assert_int_eq(amscr_db_retrieval_matrix(amscr_index_db(x), NULL, NULL, M), AMSCR_OK);
+    /* an index keeps the forward orientation only: a member's row makes its candidates' mirror */
+    ck_assert(x->hf[0].seq[0] && x->hf[0].spec[0] && !x->hf[0].seq[1] && !x->hf[0].spec[1]);
     for (size_t i = 0; i < NSHAPES; i += 5) {
         ck_assert_int_eq(amscr_index_member_scores(x, i, 0, got, NSHAPES), AMSCR_OK);
         assert_close(M + i * NSHAPES, got, NSHAPES, 1e-12);
@@ -602,9 +604,9 @@ START_TEST(stored_features)
     amscr_index_free(y);
     y = NULL;
     remove(path);
-    /* two frames announced as one: refused */
+    /* two frames announced as one: refused (from format 16 the forward heights only) */
     unsigned char *b = buf;
-    size_t at = len - 8 - (12 + NSHAPES * 2 * 2 * 64 * AMSCR__HF_BINS + 4);
+    size_t at = len - 8 - (12 + NSHAPES * 2 * 64 * AMSCR__HF_BINS + 4);
     ck_assert_int_eq(b[at], 2);
     b[at] = 1;
     uint64_t h = amscr__db_checksum(4, b, len - 8);

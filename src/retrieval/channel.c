@@ -153,6 +153,29 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
     return st;
 }
 
+amscr_status amscr__hf_build_mirror(const double *base, size_t n, double locality, amscr__hf *h)
+{
+    const size_t D = AMSCR__HF_BINS;
+    double *mir = amscr__malloc_array(2 * n, sizeof *mir), *acc = amscr__malloc_array(D, sizeof *acc);
+    size_t *cnt = amscr__malloc_array(D, sizeof *cnt);
+    uint8_t *seq = amscr__malloc_array(n * D, sizeof *seq);
+    amscr_status st = mir && acc && cnt && seq ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
+    if (st == AMSCR_OK) { /* as amscr__hf_build makes it */
+        for (size_t i = 0; i < n; i++) {
+            mir[2 * i] = -base[2 * (n - 1 - i)];
+            mir[2 * i + 1] = base[2 * (n - 1 - i) + 1];
+        }
+        heights(mir, n, locality, seq, acc, cnt);
+        h->seq[1] = seq;
+        seq = NULL;
+    }
+    free(mir);
+    free(acc);
+    free(cnt);
+    free(seq);
+    return st;
+}
+
 amscr_status amscr__hf_spectra(amscr__hf *h, amscr__hf_ws *ws)
 {
     amscr__fft_plan plan;

@@ -60,7 +60,11 @@ struct amscr__hf_ws {
 amscr_status amscr__hf_build(const double *base, size_t n, double locality, amscr__hf *out);
 void amscr__hf_free(amscr__hf *h);
 typedef struct amscr__hf_ws amscr__hf_ws;
-/* The spectra of h (spec[0..1], allocated here; free with amscr__hf_free or free()) from its
+/* The mirrored heights of h (seq[1], allocated here) from its frame's points base: bit for bit
+ * amscr__hf_build's (an index keeps a shape's forward orientation only: the one a pair reads of
+ * its lower index; channel.h's pair calls read both of the higher). */
+amscr_status amscr__hf_build_mirror(const double *base, size_t n, double locality, amscr__hf *h);
+/* The spectra of h's orientations that have heights and no spectra yet (allocated here; free with amscr__hf_free or free()) from its
  * height sequences, n and nfreq: bit for bit amscr__hf_build's (an index file keeps the heights
  * only, index_io.c). ws (may be NULL): a pair scratch whose FFT plan is used when it fits. */
 amscr_status amscr__hf_spectra(amscr__hf *h, amscr__hf_ws *ws);
@@ -95,6 +99,10 @@ void amscr__mirror_upper(double *out, size_t n);
 /* The channel's sequences of a prepared shape in `frame`, with the settings of p. */
 amscr_status amscr__hf_of_descriptor(const amscr_params *p, amscr_invariance frame, const amscr_descriptor *d,
                                      amscr__hf *out);
+/* Its mirrored heights only, into h->seq[1] (amscr__hf_build_mirror; d may be a shallow
+ * descriptor: its input samples are all that is read). */
+amscr_status amscr__hf_mirror_of_descriptor(const amscr_params *p, amscr_invariance frame,
+                                            const amscr_descriptor *d, amscr__hf *h);
 /* The channel's pair settings from p for N samples. */
 void amscr__hf_cfg_from(const amscr_params *p, size_t n, int second, amscr__hf_cfg *cfg);
 

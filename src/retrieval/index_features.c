@@ -7,6 +7,7 @@
  * nothing (index_pairs.c computes what a pair needs). */
 #include "index.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 
 typedef struct {
@@ -45,8 +46,23 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
     return amscr__base_hf(&j->b, d, hf);
 }
 
+void amscr__index_slim(amscr_index *x, size_t first)
+{
+    size_t n = amscr_db_size(x->db);
+    for (size_t e = first * (size_t)x->nf; e < n * (size_t)x->nf; e++) {
+        amscr__hf *h = &x->hf[e];
+        if (!x->map || (uintptr_t)h->seq[1] - (uintptr_t)x->map >= x->map_len) /* not in the mapped file */
+            free(h->seq[1]);
+        free(h->spec[1]);
+        h->seq[1] = NULL;
+        h->spec[1] = NULL;
+    }
+}
+
 amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig)
 {
+    if (have_sig) /* a load: an older file's mirrored heights are not kept */
+        amscr__index_slim(x, first);
     feat_job j;
     j.x = x;
     j.have_sig = have_sig;

@@ -71,7 +71,7 @@ static void write_section(const amscr_index *x, amscr__wbuf *w)
 
 /* The channel features: every shape's height sequences (built here where a lazy load left
  * them unbuilt). */
-static amscr_status write_features(const amscr_index *x, amscr__wbuf *w)
+static amscr_status write_features(const amscr_index *x, uint32_t version, amscr__wbuf *w)
 {
     size_t n = amscr_db_size(x->db), N = amscr_db_params(x->db)->num_samples, bytes = N * AMSCR__HF_BINS;
     amscr__w_u32(w, (uint32_t)x->nf);
@@ -83,11 +83,12 @@ static amscr_status write_features(const amscr_index *x, amscr__wbuf *w)
     for (size_t i = 0; i < n && x->nf > 0 && st == AMSCR_OK; i++) {
         const amscr__hf *hf = x->hf + i * (size_t)x->nf;
         amscr__hf built[2];
-        int build = hf[0].seq[0] == NULL;
+        int orients = version >= AMSCR__DB_VERSION_INDEX_I16 ? 1 : 2; /* from 16: the forward one */
+        int build = hf[0].seq[0] == NULL || (orients == 2 && hf[0].seq[1] == NULL);
         if (build && (st = amscr__base_hf(&b, amscr_db_descriptor(x->db, i), built)) != AMSCR_OK)
             break;
         for (int f = 0; f < x->nf; f++)
-            for (int o = 0; o < 2; o++)
+            for (int o = 0; o < orients; o++)
                 amscr__w_bytes(w, (build ? built : hf)[f].seq[o], bytes);
         if (build)
             amscr__base_hf_free(&b, built);
@@ -139,7 +140,7 @@ amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **o
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
     write_section(x, &w);
-    st = write_features(x, &w);
+    st = write_features(x, version, &w);
     if (st == AMSCR_OK)
         write_inner(x, version, &w);
     if (st != AMSCR_OK) {
@@ -278,7 +279,7 @@ static amscr_status read_names(amscr__rbuf *r, amscr_index *x, uint32_t version)
 
 /* The channel features of a version 4, 6 or 8 file: each shape's height sequences (index.h's x->hf,
  * their spectra not yet computed). */
-static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
+static amscr_status read_features(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
     size_t n = amscr_db_size(x->db), N = amscr_db_params(x->db)->num_samples;
     uint32_t nf = amscr__r_u32(r), ns = amscr__r_u32(r), bins = amscr__r_u32(r);
@@ -286,7 +287,8 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
         return amscr__fail(AMSCR_E_FORMAT, "index file: channel features of %u frames, %u samples, %u bins; the "
                                            "params give %d, %zu, %d", (unsigned)nf, (unsigned)ns, (unsigned)bins,
                            x->nf, N, AMSCR__HF_BINS);
-    size_t bytes = N * AMSCR__HF_BINS, per = 2 * (size_t)nf * bytes;
+    int orients = version >= AMSCR__DB_VERSION_INDEX_I16 ? 1 : 2; /* from 16: the forward one */
+    size_t bytes = N * AMSCR__HF_BINS, per = (size_t)orients * nf * bytes;
     if (per > 0 && (r->len - r->pos) / per < n)
         return amscr__fail(AMSCR_E_FORMAT, "index file: the channel features are truncated");
     for (size_t e = 0; e < n * nf; e++) {
@@ -294,7 +296,7 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
         amscr__hf_free(h);
         h->n = N;
         h->nfreq = AMSCR__HF_FREQS(N) + 1;
-        for (int o = 0; o < 2; o++) {
+        for (int o = 0; o < orients; o++) {
             h->seq[o] = x->map ? (uint8_t *)(x->map + r->pos) : malloc(bytes); /* mapped: read in place */
             if (!h->seq[o])
                 return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
@@ -363,7 +365,7 @@ static amscr_status read_inner(amscr__rbuf *r, amscr_index *x, uint32_t version)
  * nothing. */
 static amscr_status read_rest(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
-    amscr_status st = amscr__db_has_features(version) ? read_features(r, x) : AMSCR_OK;
+    amscr_status st = amscr__db_has_features(version) ? read_features(r, x, version) : AMSCR_OK;
     if (st == AMSCR_OK && version >= AMSCR__DB_VERSION_INDEX_GRAPHS)
         st = read_inner(r, x, version);
     else if (st == AMSCR_OK && x->k2 > 0)
