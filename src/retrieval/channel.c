@@ -47,33 +47,52 @@ void amscr__hf_free(amscr__hf *h)
 /* Bin weight for a bin whose centre lies `frac` of the curve away (0..0.5). */
 static double bin_weight(double frac, double locality) { return 1.0 / (1.0 + locality * frac); }
 
-/* Heights of the closed curve P (n points) into seq (n * AMSCR__HF_BINS floats). */
-static void heights(const double *P, size_t n, double locality, uint8_t *seq, double *acc, size_t *cnt)
+/* Heights of the closed curve P (n points) into seq (n * AMSCR__HF_BINS bytes); cnt: D counts.
+ * HF_LANES samples at a time, each its own sums in the same order (independent chains: the
+ * same values as one sample at a time, several times faster). */
+enum { HF_LANES = 8 };
+static void heights(const double *P, size_t n, double locality, uint8_t *seq, size_t *cnt)
 {
     const size_t D = AMSCR__HF_BINS;
-    for (size_t i = 0; i < n; i++) {
-        size_t ip = (i + 1) % n, im = (i + n - 1) % n;
-        double tx = P[2 * ip] - P[2 * im], ty = P[2 * ip + 1] - P[2 * im + 1];
-        double tl = sqrt(tx * tx + ty * ty);
-        double nx = tl > 0.0 ? -ty / tl : 0.0, ny = tl > 0.0 ? tx / tl : 0.0;
-        memset(acc, 0, D * sizeof *acc);
-        memset(cnt, 0, D * sizeof *cnt);
-        for (size_t j = 1, b = 0, next = n - 1; j < n; j++) { /* bin (j - 1) D / (n - 1) */
-            size_t q = i + j < n ? i + j : i + j - n;
+    memset(cnt, 0, D * sizeof *cnt);
+    for (size_t j = 1, b = 0, next = n - 1; j < n; j++) { /* bin (j - 1) D / (n - 1), as below */
+        while ((j - 1) * D >= next) {
+            b++;
+            next += n - 1;
+        }
+        cnt[b]++;
+    }
+    for (size_t i0 = 0; i0 < n; i0 += HF_LANES) {
+        size_t L = n - i0 < HF_LANES ? n - i0 : HF_LANES;
+        double nx[HF_LANES] = {0.0}, ny[HF_LANES] = {0.0}, px[HF_LANES] = {0.0}, py[HF_LANES] = {0.0};
+        double acc[HF_LANES][AMSCR__HF_BINS] = {{0.0}};
+        for (size_t l = 0; l < L; l++) {
+            size_t i = i0 + l, ip = (i + 1) % n, im = (i + n - 1) % n;
+            double tx = P[2 * ip] - P[2 * im], ty = P[2 * ip + 1] - P[2 * im + 1];
+            double tl = sqrt(tx * tx + ty * ty);
+            nx[l] = tl > 0.0 ? -ty / tl : 0.0;
+            ny[l] = tl > 0.0 ? tx / tl : 0.0;
+            px[l] = P[2 * i];
+            py[l] = P[2 * i + 1];
+        }
+        for (size_t j = 1, b = 0, next = n - 1; j < n; j++) {
             while ((j - 1) * D >= next) {
                 b++;
                 next += n - 1;
             }
-            acc[b] += (P[2 * q] - P[2 * i]) * nx + (P[2 * q + 1] - P[2 * i + 1]) * ny;
-            cnt[b]++;
+            for (size_t l = 0; l < L; l++) {
+                size_t i = i0 + l, q = i + j < n ? i + j : i + j - n;
+                acc[l][b] += (P[2 * q] - px[l]) * nx[l] + (P[2 * q + 1] - py[l]) * ny[l];
+            }
         }
-        for (size_t b = 0; b < D; b++) {
-            double centre = ((double)b + 0.5) / (double)D; /* fraction of the curve ahead */
-            double frac = centre < 0.5 ? centre : 1.0 - centre;
-            double v = cnt[b] ? acc[b] / (double)cnt[b] : 0.0;
-            double q = 128.0 + AMSCR__HF_QUANT * v * bin_weight(frac, locality);
-            seq[i * D + b] = (uint8_t)(q < 0.0 ? 0.0 : q > 255.0 ? 255.0 : floor(q + 0.5));
-        }
+        for (size_t l = 0; l < L; l++)
+            for (size_t b = 0; b < D; b++) {
+                double centre = ((double)b + 0.5) / (double)D; /* fraction of the curve ahead */
+                double frac = centre < 0.5 ? centre : 1.0 - centre;
+                double v = cnt[b] ? acc[l][b] / (double)cnt[b] : 0.0;
+                double q = 128.0 + AMSCR__HF_QUANT * v * bin_weight(frac, locality);
+                seq[(i0 + l) * D + b] = (uint8_t)(q < 0.0 ? 0.0 : q > 255.0 ? 255.0 : floor(q + 0.5));
+            }
     }
 }
 
@@ -118,7 +137,6 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
     out->nfreq = AMSCR__HF_FREQS(n) + 1;
     double *mir = amscr__malloc_array(2 * n, sizeof *mir);
     double *z = amscr__malloc_array(2 * n + AMSCR__HF_SPEC(out->nfreq), sizeof *z);
-    double *acc = amscr__malloc_array(D, sizeof *acc);
     size_t *cnt = amscr__malloc_array(D, sizeof *cnt);
     amscr__fft_plan plan;
     int have_plan = amscr__fft_plan_init(&plan, n) == 0;
@@ -129,7 +147,7 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
         if (!out->seq[o] || !out->spec[o])
             st = AMSCR_E_NOMEM;
     }
-    if (!mir || !z || !acc || !cnt || !have_plan || st != AMSCR_OK) {
+    if (!mir || !z || !cnt || !have_plan || st != AMSCR_OK) {
         st = amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
     } else {
         /* mirror image (x -> -x), traversed backwards so it stays counter-clockwise */
@@ -137,8 +155,8 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
             mir[2 * i] = -base[2 * (n - 1 - i)];
             mir[2 * i + 1] = base[2 * (n - 1 - i) + 1];
         }
-        heights(base, n, locality, out->seq[0], acc, cnt);
-        heights(mir, n, locality, out->seq[1], acc, cnt);
+        heights(base, n, locality, out->seq[0], cnt);
+        heights(mir, n, locality, out->seq[1], cnt);
         for (int o = 0; o < 2; o++)
             spectra(out->seq[o], n, out->nfreq, out->spec[o], &out->scale[o], &plan, z, z + 2 * n);
     }
@@ -146,7 +164,6 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
         amscr__fft_plan_free(&plan);
     free(mir);
     free(z);
-    free(acc);
     free(cnt);
     if (st != AMSCR_OK)
         amscr__hf_free(out);
@@ -156,21 +173,20 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
 amscr_status amscr__hf_build_mirror(const double *base, size_t n, double locality, amscr__hf *h)
 {
     const size_t D = AMSCR__HF_BINS;
-    double *mir = amscr__malloc_array(2 * n, sizeof *mir), *acc = amscr__malloc_array(D, sizeof *acc);
+    double *mir = amscr__malloc_array(2 * n, sizeof *mir);
     size_t *cnt = amscr__malloc_array(D, sizeof *cnt);
     uint8_t *seq = amscr__malloc_array(n * D, sizeof *seq);
-    amscr_status st = mir && acc && cnt && seq ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
+    amscr_status st = mir && cnt && seq ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
     if (st == AMSCR_OK) { /* as amscr__hf_build makes it */
         for (size_t i = 0; i < n; i++) {
             mir[2 * i] = -base[2 * (n - 1 - i)];
             mir[2 * i + 1] = base[2 * (n - 1 - i) + 1];
         }
-        heights(mir, n, locality, seq, acc, cnt);
+        heights(mir, n, locality, seq, cnt);
         h->seq[1] = seq;
         seq = NULL;
     }
     free(mir);
-    free(acc);
     free(cnt);
     free(seq);
     return st;
