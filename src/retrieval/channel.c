@@ -47,52 +47,53 @@ void amscr__hf_free(amscr__hf *h)
 /* Bin weight for a bin whose centre lies `frac` of the curve away (0..0.5). */
 static double bin_weight(double frac, double locality) { return 1.0 / (1.0 + locality * frac); }
 
-/* Heights of the closed curve P (n points) into seq (n * AMSCR__HF_BINS bytes); cnt: D counts.
- * HF_LANES samples at a time, each its own sums in the same order (independent chains: the
- * same values as one sample at a time, several times faster). */
-enum { HF_LANES = 8 };
-static void heights(const double *P, size_t n, double locality, uint8_t *seq, size_t *cnt)
+/* Heights of the closed curve P (n points) into seq (n * AMSCR__HF_BINS bytes); cum: 2 (2 n + 1)
+ * doubles. A bin's sum of the signed distances to sample i's tangent line is its points' sum
+ * less count times sample i, along the normal: the points' sums from running sums along the
+ * curve (twice round), O(n bins) rather than O(n^2). */
+static void heights(const double *P, size_t n, double locality, uint8_t *seq, double *cum)
 {
     const size_t D = AMSCR__HF_BINS;
-    memset(cnt, 0, D * sizeof *cnt);
-    for (size_t j = 1, b = 0, next = n - 1; j < n; j++) { /* bin (j - 1) D / (n - 1), as below */
+    size_t jlo[AMSCR__HF_BINS], jhi[AMSCR__HF_BINS], cnt[AMSCR__HF_BINS] = {0};
+    for (size_t b = 0; b < D; b++)
+        jlo[b] = jhi[b] = 0;
+    for (size_t j = 1, b = 0, next = n - 1; j < n; j++) { /* bin (j - 1) D / (n - 1) */
         while ((j - 1) * D >= next) {
             b++;
             next += n - 1;
         }
-        cnt[b]++;
+        if (cnt[b]++ == 0)
+            jlo[b] = j;
+        jhi[b] = j;
     }
-    for (size_t i0 = 0; i0 < n; i0 += HF_LANES) {
-        size_t L = n - i0 < HF_LANES ? n - i0 : HF_LANES;
-        double nx[HF_LANES] = {0.0}, ny[HF_LANES] = {0.0}, px[HF_LANES] = {0.0}, py[HF_LANES] = {0.0};
-        double acc[HF_LANES][AMSCR__HF_BINS] = {{0.0}};
-        for (size_t l = 0; l < L; l++) {
-            size_t i = i0 + l, ip = (i + 1) % n, im = (i + n - 1) % n;
-            double tx = P[2 * ip] - P[2 * im], ty = P[2 * ip + 1] - P[2 * im + 1];
-            double tl = sqrt(tx * tx + ty * ty);
-            nx[l] = tl > 0.0 ? -ty / tl : 0.0;
-            ny[l] = tl > 0.0 ? tx / tl : 0.0;
-            px[l] = P[2 * i];
-            py[l] = P[2 * i + 1];
+    double wt[AMSCR__HF_BINS];
+    for (size_t b = 0; b < D; b++) {
+        double centre = ((double)b + 0.5) / (double)D; /* fraction of the curve ahead */
+        wt[b] = bin_weight(centre < 0.5 ? centre : 1.0 - centre, locality);
+    }
+    double *cx = cum, *cy = cum + 2 * n + 1;
+    cx[0] = cy[0] = 0.0;
+    for (size_t t = 0; t < 2 * n; t++) {
+        size_t q = t < n ? t : t - n;
+        cx[t + 1] = cx[t] + P[2 * q];
+        cy[t + 1] = cy[t] + P[2 * q + 1];
+    }
+    for (size_t i = 0; i < n; i++) {
+        size_t ip = (i + 1) % n, im = (i + n - 1) % n;
+        double tx = P[2 * ip] - P[2 * im], ty = P[2 * ip + 1] - P[2 * im + 1];
+        double tl = sqrt(tx * tx + ty * ty);
+        double nx = tl > 0.0 ? -ty / tl : 0.0, ny = tl > 0.0 ? tx / tl : 0.0;
+        for (size_t b = 0; b < D; b++) {
+            double v = 0.0;
+            if (cnt[b]) {
+                double c = (double)cnt[b], sx = cx[i + jhi[b] + 1] - cx[i + jlo[b]];
+                double sy = cy[i + jhi[b] + 1] - cy[i + jlo[b]];
+                v = ((sx - c * P[2 * i]) * nx + (sy - c * P[2 * i + 1]) * ny) / c;
+            }
+            double q = 128.0 + AMSCR__HF_QUANT * v * wt[b];
+            /* rounded half up: q + 0.5 >= 0.5, so the conversion's truncation is the floor */
+            seq[i * D + b] = (uint8_t)(q < 0.0 ? 0.0 : q > 255.0 ? 255.0 : q + 0.5);
         }
-        for (size_t j = 1, b = 0, next = n - 1; j < n; j++) {
-            while ((j - 1) * D >= next) {
-                b++;
-                next += n - 1;
-            }
-            for (size_t l = 0; l < L; l++) {
-                size_t i = i0 + l, q = i + j < n ? i + j : i + j - n;
-                acc[l][b] += (P[2 * q] - px[l]) * nx[l] + (P[2 * q + 1] - py[l]) * ny[l];
-            }
-        }
-        for (size_t l = 0; l < L; l++)
-            for (size_t b = 0; b < D; b++) {
-                double centre = ((double)b + 0.5) / (double)D; /* fraction of the curve ahead */
-                double frac = centre < 0.5 ? centre : 1.0 - centre;
-                double v = cnt[b] ? acc[l][b] / (double)cnt[b] : 0.0;
-                double q = 128.0 + AMSCR__HF_QUANT * v * bin_weight(frac, locality);
-                seq[(i0 + l) * D + b] = (uint8_t)(q < 0.0 ? 0.0 : q > 255.0 ? 255.0 : floor(q + 0.5));
-            }
     }
 }
 
@@ -137,7 +138,7 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
     out->nfreq = AMSCR__HF_FREQS(n) + 1;
     double *mir = amscr__malloc_array(2 * n, sizeof *mir);
     double *z = amscr__malloc_array(2 * n + AMSCR__HF_SPEC(out->nfreq), sizeof *z);
-    size_t *cnt = amscr__malloc_array(D, sizeof *cnt);
+    double *cum = amscr__malloc_array(2 * (2 * n + 1), sizeof *cum);
     amscr__fft_plan plan;
     int have_plan = amscr__fft_plan_init(&plan, n) == 0;
     amscr_status st = AMSCR_OK;
@@ -147,7 +148,7 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
         if (!out->seq[o] || !out->spec[o])
             st = AMSCR_E_NOMEM;
     }
-    if (!mir || !z || !cnt || !have_plan || st != AMSCR_OK) {
+    if (!mir || !z || !cum || !have_plan || st != AMSCR_OK) {
         st = amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
     } else {
         /* mirror image (x -> -x), traversed backwards so it stays counter-clockwise */
@@ -155,8 +156,8 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
             mir[2 * i] = -base[2 * (n - 1 - i)];
             mir[2 * i + 1] = base[2 * (n - 1 - i) + 1];
         }
-        heights(base, n, locality, out->seq[0], cnt);
-        heights(mir, n, locality, out->seq[1], cnt);
+        heights(base, n, locality, out->seq[0], cum);
+        heights(mir, n, locality, out->seq[1], cum);
         for (int o = 0; o < 2; o++)
             spectra(out->seq[o], n, out->nfreq, out->spec[o], &out->scale[o], &plan, z, z + 2 * n);
     }
@@ -164,7 +165,7 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
         amscr__fft_plan_free(&plan);
     free(mir);
     free(z);
-    free(cnt);
+    free(cum);
     if (st != AMSCR_OK)
         amscr__hf_free(out);
     return st;
@@ -174,20 +175,20 @@ amscr_status amscr__hf_build_mirror(const double *base, size_t n, double localit
 {
     const size_t D = AMSCR__HF_BINS;
     double *mir = amscr__malloc_array(2 * n, sizeof *mir);
-    size_t *cnt = amscr__malloc_array(D, sizeof *cnt);
+    double *cum = amscr__malloc_array(2 * (2 * n + 1), sizeof *cum);
     uint8_t *seq = amscr__malloc_array(n * D, sizeof *seq);
-    amscr_status st = mir && cnt && seq ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
+    amscr_status st = mir && cum && seq ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
     if (st == AMSCR_OK) { /* as amscr__hf_build makes it */
         for (size_t i = 0; i < n; i++) {
             mir[2 * i] = -base[2 * (n - 1 - i)];
             mir[2 * i + 1] = base[2 * (n - 1 - i) + 1];
         }
-        heights(mir, n, locality, seq, cnt);
+        heights(mir, n, locality, seq, cum);
         h->seq[1] = seq;
         seq = NULL;
     }
     free(mir);
-    free(cnt);
+    free(cum);
     free(seq);
     return st;
 }
