@@ -138,9 +138,9 @@ amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const ams
 
 /* --------------------------------------------- each shape's kept features (index_features.c) */
 
-/* The mirrored orientation's heights and spectra of shapes first..n-1 dropped: a pair reads them
- * of its higher index only, so a query against the index never does (a member's query, a row of
- * the index: index_pairs.c makes them from the shape's input samples where a pair needs them). */
+/* The mirrored orientation's spectra of shapes first..n-1 dropped: a pair reads them of its
+ * higher index only, so a query against the index never does (a member's query, a row of the
+ * index: index_pairs.c computes them from the mirrored heights where a pair needs them). */
 void amscr__index_slim(amscr_index *x, size_t first);
 
 /* Signatures, lower-bound vectors (unless have_sig: then the signatures are there) and channel

@@ -5,6 +5,7 @@
  * query or a row matches a shape without rebuilding anything. A load from a file that holds
  * the features' heights computes only their spectra (the inner features it reads); a lazy load
  * nothing (index_pairs.c computes what a pair needs). */
+#include "db_io.h"
 #include "index.h"
 
 #include <stdint.h>
@@ -15,6 +16,25 @@ typedef struct {
     amscr__base b;
     int have_sig;
 } feat_job;
+
+/* The mirrored heights of shape i (a file from version 16 keeps the forward ones only), from its
+ * input samples (its compact record: nothing decoded). */
+static amscr_status mirror_heights(const feat_job *j, size_t i, amscr__hf *hf)
+{
+    const amscr_db *db = j->x->db;
+    size_t N = amscr_db_params(db)->num_samples;
+    double *buf = amscr__malloc_array(2 * N + 2 * AMSCR__OUTLINE_N, sizeof *buf);
+    amscr_descriptor sd, *tmp = NULL;
+    const amscr_descriptor *d = !buf                                       ? NULL
+                                : amscr__db_shallow(db, i, &sd, buf, buf + 2 * N) ? &sd
+                                                                           : amscr__db_descriptor_peek(db, i, &tmp);
+    amscr_status st = d ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    for (int f = 0; f < j->x->nf && st == AMSCR_OK; f++)
+        st = amscr__hf_mirror_of_descriptor(j->b.p, j->b.frames[f], d, &hf[f]);
+    amscr_descriptor_free(tmp);
+    free(buf);
+    return st;
+}
 
 static amscr_status feat_row(void *ctx, size_t i, void *scratch)
 {
@@ -34,9 +54,13 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
         return AMSCR_OK; /* a lazy load: built by the pairs that need them (index_pairs.c) */
     if (j->have_sig && hf[0].seq[0] != NULL) { /* the heights came with the file: their spectra */
         amscr_status st = AMSCR_OK;
-        for (int f = 0; f < x->nf && st == AMSCR_OK; f++)
+        for (int f = 0; f < x->nf && st == AMSCR_OK; f++) { /* the forward orientation's only */
+            uint8_t *mirror = hf[f].seq[1];
+            hf[f].seq[1] = NULL;
             st = hf[f].spec[0] ? AMSCR_OK : amscr__hf_spectra(&hf[f], NULL);
-        return st;
+            hf[f].seq[1] = mirror;
+        }
+        return st == AMSCR_OK && hf[0].seq[1] == NULL ? mirror_heights(j, i, hf) : st;
     }
     const amscr_descriptor *d = amscr_db_descriptor(x->db, i); /* a lazy load's: decoded here */
     if (!d)
@@ -51,18 +75,13 @@ void amscr__index_slim(amscr_index *x, size_t first)
     size_t n = amscr_db_size(x->db);
     for (size_t e = first * (size_t)x->nf; e < n * (size_t)x->nf; e++) {
         amscr__hf *h = &x->hf[e];
-        if (!x->map || (uintptr_t)h->seq[1] - (uintptr_t)x->map >= x->map_len) /* not in the mapped file */
-            free(h->seq[1]);
         free(h->spec[1]);
-        h->seq[1] = NULL;
         h->spec[1] = NULL;
     }
 }
 
 amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig)
 {
-    if (have_sig) /* a load: an older file's mirrored heights are not kept */
-        amscr__index_slim(x, first);
     feat_job j;
     j.x = x;
     j.have_sig = have_sig;

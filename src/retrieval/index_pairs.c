@@ -84,7 +84,8 @@ void amscr__base_hf_free(const amscr__base *b, amscr__hf hf[2])
 /* out[f]: stored[f] (its arrays shared, not copied) with what a pair reads of it and it lacks
  * made here: the spectra (a lazy load's heights, with ws's FFT plan when it has one) and, when
  * the pair reads the mirrored orientation (`mirror`: the shape is the pair's higher index), the
- * mirrored heights from the shape's input samples (an index keeps the forward orientation only).
+ * mirrored spectra (an index keeps the forward orientation's only) and heights (a lazy load of a
+ * file from version 16, which stores the forward ones), from the shape's input samples.
  * own[f] marks what was made: bit 0 spec[0], bit 1 seq[1], bit 2 spec[1]. */
 static amscr_status complete(const amscr__base *b, const amscr_db *db, size_t c, const amscr__hf *stored,
                              int mirror, amscr__hf_ws *ws, amscr__hf out[2], int own[2])
