@@ -235,9 +235,6 @@ START_TEST(member_rows)
     amscr_index *x = NULL;
     ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
     ck_assert_int_eq(amscr_db_retrieval_matrix(amscr_index_db(x), NULL, NULL, M), AMSCR_OK);
-    /* an index keeps the forward orientation's spectra only: a member's row computes its
-     * candidates' mirrored ones */
-    ck_assert(x->hf[0].seq[0] && x->hf[0].spec[0] && x->hf[0].seq[1] && !x->hf[0].spec[1]);
     for (size_t i = 0; i < NSHAPES; i += 5) {
         ck_assert_int_eq(amscr_index_member_scores(x, i, 0, got, NSHAPES), AMSCR_OK);
         assert_close(M + i * NSHAPES, got, NSHAPES, 1e-12);
@@ -580,7 +577,7 @@ START_TEST(stored_features)
         /* format 16 stores the forward heights: the mirrored ones made at load (a lazy load: by
          * a pair that reads them) */
         ck_assert(lazy ? y->hf[0].seq[1] == NULL : y->hf[0].seq[1] != NULL);
-        ck_assert_ptr_null(y->hf[0].spec[1]);
+        ck_assert(lazy ? y->hf[0].spec[1] == NULL : y->hf[0].spec[1] != NULL);
         same_query(x, y, q, 0);
         same_query(x, y, q, 6);
         amscr_index_free(y);

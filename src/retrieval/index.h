@@ -138,11 +138,6 @@ amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const ams
 
 /* --------------------------------------------- each shape's kept features (index_features.c) */
 
-/* The mirrored orientation's spectra of shapes first..n-1 dropped: a pair reads them of its
- * higher index only, so a query against the index never does (a member's query, a row of the
- * index: index_pairs.c computes them from the mirrored heights where a pair needs them). */
-void amscr__index_slim(amscr_index *x, size_t first);
-
 /* Signatures, lower-bound vectors (unless have_sig: then the signatures are there) and channel
  * features of shapes first..n-1, on the params' threads; drops the lists' reverse, and rebuilds
  * it when have_sig and first == 0 (a load: the lists are in place). */

@@ -171,8 +171,6 @@ amscr_status amscr__index_extend(amscr_index *x, size_t n0, amscr_progress_fn pr
         st = amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback");
     if (st == AMSCR_OK)
         st = amscr__index_reverse(x); /* the lists changed: their reverse for the queries */
-    if (st == AMSCR_OK)
-        amscr__index_slim(x, n0);
     free(c.cand);
     free(c.cd);
     free(c.cd2);

@@ -233,8 +233,6 @@ static amscr_status build_into(amscr_index *x, size_t candidates, amscr_progress
     }
     if (st == AMSCR_OK)
         st = amscr__index_reverse(x);
-    if (st == AMSCR_OK)
-        amscr__index_slim(x, 0);
     if (st != AMSCR_OK)
         amscr_index_free(x);
     return st;

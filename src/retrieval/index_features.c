@@ -8,7 +8,6 @@
 #include "db_io.h"
 #include "index.h"
 
-#include <stdint.h>
 #include <stdlib.h>
 
 typedef struct {
@@ -53,14 +52,10 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
     if (x->nf == 0 || (x->lazy && j->have_sig))
         return AMSCR_OK; /* a lazy load: built by the pairs that need them (index_pairs.c) */
     if (j->have_sig && hf[0].seq[0] != NULL) { /* the heights came with the file: their spectra */
-        amscr_status st = AMSCR_OK;
-        for (int f = 0; f < x->nf && st == AMSCR_OK; f++) { /* the forward orientation's only */
-            uint8_t *mirror = hf[f].seq[1];
-            hf[f].seq[1] = NULL;
+        amscr_status st = hf[0].seq[1] == NULL ? mirror_heights(j, i, hf) : AMSCR_OK;
+        for (int f = 0; f < x->nf && st == AMSCR_OK; f++)
             st = hf[f].spec[0] ? AMSCR_OK : amscr__hf_spectra(&hf[f], NULL);
-            hf[f].seq[1] = mirror;
-        }
-        return st == AMSCR_OK && hf[0].seq[1] == NULL ? mirror_heights(j, i, hf) : st;
+        return st;
     }
     const amscr_descriptor *d = amscr_db_descriptor(x->db, i); /* a lazy load's: decoded here */
     if (!d)
@@ -68,16 +63,6 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
     for (int f = 0; f < x->nf; f++)
         amscr__hf_free(&hf[f]);
     return amscr__base_hf(&j->b, d, hf);
-}
-
-void amscr__index_slim(amscr_index *x, size_t first)
-{
-    size_t n = amscr_db_size(x->db);
-    for (size_t e = first * (size_t)x->nf; e < n * (size_t)x->nf; e++) {
-        amscr__hf *h = &x->hf[e];
-        free(h->spec[1]);
-        h->spec[1] = NULL;
-    }
 }
 
 amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig)
