@@ -100,7 +100,7 @@ static void heights(const double *P, size_t n, double locality, uint8_t *seq, do
 /* The kept frequencies of every bin column's DFT into spec (AMSCR__HF_SPEC(nfreq) values, in
  * units of *scale: the largest magnitude / AMSCR__HF_SPEC_Q, rounded to the nearest): bin b's
  * real parts at spec + 2 b P, its imaginary parts at spec + (2 b + 1) P, P =
- * AMSCR__HF_PAD(nfreq), the padding zero. tmp: AMSCR__HF_SPEC(nfreq) doubles. */
+ * AMSCR__HF_PAD(nfreq), the 3 values after the last zero. tmp: AMSCR__HF_SPEC(nfreq) doubles. */
 static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, int16_t *spec, double *scale,
                            amscr__fft_plan *plan, double *z, double *tmp)
 {

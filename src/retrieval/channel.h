@@ -14,11 +14,12 @@
 /* Frequencies used by the shift search (the correlation is low-passed; the DP band absorbs
  * the coarser shift): the first N/8, at most N/2. */
 #define AMSCR__HF_FREQS(n) ((n) / 8 < (n) / 2 ? (n) / 8 : (n) / 2)
-/* The kept frequencies of a bin's DFT padded to a multiple of 4 (the shift search reads four
- * at a time), and the values of one orientation's spectra: real and imaginary parts of every
- * bin (amscr__hf.spec). */
-#define AMSCR__HF_PAD(nfreq) (((nfreq) + 3) / 4 * 4)
-#define AMSCR__HF_SPEC(nfreq) (2 * AMSCR__HF_BINS * AMSCR__HF_PAD(nfreq))
+/* The kept frequencies of every bin's DFT are stored back to back (AMSCR__HF_PAD: no padding
+ * between the bins), and the values of one orientation's spectra: real and imaginary parts of
+ * every bin, then 3 zeros (the shift search reads four frequencies at a time, past a bin's last
+ * into the next one's, whose products it drops; past the last bin's into the zeros). */
+#define AMSCR__HF_PAD(nfreq) (nfreq)
+#define AMSCR__HF_SPEC(nfreq) (2 * AMSCR__HF_BINS * (nfreq) + 3)
 
 /* A shape's height-function sequences: forward and mirrored, with the DFT of every bin (only
  * the frequencies the shift search reads). */
@@ -26,7 +27,7 @@ typedef struct {
     size_t n;
     size_t nfreq;    /* frequencies kept of each bin's DFT: AMSCR__HF_FREQS(n) + 1 */
     uint8_t *seq[2]; /* n * AMSCR__HF_BINS, weighted heights, quantized: 128 + QUANT * h */
-    int16_t *spec[2]; /* AMSCR__HF_SPEC(nfreq): per bin nfreq real parts, then imaginary, padded,
+    int16_t *spec[2]; /* AMSCR__HF_SPEC(nfreq): per bin nfreq real parts, then imaginary,
                        * in units of scale[o] (amscr__hf_quantize: the shift search's correlations,
                        * summed exactly in double, then scaled) */
     double scale[2];
