@@ -66,10 +66,12 @@ static void heights(const double *P, size_t n, double locality, uint8_t *seq, do
             jlo[b] = j;
         jhi[b] = j;
     }
-    double wt[AMSCR__HF_BINS];
+    double wt[AMSCR__HF_BINS], cb[AMSCR__HF_BINS];
     for (size_t b = 0; b < D; b++) {
         double centre = ((double)b + 0.5) / (double)D; /* fraction of the curve ahead */
         wt[b] = bin_weight(centre < 0.5 ? centre : 1.0 - centre, locality);
+        cb[b] = (double)cnt[b];
+        jhi[b] += 1; /* the running sums' end */
     }
     double *cx = cum, *cy = cum + 2 * n + 1;
     cx[0] = cy[0] = 0.0;
@@ -83,16 +85,14 @@ static void heights(const double *P, size_t n, double locality, uint8_t *seq, do
         double tx = P[2 * ip] - P[2 * im], ty = P[2 * ip + 1] - P[2 * im + 1];
         double tl = sqrt(tx * tx + ty * ty);
         double nx = tl > 0.0 ? -ty / tl : 0.0, ny = tl > 0.0 ? tx / tl : 0.0;
-        for (size_t b = 0; b < D; b++) {
-            double v = 0.0;
-            if (cnt[b]) {
-                double c = (double)cnt[b], sx = cx[i + jhi[b] + 1] - cx[i + jlo[b]];
-                double sy = cy[i + jhi[b] + 1] - cy[i + jlo[b]];
-                v = ((sx - c * P[2 * i]) * nx + (sy - c * P[2 * i + 1]) * ny) / c;
-            }
+        const double *ax = cx + i, *ay = cy + i, px = P[2 * i], py = P[2 * i + 1];
+        uint8_t *out = seq + i * D;
+        for (size_t b = 0; b < D; b++) { /* every bin holds a sample: n > D */
+            double c = cb[b], sx = ax[jhi[b]] - ax[jlo[b]], sy = ay[jhi[b]] - ay[jlo[b]];
+            double v = ((sx - c * px) * nx + (sy - c * py) * ny) / c;
             double q = 128.0 + AMSCR__HF_QUANT * v * wt[b];
             /* rounded half up: q + 0.5 >= 0.5, so the conversion's truncation is the floor */
-            seq[i * D + b] = (uint8_t)(q < 0.0 ? 0.0 : q > 255.0 ? 255.0 : q + 0.5);
+            out[b] = (uint8_t)(q < 0.0 ? 0.0 : q > 255.0 ? 255.0 : q + 0.5);
         }
     }
 }
@@ -178,6 +178,8 @@ amscr_status amscr__hf_build_mirror(const double *base, size_t n, double localit
     double *cum = amscr__malloc_array(2 * (2 * n + 1), sizeof *cum);
     uint8_t *seq = amscr__malloc_array(n * D, sizeof *seq);
     amscr_status st = mir && cum && seq ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
+    if (st == AMSCR_OK && n < D + 1)
+        st = amscr__fail(AMSCR_E_INVALID_ARG, "shape channel: N = %zu is below %zu", n, D + 1);
     if (st == AMSCR_OK) { /* as amscr__hf_build makes it */
         for (size_t i = 0; i < n; i++) {
             mir[2 * i] = -base[2 * (n - 1 - i)];

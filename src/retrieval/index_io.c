@@ -1,4 +1,4 @@
-/* index_io.c — the index file: a collection file (db_io.c) of version 15 (14 in 0.14's first builds, 13 in 0.11 to 0.13, 11
+/* index_io.c — the index file: a collection file (db_io.c) of version 16 (15 and 14 in 0.14, 13 in 0.11 to 0.13, 11
  * in 0.9, 9 in 0.8, 8 in 0.7, 6 in 0.6, 4 in 0.5, 3 in 0.4) whose index section follows the
  * shapes, so amscr_db_load of an index file gives its collection. From version 14 the shapes are
  * compact records (their input samples and outline: db_io.h), which the index keeps as they are
@@ -14,12 +14,15 @@
  *   versions 4, 6 and 8: u32 1 and n group names, or u32 0 (no shape has one); then the channel
  *     features: u32 frames F (0: no channel), u32 samples N, u32 bins B (AMSCR__HF_BINS), and
  *     per shape, per frame, its quantized height sequences (channel.h), forward then mirrored:
- *     2 N B bytes (F = 2, N = 128: 8 KB a shape);
+ *     2 N B bytes (F = 2, N = 128: 8 KB a shape); from version 16 the forward one only (N B
+ *     bytes, 4 KB a shape: a load makes the mirrored one from the shape's input samples);
  *   versions 9, 11 and 13: then the inner distance's graph: u32 K2 (0: none; else K, when the params give it a
  *     share), f64 its largest distance, n x K2 x (u32 neighbour, f64 distance) as the lists above,
  *     and per shape its inner features (inner.h): F K f64 re, F K f64 im, f64 norm2 (8.7 KB a
  *     shape; the reversed orientation's twist is recomputed); from version 15 re and im are F K
- *     f32 each (4.4 KB a shape: the features are float32 in memory too).
+ *     f32 each (4.4 KB a shape); from version 16 f64 scale, then re and im as F K i16 each in
+ *     units of the scale, norm2 recomputed from them (2.2 KB a shape: the features as an index
+ *     holds them in memory, inner.h; an older file's values are rounded so at load).
  * Every count is bounded by the bytes left before anything is allocated; F, N and B must be the
  * params' (any byte is a valid height). The features' spectra are not stored: a load computes
  * them from the heights (an FFT, a fifth of building the features), or, with AMSCR_INDEX_LAZY,
