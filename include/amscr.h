@@ -2658,7 +2658,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  *       amscr_index_build with candidates 0), the first call after shapes were added enters
  *       them (n pair distances a new shape), and each call then costs n pair distances and
  *       the re-ranking of one row, as amscr_index_query_scores with candidates 0.
- * Memory: the kept index, about 50 KB a shape with the retrieval preset (channel and inner
+ * Memory: the kept index, about 20 KB a shape with the retrieval preset (channel and inner
  *       features, signature, lists; not a copy of the shapes), until amscr_db_free.
  * Prefer an amscr_index to save the preparation in a file or to query with a shortlist.
  * The query is scored as a new shape even when it is a member's copy (no member rule:
@@ -2732,9 +2732,9 @@ typedef struct amscr_index amscr_index;
  * Cost: candidates 0: n^2 pair distances; M > 0: O(n (M + K^2)) pair distances.
  * Memory: the index holds a compact copy of the shapes (since 0.14: each shape's input samples
  *         and outline, ~3 KB at the defaults; a prepared shape is recomputed from them, bit for
- *         bit, when first read, e.g. through amscr_index_db, and then kept), the features (~34 KB a
- *         shape at the defaults), about 24 bytes a listed
- *         neighbour and, with the inner graph, about 17 KB of inner features a shape; the
+ *         bit, when first read, e.g. through amscr_index_db, and then kept), the channel features
+ *         and signature (~18 KB a shape at the defaults), about 24 bytes a listed
+ *         neighbour and, with the inner graph, about 2.2 KB of inner features a shape; the
  *         build's scratch is n^2 doubles with candidates 0, at most 12 n M bytes with M.
  * Threads: amscr_params_set_num_threads of the db's params; the index is the same for any
  *          thread count.
@@ -2974,7 +2974,7 @@ AMSCR_API const char *amscr_index_group(const amscr_index *x, size_t i);
  * @brief Writes the index to a temporary name in the same folder and renames it: the
  *        collection file format (amscr_db_load of it gives the collection) with an index
  *        section holding the lists, each shape's channel features (so a load does not rebuild
- *        them) and, with the inner graph, each shape's inner features (about 8.7 KB) and its
+ *        them) and, with the inner graph, each shape's inner features (about 2.2 KB) and its
  *        lists; amscr_index_load_with reads it and every earlier format version
  *        (docs/collections.md).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.

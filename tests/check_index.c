@@ -555,7 +555,7 @@ START_TEST(stored_features)
     void *buf = NULL;
     size_t len = 0, l3 = 0;
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    ck_assert_int_eq(((unsigned char *)buf)[8], 15);
+    ck_assert_int_eq(((unsigned char *)buf)[8], 16);
     ck_assert_int_eq(x->nf, 2);
     void *b13 = NULL; /* the format of 0.11 to 0.13, which older files are made from */
     size_t l13 = 0;
@@ -574,6 +574,10 @@ START_TEST(stored_features)
         ck_assert_int_eq(amscr_index_load_memory_with(buf, len, lazy ? AMSCR_INDEX_LAZY : 0u, &y), AMSCR_OK);
         ck_assert_ptr_nonnull(y->hf[0].seq[0]);
         ck_assert(lazy ? y->hf[0].spec[0] == NULL : y->hf[0].spec[0] != NULL);
+        /* format 16 stores the forward heights: the mirrored ones made at load (a lazy load: by
+         * a pair that reads them) */
+        ck_assert(lazy ? y->hf[0].seq[1] == NULL : y->hf[0].seq[1] != NULL);
+        ck_assert(lazy ? y->hf[0].spec[1] == NULL : y->hf[0].spec[1] != NULL);
         same_query(x, y, q, 0);
         same_query(x, y, q, 6);
         amscr_index_free(y);
@@ -595,6 +599,14 @@ START_TEST(stored_features)
     ck_assert_int_eq(amscr_index_load_with(path, AMSCR_INDEX_LAZY, &y), AMSCR_OK);
     same_query(x, y, q, 0);
     same_query(x, y, q, 6);
+    /* a member's row reads its candidates' mirrored heights, which format 16 does not store:
+     * made from their input samples in the mapped file, the same scores */
+    for (size_t i = 0; i < NSHAPES; i += 7) {
+        double ma[NSHAPES], mb[NSHAPES];
+        ck_assert_int_eq(amscr_index_member_scores(x, i, 0, ma, NSHAPES), AMSCR_OK);
+        ck_assert_int_eq(amscr_index_member_scores(y, i, 0, mb, NSHAPES), AMSCR_OK);
+        ck_assert(memcmp(ma, mb, sizeof ma) == 0);
+    }
     amscr_free(b2);
     ck_assert_int_eq(amscr_index_save_memory(y, &b2, &len2), AMSCR_OK);
     ck_assert_uint_eq(len2, len);
@@ -602,9 +614,9 @@ START_TEST(stored_features)
     amscr_index_free(y);
     y = NULL;
     remove(path);
-    /* two frames announced as one: refused */
+    /* two frames announced as one: refused (from format 16 the forward heights only) */
     unsigned char *b = buf;
-    size_t at = len - 8 - (12 + NSHAPES * 2 * 2 * 64 * AMSCR__HF_BINS + 4);
+    size_t at = len - 8 - (12 + NSHAPES * 2 * 64 * AMSCR__HF_BINS + 4);
     ck_assert_int_eq(b[at], 2);
     b[at] = 1;
     uint64_t h = amscr__db_checksum(4, b, len - 8);
@@ -690,6 +702,15 @@ START_TEST(inner_lists)
 }
 END_TEST
 
+/* Inner features read from a file before version 16: the values of a (rounded from them) are b's,
+ * the scale and norm to float32's precision. */
+static void same_inner(const amscr__inner *a, const amscr__inner *b)
+{
+    ck_assert(memcmp(a->re, b->re, sizeof a->re) == 0 && memcmp(a->im, b->im, sizeof a->im) == 0);
+    ck_assert(fabs(a->scale - b->scale) <= 1e-6 * b->scale);
+    ck_assert(fabs(a->norm2 - b->norm2) <= 1e-5 * b->norm2);
+}
+
 /* The inner graph's section of a file: a count that is not the params', a bad list entry or a
  * feature that is not finite are refused with a detail; a version 8 file (0.7: one graph)
  * loads to the same scores, but not one whose params give the inner graph a share. */
@@ -702,26 +723,26 @@ START_TEST(inner_section)
     size_t k2 = x->k2, fk = AMSCR__INNER_F * AMSCR__INNER_K, len = 0;
     void *buf = NULL;
     ck_assert_uint_gt(k2, 0);
-    /* version 15 (compact shapes, the inner features in float32) */
+    /* version 16 (compact shapes, the inner features as int16 and a scale) */
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    size_t sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * (4 * 2 * fk + 8), at = len - 8 - sec;
+    size_t sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * (8 + 2 * 2 * fk), at = len - 8 - sec;
     unsigned char *b = malloc(len);
     memcpy(b, buf, len);
-    ck_assert_uint_eq(b[8], 15);
+    ck_assert_uint_eq(b[8], 16);
     ck_assert_uint_eq(b[at], k2);
     b[at] = 0; /* no inner graph, the params give one */
-    reseal(b, len, 15);
+    reseal(b, len, 16);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner graph") != NULL);
     memcpy(b, buf, len);
     b[at + 12] = 1; /* shape 0's inner list not starting with itself */
-    reseal(b, len, 15);
+    reseal(b, len, 16);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner neighbour") != NULL);
     memcpy(b, buf, len);
-    float fnan = NAN;
-    memcpy(b + at + 12 + NSHAPES * k2 * 12 + 4 * 3, &fnan, 4); /* shape 0's fourth real part */
-    reseal(b, len, 15);
+    double dnan = NAN;
+    memcpy(b + at + 12 + NSHAPES * k2 * 12, &dnan, 8); /* shape 0's scale */
+    reseal(b, len, 16);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);
     ck_assert_ptr_null(y);
@@ -732,13 +753,32 @@ START_TEST(inner_section)
     y = NULL;
     free(b);
     amscr_free(buf);
-    /* version 14 (0.14's first builds: the inner features in f64): the same features, bit for bit,
-     * and a value beyond float32's range refused */
+    /* version 15 (the inner features in float32): the same values, the scale to float32's
+     * precision; a value that is not finite refused */
+    ck_assert_int_eq(amscr__index_write(x, 15, &buf, &len), AMSCR_OK);
+    sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * (4 * 2 * fk + 8), at = len - 8 - sec;
+    ck_assert_int_eq(amscr_index_load_memory(buf, len, &y), AMSCR_OK);
+    for (size_t i = 0; i < NSHAPES; i++)
+        same_inner(&y->inner[i], &x->inner[i]);
+    amscr_index_free(y);
+    y = NULL;
+    b = malloc(len);
+    memcpy(b, buf, len);
+    float fnan = NAN;
+    memcpy(b + at + 12 + NSHAPES * k2 * 12 + 4 * 3, &fnan, 4); /* shape 0's fourth real part */
+    reseal(b, len, 15);
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);
+    ck_assert_ptr_null(y);
+    free(b);
+    amscr_free(buf);
+    /* version 14 (0.14's first builds: the inner features in f64): the same features, and a
+     * value beyond float32's range refused */
     ck_assert_int_eq(amscr__index_write(x, 14, &buf, &len), AMSCR_OK);
     sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * 8 * (2 * fk + 1), at = len - 8 - sec;
     ck_assert_int_eq(amscr_index_load_memory(buf, len, &y), AMSCR_OK);
     for (size_t i = 0; i < NSHAPES; i++)
-        ck_assert(memcmp(&y->inner[i], &x->inner[i], sizeof x->inner[i]) == 0);
+        same_inner(&y->inner[i], &x->inner[i]);
     amscr_index_free(y);
     y = NULL;
     b = malloc(len);
