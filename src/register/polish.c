@@ -36,6 +36,7 @@
 #include "ordered.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -282,7 +283,17 @@ static void add_row(double N[36], double rhs[6], double weight, double sx, doubl
 static double side_cut(const curve_t *c, double *sorted, double *kept)
 {
     memcpy(sorted, c->d2, c->n * sizeof *sorted);
-    double cut = RESID_K * median(sorted, c->n);
+    double cut;
+    if (getenv("BITE_Q25B")) {
+        double med = median(sorted, c->n);
+        amscr__select_kth(sorted, c->n / 2, c->n / 4); /* the lower half holds the lower quartile */
+        double q = 4.48 * sorted[c->n / 4];
+        cut = RESID_K * (med <= 4.0 * q ? med : q);
+    } else if (getenv("BITE_Q25")) {
+        amscr__select_kth(sorted, c->n, c->n / 4);
+        cut = RESID_K * 4.48 * sorted[c->n / 4];
+    } else
+        cut = RESID_K * median(sorted, c->n);
     *kept = 0.0;
     for (size_t i = 0; i < c->n; i++)
         *kept += c->d2[i] <= cut && isfinite(c->d2[i]);
@@ -440,6 +451,8 @@ static size_t rank_starts(amscr__polish_state *ps, double S[][6], double Y[][6],
         from_frames(&ps->w, ps->f, ps->h, Y[k], S[k]);
         if (may_win[k] && cost[k] < (best < count ? cost[best] : INFINITY))
             best = k;
+        if (getenv("BITE_DBG"))
+            fprintf(stderr, "polish start %zu may %d cost %.5f (wa %.2f wb %.2f, a=%s)\n", k, may_win[k], cost[k], ps->w.wa, ps->w.wb, ps->w.a == &ps->w.src ? "src" : "tgt");
     }
     return best;
 }

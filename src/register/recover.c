@@ -27,6 +27,7 @@
 #include "nearest.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -61,12 +62,20 @@
 #define RECOVER_AMBIGUOUS 0.5
 /* Share of the samples each direction of the ranking cost keeps. */
 #define RECOVER_RANK_KEEP 0.7
+/* Fragments of the target placed on the source (the target a part of the source: a bite that
+ * cut a thin shape apart leaves a piece whose boundary, but for the cut, is an arc of the
+ * source's), their share of the target's boundary and the least share of the source's affine
+ * length they are searched at. */
+#define RECOVER_TFRAGS 5
+#define RECOVER_TSHARE 0.6
+#define RECOVER_TPHI_MIN 0.15
 
 /* Scratch of one refinement/ranking at n samples (doubles). */
 typedef struct {
     double *q, *r2, *sorted, *seg, *Hd, *P;
     size_t nd;
     amscr__grid grid; /* over Hd's vertices: the global search's first guess */
+    int tside;
 } scratch_t;
 
 /* Closest target points of X f (global search when `global`, else around seg), the adaptive
@@ -155,6 +164,23 @@ static double two_way_cost(const amscr_descriptor *f, const amscr_descriptor *h,
         s->sorted[b] = amscr__closest_on_polygon(s->P, n, f->params.closed, 0, n, h->base[2 * b], h->base[2 * b + 1],
                                                  &qx, &qy, &seg);
     }
+    if (getenv("BITE_TRUNC")) {
+        double tau = atof(getenv("BITE_TRUNC")) * 1.4142135623730951, d2 = tau > 0.0 ? tau * tau : RECOVER_INLIER_DIST * RECOVER_INLIER_DIST, sa = 0.0, sb = 0.0;
+        for (size_t a = 0; a < n; a++)
+            sa += s->r2[a] < d2 ? s->r2[a] : d2;
+        for (size_t b = 0; b < h->n; b++)
+            sb += s->sorted[b] < d2 ? s->sorted[b] : d2;
+        return sa / (double)n + sb / (double)h->n;
+    }
+    if (getenv("BITE_CONS")) {
+        double d2 = RECOVER_INLIER_DIST * RECOVER_INLIER_DIST;
+        size_t a_in = 0, b_in = 0;
+        for (size_t a = 0; a < n; a++)
+            a_in += s->r2[a] <= d2;
+        for (size_t b = 0; b < h->n; b++)
+            b_in += s->sorted[b] <= d2;
+        return 2.0 - (double)a_in / (double)n - (double)b_in / (double)h->n + 1e-3 * there;
+    }
     return there + trimmed_mean(s->sorted, h->n);
 }
 
@@ -189,10 +215,11 @@ static void fragment_order(const double *r2, size_t n, size_t order[RECOVER_FRAG
 
 /* The map of fragment k of f placed on h by partial matching, in f's normalized frame.
  * Returns a failure status when the fragment cannot be placed. */
-static amscr_status fragment_start(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                   size_t k, amscr_workspace *ws, double *pts, double X[6])
+static amscr_status fragment_place(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                   size_t k, size_t nfrags, double share, double phi_min, amscr_workspace *ws,
+                                   double *pts, double X[6])
 {
-    size_t n = f->n, len = (size_t)(RECOVER_SHARE * (double)n), start = k * n / RECOVER_FRAGS;
+    size_t n = f->n, len = (size_t)(share * (double)n), start = k * n / nfrags;
     for (size_t j = 0; j < len; j++)
         memcpy(pts + 2 * j, f->base + 2 * ((start + j) % n), 2 * sizeof *pts);
     amscr_params pp = *prm;
@@ -206,12 +233,52 @@ static amscr_status fragment_start(const amscr_params *prm, const amscr_descript
         st = amscr_descriptor_new(&pp, c, &d);
     pp.closed = 1;
     if (st == AMSCR_OK)
-        st = amscr__match_partial_min(&pp, d, h, RECOVER_PHI_MIN, ws, &mf);
+        st = amscr__match_partial_min(&pp, d, h, phi_min, ws, &mf);
     if (st == AMSCR_OK) /* d's input frame is f's normalized frame */
         amscr__affine_compose(mf.X, d->fwd, X);
     amscr_descriptor_free(d);
     amscr_contour_free(c);
     return st; /* a fragment that cannot be placed is skipped; out of memory is not */
+}
+
+static amscr_status fragment_start(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                   size_t k, amscr_workspace *ws, double *pts, double X[6])
+{
+    return fragment_place(prm, f, h, k, RECOVER_FRAGS, RECOVER_SHARE, RECOVER_PHI_MIN, ws, pts, X);
+}
+
+/* The inverse of the affine map Y; 0 when singular. */
+static int affine_inverse(const double Y[6], double X[6])
+{
+    double det = Y[0] * Y[4] - Y[1] * Y[3];
+    if (!(fabs(det) > 1e-12))
+        return 0;
+    X[0] = Y[4] / det;
+    X[1] = -Y[1] / det;
+    X[3] = -Y[3] / det;
+    X[4] = Y[0] / det;
+    X[2] = -(X[0] * Y[2] + X[1] * Y[5]);
+    X[5] = -(X[3] * Y[2] + X[4] * Y[5]);
+    return 1;
+}
+
+/* The map f -> h from fragment k of the target h placed on the source f, refined from the
+ * target's side (its samples onto the source: all of them but the cut have a partner there)
+ * and inverted; its source-side pairs left in s. Returns a failure status when the fragment
+ * cannot be placed or the map is singular. */
+static amscr_status target_fragment(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                    size_t k, amscr_workspace *ws, scratch_t *s, scratch_t *t, double *pts,
+                                    double X[6])
+{
+    double Y[6], cut;
+    amscr_status st = fragment_place(prm, h, f, k, RECOVER_TFRAGS, RECOVER_TSHARE, RECOVER_TPHI_MIN, ws, pts, Y);
+    if (st != AMSCR_OK)
+        return st;
+    refine_adaptive(prm, h, t, Y);
+    if (!affine_inverse(Y, X))
+        return amscr__fail(AMSCR_E_DEGENERATE, "registration: a singular fragment map");
+    pairs(f, s, X, 1, &cut);
+    return AMSCR_OK;
 }
 
 /* Refines `best` once more, stores the map in m and its pairs in ws->rbuf (the reported
@@ -224,7 +291,12 @@ static amscr_status finish(const amscr_params *prm, const amscr_descriptor *f, s
     amscr_status st = amscr__ws_reserve_refine(ws, n);
     if (st != AMSCR_OK)
         return st;
-    double cut = refine_adaptive(prm, f, s, best), kept = 0.0, sum = 0.0;
+    double cut, kept = 0.0, sum = 0.0;
+    if (getenv("BITE_NOFINISH") || (getenv("BITE_TFIN") && s->tside)) {
+        pairs(f, s, best, 1, &cut);
+        cut = RECOVER_INLIER_DIST * RECOVER_INLIER_DIST;
+    } else
+        cut = refine_adaptive(prm, f, s, best);
     memcpy(ws->rbuf, s->q, 2 * n * sizeof *s->q);
     memcpy(ws->rbuf + 2 * n, s->r2, n * sizeof *s->r2);
     for (size_t a = 0; a < n; a++) {
@@ -296,45 +368,82 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
     size_t n = f->n;
     if (!amscr__recover_applies(f, h, ws, m))
         return AMSCR_OK;
-    scratch_t s = {0};
+    scratch_t s = {0}, t = {0};
     amscr_status st = scratch_new(f, h, &s);
     if (st != AMSCR_OK)
         return st;
     double *pts = s.P + 2 * n;
-    double best[6], tried[RECOVER_FRAGS + 1][6], cost[RECOVER_FRAGS + 1], best_cost;
-    size_t order[RECOVER_FRAGS];
+    double best[6], tried[RECOVER_FRAGS + RECOVER_TFRAGS + 1][6], cost[RECOVER_FRAGS + RECOVER_TFRAGS + 1], best_cost;
+    size_t order[RECOVER_FRAGS], nt = 1;
+    int agree = 0;
     fragment_order(ws->rbuf + 2 * n, n, order);
     memcpy(best, m->X, sizeof best);
     refine_adaptive(prm, f, &s, best);
     memcpy(tried[0], best, sizeof best);
     best_cost = cost[0] = two_way_cost(f, h, &s, best);
-    for (size_t i = 0, nt = 1; i < RECOVER_FRAGS; i++) {
+    if (getenv("BITE_DBG"))
+        fprintf(stderr, "reported: cost %.5f inl %.3f\n", cost[0], inlier_share(s.r2, n));
+    for (size_t i = 0; i < RECOVER_FRAGS + RECOVER_TFRAGS && !agree; i++) {
         double *X = tried[nt];
-        st = fragment_start(prm, f, h, order[i], ws, pts, X);
+        int tside = i >= RECOVER_FRAGS;
+        if (tside && getenv("BITE_NOT"))
+            break;
+        if (tside && !t.q) {
+            st = scratch_new(h, f, &t);
+            if (st != AMSCR_OK)
+                break;
+        }
+        if (tside)
+            st = target_fragment(prm, f, h, i - RECOVER_FRAGS, ws, &s, &t, pts, X);
+        else {
+            st = fragment_start(prm, f, h, order[i], ws, pts, X);
+            if (st == AMSCR_OK)
+                refine_adaptive(prm, f, &s, X);
+        }
         if (st == AMSCR_E_NOMEM)
             break;
         if (st != AMSCR_OK)
             continue;
-        refine_adaptive(prm, f, &s, X);
         double c = cost[nt] = two_way_cost(f, h, &s, X);
-        if (c < best_cost) {
-            best_cost = c;
+        if (getenv("BITE_DBG"))
+            fprintf(stderr, "%s %zu: cost %.5f inl %.3f\n", tside ? "tgt" : "src", i, c, inlier_share(s.r2, n));
+        if (c < best_cost)
+            s.tside = tside;
+        if (c < best_cost || (getenv("BITE_FORCE") && (size_t)atoi(getenv("BITE_FORCE")) == i)) {
+            best_cost = getenv("BITE_FORCE") && (size_t)atoi(getenv("BITE_FORCE")) == i ? -1.0 : c;
             memcpy(best, X, sizeof best);
         }
-        int agree = 0; /* with an earlier map (tried[0]: the reported one), one of the two the best so far */
+        /* with an earlier map (tried[0]: the reported one), one of the two the best so far */
         for (size_t j = m->ambiguity < RECOVER_AMBIGUOUS ? 0 : 1; j < nt && !agree; j++)
             agree = (c <= best_cost || cost[j] <= best_cost) &&
                     amscr__map_gap2(f, X, tried[j]) <= RECOVER_AGREE * RECOVER_AGREE;
         nt++;
-        if (agree)
-            break;
+        if (getenv("BITE_FORCE"))
+            agree = 0;
     }
+    scratch_free(&t);
     if (st == AMSCR_E_NOMEM) {
         scratch_free(&s);
         return st;
     }
     amscr__clear_error();
+    double entry[6];
+    memcpy(entry, m->X, sizeof entry);
     st = finish(prm, f, &s, ws, best, m);
+    /* a map the fragments moved off the whole-curve search's winner: the search's other starts
+     * assumed the whole boundary matched and are not carried on to the polish's ranking */
+    if (!getenv("BITE_KEEPCAND") && amscr__map_gap2(f, m->X, entry) > AMSCR__DISTINCT_GAP2) {
+        m->ncand = m->ncand_base = 0;
+        if (getenv("BITE_AMB")) {
+            double amb = 0.0;
+            for (size_t j = 0; j < nt; j++)
+                if (isfinite(cost[j]) && amscr__map_gap2(f, tried[j], m->X) > AMSCR__DISTINCT_GAP2) {
+                    double r = (best_cost + AMSCR__AMBIGUITY_FLOOR) / (cost[j] + AMSCR__AMBIGUITY_FLOOR);
+                    amb = r > amb ? (r > 1.0 ? 1.0 : r) : amb;
+                }
+            m->ambiguity = amb;
+        }
+    }
     scratch_free(&s);
     return st;
 }
