@@ -36,7 +36,6 @@
 #include "ordered.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -53,6 +52,15 @@
  * distance 98.6 / 95.7 %, 5x 100 / 97.1 % at 1 / 2 % noise). A missing run's pairs lie far
  * beyond it. */
 #define RESID_K 25.0
+/* When more than half of a side has no counterpart (a bite that cut a thin shape apart, a
+ * target whose outline runs into holes the source lacks), the median lies among those pairs and
+ * the cut keeps them all. The lower quartile then speaks for the matched pairs: scaled by
+ * QUARTILE_TO_MEDIAN ((0.6745 / 0.3186)^2, the squared median of Gaussian distances over their
+ * squared lower quartile) it is what the median would be; it replaces the median when that is
+ * more than QUARTILE_GAP times larger (set by reasoning, not fitted: a clean or noisy curve's
+ * median stays within a small factor of it; measured as a whole with the recovery's changes). */
+#define QUARTILE_TO_MEDIAN 4.48
+#define QUARTILE_GAP 4.0
 /* A polish refines a map; one that changed the moved curve's area by more than this factor
  * (or flipped it) collapsed instead: a fragment paired only onto the target can always shrink
  * onto a small piece of it (measured: a 50 % fragment of device6 onto 0.2 % of the target,
@@ -279,21 +287,14 @@ static void add_row(double N[36], double rhs[6], double weight, double sx, doubl
     }
 }
 
-/* The cut of one side's squared distances (RESID_K times their median) and how many it keeps. */
+/* The cut of one side's squared distances (RESID_K times their median, or times the median their
+ * lower quartile implies when the median lies among pairs without a counterpart) and how many
+ * it keeps. */
 static double side_cut(const curve_t *c, double *sorted, double *kept)
 {
     memcpy(sorted, c->d2, c->n * sizeof *sorted);
-    double cut;
-    if (getenv("BITE_Q25B")) {
-        double med = median(sorted, c->n);
-        amscr__select_kth(sorted, c->n / 2, c->n / 4); /* the lower half holds the lower quartile */
-        double q = 4.48 * sorted[c->n / 4];
-        cut = RESID_K * (med <= 4.0 * q ? med : q);
-    } else if (getenv("BITE_Q25")) {
-        amscr__select_kth(sorted, c->n, c->n / 4);
-        cut = RESID_K * 4.48 * sorted[c->n / 4];
-    } else
-        cut = RESID_K * median(sorted, c->n);
+    amscr__select_kth(sorted, c->n, c->n / 4);
+    double cut = RESID_K * QUARTILE_TO_MEDIAN * sorted[c->n / 4];
     *kept = 0.0;
     for (size_t i = 0; i < c->n; i++)
         *kept += c->d2[i] <= cut && isfinite(c->d2[i]);
@@ -451,8 +452,6 @@ static size_t rank_starts(amscr__polish_state *ps, double S[][6], double Y[][6],
         from_frames(&ps->w, ps->f, ps->h, Y[k], S[k]);
         if (may_win[k] && cost[k] < (best < count ? cost[best] : INFINITY))
             best = k;
-        if (getenv("BITE_DBG"))
-            fprintf(stderr, "polish start %zu may %d cost %.5f (wa %.2f wb %.2f, a=%s)\n", k, may_win[k], cost[k], ps->w.wa, ps->w.wb, ps->w.a == &ps->w.src ? "src" : "tgt");
     }
     return best;
 }

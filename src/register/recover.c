@@ -18,16 +18,19 @@
  *   2b. as soon as two of these refined maps agree (RECOVER_AGREE), one of them the best so far
  *      by the cost of 3., no further fragment is placed (placements: ~60 % of the stage's time);
  *      after an ambiguous whole-curve search (RECOVER_AMBIGUOUS) two fragments must agree;
- *   3. the candidates are ranked by a two-way trimmed cost — source samples to the target and
+ *   2c. when no two agree, RECOVER_TFRAGS fragments of the TARGET are placed on the source the
+ *      same way, refined from the target's side and inverted (a bite that cut a thin shape
+ *      apart leaves a target that is a part of the source, which no source fragment fits in);
+ *   3. the candidates are ranked by a two-way capped cost — source samples to the target and
  *      target samples to the mapped source — so a map that collapses the source onto a piece
  *      of the target (low one-way cost) loses to one that covers the target.
- * The winner's closest-point pairs are left in ws->rbuf for the reported QR solve. */
+ * The winner's closest-point pairs are left in ws->rbuf for the reported QR solve; a winner that
+ * is not the search's keeps the search's other starts from winning the polish's ranking. */
 #include "dense.h"
 #include "match.h"
 #include "nearest.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -60,8 +63,6 @@
  * equally well, agrees with (measured: a 12-fold star with 10 % missing stopped on one that a
  * later fragment beats); two fragments must then agree. */
 #define RECOVER_AMBIGUOUS 0.5
-/* Share of the samples each direction of the ranking cost keeps. */
-#define RECOVER_RANK_KEEP 0.7
 /* Fragments of the target placed on the source (the target a part of the source: a bite that
  * cut a thin shape apart leaves a piece whose boundary, but for the cut, is an arc of the
  * source's), their share of the target's boundary and the least share of the source's affine
@@ -75,7 +76,6 @@ typedef struct {
     double *q, *r2, *sorted, *seg, *Hd, *P;
     size_t nd;
     amscr__grid grid; /* over Hd's vertices: the global search's first guess */
-    int tside;
 } scratch_t;
 
 /* Closest target points of X f (global search when `global`, else around seg), the adaptive
@@ -134,54 +134,29 @@ static double refine_adaptive(const amscr_params *prm, const amscr_descriptor *f
     return cut;
 }
 
-/* Mean of the smallest RECOVER_RANK_KEEP share of v (n values; reordered). */
-static double trimmed_mean(double *v, size_t n)
-{
-    size_t keep = (size_t)(RECOVER_RANK_KEEP * (double)n);
-    if (keep < 1)
-        keep = 1;
-    amscr__select_kth(v, n, keep - 1);
-    double sum = 0.0;
-    for (size_t a = 0; a < keep; a++)
-        sum += v[a];
-    return sum / (double)keep;
-}
-
-/* The two-way ranking cost of X, whose source-to-target residuals are in s->r2. */
+/* The two-way ranking cost of X, whose source-to-target residuals are in s->r2: the mean
+ * squared distance of the source samples to the target and of the target samples to the mapped
+ * source, each capped at the inlier distance squared (a part without a counterpart costs its share
+ * times the cap, whatever that share: a bite that cut a thin shape apart leaves half the source
+ * unmatched, which a trimmed mean of a fixed share would count against the right map). */
 static double two_way_cost(const amscr_descriptor *f, const amscr_descriptor *h, scratch_t *s, const double X[6])
 {
     size_t n = f->n;
+    double cap = RECOVER_INLIER_DIST * RECOVER_INLIER_DIST, there = 0.0, back = 0.0;
     for (size_t a = 0; a < n; a++) {
         double fx = f->base[2 * a], fy = f->base[2 * a + 1];
         s->P[2 * a] = X[0] * fx + X[1] * fy + X[2];
         s->P[2 * a + 1] = X[3] * fx + X[4] * fy + X[5];
-        s->sorted[a] = s->r2[a];
+        there += s->r2[a] < cap ? s->r2[a] : cap;
     }
-    double there = trimmed_mean(s->sorted, n);
     for (size_t b = 0; b < h->n; b++) {
         double qx, qy;
         size_t seg;
-        s->sorted[b] = amscr__closest_on_polygon(s->P, n, f->params.closed, 0, n, h->base[2 * b], h->base[2 * b + 1],
-                                                 &qx, &qy, &seg);
+        double d2 = amscr__closest_on_polygon(s->P, n, f->params.closed, 0, n, h->base[2 * b], h->base[2 * b + 1],
+                                              &qx, &qy, &seg);
+        back += d2 < cap ? d2 : cap;
     }
-    if (getenv("BITE_TRUNC")) {
-        double tau = atof(getenv("BITE_TRUNC")) * 1.4142135623730951, d2 = tau > 0.0 ? tau * tau : RECOVER_INLIER_DIST * RECOVER_INLIER_DIST, sa = 0.0, sb = 0.0;
-        for (size_t a = 0; a < n; a++)
-            sa += s->r2[a] < d2 ? s->r2[a] : d2;
-        for (size_t b = 0; b < h->n; b++)
-            sb += s->sorted[b] < d2 ? s->sorted[b] : d2;
-        return sa / (double)n + sb / (double)h->n;
-    }
-    if (getenv("BITE_CONS")) {
-        double d2 = RECOVER_INLIER_DIST * RECOVER_INLIER_DIST;
-        size_t a_in = 0, b_in = 0;
-        for (size_t a = 0; a < n; a++)
-            a_in += s->r2[a] <= d2;
-        for (size_t b = 0; b < h->n; b++)
-            b_in += s->sorted[b] <= d2;
-        return 2.0 - (double)a_in / (double)n - (double)b_in / (double)h->n + 1e-3 * there;
-    }
-    return there + trimmed_mean(s->sorted, h->n);
+    return there / (double)n + back / (double)h->n;
 }
 
 static double inlier_share(const double *r2, size_t n)
@@ -291,12 +266,7 @@ static amscr_status finish(const amscr_params *prm, const amscr_descriptor *f, s
     amscr_status st = amscr__ws_reserve_refine(ws, n);
     if (st != AMSCR_OK)
         return st;
-    double cut, kept = 0.0, sum = 0.0;
-    if (getenv("BITE_NOFINISH") || (getenv("BITE_TFIN") && s->tside)) {
-        pairs(f, s, best, 1, &cut);
-        cut = RECOVER_INLIER_DIST * RECOVER_INLIER_DIST;
-    } else
-        cut = refine_adaptive(prm, f, s, best);
+    double cut = refine_adaptive(prm, f, s, best), kept = 0.0, sum = 0.0;
     memcpy(ws->rbuf, s->q, 2 * n * sizeof *s->q);
     memcpy(ws->rbuf + 2 * n, s->r2, n * sizeof *s->r2);
     for (size_t a = 0; a < n; a++) {
@@ -381,13 +351,9 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
     refine_adaptive(prm, f, &s, best);
     memcpy(tried[0], best, sizeof best);
     best_cost = cost[0] = two_way_cost(f, h, &s, best);
-    if (getenv("BITE_DBG"))
-        fprintf(stderr, "reported: cost %.5f inl %.3f\n", cost[0], inlier_share(s.r2, n));
     for (size_t i = 0; i < RECOVER_FRAGS + RECOVER_TFRAGS && !agree; i++) {
         double *X = tried[nt];
         int tside = i >= RECOVER_FRAGS;
-        if (tside && getenv("BITE_NOT"))
-            break;
         if (tside && !t.q) {
             st = scratch_new(h, f, &t);
             if (st != AMSCR_OK)
@@ -405,12 +371,8 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
         if (st != AMSCR_OK)
             continue;
         double c = cost[nt] = two_way_cost(f, h, &s, X);
-        if (getenv("BITE_DBG"))
-            fprintf(stderr, "%s %zu: cost %.5f inl %.3f\n", tside ? "tgt" : "src", i, c, inlier_share(s.r2, n));
-        if (c < best_cost)
-            s.tside = tside;
-        if (c < best_cost || (getenv("BITE_FORCE") && (size_t)atoi(getenv("BITE_FORCE")) == i)) {
-            best_cost = getenv("BITE_FORCE") && (size_t)atoi(getenv("BITE_FORCE")) == i ? -1.0 : c;
+        if (c < best_cost) {
+            best_cost = c;
             memcpy(best, X, sizeof best);
         }
         /* with an earlier map (tried[0]: the reported one), one of the two the best so far */
@@ -418,8 +380,6 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
             agree = (c <= best_cost || cost[j] <= best_cost) &&
                     amscr__map_gap2(f, X, tried[j]) <= RECOVER_AGREE * RECOVER_AGREE;
         nt++;
-        if (getenv("BITE_FORCE"))
-            agree = 0;
     }
     scratch_free(&t);
     if (st == AMSCR_E_NOMEM) {
@@ -430,20 +390,15 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
     double entry[6];
     memcpy(entry, m->X, sizeof entry);
     st = finish(prm, f, &s, ws, best, m);
-    /* a map the fragments moved off the whole-curve search's winner: the search's other starts
-     * assumed the whole boundary matched and are not carried on to the polish's ranking */
-    if (!getenv("BITE_KEEPCAND") && amscr__map_gap2(f, m->X, entry) > AMSCR__DISTINCT_GAP2) {
-        m->ncand = m->ncand_base = 0;
-        if (getenv("BITE_AMB")) {
-            double amb = 0.0;
-            for (size_t j = 0; j < nt; j++)
-                if (isfinite(cost[j]) && amscr__map_gap2(f, tried[j], m->X) > AMSCR__DISTINCT_GAP2) {
-                    double r = (best_cost + AMSCR__AMBIGUITY_FLOOR) / (cost[j] + AMSCR__AMBIGUITY_FLOOR);
-                    amb = r > amb ? (r > 1.0 ? 1.0 : r) : amb;
-                }
-            m->ambiguity = amb;
-        }
-    }
+    /* a map the fragments moved off the whole-curve search's winner, and clearly better than it
+     * (the reported map not an alternative by AMSCR__ALT_RATIO): the search's other starts
+     * assumed the whole boundary matched; the polish still ranks them (the ambiguity) but none
+     * of them replaces the recovered map (its two-way cost keeps 70 % of each side: the right
+     * map of a shape cut apart leaves more of the source unmatched). Where the recovery's
+     * candidates fit alike (a symmetric shape's turns), the polish's ranking decides as before. */
+    if (st == AMSCR_OK && amscr__map_gap2(f, m->X, entry) > AMSCR__DISTINCT_GAP2 &&
+        best_cost + AMSCR__AMBIGUITY_FLOOR < AMSCR__ALT_RATIO * (cost[0] + AMSCR__AMBIGUITY_FLOOR))
+        m->ncand_base = 0;
     scratch_free(&s);
     return st;
 }
