@@ -52,15 +52,6 @@
  * distance 98.6 / 95.7 %, 5x 100 / 97.1 % at 1 / 2 % noise). A missing run's pairs lie far
  * beyond it. */
 #define RESID_K 25.0
-/* When more than half of a side has no counterpart (a bite that cut a thin shape apart, a
- * target whose outline runs into holes the source lacks), the median lies among those pairs and
- * the cut keeps them all. The lower quartile then speaks for the matched pairs: scaled by
- * QUARTILE_TO_MEDIAN ((0.6745 / 0.3186)^2, the squared median of Gaussian distances over their
- * squared lower quartile) it is what the median would be; it replaces the median when that is
- * more than QUARTILE_GAP times larger (set by reasoning, not fitted: a clean or noisy curve's
- * median stays within a small factor of it; measured as a whole with the recovery's changes). */
-#define QUARTILE_TO_MEDIAN 4.48
-#define QUARTILE_GAP 4.0
 /* A polish refines a map; one that changed the moved curve's area by more than this factor
  * (or flipped it) collapsed instead: a fragment paired only onto the target can always shrink
  * onto a small piece of it (measured: a 50 % fragment of device6 onto 0.2 % of the target,
@@ -287,14 +278,11 @@ static void add_row(double N[36], double rhs[6], double weight, double sx, doubl
     }
 }
 
-/* The cut of one side's squared distances (RESID_K times their median, or times the median their
- * lower quartile implies when the median lies among pairs without a counterpart) and how many
- * it keeps. */
+/* The cut of one side's squared distances (RESID_K times their median) and how many it keeps. */
 static double side_cut(const curve_t *c, double *sorted, double *kept)
 {
     memcpy(sorted, c->d2, c->n * sizeof *sorted);
-    amscr__select_kth(sorted, c->n, c->n / 4);
-    double cut = RESID_K * QUARTILE_TO_MEDIAN * sorted[c->n / 4];
+    double cut = RESID_K * median(sorted, c->n);
     *kept = 0.0;
     for (size_t i = 0; i < c->n; i++)
         *kept += c->d2[i] <= cut && isfinite(c->d2[i]);

@@ -18,14 +18,10 @@
  *   2b. as soon as two of these refined maps agree (RECOVER_AGREE), one of them the best so far
  *      by the cost of 3., no further fragment is placed (placements: ~60 % of the stage's time);
  *      after an ambiguous whole-curve search (RECOVER_AMBIGUOUS) two fragments must agree;
- *   2c. when no two agree, RECOVER_TFRAGS fragments of the TARGET are placed on the source the
- *      same way, refined from the target's side and inverted (a bite that cut a thin shape
- *      apart leaves a target that is a part of the source, which no source fragment fits in);
- *   3. the candidates are ranked by a two-way capped cost — source samples to the target and
+ *   3. the candidates are ranked by a two-way trimmed cost — source samples to the target and
  *      target samples to the mapped source — so a map that collapses the source onto a piece
  *      of the target (low one-way cost) loses to one that covers the target.
- * The winner's closest-point pairs are left in ws->rbuf for the reported QR solve; a winner that
- * is not the search's keeps the search's other starts from winning the polish's ranking. */
+ * The winner's closest-point pairs are left in ws->rbuf for the reported QR solve. */
 #include "dense.h"
 #include "match.h"
 #include "nearest.h"
@@ -63,13 +59,8 @@
  * equally well, agrees with (measured: a 12-fold star with 10 % missing stopped on one that a
  * later fragment beats); two fragments must then agree. */
 #define RECOVER_AMBIGUOUS 0.5
-/* Fragments of the target placed on the source (the target a part of the source: a bite that
- * cut a thin shape apart leaves a piece whose boundary, but for the cut, is an arc of the
- * source's), their share of the target's boundary and the least share of the source's affine
- * length they are searched at. */
-#define RECOVER_TFRAGS 5
-#define RECOVER_TSHARE 0.6
-#define RECOVER_TPHI_MIN 0.15
+/* Share of the samples each direction of the ranking cost keeps. */
+#define RECOVER_RANK_KEEP 0.7
 
 /* Scratch of one refinement/ranking at n samples (doubles). */
 typedef struct {
@@ -134,29 +125,37 @@ static double refine_adaptive(const amscr_params *prm, const amscr_descriptor *f
     return cut;
 }
 
-/* The two-way ranking cost of X, whose source-to-target residuals are in s->r2: the mean
- * squared distance of the source samples to the target and of the target samples to the mapped
- * source, each capped at the inlier distance squared (a part without a counterpart costs its share
- * times the cap, whatever that share: a bite that cut a thin shape apart leaves half the source
- * unmatched, which a trimmed mean of a fixed share would count against the right map). */
+/* Mean of the smallest RECOVER_RANK_KEEP share of v (n values; reordered). */
+static double trimmed_mean(double *v, size_t n)
+{
+    size_t keep = (size_t)(RECOVER_RANK_KEEP * (double)n);
+    if (keep < 1)
+        keep = 1;
+    amscr__select_kth(v, n, keep - 1);
+    double sum = 0.0;
+    for (size_t a = 0; a < keep; a++)
+        sum += v[a];
+    return sum / (double)keep;
+}
+
+/* The two-way ranking cost of X, whose source-to-target residuals are in s->r2. */
 static double two_way_cost(const amscr_descriptor *f, const amscr_descriptor *h, scratch_t *s, const double X[6])
 {
     size_t n = f->n;
-    double cap = RECOVER_INLIER_DIST * RECOVER_INLIER_DIST, there = 0.0, back = 0.0;
     for (size_t a = 0; a < n; a++) {
         double fx = f->base[2 * a], fy = f->base[2 * a + 1];
         s->P[2 * a] = X[0] * fx + X[1] * fy + X[2];
         s->P[2 * a + 1] = X[3] * fx + X[4] * fy + X[5];
-        there += s->r2[a] < cap ? s->r2[a] : cap;
+        s->sorted[a] = s->r2[a];
     }
+    double there = trimmed_mean(s->sorted, n);
     for (size_t b = 0; b < h->n; b++) {
         double qx, qy;
         size_t seg;
-        double d2 = amscr__closest_on_polygon(s->P, n, f->params.closed, 0, n, h->base[2 * b], h->base[2 * b + 1],
-                                              &qx, &qy, &seg);
-        back += d2 < cap ? d2 : cap;
+        s->sorted[b] = amscr__closest_on_polygon(s->P, n, f->params.closed, 0, n, h->base[2 * b], h->base[2 * b + 1],
+                                                 &qx, &qy, &seg);
     }
-    return there / (double)n + back / (double)h->n;
+    return there + trimmed_mean(s->sorted, h->n);
 }
 
 static double inlier_share(const double *r2, size_t n)
@@ -190,11 +189,10 @@ static void fragment_order(const double *r2, size_t n, size_t order[RECOVER_FRAG
 
 /* The map of fragment k of f placed on h by partial matching, in f's normalized frame.
  * Returns a failure status when the fragment cannot be placed. */
-static amscr_status fragment_place(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                   size_t k, size_t nfrags, double share, double phi_min, amscr_workspace *ws,
-                                   double *pts, double X[6])
+static amscr_status fragment_start(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                   size_t k, amscr_workspace *ws, double *pts, double X[6])
 {
-    size_t n = f->n, len = (size_t)(share * (double)n), start = k * n / nfrags;
+    size_t n = f->n, len = (size_t)(RECOVER_SHARE * (double)n), start = k * n / RECOVER_FRAGS;
     for (size_t j = 0; j < len; j++)
         memcpy(pts + 2 * j, f->base + 2 * ((start + j) % n), 2 * sizeof *pts);
     amscr_params pp = *prm;
@@ -208,52 +206,12 @@ static amscr_status fragment_place(const amscr_params *prm, const amscr_descript
         st = amscr_descriptor_new(&pp, c, &d);
     pp.closed = 1;
     if (st == AMSCR_OK)
-        st = amscr__match_partial_min(&pp, d, h, phi_min, ws, &mf);
+        st = amscr__match_partial_min(&pp, d, h, RECOVER_PHI_MIN, ws, &mf);
     if (st == AMSCR_OK) /* d's input frame is f's normalized frame */
         amscr__affine_compose(mf.X, d->fwd, X);
     amscr_descriptor_free(d);
     amscr_contour_free(c);
     return st; /* a fragment that cannot be placed is skipped; out of memory is not */
-}
-
-static amscr_status fragment_start(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                   size_t k, amscr_workspace *ws, double *pts, double X[6])
-{
-    return fragment_place(prm, f, h, k, RECOVER_FRAGS, RECOVER_SHARE, RECOVER_PHI_MIN, ws, pts, X);
-}
-
-/* The inverse of the affine map Y; 0 when singular. */
-static int affine_inverse(const double Y[6], double X[6])
-{
-    double det = Y[0] * Y[4] - Y[1] * Y[3];
-    if (!(fabs(det) > 1e-12))
-        return 0;
-    X[0] = Y[4] / det;
-    X[1] = -Y[1] / det;
-    X[3] = -Y[3] / det;
-    X[4] = Y[0] / det;
-    X[2] = -(X[0] * Y[2] + X[1] * Y[5]);
-    X[5] = -(X[3] * Y[2] + X[4] * Y[5]);
-    return 1;
-}
-
-/* The map f -> h from fragment k of the target h placed on the source f, refined from the
- * target's side (its samples onto the source: all of them but the cut have a partner there)
- * and inverted; its source-side pairs left in s. Returns a failure status when the fragment
- * cannot be placed or the map is singular. */
-static amscr_status target_fragment(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                    size_t k, amscr_workspace *ws, scratch_t *s, scratch_t *t, double *pts,
-                                    double X[6])
-{
-    double Y[6], cut;
-    amscr_status st = fragment_place(prm, h, f, k, RECOVER_TFRAGS, RECOVER_TSHARE, RECOVER_TPHI_MIN, ws, pts, Y);
-    if (st != AMSCR_OK)
-        return st;
-    refine_adaptive(prm, h, t, Y);
-    if (!affine_inverse(Y, X))
-        return amscr__fail(AMSCR_E_DEGENERATE, "registration: a singular fragment map");
-    pairs(f, s, X, 1, &cut);
-    return AMSCR_OK;
 }
 
 /* Refines `best` once more, stores the map in m and its pairs in ws->rbuf (the reported
@@ -338,67 +296,45 @@ amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descrip
     size_t n = f->n;
     if (!amscr__recover_applies(f, h, ws, m))
         return AMSCR_OK;
-    scratch_t s = {0}, t = {0};
+    scratch_t s = {0};
     amscr_status st = scratch_new(f, h, &s);
     if (st != AMSCR_OK)
         return st;
     double *pts = s.P + 2 * n;
-    double best[6], tried[RECOVER_FRAGS + RECOVER_TFRAGS + 1][6], cost[RECOVER_FRAGS + RECOVER_TFRAGS + 1], best_cost;
-    size_t order[RECOVER_FRAGS], nt = 1;
-    int agree = 0;
+    double best[6], tried[RECOVER_FRAGS + 1][6], cost[RECOVER_FRAGS + 1], best_cost;
+    size_t order[RECOVER_FRAGS];
     fragment_order(ws->rbuf + 2 * n, n, order);
     memcpy(best, m->X, sizeof best);
     refine_adaptive(prm, f, &s, best);
     memcpy(tried[0], best, sizeof best);
     best_cost = cost[0] = two_way_cost(f, h, &s, best);
-    for (size_t i = 0; i < RECOVER_FRAGS + RECOVER_TFRAGS && !agree; i++) {
+    for (size_t i = 0, nt = 1; i < RECOVER_FRAGS; i++) {
         double *X = tried[nt];
-        int tside = i >= RECOVER_FRAGS;
-        if (tside && !t.q) {
-            st = scratch_new(h, f, &t);
-            if (st != AMSCR_OK)
-                break;
-        }
-        if (tside)
-            st = target_fragment(prm, f, h, i - RECOVER_FRAGS, ws, &s, &t, pts, X);
-        else {
-            st = fragment_start(prm, f, h, order[i], ws, pts, X);
-            if (st == AMSCR_OK)
-                refine_adaptive(prm, f, &s, X);
-        }
+        st = fragment_start(prm, f, h, order[i], ws, pts, X);
         if (st == AMSCR_E_NOMEM)
             break;
         if (st != AMSCR_OK)
             continue;
+        refine_adaptive(prm, f, &s, X);
         double c = cost[nt] = two_way_cost(f, h, &s, X);
         if (c < best_cost) {
             best_cost = c;
             memcpy(best, X, sizeof best);
         }
-        /* with an earlier map (tried[0]: the reported one), one of the two the best so far */
+        int agree = 0; /* with an earlier map (tried[0]: the reported one), one of the two the best so far */
         for (size_t j = m->ambiguity < RECOVER_AMBIGUOUS ? 0 : 1; j < nt && !agree; j++)
             agree = (c <= best_cost || cost[j] <= best_cost) &&
                     amscr__map_gap2(f, X, tried[j]) <= RECOVER_AGREE * RECOVER_AGREE;
         nt++;
+        if (agree)
+            break;
     }
-    scratch_free(&t);
     if (st == AMSCR_E_NOMEM) {
         scratch_free(&s);
         return st;
     }
     amscr__clear_error();
-    double entry[6];
-    memcpy(entry, m->X, sizeof entry);
     st = finish(prm, f, &s, ws, best, m);
-    /* a map the fragments moved off the whole-curve search's winner, and clearly better than it
-     * (the reported map not an alternative by AMSCR__ALT_RATIO): the search's other starts
-     * assumed the whole boundary matched; the polish still ranks them (the ambiguity) but none
-     * of them replaces the recovered map (its two-way cost keeps 70 % of each side: the right
-     * map of a shape cut apart leaves more of the source unmatched). Where the recovery's
-     * candidates fit alike (a symmetric shape's turns), the polish's ranking decides as before. */
-    if (st == AMSCR_OK && amscr__map_gap2(f, m->X, entry) > AMSCR__DISTINCT_GAP2 &&
-        best_cost + AMSCR__AMBIGUITY_FLOOR < AMSCR__ALT_RATIO * (cost[0] + AMSCR__AMBIGUITY_FLOOR))
-        m->ncand_base = 0;
     scratch_free(&s);
     return st;
 }
