@@ -14,16 +14,21 @@
 #include <math.h>
 #include <stdlib.h>
 
-/* From AMSCR__INDEX_IVF_MIN shapes a shortlist query's diffusion drops, at every step, the
- * entries of its vectors below this share of the vector's largest: a large collection's near copies would
+/* In an index with the quantizer (from AMSCR__INDEX_IVF_MIN shapes) a shortlist query's
+ * diffusion drops, at every step, the entries of its vectors below this share of the vector's
+ * largest: a large collection's near copies would
  * otherwise let one query reach a share of the collection that grows with it. 1e-3 keeps the
  * exact top 10 of affine-warped queries on warped mpeg7-dev and Kimia-216 collections of 10,000
  * shapes and warped mpeg7-dev of 100,000 (1e-2 loses 0.2 %, 1e-1 5 %; docs/decisions.md). */
 #define PRUNE 1e-3
 
-/* The pruning of a row of n shapes matched with m candidates: only with a shortlist (m < n - 1;
- * every shape matched is the exact row) from AMSCR__INDEX_IVF_MIN shapes. */
-static double prune_share(size_t n, size_t m) { return n >= AMSCR__INDEX_IVF_MIN && m + 1 < n ? PRUNE : 0.0; }
+/* The pruning of a row of x's n shapes matched with m candidates: only in an index with the
+ * quantizer (a shortlist build of AMSCR__INDEX_IVF_MIN shapes or more) and with a shortlist
+ * (m < n - 1; every shape matched is the exact row). */
+static double prune_share(const amscr_index *x, size_t n, size_t m)
+{
+    return x->ivf.nc > 0 && m + 1 < n ? PRUNE : 0.0;
+}
 
 /* A sparse vector: dense values (zero outside sup) and its support, ascending. */
 typedef struct {
@@ -332,7 +337,7 @@ static amscr_status diffuse(const amscr_index *x, size_t self, const amscr__qrow
     if (st == AMSCR_OK && self == n)
         st = amscr__graph_query_row(&g, q);
     if (st == AMSCR_OK)
-        st = diffusion_row(&g, self, p->rerank_iterations, prune_share(n, q->m), r, rsup, &rlen);
+        st = diffusion_row(&g, self, p->rerank_iterations, prune_share(x, n, q->m), r, rsup, &rlen);
     if (st == AMSCR_OK)
         scores(r, rsup, rlen, n, self, q->dfull, q->have, g.dmax, out);
     amscr__graph_free(&g);
