@@ -74,13 +74,14 @@ static void apply_rows(amscr__graph *g, const svec *in, svec *out, sscratch *s)
         if (in->v[i] == 0.0)
             continue;
         amscr__graph_weights(g, i);
+        size_t o = amscr__graph_row(g, i);
         for (size_t t = 0; t < k; t++) {
-            size_t j = g->j[i * k + t];
+            size_t j = g->j[o + t];
             if (!s->mark[j]) {
                 s->mark[j] = 1;
                 s->list[c++] = j;
             }
-            s->tmp[j] += in->v[i] * g->w[i * k + t];
+            s->tmp[j] += in->v[i] * g->w[o + t];
         }
     }
     order_marked(s->list, c, s->mark, g->n);
@@ -143,9 +144,10 @@ static void apply_cols(amscr__graph *g, svec *v, sscratch *s)
     for (size_t u = 0; u < c; u++) {
         size_t i = s->list[u];
         amscr__graph_weights(g, i);
+        size_t o = amscr__graph_row(g, i);
         double sum = 0.0;
         for (size_t t = 0; t < k; t++)
-            sum += g->w[i * k + t] * v->v[g->j[i * k + t]];
+            sum += g->w[o + t] * v->v[g->j[o + t]];
         s->tmp[i] = sum;
     }
     for (size_t u = 0; u < v->len; u++)
@@ -298,21 +300,27 @@ static amscr_status diffusion_row(amscr__graph *g, size_t start, unsigned iters,
 
 /* out[j] (j < n) from the diffused row r (support rsup): halved 1 - r / max r where reached,
  * 0.5 + half the base distance / dmax for the matched shapes it does not reach, +inf for the
- * others; 0 for `self` (the library's normalization of the retrieval matrix). */
-static void scores(const double *r, const size_t *rsup, size_t rlen, size_t n, size_t self, const double *dfull,
-                   const unsigned char *have, double dmax, double *out)
+ * others; 0 for `self` (the library's normalization of the retrieval matrix). Past the fill with
+ * +inf, only the candidates and the support are visited. */
+static void scores(const double *r, const size_t *rsup, size_t rlen, size_t n, size_t self, const amscr__qrow *q,
+                   double dmax, double *out)
 {
     double rmax = 0.0;
     for (size_t u = 0; u < rlen; u++)
         rmax = r[rsup[u]] > rmax ? r[rsup[u]] : rmax;
-    for (size_t j = 0; j < n; j++) {
-        if (j == self)
-            out[j] = 0.0;
-        else if (r[j] > 0.0 && rmax > 0.0)
-            out[j] = 0.5 * (1.0 - r[j] / rmax);
-        else
-            out[j] = have[j] ? 0.5 * (1.0 + (dmax > 0.0 ? dfull[j] / dmax : 0.0)) : INFINITY;
+    for (size_t j = 0; j < n; j++)
+        out[j] = INFINITY;
+    for (size_t t = 0; t < q->m; t++) {
+        size_t j = q->cand[t];
+        out[j] = 0.5 * (1.0 + (dmax > 0.0 ? q->dfull[j] / dmax : 0.0));
     }
+    for (size_t u = 0; rmax > 0.0 && u < rlen; u++) {
+        size_t j = rsup[u];
+        if (j < n && r[j] > 0.0)
+            out[j] = 0.5 * (1.0 - r[j] / rmax);
+    }
+    if (self < n)
+        out[self] = 0.0;
 }
 
 /* The diffusion's scores of row `self` (< n: a shape of the index; n: the query). */
@@ -338,8 +346,10 @@ static amscr_status diffuse(const amscr_index *x, size_t self, const amscr__qrow
         st = amscr__graph_query_row(&g, q);
     if (st == AMSCR_OK)
         st = diffusion_row(&g, self, p->rerank_iterations, prune_share(x, n, q->m), r, rsup, &rlen);
+    if (st == AMSCR_OK && g.oom)
+        st = amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     if (st == AMSCR_OK)
-        scores(r, rsup, rlen, n, self, q->dfull, q->have, g.dmax, out);
+        scores(r, rsup, rlen, n, self, q, g.dmax, out);
     amscr__graph_free(&g);
     free(r);
     free(rsup);
