@@ -153,7 +153,7 @@ def test_corrupt_index(tmp_path, damage):
     elif damage == "flip":
         data[len(data) // 3] ^= 0x40
     elif damage == "version":
-        data[8] = 16  # a version newer than the newest
+        data[8] = 17  # a version newer than the newest
     elif damage == "magic-only":
         data = data[:8]
     elif damage == "short-header":  # magic and version, then the file ends inside the lengths (a fuzzer find)
