@@ -172,7 +172,7 @@ def test_corrupt_index(tmp_path, damage):
     if damage == "flip":  # the names and tables are checksummed, every shape is checked by the library
         assert "checksum" in r.stderr or "damaged shape" in r.stderr
     if damage == "version":
-        assert "version 16" in r.stderr
+        assert "version 17" in r.stderr
     for args in (("eval", bad), ("matrix", bad, "-o", "-"), ("index", m, "-o", bad, "--add")):
         r = run(*args)
         assert r.returncode == 1 and r.stdout == ""
