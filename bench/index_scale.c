@@ -25,7 +25,8 @@
  * bound scanned, the diffusion not pruned: the query of 0.14): % of its top 10 kept, same first hit. Times are wall clock
  * with the process's CPU seconds (all threads) in parentheses: on a busy machine CPU / threads
  * is what idle cores would give. Environment: INDEX_BENCH_NO_MIXED skips part 1,
- * INDEX_BENCH_NO_LOAD part 2's load. Exit 77 without the datasets. */
+ * INDEX_BENCH_NO_LOAD part 2's load, INDEX_BENCH_QUANTIZE gives part 2's indexes below 20,000
+ * shapes the quantizer too, INDEX_BENCH_SET=NAME draws from DATASETS/NAME instead of mpeg7-dev. Exit 77 without the datasets. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -302,6 +303,8 @@ static void part_scale(const amscr_params *p, const shape_set *s, size_t n)
     double before = rss_mb(), tb[2], tl, mb, times[NQ_SCALE], ctimes[NQ_SCALE], ib[4], sc[3];
     double prepared = (before - empty) * 1e6 / (double)n;
     amscr_index *x = build(db, M, tb);
+    if (getenv("INDEX_BENCH_QUANTIZE") && x->ivf.nc == 0 && amscr__sig_ivf_build(x->sig_lb, n, &x->ivf) != AMSCR_OK)
+        die("quantizer"); /* the build's quantizer below 20,000 shapes too */
     double per_shape = (rss_mb() - before) * 1e3 / (double)n, peak = max_rss_mb();
     index_bytes(x, ib);
     tl = mb = NAN;
@@ -350,7 +353,8 @@ int main(int argc, char **argv)
         return 2;
     }
     char manifest[4096];
-    snprintf(manifest, sizeof manifest, "%s/mpeg7-dev/manifest.tsv", argv[1]);
+    const char *set = getenv("INDEX_BENCH_SET");
+    snprintf(manifest, sizeof manifest, "%s/%s/manifest.tsv", argv[1], set ? set : "mpeg7-dev");
     shape_set s;
     amscr_params *p = NULL;
     if (shape_set_load(manifest, &s) != 0)
