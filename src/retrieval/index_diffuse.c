@@ -20,7 +20,7 @@
  * otherwise let one query reach a share of the collection that grows with it. 1e-3 keeps the
  * exact top 10 of affine-warped queries on warped mpeg7-dev and Kimia-216 collections of 10,000
  * shapes and warped mpeg7-dev of 100,000 (1e-2 loses 0.2 %, 1e-1 5 %; docs/decisions.md). */
-#define PRUNE 1e-3
+#define PRUNE 0.001
 
 /* The pruning of a row of x's n shapes matched with m candidates: only in an index with the
  * quantizer (a shortlist build of AMSCR__INDEX_IVF_MIN shapes or more) and with a shortlist

@@ -183,7 +183,12 @@ size_t amscr__sig_nearest(const float *sigs, const float *lbs, size_t n, const f
 
 /* ------------------------------------------------ the coarse quantizer of a large build */
 
-enum { IVF_ITERS = 6, IVF_TRAIN_PER_LIST = 48, IVF_PROBE_LISTS = 8, IVF_PROBE_PER_M = 16 };
+enum { IVF_ITERS = 6, IVF_TRAIN_PER_LIST = 48 };
+/* A search probes the lists nearest its bound vector: at least this many, and until they hold
+ * at least IVF_PROBE_PER_M m + 1 shapes (a build's rows and, from AMSCR__INDEX_IVF_MIN shapes,
+ * an index query: docs/decisions.md). */
+#define IVF_PROBE_LISTS 8
+#define IVF_PROBE_PER_M 16
 
 static float sq_dist(const float *a, const float *b)
 {
