@@ -42,7 +42,8 @@ static int cmp_size(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Scratch of the products: a marked set and a value vector (zero, unmarked between calls). */
+/* Scratch of the products: a marked set (unmarked between calls) and a value vector, set where
+ * a product marks or computes a row before it is read. */
 typedef struct {
     double *tmp;
     unsigned char *mark;
@@ -80,6 +81,7 @@ static void apply_rows(amscr__graph *g, const svec *in, svec *out, sscratch *s)
             if (!s->mark[j]) {
                 s->mark[j] = 1;
                 s->list[c++] = j;
+                s->tmp[j] = 0.0; /* (tmp is not zeroed beforehand) */
             }
             s->tmp[j] += in->v[i] * g->w[o + t];
         }
@@ -255,11 +257,11 @@ static amscr_status row_powers(amscr__graph *g, unsigned iters, double eps, svec
 static amscr_status diffusion_row(amscr__graph *g, size_t start, unsigned iters, double eps, double *r, size_t *rsup,
                                   size_t *rlen)
 {
-    size_t n = g->n;
-    svec a = {amscr__calloc_array(n, sizeof(double)), amscr__malloc_array(n, sizeof(size_t)), 0};
+    size_t n = g->n; /* a and b are read only on their support; v (P v reads any row) is zeroed */
+    svec a = {amscr__malloc_array(n, sizeof(double)), amscr__malloc_array(n, sizeof(size_t)), 0};
     svec v = {amscr__calloc_array(n, sizeof(double)), amscr__malloc_array(n, sizeof(size_t)), 0};
-    svec b = {amscr__calloc_array(n, sizeof(double)), amscr__malloc_array(n, sizeof(size_t)), 0};
-    sscratch s = {amscr__calloc_array(n, sizeof(double)), amscr__calloc_array(n, 1),
+    svec b = {amscr__malloc_array(n, sizeof(double)), amscr__malloc_array(n, sizeof(size_t)), 0};
+    sscratch s = {amscr__malloc_array(n, sizeof(double)), amscr__calloc_array(n, 1),
                   amscr__malloc_array(n, sizeof(size_t))};
     spacked *rows = calloc(iters ? iters : 1, sizeof *rows);
     amscr_status st = a.v && a.sup && v.v && v.sup && b.v && b.sup && s.tmp && s.mark && s.list && rows
@@ -332,7 +334,7 @@ static amscr_status diffuse(const amscr_index *x, size_t self, const amscr__qrow
     amscr__graph g = {0};
     size_t *rs = x->rev_start ? NULL : amscr__malloc_array(n + 1, sizeof *rs), *rsup = NULL;
     uint32_t *rv = x->rev_start ? NULL : amscr__malloc_array(n ? n : 1, (x->k + x->k2) * sizeof *rv);
-    double *r = amscr__calloc_array(rows, sizeof *r);
+    double *r = amscr__malloc_array(rows, sizeof *r); /* read only on its support rsup */
     rsup = amscr__malloc_array(rows, sizeof *rsup);
     int have_rev = x->rev_start || (rs && rv);
     amscr_status st = r && rsup && have_rev ? amscr__graph_alloc(&g, rows, k, x->k2 > 0 ? k : 0)
@@ -362,8 +364,9 @@ amscr_status amscr__index_scores(const amscr_index *x, size_t self, const size_t
                                  const double *dq2, size_t m, double *out)
 {
     size_t n = amscr_db_size(x->db);
-    amscr__qrow q = {cand, dq, dq2, m, amscr__calloc_array(n, sizeof(double)), NULL, amscr__calloc_array(n, 1)};
-    q.dfull2 = dq2 ? amscr__calloc_array(n, sizeof(double)) : NULL;
+    /* dfull and dfull2 are read only where `have` (zeroed) is set */
+    amscr__qrow q = {cand, dq, dq2, m, amscr__malloc_array(n ? n : 1, sizeof(double)), NULL, amscr__calloc_array(n ? n : 1, 1)};
+    q.dfull2 = dq2 ? amscr__malloc_array(n ? n : 1, sizeof(double)) : NULL;
     amscr_status st = q.dfull && q.have && (!dq2 || q.dfull2) ? AMSCR_OK
                                                             : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     for (size_t t = 0; st == AMSCR_OK && t < m; t++) {
