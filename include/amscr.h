@@ -2797,7 +2797,13 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_add(amscr_index *x, const ams
  *        equal amscr_db_query_retrieval's (to rounding, ~1e-12); with a channel weight strictly
  *        between 0 and 1 the fusion uses the build's medians. candidates M matches the query
  *        with its M signature-nearest shapes only (at least K - 1); the others get +inf unless
- *        the re-ranking reaches them. The query is scored as a new shape even when it is a
+ *        the re-ranking reaches them. An index built with candidates from 20,000 shapes keeps
+ *        its build's coarse quantizer of the signatures (kept in its file): its
+ *        queries with candidates M take the M nearest among the shapes of the quantizer's
+ *        clusters nearest the query (a few of the M signature-nearest may be missed) and drop
+ *        the re-ranking diffusion's entries below 1e-3 of the largest at every step, so a
+ *        query's cost grows far slower than the collection (docs/collections.md, "Queries at
+ *        scale"). The query is scored as a new shape even when it is a
  *        member's copy (no member rule: amscr_index_search_scores applies it).
  * @param[in]  q  a shape prepared with params compatible with the index's.
  * @param[out] out_scores  n scores, lower is better.
@@ -3474,7 +3480,8 @@ AMSCR_API size_t amscr_index_build_shortlist(const amscr_params *p, size_t n, si
  *        the m shapes of sigs (n signatures) whose signatures are nearest, by (distance, index),
  *        ascending by index, leaving out shape first + r (first SIZE_MAX: none left out, e.g. a
  *        new query); exactly the shortlists of amscr_index_build and amscr_index_query_scores
- *        (below the 20,000 shapes from which a build finds them through a coarse quantizer).
+ *        (below the 20,000 shapes from which a build and its queries find them through a coarse
+ *        quantizer).
  * @param[in]  sigs  n signatures (amscr_index_signatures of the shards, concatenated).
  * @param[in]  qsigs  nq signatures (a block of sigs for a build's rows, first its first shape).
  * @param[in]  m  1 .. n (n - 1 when first is not SIZE_MAX).

@@ -34,7 +34,8 @@
 #define AMSCR__DB_VERSION_INDEX_COMPACT 14u
 /* Version 15: version 14 with the inner features in float32 (index_io.c). */
 #define AMSCR__DB_VERSION_INDEX_F32 15u
-/* Version 16: version 15 with the inner features as int16 and a scale (index_io.c). */
+/* Version 16: version 15 with the inner features as int16 and a scale, and the coarse quantizer
+ * of the signatures after the inner graph (index_io.c: write_quantizer / read_quantizer). */
 #define AMSCR__DB_VERSION_INDEX_I16 16u
 #define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_I16
 

@@ -22,7 +22,8 @@
  *     shape; the reversed orientation's twist is recomputed); from version 15 re and im are F K
  *     f32 each (4.4 KB a shape); from version 16 f64 scale, then re and im as F K i16 each in
  *     units of the scale, norm2 recomputed from them (2.2 KB a shape: the features as an index
- *     holds them in memory, inner.h; an older file's values are rounded so at load).
+ *     holds them in memory, inner.h; an older file's values are rounded so at load);
+ *   version 16: then the coarse quantizer of the signatures (write_quantizer below).
  * Every count is bounded by the bytes left before anything is allocated; F, N and B must be the
  * params' (any byte is a valid height). The features' spectra are not stored: a load computes
  * them from the heights (an FFT, a fifth of building the features), or, with AMSCR_INDEX_LAZY,
@@ -135,6 +136,62 @@ static void write_inner(const amscr_index *x, uint32_t version, amscr__wbuf *w)
     }
 }
 
+/* ------------------------------------------- the coarse quantizer (version 16; signature.h)
+ * After the inner graph: u32 lists L (0: none: every bound scanned), then, when L > 0, u32 D
+ * (AMSCR__SIG_LB_DIM), L x D f32 centroids and n u32, each shape's list (< L); a load rebuilds
+ * the lists from them (the quantizer of a shortlist build of AMSCR__INDEX_IVF_MIN shapes or
+ * more, kept for its queries: 4 bytes a shape, 1 KB a list). */
+static void write_quantizer(const amscr_index *x, amscr__wbuf *w)
+{
+    size_t n = amscr_db_size(x->db);
+    int have = x->ivf.nc > 0 && x->ivf.n == n;
+    amscr__w_u32(w, have ? (uint32_t)x->ivf.nc : 0u);
+    if (!have)
+        return;
+    amscr__w_u32(w, AMSCR__SIG_LB_DIM);
+    amscr__w_f32s(w, x->ivf.cent, x->ivf.nc * AMSCR__SIG_LB_DIM);
+    for (size_t i = 0; i < n; i++)
+        amscr__w_u32(w, x->ivf.cell[i]);
+}
+
+static amscr_status read_quantizer(amscr__rbuf *r, amscr_index *x)
+{
+    size_t n = amscr_db_size(x->db);
+    uint32_t nc = amscr__r_u32(r), dim = nc > 0 ? amscr__r_u32(r) : AMSCR__SIG_LB_DIM;
+    if (r->bad)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: the quantizer is truncated");
+    if (nc == 0)
+        return AMSCR_OK;
+    if (dim != AMSCR__SIG_LB_DIM || nc > n)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: a quantizer of %u lists of dimension %u for %zu shapes",
+                           (unsigned)nc, (unsigned)dim, n);
+    if (((uint64_t)nc * AMSCR__SIG_LB_DIM + n) * 4u > r->len - r->pos)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: the quantizer is truncated");
+    amscr__sig_ivf *v = &x->ivf;
+    v->nc = nc;
+    v->n = n;
+    v->cent = amscr__malloc_array(nc, AMSCR__SIG_LB_DIM * sizeof *v->cent);
+    v->cell = amscr__malloc_array(n ? n : 1, sizeof *v->cell);
+    if (!v->cent || !v->cell) {
+        amscr__sig_ivf_free(v);
+        return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
+    }
+    int ok = amscr__r_f32s(r, v->cent, (size_t)nc * AMSCR__SIG_LB_DIM); /* finite */
+    for (size_t i = 0; ok && i < n; i++) {
+        v->cell[i] = amscr__r_u32(r);
+        ok = !r->bad && v->cell[i] < nc;
+    }
+    if (!ok || r->bad) {
+        amscr__sig_ivf_free(v);
+        return amscr__fail(AMSCR_E_FORMAT, "index file: a quantizer centroid is not finite or a list is out of range");
+    }
+    if (!amscr__sig_ivf_lists(v)) {
+        amscr__sig_ivf_free(v);
+        return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
+    }
+    return AMSCR_OK;
+}
+
 amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **out_buf, size_t *out_len)
 {
     amscr_status st = AMSCR_OK;
@@ -146,6 +203,8 @@ amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **o
     st = write_features(x, version, &w);
     if (st == AMSCR_OK)
         write_inner(x, version, &w);
+    if (st == AMSCR_OK && version >= AMSCR__DB_VERSION_INDEX_I16)
+        write_quantizer(x, &w);
     if (st != AMSCR_OK) {
         free(w.buf);
         return st;
@@ -374,6 +433,8 @@ static amscr_status read_rest(amscr__rbuf *r, amscr_index *x, uint32_t version)
     else if (st == AMSCR_OK && x->k2 > 0)
         st = amscr__fail(AMSCR_E_FORMAT, "index file: format %u has no inner graph, its params give one",
                          (unsigned)version);
+    if (st == AMSCR_OK && version >= AMSCR__DB_VERSION_INDEX_I16)
+        st = read_quantizer(r, x);
     if (st == AMSCR_OK && r->pos != r->len)
         st = amscr__fail(AMSCR_E_FORMAT, "index file: %zu unexpected bytes after the index section",
                          r->len - r->pos);
