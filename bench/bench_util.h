@@ -1,11 +1,25 @@
-/* bench_util.h — the benchmarks' clocks, qsort comparison and seeded random numbers (splitmix64; one
+/* bench_util.h — the benchmarks' error exit, clocks, qsort comparison and seeded random numbers (splitmix64; one
  * generator per program: each benchmark is single-threaded where it draws). */
 #ifndef AMSCR_BENCH_UTIL_H
 #define AMSCR_BENCH_UTIL_H
 
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <time.h>
+
+#include "amscr.h"
+
+#ifdef BENCH_PROGRAM
+/* Prints "BENCH_PROGRAM: WHAT: the library's last error detail" and exits 1 (a program that
+ * dies defines BENCH_PROGRAM, its name, before it includes this header). */
+static inline void die(const char *what)
+{
+    fprintf(stderr, "%s: %s: %s\n", BENCH_PROGRAM, what, amscr_last_error_detail());
+    exit(1);
+}
+#endif
 
 static inline double now(void)
 {

@@ -12,6 +12,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#define BENCH_PROGRAM "amscr-retrieval-bench"
 #include "bench_util.h"
 #include "channel.h"
 #include "inner.h"
@@ -19,8 +20,6 @@
 #include "folds_tsv.h"
 #include "mcd_set.h"
 #include "collection.h"
-
-void die(const char *what); /* retrieval_bench.c */
 
 enum { M_AMSCR, M_SIM, M_AFF, M_INNER, M_INNER_OPEN, NBASE };
 

@@ -15,17 +15,11 @@
 #include <time.h>
 #include <unistd.h>
 
+#define BENCH_PROGRAM "amscr-retrieval-bench"
 #include "bench_util.h"
 #include "mcd_set.h"
 #include "collection.h"
 #include "load_db.h"
-
-void die(const char *what); /* retrieval_ablation.c's too */
-void die(const char *what)
-{
-    fprintf(stderr, "amscr-retrieval-bench: %s: %s\n", what, amscr_last_error_detail());
-    exit(1);
-}
 
 /* A prepared db of the set with params p; *secs = the preparation's wall time. */
 static amscr_db *prepare_set(const amscr_params *p, const shape_set *s, double *secs)

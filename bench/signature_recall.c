@@ -13,6 +13,7 @@
 
 #include "affine_signature.h"
 #include "affine_warp.h"
+#define BENCH_PROGRAM "amscr-signature-recall"
 #include "bench_util.h"
 #include "channel.h"
 #include "folds_tsv.h"
@@ -20,12 +21,6 @@
 
 enum { DIM = AMSCR__AFFINE_SIG_DIM, TOP = 10, NM = 5, TIMED = 15 };
 static const size_t MS[NM] = {16, 32, 64, 128, 256};
-
-static void die(const char *what)
-{
-    fprintf(stderr, "amscr-signature-recall: %s: %s\n", what, amscr_last_error_detail());
-    exit(1);
-}
 
 static void *xmalloc(size_t n)
 {

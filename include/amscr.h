@@ -2662,7 +2662,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  *       amscr_index_build with candidates 0), the first call after shapes were added enters
  *       them (n pair distances a new shape), and each call then costs n pair distances and
  *       the re-ranking of one row, as amscr_index_query_scores with candidates 0.
- * Memory: the kept index, about 50 KB a shape with the retrieval preset (channel and inner
+ * Memory: the kept index, about 20 KB a shape with the retrieval preset (channel and inner
  *       features, signature, lists; not a copy of the shapes), until amscr_db_free.
  * Prefer an amscr_index to save the preparation in a file or to query with a shortlist.
  * The query is scored as a new shape even when it is a member's copy (no member rule:
@@ -2736,9 +2736,9 @@ typedef struct amscr_index amscr_index;
  * Cost: candidates 0: n^2 pair distances; M > 0: O(n (M + K^2)) pair distances.
  * Memory: the index holds a compact copy of the shapes (since 0.14: each shape's input samples
  *         and outline, ~3 KB at the defaults; a prepared shape is recomputed from them, bit for
- *         bit, when first read, e.g. through amscr_index_db, and then kept), the features (~34 KB a
- *         shape at the defaults), about 24 bytes a listed
- *         neighbour and, with the inner graph, about 17 KB of inner features a shape; the
+ *         bit, when first read, e.g. through amscr_index_db, and then kept), the channel features
+ *         and signature (~18 KB a shape at the defaults), about 24 bytes a listed
+ *         neighbour and, with the inner graph, about 2.2 KB of inner features a shape; the
  *         build's scratch is n^2 doubles with candidates 0, at most 12 n M bytes with M.
  * Threads: amscr_params_set_num_threads of the db's params; the index is the same for any
  *          thread count.
@@ -2801,7 +2801,13 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_add(amscr_index *x, const ams
  *        equal amscr_db_query_retrieval's (to rounding, ~1e-12); with a channel weight strictly
  *        between 0 and 1 the fusion uses the build's medians. candidates M matches the query
  *        with its M signature-nearest shapes only (at least K - 1); the others get +inf unless
- *        the re-ranking reaches them. The query is scored as a new shape even when it is a
+ *        the re-ranking reaches them. An index built with candidates from 20,000 shapes keeps
+ *        its build's coarse quantizer of the signatures (kept in its file): its
+ *        queries with candidates M take the M nearest among the shapes of the quantizer's
+ *        clusters nearest the query (a few of the M signature-nearest may be missed) and drop
+ *        the re-ranking diffusion's entries below 1e-3 of the largest at every step, so a
+ *        query's cost grows far slower than the collection (docs/collections.md, "Queries at
+ *        scale"). The query is scored as a new shape even when it is a
  *        member's copy (no member rule: amscr_index_search_scores applies it).
  * @param[in]  q  a shape prepared with params compatible with the index's.
  * @param[out] out_scores  n scores, lower is better.
@@ -2978,7 +2984,7 @@ AMSCR_API const char *amscr_index_group(const amscr_index *x, size_t i);
  * @brief Writes the index to a temporary name in the same folder and renames it: the
  *        collection file format (amscr_db_load of it gives the collection) with an index
  *        section holding the lists, each shape's channel features (so a load does not rebuild
- *        them) and, with the inner graph, each shape's inner features (about 8.7 KB) and its
+ *        them) and, with the inner graph, each shape's inner features (about 2.2 KB) and its
  *        lists; amscr_index_load_with reads it and every earlier format version
  *        (docs/collections.md).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.
@@ -3478,7 +3484,8 @@ AMSCR_API size_t amscr_index_build_shortlist(const amscr_params *p, size_t n, si
  *        the m shapes of sigs (n signatures) whose signatures are nearest, by (distance, index),
  *        ascending by index, leaving out shape first + r (first SIZE_MAX: none left out, e.g. a
  *        new query); exactly the shortlists of amscr_index_build and amscr_index_query_scores
- *        (below the 20,000 shapes from which a build finds them through a coarse quantizer).
+ *        (below the 20,000 shapes from which a build and its queries find them through a coarse
+ *        quantizer).
  * @param[in]  sigs  n signatures (amscr_index_signatures of the shards, concatenated).
  * @param[in]  qsigs  nq signatures (a block of sigs for a build's rows, first its first shape).
  * @param[in]  m  1 .. n (n - 1 when first is not SIZE_MAX).

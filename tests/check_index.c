@@ -555,7 +555,7 @@ START_TEST(stored_features)
     void *buf = NULL;
     size_t len = 0, l3 = 0;
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    ck_assert_int_eq(((unsigned char *)buf)[8], 15);
+    ck_assert_int_eq(((unsigned char *)buf)[8], AMSCR__DB_VERSION_NEWEST);
     ck_assert_int_eq(x->nf, 2);
     void *b13 = NULL; /* the format of 0.11 to 0.13, which older files are made from */
     size_t l13 = 0;
@@ -574,6 +574,10 @@ START_TEST(stored_features)
         ck_assert_int_eq(amscr_index_load_memory_with(buf, len, lazy ? AMSCR_INDEX_LAZY : 0u, &y), AMSCR_OK);
         ck_assert_ptr_nonnull(y->hf[0].seq[0]);
         ck_assert(lazy ? y->hf[0].spec[0] == NULL : y->hf[0].spec[0] != NULL);
+        /* format 16 stores the forward heights: the mirrored ones made at load (a lazy load: by
+         * a pair that reads them) */
+        ck_assert(lazy ? y->hf[0].seq[1] == NULL : y->hf[0].seq[1] != NULL);
+        ck_assert(lazy ? y->hf[0].spec[1] == NULL : y->hf[0].spec[1] != NULL);
         same_query(x, y, q, 0);
         same_query(x, y, q, 6);
         amscr_index_free(y);
@@ -595,6 +599,14 @@ START_TEST(stored_features)
     ck_assert_int_eq(amscr_index_load_with(path, AMSCR_INDEX_LAZY, &y), AMSCR_OK);
     same_query(x, y, q, 0);
     same_query(x, y, q, 6);
+    /* a member's row reads its candidates' mirrored heights, which format 16 does not store:
+     * made from their input samples in the mapped file, the same scores */
+    for (size_t i = 0; i < NSHAPES; i += 7) {
+        double ma[NSHAPES], mb[NSHAPES];
+        ck_assert_int_eq(amscr_index_member_scores(x, i, 0, ma, NSHAPES), AMSCR_OK);
+        ck_assert_int_eq(amscr_index_member_scores(y, i, 0, mb, NSHAPES), AMSCR_OK);
+        ck_assert(memcmp(ma, mb, sizeof ma) == 0);
+    }
     amscr_free(b2);
     ck_assert_int_eq(amscr_index_save_memory(y, &b2, &len2), AMSCR_OK);
     ck_assert_uint_eq(len2, len);
@@ -602,9 +614,9 @@ START_TEST(stored_features)
     amscr_index_free(y);
     y = NULL;
     remove(path);
-    /* two frames announced as one: refused */
+    /* two frames announced as one: refused (from format 16 the forward heights only) */
     unsigned char *b = buf;
-    size_t at = len - 8 - (12 + NSHAPES * 2 * 2 * 64 * AMSCR__HF_BINS + 4);
+    size_t at = len - 8 - (12 + NSHAPES * 2 * 64 * AMSCR__HF_BINS + 4 + 4); /* + inner count, quantizer's */
     ck_assert_int_eq(b[at], 2);
     b[at] = 1;
     uint64_t h = amscr__db_checksum(4, b, len - 8);
@@ -690,6 +702,15 @@ START_TEST(inner_lists)
 }
 END_TEST
 
+/* Inner features read from a file before version 16: the values of a (rounded from them) are b's,
+ * the scale and norm to float32's precision. */
+static void same_inner(const amscr__inner *a, const amscr__inner *b)
+{
+    ck_assert(memcmp(a->re, b->re, sizeof a->re) == 0 && memcmp(a->im, b->im, sizeof a->im) == 0);
+    ck_assert(fabs(a->scale - b->scale) <= 1e-6 * b->scale);
+    ck_assert(fabs(a->norm2 - b->norm2) <= 1e-5 * b->norm2);
+}
+
 /* The inner graph's section of a file: a count that is not the params', a bad list entry or a
  * feature that is not finite are refused with a detail; a version 8 file (0.7: one graph)
  * loads to the same scores, but not one whose params give the inner graph a share. */
@@ -702,26 +723,27 @@ START_TEST(inner_section)
     size_t k2 = x->k2, fk = AMSCR__INNER_F * AMSCR__INNER_K, len = 0;
     void *buf = NULL;
     ck_assert_uint_gt(k2, 0);
-    /* version 15 (compact shapes, the inner features in float32) */
+    /* version 16 (compact shapes, the inner features as int16 and a scale; then the quantizer's
+     * count, 0 in a small index) */
     ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
-    size_t sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * (4 * 2 * fk + 8), at = len - 8 - sec;
+    size_t sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * (8 + 2 * 2 * fk), at = len - 8 - 4 - sec;
     unsigned char *b = malloc(len);
     memcpy(b, buf, len);
-    ck_assert_uint_eq(b[8], 15);
+    ck_assert_uint_eq(b[8], 16);
     ck_assert_uint_eq(b[at], k2);
     b[at] = 0; /* no inner graph, the params give one */
-    reseal(b, len, 15);
+    reseal(b, len, 16);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner graph") != NULL);
     memcpy(b, buf, len);
     b[at + 12] = 1; /* shape 0's inner list not starting with itself */
-    reseal(b, len, 15);
+    reseal(b, len, 16);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner neighbour") != NULL);
     memcpy(b, buf, len);
-    float fnan = NAN;
-    memcpy(b + at + 12 + NSHAPES * k2 * 12 + 4 * 3, &fnan, 4); /* shape 0's fourth real part */
-    reseal(b, len, 15);
+    double dnan = NAN;
+    memcpy(b + at + 12 + NSHAPES * k2 * 12, &dnan, 8); /* shape 0's scale */
+    reseal(b, len, 16);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);
     ck_assert_ptr_null(y);
@@ -732,13 +754,32 @@ START_TEST(inner_section)
     y = NULL;
     free(b);
     amscr_free(buf);
-    /* version 14 (0.14's first builds: the inner features in f64): the same features, bit for bit,
-     * and a value beyond float32's range refused */
+    /* version 15 (the inner features in float32): the same values, the scale to float32's
+     * precision; a value that is not finite refused */
+    ck_assert_int_eq(amscr__index_write(x, 15, &buf, &len), AMSCR_OK);
+    sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * (4 * 2 * fk + 8), at = len - 8 - sec;
+    ck_assert_int_eq(amscr_index_load_memory(buf, len, &y), AMSCR_OK);
+    for (size_t i = 0; i < NSHAPES; i++)
+        same_inner(&y->inner[i], &x->inner[i]);
+    amscr_index_free(y);
+    y = NULL;
+    b = malloc(len);
+    memcpy(b, buf, len);
+    float fnan = NAN;
+    memcpy(b + at + 12 + NSHAPES * k2 * 12 + 4 * 3, &fnan, 4); /* shape 0's fourth real part */
+    reseal(b, len, 15);
+    ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
+    ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);
+    ck_assert_ptr_null(y);
+    free(b);
+    amscr_free(buf);
+    /* version 14 (0.14's first builds: the inner features in f64): the same features, and a
+     * value beyond float32's range refused */
     ck_assert_int_eq(amscr__index_write(x, 14, &buf, &len), AMSCR_OK);
     sec = 4 + 8 + NSHAPES * k2 * 12 + NSHAPES * 8 * (2 * fk + 1), at = len - 8 - sec;
     ck_assert_int_eq(amscr_index_load_memory(buf, len, &y), AMSCR_OK);
     for (size_t i = 0; i < NSHAPES; i++)
-        ck_assert(memcmp(&y->inner[i], &x->inner[i], sizeof x->inner[i]) == 0);
+        same_inner(&y->inner[i], &x->inner[i]);
     amscr_index_free(y);
     y = NULL;
     b = malloc(len);
@@ -1294,6 +1335,79 @@ START_TEST(quantizer_shortlist)
 }
 END_TEST
 
+/* The sublinear query of a large index (the quantizer's shortlist and the pruned diffusion; a
+ * build keeps its quantizer from AMSCR__INDEX_IVF_MIN shapes, attached here to a collection
+ * small enough to build in seconds) finds the top 10 and first hit of the query that scans every
+ * signature (the same index without its quantizer), its first hit of the exhaustive query's class
+ * (every shape matched), while probing only some of the lists; a file keeps the quantizer (the
+ * same scores after a load) and an add puts the new shapes in its lists. */
+START_TEST(quantizer_query)
+{
+    enum { N = 1200, CLASSES = 120, M = 32, TOP = 10, QUERIES = 6 };
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_db *db = db_of_classes(p, N, CLASSES);
+    amscr_index *x = NULL, *y = NULL;
+    ck_assert_int_eq(amscr_index_build(db, M, NULL, NULL, &x), AMSCR_OK);
+    ck_assert_uint_eq(x->ivf.nc, 0); /* below AMSCR__INDEX_IVF_MIN: every bound scanned */
+    ck_assert_int_eq(amscr__sig_ivf_build(x->sig_lb, N, &x->ivf), AMSCR_OK);
+    amscr__sig_ivf ivf = x->ivf, none;
+    memset(&none, 0, sizeof none);
+    ck_assert_uint_lt(16 * M + 1 + N / x->ivf.nc * 2, N); /* the probed lists hold some of the shapes */
+    void *buf = NULL;
+    size_t len = 0;
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_load_memory(buf, len, &y), AMSCR_OK);
+    ck_assert_uint_eq(y->ivf.nc, x->ivf.nc);
+    ck_assert(memcmp(y->ivf.cell, x->ivf.cell, N * sizeof *x->ivf.cell) == 0);
+    ck_assert(memcmp(y->ivf.cent, x->ivf.cent, x->ivf.nc * AMSCR__SIG_LB_DIM * sizeof(float)) == 0);
+    static double sx[N], sy[N];
+    for (unsigned q = 0; q < QUERIES; q++) {
+        amscr_descriptor *d = shape_of(p, 300000 + q * 13, CLASSES);
+        size_t a[TOP], b[TOP], c[TOP], ca = 0, cb = 0, cc = 0, kept = 0;
+        double va[TOP], vb[TOP], vc[TOP];
+        ck_assert_int_eq(amscr_index_query(x, d, M, TOP, a, va, &ca), AMSCR_OK);
+        x->ivf = none; /* every signature scanned, the exact diffusion */
+        ck_assert_int_eq(amscr_index_query(x, d, M, TOP, c, vc, &cc), AMSCR_OK);
+        ck_assert_int_eq(amscr_index_query(x, d, 0, TOP, b, vb, &cb), AMSCR_OK);
+        x->ivf = ivf;
+        ck_assert_uint_eq(ca, TOP);
+        for (size_t u = 0; u < TOP; u++)
+            for (size_t v = 0; v < TOP; v++)
+                kept += a[u] == c[v];
+        ck_assert_uint_eq(kept, TOP);
+        ck_assert_uint_eq(a[0], c[0]);
+        ck_assert_int_eq(amscr_index_label(x, a[0]), amscr_index_label(x, b[0]));
+        ck_assert_int_eq(amscr_index_query_scores(x, d, M, sx, N), AMSCR_OK);
+        ck_assert_int_eq(amscr_index_query_scores(y, d, M, sy, N), AMSCR_OK);
+        for (size_t j = 0; j < N; j++)
+            ck_assert(sx[j] == sy[j] || (isinf(sx[j]) && isinf(sy[j])));
+        amscr_descriptor_free(d);
+    }
+    amscr_db *more = NULL; /* shapes N..N+7 */
+    ck_assert_int_eq(amscr_db_new(p, &more), AMSCR_OK);
+    for (unsigned i = 0; i < 8; i++) {
+        amscr_descriptor *d = shape_of(p, N + i, CLASSES);
+        ck_assert_int_eq(amscr_db_add_descriptor(more, d, (int32_t)((N + i) % CLASSES), NULL), AMSCR_OK);
+        amscr_descriptor_free(d);
+    }
+    ck_assert_int_eq(amscr_index_add(y, more, NULL, NULL), AMSCR_OK);
+    ck_assert_uint_eq(y->ivf.n, N + 8);
+    ck_assert_uint_eq(y->ivf.start[y->ivf.nc], N + 8);
+    size_t a[1], ca = 0;
+    double va[1];
+    amscr_descriptor *d = shape_of(p, N + 3, CLASSES); /* an added shape's own samples: the member rule */
+    ck_assert_int_eq(amscr_index_search(y, d, M, 1, a, va, &ca), AMSCR_OK);
+    ck_assert_uint_eq(a[0], N + 3);
+    amscr_descriptor_free(d);
+    amscr_db_free(more);
+    amscr_free(buf);
+    amscr_index_free(x);
+    amscr_index_free(y);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+END_TEST
+
 /* The reference order of amscr__knn_select: itself first, then by distance, ties by index. */
 typedef struct {
     double d;
@@ -1380,6 +1494,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, kept_and_own_reverse);
     tcase_add_test(tc, rows_left_alone);
     tcase_add_test(tc, quantizer_shortlist);
+    tcase_add_test(tc, quantizer_query);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -114,8 +114,8 @@ START_TEST(test_against_brute_force)
             for (int refl = 0; refl < 2; refl++) {
                 double fast = amscr__inner_distance(&f[a].f, &f[b].f, refl, &ws);
                 double slow = brute(f[a].id, f[b].id, refl);
-                /* the features are float32 (inner.h): agreement to ~1e-7 relative */
-                ck_assert_msg(fabs(fast - slow) <= 1e-6 * (1.0 + slow), "%d-%d refl %d: %.12g vs %.12g", a, b, refl,
+                /* the features are int16 with a per-shape scale (inner.h): agreement to ~1e-5 */
+                ck_assert_msg(fabs(fast - slow) <= 5e-5 * (1.0 + slow), "%d-%d refl %d: %.12g vs %.12g", a, b, refl,
                               fast, slow);
                 if (a == b)
                     ck_assert(fast == 0.0);

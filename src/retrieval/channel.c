@@ -47,44 +47,65 @@ void amscr__hf_free(amscr__hf *h)
 /* Bin weight for a bin whose centre lies `frac` of the curve away (0..0.5). */
 static double bin_weight(double frac, double locality) { return 1.0 / (1.0 + locality * frac); }
 
-/* Heights of the closed curve P (n points) into seq (n * AMSCR__HF_BINS floats). */
-static void heights(const double *P, size_t n, double locality, uint8_t *seq, double *acc, size_t *cnt)
+/* Heights of the closed curve P (n points) into seq (n * AMSCR__HF_BINS bytes); cum: 2 (2 n + 1)
+ * doubles. A bin's sum of the signed distances to sample i's tangent line is its points' sum
+ * less count times sample i, along the normal: the points' sums from running sums along the
+ * curve (twice round), O(n bins) rather than O(n^2). */
+static void heights(const double *P, size_t n, double locality, uint8_t *seq, double *cum)
 {
     const size_t D = AMSCR__HF_BINS;
+    size_t jlo[AMSCR__HF_BINS], jhi[AMSCR__HF_BINS], cnt[AMSCR__HF_BINS] = {0};
+    for (size_t b = 0; b < D; b++)
+        jlo[b] = jhi[b] = 0;
+    for (size_t j = 1, b = 0, next = n - 1; j < n; j++) { /* bin (j - 1) D / (n - 1) */
+        while ((j - 1) * D >= next) {
+            b++;
+            next += n - 1;
+        }
+        if (cnt[b]++ == 0)
+            jlo[b] = j;
+        jhi[b] = j;
+    }
+    double wt[AMSCR__HF_BINS], cb[AMSCR__HF_BINS];
+    for (size_t b = 0; b < D; b++) {
+        double centre = ((double)b + 0.5) / (double)D; /* fraction of the curve ahead */
+        wt[b] = bin_weight(centre < 0.5 ? centre : 1.0 - centre, locality);
+        cb[b] = (double)cnt[b];
+        jhi[b] += 1; /* the running sums' end */
+    }
+    double *cx = cum, *cy = cum + 2 * n + 1;
+    cx[0] = cy[0] = 0.0;
+    for (size_t t = 0; t < 2 * n; t++) {
+        size_t q = t < n ? t : t - n;
+        cx[t + 1] = cx[t] + P[2 * q];
+        cy[t + 1] = cy[t] + P[2 * q + 1];
+    }
     for (size_t i = 0; i < n; i++) {
         size_t ip = (i + 1) % n, im = (i + n - 1) % n;
         double tx = P[2 * ip] - P[2 * im], ty = P[2 * ip + 1] - P[2 * im + 1];
         double tl = sqrt(tx * tx + ty * ty);
         double nx = tl > 0.0 ? -ty / tl : 0.0, ny = tl > 0.0 ? tx / tl : 0.0;
-        memset(acc, 0, D * sizeof *acc);
-        memset(cnt, 0, D * sizeof *cnt);
-        for (size_t j = 1, b = 0, next = n - 1; j < n; j++) { /* bin (j - 1) D / (n - 1) */
-            size_t q = i + j < n ? i + j : i + j - n;
-            while ((j - 1) * D >= next) {
-                b++;
-                next += n - 1;
-            }
-            acc[b] += (P[2 * q] - P[2 * i]) * nx + (P[2 * q + 1] - P[2 * i + 1]) * ny;
-            cnt[b]++;
-        }
-        for (size_t b = 0; b < D; b++) {
-            double centre = ((double)b + 0.5) / (double)D; /* fraction of the curve ahead */
-            double frac = centre < 0.5 ? centre : 1.0 - centre;
-            double v = cnt[b] ? acc[b] / (double)cnt[b] : 0.0;
-            double q = 128.0 + AMSCR__HF_QUANT * v * bin_weight(frac, locality);
-            seq[i * D + b] = (uint8_t)(q < 0.0 ? 0.0 : q > 255.0 ? 255.0 : floor(q + 0.5));
+        const double *ax = cx + i, *ay = cy + i, px = P[2 * i], py = P[2 * i + 1];
+        uint8_t *out = seq + i * D;
+        for (size_t b = 0; b < D; b++) { /* every bin holds a sample: n > D */
+            double c = cb[b], sx = ax[jhi[b]] - ax[jlo[b]], sy = ay[jhi[b]] - ay[jlo[b]];
+            double v = ((sx - c * px) * nx + (sy - c * py) * ny) / c;
+            double q = 128.0 + AMSCR__HF_QUANT * v * wt[b];
+            /* rounded half up: q + 0.5 >= 0.5, so the conversion's truncation is the floor */
+            out[b] = (uint8_t)(q < 0.0 ? 0.0 : q > 255.0 ? 255.0 : q + 0.5);
         }
     }
 }
 
-/* The kept frequencies of every bin column's DFT into spec (AMSCR__HF_SPEC(nfreq) values):
- * bin b's real parts at spec + 2 b P, its imaginary parts at spec + (2 b + 1) P, P =
- * AMSCR__HF_PAD(nfreq), the padding zero. */
-static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, float *spec, amscr__fft_plan *plan,
-                           double *z)
+/* The kept frequencies of every bin column's DFT into spec (AMSCR__HF_SPEC(nfreq) values, in
+ * units of *scale: the largest magnitude / AMSCR__HF_SPEC_Q, rounded to the nearest): bin b's
+ * real parts at spec + 2 b P, its imaginary parts at spec + (2 b + 1) P, P =
+ * AMSCR__HF_PAD(nfreq), the 3 values after the last zero. tmp: AMSCR__HF_SPEC(nfreq) doubles. */
+static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, int16_t *spec, double *scale,
+                           amscr__fft_plan *plan, double *z, double *tmp)
 {
-    const size_t D = AMSCR__HF_BINS, P = AMSCR__HF_PAD(nfreq);
-    memset(spec, 0, AMSCR__HF_SPEC(nfreq) * sizeof *spec);
+    const size_t D = AMSCR__HF_BINS, P = AMSCR__HF_PAD(nfreq), S = AMSCR__HF_SPEC(nfreq);
+    memset(tmp, 0, S * sizeof *tmp);
     for (size_t b = 0; b < D; b++) {
         for (size_t i = 0; i < n; i++) {
             z[2 * i] = (double)seq[i * D + b] - 128.0;
@@ -92,9 +113,17 @@ static amscr_status spectra(const uint8_t *seq, size_t n, size_t nfreq, float *s
         }
         amscr__fft(plan, z, 0);
         for (size_t f = 0; f < nfreq; f++) {
-            spec[2 * b * P + f] = (float)z[2 * f];
-            spec[(2 * b + 1) * P + f] = (float)z[2 * f + 1];
+            tmp[2 * b * P + f] = z[2 * f];
+            tmp[(2 * b + 1) * P + f] = z[2 * f + 1];
         }
+    }
+    double top = 0.0;
+    for (size_t t = 0; t < S; t++)
+        top = fabs(tmp[t]) > top ? fabs(tmp[t]) : top;
+    *scale = top / AMSCR__HF_SPEC_Q;
+    for (size_t t = 0; t < S; t++) {
+        double q = top > 0.0 ? tmp[t] / *scale : 0.0;
+        spec[t] = (int16_t)(q > AMSCR__HF_SPEC_Q ? AMSCR__HF_SPEC_Q : q < -AMSCR__HF_SPEC_Q ? -AMSCR__HF_SPEC_Q : lround(q));
     }
     return AMSCR_OK;
 }
@@ -107,19 +136,19 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
         return amscr__fail(AMSCR_E_INVALID_ARG, "shape channel: N = %zu is below %zu", n, D + 1);
     out->n = n;
     out->nfreq = AMSCR__HF_FREQS(n) + 1;
-    double *mir = amscr__malloc_array(2 * n, sizeof *mir), *z = amscr__malloc_array(2 * n, sizeof *z);
-    double *acc = amscr__malloc_array(D, sizeof *acc);
-    size_t *cnt = amscr__malloc_array(D, sizeof *cnt);
+    double *mir = amscr__malloc_array(2 * n, sizeof *mir);
+    double *z = amscr__malloc_array(2 * n + AMSCR__HF_SPEC(out->nfreq), sizeof *z);
+    double *cum = amscr__malloc_array(2 * (2 * n + 1), sizeof *cum);
     amscr__fft_plan plan;
     int have_plan = amscr__fft_plan_init(&plan, n) == 0;
     amscr_status st = AMSCR_OK;
     for (int o = 0; o < 2; o++) {
         out->seq[o] = amscr__malloc_array(n * D, sizeof(uint8_t));
-        out->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(out->nfreq), sizeof(float));
+        out->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(out->nfreq), sizeof(int16_t));
         if (!out->seq[o] || !out->spec[o])
             st = AMSCR_E_NOMEM;
     }
-    if (!mir || !z || !acc || !cnt || !have_plan || st != AMSCR_OK) {
+    if (!mir || !z || !cum || !have_plan || st != AMSCR_OK) {
         st = amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
     } else {
         /* mirror image (x -> -x), traversed backwards so it stays counter-clockwise */
@@ -127,19 +156,42 @@ amscr_status amscr__hf_build(const double *base, size_t n, double locality, amsc
             mir[2 * i] = -base[2 * (n - 1 - i)];
             mir[2 * i + 1] = base[2 * (n - 1 - i) + 1];
         }
-        heights(base, n, locality, out->seq[0], acc, cnt);
-        heights(mir, n, locality, out->seq[1], acc, cnt);
+        heights(base, n, locality, out->seq[0], cum);
+        heights(mir, n, locality, out->seq[1], cum);
         for (int o = 0; o < 2; o++)
-            spectra(out->seq[o], n, out->nfreq, out->spec[o], &plan, z);
+            spectra(out->seq[o], n, out->nfreq, out->spec[o], &out->scale[o], &plan, z, z + 2 * n);
     }
     if (have_plan)
         amscr__fft_plan_free(&plan);
     free(mir);
     free(z);
-    free(acc);
-    free(cnt);
+    free(cum);
     if (st != AMSCR_OK)
         amscr__hf_free(out);
+    return st;
+}
+
+amscr_status amscr__hf_build_mirror(const double *base, size_t n, double locality, amscr__hf *h)
+{
+    const size_t D = AMSCR__HF_BINS;
+    double *mir = amscr__malloc_array(2 * n, sizeof *mir);
+    double *cum = amscr__malloc_array(2 * (2 * n + 1), sizeof *cum);
+    uint8_t *seq = amscr__malloc_array(n * D, sizeof *seq);
+    amscr_status st = mir && cum && seq ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
+    if (st == AMSCR_OK && n < D + 1)
+        st = amscr__fail(AMSCR_E_INVALID_ARG, "shape channel: N = %zu is below %zu", n, D + 1);
+    if (st == AMSCR_OK) { /* as amscr__hf_build makes it */
+        for (size_t i = 0; i < n; i++) {
+            mir[2 * i] = -base[2 * (n - 1 - i)];
+            mir[2 * i + 1] = base[2 * (n - 1 - i) + 1];
+        }
+        heights(mir, n, locality, seq, cum);
+        h->seq[1] = seq;
+        seq = NULL;
+    }
+    free(mir);
+    free(cum);
+    free(seq);
     return st;
 }
 
@@ -147,13 +199,15 @@ amscr_status amscr__hf_spectra(amscr__hf *h, amscr__hf_ws *ws)
 {
     amscr__fft_plan plan;
     int own = !ws || ws->n != h->n || !ws->have_plan;
-    double *z = own ? amscr__malloc_array(2 * h->n, sizeof *z) : ws->z;
+    double *z = own ? amscr__malloc_array(2 * h->n + AMSCR__HF_SPEC(h->nfreq), sizeof *z) : ws->z;
     int have_plan = own && amscr__fft_plan_init(&plan, h->n) == 0;
     amscr_status st = z && (have_plan || !own) ? AMSCR_OK : AMSCR_E_NOMEM;
     for (int o = 0; o < 2 && st == AMSCR_OK; o++) {
-        h->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(h->nfreq), sizeof(float));
+        if (h->spec[o] || !h->seq[o])
+            continue; /* kept, or an orientation not held */
+        h->spec[o] = amscr__malloc_array(AMSCR__HF_SPEC(h->nfreq), sizeof(int16_t));
         if (h->spec[o])
-            spectra(h->seq[o], h->n, h->nfreq, h->spec[o], own ? &plan : &ws->plan, z);
+            spectra(h->seq[o], h->n, h->nfreq, h->spec[o], &h->scale[o], own ? &plan : &ws->plan, z, z + 2 * h->n);
         else
             st = AMSCR_E_NOMEM;
     }
@@ -169,7 +223,7 @@ amscr_status amscr__hf_ws_init(amscr__hf_ws *ws, size_t n, size_t band)
     memset(ws, 0, sizeof *ws);
     size_t W = 2 * band + 1;
     ws->n = n;
-    ws->z = amscr__malloc_array(2 * n, sizeof *ws->z);
+    ws->z = amscr__malloc_array(2 * n + AMSCR__HF_SPEC(AMSCR__HF_FREQS(n) + 1), sizeof *ws->z); /* + spectra()'s */
     ws->acc = amscr__malloc_array(4 * (AMSCR__HF_FREQS(n) + 1), sizeof *ws->acc);
     ws->row = amscr__malloc_array(4 * W, sizeof *ws->row);
     ws->start = amscr__malloc_array(4 * W, sizeof *ws->start);
@@ -199,16 +253,18 @@ void amscr__hf_ws_free(amscr__hf_ws *ws)
 
 /* The low-passed cross-spectra conj(A) B summed over the bins, for orientation 0 of b and,
  * when `both`, orientation 1: acc[4 f + 2 o] real, acc[4 f + 2 o + 1] imaginary part. Four
- * frequencies at a time side by side (vector registers), each summed over the bins in order. */
+ * frequencies at a time side by side (vector registers), each summed over the bins in order:
+ * products of the int16 values, exact in double whatever the order, then scaled. */
 static void cross_spectra(const amscr__hf *a, const amscr__hf *b, int both, double *restrict acc)
 {
     const size_t D = AMSCR__HF_BINS, F = a->nfreq, P = AMSCR__HF_PAD(F);
+    const double sc[2] = {a->scale[0] * b->scale[0], a->scale[0] * b->scale[1]};
     for (size_t f0 = 0; f0 < F; f0 += 4) {
         double re[2][4] = {{0.0}}, im[2][4] = {{0.0}};
         for (size_t bin = 0; bin < D; bin++) {
-            const float *ar = a->spec[0] + 2 * bin * P + f0, *ai = ar + P;
+            const int16_t *ar = a->spec[0] + 2 * bin * P + f0, *ai = ar + P;
             for (int o = 0; o < (both ? 2 : 1); o++) {
-                const float *br = b->spec[o] + 2 * bin * P + f0, *bi = br + P;
+                const int16_t *br = b->spec[o] + 2 * bin * P + f0, *bi = br + P;
                 for (size_t t = 0; t < 4; t++) {
                     re[o][t] += (double)ar[t] * br[t] + (double)ai[t] * bi[t];
                     im[o][t] += (double)ar[t] * bi[t] - (double)ai[t] * br[t];
@@ -217,8 +273,8 @@ static void cross_spectra(const amscr__hf *a, const amscr__hf *b, int both, doub
         }
         for (size_t t = 0; t < 4 && f0 + t < F; t++)
             for (int o = 0; o < 2; o++) {
-                acc[4 * (f0 + t) + 2 * (size_t)o] = re[o][t];
-                acc[4 * (f0 + t) + 2 * (size_t)o + 1] = im[o][t];
+                acc[4 * (f0 + t) + 2 * (size_t)o] = re[o][t] * sc[o];
+                acc[4 * (f0 + t) + 2 * (size_t)o + 1] = im[o][t] * sc[o];
             }
     }
 }

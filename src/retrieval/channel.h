@@ -14,11 +14,12 @@
 /* Frequencies used by the shift search (the correlation is low-passed; the DP band absorbs
  * the coarser shift): the first N/8, at most N/2. */
 #define AMSCR__HF_FREQS(n) ((n) / 8 < (n) / 2 ? (n) / 8 : (n) / 2)
-/* The kept frequencies of a bin's DFT padded to a multiple of 4 (the shift search reads four
- * at a time), and the values of one orientation's spectra: real and imaginary parts of every
- * bin (amscr__hf.spec). */
-#define AMSCR__HF_PAD(nfreq) (((nfreq) + 3) / 4 * 4)
-#define AMSCR__HF_SPEC(nfreq) (2 * AMSCR__HF_BINS * AMSCR__HF_PAD(nfreq))
+/* The kept frequencies of every bin's DFT are stored back to back (AMSCR__HF_PAD: no padding
+ * between the bins), and the values of one orientation's spectra: real and imaginary parts of
+ * every bin, then 3 zeros (the shift search reads four frequencies at a time, past a bin's last
+ * into the next one's, whose products it drops; past the last bin's into the zeros). */
+#define AMSCR__HF_PAD(nfreq) (nfreq)
+#define AMSCR__HF_SPEC(nfreq) (2 * AMSCR__HF_BINS * (nfreq) + 3)
 
 /* A shape's height-function sequences: forward and mirrored, with the DFT of every bin (only
  * the frequencies the shift search reads). */
@@ -26,9 +27,15 @@ typedef struct {
     size_t n;
     size_t nfreq;    /* frequencies kept of each bin's DFT: AMSCR__HF_FREQS(n) + 1 */
     uint8_t *seq[2]; /* n * AMSCR__HF_BINS, weighted heights, quantized: 128 + QUANT * h */
-    float *spec[2]; /* AMSCR__HF_SPEC(nfreq): per bin nfreq real parts, then imaginary, padded
-                     * (float32: the shift search's correlations, summed in double) */
+    int16_t *spec[2]; /* AMSCR__HF_SPEC(nfreq): per bin nfreq real parts, then imaginary,
+                       * in units of scale[o] (amscr__hf_quantize: the shift search's correlations,
+                       * summed exactly in double, then scaled) */
+    double scale[2];
 } amscr__hf;
+
+/* The largest magnitude of an orientation's spectra held as this int16 (the scale is that
+ * magnitude / AMSCR__HF_SPEC_Q): a spectrum value is off by at most half a step. */
+#define AMSCR__HF_SPEC_Q 32767.0
 
 typedef struct {
     size_t band;           /* half width of the DP band, samples */
@@ -54,7 +61,11 @@ struct amscr__hf_ws {
 amscr_status amscr__hf_build(const double *base, size_t n, double locality, amscr__hf *out);
 void amscr__hf_free(amscr__hf *h);
 typedef struct amscr__hf_ws amscr__hf_ws;
-/* The spectra of h (spec[0..1], allocated here; free with amscr__hf_free or free()) from its
+/* The mirrored heights of h (seq[1], allocated here) from its frame's points base: bit for bit
+ * amscr__hf_build's (an index keeps a shape's forward orientation only: the one a pair reads of
+ * its lower index; channel.h's pair calls read both of the higher). */
+amscr_status amscr__hf_build_mirror(const double *base, size_t n, double locality, amscr__hf *h);
+/* The spectra of h's orientations that have heights and no spectra yet (allocated here; free with amscr__hf_free or free()) from its
  * height sequences, n and nfreq: bit for bit amscr__hf_build's (an index file keeps the heights
  * only, index_io.c). ws (may be NULL): a pair scratch whose FFT plan is used when it fits. */
 amscr_status amscr__hf_spectra(amscr__hf *h, amscr__hf_ws *ws);
@@ -89,6 +100,10 @@ void amscr__mirror_upper(double *out, size_t n);
 /* The channel's sequences of a prepared shape in `frame`, with the settings of p. */
 amscr_status amscr__hf_of_descriptor(const amscr_params *p, amscr_invariance frame, const amscr_descriptor *d,
                                      amscr__hf *out);
+/* Its mirrored heights only, into h->seq[1] (amscr__hf_build_mirror; d may be a shallow
+ * descriptor: its input samples are all that is read). */
+amscr_status amscr__hf_mirror_of_descriptor(const amscr_params *p, amscr_invariance frame,
+                                            const amscr_descriptor *d, amscr__hf *h);
 /* The channel's pair settings from p for N samples. */
 void amscr__hf_cfg_from(const amscr_params *p, size_t n, int second, amscr__hf_cfg *cfg);
 

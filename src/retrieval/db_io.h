@@ -34,7 +34,10 @@
 #define AMSCR__DB_VERSION_INDEX_COMPACT 14u
 /* Version 15: version 14 with the inner features in float32 (index_io.c). */
 #define AMSCR__DB_VERSION_INDEX_F32 15u
-#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_F32
+/* Version 16: version 15 with the inner features as int16 and a scale, and the coarse quantizer
+ * of the signatures after the inner graph (index_io.c: write_quantizer / read_quantizer). */
+#define AMSCR__DB_VERSION_INDEX_I16 16u
+#define AMSCR__DB_VERSION_NEWEST AMSCR__DB_VERSION_INDEX_I16
 
 /* Whether a file of `version` is an index file (an index section after the shapes). */
 static inline int amscr__db_is_index(uint32_t version)
@@ -43,7 +46,7 @@ static inline int amscr__db_is_index(uint32_t version)
            version == AMSCR__DB_VERSION_INDEX_BANDS || version == AMSCR__DB_VERSION_INDEX_INNER ||
            version == AMSCR__DB_VERSION_INDEX_GRAPHS || version == AMSCR__DB_VERSION_INDEX_CLOSING ||
            version == AMSCR__DB_VERSION_INDEX_VIEW || version == AMSCR__DB_VERSION_INDEX_COMPACT ||
-           version == AMSCR__DB_VERSION_INDEX_F32;
+           version == AMSCR__DB_VERSION_INDEX_F32 || version == AMSCR__DB_VERSION_INDEX_I16;
 }
 
 /* Whether an index file of `version` stores the shapes' channel features. */
@@ -52,7 +55,8 @@ static inline int amscr__db_has_features(uint32_t version)
     return version == AMSCR__DB_VERSION_FEATURES || version == AMSCR__DB_VERSION_INDEX_BANDS ||
            version == AMSCR__DB_VERSION_INDEX_INNER || version == AMSCR__DB_VERSION_INDEX_GRAPHS ||
            version == AMSCR__DB_VERSION_INDEX_CLOSING || version == AMSCR__DB_VERSION_INDEX_VIEW ||
-           version == AMSCR__DB_VERSION_INDEX_COMPACT || version == AMSCR__DB_VERSION_INDEX_F32;
+           version == AMSCR__DB_VERSION_INDEX_COMPACT || version == AMSCR__DB_VERSION_INDEX_F32 ||
+           version == AMSCR__DB_VERSION_INDEX_I16;
 }
 
 /* The bytes of the retrieval block in a file of `version` (0: none). */

@@ -66,6 +66,19 @@ amscr_status amscr__hf_of_descriptor(const amscr_params *p, amscr_invariance fra
     return st;
 }
 
+amscr_status amscr__hf_mirror_of_descriptor(const amscr_params *p, amscr_invariance frame,
+                                            const amscr_descriptor *d, amscr__hf *h)
+{
+    double *xy = amscr__malloc_array(2 * d->n, sizeof *xy);
+    if (!xy)
+        return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
+    amscr_status st = channel_frame(frame, d, xy);
+    if (st == AMSCR_OK)
+        st = amscr__hf_build_mirror(xy, d->n, p->channel_locality, h);
+    free(xy);
+    return st;
+}
+
 /* The frames of the channel and their shares: the primary frame, plus the whitened frame with
  * channel_affine_share when the primary one is the similarity frame. Returns the count. */
 int amscr__channel_frames(const amscr_params *p, amscr_invariance frames[2], double share[2])

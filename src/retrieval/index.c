@@ -165,6 +165,8 @@ size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const floa
                 cand[c++] = j;
         return c;
     }
+    if (x->ivf.nc > 0 && x->ivf.n == n)
+        return amscr__sig_ivf_nearest(&x->ivf, x->sig, x->sig_lb, n, sig, lb, m, exclude, cand);
     return amscr__sig_nearest(x->sig, x->sig_lb, n, sig, lb, m, exclude, cand);
 }
 
@@ -212,6 +214,7 @@ void amscr_index_free(amscr_index *x)
     free(x->hf);
     free(x->sig);
     free(x->sig_lb);
+    amscr__sig_ivf_free(&x->ivf);
     free(x->nb_idx);
     free(x->nb_dist);
     free(x->inner);

@@ -13,6 +13,10 @@
 
 /* The shortlist a build seeks each shape's neighbours in (index_build.c tells why 192). */
 #define AMSCR__INDEX_BUILD_SHORTLIST 192
+/* From this many shapes a shortlist build finds the shortlists among the lists of a coarse
+ * quantizer (signature.h) instead of scanning every shape's lower bound, and keeps it for the
+ * queries (index.c: amscr__index_shortlist). */
+#define AMSCR__INDEX_IVF_MIN 20000
 
 struct amscr_index {
     amscr_db *db;         /* the collection (owned, unless db_borrowed) */
@@ -22,6 +26,9 @@ struct amscr_index {
     double dmax;          /* largest base distance of the collection */
     double med_a, med_h;  /* the fusion's medians (0 < channel weight < 1; else 0) */
     size_t sig_dim;       /* AMSCR__SIG_DIM */
+    amscr__sig_ivf ivf;   /* the coarse quantizer of the lower-bound vectors a shortlist is sought in
+                           * (a shortlist build of at least AMSCR__INDEX_IVF_MIN shapes; nc 0: none, every
+                           * bound scanned) */
     float *sig;           /* n x sig_dim (signature.h) */
     float *sig_lb;        /* n x AMSCR__SIG_LB_DIM: their lower-bound vectors */
     int nf;               /* channel frames whose features are kept (0: no channel) */
@@ -103,8 +110,8 @@ int amscr__member_rule_applies(const amscr_params *p);
 amscr_status amscr__index_search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates,
                                         double *out);
 /* The candidates of shape-like q: every shape (m = 0 or >= n) or the m whose signatures are
- * nearest sig / lb (exclude: an index to leave out or SIZE_MAX), ascending; 0 when out of
- * memory. */
+ * nearest sig / lb (exclude: an index to leave out or SIZE_MAX), ascending, sought in the lists
+ * of x's quantizer nearest lb when x has one (x->ivf); 0 when out of memory. */
 size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,
                               size_t *cand);
 /* Frees the lists' reverse and the stored rows' affinities (index_reverse.c builds them). */

@@ -151,6 +151,8 @@ amscr_status amscr__index_extend(amscr_index *x, size_t n0, amscr_progress_fn pr
     amscr_status st = amscr__index_reserve(x, n);
     if (st == AMSCR_OK)
         st = amscr__index_features(x, n0, 0);
+    if (st == AMSCR_OK && x->ivf.nc > 0) /* the new shapes into the quantizer's lists */
+        st = amscr__sig_ivf_add(&x->ivf, x->sig_lb, n);
     add_ctx c = {x, {0}, n0, n, NULL, NULL, NULL, NULL};
     amscr__base_init(&c.b, amscr_db_params(x->db), x->med_a, x->med_h);
     size_t batch = 4 * (size_t)c.b.threads; /* rows computed together (memory: batch x n) */

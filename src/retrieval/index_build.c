@@ -18,9 +18,6 @@ enum { MEDIAN_SAMPLE = 256 };
  * keep only 98.8 % of the exact top 10; docs/measurements.md, "The index: build, query,
  * recall"). */
 enum { BUILD_SHORTLIST = AMSCR__INDEX_BUILD_SHORTLIST };
-/* From this many shapes a build finds the shortlists among the lists of a coarse quantizer
- * (signature.h) instead of scanning every shape's lower bound. */
-enum { IVF_MIN_SHAPES = 20000 };
 
 /* Lists and dmax from the full base matrix (the retrieval matrix before its re-ranking). */
 static amscr_status build_full(amscr_index *x, amscr_progress_fn progress, void *user)
@@ -82,7 +79,6 @@ typedef struct {
     size_t first, m;
     uint32_t *S;
     double *D;
-    const amscr__sig_ivf *ivf; /* NULL: exact shortlists */
 } rows_ctx;
 
 static amscr_status pw_init(void *ctx, void **scratch)
@@ -97,10 +93,7 @@ static amscr_status shortlist_row(void *ctx, size_t i, void *scratch)
     amscr_index *x = c->x;
     size_t *cand = amscr__malloc_array(c->m, sizeof *cand);
     const float *sig = x->sig + i * x->sig_dim, *lb = x->sig_lb + i * AMSCR__SIG_LB_DIM;
-    size_t got = !cand ? 0
-                 : c->ivf ? amscr__sig_ivf_nearest(c->ivf, x->sig, x->sig_lb, amscr_db_size(x->db), sig, lb, c->m, i,
-                                                   cand)
-                          : amscr__index_shortlist(x, sig, lb, c->m, i, cand);
+    size_t got = cand ? amscr__index_shortlist(x, sig, lb, c->m, i, cand) : 0; /* x's quantizer, if any */
     for (size_t t = 0; t < got; t++)
         c->S[(i - c->first) * c->m + t] = (uint32_t)cand[t];
     free(cand);
@@ -180,20 +173,19 @@ static amscr_status list_row(void *ctx, size_t i, void *scratch)
     return st;
 }
 
-/* Rows first..n-1 from their M signature-nearest shapes; x->dmax grows to their largest. */
+/* Rows first..n-1 from their M signature-nearest shapes (of the quantizer's lists from
+ * AMSCR__INDEX_IVF_MIN shapes: built here and kept for the queries); x->dmax grows to their
+ * largest. */
 amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_progress_fn progress, void *user)
 {
     size_t n = amscr_db_size(x->db), rows = n - first;
-    rows_ctx c = {x, {0}, first, m, NULL, NULL, NULL};
-    amscr__sig_ivf ivf = {0, NULL, NULL, NULL};
+    rows_ctx c = {x, {0}, first, m, NULL, NULL};
     amscr__base_init(&c.b, amscr_db_params(x->db), x->med_a, x->med_h);
     c.S = amscr__malloc_array(rows, m * sizeof *c.S);
     c.D = amscr__malloc_array(rows, m * sizeof *c.D);
     amscr_status st = c.S && c.D ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
-    if (st == AMSCR_OK && n >= IVF_MIN_SHAPES) {
-        st = amscr__sig_ivf_build(x->sig_lb, n, &ivf);
-        c.ivf = &ivf;
-    }
+    if (st == AMSCR_OK && n >= AMSCR__INDEX_IVF_MIN && x->ivf.nc == 0)
+        st = amscr__sig_ivf_build(x->sig_lb, n, &x->ivf);
     amscr__rows_fn f1 = {NULL, NULL, shortlist_row, &c, NULL};
     amscr__rows_fn f2 = {pw_init, amscr__pair_ws_delete, distance_row, &c, NULL};
     amscr__rows_fn f3 = {NULL, NULL, list_row, &c, NULL};
@@ -211,7 +203,6 @@ amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_pro
         x->dmax = c.D[t] > x->dmax ? c.D[t] : x->dmax;
     free(c.S);
     free(c.D);
-    amscr__sig_ivf_free(&ivf);
     return st;
 }
 

@@ -5,6 +5,7 @@
  * query or a row matches a shape without rebuilding anything. A load from a file that holds
  * the features' heights computes only their spectra (the inner features it reads); a lazy load
  * nothing (index_pairs.c computes what a pair needs). */
+#include "db_io.h"
 #include "index.h"
 
 #include <stdlib.h>
@@ -14,6 +15,25 @@ typedef struct {
     amscr__base b;
     int have_sig;
 } feat_job;
+
+/* The mirrored heights of shape i (a file from version 16 keeps the forward ones only), from its
+ * input samples (its compact record: nothing decoded). */
+static amscr_status mirror_heights(const feat_job *j, size_t i, amscr__hf *hf)
+{
+    const amscr_db *db = j->x->db;
+    size_t N = amscr_db_params(db)->num_samples;
+    double *buf = amscr__malloc_array(2 * N + 2 * AMSCR__OUTLINE_N, sizeof *buf);
+    amscr_descriptor sd, *tmp = NULL;
+    const amscr_descriptor *d = !buf                                       ? NULL
+                                : amscr__db_shallow(db, i, &sd, buf, buf + 2 * N) ? &sd
+                                                                           : amscr__db_descriptor_peek(db, i, &tmp);
+    amscr_status st = d ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    for (int f = 0; f < j->x->nf && st == AMSCR_OK; f++)
+        st = amscr__hf_mirror_of_descriptor(j->b.p, j->b.frames[f], d, &hf[f]);
+    amscr_descriptor_free(tmp);
+    free(buf);
+    return st;
+}
 
 static amscr_status feat_row(void *ctx, size_t i, void *scratch)
 {
@@ -32,7 +52,7 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
     if (x->nf == 0 || (x->lazy && j->have_sig))
         return AMSCR_OK; /* a lazy load: built by the pairs that need them (index_pairs.c) */
     if (j->have_sig && hf[0].seq[0] != NULL) { /* the heights came with the file: their spectra */
-        amscr_status st = AMSCR_OK;
+        amscr_status st = hf[0].seq[1] == NULL ? mirror_heights(j, i, hf) : AMSCR_OK;
         for (int f = 0; f < x->nf && st == AMSCR_OK; f++)
             st = hf[f].spec[0] ? AMSCR_OK : amscr__hf_spectra(&hf[f], NULL);
         return st;

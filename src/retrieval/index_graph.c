@@ -13,17 +13,25 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Rows a graph first has room for (it grows by doubling). */
+enum { GRAPH_ROWS0 = 256 };
+
 amscr_status amscr__graph_alloc(amscr__graph *g, size_t n, size_t k, size_t k2)
 {
     g->n = n;
     g->k = k;
     g->k2 = k2;
     g->kk = k + k2;
-    g->j = amscr__malloc_array(n, g->kk * sizeof *g->j);
-    g->d = amscr__malloc_array(n, g->kk * sizeof *g->d);
-    g->w = amscr__malloc_array(n, g->kk * sizeof *g->w);
-    g->state = amscr__calloc_array(n, 1);
-    return g->j && g->d && g->w && g->state ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    g->cap = (n < GRAPH_ROWS0 ? n : GRAPH_ROWS0) + 1;
+    g->used = 1; /* slot 0: the spare row */
+    g->oom = 0;
+    g->j = amscr__malloc_array(g->cap, g->kk * sizeof *g->j);
+    g->d = amscr__malloc_array(g->cap, g->kk * sizeof *g->d);
+    g->w = amscr__malloc_array(g->cap, g->kk * sizeof *g->w);
+    g->slot = amscr__malloc_array(n ? n : 1, sizeof *g->slot);
+    g->state = amscr__calloc_array(n ? n : 1, 1);
+    return g->j && g->d && g->w && g->slot && g->state ? AMSCR_OK
+                                                        : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
 }
 
 void amscr__graph_free(amscr__graph *g)
@@ -31,7 +39,34 @@ void amscr__graph_free(amscr__graph *g)
     free(g->j);
     free(g->d);
     free(g->w);
+    free(g->slot);
     free(g->state);
+}
+
+/* Room for row i (not built yet): the next slot, the storage doubled when full; out of memory,
+ * the spare slot 0 and g->oom. */
+static void claim(amscr__graph *g, size_t i)
+{
+    if (g->used == g->cap) {
+        size_t cap = 2 * g->cap < g->n + 1 ? 2 * g->cap : g->n + 1, kk = g->kk ? g->kk : 1;
+        uint32_t *j = cap > SIZE_MAX / kk / sizeof *j ? NULL : realloc(g->j, cap * kk * sizeof *j);
+        if (j)
+            g->j = j;
+        double *d = j && cap <= SIZE_MAX / kk / sizeof *d ? realloc(g->d, cap * kk * sizeof *d) : NULL;
+        if (d)
+            g->d = d;
+        double *w = d ? realloc(g->w, cap * kk * sizeof *w) : NULL;
+        if (w) {
+            g->w = w;
+            g->cap = cap;
+        }
+    }
+    if (g->used == g->cap) {
+        g->oom = 1;
+        g->slot[i] = 0;
+        return;
+    }
+    g->slot[i] = (uint32_t)g->used++;
 }
 
 /* k entries (j, d) of a row from a stored list (sj, sd: ks entries) with the query (index q,
@@ -57,28 +92,28 @@ static void merge_row(const uint32_t *sj, const double *sd, size_t ks, size_t q,
 /* Row i of the graph: its stored lists with the query (index g->n - 1) merged in when `have`. */
 static void collection_row(const amscr_index *x, size_t i, int have, amscr__graph *g)
 {
-    size_t kk = g->kk, q = g->n - 1;
+    size_t o = amscr__graph_row(g, i), q = g->n - 1;
     merge_row(x->nb_idx + i * x->k, x->nb_dist + i * x->k, x->k, q, have ? g->dfull[i] : 0.0, have, g->k,
-              g->j + i * kk, g->d + i * kk);
+              g->j + o, g->d + o);
     if (g->k2 > 0)
         merge_row(x->in_idx + i * x->k2, x->in_dist + i * x->k2, x->k2, q, have ? g->dfull2[i] : 0.0, have, g->k2,
-                  g->j + i * kk + g->k, g->d + i * kk + g->k);
+                  g->j + o + g->k, g->d + o + g->k);
 }
 
 /* The query's k entries from (off): itself, then its k - 1 nearest candidates by (distance dq,
  * index). */
 static amscr_status query_part(const size_t *cand, const double *dq, size_t m, size_t k, size_t off, amscr__graph *g)
 {
-    size_t kk = g->kk, q = g->n - 1, *order = amscr__malloc_array(m ? m : 1, sizeof *order);
+    size_t q = g->n - 1, o = amscr__graph_row(g, q) + off, *order = amscr__malloc_array(m ? m : 1, sizeof *order);
     if (!order)
         return amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     amscr_status st = amscr_topk(dq, m, k - 1, SIZE_MAX, order);
     if (st == AMSCR_OK) {
-        g->j[q * kk + off] = (uint32_t)q;
-        g->d[q * kk + off] = 0.0;
+        g->j[o] = (uint32_t)q;
+        g->d[o] = 0.0;
         for (size_t t = 1; t < k; t++) {
-            g->j[q * kk + off + t] = (uint32_t)cand[order[t - 1]];
-            g->d[q * kk + off + t] = dq[order[t - 1]];
+            g->j[o + t] = (uint32_t)cand[order[t - 1]];
+            g->d[o + t] = dq[order[t - 1]];
         }
     }
     free(order);
@@ -87,6 +122,9 @@ static amscr_status query_part(const size_t *cand, const double *dq, size_t m, s
 
 amscr_status amscr__graph_query_row(amscr__graph *g, const amscr__qrow *q)
 {
+    claim(g, g->n - 1);
+    if (g->oom)
+        return amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     amscr_status st = query_part(q->cand, q->dq, q->m, g->k, 0, g);
     if (st == AMSCR_OK && g->k2 > 0)
         st = query_part(q->cand, q->dq2, q->m, g->k2, g->k, g);
@@ -98,6 +136,7 @@ amscr_status amscr__graph_query_row(amscr__graph *g, const amscr__qrow *q)
 static void need_row(amscr__graph *g, size_t i)
 {
     if (g->state[i] == 0) {
+        claim(g, i);
         collection_row(g->x, i, g->query && g->have[i], g);
         g->state[i] = 1;
     }
@@ -107,12 +146,12 @@ static void need_row(amscr__graph *g, size_t i)
  * normalized to sum `mass` (as amscr_rerank_diffusion), with s the rows' k-th distances. */
 static void part_weights(amscr__graph *g, size_t i, size_t off, size_t k, double tiny, double mass)
 {
-    size_t kk = g->kk;
-    double sum = 0.0, si = g->d[i * kk + off + k - 1], *w = g->w + i * kk + off;
-    const uint32_t *jj = g->j + i * kk + off;
-    const double *d = g->d + i * kk + off;
+    size_t o = amscr__graph_row(g, i) + off;
+    double sum = 0.0, si = g->d[o + k - 1], *w = g->w + o;
+    const uint32_t *jj = g->j + o;
+    const double *d = g->d + o;
     for (size_t t = 0; t < k; t++) {
-        double s = sqrt((si + tiny) * (g->d[(size_t)jj[t] * kk + off + k - 1] + tiny));
+        double s = sqrt((si + tiny) * (g->d[amscr__graph_row(g, jj[t]) + off + k - 1] + tiny));
         w[t] = exp(-d[t] / s);
         sum += w[t];
     }
@@ -156,12 +195,12 @@ void amscr__graph_weights(amscr__graph *g, size_t i)
         return;
     need_row(g, i);
     if (left_alone(g, i)) {
-        memcpy(g->w + i * kk, g->fixed + i * kk, kk * sizeof *g->w);
+        memcpy(g->w + amscr__graph_row(g, i), g->fixed + i * kk, kk * sizeof *g->w);
         g->state[i] = 2;
         return;
     }
-    for (size_t t = 0; t < kk; t++)
-        need_row(g, g->j[i * kk + t]);
+    for (size_t t = 0; t < kk; t++) /* (each may move the rows: i's offset read anew) */
+        need_row(g, g->j[amscr__graph_row(g, i) + t]);
     part_weights(g, i, 0, g->k, g->tiny, g->k2 > 0 ? 1.0 - g->share : 1.0);
     if (g->k2 > 0)
         part_weights(g, i, g->k, g->k2, g->tiny2, g->share);
@@ -207,12 +246,21 @@ amscr_status amscr__graph_fixed_weights(amscr_index *x)
     amscr__qrow q = {NULL, NULL, NULL, 0, NULL, NULL, have};
     amscr_status st = have ? amscr__graph_alloc(&g, n + 1, k, x->k2 > 0 ? k : 0)
                            : amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    double *w = st == AMSCR_OK ? amscr__malloc_array(n ? n : 1, g.kk * sizeof *w) : NULL;
+    if (st == AMSCR_OK && !w)
+        st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
     if (st == AMSCR_OK) {
         amscr__graph_setup(&g, x, n, &q);
         for (size_t i = 0; i < n; i++)
             amscr__graph_weights(&g, i);
-        x->w_fixed = g.w;
-        g.w = NULL;
+        if (g.oom)
+            st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    }
+    for (size_t i = 0; st == AMSCR_OK && i < n; i++) /* by row */
+        memcpy(w + i * g.kk, g.w + amscr__graph_row(&g, i), g.kk * sizeof *w);
+    if (st == AMSCR_OK) {
+        x->w_fixed = w;
+        w = NULL;
         x->w_k = k;
         x->w_kk = g.kk;
         x->w_tiny = g.tiny;
@@ -220,5 +268,6 @@ amscr_status amscr__graph_fixed_weights(amscr_index *x)
     }
     amscr__graph_free(&g);
     free(have);
+    free(w);
     return st;
 }

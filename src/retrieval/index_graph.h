@@ -18,12 +18,17 @@ typedef struct {
 } amscr__qrow;
 
 /* The graph of the n + 1 (or n) shapes, its rows built on demand: a query touches only the
- * shapes its diffusion reaches, never the whole collection. */
+ * shapes its diffusion reaches, never the whole collection. The rows built are stored one after
+ * the other (row i at slot[i], in the order they were built), so a query's graph holds only
+ * what its diffusion reaches. */
 typedef struct {
     size_t n, k, k2, kk;   /* rows (the query last, when there is one), kk = k + k2 entries each: k of the
                             * base distance's graph, then k2 of the inner distance's (0: one graph) */
-    uint32_t *j;           /* neighbours */
+    uint32_t *j;           /* neighbours, kk a row built */
     double *d, *w;         /* base (then inner) distances, then the affinities */
+    uint32_t *slot;        /* n: where row i is stored (j + slot[i] * kk; set once state[i] > 0) */
+    size_t used, cap;      /* rows stored and room for (slot 0: a spare row, for a row met out of memory) */
+    int oom;               /* a row found no room: the diffusion fails (AMSCR_E_NOMEM) */
     unsigned char *state;  /* per row: 0 not built, 1 list built, 2 affinities too */
     const amscr_index *x;
     const double *dfull;   /* the query's distances (dfull[i] where have[i]) */
@@ -39,6 +44,9 @@ typedef struct {
     size_t m;
     const double *fixed;   /* the stored rows' affinities (x->w_fixed) when they hold for this graph, else NULL */
 } amscr__graph;
+
+/* The offset of built row i's entries in j, d and w. */
+static inline size_t amscr__graph_row(const amscr__graph *g, size_t i) { return (size_t)g->slot[i] * g->kk; }
 
 amscr_status amscr__graph_alloc(amscr__graph *g, size_t n, size_t k, size_t k2);
 void amscr__graph_free(amscr__graph *g);

@@ -1,4 +1,4 @@
-/* index_io.c — the index file: a collection file (db_io.c) of version 15 (14 in 0.14's first builds, 13 in 0.11 to 0.13, 11
+/* index_io.c — the index file: a collection file (db_io.c) of version 16 (15 and 14 in 0.14, 13 in 0.11 to 0.13, 11
  * in 0.9, 9 in 0.8, 8 in 0.7, 6 in 0.6, 4 in 0.5, 3 in 0.4) whose index section follows the
  * shapes, so amscr_db_load of an index file gives its collection. From version 14 the shapes are
  * compact records (their input samples and outline: db_io.h), which the index keeps as they are
@@ -14,12 +14,16 @@
  *   versions 4, 6 and 8: u32 1 and n group names, or u32 0 (no shape has one); then the channel
  *     features: u32 frames F (0: no channel), u32 samples N, u32 bins B (AMSCR__HF_BINS), and
  *     per shape, per frame, its quantized height sequences (channel.h), forward then mirrored:
- *     2 N B bytes (F = 2, N = 128: 8 KB a shape);
+ *     2 N B bytes (F = 2, N = 128: 8 KB a shape); from version 16 the forward one only (N B
+ *     bytes, 4 KB a shape: a load makes the mirrored one from the shape's input samples);
  *   versions 9, 11 and 13: then the inner distance's graph: u32 K2 (0: none; else K, when the params give it a
  *     share), f64 its largest distance, n x K2 x (u32 neighbour, f64 distance) as the lists above,
  *     and per shape its inner features (inner.h): F K f64 re, F K f64 im, f64 norm2 (8.7 KB a
  *     shape; the reversed orientation's twist is recomputed); from version 15 re and im are F K
- *     f32 each (4.4 KB a shape: the features are float32 in memory too).
+ *     f32 each (4.4 KB a shape); from version 16 f64 scale, then re and im as F K i16 each in
+ *     units of the scale, norm2 recomputed from them (2.2 KB a shape: the features as an index
+ *     holds them in memory, inner.h; an older file's values are rounded so at load);
+ *   version 16: then the coarse quantizer of the signatures (write_quantizer below).
  * Every count is bounded by the bytes left before anything is allocated; F, N and B must be the
  * params' (any byte is a valid height). The features' spectra are not stored: a load computes
  * them from the heights (an FFT, a fifth of building the features), or, with AMSCR_INDEX_LAZY,
@@ -71,7 +75,7 @@ static void write_section(const amscr_index *x, amscr__wbuf *w)
 
 /* The channel features: every shape's height sequences (built here where a lazy load left
  * them unbuilt). */
-static amscr_status write_features(const amscr_index *x, amscr__wbuf *w)
+static amscr_status write_features(const amscr_index *x, uint32_t version, amscr__wbuf *w)
 {
     size_t n = amscr_db_size(x->db), N = amscr_db_params(x->db)->num_samples, bytes = N * AMSCR__HF_BINS;
     amscr__w_u32(w, (uint32_t)x->nf);
@@ -83,11 +87,12 @@ static amscr_status write_features(const amscr_index *x, amscr__wbuf *w)
     for (size_t i = 0; i < n && x->nf > 0 && st == AMSCR_OK; i++) {
         const amscr__hf *hf = x->hf + i * (size_t)x->nf;
         amscr__hf built[2];
-        int build = hf[0].seq[0] == NULL;
+        int orients = version >= AMSCR__DB_VERSION_INDEX_I16 ? 1 : 2; /* from 16: the forward one */
+        int build = hf[0].seq[0] == NULL || (orients == 2 && hf[0].seq[1] == NULL);
         if (build && (st = amscr__base_hf(&b, amscr_db_descriptor(x->db, i), built)) != AMSCR_OK)
             break;
         for (int f = 0; f < x->nf; f++)
-            for (int o = 0; o < 2; o++)
+            for (int o = 0; o < orients; o++)
                 amscr__w_bytes(w, (build ? built : hf)[f].seq[o], bytes);
         if (build)
             amscr__base_hf_free(&b, built);
@@ -110,17 +115,81 @@ static void write_inner(const amscr_index *x, uint32_t version, amscr__wbuf *w)
     }
     for (size_t i = 0; i < n; i++) {
         const amscr__inner *f = &x->inner[i];
-        if (version >= AMSCR__DB_VERSION_INDEX_F32) {
-            amscr__w_f32s(w, &f->re[0][0], fk);
-            amscr__w_f32s(w, &f->im[0][0], fk);
-        } else {
-            for (size_t j = 0; j < fk; j++)
-                amscr__w_f64(w, (&f->re[0][0])[j]);
-            for (size_t j = 0; j < fk; j++)
-                amscr__w_f64(w, (&f->im[0][0])[j]);
+        const int16_t *v = &f->re[0][0];
+        if (version >= AMSCR__DB_VERSION_INDEX_I16) {
+            amscr__w_f64(w, f->scale);
+            for (size_t j = 0; j < 2 * fk; j++) { /* re, then im */
+                uint16_t u = (uint16_t)v[j];
+                unsigned char b2[2] = {(unsigned char)(u & 0xff), (unsigned char)(u >> 8)};
+                amscr__w_bytes(w, b2, 2);
+            }
+            continue;
         }
+        for (size_t j = 0; j < 2 * fk; j++) /* the values as they are held: exact in float32 and f64 */
+            if (version >= AMSCR__DB_VERSION_INDEX_F32) {
+                float u = (float)(v[j] * f->scale);
+                amscr__w_f32s(w, &u, 1);
+            } else {
+                amscr__w_f64(w, v[j] * f->scale);
+            }
         amscr__w_f64(w, f->norm2);
     }
+}
+
+/* ------------------------------------------- the coarse quantizer (version 16; signature.h)
+ * After the inner graph: u32 lists L (0: none: every bound scanned), then, when L > 0, u32 D
+ * (AMSCR__SIG_LB_DIM), L x D f32 centroids and n u32, each shape's list (< L); a load rebuilds
+ * the lists from them (the quantizer of a shortlist build of AMSCR__INDEX_IVF_MIN shapes or
+ * more, kept for its queries: 4 bytes a shape, 1 KB a list). */
+static void write_quantizer(const amscr_index *x, amscr__wbuf *w)
+{
+    size_t n = amscr_db_size(x->db);
+    int have = x->ivf.nc > 0 && x->ivf.n == n;
+    amscr__w_u32(w, have ? (uint32_t)x->ivf.nc : 0u);
+    if (!have)
+        return;
+    amscr__w_u32(w, AMSCR__SIG_LB_DIM);
+    amscr__w_f32s(w, x->ivf.cent, x->ivf.nc * AMSCR__SIG_LB_DIM);
+    for (size_t i = 0; i < n; i++)
+        amscr__w_u32(w, x->ivf.cell[i]);
+}
+
+static amscr_status read_quantizer(amscr__rbuf *r, amscr_index *x)
+{
+    size_t n = amscr_db_size(x->db);
+    uint32_t nc = amscr__r_u32(r), dim = nc > 0 ? amscr__r_u32(r) : AMSCR__SIG_LB_DIM;
+    if (r->bad)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: the quantizer is truncated");
+    if (nc == 0)
+        return AMSCR_OK;
+    if (dim != AMSCR__SIG_LB_DIM || nc > n)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: a quantizer of %u lists of dimension %u for %zu shapes",
+                           (unsigned)nc, (unsigned)dim, n);
+    if (((uint64_t)nc * AMSCR__SIG_LB_DIM + n) * 4u > r->len - r->pos)
+        return amscr__fail(AMSCR_E_FORMAT, "index file: the quantizer is truncated");
+    amscr__sig_ivf *v = &x->ivf;
+    v->nc = nc;
+    v->n = n;
+    v->cent = amscr__malloc_array(nc, AMSCR__SIG_LB_DIM * sizeof *v->cent);
+    v->cell = amscr__malloc_array(n ? n : 1, sizeof *v->cell);
+    if (!v->cent || !v->cell) {
+        amscr__sig_ivf_free(v);
+        return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
+    }
+    int ok = amscr__r_f32s(r, v->cent, (size_t)nc * AMSCR__SIG_LB_DIM); /* finite */
+    for (size_t i = 0; ok && i < n; i++) {
+        v->cell[i] = amscr__r_u32(r);
+        ok = !r->bad && v->cell[i] < nc;
+    }
+    if (!ok || r->bad) {
+        amscr__sig_ivf_free(v);
+        return amscr__fail(AMSCR_E_FORMAT, "index file: a quantizer centroid is not finite or a list is out of range");
+    }
+    if (!amscr__sig_ivf_lists(v)) {
+        amscr__sig_ivf_free(v);
+        return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
+    }
+    return AMSCR_OK;
 }
 
 amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **out_buf, size_t *out_len)
@@ -131,9 +200,11 @@ amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **o
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
     write_section(x, &w);
-    st = write_features(x, &w);
+    st = write_features(x, version, &w);
     if (st == AMSCR_OK)
         write_inner(x, version, &w);
+    if (st == AMSCR_OK && version >= AMSCR__DB_VERSION_INDEX_I16)
+        write_quantizer(x, &w);
     if (st != AMSCR_OK) {
         free(w.buf);
         return st;
@@ -270,7 +341,7 @@ static amscr_status read_names(amscr__rbuf *r, amscr_index *x, uint32_t version)
 
 /* The channel features of a version 4, 6 or 8 file: each shape's height sequences (index.h's x->hf,
  * their spectra not yet computed). */
-static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
+static amscr_status read_features(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
     size_t n = amscr_db_size(x->db), N = amscr_db_params(x->db)->num_samples;
     uint32_t nf = amscr__r_u32(r), ns = amscr__r_u32(r), bins = amscr__r_u32(r);
@@ -278,7 +349,8 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
         return amscr__fail(AMSCR_E_FORMAT, "index file: channel features of %u frames, %u samples, %u bins; the "
                                            "params give %d, %zu, %d", (unsigned)nf, (unsigned)ns, (unsigned)bins,
                            x->nf, N, AMSCR__HF_BINS);
-    size_t bytes = N * AMSCR__HF_BINS, per = 2 * (size_t)nf * bytes;
+    int orients = version >= AMSCR__DB_VERSION_INDEX_I16 ? 1 : 2; /* from 16: the forward one */
+    size_t bytes = N * AMSCR__HF_BINS, per = (size_t)orients * nf * bytes;
     if (per > 0 && (r->len - r->pos) / per < n)
         return amscr__fail(AMSCR_E_FORMAT, "index file: the channel features are truncated");
     for (size_t e = 0; e < n * nf; e++) {
@@ -286,7 +358,7 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
         amscr__hf_free(h);
         h->n = N;
         h->nfreq = AMSCR__HF_FREQS(N) + 1;
-        for (int o = 0; o < 2; o++) {
+        for (int o = 0; o < orients; o++) {
             h->seq[o] = x->map ? (uint8_t *)(x->map + r->pos) : malloc(bytes); /* mapped: read in place */
             if (!h->seq[o])
                 return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
@@ -298,25 +370,11 @@ static amscr_status read_features(amscr__rbuf *r, amscr_index *x)
     return AMSCR_OK;
 }
 
-/* n finite doubles of a file before version 15 into floats (0 and r->bad: short, not finite or
- * beyond float's range). */
-static int read_f64_as_f32(amscr__rbuf *r, float *d, size_t n)
-{
-    for (size_t i = 0; i < n; i++) {
-        double v = 0.0;
-        if (!amscr__r_f64s(r, &v, 1) || !(fabs(v) <= FLT_MAX)) {
-            r->bad = 1;
-            return 0;
-        }
-        d[i] = (float)v;
-    }
-    return 1;
-}
-
-/* The inner distance's graph of a file of version 9 or later (its K2 must be the params'). */
+/* The inner distance's graph of a file of version 9 or later (its K2 must be the params'): the
+ * features of a file before version 16 (float32 or double values) rounded as a build rounds them. */
 static amscr_status read_inner(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
-    int f32 = version >= AMSCR__DB_VERSION_INDEX_F32;
+    int f32 = version >= AMSCR__DB_VERSION_INDEX_F32, i16 = version >= AMSCR__DB_VERSION_INDEX_I16;
     size_t n = amscr_db_size(x->db), fk = AMSCR__INNER_F * AMSCR__INNER_K;
     uint32_t k2 = amscr__r_u32(r);
     if (r->bad || k2 != x->k2)
@@ -327,25 +385,41 @@ static amscr_status read_inner(amscr__rbuf *r, amscr_index *x, uint32_t version)
     x->dmax2 = amscr__r_f64(r);
     if (r->bad || !(x->dmax2 >= 0.0) || !isfinite(x->dmax2))
         return amscr__fail(AMSCR_E_FORMAT, "index file: bad largest inner distance");
-    size_t per = 12 * (size_t)k2 + (f32 ? 4 : 8) * 2 * fk + 8;
+    size_t per = 12 * (size_t)k2 + (i16 ? 2 * 2 * fk + 8 : (f32 ? 4 : 8) * 2 * fk + 8);
     if ((r->len - r->pos) / per < n)
         return amscr__fail(AMSCR_E_FORMAT, "index file: the inner graph is truncated");
     amscr_status st = read_list(r, n, k2, x->in_idx, x->in_dist, "inner ");
-    amscr__inner_ws ws;
-    if (st != AMSCR_OK)
-        return st;
-    if (amscr__inner_ws_init(&ws) != AMSCR_OK)
-        return amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
+    double(*v)[AMSCR__INNER_F][AMSCR__INNER_K] = malloc(2 * sizeof *v);
+    if (st == AMSCR_OK && !v)
+        st = amscr__fail(AMSCR_E_NOMEM, "index file: out of memory");
     for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
         amscr__inner *f = &x->inner[i];
-        int ok = f32 ? amscr__r_f32s(r, &f->re[0][0], fk) && amscr__r_f32s(r, &f->im[0][0], fk)
-                     : read_f64_as_f32(r, &f->re[0][0], fk) && read_f64_as_f32(r, &f->im[0][0], fk);
-        if (!ok || !amscr__r_f64s(r, &f->norm2, 1) || !(f->norm2 >= 0.0))
+        int ok = 1;
+        if (i16) {
+            double scale = amscr__r_f64(r), sum = 0.0;
+            int16_t *q = &f->re[0][0];
+            for (size_t j = 0; j < 2 * fk; j++, r->pos += 2)
+                q[j] = (int16_t)(uint16_t)(r->p[r->pos] | (unsigned)r->p[r->pos + 1] << 8);
+            for (size_t j = 0; j < 2 * fk; j++) /* the norm as a build computes it */
+                sum += ((j % fk) / AMSCR__INNER_K == 0 ? 1.0 : 2.0) * ((double)q[j] * q[j]);
+            ok = !r->bad && scale >= 0.0 && scale <= FLT_MAX;
+            f->scale = scale;
+            f->norm2 = sum * scale * scale / (double)AMSCR__INNER_N;
+        } else {
+            double *d = &v[0][0][0], norm2 = 0.0;
+            for (size_t j = 0; j < 2 * fk && ok; j++) {
+                float u = 0.0f;
+                ok = f32 ? amscr__r_f32s(r, &u, 1) : amscr__r_f64s(r, &d[j], 1);
+                if (f32)
+                    d[j] = u;
+                ok = ok && fabs(d[j]) <= FLT_MAX;
+            }
+            ok = ok && amscr__r_f64s(r, &norm2, 1) && norm2 >= 0.0 && amscr__inner_quantize(f, &v[0][0][0]);
+        }
+        if (!ok)
             st = amscr__fail(AMSCR_E_FORMAT, "index file: shape %zu's inner features are invalid", i);
-        else
-            amscr__inner_twist(f, &ws);
     }
-    amscr__inner_ws_free(&ws);
+    free(v);
     return st;
 }
 
@@ -353,12 +427,14 @@ static amscr_status read_inner(amscr__rbuf *r, amscr_index *x, uint32_t version)
  * nothing. */
 static amscr_status read_rest(amscr__rbuf *r, amscr_index *x, uint32_t version)
 {
-    amscr_status st = amscr__db_has_features(version) ? read_features(r, x) : AMSCR_OK;
+    amscr_status st = amscr__db_has_features(version) ? read_features(r, x, version) : AMSCR_OK;
     if (st == AMSCR_OK && version >= AMSCR__DB_VERSION_INDEX_GRAPHS)
         st = read_inner(r, x, version);
     else if (st == AMSCR_OK && x->k2 > 0)
         st = amscr__fail(AMSCR_E_FORMAT, "index file: format %u has no inner graph, its params give one",
                          (unsigned)version);
+    if (st == AMSCR_OK && version >= AMSCR__DB_VERSION_INDEX_I16)
+        st = read_quantizer(r, x);
     if (st == AMSCR_OK && r->pos != r->len)
         st = amscr__fail(AMSCR_E_FORMAT, "index file: %zu unexpected bytes after the index section",
                          r->len - r->pos);

@@ -3,6 +3,7 @@
  * index's neighbour lists and a query's distances agree with amscr_db_retrieval_matrix to
  * the bit. Rows of pairs are split over POSIX threads; the calling thread works too and is
  * the only one that reports progress. */
+#include "db_io.h"
 #include "index.h"
 
 #include <math.h>
@@ -80,57 +81,97 @@ void amscr__base_hf_free(const amscr__base *b, amscr__hf hf[2])
         amscr__hf_free(&hf[f]);
 }
 
-static void spectra_free(const amscr__base *b, amscr__hf out[2])
-{
-    for (int f = 0; f < b->nf; f++) {
-        free(out[f].spec[0]);
-        free(out[f].spec[1]);
-    }
-}
-
-/* out[f]: the heights of stored[f] (shared, not copied) with their spectra computed here (with
- * ws's FFT plan when it has one). */
-static amscr_status with_spectra(const amscr__base *b, const amscr__hf *stored, amscr__hf_ws *ws, amscr__hf out[2])
+/* out[f]: stored[f] (its arrays shared, not copied) with what a pair reads of it and it lacks
+ * made here: the spectra (a lazy load's heights, with ws's FFT plan when it has one) and, when
+ * the pair reads the mirrored orientation (`mirror`: the shape is the pair's higher index), the
+ * mirrored spectra (an index keeps the forward orientation's only) and heights (a lazy load of a
+ * file from version 16, which stores the forward ones), from the shape's input samples.
+ * own[f] marks what was made: bit 0 spec[0], bit 1 seq[1], bit 2 spec[1]. */
+static amscr_status complete(const amscr__base *b, const amscr_db *db, size_t c, const amscr__hf *stored,
+                             int mirror, amscr__hf_ws *ws, amscr__hf out[2], int own[2])
 {
     amscr_status st = AMSCR_OK;
+    amscr_descriptor sd, *tmp = NULL;
+    const amscr_descriptor *d = NULL;
+    double *buf = NULL;
+    own[0] = own[1] = 0;
     for (int f = 0; f < b->nf; f++) {
         out[f] = stored[f];
-        out[f].spec[0] = out[f].spec[1] = NULL;
+        if (!mirror || out[f].seq[1])
+            continue;
+        if (!d) {
+            size_t N = b->p->num_samples;
+            buf = amscr__malloc_array(2 * N + 2 * AMSCR__OUTLINE_N, sizeof *buf);
+            if (!buf) {
+                st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+                break;
+            }
+            d = amscr__db_shallow(db, c, &sd, buf, buf + 2 * N) ? &sd : amscr__db_descriptor_peek(db, c, &tmp);
+            if (!d) {
+                st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+                break;
+            }
+        }
+        st = amscr__hf_mirror_of_descriptor(b->p, b->frames[f], d, &out[f]);
+        if (st != AMSCR_OK)
+            break;
+        own[f] |= 2;
     }
-    for (int f = 0; f < b->nf && st == AMSCR_OK; f++)
+    free(buf);
+    amscr_descriptor_free(tmp);
+    for (int f = 0; f < b->nf && st == AMSCR_OK; f++) {
+        int had0 = out[f].spec[0] != NULL, had1 = out[f].spec[1] != NULL;
+        if (!mirror && out[f].spec[0])
+            continue;
         st = amscr__hf_spectra(&out[f], ws);
-    if (st != AMSCR_OK)
-        spectra_free(b, out);
+        own[f] |= (!had0 && out[f].spec[0] ? 1 : 0) | (!had1 && out[f].spec[1] ? 4 : 0);
+    }
     return st;
 }
 
+static void complete_free(const amscr__base *b, amscr__hf out[2], const int own[2])
+{
+    for (int f = 0; f < b->nf; f++) {
+        if (own[f] & 1)
+            free(out[f].spec[0]);
+        if (own[f] & 2)
+            free(out[f].seq[1]);
+        if (own[f] & 4)
+            free(out[f].spec[1]);
+    }
+}
+
 /* A candidate's side of a pair: its channel sequences (stored, or built here: not kept, not
- * built yet by a lazy load, or heights without spectra from a file) and, when the pair reads
- * it, its prepared shape (a lazy load decodes it here). */
+ * built yet by a lazy load, or completed: complete()) and, when the pair reads it, its prepared
+ * shape (a lazy load decodes it here). */
 typedef struct {
     amscr__hf built[2];
     const amscr__hf *hf;
     const amscr_descriptor *d;
-    int build, spectra;
+    int build, part, own[2];
 } side_t;
 
-static amscr_status side_open(const amscr__base *b, const amscr_db *db, const amscr__hf *hfs, size_t c,
+static amscr_status side_open(const amscr__base *b, const amscr_db *db, const amscr__hf *hfs, size_t c, int mirror,
                               amscr__pair_ws *pw, side_t *o)
 {
     const amscr__hf *stored = hfs ? hfs + c * (size_t)b->nf : NULL;
     o->build = !stored || (b->nf > 0 && stored[0].seq[0] == NULL);
-    o->spectra = !o->build && b->nf > 0 && stored[0].spec[0] == NULL;
-    o->hf = o->build || o->spectra ? o->built : stored;
+    o->part = !o->build && b->nf > 0 &&
+              (stored[0].spec[0] == NULL || (mirror && (stored[0].seq[1] == NULL || stored[0].spec[1] == NULL)));
+    o->hf = o->build || o->part ? o->built : stored;
     o->d = o->build || b->w < 1.0 ? amscr_db_descriptor(db, c) : NULL;
     amscr_status st = AMSCR_OK;
     if ((o->build || b->w < 1.0) && !o->d)
         st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
     else if (o->build)
         st = amscr__base_hf(b, o->d, o->built);
-    else if (o->spectra)
-        st = with_spectra(b, stored, pw->have_hws ? &pw->hws : NULL, o->built);
+    else if (o->part) {
+        st = complete(b, db, c, stored, mirror, pw->have_hws ? &pw->hws : NULL, o->built, o->own);
+        if (st != AMSCR_OK)
+            complete_free(b, o->built, o->own);
+    }
     if (st != AMSCR_OK)
-        o->build = o->spectra = 0; /* nothing to release */
+        o->build = o->part = 0; /* nothing to release */
     return st;
 }
 
@@ -138,8 +179,8 @@ static void side_close(const amscr__base *b, side_t *o)
 {
     if (o->build)
         amscr__base_hf_free(b, o->built);
-    if (o->spectra)
-        spectra_free(b, o->built);
+    if (o->part)
+        complete_free(b, o->built, o->own);
 }
 
 /* out[t] for m <= AMSCR__HF_GROUP pairs: the base distance of lo[t] and hi[t] (lo the lower
@@ -180,6 +221,12 @@ amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const a
 {
     amscr_status st = AMSCR_OK;
     enum { G = AMSCR__HF_GROUP };
+    amscr__hf qfull[2];
+    int qown[2] = {0, 0}, qpart = b->nf > 0 && hq && qpos < amscr_db_size(db) && (!hq[0].seq[1] || !hq[0].spec[1]);
+    if (qpart) { /* an index's row (its shape's forward orientation kept): the pairs may read its mirror */
+        st = complete(b, db, qpos, hq, 1, pw->have_hws ? &pw->hws : NULL, qfull, qown);
+        hq = qfull;
+    }
     for (size_t t0 = 0; t0 < m && st == AMSCR_OK; t0 += G) {
         size_t g = m - t0 < G ? m - t0 : G, open = 0;
         side_t side[G];
@@ -187,8 +234,8 @@ amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const a
         const amscr__hf *hlo[G], *hhi[G];
         for (; open < g && st == AMSCR_OK; open++) {
             size_t c = cand[t0 + open];
-            st = side_open(b, db, hfs, c, pw, &side[open]);
             int first = c < qpos; /* the candidate is the pair's lower index */
+            st = side_open(b, db, hfs, c, !first, pw, &side[open]);
             lo[open] = first ? side[open].d : q;
             hlo[open] = first ? side[open].hf : hq;
             hi[open] = first ? q : side[open].d;
@@ -199,6 +246,8 @@ amscr_status amscr__base_pairs(const amscr__base *b, const amscr_db *db, const a
         for (size_t t = 0; t < open; t++)
             side_close(b, &side[t]);
     }
+    if (qpart)
+        complete_free(b, qfull, qown);
     return st;
 }
 

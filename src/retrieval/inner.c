@@ -26,6 +26,7 @@ amscr_status amscr__inner_ws_init(amscr__inner_ws *ws)
 {
     if (amscr__fft_plan_init(&ws->plan, N) != 0)
         return amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
+    ws->have_tw = 0;
     for (size_t m = 0; m < N; m++) {
         double a = -2.0 * AMSCR__PI * (double)m / (double)N;
         ws->cs[2 * m] = cos(a);
@@ -107,16 +108,48 @@ static int inner_matrix_of(const double *V, double *D)
     return 1;
 }
 
-/* The reversed orientation's twist of column k: tre + i tim = (re + i im) e^{-2 pi i f (k + 1) / N}. */
-static void twist(amscr__inner *f, const double *cs)
+/* The reversed orientation's twist of b's column k, in b's units, into ws->tw (unless it holds
+ * b's already): tw[0] + i tw[1] = (re + i im) e^{-2 pi i f (k + 1) / N}. */
+static void twist(const amscr__inner *b, amscr__inner_ws *ws)
 {
-    for (size_t k = 0; k < AMSCR__INNER_K; k++)
-        for (size_t q = 0; q < AMSCR__INNER_F; q++) {
-            const double *c = cs + 2 * ((q * (k + 1)) % N);
-            double br = f->re[q][k], bi = f->im[q][k];
-            f->tre[q][k] = (float)(br * c[0] - bi * c[1]);
-            f->tim[q][k] = (float)(br * c[1] + bi * c[0]);
+    if (ws->have_tw && memcmp(ws->tw_of, b->re, sizeof ws->tw_of) == 0)
+        return;
+    for (size_t q = 0; q < AMSCR__INNER_F; q++)
+        for (size_t k = 0; k < AMSCR__INNER_K; k++) {
+            const double *c = ws->cs + 2 * ((q * (k + 1)) % N);
+            double br = b->re[q][k], bi = b->im[q][k];
+            ws->tw[0][q][k] = br * c[0] - bi * c[1];
+            ws->tw[1][q][k] = br * c[1] + bi * c[0];
         }
+    memcpy(ws->tw_of, b->re, sizeof ws->tw_of);
+    ws->have_tw = 1;
+}
+
+int amscr__inner_quantize(amscr__inner *f, const double *v)
+{
+    const double *x = v;
+    const size_t fk = AMSCR__INNER_F * AMSCR__INNER_K;
+    double top = 0.0, sum = 0.0;
+    for (size_t t = 0; t < 2 * fk; t++) {
+        if (!isfinite(x[t]))
+            return 0;
+        top = fabs(x[t]) > top ? fabs(x[t]) : top;
+    }
+    f->scale = top / AMSCR__INNER_Q;
+    for (size_t q = 0; q < AMSCR__INNER_F; q++)
+        for (size_t k = 0; k < AMSCR__INNER_K; k++) {
+            int16_t r[2];
+            for (int c = 0; c < 2; c++) {
+                double u = top > 0.0 ? x[(size_t)c * fk + q * AMSCR__INNER_K + k] / f->scale : 0.0;
+                r[c] = (int16_t)(u > AMSCR__INNER_Q ? AMSCR__INNER_Q : u < -AMSCR__INNER_Q ? -AMSCR__INNER_Q : lround(u));
+            }
+            f->re[q][k] = r[0];
+            f->im[q][k] = r[1];
+            /* exact: integers below 2^53 */
+            sum += (q == 0 || 2 * q == N ? 1.0 : 2.0) * ((double)r[0] * r[0] + (double)r[1] * r[1]);
+        }
+    f->norm2 = sum * f->scale * f->scale / (double)N;
+    return 1;
 }
 
 /* The features of the N vertices in ws->xy. */
@@ -124,7 +157,6 @@ static amscr_status from_vertices(amscr__inner *out, amscr__inner_ws *ws)
 {
     if (!inner_matrix_of(ws->xy, ws->id))
         return amscr__fail(AMSCR_E_DEGENERATE, "inner distance: the curve has no extent");
-    out->norm2 = 0.0;
     for (size_t k = 0; k < AMSCR__INNER_K; k++) {
         size_t off = k + 1;
         double w = sqrt(off < N / 2 ? 2.0 : 1.0);
@@ -134,13 +166,12 @@ static amscr_status from_vertices(amscr__inner *out, amscr__inner_ws *ws)
         }
         amscr__fft(&ws->plan, ws->z, 0);
         for (size_t f = 0; f < AMSCR__INNER_F; f++) {
-            double br = (float)ws->z[2 * f], bi = (float)ws->z[2 * f + 1];
-            out->norm2 += (f == 0 || 2 * f == N ? 1.0 : 2.0) * (br * br + bi * bi) / (double)N;
-            out->re[f][k] = (float)br;
-            out->im[f][k] = (float)bi;
+            ws->fz[0][f][k] = ws->z[2 * f];
+            ws->fz[1][f][k] = ws->z[2 * f + 1];
         }
     }
-    twist(out, ws->cs);
+    if (!amscr__inner_quantize(out, &ws->fz[0][0][0]))
+        return amscr__fail(AMSCR_E_DEGENERATE, "inner distance: the curve has no extent");
     return AMSCR_OK;
 }
 
@@ -179,13 +210,12 @@ amscr_status amscr__inner_build_shape(const amscr_descriptor *d, double closing,
     return from_vertices(out, ws);
 }
 
-void amscr__inner_twist(amscr__inner *f, const amscr__inner_ws *ws) { twist(f, ws->cs); }
-
 /* The four sums over the columns k of frequencies f0 .. f0 + g - 1 into s[f][0..3] (X's real and
- * imaginary part, Y's; Y 0 without `refl`): the g frequencies side by side, each summed over
- * k in order (the chain of one sum no longer waits on itself alone). */
-static inline void column_sums(const amscr__inner *a, const amscr__inner *b, int refl, size_t f0, size_t g,
-                               double (*s)[4])
+ * imaginary part, Y's; Y 0 without `refl`), in the units of a and b: the g frequencies side by
+ * side, each summed over k in order (the chain of one sum no longer waits on itself alone). X's
+ * sums of integer products are exact; Y reads b's twist tw. */
+static inline void column_sums(const amscr__inner *a, const amscr__inner *b, const amscr__inner_ws *ws, int refl,
+                               size_t f0, size_t g, double (*s)[4])
 {
     double xr[4] = {0.0}, xi[4] = {0.0}, yr[4] = {0.0}, yi[4] = {0.0};
     for (size_t k = 0; k < AMSCR__INNER_K; k++)
@@ -196,7 +226,7 @@ static inline void column_sums(const amscr__inner *a, const amscr__inner *b, int
         }
     for (size_t k = 0; refl && k < AMSCR__INNER_K; k++)
         for (size_t t = 0; t < g; t++) {
-            double ar = a->re[f0 + t][k], ai = a->im[f0 + t][k], tr = b->tre[f0 + t][k], ti = b->tim[f0 + t][k];
+            double ar = a->re[f0 + t][k], ai = a->im[f0 + t][k], tr = ws->tw[0][f0 + t][k], ti = ws->tw[1][f0 + t][k];
             yr[t] += ar * tr - ai * ti;
             yi[t] += ar * ti + ai * tr;
         }
@@ -213,14 +243,16 @@ static inline void column_sums(const amscr__inner *a, const amscr__inner *b, int
  * reversed (imaginary part: sum_k A B e^{-2 pi i f (k + 1) / N}, sum_i a[i] b[-i - s - k - 1]). */
 static void spectrum(const amscr__inner *a, const amscr__inner *b, int refl, amscr__inner_ws *ws)
 {
-    double *z = ws->z, s[AMSCR__INNER_F][4];
+    double *z = ws->z, s[AMSCR__INNER_F][4], u = a->scale * b->scale;
     size_t f0 = 0;
+    if (refl)
+        twist(b, ws);
     for (; f0 + 4 <= AMSCR__INNER_F; f0 += 4)
-        column_sums(a, b, refl, f0, 4, s);
+        column_sums(a, b, ws, refl, f0, 4, s);
     for (; f0 < AMSCR__INNER_F; f0++)
-        column_sums(a, b, refl, f0, 1, s);
+        column_sums(a, b, ws, refl, f0, 1, s);
     for (size_t f = 0; f < AMSCR__INNER_F; f++) {
-        double xr = s[f][0], xi = s[f][1], yr = s[f][2], yi = s[f][3];
+        double xr = u * s[f][0], xi = u * s[f][1], yr = u * s[f][2], yi = u * s[f][3];
         z[2 * f] = xr - yi; /* X + i Y */
         z[2 * f + 1] = xi + yr;
         if (f > 0 && f < N / 2) { /* conj(X) + i conj(Y) at N - f */

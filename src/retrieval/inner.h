@@ -17,12 +17,15 @@
 /* A shape's inner distances in offset form, column k (offset k + 1) the sequence
  * i -> ID(i, i + k + 1) over the N vertices, scaled by the square root of its share of the
  * whole matrix (2 for offsets below N/2, 1 for N/2): the DFT of every column at the kept
- * frequencies, as re[f][k] + i im[f][k] (columns contiguous: the pair loop runs along k), the
- * same turned by e^{-2 pi i f (k + 1) / N} (tre, tim: the reversed orientation's shift of
- * column k), and the sum of squares of the columns so low-passed (of the values as stored). */
+ * frequencies, as re[f][k] + i im[f][k] (columns contiguous: the pair loop runs along k), in
+ * units of `scale` (the largest magnitude / AMSCR__INNER_Q, rounded to the nearest: 2.2 KB a
+ * shape), and the sum of squares of the columns so low-passed (of the values as stored). The
+ * reversed orientation's twist of the columns is computed where a pair needs it (the pair's
+ * second shape; a workspace keeps the last one's). */
+#define AMSCR__INNER_Q 32767.0
 typedef struct {
-    float re[AMSCR__INNER_F][AMSCR__INNER_K], im[AMSCR__INNER_F][AMSCR__INNER_K]; /* float32: summed in double */
-    float tre[AMSCR__INNER_F][AMSCR__INNER_K], tim[AMSCR__INNER_F][AMSCR__INNER_K];
+    int16_t re[AMSCR__INNER_F][AMSCR__INNER_K], im[AMSCR__INNER_F][AMSCR__INNER_K];
+    double scale;
     double norm2;
 } amscr__inner;
 
@@ -33,6 +36,10 @@ typedef struct {
     double cs[2 * AMSCR__INNER_N]; /* e^{-2 pi i m / N}, m = 0..N-1 */
     double xy[2 * AMSCR__INNER_N];
     double id[AMSCR__INNER_N * AMSCR__INNER_N];
+    double fz[2][AMSCR__INNER_F][AMSCR__INNER_K]; /* a shape's values before their rounding */
+    int16_t tw_of[2][AMSCR__INNER_F][AMSCR__INNER_K]; /* the shape whose twist tw holds (have_tw) */
+    double tw[2][AMSCR__INNER_F][AMSCR__INNER_K];
+    int have_tw;
 } amscr__inner_ws;
 
 amscr_status amscr__inner_ws_init(amscr__inner_ws *ws);
@@ -54,8 +61,10 @@ amscr_status amscr__inner_build_shape(const amscr_descriptor *d, double closing,
  * divided by its mean) at the best cyclic shift, and orientation when `reflections`; 0 for
  * a shape against itself, symmetric. */
 double amscr__inner_distance(const amscr__inner *a, const amscr__inner *b, int reflections, amscr__inner_ws *ws);
-/* tre, tim of f from its re, im (features read from a file). */
-void amscr__inner_twist(amscr__inner *f, const amscr__inner_ws *ws);
+/* f's values re, im and scale from the values v (F K real parts, then F K imaginary) as computed
+ * (a file before version 16: its float32 or double values), its norm2 from the rounded values;
+ * 0 when a value is not finite. */
+int amscr__inner_quantize(amscr__inner *f, const double *v);
 
 /* ------------------------------------------------ over a collection (inner_matrix.c) */
 

@@ -183,7 +183,12 @@ size_t amscr__sig_nearest(const float *sigs, const float *lbs, size_t n, const f
 
 /* ------------------------------------------------ the coarse quantizer of a large build */
 
-enum { IVF_ITERS = 6, IVF_TRAIN_PER_LIST = 48, IVF_PROBE_LISTS = 8, IVF_PROBE_PER_M = 16 };
+enum { IVF_ITERS = 6, IVF_TRAIN_PER_LIST = 48 };
+/* A search probes the lists nearest its bound vector: at least this many, and until they hold
+ * at least IVF_PROBE_PER_M m + 1 shapes (a build's rows and, from AMSCR__INDEX_IVF_MIN shapes,
+ * an index query: docs/decisions.md). */
+#define IVF_PROBE_LISTS 8
+#define IVF_PROBE_PER_M 16
 
 static float sq_dist(const float *a, const float *b)
 {
@@ -244,27 +249,59 @@ static int ivf_train(amscr__sig_ivf *v, const float *lbs, size_t n)
     return 1;
 }
 
+int amscr__sig_ivf_lists(amscr__sig_ivf *v)
+{
+    size_t *start = amscr__calloc_array(v->nc + 1, sizeof *start), *ids = amscr__malloc_array(v->n ? v->n : 1, sizeof *ids);
+    size_t *fill = amscr__calloc_array(v->nc ? v->nc : 1, sizeof *fill);
+    int ok = start && ids && fill;
+    for (size_t i = 0; ok && i < v->n; i++)
+        start[v->cell[i] + 1]++;
+    for (size_t c = 0; ok && c < v->nc; c++)
+        start[c + 1] += start[c];
+    for (size_t i = 0; ok && i < v->n; i++) /* ascending within a list */
+        ids[start[v->cell[i]] + fill[v->cell[i]]++] = i;
+    free(fill);
+    if (!ok) { /* the old lists kept */
+        free(start);
+        free(ids);
+        return 0;
+    }
+    free(v->start);
+    free(v->ids);
+    v->start = start;
+    v->ids = ids;
+    return 1;
+}
+
 amscr_status amscr__sig_ivf_build(const float *lbs, size_t n, amscr__sig_ivf *v)
 {
     memset(v, 0, sizeof *v);
     v->nc = (size_t)ceil(sqrt((double)n));
+    v->n = n;
     v->cent = amscr__malloc_array(v->nc, AMSCR__SIG_LB_DIM * sizeof *v->cent);
-    v->start = amscr__calloc_array(v->nc + 1, sizeof *v->start);
-    v->ids = amscr__malloc_array(n ? n : 1, sizeof *v->ids);
-    size_t *of = amscr__malloc_array(n ? n : 1, sizeof *of), *fill = amscr__calloc_array(v->nc, sizeof *fill);
-    int ok = v->cent && v->start && v->ids && of && fill && ivf_train(v, lbs, n);
-    for (size_t i = 0; ok && i < n; i++) {
-        of[i] = nearest_centroid(v, lbs + i * AMSCR__SIG_LB_DIM);
-        v->start[of[i] + 1]++;
-    }
-    for (size_t c = 0; ok && c < v->nc; c++)
-        v->start[c + 1] += v->start[c];
-    for (size_t i = 0; ok && i < n; i++) /* ascending within a list */
-        v->ids[v->start[of[i]] + fill[of[i]]++] = i;
-    free(of);
-    free(fill);
-    if (!ok) {
+    v->cell = amscr__malloc_array(n ? n : 1, sizeof *v->cell);
+    int ok = v->cent && v->cell && ivf_train(v, lbs, n);
+    for (size_t i = 0; ok && i < n; i++)
+        v->cell[i] = (uint32_t)nearest_centroid(v, lbs + i * AMSCR__SIG_LB_DIM);
+    if (!ok || !amscr__sig_ivf_lists(v)) {
         amscr__sig_ivf_free(v);
+        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    }
+    return AMSCR_OK;
+}
+
+amscr_status amscr__sig_ivf_add(amscr__sig_ivf *v, const float *lbs, size_t n)
+{
+    uint32_t *cell = n > v->n ? realloc(v->cell, n * sizeof *cell) : v->cell;
+    if (!cell)
+        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    v->cell = cell;
+    for (size_t i = v->n; i < n; i++)
+        cell[i] = (uint32_t)nearest_centroid(v, lbs + i * AMSCR__SIG_LB_DIM);
+    size_t n0 = v->n;
+    v->n = n;
+    if (!amscr__sig_ivf_lists(v)) {
+        v->n = n0;
         return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
     }
     return AMSCR_OK;
@@ -273,6 +310,7 @@ amscr_status amscr__sig_ivf_build(const float *lbs, size_t n, amscr__sig_ivf *v)
 void amscr__sig_ivf_free(amscr__sig_ivf *v)
 {
     free(v->cent);
+    free(v->cell);
     free(v->start);
     free(v->ids);
     memset(v, 0, sizeof *v);
@@ -288,12 +326,17 @@ size_t amscr__sig_ivf_nearest(const amscr__sig_ivf *v, const float *sigs, const 
                               const float *lb, size_t m, size_t exclude, size_t *cand)
 {
     double *cd = amscr__malloc_array(v->nc, sizeof *cd);
-    size_t *order = amscr__malloc_array(v->nc, sizeof *order), *ids = amscr__malloc_array(n, sizeof *ids), got = 0;
-    int ok = cd && order && ids;
+    size_t *order = amscr__malloc_array(v->nc, sizeof *order), *ids = NULL, got = 0, lists = 0;
+    int ok = cd && order;
     for (size_t c = 0; ok && c < v->nc; c++)
         cd[c] = sq_dist(v->cent + c * AMSCR__SIG_LB_DIM, lb);
     ok = ok && amscr_topk(cd, v->nc, v->nc, SIZE_MAX, order) == AMSCR_OK;
-    for (size_t r = 0; ok && r < v->nc && (r < IVF_PROBE_LISTS || got < IVF_PROBE_PER_M * m + 1); r++)
+    for (; ok && lists < v->nc && (lists < IVF_PROBE_LISTS || got < IVF_PROBE_PER_M * m + 1); lists++)
+        got += v->start[order[lists] + 1] - v->start[order[lists]];
+    ids = ok ? amscr__malloc_array(got ? got : 1, sizeof *ids) : NULL;
+    ok = ok && ids;
+    got = 0;
+    for (size_t r = 0; ok && r < lists; r++)
         for (size_t t = v->start[order[r]]; t < v->start[order[r] + 1]; t++)
             ids[got++] = v->ids[t];
     if (ok)

@@ -33,17 +33,25 @@ double amscr__sig_distance(const float *a, const float *b);
 size_t amscr__sig_nearest(const float *sigs, const float *lbs, size_t n, const float *sig, const float *lb, size_t m,
                           size_t exclude, size_t *cand);
 
-/* A coarse quantizer of the lower-bound vectors (a large build's shortlists): ceil(sqrt(n))
- * K-means lists, each holding its shapes in ascending order. */
+/* A coarse quantizer of the lower-bound vectors (a large build's shortlists, and a large
+ * index's queries: index.c): ceil(sqrt(n)) K-means lists, each holding its shapes in ascending
+ * order. */
 typedef struct {
-    size_t nc;     /* lists */
+    size_t nc;     /* lists (0: no quantizer) */
+    size_t n;      /* shapes */
     float *cent;   /* nc x AMSCR__SIG_LB_DIM centroids */
+    uint32_t *cell; /* n: each shape's list */
     size_t *start; /* nc + 1 offsets into ids */
     size_t *ids;   /* the n shapes, list by list */
 } amscr__sig_ivf;
 
 amscr_status amscr__sig_ivf_build(const float *lbs, size_t n, amscr__sig_ivf *v);
 void amscr__sig_ivf_free(amscr__sig_ivf *v);
+/* v's lists (start, ids) from its cells (v->n shapes, each < v->nc); 0 when out of memory. */
+int amscr__sig_ivf_lists(amscr__sig_ivf *v);
+/* Shapes v->n..n-1 (lower-bound vectors lbs) into the lists of their nearest centroids (the
+ * centroids unchanged). */
+amscr_status amscr__sig_ivf_add(amscr__sig_ivf *v, const float *lbs, size_t n);
 /* amscr__sig_nearest among the shapes of the lists nearest lb (at least 8 lists and 16 m + 1
  * shapes): the m nearest of those, not necessarily the m nearest of all. */
 size_t amscr__sig_ivf_nearest(const amscr__sig_ivf *v, const float *sigs, const float *lbs, size_t n, const float *sig,

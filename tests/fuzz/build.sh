@@ -48,7 +48,7 @@ for src in src/*/*.c; do
   lib_objs+=("$obj")
 done
 tool_objs=()
-for src in tools/cli/image.c tools/cli/util.c tools/cli/collection.c; do
+for src in tools/cli/image.c tools/cli/image_pgm.c tools/cli/image_png.c tools/cli/util.c tools/cli/collection.c; do
   obj="$OUT/obj/tool_$(basename "${src%.c}").o"
   throttle
   # shellcheck disable=SC2086

@@ -1,4 +1,4 @@
-/* fuzz_image.h — the image decoders of the tool (tools/cli/image.c) on arbitrary bytes.
+/* fuzz_image.h — the image decoders of the tool (tools/cli/image_pgm.c, image_png.c) on arbitrary bytes.
  *
  * tools/cli/image.h decodes files only (image_read(path, ...)), so each input is written to one
  * scratch file per process (in /dev/shm when it exists: no disk traffic) and decoded from

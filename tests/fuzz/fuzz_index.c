@@ -3,7 +3,7 @@
  * features of a version 4 file too). Properties
  * on success: neighbour lists start with the shape itself and stay in range, the collection
  * loader reads the same bytes to the same collection, and the index serializes into bytes
- * that load again to the same counts; a lazy load of the bytes mapped (as a file's: the shapes
+ * that load again to the same counts, a quantizer's lists hold every shape once; a lazy load of the bytes mapped (as a file's: the shapes
  * checked, decoded when needed) succeeds or fails with a lazy load of the bytes as given (the
  * shapes decoded at load), to the same collection bytes. On failure: a detail. */
 #define _DEFAULT_SOURCE /* MAP_ANONYMOUS */
@@ -64,6 +64,12 @@ static void one(const uint8_t *data, size_t size)
     lazy_mapped(data, size);
     size_t n = amscr_index_size(x);
     FUZZ_CHECK(amscr_index_neighbours(x) <= n);
+    /* a quantizer (version 16): every shape in one list, the lists ascending and within range */
+    FUZZ_CHECK(x->ivf.nc == 0 || (x->ivf.nc <= n && x->ivf.n == n && x->ivf.start[x->ivf.nc] == n));
+    for (size_t c = 0; c < x->ivf.nc; c++)
+        for (size_t t = x->ivf.start[c]; t < x->ivf.start[c + 1]; t++)
+            FUZZ_CHECK(x->ivf.ids[t] < n && x->ivf.cell[x->ivf.ids[t]] == c &&
+                       (t == x->ivf.start[c] || x->ivf.ids[t] > x->ivf.ids[t - 1]));
     amscr_db *db = NULL;
     FUZZ_CHECK(amscr_db_load_memory(data, size, &db) == AMSCR_OK && amscr_db_size(db) == n);
     amscr_db_free(db);

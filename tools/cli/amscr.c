@@ -47,10 +47,9 @@ int main(int argc, char **argv)
         return usage_error(NULL, "unknown command '%s' (see 'amscr --help')", name);
     opts o;
     opts_init(&o, c);
-    int help_status = TOOL_EXIT_OK;
-    int r = parse_args(&o, c, argc, argv, &help_status);
+    int r = parse_args(&o, c, argc, argv);
     if (r < 0)
-        return help_status;
+        return print_command_help(c);
     if (r != 0)
         return r;
     return c->run(&o);

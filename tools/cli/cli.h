@@ -146,11 +146,8 @@ int print_command_help(const tool_command *c);
 /* options.c */
 /* The options before parsing: the command's defaults. */
 void opts_init(opts *o, const tool_command *c);
-/* Parses argv[2..]. Returns 0, TOOL_EXIT_USAGE, or -1 when help was printed (help_status
- * then holds the exit code of the help). */
-int parse_args(opts *o, const tool_command *c, int argc, char **argv, int *help_status);
-/* Prints "amscr: WHAT: message" and returns TOOL_EXIT_USAGE. */
-int usage_error(const char *what, const char *fmt, ...) TOOL_PRINTF(2, 3);
+/* Parses argv[2..]. Returns 0, TOOL_EXIT_USAGE, or -1 when --help (-h) was asked. */
+int parse_args(opts *o, const tool_command *c, int argc, char **argv);
 
 /* The handlers (cmd_*.c): each returns the exit code. */
 int cmd_contour(opts *o);

@@ -117,17 +117,6 @@ static const optdef OPTS[] = {
     {"--pixel-chain", O_PIXEL_CHAIN, 0, C_ALL, NULL},
 };
 
-int usage_error(const char *what, const char *fmt, ...)
-{
-    char msg[600];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    tool_error(what, "%s", msg);
-    return TOOL_EXIT_USAGE;
-}
-
 void opts_init(opts *o, const tool_command *c)
 {
     memset(o, 0, sizeof *o);
@@ -444,7 +433,7 @@ static int parse_option(opts *o, int argc, char **argv, int *i)
     return set_option(o, d, v);
 }
 
-int parse_args(opts *o, const tool_command *c, int argc, char **argv, int *help_status)
+int parse_args(opts *o, const tool_command *c, int argc, char **argv)
 {
     int only_pos = 0;
     for (int i = 2; i < argc; i++) {
@@ -454,10 +443,8 @@ int parse_args(opts *o, const tool_command *c, int argc, char **argv, int *help_
             continue;
         }
         if (!only_pos && a[0] == '-' && a[1] != '\0') {
-            if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-                *help_status = print_command_help(c);
+            if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0)
                 return -1;
-            }
             int r = parse_option(o, argc, argv, &i);
             if (r != 0)
                 return r;

@@ -1,5 +1,5 @@
-/* raster.h — the drawing primitives of draw.c shared by the other pictures (sheet.c,
- * eval_plot.c): an RGB float raster with anti-aliased coverage layers, the 5x7 bitmap font,
+/* raster.h — the drawing primitives of the tool's pictures (raster.c, picture_file.c) that draw.c,
+ * sheet.c and eval_plot.c use: an RGB float raster with anti-aliased coverage layers, the 5x7 bitmap font,
  * PNG and text files written atomically, SVG text escaping. Tool-internal. */
 #ifndef AMSCR_TOOL_RASTER_H
 #define AMSCR_TOOL_RASTER_H

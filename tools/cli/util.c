@@ -46,6 +46,17 @@ void tool_error(const char *what, const char *fmt, ...)
     print_line(what, msg);
 }
 
+int usage_error(const char *what, const char *fmt, ...)
+{
+    char msg[600];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    tool_error(what, "%s", msg);
+    return TOOL_EXIT_USAGE;
+}
+
 const char *lib_detail(void)
 {
     const char *d = amscr_last_error_detail();

@@ -23,7 +23,9 @@ enum { TOOL_EXIT_OK = 0, TOOL_EXIT_FAIL = 1, TOOL_EXIT_USAGE = 2 };
  * later ones are dropped, so the user always sees exactly one line. `what` is a file
  * name, a subcommand or an option (may be NULL: "amscr: message"). */
 void tool_error(const char *what, const char *fmt, ...) TOOL_PRINTF(2, 3);
-/* The same for a failed library call: "amscr: WHAT: <detail or strerror>". When the
+/* tool_error, then returns TOOL_EXIT_USAGE (a wrong command line). */
+int usage_error(const char *what, const char *fmt, ...) TOOL_PRINTF(2, 3);
+/* tool_error for a failed library call: "amscr: WHAT: <detail or strerror>". When the
  * library detail already starts with "WHAT:" it is printed as is after "amscr: ". */
 void tool_lib_error(const char *what, amscr_status st);
 /* amscr_last_error_detail() without a leading "amscr_function: " prefix. */

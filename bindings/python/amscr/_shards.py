@@ -43,6 +43,7 @@ from .errors import AmscrError, FileError, FormatError, InvalidArgumentError, _c
 from .index import Index
 from .params import Params, _params_from_dict
 from .shape import Shape
+from ._placement import _block, _threads_by_host, _tile_threads
 
 FORMAT = 'amscr-sharded-index'
 VERSION = 1
@@ -139,7 +140,6 @@ def widths(params: Params, n: int) -> Tuple[int, int]:
 
 # ========================================================================== worker side
 def _threads(threads) -> int:
-    from .distributed import _tile_threads
     return _tile_threads(threads)
 
 
@@ -148,7 +148,6 @@ def _shard_index(data: bytes, threads) -> Index:
     coll = Collection.from_bytes(data)
     t = _threads(threads)
     if coll.params.threads != t:
-        from .distributed import _block
         coll = _block(coll, 0, len(coll), t)
     return Index(coll, progress=False, candidates=SHARD_LIST if len(coll) > SHARD_LIST + 1 else 0)
 
@@ -806,11 +805,9 @@ def build_index(client, collection: Collection, path: Optional[PathLike] = None,
     m = int(lib.amscr_index_default_candidates(n)) if candidates is None else int(candidates)
     ns = min(int(shards) if shards is not None else len(workers), n)
     bounds = _bounds(n, ns)
-    from .distributed import _block
     datas = [_block(collection, lo, hi, params.threads).to_bytes() for lo, hi in bounds]
     placed = [workers[s % len(workers)] for s in range(ns)]
     rows = [client.scatter(datas[s], workers=[placed[s]], hash=False) for s in range(ns)]
-    from .distributed import _threads_by_host
     th = _threads_by_host(client)
     idx = [client.submit(_shard_index, rows[s], th, pure=False, workers=[placed[s]])
            for s in range(ns)]

@@ -51,7 +51,6 @@ import math
 import os
 import threading
 import uuid
-from collections import defaultdict
 from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -60,7 +59,6 @@ try:
     import dask
     import distributed
     from distributed import as_completed
-    from distributed.comm import get_address_host
 except ImportError as e:  # pragma: no cover - exercised only without Dask
     raise ImportError('amscr.distributed needs Dask: pip install "dask[distributed]>=2023" '
                       '(or pip install "amscr[distributed]")') from e
@@ -70,6 +68,7 @@ from ._util import dbuf
 from .collection import Collection
 from .errors import AmscrError, FormatError, _check
 from .shape import Shape
+from ._placement import _block, _cores, _threads_by_host, _tile_threads, _worker_address
 
 __all__ = ['distance_matrix', 'cross_matrix', 'topk', 'tile_size', 'LostTilesError', 'build_index', 'load_index',
            'ShardedIndex', 'ShardSetError']
@@ -131,46 +130,6 @@ _PARSED = [0]  # collections parsed in this process (tests read it through clien
 
 def _parsed_count() -> int:
     return _PARSED[0]
-
-
-def _worker_address() -> Optional[str]:
-    try:
-        return distributed.get_worker().address
-    except ValueError:
-        return None
-
-
-def _cores() -> int:
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except (AttributeError, OSError):  # pragma: no cover - non-Linux
-        return max(1, os.cpu_count() or 1)
-
-
-def _tile_threads(threads: Union[int, Dict[str, int], None]) -> int:
-    """C threads of this tile: an explicit count, or this worker host's share of its cores."""
-    if isinstance(threads, int):
-        return threads
-    addr = _worker_address()
-    if threads and addr is not None and get_address_host(addr) in threads:
-        return threads[get_address_host(addr)]
-    try:
-        nthreads = distributed.get_worker().nthreads
-    except ValueError:  # not on a worker
-        nthreads = 1
-    return max(1, _cores() // max(1, nthreads))
-
-
-def _block(coll: Collection, lo: int, hi: int, threads: int) -> Collection:
-    """Shapes lo..hi-1 of `coll` as a collection computing with `threads` C threads (one copy of
-    each prepared shape; `coll` itself when nothing changes)."""
-    p = coll.params
-    if lo == 0 and hi == len(coll) and p.threads == threads:
-        return coll
-    sub = Collection(p, threads=threads)
-    with coll._lock.read():
-        sub._add_copies(coll, range(lo, hi))
-    return sub
 
 
 def _matrix_tile(payload: _Payload, r0: int, r1: int, c0: int, c1: int, threads) -> np.ndarray:
@@ -269,21 +228,6 @@ def tile_size(nrows: int, ncols: int, nthreads: int, tile: TileArg = None) -> Tu
 
 def _bounds(n: int, t: int) -> List[Tuple[int, int]]:
     return [(lo, min(lo + t, n)) for lo in range(0, n, t)]
-
-
-def _threads_by_host(client) -> Dict[str, int]:
-    """C threads per tile on each host: its cores over the Dask threads of its workers."""
-    nthreads = client.nthreads()
-    if not nthreads:
-        return {}
-    cores = client.run(_cores)
-    dask_threads: Dict[str, int] = defaultdict(int)
-    host_cores: Dict[str, int] = {}
-    for addr, nt in nthreads.items():
-        h = get_address_host(addr)
-        dask_threads[h] += nt
-        host_cores[h] = cores.get(addr, 1)
-    return {h: max(1, host_cores[h] // dask_threads[h]) for h in dask_threads}
 
 
 def _check_threads(threads: Any) -> Optional[int]:
