@@ -16,8 +16,16 @@ size = RMS radius about the centroid.
 ECC (--ecc; opencv-python-headless): cv2.findTransformECC, MOTION_AFFINE, on rendered, blurred
 masks, from 8 starting rotations (centroid and area matched), the best correlation kept.
 
+--sets A,B,P (the check's view): fold A / fold B of the manifest's classes (folds.tsv) and 35
+procedural silhouettes (bindings/python/tests/shapegen.py, set 1, 200 px, traced the same way) side
+by side: ok % under the max rule above and under the check's rule (RMS of the error over the
+source's points < 2 % of the size), and wrong + confident (an RMS failure with confidence >= 0.25).
+--stages NAME,... switches optional stages on (order, even_spacing, ...); --reversed gives the
+fragments' points in the other order (against the target's way round).
+
 Usage: nice python3 bench/registration_heldout.py [--data DIR] [--ecc] [--draws 2] [--stray F] [--only KEYS]
-Deterministic: every draw is seeded by (condition, class index, draw).
+       [--sets A,B,P] [--stages NAMES] [--reversed]
+Deterministic: every draw is seeded by (condition, class index, draw); procedural shape i has index 1000 + i.
 """
 import argparse
 import math
@@ -113,9 +121,10 @@ def with_strays(src, share, rng):
     return out
 
 
-def map_error(M, T, src, size):
+def map_error(M, T, src, size, rms=False):
     d = apply(M, src) - apply(T, src)
-    return float(np.sqrt((d * d).sum(axis=1)).max() / size)
+    d = np.sqrt((d * d).sum(axis=1))
+    return float((np.sqrt((d * d).mean()) if rms else d.max()) / size)
 
 
 def preset_error(src, tgt, T, size):
@@ -135,10 +144,11 @@ def error_summary(errs):
         n, 100 * np.mean(e < 2), e[n // 2], e[9 * n // 10], e[95 * n // 100])
 
 
-def amscr_register(src, tgt, partial):
+def amscr_register(src, tgt, partial, stages=None):
     """The recovered 2x3 map, or None when the call fails."""
+    opts = {'stages': stages} if stages else {}
     try:
-        r = amscr.register(src, tgt, partial=True) if partial else amscr.register(src, tgt)
+        r = amscr.register(src, tgt, partial=True, **opts) if partial else amscr.register(src, tgt, **opts)
     except amscr.AmscrError:
         return None, None
     return np.hstack([r.A, r.B[:, None]]), r
@@ -219,6 +229,68 @@ def load_shapes(data, nclass, subpixel=False):
     return shapes
 
 
+CONFIDENT = 0.25
+
+
+def load_sets(data, sets, subpixel=False):
+    """[(set, class, contour, seed index)]: the manifest's classes of folds.tsv's folds in `sets`
+    (A, B) and, for P, 35 procedural silhouettes (shapegen set 1)."""
+    out = []
+    if set(sets) & {'A', 'B'}:
+        folds = dict(l.rstrip('\n').split('\t') for l in list(open(os.path.join(data, 'folds.tsv')))[1:])
+        for si, (cls, f) in enumerate(load_shapes(data, 10 ** 6, subpixel)):
+            if folds.get(cls) in sets:
+                out.append((folds[cls], cls, f, si))
+    if 'P' in sets:
+        sys.path.insert(1, os.path.join(HERE, '..', 'bindings', 'python', 'tests'))
+        import shapegen
+        for i in range(35):
+            out.append(('P', 'proc%02d' % i, amscr.contour_from_mask(shapegen.silhouette(1, i), subpixel=subpixel),
+                        1000 + i))
+    return out
+
+
+def sets_table(args, conds):
+    """The check's view: the sets side by side, both success rules and wrong + confident."""
+    sets = args.sets.split(',')
+    shapes = load_sets(args.data, sets, args.tracer == 'subpixel')
+    stages = {k: True for k in args.stages.split(',')} if args.stages else None
+    res, fails = {}, []
+    for key, label, amount, _ in conds:
+        ci = [c[0] for c in CONDITIONS].index(key)
+        for fold, cls, f, si in shapes:
+            for d in range(args.draws):
+                rng = np.random.default_rng([14, ci, si, d])
+                src, tgt, T, size, partial = make_case(f, key, amount, rng)
+                if partial and args.reversed:
+                    src = src[::-1].copy()
+                t0 = time.perf_counter()
+                M, r = amscr_register(src, tgt, partial, stages)
+                ms = 1e3 * (time.perf_counter() - t0)
+                em, er = ((map_error(M, T, src, size), map_error(M, T, src, size, rms=True)) if M is not None
+                          else (math.inf, math.inf))
+                conf = r.confidence if r is not None else 0.0
+                res.setdefault((fold, key), []).append((em < 0.02, er < 0.02, er >= 0.02 and conf >= CONFIDENT, ms))
+                if er >= 0.02:
+                    fails.append('%s %s %s d%d: rms %.2f %% max %.2f %% conf %.3f' % (key, fold, cls, d, 100 * er,
+                                                                                       100 * em, conf))
+        print('.', end='', file=sys.stderr, flush=True)
+    print(file=sys.stderr)
+    names = {'A': 'fold A', 'B': 'fold B', 'P': 'procedural'}
+    print('ok %% max rule / ok %% RMS rule / wrong + confident %% (%d draws%s)' %
+          (args.draws, ', stages ' + args.stages if args.stages else ''))
+    print('| condition | ' + ' | '.join('%s (%d)' % (names[k], len(res[(k, conds[0][0])])) for k in sets) + ' | ms |')
+    print('|---|' + '---|' * len(sets) + '---|')
+    for key, label, _, _ in conds:
+        cells = ['%.1f / %.1f / %.1f' % tuple(100 * np.mean([r[i] for r in res[(k, key)]]) for i in range(3))
+                 for k in sets]
+        ms = np.mean([r[3] for k in sets for r in res[(k, key)]])
+        print('| %s | %s | %.1f |' % (label, ' | '.join(cells), ms))
+    if args.failures:
+        print('\n'.join(fails))
+    return 0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--data', default=os.environ.get('AMSCR_HELDOUT_DATA', '/work/shared/datasets/mpeg7-dev'))
@@ -231,10 +303,16 @@ def main():
                          'the error is still measured on the clean source')
     ap.add_argument('--tracer', choices=['pixel-chain', 'subpixel'], default='pixel-chain',
                     help='how the source silhouettes are traced (the published table: pixel-chain)')
+    ap.add_argument('--sets', help="comma-separated sets side by side: A, B (folds.tsv), P (procedural)")
+    ap.add_argument('--stages', default='', help='comma-separated optional stages switched on (--sets)')
+    ap.add_argument('--failures', action='store_true', help='list the RMS failures (--sets)')
+    ap.add_argument('--reversed', action='store_true', help="fragments given against the target's way (--sets)")
     args = ap.parse_args()
     if not os.path.exists(os.path.join(args.data, 'manifest.tsv')):
         print('no manifest in %s: skipped' % args.data)
         return 0
+    if args.sets:
+        return sets_table(args, [c for c in CONDITIONS if not args.only or c[0] in args.only.split(',')])
     cv2 = None
     if args.ecc:
         try:

@@ -1398,7 +1398,9 @@ AMSCR_API unsigned amscr_params_get_refine(const amscr_params *p);
  *        source open and the target closed whatever `closed` says; with amscr_register the
  *        descriptors must have been prepared so. A partial result has no per-scale systems:
  *        residuals 0, no kept scale, threshold +inf. Short fragments may be ambiguous
- *        (amscr_result_confidence).
+ *        (amscr_result_confidence). Since 0.15 the fragment's points may run either way
+ *        along the target (both are searched; without reflections only maps that keep the
+ *        orientation, determinant > 0, are placed).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -2255,7 +2257,9 @@ AMSCR_API double amscr_result_inlier_fraction(const amscr_result *r);
  *        [0, 1) of the target's boundary, of the target points matched to the source's first
  *        and last samples. The parameter runs along the target's samples (its
  *        parametrization) from the target's first input point in its input direction. For a
- *        partial match: where the fragment starts and ends (end < start when it wraps).
+ *        partial match: where the fragment starts and ends (end < start when it wraps; for
+ *        a fragment whose points run against the target's direction the fragment covers the
+ *        boundary from end to start).
  * @param[out] out_start, out_end  the two fractions.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL).
  * Ownership: none.

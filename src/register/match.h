@@ -41,9 +41,12 @@
  * maps that score alike (in the search's ranking or the polish's), the further minima are ranked
  * too (shift_search.c), so that a shape with more symmetries than three (a square's four quarter
  * turns, a regular star's fifths) lists each as an alternative — up to AMSCR__CANDIDATES_MAX per
- * orientation (a 12-fold symmetry); they never become the reported map. */
+ * orientation (a 12-fold symmetry). One of them becomes the reported map only when it scores
+ * clearly better than the best of the lowest three: its cost below AMSCR__HELD_WIN times theirs (a near-symmetric shape whose right turn the criterion ranks
+ * fourth or later, measured on bench/registration_heldout.py --sets). */
 #define AMSCR__CANDIDATES 3
 #define AMSCR__CANDIDATES_MAX 12
+#define AMSCR__HELD_WIN 0.9
 
 /* Per-stage timing, compiled only into the benchmark's copy of the library
  * (-DAMSCR_STAGE_TIMING): the product's hot path has no clock calls. */
@@ -108,7 +111,7 @@ typedef struct {
     double cand[2 * AMSCR__CANDIDATES_MAX][6];
     int cand_o[2 * AMSCR__CANDIDATES_MAX]; /* their orientations */
     size_t ncand;
-    size_t ncand_base; /* the first ncand_base of cand may win (the rest: further minima, listed only) */
+    size_t ncand_base; /* the first ncand_base of cand may win (the rest: further minima, AMSCR__HELD_WIN) */
     /* the last ranking of distinct starts (the search's, or the polish's when it re-ranked):
      * their maps (normalized frames), orientations, ranking costs and the winner (nrank 0:
      * none); the first rank_nbase are the lowest minima (they may win), further minima follow */
@@ -217,6 +220,9 @@ amscr_status amscr__method_at(const amscr_params *prm, const amscr_descriptor *f
  * orientations ro, costs cost, winner best) are AMSCR__CANDIDATES distinct maps that all score
  * about as well as the winner, by the alternatives' tests: a shape with three or more
  * symmetries, which may have more (its further minima are then ranked too). */
+/* Whether a further minimum of cost `cost` beats the best of the lowest minima (cost `best`):
+ * AMSCR__HELD_WIN. */
+int amscr__held_wins(double cost, double best);
 int amscr__lowest_alike(const amscr_descriptor *f, double X[][6], const int *ro, const double *cost, size_t nbase,
                         size_t best, int o);
 /* The further minima of orientation o the search held back, scored as the ranked ones were
@@ -295,9 +301,11 @@ double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const doub
 amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                   amscr_workspace *ws, match_t *m);
 /* The same with the fragment's share of the target's affine length searched from phi_min up (a
- * caller that knows the fragment is long: fewer placements to try). */
+ * caller that knows the fragment is long: fewer placements to try); either_way: the fragment's
+ * points may run either way along the target (the caller's fragment; 0: a piece of a prepared
+ * closed source, which runs the target's way). */
 amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                      double phi_min, amscr_workspace *ws, match_t *m);
+                                      double phi_min, int either_way, amscr_workspace *ws, match_t *m);
 
 /* polish.c: m's map polished on the input points the descriptors kept (f->raw, h->raw; a closed
  * target, affine invariance): the chosen map and the search's other distinct candidates,
@@ -312,7 +320,8 @@ amscr_status amscr__polish_fit(const amscr_descriptor *f, const amscr_descriptor
 int amscr__polish_reranked(const amscr__polish_state *ps);
 /* The polish's ranking in m extended by further starts of orientation o (X, n, normalized
  * frames): each that differs from every ranked map polished as the ranked starts were and
- * appended (never the winner); the ambiguity takes them in. AMSCR_E_NOMEM when out of memory. */
+ * appended; one clearly better than the winner (AMSCR__HELD_WIN) is polished on and becomes it
+ * (m->X, the polish's map for its later steps); the ambiguity takes them in. AMSCR_E_NOMEM when out of memory. */
 amscr_status amscr__polish_rank_more(amscr__polish_state *ps, double X[][6], size_t n, int o, match_t *m);
 /* Whether the order and even-spacing steps apply to the polished map (markedly noisier points,
  * no gap, not partial). */
@@ -324,8 +333,9 @@ amscr_status amscr__polish_even(amscr__polish_state *w, match_t *m);
 void amscr__polish_end(amscr__polish_state *w);
 /* polish_rank.c: the polish's start maps into S (normalized frames) with their orientations so:
  * m's chosen map first, then, when the search could not tell its candidates apart, each
- * candidate that differs from all before; may_win[k]: start k may become the reported map (the
- * search's further minima are ranked for the alternatives only). Returns their count. */
+ * candidate that differs from all before; may_win[k]: start k may become the reported map by
+ * the lowest cost (the search's further minima: only when clearly better, AMSCR__HELD_WIN).
+ * Returns their count. */
 size_t amscr__polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6], int *so,
                             unsigned char *may_win);
 /* The ambiguity of start `best` among the count polished starts S (costs cost): its cost over

@@ -41,11 +41,18 @@
 #define PART_HINT 3
 #define PART_TRIM 0.9
 #define PART_ITERS 20
+/* A placement whose refinement changed the map's area (|det|) by more than this factor, or its
+ * sign, has collapsed the fragment onto a straight or flat piece of the target (a tiny one-way
+ * cost, the wrong place): it wins only when every placement did (measured on the fragments of
+ * bench/registration_heldout.py --sets: the right placements change by at most ~15 %, the
+ * collapsed ones by 10-1000x). As the polish's MAX_AREA_CHANGE. The caller's fragments only
+ * (either_way): on the recovery's pieces of a closed source it lost traced bite pairs. */
+#define PART_AREA_CHANGE 2.0
 
 typedef struct {
     size_t s;  /* start index in the uniform target */
     double phi;
-    int o;     /* 1: the target traversed backwards (mirror, reflections on) */
+    int o;     /* 1: the target traversed backwards (a mirror, or the fragment run the other way) */
     double cost;
     double X[6];  /* the search's fit, then the refined map */
     double X0[6]; /* the search's fit */
@@ -180,6 +187,13 @@ static double refine_placement(const amscr_params *prm, const amscr_descriptor *
     return cost;
 }
 
+/* Whether the refined map X kept the area of the search's fit X0 (within PART_AREA_CHANGE). */
+static int kept_area(const double X0[6], const double X[6])
+{
+    double ratio = (X[0] * X[4] - X[1] * X[3]) / (X0[0] * X0[4] - X0[1] * X0[3]);
+    return ratio >= 1.0 / PART_AREA_CHANGE && ratio <= PART_AREA_CHANGE;
+}
+
 /* Partners (dense target edges) of the samples under placement pl: sample a at fragment
  * position u_a -> uniform target index s ± phi U u_a -> its dense edge. */
 static void initial_partners(const placement *pl, const double *cumF, double LF, const double *Hp, size_t n,
@@ -196,9 +210,11 @@ static void initial_partners(const placement *pl, const double *cumF, double LF,
     }
 }
 
-/* The placement search over (start, length, orientation); best[] ascending. */
+/* The placement search over (start, length, orientation); best[] ascending. norient: the
+ * target's traversals tried (2: also backwards); keep_sign: only fits whose determinant has
+ * this sign (0: either). */
 static size_t search_placements(const amscr_params *prm, const double *F, const double *Hu, double phi_min,
-                                placement *best)
+                                int norient, int keep_sign, placement *best)
 {
     double mom[6] = {0, 0, 0, 0, 0, 0}, M9[9], Minv[9];
     for (size_t j = 0; j < PART_K; j++)
@@ -207,13 +223,12 @@ static size_t search_placements(const amscr_params *prm, const double *F, const 
     if (!amscr__inv3(M9, Minv))
         return 0;
     size_t nb = 0;
-    int norient = prm->reflections ? 2 : 1;
     for (int o = 0; o < norient; o++)
         for (double phi = phi_min; phi <= 1.0 + 1e-9; phi *= PART_PHI_STEP)
             for (size_t k = 0; k < PART_STARTS; k++) {
                 placement c = {k * (PART_U / PART_STARTS), phi, o, 0.0, {0}, {0}, 0.0};
                 c.cost = place_cost(prm, F, mom, Minv, Hu, c.s, phi, o, c.X);
-                if (isfinite(c.cost))
+                if (isfinite(c.cost) && (!keep_sign || keep_sign * (c.X[0] * c.X[4] - c.X[1] * c.X[3]) > 0.0))
                     keep_placement(best, &nb, &c);
             }
     return nb;
@@ -222,7 +237,15 @@ static size_t search_placements(const amscr_params *prm, const double *F, const 
 amscr_status amscr__match_partial(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                   amscr_workspace *ws, match_t *m)
 {
-    return amscr__match_partial_min(prm, f, h, PART_PHI_MIN, ws, m);
+    return amscr__match_partial_min(prm, f, h, PART_PHI_MIN, 1, ws, m);
+}
+
+/* The sign of the determinant of a map in the normalized frames f -> h once in input coordinates
+ * (h->inv o X o f->fwd) is that of X times this. */
+static int frames_sign(const amscr_descriptor *f, const amscr_descriptor *h)
+{
+    double a = f->fwd[0] * f->fwd[4] - f->fwd[1] * f->fwd[3], b = h->inv[0] * h->inv[4] - h->inv[1] * h->inv[3];
+    return a * b < 0.0 ? -1 : 1;
 }
 
 /* The fragment f and the target h sampled along their affine arc lengths (each smoothed at
@@ -264,7 +287,7 @@ static double partial_ambiguity(const amscr_descriptor *f, const placement *best
 }
 
 amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                      double phi_min, amscr_workspace *ws, match_t *m)
+                                      double phi_min, int either_way, amscr_workspace *ws, match_t *m)
 {
     size_t n = f->n;
     /* no per-scale systems here: the scale diagnostics are zero, nothing kept, no threshold */
@@ -291,19 +314,32 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
         return st;
     }
     placement best[PART_KEEP];
-    size_t nb = search_placements(prm, F, Hu, phi_min, best);
+    /* The fragment's points may run either way along the target (an open curve has no
+     * orientation of its own): with either_way both traversals are searched, and without
+     * reflections only the maps that keep the orientation (determinant > 0 in input coordinates)
+     * are placements; else the traversal as given, mirrored too with reflections. */
+    int sign = frames_sign(f, h);
+    size_t nb = either_way ? search_placements(prm, F, Hu, phi_min, 2, prm->reflections ? 0 : sign, best)
+                           : search_placements(prm, F, Hu, phi_min, prm->reflections ? 2 : 1, 0, best);
     double *q = ws->rbuf, *r2 = q + 2 * n, *sorted = r2 + n, *Hd = q + 8 * n;
     size_t nd = amscr__densify(h->base, n, 1, Hd);
     amscr__closed_edges(Hd, nd, E);
     size_t win = 0;
+    int kept[PART_KEEP], any_kept = 0;
     double cut = 0.0;
     for (size_t c = 0; c < nb; c++) {
         memcpy(best[c].X0, best[c].X, sizeof best[c].X0);
         initial_partners(&best[c], cumF, LF, Hp, n, nd, b);
         best[c].tcost = refine_placement(prm, f, Hd, E, nd, best[c].X, b, q, r2, sorted, &cut);
-        if (best[c].tcost < best[win].tcost)
-            win = c;
+        kept[c] = !either_way || kept_area(best[c].X0, best[c].X);
+        any_kept |= kept[c];
     }
+    for (size_t c = 1; c < nb; c++) /* the lowest cost among the placements that kept their area */
+        if ((kept[c] || !any_kept) && (!(kept[win] || !any_kept) || best[c].tcost < best[win].tcost))
+            win = c;
+    for (size_t c = 0; c < nb && any_kept; c++) /* a collapsed placement is no alternative either */
+        if (!kept[c])
+            best[c].tcost = INFINITY;
     if (nb == 0) {
         free(buf);
         free(b);
@@ -327,7 +363,7 @@ amscr_status amscr__match_partial_min(const amscr_params *prm, const amscr_descr
     m->rcost = cost;
     m->rcut = cut;
     m->refined = 1;
-    m->reflected = best[win].o;
+    m->reflected = either_way ? sign * (X[0] * X[4] - X[1] * X[3]) < 0.0 : best[win].o;
     free(buf);
     free(b);
     return isfinite(m->dist) ? AMSCR_OK : amscr__fail(AMSCR_E_NUMERIC, "partial registration: non-finite distance");

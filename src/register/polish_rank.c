@@ -13,8 +13,9 @@
 
 /* The start maps: the chosen one first, then — when the search could not tell its candidates
  * apart (ambiguity at least AMBIGUOUS_SEARCH) — each candidate that differs from all before.
- * may_win[k]: start k may become the reported map (the search's further minima are polished and
- * ranked for the alternatives only). */
+ * may_win[k]: start k may become the reported map by the ranking's lowest cost (the search's
+ * further minima are polished and ranked for the alternatives, and win only when clearly better:
+ * AMSCR__HELD_WIN). */
 size_t amscr__polish_starts(const amscr_descriptor *f, const match_t *m, double S[][6], int *so, unsigned char *may_win)
 {
     size_t count = 1;

@@ -206,7 +206,7 @@ static amscr_status fragment_start(const amscr_params *prm, const amscr_descript
         st = amscr_descriptor_new(&pp, c, &d);
     pp.closed = 1;
     if (st == AMSCR_OK)
-        st = amscr__match_partial_min(&pp, d, h, RECOVER_PHI_MIN, ws, &mf);
+        st = amscr__match_partial_min(&pp, d, h, RECOVER_PHI_MIN, 0, ws, &mf);
     if (st == AMSCR_OK) /* d's input frame is f's normalized frame */
         amscr__affine_compose(mf.X, d->fwd, X);
     amscr_descriptor_free(d);

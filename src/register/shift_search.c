@@ -18,7 +18,8 @@
  *
  * One ranking rule picks the winner: the lowest score, ties broken by the lower distance, then
  * by the earlier candidate (orientations in order, each one's candidates best criterion first);
- * the further minima are scored and ranked alike (the alternatives, the ambiguity) but never win.
+ * the further minima are scored and ranked alike (the alternatives, the ambiguity) and win only
+ * when clearly better (AMSCR__HELD_WIN: below 0.9x the best score).
  * The score is the cheapest quantity that judges the start point (see score_start). The winner
  * gets the whole method and the refinement.
  */
@@ -346,7 +347,7 @@ static double ambiguity_of(const amscr_descriptor *f, const double X[][6], const
 
 /* Candidates from..s->count-1 scored (the cheap kinds need no run of the method) into s; the
  * winner by the one ranking rule among the first s->nbase (the further minima are ranked for the
- * alternatives and the ambiguity only: the reported map is the best of the lowest minima). */
+ * alternatives and the ambiguity, and win only when clearly better: amscr__held_wins). */
 static amscr_status score_starts(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                  const double *crit, size_t from, amscr_workspace *ws, amscr__search *s)
 {
@@ -368,10 +369,16 @@ static amscr_status score_starts(const amscr_params *prm, const amscr_descriptor
         s->dist[i] = dist;
         /* the one ranking rule: lower score, then lower distance, then the earlier candidate */
         double bs = s->score[s->best], bd = s->dist[s->best];
-        if (i == 0 || (i < s->nbase && (score < bs || (score == bs && dist < bd))))
+        if (i == 0 || (i < s->nbase && (score < bs || (score == bs && dist < bd))) ||
+            (i >= s->nbase && amscr__held_wins(score, bs)))
             s->best = i;
     }
     return AMSCR_OK;
+}
+
+int amscr__held_wins(double cost, double best)
+{
+    return cost < AMSCR__HELD_WIN * best;
 }
 
 /* The held further minima of orientation o refined to a continuous shift (its criterion
