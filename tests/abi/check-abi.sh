@@ -27,6 +27,8 @@ baseline=tests/abi/amscr-$series.abi
 if [ -z "$lib" ]; then
   if [ ! -f build-abi/build.ninja ]; then
     meson setup build-abi --buildtype=debugoptimized -Dtests=disabled >/dev/null
+  else  # a version bump renames the library's target: regenerate first
+    meson setup --reconfigure build-abi >/dev/null
   fi
   meson compile -C build-abi amscr:shared_library >/dev/null
   lib=build-abi/libamscr.so
