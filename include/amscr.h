@@ -1398,7 +1398,7 @@ AMSCR_API unsigned amscr_params_get_refine(const amscr_params *p);
  *        source open and the target closed whatever `closed` says; with amscr_register the
  *        descriptors must have been prepared so. A partial result has no per-scale systems:
  *        residuals 0, no kept scale, threshold +inf. Short fragments may be ambiguous
- *        (amscr_result_confidence). Since 0.15 the fragment's points may run either way
+ *        (amscr_result_confidence). The fragment's points may run either way
  *        along the target (both are searched; without reflections only maps that keep the
  *        orientation, determinant > 0, are placed).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
@@ -2734,7 +2734,7 @@ typedef struct amscr_index amscr_index;
  *        weight strictly between 0 and 1 the fusion's medians come from a sample of the
  *        shapes (docs/collections.md, "The index file").
  * Cost: candidates 0: n^2 pair distances; M > 0: O(n (M + K^2)) pair distances.
- * Memory: the index holds a compact copy of the shapes (since 0.14: each shape's input samples
+ * Memory: the index holds a compact copy of the shapes (each shape's input samples
  *         and outline, ~3 KB at the defaults; a prepared shape is recomputed from them, bit for
  *         bit, when first read, e.g. through amscr_index_db, and then kept), the channel features
  *         and signature (~18 KB a shape at the defaults), about 24 bytes a listed

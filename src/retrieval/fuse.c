@@ -51,32 +51,34 @@ static amscr_status channel_frame(amscr_invariance frame, const amscr_descriptor
     return AMSCR_OK;
 }
 
+typedef amscr_status (*hf_builder)(const double *xy, size_t n, double locality, amscr__hf *out);
+
+/* d's samples in `frame`, then `build` of them (the forward or the mirrored heights). */
+static amscr_status hf_in_frame(const amscr_params *p, amscr_invariance frame, const amscr_descriptor *d,
+                                hf_builder build, amscr__hf *out)
+{
+    double *xy = amscr__malloc_array(2 * d->n, sizeof *xy);
+    if (!xy)
+        return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
+    amscr_status st = channel_frame(frame, d, xy);
+    if (st == AMSCR_OK)
+        st = build(xy, d->n, p->channel_locality, out);
+    free(xy);
+    return st;
+}
+
 amscr_status amscr__hf_of_descriptor(const amscr_params *p, amscr_invariance frame, const amscr_descriptor *d,
                                      amscr__hf *out)
 {
     if (!d->params.closed)
         return amscr__fail(AMSCR_E_INVALID_ARG, "shape channel: needs closed curves");
-    double *xy = amscr__malloc_array(2 * d->n, sizeof *xy);
-    if (!xy)
-        return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
-    amscr_status st = channel_frame(frame, d, xy);
-    if (st == AMSCR_OK)
-        st = amscr__hf_build(xy, d->n, p->channel_locality, out);
-    free(xy);
-    return st;
+    return hf_in_frame(p, frame, d, amscr__hf_build, out);
 }
 
 amscr_status amscr__hf_mirror_of_descriptor(const amscr_params *p, amscr_invariance frame,
                                             const amscr_descriptor *d, amscr__hf *h)
 {
-    double *xy = amscr__malloc_array(2 * d->n, sizeof *xy);
-    if (!xy)
-        return amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
-    amscr_status st = channel_frame(frame, d, xy);
-    if (st == AMSCR_OK)
-        st = amscr__hf_build_mirror(xy, d->n, p->channel_locality, h);
-    free(xy);
-    return st;
+    return hf_in_frame(p, frame, d, amscr__hf_build_mirror, h);
 }
 
 /* The frames of the channel and their shares: the primary frame, plus the whitened frame with
