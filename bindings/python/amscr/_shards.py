@@ -484,9 +484,13 @@ class ShardedIndex:
 
     def _gather(self, futs: List[Any]) -> List[Any]:
         """The results of one task a shard; a shard lost with its worker is a clear error."""
+        return self._guard(lambda: self.client.gather(futs))
+
+    def _guard(self, call: Any) -> Any:
+        """call(); a failure while a shard's worker is gone is the clear error of a lost shard."""
         lost = [s for s, sh in enumerate(self._shards) if sh.status in ('lost', 'cancelled', 'error')]
         try:
-            return self.client.gather(futs)
+            return call()
         except AmscrError:
             raise
         except Exception as e:  # noqa: BLE001 - Dask's errors for lost data vary by version
@@ -532,7 +536,7 @@ class ShardedIndex:
         out = np.zeros((nq, n), dtype=np.float64)
         if nq == 0 or n == 0:
             return out
-        qf = self.client.scatter(q.to_bytes(), broadcast=True, hash=False)
+        qf = self._guard(lambda: self.client.scatter(q.to_bytes(), broadcast=True, hash=False))
         member = np.full(nq, -1, dtype=np.int64)
         if self.params.rerank_k > 0:  # the rule matters only with re-ranking (weights are 0 or 1 here)
             for s, found in enumerate(self._gather([self.client.submit(_members, sh, qf, pure=False,
