@@ -193,9 +193,36 @@ static int outline_kept(size_t per, int compact, const amscr_params *prm)
                                                        .num_scales = prm->num_scales});
 }
 
-/* Shape bytes at `at` decoded: 0, or 1 truncated / not finite, 2 degenerate, 3 out of memory. */
-static int decode_shape(const unsigned char *p, size_t at, size_t per, int compact, const amscr_params *prm,
-                        int32_t *label, amscr_descriptor **out)
+/* Whether the curve xy (n points) has an invertible moment matrix (amscr__descriptor_finish's
+ * test). */
+static int level_ok(const double *xy, size_t n)
+{
+    double mom[6], M9[9], inv[9];
+    amscr__moments(xy, n, mom);
+    amscr__moment_matrix(mom, M9);
+    return amscr__inv3(M9, inv);
+}
+
+/* Whether a full record's input (d's) rebuilds into a prepared shape, as it must: a save keeps only
+ * the input (a compact record) and a load rebuilds from it. AMSCR_OK, AMSCR_E_DEGENERATE, or
+ * AMSCR_E_NOMEM. */
+static amscr_status input_rebuilds(const amscr_descriptor *d)
+{
+    amscr_descriptor *t = NULL;
+    if (amscr__descriptor_alloc(d->n, d->p, &t) != AMSCR_OK)
+        return AMSCR_E_NOMEM;
+    t->params = d->params;
+    memcpy(t->input, d->input, 2 * d->n * sizeof *t->input);
+    amscr_status st = amscr__descriptor_rebuild(t);
+    amscr_descriptor_free(t);
+    return st;
+}
+
+/* Shape bytes at `at` decoded: 0, or 1 truncated / not finite, 2 degenerate, 3 out of memory. A
+ * full record's input must have extent, and with rebuild_check rebuild (an index's: its save keeps
+ * only the input; a plain collection's stored levels are trusted, its load twice as fast). */
+static int decode_shape(const unsigned char *p, size_t at, size_t per, int compact, int rebuild_check,
+                        const amscr_params *prm, int32_t *label, amscr_descriptor **out)
 {
     size_t N = prm->num_samples, np = prm->num_scales;
     int outline = outline_kept(per, compact, prm);
@@ -217,6 +244,8 @@ static int decode_shape(const unsigned char *p, size_t at, size_t per, int compa
         bad = 1;
     else {
         amscr_status st = compact ? amscr__descriptor_rebuild(d) : amscr__descriptor_finish(d);
+        if (st == AMSCR_OK && !compact)
+            st = !level_ok(d->input, N) ? AMSCR_E_DEGENERATE : rebuild_check ? input_rebuilds(d) : AMSCR_OK;
         bad = st == AMSCR_OK ? 0 : st == AMSCR_E_DEGENERATE ? 2 : 3;
     }
     if (bad) {
@@ -231,7 +260,7 @@ amscr_status amscr__db_decode(const unsigned char *p, size_t at, size_t per, int
                               int32_t *label, amscr_descriptor **out)
 {
     int32_t lab = 0;
-    int bad = decode_shape(p, at, per, compact, prm, &lab, out);
+    int bad = decode_shape(p, at, per, compact, 0, prm, &lab, out);
     if (bad == 1)
         return amscr__fail(AMSCR_E_FORMAT, "collection: a shape is truncated or has non-finite values");
     if (bad == 2)
@@ -257,18 +286,9 @@ typedef struct {
     int32_t *label;
     unsigned char *bad; /* per shape: 0, or 1 truncated / not finite, 2 degenerate, 3 out of memory */
     int check_only;
+    int rebuild_check; /* full records of an index: their input must rebuild (decode_shape) */
     unsigned t, nt;
 } shapes_job;
-
-/* Whether the curve xy (n points) has an invertible moment matrix (amscr__descriptor_finish's
- * test). */
-static int level_ok(const double *xy, size_t n)
-{
-    double mom[6], M9[9], inv[9];
-    amscr__moments(xy, n, mom);
-    amscr__moment_matrix(mom, M9);
-    return amscr__inv3(M9, inv);
-}
 
 /* Shape i checked as a decode would, in scratch (2N doubles). */
 static void check_shape(const shapes_job *j, uint64_t i, double *scratch)
@@ -290,6 +310,8 @@ static void check_shape(const shapes_job *j, uint64_t i, double *scratch)
         j->bad[i] = 1;
         return;
     }
+    if (!level_ok(scratch, N)) /* the input, as a compact record's */
+        j->bad[i] = 2;
     for (size_t k = 0; k <= p; k++) {
         if (!amscr__r_f64s(&r, scratch, 2 * N)) {
             j->bad[i] = 1;
@@ -304,8 +326,8 @@ static void check_shape(const shapes_job *j, uint64_t i, double *scratch)
 
 static void read_shape(const shapes_job *j, uint64_t i)
 {
-    j->bad[i] = (unsigned char)decode_shape(j->p, j->pos0 + (size_t)i * j->per, j->per, j->compact, j->prm,
-                                            &j->label[i], &j->d[i]);
+    j->bad[i] = (unsigned char)decode_shape(j->p, j->pos0 + (size_t)i * j->per, j->per, j->compact,
+                                            j->rebuild_check, j->prm, &j->label[i], &j->d[i]);
 }
 
 static void *shapes_worker(void *arg)
@@ -358,7 +380,8 @@ static amscr_status r_shapes(amscr__rbuf *r, uint32_t version, const amscr_param
                              amscr_db *db)
 {
     size_t per = (size_t)amscr__db_shape_bytes(version, prm);
-    shapes_job j = {r->p, r->pos, per, amscr__db_compact(version), prm, count, NULL, NULL, NULL, lazy, 0, 1};
+    shapes_job j = {r->p, r->pos, per, amscr__db_compact(version), prm, count, NULL, NULL, NULL, lazy,
+                    !amscr__db_compact(version) && amscr__db_is_index(version), 0, 1};
     j.d = amscr__calloc_array(count ? count : 1, sizeof *j.d);
     j.label = amscr__malloc_array(count ? count : 1, sizeof *j.label);
     j.bad = amscr__calloc_array(count ? count : 1, 1);
