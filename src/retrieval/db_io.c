@@ -338,7 +338,11 @@ static void *shapes_worker(void *arg)
     for (uint64_t i = j->t; i < j->count; i += j->nt)
         if (!j->check_only)
             read_shape(j, i);
-        else if (scratch)
+        else if (j->rebuild_check) { /* an old index's full record: checked as its decode (the rebuild) */
+            read_shape(j, i);
+            amscr_descriptor_free(j->d[i]);
+            j->d[i] = NULL;
+        } else if (scratch)
             check_shape(j, i, scratch);
         else
             j->bad[i] = 3;
