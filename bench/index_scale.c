@@ -204,10 +204,12 @@ static void index_bytes(const amscr_index *x, double b[4])
 {
     b[3] = (double)amscr__db_shape_bytes(AMSCR__DB_VERSION_NEWEST, amscr_db_params(x->db));
     size_t n = amscr_db_size(x->db), hf = 0;
-    for (size_t i = 0; i < n * (size_t)x->nf; i++)
-        hf += 2 * (x->hf[i].n * AMSCR__HF_BINS + AMSCR__HF_SPEC(x->hf[i].nfreq) * sizeof *x->hf[i].spec[0]);
+    for (size_t i = 0; i < n * (size_t)x->nf; i++) /* the orientations held */
+        for (int o = 0; o < 2; o++)
+            hf += (x->hf[i].seq[o] ? x->hf[i].n * AMSCR__HF_BINS : 0) +
+                  (x->hf[i].spec[o] ? AMSCR__HF_SPEC(x->hf[i].nfreq) * sizeof *x->hf[i].spec[0] : 0);
     b[0] = (double)hf / (double)n;
-    b[1] = (double)(x->sig_dim + AMSCR__SIG_LB_DIM) * sizeof(float);
+    b[1] = (double)x->sig_dim * sizeof *x->sigq + sizeof *x->sige + AMSCR__SIG_LB_DIM * sizeof(float);
     b[2] = (double)(x->k + x->k2) * (sizeof(uint32_t) + sizeof(double)) + (x->rev ? (double)(x->k + x->k2) * 4 + 8
                                                                                   : 0.0);
     b[0] += x->k2 ? (double)sizeof(amscr__inner) : 0.0; /* the inner features with the channel's */
@@ -219,18 +221,21 @@ static void search_cost(const amscr_index *x, size_t m, double out[3])
 {
     size_t n = amscr_db_size(x->db), *a = malloc(m * sizeof *a), *b = malloc(m * sizeof *b), same = 0;
     amscr__sig_ivf v = x->ivf; /* the index's own from AMSCR__INDEX_IVF_MIN shapes */
+    amscr__sig_rows rows = {NULL, x->sigq, x->sige};
     if (!a || !b || (v.nc == 0 && amscr__sig_ivf_build(x->sig_lb, n, &v) != AMSCR_OK))
         die("out of memory");
     double te = 0.0, ti = 0.0;
     for (size_t r = 0; r < SEARCH_ROWS; r++) {
         size_t i = r * n / SEARCH_ROWS;
-        const float *sig = x->sig + i * x->sig_dim, *lb = x->sig_lb + i * AMSCR__SIG_LB_DIM;
+        float sig[AMSCR__SIG_DIM];
+        const float *lb = x->sig_lb + i * AMSCR__SIG_LB_DIM;
+        amscr__index_sig(x, i, sig);
         double t = thread_cpu();
-        if (amscr__sig_nearest(x->sig, x->sig_lb, n, sig, lb, m, i, a) != m)
+        if (amscr__sig_nearest(&rows, x->sig_lb, n, sig, lb, m, i, a) != m)
             die("search");
         te += thread_cpu() - t;
         t = thread_cpu();
-        if (amscr__sig_ivf_nearest(&v, x->sig, x->sig_lb, n, sig, lb, m, i, b) != m)
+        if (amscr__sig_ivf_nearest(&v, &rows, x->sig_lb, n, sig, lb, m, i, b) != m)
             die("search");
         ti += thread_cpu() - t;
         for (size_t u = 0, w = 0; u < m; u++) { /* both ascending */

@@ -3446,7 +3446,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_pair_distances_at(const amscr
 AMSCR_API size_t amscr_signature_size(void);
 
 /**
- * @brief The stored signatures of x's shapes, in order (amscr_signature_size() floats each).
+ * @brief The stored signatures of x's shapes, in order (amscr_signature_size() floats each): each
+ *        shape's amscr_shape_signature held in 16 bits (its values rounded to steps of at most
+ *        1/32768 of its largest), the values its shortlists are sought by.
  * @param[out] out  n floats.
  * @param[in]  n  must equal amscr_index_size(x) * amscr_signature_size().
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n).
@@ -3457,7 +3459,8 @@ AMSCR_API size_t amscr_signature_size(void);
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_signatures(const amscr_index *x, float *out, size_t n);
 
 /**
- * @brief A prepared shape's signature, as an index computes a query's or a member's.
+ * @brief A prepared shape's signature, as an index computes a new query's (a member's is the one
+ *        it stores: amscr_index_signatures).
  * @param[out] out  n floats.
  * @param[in]  n  must equal amscr_signature_size().
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n).

@@ -574,10 +574,10 @@ START_TEST(stored_features)
         ck_assert_int_eq(amscr_index_load_memory_with(buf, len, lazy ? AMSCR_INDEX_LAZY : 0u, &y), AMSCR_OK);
         ck_assert_ptr_nonnull(y->hf[0].seq[0]);
         ck_assert(lazy ? y->hf[0].spec[0] == NULL : y->hf[0].spec[0] != NULL);
-        /* format 16 stores the forward heights: the mirrored ones made at load (a lazy load: by
-         * a pair that reads them) */
-        ck_assert(lazy ? y->hf[0].seq[1] == NULL : y->hf[0].seq[1] != NULL);
-        ck_assert(lazy ? y->hf[0].spec[1] == NULL : y->hf[0].spec[1] != NULL);
+        /* an index keeps the forward orientation only (the mirrored one is made by a pair that
+         * reads it), loaded eagerly or lazily, as it was built */
+        ck_assert(y->hf[0].seq[1] == NULL && y->hf[0].spec[1] == NULL);
+        ck_assert(x->hf[0].seq[1] == NULL && x->hf[0].spec[1] == NULL);
         same_query(x, y, q, 0);
         same_query(x, y, q, 6);
         amscr_index_free(y);
@@ -1300,7 +1300,8 @@ START_TEST(kept_and_own_reverse)
 END_TEST
 
 /* The coarse quantizer's shortlist: m distinct shapes, ascending, without the excluded one, and
- * most of the exact shortlist. */
+ * most of the exact shortlist. Rows in 16 bits give the shortlists of their dequantized floats,
+ * and quantize back from them to the same bits. */
 START_TEST(quantizer_shortlist)
 {
     enum { N = 3000, M = 32, ROWS = 20, CLUSTERS = 60 };
@@ -1310,18 +1311,29 @@ START_TEST(quantizer_shortlist)
     amscr_test_rng_seed(&r, 77);
     for (size_t i = 0; i < N; i++)
         for (size_t t = 0; t < AMSCR__SIG_DIM; t++) /* clustered: a centre per class plus noise */
-            sig[i * AMSCR__SIG_DIM + t] = (float)(sin((double)((i % CLUSTERS) * 131 + t)) +
+            sig[i * AMSCR__SIG_DIM + t] = (float)(fabs(sin((double)((i % CLUSTERS) * 131 + t))) +
                                                   0.2 * amscr_test_uniform(&r));
-    for (size_t i = 0; i < N; i++)
+    uint16_t *q16 = malloc((size_t)N * AMSCR__SIG_DIM * sizeof *q16), back[AMSCR__SIG_DIM];
+    int32_t *e = malloc(N * sizeof *e), e2 = 0;
+    for (size_t i = 0; i < N; i++) { /* the rows as an index keeps them */
+        amscr__sig_quantize(sig + i * AMSCR__SIG_DIM, q16 + i * AMSCR__SIG_DIM, &e[i]);
+        amscr__sig_dequantize(q16 + i * AMSCR__SIG_DIM, e[i], sig + i * AMSCR__SIG_DIM);
+        amscr__sig_quantize(sig + i * AMSCR__SIG_DIM, back, &e2);
+        ck_assert(e2 == e[i] && memcmp(back, q16 + i * AMSCR__SIG_DIM, sizeof back) == 0);
         amscr__sig_bound_vector(sig + i * AMSCR__SIG_DIM, lb + i * AMSCR__SIG_LB_DIM);
+    }
+    amscr__sig_rows rows = {sig, NULL, NULL}, rows16 = {NULL, q16, e};
     amscr__sig_ivf v;
     ck_assert_int_eq(amscr__sig_ivf_build(lb, N, &v), AMSCR_OK);
     size_t a[M], b[M], same = 0;
     for (size_t q = 0; q < ROWS; q++) {
         size_t i = q * 149;
         const float *s = sig + i * AMSCR__SIG_DIM, *l = lb + i * AMSCR__SIG_LB_DIM;
-        ck_assert_uint_eq(amscr__sig_nearest(sig, lb, N, s, l, M, i, a), M);
-        ck_assert_uint_eq(amscr__sig_ivf_nearest(&v, sig, lb, N, s, l, M, i, b), M);
+        size_t c[M];
+        ck_assert_uint_eq(amscr__sig_nearest(&rows, lb, N, s, l, M, i, a), M);
+        ck_assert_uint_eq(amscr__sig_nearest(&rows16, lb, N, s, l, M, i, c), M);
+        ck_assert_mem_eq(a, c, sizeof a);
+        ck_assert_uint_eq(amscr__sig_ivf_nearest(&v, &rows16, lb, N, s, l, M, i, b), M);
         for (size_t u = 0; u < M; u++) {
             ck_assert(b[u] != i && b[u] < N && (u == 0 || b[u] > b[u - 1]));
             for (size_t w = 0; w < M; w++)
@@ -1331,6 +1343,8 @@ START_TEST(quantizer_shortlist)
     ck_assert_msg(same >= 9 * M * ROWS / 10, "%zu of %d", same, M * ROWS);
     amscr__sig_ivf_free(&v);
     free(sig);
+    free(q16);
+    free(e);
     free(lb);
 }
 END_TEST

@@ -38,10 +38,14 @@ amscr_status amscr__index_reserve(amscr_index *x, size_t n)
     size_t cap = x->cap ? x->cap : 64, k = x->k ? x->k : 1;
     while (cap < n)
         cap *= 2;
-    float *sig = x->sig_dim && cap > SIZE_MAX / x->sig_dim / sizeof(float) ? NULL
-                                                                         : realloc(x->sig, cap * x->sig_dim * sizeof *sig);
+    uint16_t *sig = x->sig_dim && cap > SIZE_MAX / x->sig_dim / sizeof *sig
+                        ? NULL
+                        : realloc(x->sigq, cap * x->sig_dim * sizeof *sig);
     if (sig)
-        x->sig = sig;
+        x->sigq = sig;
+    int32_t *sige = realloc(x->sige, cap * sizeof *sige);
+    if (sige)
+        x->sige = sige;
     float *lb = cap > SIZE_MAX / AMSCR__SIG_LB_DIM / sizeof *lb ? NULL
                                                                 : realloc(x->sig_lb, cap * AMSCR__SIG_LB_DIM * sizeof *lb);
     if (lb)
@@ -66,7 +70,7 @@ amscr_status amscr__index_reserve(amscr_index *x, size_t n)
         for (size_t i = x->cap; i < cap; i++)
             gr[i] = NULL;
     }
-    if (!sig || !lb || !hf || !lists_ok || !inner_ok || !nm || !gr)
+    if (!sig || !sige || !lb || !hf || !lists_ok || !inner_ok || !nm || !gr)
         return amscr__fail(AMSCR_E_NOMEM, "index: out of memory for %zu shapes", n);
     x->cap = cap;
     return AMSCR_OK;
@@ -154,6 +158,19 @@ amscr_status amscr__index_compact_db(amscr_index *x)
 
 amscr_status amscr__index_alloc_on(const amscr_db *db, amscr_index **out) { return index_alloc(db, 1, out); }
 
+void amscr__index_sig(const amscr_index *x, size_t i, float *out)
+{
+    amscr__sig_dequantize(x->sigq + i * x->sig_dim, x->sige[i], out);
+}
+
+void amscr__index_set_sig(amscr_index *x, size_t i, const float *sig)
+{
+    float kept[AMSCR__SIG_DIM];
+    amscr__sig_quantize(sig, x->sigq + i * x->sig_dim, &x->sige[i]);
+    amscr__index_sig(x, i, kept);
+    amscr__sig_bound_vector(kept, x->sig_lb + i * AMSCR__SIG_LB_DIM);
+}
+
 size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const float *lb, size_t m, size_t exclude,
                               size_t *cand)
 {
@@ -165,9 +182,10 @@ size_t amscr__index_shortlist(const amscr_index *x, const float *sig, const floa
                 cand[c++] = j;
         return c;
     }
+    amscr__sig_rows rows = {NULL, x->sigq, x->sige};
     if (x->ivf.nc > 0 && x->ivf.n == n)
-        return amscr__sig_ivf_nearest(&x->ivf, x->sig, x->sig_lb, n, sig, lb, m, exclude, cand);
-    return amscr__sig_nearest(x->sig, x->sig_lb, n, sig, lb, m, exclude, cand);
+        return amscr__sig_ivf_nearest(&x->ivf, &rows, x->sig_lb, n, sig, lb, m, exclude, cand);
+    return amscr__sig_nearest(&rows, x->sig_lb, n, sig, lb, m, exclude, cand);
 }
 
 void amscr__index_detach_map(amscr_index *x)
@@ -209,10 +227,12 @@ void amscr_index_free(amscr_index *x)
         free(x->classes[c]);
     free(x->names);
     free(x->classes);
+    amscr__index_drop_mirrors(x, x->mirror_pool ? x->pool_first : amscr_db_size(x->db)); /* a failed build's */
     for (size_t i = 0; x->hf && i < x->cap * (size_t)x->nf; i++)
         amscr__hf_free(&x->hf[i]);
     free(x->hf);
-    free(x->sig);
+    free(x->sigq);
+    free(x->sige);
     free(x->sig_lb);
     amscr__sig_ivf_free(&x->ivf);
     free(x->nb_idx);

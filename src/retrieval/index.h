@@ -29,12 +29,17 @@ struct amscr_index {
     amscr__sig_ivf ivf;   /* the coarse quantizer of the lower-bound vectors a shortlist is sought in
                            * (a shortlist build of at least AMSCR__INDEX_IVF_MIN shapes; nc 0: none, every
                            * bound scanned) */
-    float *sig;           /* n x sig_dim (signature.h) */
+    uint16_t *sigq;       /* n x sig_dim: the signatures in 16 bits (signature.h) */
+    int32_t *sige;        /* n: their exponents */
     float *sig_lb;        /* n x AMSCR__SIG_LB_DIM: their lower-bound vectors */
     int nf;               /* channel frames whose features are kept (0: no channel) */
     amscr__hf *hf;        /* n x nf: each shape's channel features, ready for matching (an entry
                            * with no sequences, after a lazy load: built where a pair needs it) */
     int lazy;             /* loaded with AMSCR_INDEX_LAZY: features of loaded shapes not built */
+    unsigned char *mirror_pool; /* the mirrored orientation of the features of shapes whose rows are
+                                 * being built (a build, an add), in one block (index_features.c)
+                                 * freed whole once the rows are; NULL otherwise */
+    size_t pool_first;    /* the first shape whose mirrored features the pool holds */
     unsigned char *map;   /* the index file, mapped, while loaded shapes' heights point into it and
                            * db decodes its prepared shapes from it (a lazy load of a file;
                            * index_io.c, db.c), else NULL */
@@ -109,6 +114,12 @@ amscr_status amscr__index_check_db(const amscr_db *db, const char *what);
 int amscr__member_rule_applies(const amscr_params *p);
 amscr_status amscr__index_search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates,
                                         double *out);
+/* Shape i's signature (dequantized) into out[AMSCR__SIG_DIM]. */
+void amscr__index_sig(const amscr_index *x, size_t i, float *out);
+/* Shape i's signature from the floats sig (computed, or read from a file: rounded to 16 bits),
+ * and its lower-bound vector from what is kept. */
+void amscr__index_set_sig(amscr_index *x, size_t i, const float *sig);
+
 /* The candidates of shape-like q: every shape (m = 0 or >= n) or the m whose signatures are
  * nearest sig / lb (exclude: an index to leave out or SIZE_MAX), ascending, sought in the lists
  * of x's quantizer nearest lb when x has one (x->ivf); 0 when out of memory. */
@@ -149,6 +160,9 @@ amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const ams
  * features of shapes first..n-1, on the params' threads; drops the lists' reverse, and rebuilds
  * it when have_sig and first == 0 (a load: the lists are in place). */
 amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig);
+/* The mirrored orientation of the channel features of shapes first..n-1 freed, once their rows
+ * are built (index_features.c: the pairs that read it make it), and the mirror pool with it. */
+void amscr__index_drop_mirrors(amscr_index *x, size_t first);
 
 /* ------------------------------------------------------------------- the neighbour lists */
 

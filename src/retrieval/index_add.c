@@ -74,8 +74,9 @@ static amscr_status add_distances(void *ctx, size_t j, void *scratch)
     add_ctx *c = ctx;
     amscr_index *x = c->x;
     size_t r = j - c->j0, *cand = c->cand + r * c->n;
-    size_t m = amscr__index_shortlist(x, x->sig + j * x->sig_dim, x->sig_lb + j * AMSCR__SIG_LB_DIM, x->candidates,
-                                      j, cand);
+    float sig[AMSCR__SIG_DIM];
+    amscr__index_sig(x, j, sig);
+    size_t m = amscr__index_shortlist(x, sig, x->sig_lb + j * AMSCR__SIG_LB_DIM, x->candidates, j, cand);
     if (m == 0 && c->n > 1)
         return AMSCR_E_NOMEM;
     c->m[r] = m;
@@ -173,6 +174,7 @@ amscr_status amscr__index_extend(amscr_index *x, size_t n0, amscr_progress_fn pr
         st = amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback");
     if (st == AMSCR_OK)
         st = amscr__index_reverse(x); /* the lists changed: their reverse for the queries */
+    amscr__index_drop_mirrors(x, n0);
     free(c.cand);
     free(c.cd);
     free(c.cd2);

@@ -92,7 +92,9 @@ static amscr_status shortlist_row(void *ctx, size_t i, void *scratch)
     rows_ctx *c = ctx;
     amscr_index *x = c->x;
     size_t *cand = amscr__malloc_array(c->m, sizeof *cand);
-    const float *sig = x->sig + i * x->sig_dim, *lb = x->sig_lb + i * AMSCR__SIG_LB_DIM;
+    float sig[AMSCR__SIG_DIM];
+    const float *lb = x->sig_lb + i * AMSCR__SIG_LB_DIM;
+    amscr__index_sig(x, i, sig);
     size_t got = cand ? amscr__index_shortlist(x, sig, lb, c->m, i, cand) : 0; /* x's quantizer, if any */
     for (size_t t = 0; t < got; t++)
         c->S[(i - c->first) * c->m + t] = (uint32_t)cand[t];
@@ -224,6 +226,8 @@ static amscr_status build_into(amscr_index *x, size_t candidates, amscr_progress
     }
     if (st == AMSCR_OK)
         st = amscr__index_reverse(x);
+    if (st == AMSCR_OK)
+        amscr__index_drop_mirrors(x, 0);
     if (st != AMSCR_OK)
         amscr_index_free(x);
     return st;

@@ -51,10 +51,10 @@ static void write_section(const amscr_index *x, amscr__wbuf *w)
     amscr__w_f64(w, x->dmax);
     amscr__w_f64(w, x->med_a);
     amscr__w_f64(w, x->med_h);
-    for (size_t i = 0; i < n * x->sig_dim; i++) {
-        uint32_t u;
-        memcpy(&u, &x->sig[i], sizeof u);
-        amscr__w_u32(w, u);
+    for (size_t i = 0; i < n; i++) { /* the 16-bit values as floats (exact) */
+        float sig[AMSCR__SIG_DIM];
+        amscr__index_sig(x, i, sig);
+        amscr__w_f32s(w, sig, AMSCR__SIG_DIM);
     }
     for (size_t i = 0; i < n * k; i++) {
         amscr__w_u32(w, x->nb_idx[i]);
@@ -300,11 +300,14 @@ static amscr_status read_list(amscr__rbuf *r, size_t n, size_t k, uint32_t *idx,
 static amscr_status read_lists(amscr__rbuf *r, amscr_index *x)
 {
     size_t n = amscr_db_size(x->db);
-    for (size_t i = 0; i < n * x->sig_dim; i++) {
-        uint32_t u = amscr__r_u32(r);
-        memcpy(&x->sig[i], &u, sizeof u);
-        if (r->bad || !isfinite(x->sig[i]))
+    for (size_t i = 0; i < n; i++) { /* kept in 16 bits: the values this release writes, exactly */
+        float sig[AMSCR__SIG_DIM];
+        if (!amscr__r_f32s(r, sig, AMSCR__SIG_DIM))
             return amscr__fail(AMSCR_E_FORMAT, "index file: a signature is not finite");
+        for (size_t t = 0; t < AMSCR__SIG_DIM; t++)
+            if (sig[t] < 0.0f)
+                return amscr__fail(AMSCR_E_FORMAT, "index file: a signature value is negative");
+        amscr__index_set_sig(x, i, sig);
     }
     return read_list(r, n, x->k, x->nb_idx, x->nb_dist, "");
 }

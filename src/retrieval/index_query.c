@@ -59,7 +59,7 @@ static amscr_status query_scores(const amscr_index *x, const amscr_descriptor *q
     if (st == AMSCR_OK) {
         size_t want = shortlist_size(x, candidates);
         if (want > 0 && self < n) /* a member's signature is stored */
-            memcpy(sig, x->sig + self * x->sig_dim, sizeof sig);
+            amscr__index_sig(x, self, sig);
         else if (want > 0)
             amscr__shape_signature(q, sig);
         if (want > 0)

@@ -145,11 +145,11 @@ amscr_status amscr_index_signatures(const amscr_index *x, float *out, size_t n)
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
     size_t size = amscr_db_size(x->db);
-    if (n != size * AMSCR__SIG_DIM || (n > 0 && (!out || !x->sig || x->sig_dim != AMSCR__SIG_DIM)))
+    if (n != size * AMSCR__SIG_DIM || (n > 0 && (!out || !x->sigq || x->sig_dim != AMSCR__SIG_DIM)))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_signatures: the output holds %zu floats, %zu shapes "
                                                 "need %zu", n, size, size * (size_t)AMSCR__SIG_DIM);
-    if (n > 0)
-        memcpy(out, x->sig, n * sizeof *out);
+    for (size_t i = 0; i < size; i++) /* the values the index searches by */
+        amscr__index_sig(x, i, out + i * AMSCR__SIG_DIM);
     return AMSCR_OK;
 }
 
@@ -190,7 +190,8 @@ static amscr_status near_row(void *ctx, size_t r, void *scratch)
     float lb[AMSCR__SIG_LB_DIM];
     const float *sig = c->qsigs + r * AMSCR__SIG_DIM;
     amscr__sig_bound_vector(sig, lb);
-    size_t got = amscr__sig_nearest(c->sigs, c->lbs, c->n, sig, lb, c->m, c->first == SIZE_MAX ? SIZE_MAX : c->first + r,
+    amscr__sig_rows rows = {c->sigs, NULL, NULL};
+    size_t got = amscr__sig_nearest(&rows, c->lbs, c->n, sig, lb, c->m, c->first == SIZE_MAX ? SIZE_MAX : c->first + r,
                                     c->out + r * c->m);
     return got == c->m ? AMSCR_OK : AMSCR_E_NOMEM;
 }

@@ -64,13 +64,35 @@ double amscr__sig_bound(const float *la, const float *lb)
     return sum * BOUND_SAFETY;
 }
 
-/* Frequencies k0..k1-1 of the distance's sums into same / mirror (one sum a bin: the loop
- * vectorizes). */
+void amscr__sig_quantize(const float *sig, uint16_t *q, int32_t *e)
+{
+    float top = 0.0f;
+    for (size_t t = 0; t < AMSCR__SIG_DIM; t++)
+        top = sig[t] > top ? sig[t] : top;
+    int k = 0;
+    frexpf(top, &k); /* top = m 2^k, 0.5 <= m < 1: top / 2^(k - 16) below 65536 */
+    *e = top > 0.0f ? (k - 16 < -126 ? -126 : k - 16) : 0;
+    float inv = ldexpf(1.0f, -*e);
+    for (size_t t = 0; t < AMSCR__SIG_DIM; t++) {
+        float v = sig[t] > 0.0f ? sig[t] * inv + 0.5f : 0.0f; /* exact product: a power of two */
+        q[t] = (uint16_t)(v >= 65535.0f ? 65535.0f : v);
+    }
+}
+
+void amscr__sig_dequantize(const uint16_t *q, int32_t e, float *out)
+{
+    float s = ldexpf(1.0f, e);
+    for (size_t t = 0; t < AMSCR__SIG_DIM; t++)
+        out[t] = (float)q[t] * s;
+}
+
+/* Frequencies k0..k1-1 of the distance's sums into same / mirror, a's from frequency k0 on (one
+ * sum a bin: the loop vectorizes). */
 static void sig_sums(const float *a, const float *b, size_t k0, size_t k1, float same[2][BINS], float mirror[2][BINS])
 {
     for (size_t k = k0; k < k1; k++)
         for (size_t f = 0; f < 2; f++) {
-            const float *x = a + k * BLOCK + f * 2 * BINS, *y = b + k * BLOCK + f * 2 * BINS;
+            const float *x = a + (k - k0) * BLOCK + f * 2 * BINS, *y = b + k * BLOCK + f * 2 * BINS;
             for (size_t t = 0; t < BINS; t++) {
                 float e = x[t] - y[t], e2 = x[BINS + t] - y[BINS + t];
                 float g = x[t] - y[BINS + t], g2 = x[BINS + t] - y[t];
@@ -105,13 +127,27 @@ double amscr__sig_distance(const float *a, const float *b)
 /* Frequencies a partial sum covers before the search checks it against its threshold. */
 enum { EARLY_STEP = 4 };
 
-/* amscr__sig_distance, or (once a partial sum exceeds tau) that partial sum: a value > tau
- * whenever the distance is. */
-static double sig_distance_within(const float *a, const float *b, double tau)
+/* Frequencies k0..k1-1 of row i of R (k1 - k0 <= EARLY_STEP): in R's floats, or dequantized into
+ * buf. */
+static const float *row_block(const amscr__sig_rows *R, size_t i, size_t k0, size_t k1, float *buf)
 {
-    float same[2][BINS] = {{0.0f}}, mirror[2][BINS] = {{0.0f}};
+    if (R->f)
+        return R->f + i * AMSCR__SIG_DIM + k0 * BLOCK;
+    const uint16_t *q = R->q + i * AMSCR__SIG_DIM + k0 * BLOCK;
+    float s = ldexpf(1.0f, R->e[i]);
+    for (size_t t = 0; t < (k1 - k0) * BLOCK; t++)
+        buf[t] = (float)q[t] * s;
+    return buf;
+}
+
+/* The distance of row i of R and b, or (once a partial sum exceeds tau) that partial sum: a
+ * value > tau whenever the distance is (tau infinite: the distance). */
+static double sig_distance_within(const amscr__sig_rows *R, size_t i, const float *b, double tau)
+{
+    float same[2][BINS] = {{0.0f}}, mirror[2][BINS] = {{0.0f}}, buf[EARLY_STEP * BLOCK];
     for (size_t k = 0; k < FREQS; k += EARLY_STEP) {
-        sig_sums(a, b, k, k + EARLY_STEP < FREQS ? k + EARLY_STEP : FREQS, same, mirror);
+        size_t k1 = k + EARLY_STEP < FREQS ? k + EARLY_STEP : FREQS;
+        sig_sums(row_block(R, i, k, k1, buf), b, k, k1, same, mirror);
         double v = sig_value(same, mirror);
         if (v > tau || k + EARLY_STEP >= FREQS)
             return v;
@@ -132,8 +168,8 @@ static void sort_indices(size_t *c, size_t m)
 
 /* The exact search among ids[0..nids-1] (ascending; NULL: the n shapes 0..n-1). */
 
-static size_t nearest_among(const float *sigs, const float *lbs, const size_t *ids, size_t nids, const float *sig,
-                            const float *lb, size_t m, size_t exclude, size_t *cand)
+static size_t nearest_among(const amscr__sig_rows *sigs, const float *lbs, const size_t *ids, size_t nids,
+                            const float *sig, const float *lb, size_t m, size_t exclude, size_t *cand)
 {
     size_t ex = SIZE_MAX;
     for (size_t t = 0; t < nids && exclude != SIZE_MAX; t++)
@@ -149,16 +185,14 @@ static size_t nearest_among(const float *sigs, const float *lbs, const size_t *i
     }
     ok = ok && amscr_topk(bound, nids, first, ex, order) == AMSCR_OK;
     for (size_t t = 0; ok && t < first; t++)
-        full[order[t]] = amscr__sig_distance(sigs + (ids ? ids[order[t]] : order[t]) * AMSCR__SIG_DIM, sig);
+        full[order[t]] = sig_distance_within(sigs, ids ? ids[order[t]] : order[t], sig, INFINITY);
     ok = ok && amscr_topk(full, nids, m, ex, cand) == AMSCR_OK;
-    
     if (ok && m > 0) {
         double tau = full[cand[m - 1]];
         int more = 0;
         for (size_t t = 0; t < nids; t++)
             if (t != ex && isinf(full[t]) && bound[t] <= tau) {
-                full[t] = sig_distance_within(sigs + (ids ? ids[t] : t) * AMSCR__SIG_DIM, sig, tau);
-                
+                full[t] = sig_distance_within(sigs, ids ? ids[t] : t, sig, tau);
                 more = 1;
             }
         if (more)
@@ -175,8 +209,8 @@ static size_t nearest_among(const float *sigs, const float *lbs, const size_t *i
     return m;
 }
 
-size_t amscr__sig_nearest(const float *sigs, const float *lbs, size_t n, const float *sig, const float *lb, size_t m,
-                          size_t exclude, size_t *cand)
+size_t amscr__sig_nearest(const amscr__sig_rows *sigs, const float *lbs, size_t n, const float *sig, const float *lb,
+                          size_t m, size_t exclude, size_t *cand)
 {
     return nearest_among(sigs, lbs, NULL, n, sig, lb, m, exclude, cand);
 }
@@ -322,8 +356,8 @@ static int cmp_size(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-size_t amscr__sig_ivf_nearest(const amscr__sig_ivf *v, const float *sigs, const float *lbs, size_t n, const float *sig,
-                              const float *lb, size_t m, size_t exclude, size_t *cand)
+size_t amscr__sig_ivf_nearest(const amscr__sig_ivf *v, const amscr__sig_rows *sigs, const float *lbs, size_t n,
+                              const float *sig, const float *lb, size_t m, size_t exclude, size_t *cand)
 {
     double *cd = amscr__malloc_array(v->nc, sizeof *cd);
     size_t *order = amscr__malloc_array(v->nc, sizeof *order), *ids = NULL, got = 0, lists = 0;

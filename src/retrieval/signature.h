@@ -19,6 +19,20 @@
 /* The signature of d into out[AMSCR__SIG_DIM]: amscr__affine_signature's values, reordered by
  * frequency, then frame, orientation and bin. */
 void amscr__shape_signature(const amscr_descriptor *d, float *out);
+/* A signature held in 16 bits (an index's rows, 2 KB a shape rather than 4): value t is
+ * q[t] * 2^e, e the row's exponent (its largest value takes 16 bits), the values rounded to the
+ * nearest. Exact in float both ways: the dequantized row quantizes back to the same q and e (an
+ * index file keeps the dequantized floats). The values are >= 0 (magnitudes). */
+void amscr__sig_quantize(const float *sig, uint16_t *q, int32_t *e);
+void amscr__sig_dequantize(const uint16_t *q, int32_t e, float *out);
+
+/* Rows of signatures: n x AMSCR__SIG_DIM floats f, or (f NULL) quantized rows q with their
+ * exponents e; a search reads a quantized row as its dequantized floats (the same distances). */
+typedef struct {
+    const float *f;
+    const uint16_t *q;
+    const int32_t *e;
+} amscr__sig_rows;
 /* The lower-bound vector of a signature into lb[AMSCR__SIG_LB_DIM]. */
 void amscr__sig_bound_vector(const float *sig, float *lb);
 /* A lower bound of amscr__sig_distance from the two lower-bound vectors. */
@@ -27,11 +41,11 @@ double amscr__sig_bound(const float *la, const float *lb);
 double amscr__sig_distance(const float *a, const float *b);
 
 /* The m signatures nearest sig (lower-bound vector lb) among the n of sigs / lbs (rows of
- * AMSCR__SIG_DIM and AMSCR__SIG_LB_DIM floats), by (distance, index), leaving out `exclude`
+ * AMSCR__SIG_DIM values and AMSCR__SIG_LB_DIM floats), by (distance, index), leaving out `exclude`
  * (or SIZE_MAX), into cand in ascending index order; exactly those of the full distances.
  * Returns m, 0 when out of memory. */
-size_t amscr__sig_nearest(const float *sigs, const float *lbs, size_t n, const float *sig, const float *lb, size_t m,
-                          size_t exclude, size_t *cand);
+size_t amscr__sig_nearest(const amscr__sig_rows *sigs, const float *lbs, size_t n, const float *sig, const float *lb,
+                          size_t m, size_t exclude, size_t *cand);
 
 /* A coarse quantizer of the lower-bound vectors (a large build's shortlists, and a large
  * index's queries: index.c): ceil(sqrt(n)) K-means lists, each holding its shapes in ascending
@@ -54,7 +68,7 @@ int amscr__sig_ivf_lists(amscr__sig_ivf *v);
 amscr_status amscr__sig_ivf_add(amscr__sig_ivf *v, const float *lbs, size_t n);
 /* amscr__sig_nearest among the shapes of the lists nearest lb (at least 8 lists and 16 m + 1
  * shapes): the m nearest of those, not necessarily the m nearest of all. */
-size_t amscr__sig_ivf_nearest(const amscr__sig_ivf *v, const float *sigs, const float *lbs, size_t n, const float *sig,
-                              const float *lb, size_t m, size_t exclude, size_t *cand);
+size_t amscr__sig_ivf_nearest(const amscr__sig_ivf *v, const amscr__sig_rows *sigs, const float *lbs, size_t n,
+                              const float *sig, const float *lb, size_t m, size_t exclude, size_t *cand);
 
 #endif
