@@ -107,8 +107,8 @@ def one_size(args, shapes):
 
 def python_rss(args):
     """amscr.Index(collection) in Python: the process's RSS before and after the build, a shape,
-    and the saved file's bytes a shape (the mpeg7-dev index of --rss-index, its shapes --rss-copies
-    times)."""
+    the saved file's bytes a shape and a load's RSS in a new process (the mpeg7-dev index of
+    --rss-index, its shapes --rss-copies times)."""
     import gc
     import psutil
     import amscr
@@ -125,8 +125,22 @@ def python_rss(args):
     path = os.path.join(args.work, "rss.idx")
     os.makedirs(args.work, exist_ok=True)
     x.save(path)
-    print("amscr.Index(collection) of %d shapes: RSS %.0f -> %.0f MB, %.1f KB a shape; file %.1f KB a shape"
-          % (n, r0 / 1e6, r1 / 1e6, (r1 - r0) / n / 1e3, os.path.getsize(path) / n / 1e3))
+    code = ("import amscr, psutil, sys; p = psutil.Process(); r0 = p.memory_info().rss; "
+            "x = amscr.Index.load(sys.argv[1]); print((p.memory_info().rss - r0) / len(x) / 1e3)")
+    load = float(subprocess.run([sys.executable, "-c", code, path], capture_output=True, text=True, check=True).stdout)
+    print("amscr.Index(collection) of %d shapes: RSS %.0f -> %.0f MB, %.1f KB a shape; file %.1f KB a shape; "
+          "amscr.Index.load in a new process %.1f KB a shape"
+          % (n, r0 / 1e6, r1 / 1e6, (r1 - r0) / n / 1e3, os.path.getsize(path) / n / 1e3, load))
+    rng, ms = random.Random(3), {"a member": [], "an affine-warped member": []}
+    for i in rng.sample(range(n), 60):  # Index.query, M = 256: the median CPU
+        a, c, s = rng.uniform(0, 6.3), rng.uniform(0.7, 1.3), rng.uniform(-0.3, 0.3)
+        shape = coll.shape(i)  # the member itself (scored as the member), and warped
+        warped = shape.input_points @ [[c * math.cos(a), math.sin(a)], [s - math.sin(a), math.cos(a)]]
+        for kind, q in (("a member", shape), ("an affine-warped member", warped)):
+            t = time.process_time()
+            x.query(q)
+            ms[kind].append(1e3 * (time.process_time() - t))
+    print("; ".join("a query of %s %.1f ms of CPU" % (k, statistics.median(v)) for k, v in ms.items()))
 
 
 def main():
