@@ -36,32 +36,23 @@
 
 #include <sys/resource.h>
 
+#define BENCH_PROGRAM "amscr-index-bench"
 #include "affine_warp.h"
 #include "amscr.h"
+#include "bench_util.h"
 #include "db_io.h"
 #include "index.h"
 #include "mcd_set.h"
 
 enum { TOP = 10, NQ = 50, NQ_SCALE = 50, NQ_EXACT = 10, SEARCH_ROWS = 200, BUILD_M = 192 };
 
-static void die(const char *what)
-{
-    fprintf(stderr, "amscr-index-bench: %s: %s\n", what, amscr_last_error_detail());
-    exit(1);
-}
-
-static double clock_s(clockid_t id)
+/* CPU seconds of the process (all threads). */
+static double cpu(void)
 {
     struct timespec t;
-    clock_gettime(id, &t);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
-
-static double now(void) { return clock_s(CLOCK_MONOTONIC); }
-static double cpu(void) { return clock_s(CLOCK_PROCESS_CPUTIME_ID); }
-/* CPU seconds of the calling thread (the shortlist searches: not slowed by a busy machine's
- * other jobs, as wall clock is). */
-static double thread_cpu(void) { return clock_s(CLOCK_THREAD_CPUTIME_ID); }
 
 static double rss_mb(void)
 {
@@ -108,15 +99,9 @@ static void add(amscr_db *db, amscr_descriptor *d, int32_t label)
     amscr_descriptor_free(d);
 }
 
-static int cmp_dbl(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 static double median(double *v, size_t n)
 {
-    qsort(v, n, sizeof *v, cmp_dbl);
+    qsort(v, n, sizeof *v, cmp_double);
     return n ? v[n / 2] : 0.0;
 }
 
@@ -230,14 +215,14 @@ static void search_cost(const amscr_index *x, size_t m, double out[3])
         float sig[AMSCR__SIG_DIM];
         const float *lb = x->sig_lb + i * AMSCR__SIG_LB_DIM;
         amscr__index_sig(x, i, sig);
-        double t = thread_cpu();
+        double t = cpu_now();
         if (amscr__sig_nearest(&rows, x->sig_lb, n, sig, lb, m, i, a) != m)
             die("search");
-        te += thread_cpu() - t;
-        t = thread_cpu();
+        te += cpu_now() - t;
+        t = cpu_now();
         if (amscr__sig_ivf_nearest(&v, &rows, x->sig_lb, n, sig, lb, m, i, b) != m)
             die("search");
-        ti += thread_cpu() - t;
+        ti += cpu_now() - t;
         for (size_t u = 0, w = 0; u < m; u++) { /* both ascending */
             while (w < m && b[w] < a[u])
                 w++;
