@@ -17,21 +17,13 @@ every shard's shapes, or with its share of the query's M signature-nearest, on i
 ``amscr_index_graph_member_scores``): the scores are those of ``amscr.Index(collection,
 candidates=M).scores(query, candidates=M)``.
 
-A saved set is a directory: ``manifest.json`` (written last, by an atomic rename: the commit
-point), one ``shard-SSS-CHECKSUM.amscr-index`` per shard (an ordinary index file that ``amscr
-search`` and :meth:`amscr.Index.load` read alone; its own lists come from a short shortlist build
-and serve only such a use) and ``graph-CHECKSUM.npz`` (the global lists). Each file is named by
-its SHA-256; the manifest holds the checksums, each shard's first shape and count, and the
-options (:class:`amscr.Params`).
+A saved set is a directory of ordinary index files, the global lists and a manifest
+(:mod:`amscr._shard_files`).
 """
 from __future__ import annotations
 
-import errno
-import hashlib
 import io
-import json
 import os
-import tempfile
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -39,15 +31,13 @@ import numpy as np
 from ._lib import ffi, lib
 from ._util import dbuf
 from .collection import Collection
-from .errors import AmscrError, FileError, FormatError, InvalidArgumentError, _check
+from .errors import AmscrError, FormatError, InvalidArgumentError, _check
 from .index import Index
-from .params import Params, _params_from_dict
+from .params import Params
 from .shape import Shape
 from ._placement import _block, _threads_by_host, _tile_threads
+from ._shard_files import ShardSetError, read_set, write_set
 
-FORMAT = 'amscr-sharded-index'
-VERSION = 1
-MANIFEST = 'manifest.json'
 SHARD_LIST = 16  # the shortlist of a shard's own (local) lists: they serve only the shard opened alone
 QPOS_AFTER = 2 ** 64 - 1  # SIZE_MAX: the query after every shape
 
@@ -68,11 +58,6 @@ def _register_sizeof() -> None:
 
 
 _register_sizeof()
-
-
-class ShardSetError(AmscrError, ValueError):
-    """A saved shard set that cannot be used: a shard file missing, foreign (another set's, or
-    altered) or built with other options than the manifest's. The message names the file."""
 
 
 # ========================================================================== the graph (client)
@@ -635,130 +620,7 @@ class ShardedIndex:
         os.makedirs(d, exist_ok=True)
         datas = self._gather([self.client.submit(_index_bytes, sh, pure=False, workers=[self._workers[s]])
                               for s, sh in enumerate(self._shards)])
-        entries = []
-        keep = {MANIFEST}
-        for s, data in enumerate(datas):
-            sha = hashlib.sha256(data).hexdigest()
-            name = 'shard-%03d-%s.amscr-index' % (s, sha[:16])
-            _write_atomic(d, name, data)
-            keep.add(name)
-            entries.append({'file': name, 'sha256': sha, 'first': self.bounds[s][0], 'count':
-                            self.bounds[s][1] - self.bounds[s][0]})
-        gdata = self._graph.to_bytes()
-        gsha = hashlib.sha256(gdata).hexdigest()
-        gname = 'graph-%s.npz' % gsha[:16]
-        _write_atomic(d, gname, gdata)
-        keep.add(gname)
-        manifest = {'format': FORMAT, 'version': VERSION, 'shapes': len(self), 'params': self.params._plain_dict(),
-                    'shards': entries, 'graph': {'file': gname, 'sha256': gsha}, 'candidates': self.candidates}
-        _write_atomic(d, MANIFEST, (json.dumps(manifest, indent=1, sort_keys=True) + '\n').encode())
-        for f in os.listdir(d):  # the replaced set's files and leftovers of cut-off writes
-            if f not in keep and (_ours(f)):
-                try:
-                    os.unlink(os.path.join(d, f))
-                except OSError:
-                    pass
-
-
-def _ours(f: str) -> bool:
-    return ((f.startswith('shard-') and f.endswith('.amscr-index')) or (f.startswith('graph-') and f.endswith('.npz'))
-            or (f.startswith('.amscr-tmp-')))
-
-
-def _umask() -> int:
-    """The process's umask, read without changing it where Linux tells it (os.umask changes it
-    for every thread while it is read)."""
-    try:
-        with open('/proc/self/status') as f:
-            for line in f:
-                if line.startswith('Umask:'):
-                    return int(line.split()[1], 8)
-    except (OSError, ValueError):
-        pass
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def _write_atomic(d: str, name: str, data: bytes) -> None:
-    """Writes d/name by a temporary file in d, fsync and rename; mode 0666 less the umask."""
-    fd, tmp = tempfile.mkstemp(prefix='.amscr-tmp-', dir=d)
-    try:
-        try:
-            with os.fdopen(fd, 'wb') as f:
-                f.write(data)
-                f.flush()
-                os.fsync(f.fileno())
-            os.chmod(tmp, 0o666 & ~_umask())
-            os.replace(tmp, os.path.join(d, name))
-        except BaseException:
-            os.unlink(tmp)
-            raise
-    except OSError as e:
-        raise FileError('amscr.distributed: cannot write %s: %s' % (os.path.join(d, name), e.strerror or e),
-                        lib.AMSCR_E_IO) from e
-    try:
-        dfd = os.open(d, os.O_RDONLY)
-        try:
-            os.fsync(dfd)
-        finally:
-            os.close(dfd)
-    except OSError:  # pragma: no cover - a file system without directory fsync
-        pass
-
-
-def _read_manifest(d: str) -> Dict[str, Any]:
-    p = os.path.join(d, MANIFEST)
-    try:
-        with open(p, 'rb') as f:
-            m = json.loads(f.read().decode('utf-8'))
-    except FileNotFoundError:
-        raise FileError('amscr.distributed.load_index: no shard set in %s (%s is missing)' % (d, MANIFEST),
-                        lib.AMSCR_E_IO) from None
-    except (ValueError, UnicodeDecodeError) as e:
-        raise FormatError('amscr.distributed.load_index: %s is not a shard set manifest: %s' % (p, e),
-                          lib.AMSCR_E_FORMAT) from None
-    if not isinstance(m, dict) or m.get('format') != FORMAT:
-        raise FormatError('amscr.distributed.load_index: %s is not a shard set manifest' % p, lib.AMSCR_E_FORMAT)
-    if m.get('version') != VERSION:
-        raise FormatError('amscr.distributed.load_index: %s is of version %r; this amscr reads version %d'
-                          % (p, m.get('version'), VERSION), lib.AMSCR_E_FORMAT)
-    return m
-
-
-def _differing(a: Dict[str, Any], b: Dict[str, Any]) -> List[str]:
-    skip = {'threads'}
-    return ['%s %r (the manifest: %r)' % (key, b.get(key), a.get(key)) for key in sorted(set(a) | set(b))
-            if key not in skip and a.get(key) != b.get(key)]
-
-
-def _read_shard(d: str, s: int, entry: Dict[str, Any], params: Params) -> bytes:
-    """Shard s's bytes, checked against the manifest (ShardSetError naming the file otherwise)."""
-    name = str(entry.get('file'))
-    p = os.path.join(d, name)
-    try:
-        with open(p, 'rb') as f:
-            data = f.read()
-    except FileNotFoundError:
-        raise ShardSetError('amscr.distributed.load_index: shard %d of %s, %s, is missing' % (s, d, name),
-                            lib.AMSCR_E_IO) from None
-    except OSError as e:
-        raise FileError('amscr.distributed.load_index: cannot read shard %d, %s: %s' % (s, p, e.strerror),
-                        lib.AMSCR_E_IO) from None
-    if hashlib.sha256(data).hexdigest() == entry.get('sha256'):
-        return data
-    try:  # tell what differs
-        x = Index.from_bytes(data)
-    except AmscrError:
-        raise ShardSetError('amscr.distributed.load_index: shard %d, %s, is not an index file (its checksum '
-                            'differs from the manifest\'s)' % (s, p), lib.AMSCR_E_FORMAT) from None
-    diff = _differing(params._plain_dict(), x.collection_params()._plain_dict())
-    if diff:
-        raise ShardSetError('amscr.distributed.load_index: shard %d, %s, was built with other options than the '
-                            'set: %s' % (s, p, '; '.join(diff)), lib.AMSCR_E_FORMAT)
-    raise ShardSetError('amscr.distributed.load_index: shard %d, %s, is foreign to this set (%d shapes, the '
-                        'manifest %s; its checksum differs from the manifest\'s: another set\'s shard, or '
-                        'altered)' % (s, p, len(x), entry.get('count')), lib.AMSCR_E_FORMAT)
+        write_set(d, datas, self.bounds, self._graph.to_bytes(), len(self), self.params, self.candidates)
 
 
 def _workers(client) -> List[str]:
@@ -864,40 +726,14 @@ def load_index(client, path: PathLike) -> ShardedIndex:
         the file).
     """
     d = os.fspath(path)
-    m = _read_manifest(d)
-    try:
-        params = _params_from_dict(m['params'])
-        n = int(m['shapes'])
-        entries = list(m['shards'])
-        bounds = [(int(e['first']), int(e['first']) + int(e['count'])) for e in entries]
-        gentry = m['graph']
-        candidates = int(m.get('candidates', 0))
-        if candidates < 0:
-            raise ValueError('candidates %d' % candidates)
-    except (KeyError, TypeError, ValueError) as e:
-        raise FormatError('amscr.distributed.load_index: %s: a malformed manifest (%s)' % (os.path.join(d, MANIFEST), e),
-                          lib.AMSCR_E_FORMAT) from None
-    if [b[0] for b in bounds] != [0] + [b[1] for b in bounds[:-1]] or (bounds and bounds[-1][1] != n):
-        raise FormatError('amscr.distributed.load_index: %s: shards do not cover the %d shapes in order'
-                          % (os.path.join(d, MANIFEST), n), lib.AMSCR_E_FORMAT)
-    gp = os.path.join(d, str(gentry.get('file')))
-    try:
-        with open(gp, 'rb') as f:
-            gdata = f.read()
-    except FileNotFoundError:
-        raise ShardSetError('amscr.distributed.load_index: the graph of %s, %s, is missing' % (d, gentry.get('file')),
-                            lib.AMSCR_E_IO) from None
-    if hashlib.sha256(gdata).hexdigest() != gentry.get('sha256'):
-        raise ShardSetError('amscr.distributed.load_index: the graph %s is foreign to this set (its checksum '
-                            'differs from the manifest\'s)' % gp, lib.AMSCR_E_FORMAT)
-    datas = [_read_shard(d, s, e, params) for s, e in enumerate(entries)]
+    params, n, bounds, candidates, gp, gdata, datas = read_set(d)
     try:
         graph = _Graph.from_bytes(params, n, gdata)
     except (KeyError, ValueError, OSError) as e:
         raise FormatError('amscr.distributed.load_index: the graph %s is corrupt: %s' % (gp, e),
                           lib.AMSCR_E_FORMAT) from None
     workers = _workers(client)
-    placed = [workers[s % len(workers)] for s in range(len(entries))]
+    placed = [workers[s % len(workers)] for s in range(len(datas))]
     idx = [client.submit(_shard_from_file_bytes, datas[s], pure=False, workers=[placed[s]])
-           for s in range(len(entries))]
+           for s in range(len(datas))]
     return ShardedIndex(client, idx, bounds, graph, params, placed, candidates)
