@@ -101,6 +101,8 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
     amscr_status st = amscr__base_hf(&j->b, d, hf);
     if (st == AMSCR_OK && x->mirror_pool && i >= x->pool_first)
         mirror_to_pool(x, i);
+    else if (st == AMSCR_OK && j->have_sig) /* a load of a file without the heights: no rows follow */
+        mirror_free(hf, x->nf, NULL, 0);
     return st;
 }
 

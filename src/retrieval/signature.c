@@ -117,13 +117,6 @@ static double sig_value(float same[2][BINS], float mirror[2][BINS])
     return sum;
 }
 
-double amscr__sig_distance(const float *a, const float *b)
-{
-    float same[2][BINS] = {{0.0f}}, mirror[2][BINS] = {{0.0f}};
-    sig_sums(a, b, 0, FREQS, same, mirror);
-    return sig_value(same, mirror);
-}
-
 /* Frequencies a partial sum covers before the search checks it against its threshold. */
 enum { EARLY_STEP = 4 };
 

@@ -35,10 +35,9 @@ typedef struct {
 } amscr__sig_rows;
 /* The lower-bound vector of a signature into lb[AMSCR__SIG_LB_DIM]. */
 void amscr__sig_bound_vector(const float *sig, float *lb);
-/* A lower bound of amscr__sig_distance from the two lower-bound vectors. */
+/* A lower bound of the signature distance (amscr__affine_signature_distance of two signatures,
+ * in float: the search's) from the two lower-bound vectors. */
 double amscr__sig_bound(const float *la, const float *lb);
-/* amscr__affine_signature_distance of two signatures (in float). */
-double amscr__sig_distance(const float *a, const float *b);
 
 /* The m signatures nearest sig (lower-bound vector lb) among the n of sigs / lbs (rows of
  * AMSCR__SIG_DIM values and AMSCR__SIG_LB_DIM floats), by (distance, index), leaving out `exclude`
