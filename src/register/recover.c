@@ -27,7 +27,6 @@
 #include "nearest.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -62,13 +61,6 @@
 #define RECOVER_AMBIGUOUS 0.5
 /* Share of the samples each direction of the ranking cost keeps. */
 #define RECOVER_RANK_KEEP 0.7
-/* Fragments of the target placed on the source when no two source fragments agree (a bite
- * that cut a thin shape apart leaves a target that is a part of the source, its boundary but
- * for the cut an arc of the source's, while no 60 % fragment of the source fits inside it):
- * their count, share of the target's boundary and least share of the source's affine length. */
-#define RECOVER_TFRAGS 5
-#define RECOVER_TSHARE 0.6
-#define RECOVER_TPHI_MIN 0.15
 
 /* Scratch of one refinement/ranking at n samples (doubles). */
 typedef struct {
@@ -146,22 +138,10 @@ static double trimmed_mean(double *v, size_t n)
     return sum / (double)keep;
 }
 
-/* Mean of v (n values) with each value capped at the inlier distance squared. */
-static double capped_mean(const double *v, size_t n)
-{
-    double cap = RECOVER_INLIER_DIST * RECOVER_INLIER_DIST, sum = 0.0;
-    for (size_t a = 0; a < n; a++)
-        sum += v[a] < cap ? v[a] : cap;
-    return sum / (double)n;
-}
-
 /* The two-way ranking cost of X, whose source-to-target residuals are in s->r2. */
-static double two_way_cost(const amscr_descriptor *f, const amscr_descriptor *h, scratch_t *s, const double X[6],
-                           double *capped)
+static double two_way_cost(const amscr_descriptor *f, const amscr_descriptor *h, scratch_t *s, const double X[6])
 {
     size_t n = f->n;
-    if (capped)
-        *capped = capped_mean(s->r2, n);
     for (size_t a = 0; a < n; a++) {
         double fx = f->base[2 * a], fy = f->base[2 * a + 1];
         s->P[2 * a] = X[0] * fx + X[1] * fy + X[2];
@@ -175,8 +155,6 @@ static double two_way_cost(const amscr_descriptor *f, const amscr_descriptor *h,
         s->sorted[b] = amscr__closest_on_polygon(s->P, n, f->params.closed, 0, n, h->base[2 * b], h->base[2 * b + 1],
                                                  &qx, &qy, &seg);
     }
-    if (capped)
-        *capped += capped_mean(s->sorted, h->n);
     return there + trimmed_mean(s->sorted, h->n);
 }
 
@@ -209,14 +187,12 @@ static void fragment_order(const double *r2, size_t n, size_t order[RECOVER_FRAG
         }
 }
 
-/* The map of fragment k of nfrags (share of f's boundary each) placed on h by partial matching
- * (h's affine length searched from phi_min), in f's normalized frame. Returns a failure status
- * when the fragment cannot be placed. */
-static amscr_status fragment_place(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                   size_t k, size_t nfrags, double share, double phi_min, amscr_workspace *ws,
-                                   double *pts, double X[6])
+/* The map of fragment k of f placed on h by partial matching, in f's normalized frame.
+ * Returns a failure status when the fragment cannot be placed. */
+static amscr_status fragment_start(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                   size_t k, amscr_workspace *ws, double *pts, double X[6])
 {
-    size_t n = f->n, len = (size_t)(share * (double)n), start = k * n / nfrags;
+    size_t n = f->n, len = (size_t)(RECOVER_SHARE * (double)n), start = k * n / RECOVER_FRAGS;
     for (size_t j = 0; j < len; j++)
         memcpy(pts + 2 * j, f->base + 2 * ((start + j) % n), 2 * sizeof *pts);
     amscr_params pp = *prm;
@@ -230,55 +206,12 @@ static amscr_status fragment_place(const amscr_params *prm, const amscr_descript
         st = amscr_descriptor_new(&pp, c, &d);
     pp.closed = 1;
     if (st == AMSCR_OK)
-        st = amscr__match_partial_min(&pp, d, h, phi_min, 0, ws, &mf);
+        st = amscr__match_partial_min(&pp, d, h, RECOVER_PHI_MIN, 0, ws, &mf);
     if (st == AMSCR_OK) /* d's input frame is f's normalized frame */
         amscr__affine_compose(mf.X, d->fwd, X);
     amscr_descriptor_free(d);
     amscr_contour_free(c);
     return st; /* a fragment that cannot be placed is skipped; out of memory is not */
-}
-
-/* The inverse of the affine map Y; 0 when singular. */
-static int affine_inverse(const double Y[6], double X[6])
-{
-    double det = Y[0] * Y[4] - Y[1] * Y[3];
-    if (!(fabs(det) > 1e-12))
-        return 0;
-    X[0] = Y[4] / det;
-    X[1] = -Y[1] / det;
-    X[3] = -Y[3] / det;
-    X[4] = Y[0] / det;
-    X[2] = -(X[0] * Y[2] + X[1] * Y[5]);
-    X[5] = -(X[3] * Y[2] + X[4] * Y[5]);
-    return 1;
-}
-
-/* Candidate i of the recovery: source fragment order[i] placed on the target and refined on the
- * source, or (i >= RECOVER_FRAGS) target fragment i - RECOVER_FRAGS placed on the source, refined
- * from the target's side (t: the target's scratch; all of its samples but the cut have a partner
- * on the source) and inverted. Its source-side pairs are left in s. */
-static amscr_status candidate(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                              size_t i, const size_t *order, amscr_workspace *ws, scratch_t *s, scratch_t *t,
-                              double X[6])
-{
-    double *pts = s->P + 2 * f->n, Y[6], cut;
-    if (i < RECOVER_FRAGS) {
-        amscr_status st = fragment_place(prm, f, h, order[i], RECOVER_FRAGS, RECOVER_SHARE, RECOVER_PHI_MIN, ws, pts, X);
-        if (st == AMSCR_OK)
-            refine_adaptive(prm, f, s, X);
-        return st;
-    }
-    amscr_status st = fragment_place(prm, h, f, i - RECOVER_FRAGS, RECOVER_TFRAGS, RECOVER_TSHARE, RECOVER_TPHI_MIN, ws,
-                                     pts, Y);
-    if (st != AMSCR_OK)
-        return st;
-    refine_adaptive(prm, h, t, Y);
-    if (getenv("BITE_DBG"))
-        fprintf(stderr, "  tfrag %zu: target-side inl %.3f det %.4f\n", i - RECOVER_FRAGS, inlier_share(t->r2, h->n), Y[0] * Y[4] - Y[1] * Y[3]);
-    if (!affine_inverse(Y, X))
-        return amscr__fail(AMSCR_E_DEGENERATE, "registration: a singular fragment map");
-    pairs(f, s, X, 1, &cut);
-    return AMSCR_OK;
 }
 
 /* Refines `best` once more, stores the map in m and its pairs in ws->rbuf (the reported
@@ -357,93 +290,51 @@ int amscr__recover_applies(const amscr_descriptor *f, const amscr_descriptor *h,
     return m->refined && f->n == h->n && inlier_share(ws->rbuf + 2 * f->n, f->n) < RECOVER_INLIERS;
 }
 
-/* The winner among the recovery's candidates (tried[0..nt), costs cost): the lowest two-way
- * trimmed cost, unless its capped cost is more than BITE_VETO times the lowest capped cost, then
- * that one (probe switch). */
-static size_t pick(const double *cost, const double *capped, size_t nt)
-{
-    size_t b = 0, bc = 0;
-    for (size_t j = 1; j < nt; j++) {
-        b = cost[j] < cost[b] ? j : b;
-        bc = capped[j] < capped[bc] ? j : bc;
-    }
-    if (getenv("BITE_FORCE") && (size_t)atoi(getenv("BITE_FORCE")) < nt)
-        return (size_t)atoi(getenv("BITE_FORCE"));
-    const char *veto = getenv("BITE_VETO");
-    if (veto && capped[b] > atof(veto) * capped[bc])
-        return bc;
-    return b;
-}
-
-/* Whether cost c is clearly below cost c0 (c0 not an alternative to it by AMSCR__ALT_RATIO). */
-static int clearly_better(double c, double c0)
-{
-    return c + AMSCR__AMBIGUITY_FLOOR < AMSCR__ALT_RATIO * (c0 + AMSCR__AMBIGUITY_FLOOR);
-}
-
-/* Tries the candidates until two agree (tried[0]: the refined reported map); returns how many
- * were kept in tried/cost/capped, *st the last status (out of memory stops). */
-static size_t try_candidates(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                             amscr_workspace *ws, const match_t *m, scratch_t *s, double tried[][6], double *cost,
-                             double *capped, amscr_status *st)
-{
-    size_t order[RECOVER_FRAGS], nt = 1;
-    scratch_t t = {0};
-    fragment_order(ws->rbuf + 2 * f->n, f->n, order);
-    int agree = 0, tfrags = !getenv("BITE_NOT");
-    for (size_t i = 0; i < RECOVER_FRAGS + (tfrags ? RECOVER_TFRAGS : 0) && !agree; i++) {
-        if (i >= RECOVER_FRAGS && !t.q && (*st = scratch_new(h, f, &t)) != AMSCR_OK)
-            break;
-        *st = candidate(prm, f, h, i, order, ws, s, &t, tried[nt]);
-        if (*st == AMSCR_E_NOMEM)
-            break;
-        if (*st != AMSCR_OK)
-            continue;
-        double c = cost[nt] = two_way_cost(f, h, s, tried[nt], &capped[nt]), best_cost = cost[pick(cost, capped, nt)];
-        /* with an earlier map (tried[0]: the reported one), one of the two the best so far */
-        for (size_t j = m->ambiguity < RECOVER_AMBIGUOUS ? 0 : 1; j < nt && !agree; j++)
-            agree = (c <= best_cost || cost[j] <= best_cost) &&
-                    amscr__map_gap2(f, tried[nt], tried[j]) <= RECOVER_AGREE * RECOVER_AGREE;
-        if (getenv("BITE_DBG"))
-            fprintf(stderr, "cand %zu: cost %.5f capped %.5f inl %.3f gap0 %.4f\n", i, c, capped[nt], inlier_share(s->r2, f->n), amscr__map_gap2(f, tried[nt], tried[0]));
-        nt++;
-    }
-    scratch_free(&t);
-    return nt;
-}
-
 amscr_status amscr__recover_missing(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                     amscr_workspace *ws, match_t *m)
 {
+    size_t n = f->n;
     if (!amscr__recover_applies(f, h, ws, m))
         return AMSCR_OK;
     scratch_t s = {0};
     amscr_status st = scratch_new(f, h, &s);
     if (st != AMSCR_OK)
         return st;
-    double tried[RECOVER_FRAGS + RECOVER_TFRAGS + 1][6], cost[RECOVER_FRAGS + RECOVER_TFRAGS + 1],
-        capped[RECOVER_FRAGS + RECOVER_TFRAGS + 1], entry[6];
-    memcpy(entry, m->X, sizeof entry);
-    memcpy(tried[0], m->X, sizeof tried[0]);
-    refine_adaptive(prm, f, &s, tried[0]);
-    cost[0] = two_way_cost(f, h, &s, tried[0], &capped[0]);
-    size_t nt = try_candidates(prm, f, h, ws, m, &s, tried, cost, capped, &st);
+    double *pts = s.P + 2 * n;
+    double best[6], tried[RECOVER_FRAGS + 1][6], cost[RECOVER_FRAGS + 1], best_cost;
+    size_t order[RECOVER_FRAGS];
+    fragment_order(ws->rbuf + 2 * n, n, order);
+    memcpy(best, m->X, sizeof best);
+    refine_adaptive(prm, f, &s, best);
+    memcpy(tried[0], best, sizeof best);
+    best_cost = cost[0] = two_way_cost(f, h, &s, best);
+    for (size_t i = 0, nt = 1; i < RECOVER_FRAGS; i++) {
+        double *X = tried[nt];
+        st = fragment_start(prm, f, h, order[i], ws, pts, X);
+        if (st == AMSCR_E_NOMEM)
+            break;
+        if (st != AMSCR_OK)
+            continue;
+        refine_adaptive(prm, f, &s, X);
+        double c = cost[nt] = two_way_cost(f, h, &s, X);
+        if (c < best_cost) {
+            best_cost = c;
+            memcpy(best, X, sizeof best);
+        }
+        int agree = 0; /* with an earlier map (tried[0]: the reported one), one of the two the best so far */
+        for (size_t j = m->ambiguity < RECOVER_AMBIGUOUS ? 0 : 1; j < nt && !agree; j++)
+            agree = (c <= best_cost || cost[j] <= best_cost) &&
+                    amscr__map_gap2(f, X, tried[j]) <= RECOVER_AGREE * RECOVER_AGREE;
+        nt++;
+        if (agree)
+            break;
+    }
     if (st == AMSCR_E_NOMEM) {
         scratch_free(&s);
         return st;
     }
     amscr__clear_error();
-    size_t b = pick(cost, capped, nt);
-    if (getenv("BITE_DBG"))
-        fprintf(stderr, "reported cost %.5f capped %.5f amb %.3f; pick %zu of %zu\n", cost[0], capped[0], m->ambiguity, b, nt);
-    st = finish(prm, f, &s, ws, tried[b], m);
-    /* a map the fragments moved off the whole-curve search's winner, and clearly better than it
-     * (the reported map not an alternative by AMSCR__ALT_RATIO): the search's other starts
-     * assumed the whole boundary matched; the polish still ranks them (the ambiguity) but none
-     * of them replaces the recovered map. */
-    if (!getenv("BITE_NOC") && st == AMSCR_OK && amscr__map_gap2(f, m->X, entry) > AMSCR__DISTINCT_GAP2 &&
-        (clearly_better(cost[b], cost[0]) || (getenv("BITE_VETO") && clearly_better(capped[b], capped[0]))))
-        m->ncand_base = 0;
+    st = finish(prm, f, &s, ws, best, m);
     scratch_free(&s);
     return st;
 }
@@ -459,7 +350,7 @@ amscr_status amscr__rank_converged(const amscr_params *prm, const amscr_descript
         return st;
     for (size_t k = 0; k < count; k++) {
         refine_adaptive(prm, f, &s, X[k]);
-        cost[k] = two_way_cost(f, h, &s, X[k], NULL);
+        cost[k] = two_way_cost(f, h, &s, X[k]);
     }
     scratch_free(&s);
     return AMSCR_OK;
