@@ -2217,8 +2217,11 @@ AMSCR_API double amscr_result_backward_error(const amscr_result *r);
  *        value is the largest ratio of the chosen map's cost to such an alternative's, as in
  *        amscr_result_ambiguity (both refined to convergence, the two-way trimmed
  *        closest-point cost). 1: a symmetric turn of the source explains the damaged target
- *        exactly as well (a 4-armed cross with one arm cut); 0: the source has no symmetry,
- *        or none fits. The confidence uses the larger of the two ambiguities.
+ *        exactly as well (a 4-armed cross with one arm cut), or (since 0.17) any other of the
+ *        source's own turns, composed and refined alike, fits the target clearly better than
+ *        the chosen map (below 0.9 times its cost: the map is not the best fit of a
+ *        near-symmetric source); 0: the source has no symmetry, or none fits. The confidence
+ *        uses the larger of the two ambiguities.
  * @return the value; NaN when it was not measured (a clean match, an unconfident map, a partial
  *         match) or for NULL.
  * Ownership: none.

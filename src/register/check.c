@@ -114,59 +114,84 @@ double amscr__confidence(const amscr_result *r)
     return (1.0 - amb) * share / (1.0 + fb * fb);
 }
 
-/* The ambiguity near a symmetry of the source: the source registered onto itself ranks its
- * own candidate turns; each refined to convergence that maps the source onto itself about as
- * well as the identity (within the ambiguity's floor: a symmetry) gives the alternative
- * X o S, which is refined on the target in turn. When part of the target is missing, the
- * ranking's few refinement steps can leave such a turn far from its minimum, where converged it
- * fits exactly as well (a 4-armed cross with an arm cut: every quarter turn). */
-static amscr_status symmetric_ambiguity(const amscr_params *prm, const amscr_descriptor *f,
-                                        const amscr_descriptor *h, amscr_workspace *ws, amscr_result *r)
+/* The source's own distinct turns: the source registered onto itself ranks its candidate
+ * turns, each refined to convergence (S[1..], cost[1..]; S[0] the identity). Returns how many
+ * in all (1: none), or 0 with the status in *st. */
+static size_t self_turns(const amscr_params *prm, const amscr_descriptor *f, amscr_workspace *ws, double S[][6],
+                         double *cost, amscr_status *st)
 {
     amscr_result *s = calloc(1, sizeof *s);
-    double (*S)[6] = amscr__malloc_array(AMSCR__MAX_ALTERNATIVES + 1, sizeof *S);
-    double *cost = amscr__malloc_array(AMSCR__MAX_ALTERNATIVES + 1, sizeof *cost);
-    amscr_status st = s && S && cost ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "symmetric ambiguity: out of memory");
     amscr_params self = *prm; /* the source onto itself: a clean pair, the polish has nothing to add */
     self.polish = 0;
-    if (st == AMSCR_OK) {
+    *st = s ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "symmetric ambiguity: out of memory");
+    if (*st == AMSCR_OK) {
         s->backward = 1;
-        st = amscr__run_stages(&self, f, f, ws, s);
+        *st = amscr__run_stages(&self, f, f, ws, s);
     }
-    size_t n = 1;
     const double I[6] = {1, 0, 0, 0, 1, 0};
-    if (st == AMSCR_OK) {
-        const match_t *m = &s->m;
-        for (size_t k = 0; k < m->nrank && n <= AMSCR__MAX_ALTERNATIVES; k++)
-            if (amscr__map_gap2(f, m->rank_X[k], I) > AMSCR__DISTINCT_GAP2)
-                memcpy(S[n++], m->rank_X[k], sizeof S[0]);
-        memcpy(S[0], I, sizeof S[0]);
-        st = amscr__rank_converged(prm, f, f, S + 1, n - 1, cost + 1);
-    }
-    double amb = 0.0;
-    if (st == AMSCR_OK) {
-        size_t ns = 1; /* the symmetries, composed with the map */
-        memcpy(S[0], r->m.X, sizeof S[0]);
-        for (size_t k = 1; k < n; k++)
-            if (amscr__map_gap2(f, S[k], I) > AMSCR__DISTINCT_GAP2 &&
-                AMSCR__AMBIGUITY_FLOOR / (cost[k] + AMSCR__AMBIGUITY_FLOOR) >= AMSCR__ALT_RATIO)
-                amscr__affine_compose(r->m.X, S[k], S[ns++]);
-        if (ns > 1)
-            st = amscr__rank_converged(prm, f, h, S, ns, cost);
-        for (size_t k = 1; st == AMSCR_OK && k < ns; k++) {
-            if (!(amscr__map_gap2(f, S[k], S[0]) > AMSCR__DISTINCT_GAP2))
-                continue;
-            double q = (cost[0] + AMSCR__AMBIGUITY_FLOOR) / (cost[k] + AMSCR__AMBIGUITY_FLOOR);
-            amb = q > amb ? (q > 1.0 ? 1.0 : q) : amb;
+    size_t n = 1;
+    memcpy(S[0], I, sizeof S[0]);
+    for (size_t k = 0; *st == AMSCR_OK && k < s->m.nrank && n <= AMSCR__MAX_ALTERNATIVES; k++)
+        if (amscr__map_gap2(f, s->m.rank_X[k], I) > AMSCR__DISTINCT_GAP2)
+            memcpy(S[n++], s->m.rank_X[k], sizeof S[0]);
+    if (*st == AMSCR_OK)
+        *st = amscr__rank_converged(prm, f, f, S + 1, n - 1, cost + 1);
+    amscr_result_free(s);
+    return *st == AMSCR_OK ? n : 0;
+}
+
+/* The ambiguity near a symmetry of the source, from its own distinct turns S[1..n-1] and their
+ * costs onto itself: each that, converged, maps the source onto itself about as well as the
+ * identity (within the ambiguity's floor: a symmetry) gives the alternative X o S, refined on
+ * the target in turn; the ambiguity is the largest ratio of costs, as the search's. When part of
+ * the target is missing, the ranking's few refinement steps can leave such a turn far from its
+ * minimum, where converged it fits exactly as well (a 4-armed cross with an arm cut: every
+ * quarter turn). Every other turn is tried on the target too: one that, converged there, fits it
+ * clearly better than the map itself (amscr__held_wins) shows that the map is not the best fit
+ * of a near-symmetric source: ambiguity 1. */
+static amscr_status turns_on_target(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                    double S[][6], const double *self_cost, size_t n, amscr_result *r)
+{
+    const double I[6] = {1, 0, 0, 0, 1, 0};
+    double T[AMSCR__MAX_ALTERNATIVES + 1][6], cost[AMSCR__MAX_ALTERNATIVES + 1];
+    unsigned char symmetry[AMSCR__MAX_ALTERNATIVES + 1];
+    size_t nt = 1;
+    memcpy(T[0], r->m.X, sizeof T[0]);
+    for (size_t k = 1; k < n; k++)
+        if (amscr__map_gap2(f, S[k], I) > AMSCR__DISTINCT_GAP2) {
+            symmetry[nt] = AMSCR__AMBIGUITY_FLOOR / (self_cost[k] + AMSCR__AMBIGUITY_FLOOR) >= AMSCR__ALT_RATIO;
+            amscr__affine_compose(r->m.X, S[k], T[nt++]);
         }
+    amscr_status st = nt > 1 ? amscr__rank_converged(prm, f, h, T, nt, cost) : AMSCR_OK;
+    double amb = 0.0;
+    for (size_t k = 1; st == AMSCR_OK && k < nt; k++) {
+        if (!(amscr__map_gap2(f, T[k], T[0]) > AMSCR__DISTINCT_GAP2))
+            continue;
+        double q = (cost[0] + AMSCR__AMBIGUITY_FLOOR) / (cost[k] + AMSCR__AMBIGUITY_FLOOR);
+        if (!symmetry[k])
+            q = amscr__held_wins(cost[k], cost[0]) ? 1.0 : 0.0;
+        amb = q > amb ? (q > 1.0 ? 1.0 : q) : amb;
     }
     if (st == AMSCR_OK)
         r->amb_conv = amb;
-    else if (st != AMSCR_E_NOMEM) {
+    return st;
+}
+
+/* The ambiguity near a symmetry of the source (r->amb_conv; left NaN when either registration
+ * fails: no evidence either way). */
+static amscr_status symmetric_ambiguity(const amscr_params *prm, const amscr_descriptor *f,
+                                        const amscr_descriptor *h, amscr_workspace *ws, amscr_result *r)
+{
+    double (*S)[6] = amscr__malloc_array(AMSCR__MAX_ALTERNATIVES + 1, sizeof *S);
+    double *cost = amscr__malloc_array(AMSCR__MAX_ALTERNATIVES + 1, sizeof *cost);
+    amscr_status st = S && cost ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "symmetric ambiguity: out of memory");
+    size_t n = st == AMSCR_OK ? self_turns(prm, f, ws, S, cost, &st) : 0;
+    if (st == AMSCR_OK)
+        st = turns_on_target(prm, f, h, S, cost, n, r);
+    if (st != AMSCR_OK && st != AMSCR_E_NOMEM) {
         st = AMSCR_OK; /* no evidence either way */
         amscr__clear_error();
     }
-    amscr_result_free(s);
     free(S);
     free(cost);
     return st;
