@@ -336,8 +336,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_parse_text(const char *text
 
 /**
  * @brief Writes a contour as a text point list ("%.17g %.17g" per line). The file is
- *        written to a temporary name in the same folder and renamed, so a failure never
- *        leaves a partial file.
+ *        written whole before it takes its name (an unnamed file of the folder, O_TMPFILE,
+ *        linked in; where the system has none, a temporary name renamed), so a failure never
+ *        leaves a partial file (since 0.17, a killed process none at all with unnamed files).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, non-finite coordinates); AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: const.
@@ -2614,8 +2615,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_retrieval_matrix_heldout(const a
 /**
  * @brief Writes the prepared collection (versioned little-endian binary format with a
  *        checksum, 4 + 8 * (12 + 4N + 2Np) bytes per shape, 1 KB more when the params close
- *        the inner distance's silhouette) to a temporary name in the same folder and renames
- *        it; amscr_db_load reads it and every earlier format version.
+ *        the inner distance's silhouette), whole before it takes its name (as
+ *        amscr_contour_write_text); amscr_db_load reads it and every earlier format version.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: const.
@@ -2984,7 +2985,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_set_group(amscr_index *x, siz
 AMSCR_API const char *amscr_index_group(const amscr_index *x, size_t i);
 
 /**
- * @brief Writes the index to a temporary name in the same folder and renames it: the
+ * @brief Writes the index, whole before it takes its name (as amscr_contour_write_text): the
  *        collection file format (amscr_db_load of it gives the collection) with an index
  *        section holding the lists, each shape's channel features (so a load does not rebuild
  *        them) and, with the inner graph, each shape's inner features (about 2.2 KB) and its

@@ -2,8 +2,10 @@
  * (amscr_db_query_retrieval): the exact query equals the query's row of the retrieval matrix
  * of the collection plus the query; an index query with every shape a candidate equals it;
  * member rows; file and memory round trips; damaged files; add; thread-count independence. */
+#define _GNU_SOURCE /* O_TMPFILE: whether the killed save could leave nothing behind */
 #include <amscr.h>
 #include <check.h>
+#include <fcntl.h>
 #include <dirent.h>
 #include <math.h>
 #include <pthread.h>
@@ -929,8 +931,8 @@ static unsigned char *file_bytes(const char *path, size_t *len)
 }
 
 /* A save cut off, by a full disk (the file-size limit: writes fail) or by the process killed
- * mid-write (SIGXFSZ's default), never replaces the good file, whose mode stays; the failed
- * save reports an I/O error. */
+ * mid-write (SIGXFSZ's default), never replaces the good file, whose mode stays, and leaves no
+ * temporary file where the directory takes unnamed ones; the failed save reports an I/O error. */
 START_TEST(cut_off_save)
 {
     amscr_params *p = params_of(1.0, 8, 2);
@@ -975,15 +977,25 @@ START_TEST(cut_off_save)
     remove(path);
     char tmpl[64];
     snprintf(tmpl, sizeof tmpl, "%s.tmp.", path + 5);
-    DIR *dir = opendir("/tmp"); /* the killed save's temporary file: cleaned up here */
+    int left = 0, unnamed = 0; /* the killed save's temporary file: none where the directory takes */
+#ifdef O_TMPFILE                  /* unnamed files (O_TMPFILE); elsewhere it is cleaned up here */
+    int probe = open("/tmp", O_TMPFILE | O_WRONLY, 0600);
+    unnamed = probe >= 0;
+    if (probe >= 0)
+        close(probe);
+#endif
+    DIR *dir = opendir("/tmp");
     for (struct dirent *e = dir ? readdir(dir) : NULL; e; e = readdir(dir))
         if (strncmp(e->d_name, tmpl, strlen(tmpl)) == 0) {
             char t[300];
             snprintf(t, sizeof t, "/tmp/%s", e->d_name);
             remove(t);
+            left++;
         }
     if (dir)
         closedir(dir);
+    if (unnamed)
+        ck_assert_int_eq(left, 0);
     amscr_index_free(x);
     amscr_params_free(p);
 }

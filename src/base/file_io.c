@@ -1,8 +1,11 @@
 /* file_io.c — whole files: read into memory, mapped read-only (no copy, the page cache's
- * pages; read where a file cannot be mapped), and written atomically (a temporary name, then a
- * rename, with the mode of file_mode.c). The collection and index files use them (db_io.c,
- * index_io.c). */
-#define _DEFAULT_SOURCE /* MAP_POPULATE, where the system has it */
+ * pages; read where a file cannot be mapped), and written atomically with the mode of
+ * file_mode.c: into an unnamed file of the target's directory (O_TMPFILE, where the system has
+ * it), named only once whole and on the disk, so a write cut off — the process killed, the disk
+ * full — leaves nothing behind and never replaces the file; elsewhere through a temporary name
+ * and a rename (a kill mid-write then leaves that temporary file). The collection, index and
+ * point-list files use them (db_io.c, index_io.c, contour_text.c). */
+#define _GNU_SOURCE /* O_TMPFILE, linkat; MAP_POPULATE, where the system has them */
 #include "internal.h"
 
 #include <errno.h>
@@ -15,32 +18,127 @@
 #include <sys/mman.h>
 #include <sys/stat.h>
 
+/* strerror, thread-safe: strerror_r in its GNU form (glibc under _GNU_SOURCE) or its XSI form. */
+static const char *errstr(int err, char *buf, size_t len)
+{
+#if defined(__GLIBC__)
+    return strerror_r(err, buf, len);
+#else
+    if (strerror_r(err, buf, len) != 0)
+        snprintf(buf, len, "error %d", err);
+    return buf;
+#endif
+}
+
+/* Writes all of buf to fd and flushes it to the disk; 0 with errno set when it cannot. */
+static int write_all(int fd, const unsigned char *buf, size_t len)
+{
+    while (len > 0) {
+        ssize_t w = write(fd, buf, len < ((size_t)1 << 30) ? len : ((size_t)1 << 30));
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            return 0;
+        buf += w;
+        len -= (size_t)w;
+    }
+    return fsync(fd) == 0 || errno == EINVAL || errno == EROFS;
+}
+
+/* Gives the written unnamed file fd the name path: a link when path is new, else a link under a
+ * fresh temporary name renamed over it (the name exists for the rename's instant). 0 with errno
+ * set when it cannot. */
+static int name_unnamed(int fd, const char *path, char *tmp, size_t tmp_len)
+{
+    char proc[64];
+    snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
+    if (linkat(AT_FDCWD, proc, AT_FDCWD, path, AT_SYMLINK_FOLLOW) == 0)
+        return 1;
+    if (errno != EEXIST)
+        return 0;
+    for (unsigned k = 0; k < 64; k++) { /* the pid and the descriptor make it unique; k skips strays */
+        snprintf(tmp, tmp_len, "%s.tmp.%ld.%d.%u", path, (long)getpid(), fd, k);
+        if (linkat(AT_FDCWD, proc, AT_FDCWD, tmp, AT_SYMLINK_FOLLOW) == 0) {
+            if (rename(tmp, path) == 0)
+                return 1;
+            int e = errno;
+            unlink(tmp);
+            errno = e;
+            return 0;
+        }
+        if (errno != EEXIST)
+            return 0;
+    }
+    return 0;
+}
+
+/* The directory of path, into dir (size len): "." when path has none. */
+static void dir_of(const char *path, char *dir, size_t len)
+{
+    const char *slash = strrchr(path, '/');
+    size_t n = slash ? (slash == path ? 1 : (size_t)(slash - path)) : 0;
+    snprintf(dir, len, "%.*s", n ? (int)n : 1, n ? path : ".");
+}
+
+/* The O_TMPFILE way: 1 when it wrote the file or failed where a temporary name would fail too
+ * (*st says which), 0 when the system has no unnamed files here (nothing was written). */
+static int write_unnamed(const char *path, const void *buf, size_t len, char *tmp, size_t tmp_len,
+                         amscr_status *st)
+{
+#ifdef O_TMPFILE
+    dir_of(path, tmp, tmp_len);
+    mode_t mode = (mode_t)amscr__file_mode(path);
+    int fd = open(tmp, O_TMPFILE | O_WRONLY | O_CLOEXEC, mode);
+    if (fd < 0)
+        return 0;
+    (void)fchmod(fd, mode); /* the umask applied at open; a replaced file's mode is kept whole */
+    char eb[128];
+    if (!write_all(fd, buf, len)) {
+        *st = amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, errstr(errno, eb, sizeof eb));
+        close(fd);
+        return 1;
+    }
+    int named = name_unnamed(fd, path, tmp, tmp_len), e = errno;
+    close(fd);
+    if (!named && (e == ENOENT || e == EPERM || e == EOPNOTSUPP || e == EXDEV))
+        return 0; /* no /proc, or no links here: the temporary name's way */
+    *st = named ? AMSCR_OK : amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, errstr(e, eb, sizeof eb));
+    return 1;
+#else
+    (void)path, (void)buf, (void)len, (void)tmp, (void)tmp_len, (void)st;
+    return 0;
+#endif
+}
+
+/* The temporary name's way: path.tmp.XXXXXX written, then renamed over path. */
+static amscr_status write_named(const char *path, const void *buf, size_t len, char *tmp, size_t tmp_len)
+{
+    char eb[128];
+    snprintf(tmp, tmp_len, "%s.tmp.XXXXXX", path);
+    int fd = mkstemp(tmp);
+    if (fd < 0)
+        return amscr__fail(AMSCR_E_IO, "%s: cannot create a temporary file: %s", path,
+                           errstr(errno, eb, sizeof eb));
+    (void)fchmod(fd, (mode_t)amscr__file_mode(path)); /* mkstemp made it 0600 (best effort) */
+    int ok = write_all(fd, buf, len), e = errno;
+    ok = close(fd) == 0 && ok;
+    if (ok && rename(tmp, path) != 0)
+        ok = 0, e = errno;
+    if (ok)
+        return AMSCR_OK;
+    unlink(tmp);
+    return amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, errstr(e, eb, sizeof eb));
+}
+
 amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t len)
 {
-    size_t plen = strlen(path);
-    char *tmp = malloc(plen + 16);
+    size_t tmp_len = strlen(path) + 64;
+    char *tmp = malloc(tmp_len);
     if (!tmp)
         return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", path);
-    memcpy(tmp, path, plen);
-    memcpy(tmp + plen, ".tmp.XXXXXX", 12);
     amscr_status st = AMSCR_OK;
-    int fd = mkstemp(tmp);
-    if (fd < 0) {
-        st = amscr__fail(AMSCR_E_IO, "%s: cannot create a temporary file: %s", path, strerror(errno));
-    } else {
-        (void)fchmod(fd, (mode_t)amscr__file_mode(path)); /* mkstemp made it 0600 (best effort) */
-        FILE *f = fdopen(fd, "wb");
-        int ok = f && fwrite(buf, 1, len, f) == len;
-        ok = ok && fflush(f) == 0 && fsync(fd) == 0; /* on the disk before it takes the name */
-        if (f)
-            ok = (fclose(f) == 0) && ok;
-        else
-            close(fd);
-        if (!ok || rename(tmp, path) != 0) {
-            st = amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, strerror(errno));
-            remove(tmp);
-        }
-    }
+    if (!write_unnamed(path, buf, len, tmp, tmp_len, &st))
+        st = write_named(path, buf, len, tmp, tmp_len);
     free(tmp);
     return st;
 }
@@ -58,7 +156,10 @@ amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out
 {
     FILE *f = fopen(path, "rb");
     if (!f)
-        return amscr__fail(AMSCR_E_IO, "%s: %s", path, strerror(errno));
+        {
+        char eb[128];
+        return amscr__fail(AMSCR_E_IO, "%s: %s", path, errstr(errno, eb, sizeof eb));
+    }
     size_t cap = file_size(f), len = 0;
     cap = cap ? cap + 1 : (size_t)1 << 16; /* one more byte: the end is seen without a second buffer */
     unsigned char *buf = malloc(cap);

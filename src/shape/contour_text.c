@@ -1,5 +1,7 @@
 /* contour_text.c — text point lists: reading, parsing from memory, atomic writing.
  *
+ * Written through amscr__file_write_atomic (file_io.c): the whole list or nothing.
+ *
  * Format: one point per line, "x y", "x,y", "x, y" or tab-separated; '#' starts a
  * comment anywhere on a line; blank lines are ignored; CRLF line ends are accepted.
  * Numbers are read with strtod (the "C" locale is assumed) and must be finite. */
@@ -10,8 +12,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 /* Thread-safe strerror (XSI strerror_r) into buf. */
 static const char *ct_errstr(int err, char *buf, size_t len)
@@ -215,50 +215,14 @@ amscr_status amscr_contour_write_text(const amscr_contour *c, const char *path)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_contour_write_text: empty contour");
     if (!amscr__all_finite(c->xy, 2 * c->n))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_contour_write_text: non-finite coordinate");
-    size_t plen = strlen(path);
-    static const char suffix[] = ".tmp.XXXXXX";
-    char *tmp = malloc(plen + sizeof suffix);
-    if (!tmp)
+    enum { LINE_MAX_CHARS = 2 * 24 + 2 }; /* two %.17g numbers (at most 24 characters each), ' ', '\n' */
+    char *buf = amscr__malloc_array(c->n + 1, LINE_MAX_CHARS); /* room for the last NUL */
+    if (!buf)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_write_text: out of memory");
-    memcpy(tmp, path, plen);
-    memcpy(tmp + plen, suffix, sizeof suffix);
-
-    char eb[128];
-    int fd = mkstemp(tmp);
-    if (fd < 0) {
-        amscr_status st = amscr__fail(AMSCR_E_IO, "%s: cannot create temporary file: %s", path,
-                                      ct_errstr(errno, eb, sizeof eb));
-        free(tmp);
-        return st;
-    }
-    /* mkstemp creates 0600; give the file ordinary permissions (best effort). */
-    (void)fchmod(fd, (mode_t)amscr__file_mode(path));
-    FILE *f = fdopen(fd, "w");
-    if (!f) {
-        int e = errno;
-        close(fd);
-        unlink(tmp);
-        free(tmp);
-        return amscr__fail(AMSCR_E_IO, "%s: %s", path, ct_errstr(e, eb, sizeof eb));
-    }
-    int err = 0;
-    errno = 0;
-    for (size_t i = 0; i < c->n && !err; i++)
-        if (fprintf(f, "%.17g %.17g\n", c->xy[2 * i], c->xy[2 * i + 1]) < 0)
-            err = errno ? errno : EIO;
-    if (!err && fflush(f) != 0)
-        err = errno ? errno : EIO;
-    if (!err && fsync(fileno(f)) != 0 && errno != EINVAL && errno != EROFS)
-        err = errno ? errno : EIO;
-    if (fclose(f) != 0 && !err)
-        err = errno ? errno : EIO;
-    if (!err && rename(tmp, path) != 0)
-        err = errno ? errno : EIO;
-    if (err) {
-        unlink(tmp);
-        free(tmp);
-        return amscr__fail(AMSCR_E_IO, "%s: write failed: %s", path, ct_errstr(err, eb, sizeof eb));
-    }
-    free(tmp);
-    return AMSCR_OK;
+    size_t len = 0;
+    for (size_t i = 0; i < c->n; i++)
+        len += (size_t)snprintf(buf + len, LINE_MAX_CHARS + 1, "%.17g %.17g\n", c->xy[2 * i], c->xy[2 * i + 1]);
+    amscr_status st = amscr__file_write_atomic(path, buf, len); /* the file's whole text, or nothing */
+    free(buf);
+    return st;
 }

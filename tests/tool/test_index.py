@@ -325,3 +325,54 @@ def test_affine_view_and_the_index(tmp_path):
     assert r.returncode != 0 and "affine" in r.stderr
     for bad in ("0.5", "101", "x", "-1"):
         assert run("search", q, m, "--affine-view", bad).returncode == 2
+
+
+def killed_run(*args, limit):
+    """Runs the tool with a file-size limit of `limit` bytes: a write beyond it kills the tool
+    (SIGXFSZ), as a full disk or a kill mid-write would cut a save off."""
+    import resource
+    import signal
+    import subprocess
+
+    from imgutil import tool_path
+
+    def cap():
+        signal.signal(signal.SIGXFSZ, signal.SIG_DFL)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+    return subprocess.run([tool_path()] + [str(a) for a in args], capture_output=True, preexec_fn=cap)
+
+
+@pytest.mark.parametrize("what", ["index", "matrix"])
+def test_a_killed_save_leaves_the_old_file_and_nothing_else(tmp_path, what):
+    """An index (the library's writer) or a matrix (the tool's) whose save is killed mid-write
+    leaves the file it would replace as it was and no temporary file beside it, where the
+    system has unnamed files (O_TMPFILE; Linux, most file systems)."""
+    m = make_manifest(tmp_path)
+    out = tmp_path / "out"
+    out.mkdir()
+    name = "x.idx" if what == "index" else "x.tsv"
+    args = ("index", m, "-o", out / name) if what == "index" else ("matrix", m, "-o", out / name, "--no-rerank")
+    assert run(*args).returncode == 0
+    good = (out / name).read_bytes()
+    assert len(good) > 1024
+    r = killed_run(*args, limit=len(good) // 2)
+    assert r.returncode == -signal_number("SIGXFSZ"), r.stderr
+    assert (out / name).read_bytes() == good
+    if unnamed_files(out):
+        assert sorted(os.listdir(out)) == [name]
+
+
+def signal_number(name):
+    import signal
+    return int(getattr(signal, name))
+
+
+def unnamed_files(d):
+    flag = getattr(os, "O_TMPFILE", None)
+    if flag is None:
+        return False
+    try:
+        os.close(os.open(str(d), flag | os.O_WRONLY, 0o600))
+        return True
+    except OSError:
+        return False

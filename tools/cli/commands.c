@@ -155,7 +155,7 @@ static const char HELP_INDEX[] =
     "take a collection with the same results, and one search never recomputes the\n"
     "collection's matrix (with a fused --channel-weight below 1 the query is scaled by\n"
     "the medians of the build). The file is versioned and checksummed, and written\n"
-    "under a temporary name then renamed. Index files of amscr before 0.4 are refused:\n"
+    "whole before it takes its name. Index files of amscr before 0.4 are refused:\n"
     "build them again.\n"
     "\n"
     "  -o, --output FILE       the index file\n"

@@ -1,4 +1,5 @@
 /* util.c — helpers of the amscr tool (see util.h). */
+#define _GNU_SOURCE /* O_TMPFILE, where the system has it */
 #include "util.h"
 
 #include <errno.h>
@@ -123,11 +124,58 @@ char *xstrdup(const char *s)
 }
 
 /* ----------------------------------------------------------- output files */
+/* An unnamed file in dir (O_TMPFILE, where the system has it and /proc names its descriptors:
+ * a write cut off leaves nothing behind), mode 0666 less the umask; -1 when there is none. */
+static int open_unnamed(const char *dir)
+{
+#ifdef O_TMPFILE
+    int fd = open(dir, O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+    char proc[64];
+    snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
+    if (fd >= 0 && access(proc, F_OK) != 0) {
+        close(fd);
+        fd = -1;
+    }
+    return fd;
+#else
+    (void)dir;
+    return -1;
+#endif
+}
+
+/* Gives the unnamed file fd the name o->path: a link when the path is new, else a link under a
+ * fresh temporary name (o->tmp) renamed over it. 0, or -1 with errno set. */
+static int name_unnamed(tool_out *o, int fd)
+{
+    char proc[64];
+    snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
+    if (linkat(AT_FDCWD, proc, AT_FDCWD, o->path, AT_SYMLINK_FOLLOW) == 0)
+        return 0;
+    for (unsigned k = 0; errno == EEXIST && k < 64; k++) {
+        snprintf(o->tmp, o->tmp_cap, "%s/.%s.%ld.%d.%u", o->dir, path_base(o->path), (long)getpid(), fd, k);
+        if (linkat(AT_FDCWD, proc, AT_FDCWD, o->tmp, AT_SYMLINK_FOLLOW) != 0)
+            continue;
+        if (rename(o->tmp, o->path) == 0)
+            return 0;
+        int e = errno;
+        unlink(o->tmp);
+        errno = e;
+        return -1;
+    }
+    return -1;
+}
+
+static void out_free(tool_out *o)
+{
+    free(o->tmp);
+    free(o->path);
+    free(o->dir);
+    o->tmp = o->path = o->dir = NULL;
+}
+
 int tool_out_open(tool_out *o, const char *path)
 {
-    o->fp = NULL;
-    o->tmp = NULL;
-    o->path = NULL;
+    memset(o, 0, sizeof *o);
     if (strcmp(path, "-") == 0) {
         o->fp = stdout;
         return 0;
@@ -137,42 +185,32 @@ int tool_out_open(tool_out *o, const char *path)
         tool_error(path, "is a directory");
         return -1;
     }
-    char *dir = path_dir(path);
-    if (dir == NULL)
-        return -1;
-    const char *base = path_base(path);
-    size_t n = strlen(dir) + strlen(base) + 16;
-    o->tmp = xmalloc_array(n, 1);
+    o->dir = path_dir(path);
+    o->tmp_cap = o->dir ? strlen(o->dir) + strlen(path_base(path)) + 64 : 0;
+    o->tmp = o->dir ? xmalloc_array(o->tmp_cap, 1) : NULL;
     o->path = xstrdup(path);
     if (o->tmp == NULL || o->path == NULL) {
-        free(dir);
-        free(o->tmp);
-        free(o->path);
-        o->tmp = o->path = NULL;
+        out_free(o);
         return -1;
     }
-    snprintf(o->tmp, n, "%s/.%s.XXXXXX", dir, base);
-    free(dir);
-    int fd = mkstemp(o->tmp);
+    int fd = open_unnamed(o->dir);
+    o->unnamed = fd >= 0;
     if (fd < 0) {
-        tool_error(path, "cannot create output file: %s", strerror(errno));
-        free(o->tmp);
-        free(o->path);
-        o->tmp = o->path = NULL;
-        return -1;
+        snprintf(o->tmp, o->tmp_cap, "%s/.%s.XXXXXX", o->dir, path_base(path));
+        fd = mkstemp(o->tmp);
+        mode_t mask = umask(0); /* mkstemp makes 0600; give the usual 0666 & ~umask */
+        umask(mask);
+        if (fd >= 0)
+            (void)fchmod(fd, 0666 & ~mask);
     }
-    /* mkstemp makes 0600; give the usual 0666 & ~umask. */
-    mode_t mask = umask(0);
-    umask(mask);
-    (void)fchmod(fd, 0666 & ~mask);
-    o->fp = fdopen(fd, "wb");
+    o->fp = fd >= 0 ? fdopen(fd, "wb") : NULL;
     if (o->fp == NULL) {
         tool_error(path, "cannot create output file: %s", strerror(errno));
-        close(fd);
-        unlink(o->tmp);
-        free(o->tmp);
-        free(o->path);
-        o->tmp = o->path = NULL;
+        if (fd >= 0)
+            close(fd);
+        if (fd >= 0 && !o->unnamed)
+            unlink(o->tmp);
+        out_free(o);
         return -1;
     }
     return 0;
@@ -182,7 +220,7 @@ int tool_out_commit(tool_out *o)
 {
     if (o->fp == NULL)
         return -1;
-    if (o->tmp == NULL) { /* stdout */
+    if (o->path == NULL) { /* stdout */
         int bad = fflush(o->fp) != 0 || ferror(o->fp);
         o->fp = NULL;
         if (bad) {
@@ -193,35 +231,36 @@ int tool_out_commit(tool_out *o)
     }
     int bad = fflush(o->fp) != 0 || ferror(o->fp);
     int err = errno;
+    if (!bad && o->unnamed && name_unnamed(o, fileno(o->fp)) != 0) {
+        bad = 1;
+        err = errno;
+    }
     if (fclose(o->fp) != 0 && !bad) {
         bad = 1;
         err = errno;
     }
     o->fp = NULL;
-    if (!bad && rename(o->tmp, o->path) != 0) {
+    if (!bad && !o->unnamed && rename(o->tmp, o->path) != 0) {
         bad = 1;
         err = errno;
     }
     if (bad) {
         tool_error(o->path, "cannot write output file: %s", strerror(err));
-        unlink(o->tmp);
+        if (!o->unnamed)
+            unlink(o->tmp);
     }
-    free(o->tmp);
-    free(o->path);
-    o->tmp = o->path = NULL;
+    out_free(o);
     return bad ? -1 : 0;
 }
 
 void tool_out_abort(tool_out *o)
 {
-    if (o->fp != NULL && o->tmp != NULL)
+    if (o->fp != NULL && o->path != NULL)
         fclose(o->fp);
-    if (o->tmp != NULL)
+    if (o->path != NULL && !o->unnamed)
         unlink(o->tmp);
-    free(o->tmp);
-    free(o->path);
+    out_free(o);
     o->fp = NULL;
-    o->tmp = o->path = NULL;
 }
 
 /* ------------------------------------------------------------ strings */

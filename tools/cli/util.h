@@ -43,13 +43,17 @@ void *xcalloc_array(size_t n, size_t size);
 char *xstrdup(const char *s);
 
 /* ----------------------------------------------------------- output files */
-/* An output written to a temporary file in the destination's folder and renamed over
- * the destination on commit, so a failure never leaves a partial file. Path "-" means
- * stdout (no temporary). */
+/* An output written to an unnamed file in the destination's folder (O_TMPFILE), named on
+ * commit — where the system has none, to a temporary file renamed over the destination — so a
+ * failure never leaves a partial file, and a kill mid-write none at all. Path "-" means stdout
+ * (no temporary). */
 typedef struct tool_out {
     FILE *fp;
-    char *tmp;   /* temporary path, NULL for stdout */
-    char *path;  /* final path */
+    char *tmp;      /* temporary path (or room for one), NULL for stdout */
+    size_t tmp_cap; /* its size */
+    char *path;     /* final path, NULL for stdout */
+    char *dir;      /* its folder */
+    int unnamed;    /* fp is an unnamed file */
 } tool_out;
 
 /* Opens; on failure prints the error (naming `path`) and returns -1. */
