@@ -211,7 +211,7 @@ def parse_points(text: Union[str, bytes]) -> np.ndarray:
 
 
 def write_points(path: Union[str, os.PathLike], points: ArrayLike) -> None:
-    """Writes points as a text point list, atomically (temporary file + rename).
+    """Writes points as a text point list, atomically (whole before it takes its name).
 
     Args:
         path: the file to write.
