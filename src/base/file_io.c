@@ -155,11 +155,9 @@ static size_t file_size(FILE *f)
 amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out_len)
 {
     FILE *f = fopen(path, "rb");
+    char eb[128];
     if (!f)
-        {
-        char eb[128];
         return amscr__fail(AMSCR_E_IO, "%s: %s", path, errstr(errno, eb, sizeof eb));
-    }
     size_t cap = file_size(f), len = 0;
     cap = cap ? cap + 1 : (size_t)1 << 16; /* one more byte: the end is seen without a second buffer */
     unsigned char *buf = malloc(cap);
