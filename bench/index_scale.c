@@ -325,12 +325,17 @@ static void part_scale(const amscr_params *p, const shape_set *s, size_t n)
     }
     search_cost(x, BUILD_M, sc);
     double cmed = median(ctimes, NQ_SCALE), cp90 = ctimes[NQ_SCALE * 9 / 10]; /* sorted by median() */
+    char load[48] = "not run", scan[48] = "no quantizer (the same query)";
+    if (!isnan(tl))
+        snprintf(load, sizeof load, "%.2f s, %.0f MB", tl, mb);
+    if (ivf.nc)
+        snprintf(scan, sizeof scan, "%.1f %% / %.0f %%", 100.0 * (double)scan_in / (TOP * NQ_SCALE),
+                 100.0 * (double)scan_first / NQ_SCALE);
     printf("| warped copies | %zu | %zu | %.1f s (%.1f) | %.0f MB | %.1f KB | %.0f + %.0f + %.0f + %.0f B | %.0f B | "
-           "%.2f s, %.0f MB | %.1f ms (%.1f; p90 %.1f) | %.1f %% / %.0f %% | %.1f %% / %.0f %% | %.3f / %.3f ms, %.1f %% "
-           "|\n", n, M, tb[0], tb[1], peak, per_shape, ib[0], ib[1], ib[2], ib[3], prepared, tl, mb,
-           1e3 * median(times, NQ_SCALE), 1e3 * cmed, 1e3 * cp90, 100.0 * (double)top_in / (double)(TOP * NQ_EXACT),
-           100.0 * (double)same_first / (double)NQ_EXACT, ivf.nc ? 100.0 * (double)scan_in / (TOP * NQ_SCALE) : NAN,
-           ivf.nc ? 100.0 * (double)scan_first / NQ_SCALE : NAN, sc[0], sc[1], sc[2]);
+           "%s | %.1f ms (%.1f; p90 %.1f) | %.1f %% / %.0f %% | %s | %.3f / %.3f ms, %.1f %% |\n", n, M, tb[0], tb[1],
+           peak, per_shape, ib[0], ib[1], ib[2], ib[3], prepared, load, 1e3 * median(times, NQ_SCALE), 1e3 * cmed,
+           1e3 * cp90, 100.0 * (double)top_in / (double)(TOP * NQ_EXACT), 100.0 * (double)same_first / (double)NQ_EXACT,
+           scan, sc[0], sc[1], sc[2]);
     fflush(stdout);
     amscr_index_free(x);
     amscr_db_free(db);
