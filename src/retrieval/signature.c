@@ -79,12 +79,15 @@ void amscr__sig_quantize(const float *sig, uint16_t *q, int32_t *e)
     }
 }
 
-void amscr__sig_dequantize(const uint16_t *q, int32_t e, float *out)
+/* n values of q at the scale 2^e into out. */
+static void dequantize_n(const uint16_t *q, int32_t e, size_t n, float *out)
 {
     float s = ldexpf(1.0f, e);
-    for (size_t t = 0; t < AMSCR__SIG_DIM; t++)
+    for (size_t t = 0; t < n; t++)
         out[t] = (float)q[t] * s;
 }
+
+void amscr__sig_dequantize(const uint16_t *q, int32_t e, float *out) { dequantize_n(q, e, AMSCR__SIG_DIM, out); }
 
 /* Frequencies k0..k1-1 of the distance's sums into same / mirror, a's from frequency k0 on (one
  * sum a bin: the loop vectorizes). */
@@ -126,10 +129,7 @@ static const float *row_block(const amscr__sig_rows *R, size_t i, size_t k0, siz
 {
     if (R->f)
         return R->f + i * AMSCR__SIG_DIM + k0 * BLOCK;
-    const uint16_t *q = R->q + i * AMSCR__SIG_DIM + k0 * BLOCK;
-    float s = ldexpf(1.0f, R->e[i]);
-    for (size_t t = 0; t < (k1 - k0) * BLOCK; t++)
-        buf[t] = (float)q[t] * s;
+    dequantize_n(R->q + i * AMSCR__SIG_DIM + k0 * BLOCK, R->e[i], (k1 - k0) * BLOCK, buf);
     return buf;
 }
 
