@@ -17,14 +17,15 @@ every shard's shapes, or with its share of the query's M signature-nearest, on i
 ``amscr_index_graph_member_scores``): the scores are those of ``amscr.Index(collection,
 candidates=M).scores(query, candidates=M)``.
 
-A saved set is a directory of ordinary index files, the global lists and a manifest
-(:mod:`amscr._shard_files`).
+What the workers compute is :mod:`amscr._shard_tasks`; the global lists are made from it by
+:mod:`amscr._shard_build`. A saved set is a directory of ordinary index files, the global lists
+and a manifest (:mod:`amscr._shard_files`).
 """
 from __future__ import annotations
 
 import io
 import os
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -35,11 +36,11 @@ from .errors import AmscrError, FormatError, InvalidArgumentError, _check
 from .index import Index
 from .params import Params
 from .shape import Shape
-from ._placement import _block, _threads_by_host, _tile_threads
+from ._placement import _block, _threads_by_host
+from ._shard_build import _merge_lists, _shortlist_lists, widths
 from ._shard_files import ShardSetError, read_set, write_set
-
-SHARD_LIST = 16  # the shortlist of a shard's own (local) lists: they serve only the shard opened alone
-QPOS_AFTER = 2 ** 64 - 1  # SIZE_MAX: the query after every shape
+from ._shard_tasks import (QPOS_AFTER, _index_bytes, _members, _pair_block, _query_block, _shard_from_file_bytes,
+                           _shard_index, _shortlists, _signatures)
 
 PathLike = Union[str, 'os.PathLike[str]']
 
@@ -116,304 +117,7 @@ class _Graph:
                        float(z['dmax2']))
 
 
-def widths(params: Params, n: int) -> Tuple[int, int]:
-    """(k, k2): the base and inner lists' entries a shape for n shapes (C ``amscr_index_graph_widths``)."""
-    k, k2 = ffi.new('size_t *'), ffi.new('size_t *')
-    lib.amscr_index_graph_widths(params._p, n, k, k2)
-    return int(k[0]), int(k2[0])
-
-
-# ========================================================================== worker side
-def _threads(threads) -> int:
-    return _tile_threads(threads)
-
-
-def _shard_index(data: bytes, threads) -> Index:
-    """Shard from its collection's bytes: an ordinary index (local lists from a short shortlist)."""
-    coll = Collection.from_bytes(data)
-    t = _threads(threads)
-    if coll.params.threads != t:
-        coll = _block(coll, 0, len(coll), t)
-    return Index(coll, progress=False, candidates=SHARD_LIST if len(coll) > SHARD_LIST + 1 else 0)
-
-
-def _shard_from_file_bytes(data: bytes) -> Index:
-    return Index.from_bytes(data)  # computes on the threads the shard was built with
-
-
-def _index_bytes(index: Index) -> bytes:
-    return index.to_bytes()
-
-
-def _distances(index: Index, qdb, count: int, where: str) -> Tuple[np.ndarray, np.ndarray]:
-    """Base and inner distances (count x len(index)) of shapes 0..count-1 of C db qdb, which come
-    (`where`) 'after' every shape of the index (queries), 'before' them (an earlier block), or are
-    the index's own shapes ('diagonal': each pair computed once and mirrored)."""
-    diagonal = where == 'diagonal'
-    qpos = {'after': QPOS_AFTER, 'before': 0, 'diagonal': None}[where]
-    m = len(index)
-    D = np.zeros((count, m), dtype=np.float64)
-    D2 = np.zeros((count, m), dtype=np.float64)
-    with index._lock.read():
-        for i in range(count):
-            first = i + 1 if diagonal else 0
-            _check(lib.amscr_index_pair_distances(index._x, lib.amscr_db_descriptor(qdb, i),
-                                                  i if diagonal else qpos, first,
-                                                  dbuf(D[i, first:]), dbuf(D2[i, first:]), m - first))
-    if diagonal:
-        D += D.T
-        D2 += D2.T
-    return D, D2
-
-
-def _best(D: np.ndarray, cols0: int, k: int, self0: Optional[int]) -> Tuple[np.ndarray, np.ndarray]:
-    """Each row's k best (distance, column) among D's columns (numbered from cols0), a row's own
-    column (self0 + row) left out."""
-    m, c = D.shape
-    cols = np.broadcast_to(np.arange(cols0, cols0 + c, dtype=np.int64), (m, c))
-    key = D.copy()
-    if self0 is not None:
-        r = np.arange(m)
-        key[r, self0 + r - cols0] = np.inf
-    order = np.lexsort((cols, key), axis=-1)[:, :k]
-    idx = np.take_along_axis(cols, order, 1)
-    dist = np.take_along_axis(key, order, 1)
-    return idx, dist
-
-
-def _pair_block(rows_data: bytes, index: Index, r0: int, c0: int, k: int, k2: int) -> Dict[str, Any]:
-    """Block (rows of shard s, columns of shard t), s <= t, on shard t's worker: each row's and
-    (s < t) each column's best candidates under both distances, and the block's largest ones."""
-    same = r0 == c0
-    rows = index if same else Collection.from_bytes(rows_data)
-    qdb = lib.amscr_index_db(index._x) if same else rows._db
-    count = len(index) if same else len(rows)
-    D, D2 = _distances(index, qdb, count, 'diagonal' if same else 'before')
-    out: Dict[str, Any] = {'dmax': float(D.max(initial=0.0)), 'dmax2': float(D2.max(initial=0.0))}
-    out['rows'] = (_best(D, c0, k, r0 if same else None), _best(D2, c0, k2, r0 if same else None))
-    if not same:
-        out['cols'] = (_best(D.T, r0, k, None), _best(D2.T, r0, k2, None))
-    return out
-
-
-def _members(index: Index, qdata: bytes) -> List[int]:
-    """Each query's member in a shard (C ``amscr_index_find_member``), -1 for none."""
-    q = Collection.from_bytes(qdata)
-    out = ffi.new('size_t *')
-    res = []
-    with index._lock.read():
-        for i in range(len(q)):
-            _check(lib.amscr_index_find_member(index._x, lib.amscr_db_descriptor(q._db, i), out))
-            res.append(-1 if out[0] == ffi.cast('size_t', -1) else int(out[0]))
-    return res
-
-
-def _signatures(index: Index) -> np.ndarray:
-    """A shard's signatures (len x amscr_signature_size floats, C ``amscr_index_signatures``)."""
-    d = int(lib.amscr_signature_size())
-    out = np.zeros((len(index), d), dtype=np.float32)
-    with index._lock.read():
-        _check(lib.amscr_index_signatures(index._x, ffi.from_buffer('float[]', out) if out.size else ffi.NULL,
-                                          out.size))
-    return out
-
-
-def _shortlists(sigs: np.ndarray, qsigs: np.ndarray, first: int, m: int, threads) -> np.ndarray:
-    """Each query's m signature-nearest of sigs (C ``amscr_signature_shortlists``); query r is shape
-    first + r of sigs (left out), or a new shape (first QPOS_AFTER)."""
-    nq = len(qsigs)
-    out = np.zeros((nq, m), dtype=np.uintp)
-    if nq == 0:
-        return out.astype(np.int64)
-    sigs = np.ascontiguousarray(sigs, dtype=np.float32)
-    qsigs = np.ascontiguousarray(qsigs, dtype=np.float32)
-    _check(lib.amscr_signature_shortlists(ffi.from_buffer('float[]', sigs), len(sigs), ffi.from_buffer('float[]', qsigs),
-                                          nq, first, m, _threads(threads), ffi.from_buffer('size_t[]', out), out.size))
-    return out.astype(np.int64)
-
-
-def _pairs_at(rows_data: Optional[bytes], index: Index, a: np.ndarray, b: np.ndarray, qpos: Optional[int],
-              base: bool, inner: bool) -> Tuple[np.ndarray, np.ndarray]:
-    """Distances of pairs (a[t], b[t]) on shard b's worker: a local to the rows' block (rows_data's
-    collection, or the shard itself when rows_data is None: then a < b and qpos is a), b local to
-    the shard, a ascending. qpos: QPOS_AFTER (queries), 0 (an earlier block), None (the shard's own)
-    or an array (each pair's)."""
-    m = len(a)
-    D = np.zeros(m, dtype=np.float64)
-    D2 = np.zeros(m, dtype=np.float64)
-    if m == 0:
-        return D, D2
-    rows = None if rows_data is None else Collection.from_bytes(rows_data)
-    with index._lock.read():
-        qdb = lib.amscr_index_db(index._x) if rows is None else rows._db
-        starts = np.flatnonzero(np.r_[True, a[1:] != a[:-1]])
-        ends = np.r_[starts[1:], m]
-        for lo, hi in zip(starts, ends):
-            i = int(a[lo])
-            qp = i if qpos is None else int(qpos[lo]) if isinstance(qpos, np.ndarray) else qpos
-            order = np.argsort(b[lo:hi], kind='stable')
-            cand = np.ascontiguousarray(b[lo:hi][order], dtype=np.uintp)
-            db_ = np.zeros(hi - lo)
-            di_ = np.zeros(hi - lo)
-            _check(lib.amscr_index_pair_distances_at(index._x, lib.amscr_db_descriptor(qdb, i),
-                                                     qp, ffi.from_buffer('size_t[]', cand),
-                                                     hi - lo, dbuf(db_) if base else ffi.NULL,
-                                                     dbuf(di_) if inner else ffi.NULL))
-            D[lo:hi][order] = db_
-            D2[lo:hi][order] = di_
-    return D, D2
-
-
-def _query_block(index: Index, qdata: bytes, a=None, b=None, qpos=None):
-    """The queries' base and inner distances to every shape of a shard (queries after every shape),
-    or (a, b given) to shapes b[t] of the shard for query a[t] only (qpos: each pair's position of
-    the query, for members; then base distances only)."""
-    if a is not None:
-        return _pairs_at(qdata, index, a, b, QPOS_AFTER if qpos is None else qpos, True, qpos is None)
-    q = Collection.from_bytes(qdata)
-    return _distances(index, q._db, len(q), 'after')
-
-
-# ========================================================================== client side
-def _merge_lists(parts: List[Tuple[np.ndarray, np.ndarray]], r0: int, n: int, k: int) -> Tuple[np.ndarray, np.ndarray]:
-    """Lists of rows r0..r0+n-1 from their candidates: itself first, then k - 1 by (distance, index)."""
-    idx = np.zeros((n, k), dtype=np.uint32)
-    dist = np.zeros((n, k), dtype=np.float64)
-    if k == 0:
-        return idx, dist
-    ci = np.concatenate([p[0] for p in parts], axis=1)
-    cd = np.concatenate([p[1] for p in parts], axis=1)
-    order = np.lexsort((ci, cd), axis=-1)[:, :k - 1]
-    idx[:, 0] = np.arange(r0, r0 + n)
-    idx[:, 1:] = np.take_along_axis(ci, order, 1)
-    dist[:, 1:] = np.take_along_axis(cd, order, 1)
-    return idx, dist
-
-
-class _Store:
-    """Pair distances by key a * n + b (a < b), kept sorted."""
-
-    def __init__(self):
-        self.keys = np.zeros(0, dtype=np.int64)
-        self.vals = np.zeros(0, dtype=np.float64)
-
-    def missing(self, keys: np.ndarray) -> np.ndarray:
-        keys = np.unique(keys)
-        pos = np.searchsorted(self.keys, keys)
-        found = (pos < len(self.keys)) & (self.keys[np.minimum(pos, len(self.keys) - 1)] == keys) if len(self.keys) \
-            else np.zeros(len(keys), dtype=bool)
-        return keys[~found]
-
-    def add(self, keys: np.ndarray, vals: np.ndarray) -> None:
-        k = np.concatenate([self.keys, keys])
-        order = np.argsort(k, kind='stable')
-        self.keys, self.vals = k[order], np.concatenate([self.vals, vals])[order]
-
-    def get(self, keys: np.ndarray) -> np.ndarray:
-        return self.vals[np.searchsorted(self.keys, keys)]
-
-
-def _keys(i: np.ndarray, j: np.ndarray, n: int) -> np.ndarray:
-    i, j = np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64)
-    return np.minimum(i, j) * n + np.maximum(i, j)
-
-
-def _knn(i: int, cj: np.ndarray, cd: np.ndarray, k: int) -> Tuple[np.ndarray, np.ndarray]:
-    """Row i's list: itself first, then its k - 1 nearest of cj by (distance, index)."""
-    order = np.lexsort((cj, cd))[:k - 1]
-    return np.r_[i, cj[order]], np.r_[0.0, cd[order]]
-
-
-def _shortlist_lists(client, params: Params, n: int, bounds, rows, idx, placed, mb: int, th):
-    """The global lists of a shortlist build, as amscr_index_build(candidates) computes them: each
-    shape matched with its mb signature-nearest shapes of the whole collection, then with its
-    neighbours' neighbours (the base lists, then the inner lists from the shortlist and the base
-    list, refined the same way). Each round's pairs are computed once, on the worker holding the
-    later shape's shard. Returns the graph's arrays, the signatures and the pairs matched."""
-    k, k2 = widths(params, n)
-    starts = np.array([lo for lo, _ in bounds], dtype=np.int64)
-    sigs = np.concatenate(client.gather([client.submit(_signatures, idx[s], pure=False, workers=[placed[s]])
-                                         for s in range(len(bounds))]))
-    sf = client.scatter(sigs, broadcast=True, hash=False)
-    S = np.concatenate(client.gather([client.submit(_shortlists, sf, sigs[lo:hi], lo, mb, th, pure=False,
-                                                    workers=[placed[s]]) for s, (lo, hi) in enumerate(bounds)]))
-    base, inner = _Store(), _Store()
-
-    def run(keys: np.ndarray, want_base: bool, want_inner: bool) -> None:
-        keys = np.unique(keys)
-        if len(keys) == 0:
-            return
-        a, b = keys // n, keys % n
-        sa, sb = np.searchsorted(starts, a, 'right') - 1, np.searchsorted(starts, b, 'right') - 1
-        groups, futs = [], []
-        for s, t in sorted(set(zip(sa.tolist(), sb.tolist()))):
-            sel = np.flatnonzero((sa == s) & (sb == t))
-            groups.append(sel)
-            futs.append(client.submit(_pairs_at, None if s == t else rows[s], idx[t], a[sel] - starts[s],
-                                      b[sel] - starts[t], None if s == t else 0, want_base, want_inner,
-                                      pure=False, workers=[placed[t]]))
-        D, D2 = np.zeros(len(keys)), np.zeros(len(keys))
-        for sel, (d, d2) in zip(groups, client.gather(futs)):
-            D[sel], D2[sel] = d, d2
-        if want_base:
-            base.add(keys, D)
-        if want_inner:
-            inner.add(keys, D2)
-
-    ii = np.repeat(np.arange(n, dtype=np.int64), mb).reshape(n, mb)
-    run(_keys(ii, S, n).ravel(), True, k2 > 0)
-    nb_idx = np.zeros((n, k), dtype=np.int64)
-    nb_dist = np.zeros((n, k))
-    if k > 0:
-        D = base.get(_keys(ii, S, n))
-        for i in range(n):
-            nb_idx[i], nb_dist[i] = _knn(i, S[i], D[i], k)
-    if k >= 3:  # the refinement by the neighbours' neighbours (index_refine.c)
-        R = []
-        for i in range(n):
-            c = np.unique(nb_idx[nb_idx[i, 1:], 1:])
-            R.append(np.setdiff1d(c[c != i], S[i], assume_unique=True))
-        run(base.missing(np.concatenate([_keys(np.full(len(r), i), r, n) for i, r in enumerate(R)])), True, False)
-        new_idx, new_dist = nb_idx.copy(), nb_dist.copy()
-        for i in range(n):
-            cj = np.r_[nb_idx[i, 1:], R[i]]
-            new_idx[i], new_dist[i] = _knn(i, cj, np.r_[nb_dist[i, 1:], base.get(_keys(np.full(len(R[i]), i), R[i], n))],
-                                           k)
-        nb_idx, nb_dist = new_idx, new_dist
-    dmax = float(base.vals.max(initial=0.0))
-    in_idx = np.zeros((n, k2), dtype=np.int64)
-    in_dist = np.zeros((n, k2))
-    dmax2 = 0.0
-    if k2 > 0:  # the inner lists: the shortlist and the base list (index_inner.c), then refined
-        C = [np.r_[S[i], np.setdiff1d(nb_idx[i, 1:], S[i])] for i in range(n)]
-        run(inner.missing(np.concatenate([_keys(np.full(len(c), i), c, n) for i, c in enumerate(C)])), False, True)
-        for i in range(n):
-            d = inner.get(_keys(np.full(len(C[i]), i), C[i], n))
-            dmax2 = max(dmax2, float(d.max(initial=0.0)))
-            in_idx[i], in_dist[i] = _knn(i, C[i], d, k2)
-        if k2 > 2:
-            R = []
-            for i in range(n):
-                seen = set(in_idx[i, 1:].tolist())
-                r = []
-                for l in in_idx[in_idx[i, 1:], 1:].ravel().tolist():
-                    if l != i and l not in seen:
-                        seen.add(l)
-                        r.append(l)
-                R.append(np.array(r, dtype=np.int64))
-            run(inner.missing(np.concatenate([_keys(np.full(len(r), i), r, n) for i, r in enumerate(R)])), False,
-                True)
-            new_idx, new_dist = in_idx.copy(), in_dist.copy()
-            for i in range(n):
-                d = inner.get(_keys(np.full(len(R[i]), i), R[i], n))
-                dmax2 = max(dmax2, float(d.max(initial=0.0)))
-                new_idx[i], new_dist[i] = _knn(i, np.r_[in_idx[i, 1:], R[i]], np.r_[in_dist[i, 1:], d], k2)
-            in_idx, in_dist = new_idx, new_dist
-    sf.release()
-    pairs = len(np.union1d(base.keys, inner.keys))
-    return (nb_idx, nb_dist, in_idx, in_dist, dmax, dmax2), sigs, pairs
-
-
+# ========================================================================== the set (client)
 def _bounds(n: int, shards: int) -> List[Tuple[int, int]]:
     b = [n * s // shards for s in range(shards + 1)]
     return [(b[s], b[s + 1]) for s in range(shards)]
