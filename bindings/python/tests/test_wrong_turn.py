@@ -1,6 +1,6 @@
 """A near-symmetric source whose damaged target drew the registration onto another of its turns
 (bench/registration_traced.py --families, procedural shapes): the map is off by a turn, and the
-confidence must say so. Each of the source's own turns, composed with the map and refined on the
+confidence must say so. One of the source's own turns, composed with the map and refined on the
 target, fits the target clearly better than the map itself: the symmetry ambiguity reads 1 and
 the confidence 0. Before, these pairs read 0.32-0.85. Skipped without OpenCV or scikit-image."""
 import os
