@@ -338,7 +338,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_parse_text(const char *text
  * @brief Writes a contour as a text point list ("%.17g %.17g" per line). The file is
  *        written whole before it takes its name (an unnamed file of the folder, O_TMPFILE,
  *        linked in; where the system has none, a temporary name renamed), so a failure never
- *        leaves a partial file (since 0.17, a killed process none at all with unnamed files).
+ *        leaves a partial file (and, with unnamed files, a killed process leaves none at all).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, non-finite coordinates); AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: const.
@@ -2171,8 +2171,8 @@ AMSCR_API double amscr_result_threshold(const amscr_result *r);
  *        samples found no target boundary near them, the
  *        registered regions overlap little, or the target registered back onto the source on
  *        its own does not undo the map. Reject maps below 0.25. It flags wrong maps, not small
- *        biases (a map 3 % of the size off can still read high). Before 0.14 the value was
- *        (1 - ambiguity) x inlier fraction; partial matches keep that value.
+ *        biases (a map a few percent of the size off can still read high). A partial match
+ *        (no region, no way back) reads (1 - ambiguity) x inlier fraction.
  * @return the value; NaN for NULL.
  * Ownership: none.
  * Thread-safety: const.
@@ -2218,7 +2218,7 @@ AMSCR_API double amscr_result_backward_error(const amscr_result *r);
  *        value is the largest ratio of the chosen map's cost to such an alternative's, as in
  *        amscr_result_ambiguity (both refined to convergence, the two-way trimmed
  *        closest-point cost). 1: a symmetric turn of the source explains the damaged target
- *        exactly as well (a 4-armed cross with one arm cut), or (since 0.17) any other of the
+ *        exactly as well (a 4-armed cross with one arm cut), or any other of the
  *        source's own turns, composed and refined alike, fits the target clearly better than
  *        the chosen map (below 0.9 times its cost: the map is not the best fit of a
  *        near-symmetric source); 0: the source has no symmetry, or none fits. The confidence
