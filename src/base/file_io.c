@@ -18,8 +18,8 @@
 #include <sys/mman.h>
 #include <sys/stat.h>
 
-/* strerror, thread-safe: strerror_r in its GNU form (glibc under _GNU_SOURCE) or its XSI form. */
-static const char *errstr(int err, char *buf, size_t len)
+/* strerror_r in its GNU form (glibc under _GNU_SOURCE) or its XSI form. */
+const char *amscr__errstr(int err, char *buf, size_t len)
 {
 #if defined(__GLIBC__)
     return strerror_r(err, buf, len);
@@ -94,7 +94,7 @@ static int write_unnamed(const char *path, const void *buf, size_t len, char *tm
     (void)fchmod(fd, mode); /* the umask applied at open; a replaced file's mode is kept whole */
     char eb[128];
     if (!write_all(fd, buf, len)) {
-        *st = amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, errstr(errno, eb, sizeof eb));
+        *st = amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, amscr__errstr(errno, eb, sizeof eb));
         close(fd);
         return 1;
     }
@@ -102,7 +102,7 @@ static int write_unnamed(const char *path, const void *buf, size_t len, char *tm
     close(fd);
     if (!named && (e == ENOENT || e == EPERM || e == EOPNOTSUPP || e == EXDEV))
         return 0; /* no /proc, or no links here: the temporary name's way */
-    *st = named ? AMSCR_OK : amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, errstr(e, eb, sizeof eb));
+    *st = named ? AMSCR_OK : amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, amscr__errstr(e, eb, sizeof eb));
     return 1;
 #else
     (void)path, (void)buf, (void)len, (void)tmp, (void)tmp_len, (void)st;
@@ -118,7 +118,7 @@ static amscr_status write_named(const char *path, const void *buf, size_t len, c
     int fd = mkstemp(tmp);
     if (fd < 0)
         return amscr__fail(AMSCR_E_IO, "%s: cannot create a temporary file: %s", path,
-                           errstr(errno, eb, sizeof eb));
+                           amscr__errstr(errno, eb, sizeof eb));
     (void)fchmod(fd, (mode_t)amscr__file_mode(path)); /* mkstemp made it 0600 (best effort) */
     int ok = write_all(fd, buf, len), e = errno;
     ok = close(fd) == 0 && ok;
@@ -127,7 +127,7 @@ static amscr_status write_named(const char *path, const void *buf, size_t len, c
     if (ok)
         return AMSCR_OK;
     unlink(tmp);
-    return amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, errstr(e, eb, sizeof eb));
+    return amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, amscr__errstr(e, eb, sizeof eb));
 }
 
 amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t len)
@@ -157,7 +157,7 @@ amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out
     FILE *f = fopen(path, "rb");
     char eb[128];
     if (!f)
-        return amscr__fail(AMSCR_E_IO, "%s: %s", path, errstr(errno, eb, sizeof eb));
+        return amscr__fail(AMSCR_E_IO, "%s: %s", path, amscr__errstr(errno, eb, sizeof eb));
     size_t cap = file_size(f), len = 0;
     cap = cap ? cap + 1 : (size_t)1 << 16; /* one more byte: the end is seen without a second buffer */
     unsigned char *buf = malloc(cap);

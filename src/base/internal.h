@@ -302,7 +302,10 @@ unsigned amscr__resolve_threads(unsigned requested);
 
 /* The mode of a file written to path (file_mode.c): the replaced file's, else 0666 & ~umask. */
 unsigned amscr__file_mode(const char *path);
-/* Whole files (file_io.c). buf written to path through a temporary name and a rename. */
+/* strerror, thread-safe: the message of errno value err, in buf (size len) or static (file_io.c). */
+const char *amscr__errstr(int err, char *buf, size_t len);
+/* Whole files (file_io.c). buf written to path whole before it takes its name (an unnamed
+ * O_TMPFILE file linked in, else a temporary name renamed). */
 amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t len);
 /* The whole file at path (caller frees *out). */
 amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out_len);

@@ -13,14 +13,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Thread-safe strerror (XSI strerror_r) into buf. */
-static const char *ct_errstr(int err, char *buf, size_t len)
-{
-    if (strerror_r(err, buf, len) != 0)
-        snprintf(buf, len, "error %d", err);
-    return buf;
-}
-
 /* Horizontal white space inside a line ('\r' included so CRLF and stray CRs pass). */
 static int ct_is_space(char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\v' || ch == '\f'; }
 
@@ -164,7 +156,7 @@ amscr_status amscr_contour_read_text(const char *path, amscr_contour **out)
     char eb[128];
     FILE *f = fopen(path, "rb");
     if (!f)
-        return amscr__fail(AMSCR_E_IO, "%s: %s", path, ct_errstr(errno, eb, sizeof eb));
+        return amscr__fail(AMSCR_E_IO, "%s: %s", path, amscr__errstr(errno, eb, sizeof eb));
     size_t cap = 1 << 16, len = 0;
     char *buf = malloc(cap);
     if (!buf) {
@@ -194,7 +186,7 @@ amscr_status amscr_contour_read_text(const char *path, amscr_contour **out)
                 int e = errno;
                 free(buf);
                 fclose(f);
-                return amscr__fail(AMSCR_E_IO, "%s: read error: %s", path, ct_errstr(e, eb, sizeof eb));
+                return amscr__fail(AMSCR_E_IO, "%s: read error: %s", path, amscr__errstr(e, eb, sizeof eb));
             }
             break;
         }
