@@ -270,19 +270,21 @@ def sets_table(args, conds):
                 em, er = ((map_error(M, T, src, size), map_error(M, T, src, size, rms=True)) if M is not None
                           else (math.inf, math.inf))
                 conf = r.confidence if r is not None else 0.0
-                res.setdefault((fold, key), []).append((em < 0.02, er < 0.02, er >= 0.02 and conf >= CONFIDENT, ms))
+                res.setdefault((fold, key), []).append((em < 0.02, er < 0.02, er >= 0.02 and conf >= CONFIDENT, ms,
+                                                        er < 0.02 and conf >= CONFIDENT))
                 if er >= 0.02:
                     fails.append('%s %s %s d%d: rms %.2f %% max %.2f %% conf %.3f' % (key, fold, cls, d, 100 * er,
                                                                                        100 * em, conf))
         print('.', end='', file=sys.stderr, flush=True)
     print(file=sys.stderr)
     names = {'A': 'fold A', 'B': 'fold B', 'P': 'procedural'}
-    print('ok %% max rule / ok %% RMS rule / wrong + confident %% (%d draws%s)' %
+    print('ok %% max rule / ok %% RMS rule / wrong + confident %% / successes confident %% (%d draws%s)' %
           (args.draws, ', stages ' + args.stages if args.stages else ''))
     print('| condition | ' + ' | '.join('%s (%d)' % (names[k], len(res[(k, conds[0][0])])) for k in sets) + ' | ms |')
     print('|---|' + '---|' * len(sets) + '---|')
     for key, label, _, _ in conds:
-        cells = ['%.1f / %.1f / %.1f' % tuple(100 * np.mean([r[i] for r in res[(k, key)]]) for i in range(3))
+        cells = ['%.1f / %.1f / %.1f / %.1f' % (*(100 * np.mean([r[i] for r in res[(k, key)]]) for i in range(3)),
+                                                100 * sum(r[4] for r in res[(k, key)]) / max(1, sum(r[1] for r in res[(k, key)])))
                  for k in sets]
         ms = np.mean([r[3] for k in sets for r in res[(k, key)]])
         print('| %s | %s | %.1f |' % (label, ' | '.join(cells), ms))

@@ -98,7 +98,7 @@ extern "C" {
 
 /** Compile-time version; amscr_version_number() gives the runtime one. */
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 17
+#define AMSCR_VERSION_MINOR 18
 #define AMSCR_VERSION_PATCH 0
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
@@ -2163,16 +2163,18 @@ AMSCR_API double amscr_result_threshold(const amscr_result *r);
 
 /**
  * @brief How sure the registration is, in [0, 1]: (1 - a) x min(inlier fraction, overlap) /
- *        (1 + (e / 0.01)^2), a the larger of amscr_result_ambiguity and
+ *        (1 + (e / 0.01)^2) / (1 + (s / 0.01)^2), a the larger of amscr_result_ambiguity and
  *        amscr_result_symmetry_ambiguity (when measured), e the forward-backward error (0 when
- *        the check did not run; amscr_result_backward_error). Near 0: reject the map, because
+ *        the check did not run; amscr_result_backward_error), s the map's standard error (0
+ *        when not measured; amscr_result_standard_error). Near 0: reject the map, because
  *        another, clearly different map explains the target almost as well (a symmetric shape,
  *        a symmetric shape with a part missing, a fragment too short to place), most source
- *        samples found no target boundary near them, the
- *        registered regions overlap little, or the target registered back onto the source on
- *        its own does not undo the map. Reject maps below 0.25. It flags wrong maps, not small
- *        biases (a map a few percent of the size off can still read high). A partial match
- *        (no region, no way back) reads (1 - ambiguity) x inlier fraction.
+ *        samples found no target boundary near them, the registered regions overlap little,
+ *        the target registered back onto the source on its own does not undo the map, or the
+ *        map rests on a few parts of the boundary that disagree with the rest. Reject maps
+ *        below 0.25. It flags wrong and imprecise maps, not a bias the whole boundary shares
+ *        (a map a few percent of the size off can still read high). A partial match (no
+ *        region, no way back) reads (1 - ambiguity) x inlier fraction / (1 + (s / 0.01)^2).
  * @return the value; NaN for NULL.
  * Ownership: none.
  * Thread-safety: const.
@@ -2208,6 +2210,25 @@ AMSCR_API double amscr_result_overlap(const amscr_result *r);
  * @since 0.14
  */
 AMSCR_API double amscr_result_backward_error(const amscr_result *r);
+
+/**
+ * @brief The map's standard error, from the data: the source's samples fall into floor(sqrt(N))
+ *        blocks of consecutive samples along the curve; each block in turn is left out and the
+ *        map solved again (one point-to-line step from the reported map, on the other blocks'
+ *        samples within 5 % of the target's size of its boundary); the value is the block
+ *        jackknife's RMS displacement of the source's samples, in units of the target's RMS
+ *        radius (in the affine-normalized frame). A map every part of the boundary agrees on
+ *        reads about 0.001; 0.01 halves the confidence (a map resting on one part that pulls
+ *        it, as a thin part traced at low resolution or a touching object does). It measures
+ *        how firmly the data fix the map, not its distance from the truth: a bias the whole
+ *        boundary shares is not seen. The map itself does not change.
+ * @return the value; NaN when not measured (an invariance other than affine, fewer than 9
+ *         samples, too few inliers to solve without one block) or for NULL.
+ * Ownership: none.
+ * Thread-safety: const.
+ * @since 0.18
+ */
+AMSCR_API double amscr_result_standard_error(const amscr_result *r);
 
 /**
  * @brief The ambiguity near a symmetry of the source, in [0, 1]: when the map is confident but
@@ -2246,9 +2267,9 @@ AMSCR_API double amscr_result_ambiguity(const amscr_result *r);
 
 /**
  * @brief Fraction of the source samples whose closest target boundary point lies within
- *        3 times the median closest-point distance (at least 1 % of the target's RMS radius)
- *        of their image under the map: 1 for a complete, clean match; about 1 - the missing
- *        share when part of the target's boundary is missing.
+ *        5 % of the target's RMS radius (in the affine-normalized frame) of their image under
+ *        the map: 1 for a complete, clean match; about 1 - the missing share when part of the
+ *        target's boundary is missing.
  * @return the value; NaN for NULL.
  * Ownership: none.
  * Thread-safety: const.

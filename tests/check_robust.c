@@ -105,7 +105,9 @@ static double confidence_of(const double *s, size_t n, double *out_amb)
     ck_assert(c >= 0.0 && c <= 1.0);
     double share = fmin(amscr_result_inlier_fraction(r), amscr_result_overlap(r)), fb = amscr_result_backward_error(r);
     double sa = amscr_result_symmetry_ambiguity(r), amb = isnan(sa) ? *out_amb : fmax(sa, *out_amb);
-    ck_assert_double_eq_tol(c, (1.0 - amb) * share / (1.0 + (isnan(fb) ? 0.0 : pow(fb / 0.01, 2))), 1e-12);
+    double se = amscr_result_standard_error(r);
+    ck_assert_double_eq_tol(c, (1.0 - amb) * share / (1.0 + (isnan(fb) ? 0.0 : pow(fb / 0.01, 2))) /
+                                   (1.0 + (isnan(se) ? 0.0 : pow(se / 0.01, 2))), 1e-12);
     amscr_result_free(r);
     free(a);
     free(t);
@@ -319,21 +321,83 @@ START_TEST(forward_backward_exact_pair)
     double fb = amscr_result_backward_error(r), sa = amscr_result_symmetry_ambiguity(r);
     double conf = amscr_result_confidence(r), inl = amscr_result_inlier_fraction(r), ov = amscr_result_overlap(r);
     printf("robust: 20 %% cut: error %.4f %%, forward-backward %.3g, near a symmetry %.3f, inliers %.3f, overlap "
-           "%.3f, confidence %.3f\n",
-           100.0 * err, fb, sa, inl, ov, conf);
+           "%.3f, standard error %.3g, confidence %.3f\n",
+           100.0 * err, fb, sa, inl, ov, amscr_result_standard_error(r), conf);
     fflush(stdout);
     ck_assert_msg(err < 0.01, "error %.3f %%", 100.0 * err);
     ck_assert_msg(fmin(inl, ov) < 0.85 && fb < 1e-3, "forward-backward %.3g (inliers %.3f, overlap %.3f)", fb, inl,
                   ov);
     ck_assert_msg(sa < 0.5, "near a symmetry %.3f", sa);
     ck_assert_msg(conf > 0.5, "confidence %.3f", conf);
-    double e = fb / 0.01;
-    ck_assert_double_eq_tol(conf, (1.0 - fmax(sa, amscr_result_ambiguity(r))) * fmin(ov, inl) / (1.0 + e * e), 1e-12);
+    double e = fb / 0.01, s = amscr_result_standard_error(r) / 0.01;
+    ck_assert_msg(s < 0.01, "standard error %.3g", 0.01 * s); /* the cut's chord is trimmed away */
+    ck_assert_double_eq_tol(conf, (1.0 - fmax(sa, amscr_result_ambiguity(r))) * fmin(ov, inl) / (1.0 + e * e) /
+                                      (1.0 + s * s), 1e-12);
     amscr_result_free(r);
 }
 END_TEST
 
 /* Bad input: partial needs an open source and a closed target; the flag is 0 or 1. */
+/* The standard error of a map (src onto tgt, n points each) registered with the preset, or
+ * with similarity invariance. */
+static double standard_error_of(const double *src, const double *tgt, size_t n, int similarity, double *conf)
+{
+    amscr_params *p = NULL;
+    amscr_contour *cs = NULL, *ct = NULL;
+    amscr_result *r = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+    if (similarity)
+        ck_assert_int_eq(amscr_params_set_invariance(p, AMSCR_INVARIANCE_SIMILARITY), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_new(src, n, &cs), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_new(tgt, n, &ct), AMSCR_OK);
+    ck_assert_int_eq(amscr_register_contours(p, cs, ct, &r), AMSCR_OK);
+    double se = amscr_result_standard_error(r);
+    *conf = amscr_result_confidence(r);
+    amscr_result_free(r);
+    amscr_contour_free(cs);
+    amscr_contour_free(ct);
+    amscr_params_free(p);
+    return se;
+}
+
+/* The standard error reads how firmly the data fix the map: about 0 for an exact affine copy,
+ * growing with noise spread along the whole boundary yet below the 1 % that halves the
+ * confidence, and above it when two parts of the boundary call for different maps; not
+ * measured under similarity invariance. */
+START_TEST(standard_error_reads_the_fit)
+{
+    enum { N = 400 };
+    double src[2 * N], tgt[2 * N], noisy[2 * N], T[6], size, conf, se[4];
+    make_pair(31, N, src, tgt, T, &size);
+    se[0] = standard_error_of(src, tgt, N, 0, &conf);
+    for (int k = 1; k <= 2; k++) {
+        amscr_test_rng rng;
+        amscr_test_rng_seed(&rng, 31);
+        memcpy(noisy, tgt, sizeof noisy);
+        amscr_test_add_noise(&rng, noisy, N, (k == 1 ? 0.005 : 0.02) * size);
+        se[k] = standard_error_of(src, noisy, N, 0, &conf);
+    }
+    /* the half of the target right of its centroid stretched by another 20 % along x: no one
+     * affine map fits both halves */
+    memcpy(noisy, tgt, sizeof noisy);
+    double cx = 0.0;
+    for (size_t i = 0; i < N; i++)
+        cx += tgt[2 * i] / N;
+    for (size_t i = 0; i < N; i++)
+        if (tgt[2 * i] > cx)
+            noisy[2 * i] += 0.2 * (tgt[2 * i] - cx);
+    se[3] = standard_error_of(src, noisy, N, 0, &conf);
+    printf("robust: standard error exact %.3g, noise 0.5 %% %.3g, 2 %% %.3g, a half stretched %.3g (confidence %.3f)\n",
+           se[0], se[1], se[2], se[3], conf);
+    fflush(stdout);
+    ck_assert_msg(se[0] < 1e-5, "exact pair: %.3g", se[0]);
+    ck_assert_msg(se[0] < se[1] && se[1] < se[2] && se[2] < 0.01, "noise: %.3g %.3g", se[1], se[2]);
+    ck_assert_msg(se[3] > 0.01 && conf < 0.5, "a half stretched: %.3g, confidence %.3f", se[3], conf);
+    ck_assert(isnan(standard_error_of(src, tgt, N, 1, &conf)));
+    ck_assert(isnan(amscr_result_standard_error(NULL)));
+}
+END_TEST
+
 START_TEST(partial_errors)
 {
     amscr_params *p = NULL;
@@ -439,6 +503,7 @@ Suite *amscr_suite_robust(void)
     tcase_add_test(tc, touching_object_inliers);
     tcase_add_test(tc, symmetric_shape_with_a_bite);
     tcase_add_test(tc, forward_backward_exact_pair);
+    tcase_add_test(tc, standard_error_reads_the_fit);
     tcase_add_test(tc, kimia_fragments);
     tcase_add_test(tc, kimia_missing_10);
     tcase_add_test(tc, kimia_missing_20);

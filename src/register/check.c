@@ -109,9 +109,10 @@ static amscr_status map_overlap(const amscr_descriptor *f, const amscr_descripto
 double amscr__confidence(const amscr_result *r)
 {
     double fb = isfinite(r->fb) ? r->fb / AMSCR__FB_SCALE : 0.0;
+    double se = isfinite(r->se) ? r->se / AMSCR__FB_SCALE : 0.0;
     double share = r->overlap < r->inlier ? r->overlap : r->inlier;
     double amb = r->amb_conv > r->m.ambiguity ? r->amb_conv : r->m.ambiguity;
-    return (1.0 - amb) * share / (1.0 + fb * fb);
+    return (1.0 - amb) * share / (1.0 + fb * fb) / (1.0 + se * se);
 }
 
 /* The source's own distinct turns: the source registered onto itself ranks its candidate

@@ -1,7 +1,8 @@
 /* correspond.c — what a finished registration says beyond the map: for every source
  * sample the closest point of the target's boundary to its image (dense correspondences, for
- * landmark transfer), the share of samples that found the boundary near them (inliers), and
- * where the source's first and last samples fall on the target (the part it covers). */
+ * landmark transfer), the share of samples that found the boundary near them (inliers), where
+ * the source's first and last samples fall on the target (the part it covers), and, from the
+ * inliers' residuals along the boundary's normal, the map's standard error (precision.c). */
 #include "dense.h"
 #include "match.h"
 
@@ -32,15 +33,31 @@ double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const doub
     return s / (double)f->n;
 }
 
-amscr_status amscr__correspond(const amscr_descriptor *f, const amscr_descriptor *h, amscr_result *r)
+/* The pairs whose residual lies beyond AMSCR__TRIM_K times the median squared distance (the n
+ * values at nr + 3n, reordered) lose their normal: the jackknife leaves them out, as the
+ * polish's fit does. */
+static void trim_pairs(double *nr, size_t n)
+{
+    double *d2 = nr + 3 * n;
+    amscr__select_kth(d2, n, n / 2);
+    double cut = AMSCR__TRIM_K * d2[n / 2];
+    for (size_t a = 0; a < n; a++)
+        if (nr[3 * a + 2] * nr[3 * a + 2] > cut)
+            nr[3 * a] = nr[3 * a + 1] = 0.0;
+}
+
+amscr_status amscr__correspond(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                               amscr_result *r)
 {
     size_t n = f->n;
     int closed = h->params.closed;
     double *Hd = amscr__malloc_array(2 * AMSCR__DENSE * h->n, sizeof *Hd);
     double *corr = amscr__malloc_array(5 * n, sizeof *corr);
-    if (!Hd || !corr) {
+    double *nr = amscr__malloc_array(4 * n, sizeof *nr); /* a kept pair's normal and residual; d2 */
+    if (!Hd || !corr || !nr) {
         free(Hd);
         free(corr);
+        free(nr);
         return amscr__fail(AMSCR_E_NOMEM, "correspondences: out of memory");
     }
     size_t nd = amscr__densify(h->base, h->n, closed, Hd), nedge = closed ? nd : nd - 1;
@@ -64,10 +81,29 @@ amscr_status amscr__correspond(const amscr_descriptor *f, const amscr_descriptor
         c[2] = fmod(((double)seg + t) / (double)nedge, 1.0);
         c[3] = iv[0] * qx + iv[1] * qy + iv[2];
         c[4] = iv[3] * qx + iv[4] * qy + iv[5];
+        double el = sqrt(l2), *s = nr + 3 * a;
+        int in = sqrt(d2) <= AMSCR__INLIER_DIST && el > 0.0;
+        s[0] = in ? -ey / el : 0.0;
+        s[1] = in ? ex / el : 0.0;
+        s[2] = s[0] * (px - qx) + s[1] * (py - qy);
+        nr[3 * n + a] = d2;
         if (sqrt(d2) <= AMSCR__INLIER_DIST)
             inl++;
     }
+    /* the jackknife re-solves an affine map (other groups' maps have fewer freedoms) from the
+     * inliers the polish's trimming keeps */
+    r->se = NAN;
+    amscr_status st = AMSCR_OK;
+    if (prm->invariance == AMSCR_INVARIANCE_AFFINE) {
+        trim_pairs(nr, n);
+        st = amscr__map_precision(f, nr, n, &r->se);
+    }
+    free(nr);
     free(Hd);
+    if (st != AMSCR_OK) {
+        free(corr);
+        return st;
+    }
     free(r->corr);
     r->corr = corr;
     r->ncorr = n;

@@ -13,12 +13,9 @@
 /* Converged when a step moves the curve by less than this RMS (frame of RMS radius sqrt 2:
  * 0.007 % of the size, far below any error that matters). */
 #define POLISH_TOL 1e-4
-/* Adaptive trimming: pairs within RESID_K times the median squared distance (5x the median
- * distance: 3.4 sigma of Gaussian noise, which keeps all but 0.07 % of noisy pairs — a tighter
- * cut drops the tails that carry a thin part's tip and lets the map slide; measured: 3x the
- * distance 98.6 / 95.7 %, 5x 100 / 97.1 % at 1 / 2 % noise). A missing run's pairs lie far
- * beyond it. */
-#define RESID_K 25.0
+/* Adaptive trimming: pairs within RESID_K (AMSCR__TRIM_K, match.h) times the median squared
+ * distance. */
+#define RESID_K AMSCR__TRIM_K
 /* A polish refines a map; one that changed the moved curve's area by more than this factor
  * (or flipped it) collapsed instead: a fragment paired only onto the target can always shrink
  * onto a small piece of it (measured: a 50 % fragment of device6 onto 0.2 % of the target,

@@ -108,6 +108,7 @@ double amscr_result_inlier_fraction(const amscr_result *r) { return r ? r->inlie
 double amscr_result_confidence(const amscr_result *r) { return r ? amscr__confidence(r) : NAN; }
 double amscr_result_overlap(const amscr_result *r) { return r ? r->overlap : NAN; }
 double amscr_result_backward_error(const amscr_result *r) { return r ? r->fb : NAN; }
+double amscr_result_standard_error(const amscr_result *r) { return r ? r->se : NAN; }
 double amscr_result_symmetry_ambiguity(const amscr_result *r) { return r ? r->amb_conv : NAN; }
 
 amscr_status amscr_result_part(const amscr_result *r, double *out_start, double *out_end)

@@ -126,7 +126,7 @@ static amscr_status run_alternatives(stage_ctx *c)
 }
 static amscr_status run_correspond(stage_ctx *c)
 {
-    amscr_status st = amscr__correspond(c->f, c->h, c->r);
+    amscr_status st = amscr__correspond(c->prm, c->f, c->h, c->r);
     return st == AMSCR_OK ? amscr__check(c->prm, c->f, c->h, c->ws, c->r) : st;
 }
 

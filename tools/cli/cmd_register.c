@@ -28,7 +28,7 @@ typedef struct reg_report {
     int refl;
     const char *mname;
     /* confidence, the part of the target covered, dense correspondences */
-    double conf, amb, inl, overlap, fb, symamb, part[2];
+    double conf, amb, inl, overlap, fb, se, symamb, part[2];
     size_t ncorr;
     double *corr_param, *corr_xy; /* ncorr and 2 ncorr */
     /* the pipeline's stages and whether each ran; the maps that fit about as well (0.5) */
@@ -176,6 +176,7 @@ static int read_report(const amscr_result *res, const amscr_params *p, reg_repor
     r->inl = amscr_result_inlier_fraction(res);
     r->overlap = amscr_result_overlap(res);
     r->fb = amscr_result_backward_error(res);
+    r->se = amscr_result_standard_error(res);
     r->symamb = amscr_result_symmetry_ambiguity(res);
     if (amscr_result_part(res, &r->part[0], &r->part[1]) != AMSCR_OK ||
         amscr_result_correspondences(res, NULL, NULL, NULL, &r->ncorr) != AMSCR_OK)
@@ -247,6 +248,8 @@ static void json_confidence(sbuf *b, const opts *o, const reg_report *r)
     sb_json_num(b, r->fb);
     sb_puts(b, ", \"symmetry_ambiguity\": ");
     sb_json_num(b, r->symamb);
+    sb_puts(b, ", \"standard_error\": ");
+    sb_json_num(b, r->se);
     sb_printf(b, ", \"partial\": %s, \"part\": ", o->partial ? "true" : "false");
     sb_json_nums(b, r->part, NULL, 2);
     sb_puts(b, ", \"correspondences\": {\"param\": ");
@@ -361,6 +364,8 @@ static void format_text(sbuf *b, const opts *o, const amscr_contour *src, const 
     sb_printf(b, "confidence  %.3f (ambiguity %.3f, inliers %.1f %%", r->conf, r->amb, 100.0 * r->inl);
     if (isfinite(r->overlap))
         sb_printf(b, ", overlap %.1f %%", 100.0 * r->overlap);
+    if (isfinite(r->se))
+        sb_printf(b, ", standard error %.2f %% of the size", 100.0 * r->se);
     sb_printf(b, ")%s\n", r->conf < 0.25 ? "  LOW: the map may be wrong" : "");
     if (o->partial)
         sb_printf(b, "part        %.4f .. %.4f of the target's boundary\n", r->part[0], r->part[1]);

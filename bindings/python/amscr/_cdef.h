@@ -2,9 +2,9 @@
 /* Regenerate with: python3 scripts/gen_cdef.py -o bindings/python/amscr/_cdef.h */
 
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 17
+#define AMSCR_VERSION_MINOR 18
 #define AMSCR_VERSION_PATCH 0
-#define AMSCR_VERSION_NUMBER 1700
+#define AMSCR_VERSION_NUMBER 1800
 #define AMSCR_MAX_IMAGE_SIDE 32768
 #define AMSCR_MAX_IMAGE_PIXELS 268435456
 #define AMSCR_MAX_POINTS 16777216
@@ -268,6 +268,7 @@ double amscr_result_threshold(const amscr_result *r);
 double amscr_result_confidence(const amscr_result *r);
 double amscr_result_overlap(const amscr_result *r);
 double amscr_result_backward_error(const amscr_result *r);
+double amscr_result_standard_error(const amscr_result *r);
 double amscr_result_symmetry_ambiguity(const amscr_result *r);
 double amscr_result_ambiguity(const amscr_result *r);
 double amscr_result_inlier_fraction(const amscr_result *r);

@@ -67,8 +67,9 @@ class Registration:
         reflected: True when the match used the mirrored target.
         method: the method used.
         confidence: how sure the map is, in [0, 1]: (1 - max(ambiguity, symmetry_ambiguity))
-            x min(inlier_fraction, overlap) / (1 + (backward_error / 0.01)^2) (a value not
-            measured, NaN, counts as no evidence against the map); reject maps below 0.25.
+            x min(inlier_fraction, overlap) / (1 + (backward_error / 0.01)^2)
+            / (1 + (standard_error / 0.01)^2) (a value not measured, NaN, counts as no
+            evidence against the map); reject maps below 0.25.
         ambiguity: cost of the chosen map over that of the best clearly different candidate
             (1: a symmetric shape or a fragment that fits several places).
         inlier_fraction: share of source samples within 5 % of the target's size of its boundary.
@@ -78,6 +79,12 @@ class Registration:
             target registered onto the source on its own and composed with the map: the RMS
             displacement of the source samples, in units of its RMS radius (about 0 when the
             two maps agree); NaN when the check did not run.
+        standard_error: how firmly the data fix the map: the block jackknife of the final fit
+            (the source's samples in floor(sqrt(N)) runs along the curve, each left out in
+            turn and the map solved again on the rest), the RMS displacement of the source
+            samples, in units of the target's RMS radius (about 0.001 when every part of the
+            boundary agrees; 0.01 halves the confidence); NaN when not measured (an invariance
+            other than affine).
         symmetry_ambiguity: when the map is confident but less than 95 % of the shape agrees,
             the ambiguity against the source's own symmetries composed with the map (1: a
             symmetric turn fits the damaged target as well); NaN when not measured.
@@ -127,6 +134,7 @@ class Registration:
         self.inlier_fraction = float(lib.amscr_result_inlier_fraction(r))
         self.overlap = float(lib.amscr_result_overlap(r))
         self.backward_error = float(lib.amscr_result_backward_error(r))
+        self.standard_error = float(lib.amscr_result_standard_error(r))
         self.symmetry_ambiguity = float(lib.amscr_result_symmetry_ambiguity(r))
         part = ffi.new('double[2]')
         _check(lib.amscr_result_part(r, part, part + 1))

@@ -3,6 +3,7 @@
 confidence must say so. One of the source's own turns, composed with the map and refined on the
 target, fits the target clearly better than the map itself: the symmetry ambiguity reads 1 and
 the confidence 0. Before, these pairs read 0.32-0.85. Skipped without OpenCV or scikit-image."""
+import math
 import os
 import sys
 
@@ -41,8 +42,8 @@ def pair(B, i, key, draw):
 def test_a_wrong_turn_is_not_confident(bench, i, key, draw):
     r, err = pair(bench, i, key, draw)
     assert err < 2.0 or r.confidence < 0.25, 'map %.1f %% off, confidence %.2f' % (err, r.confidence)
-    if err >= 2.0:
-        assert r.symmetry_ambiguity == 1.0
+    if err >= 2.0:  # the symmetry check says it, unless the standard error said it first
+        assert r.symmetry_ambiguity == 1.0 or (math.isnan(r.symmetry_ambiguity) and r.standard_error > 0.005)
 
 
 @pytest.mark.parametrize('key', ['clean', 'touching0.1'])
