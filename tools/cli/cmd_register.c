@@ -365,7 +365,7 @@ static void format_text(sbuf *b, const opts *o, const amscr_contour *src, const 
     if (isfinite(r->overlap))
         sb_printf(b, ", overlap %.1f %%", 100.0 * r->overlap);
     if (isfinite(r->se))
-        sb_printf(b, ", standard error %.2f %% of the size", 100.0 * r->se);
+        sb_printf(b, ", standard error %.2f %%", 100.0 * r->se);
     sb_printf(b, ")%s\n", r->conf < 0.25 ? "  LOW: the map may be wrong" : "");
     if (o->partial)
         sb_printf(b, "part        %.4f .. %.4f of the target's boundary\n", r->part[0], r->part[1]);
