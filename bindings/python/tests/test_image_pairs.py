@@ -76,6 +76,7 @@ def test_register_a_warped_silhouette(tmp_path, shape, warp):
     err = np.hypot(*(f @ M[:, :2].T + M[:, 2] - truth).T).max() / size
     assert err < min(0.02, 3 * ERRORS[(shape, warp)]), err
     assert j['confidence'] >= 0.9, j['confidence']
+    assert 0.0 < j['standard_error'] < 0.005, j['standard_error']  # every part of the boundary agrees
 
 
 # Measured map errors (fraction of the size); confidences 0.976-0.997.
