@@ -6,18 +6,15 @@ confidence must say so. Before the standard error entered it, these pairs read 0
 pair and a finely traced one of the same shapes stay confident. Skipped without OpenCV or
 scikit-image."""
 import math
-import os
-import sys
 
 import numpy as np
 import pytest
 
 import amscr
 
-cv2 = pytest.importorskip('cv2')
+pytest.importorskip('cv2')
 pytest.importorskip('skimage')
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'bench'))
-import shapegen  # noqa: E402  (beside this file)
+import family_pairs  # noqa: E402  (beside this file)
 
 # (procedural shape, condition, draw): wrong + confident pairs of the families sweep in 0.17.0
 IMPRECISE = [(8, 'lowres30', 1), (8, 'lowres30', 5), (8, 'lowres40', 0), (8, 'lowres40', 1), (11, 'lowres40', 3),
@@ -26,18 +23,10 @@ IMPRECISE = [(8, 'lowres30', 1), (8, 'lowres30', 5), (8, 'lowres40', 0), (8, 'lo
 
 @pytest.fixture(scope='module')
 def bench():
-    import registration_traced as B
-    B.SPAN, B.CANVAS = 200.0, 280  # as --families sets them
-    return B
+    return family_pairs.bench()
 
 
-def pair(B, i, key, draw):
-    _, _, kind, level, thr, seed = [c for c in B.family_conditions() if c[0] == key][0]
-    src = B.load_source(shapegen.silhouette(1, i))
-    f = B.subpixel_contour(src)
-    tgt, T = B.family_target(src, f, kind, level, np.random.default_rng([1000 + i, seed, draw, 2024]))
-    r = amscr.register(amscr.contour_from_mask(src, join=True), amscr.contour_from_mask(tgt, join=True))
-    return r, B.errors(np.hstack([np.asarray(r.A), np.asarray(r.B)[:, None]]), T, f)[0], thr
+pair = family_pairs.pair
 
 
 @pytest.mark.parametrize('i,key,draw', IMPRECISE)

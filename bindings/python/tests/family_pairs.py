@@ -1,0 +1,31 @@
+"""The pairs of bench/registration_traced.py --families on the procedural shapes, one at a time,
+for the tests that pin a pair of that sweep: the source silhouette, its damaged target (as the
+bench seeds it) and the library's registration of the two traced contours. Needs OpenCV and
+scikit-image (the callers skip without them)."""
+import os
+import sys
+
+import numpy as np
+
+import amscr
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'bench'))
+import shapegen  # noqa: E402  (beside this file)
+
+
+def bench():
+    """registration_traced, set up as --families sets it."""
+    import registration_traced as B
+    B.SPAN, B.CANVAS = 200.0, 280
+    return B
+
+
+def pair(B, i, key, draw):
+    """(registration, RMS error % of R, success threshold %) of procedural shape i under the
+    families condition `key`, draw `draw`."""
+    _, _, kind, level, thr, seed = [c for c in B.family_conditions() if c[0] == key][0]
+    src = B.load_source(shapegen.silhouette(1, i))
+    f = B.subpixel_contour(src)
+    tgt, T = B.family_target(src, f, kind, level, np.random.default_rng([1000 + i, seed, draw, 2024]))
+    r = amscr.register(amscr.contour_from_mask(src, join=True), amscr.contour_from_mask(tgt, join=True))
+    return r, B.errors(np.hstack([np.asarray(r.A), np.asarray(r.B)[:, None]]), T, f)[0], thr
