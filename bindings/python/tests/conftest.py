@@ -11,6 +11,8 @@ import importlib.util
 import os
 import sys
 
+import pytest
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 PKG_ROOT = os.path.dirname(HERE)  # bindings/python
 REPO_ROOT = os.path.normpath(os.path.join(PKG_ROOT, '..', '..'))
@@ -42,3 +44,11 @@ def pytest_report_header(config):
     return 'amscr %s from %s, %s mode, library %s (%s)' % (
         amscr.__version__, os.path.dirname(amscr.__file__), 'API' if amscr.API_MODE else 'ABI',
         amscr.library_version(), amscr.LIBRARY_PATH)
+
+
+@pytest.fixture(scope='module')
+def family_bench():
+    """bench/registration_traced.py set up as --families sets it (family_pairs.py; OpenCV and
+    scikit-image needed: the callers skip without them)."""
+    import family_pairs
+    return family_pairs.bench()

@@ -14,32 +14,24 @@ import amscr
 
 pytest.importorskip('cv2')
 pytest.importorskip('skimage')
-import family_pairs  # noqa: E402  (beside this file)
+from family_pairs import pair  # noqa: E402  (beside this file)
 
 # (procedural shape, condition, draw): wrong + confident pairs of the families sweep in 0.17.0
 IMPRECISE = [(8, 'lowres30', 1), (8, 'lowres30', 5), (8, 'lowres40', 0), (8, 'lowres40', 1), (11, 'lowres40', 3),
              (11, 'lowres40', 5), (23, 'lowres30', 6), (28, 'lowres40', 6), (33, 'noise2', 7)]
 
 
-@pytest.fixture(scope='module')
-def bench():
-    return family_pairs.bench()
-
-
-pair = family_pairs.pair
-
-
 @pytest.mark.parametrize('i,key,draw', IMPRECISE)
-def test_an_imprecise_map_is_not_confident(bench, i, key, draw):
-    r, err, thr = pair(bench, i, key, draw)
+def test_an_imprecise_map_is_not_confident(family_bench, i, key, draw):
+    r, err, thr = pair(family_bench, i, key, draw)
     assert err < thr or r.confidence < 0.25, 'map %.1f %% off, confidence %.2f' % (err, r.confidence)
     if err >= thr:
         assert r.standard_error > 0.005, 'standard error %.4f' % r.standard_error
 
 
 @pytest.mark.parametrize('i,key,draw', [(8, 'clean', 1), (11, 'lowres80', 3), (23, 'noise1', 6)])
-def test_a_precise_map_stays_confident(bench, i, key, draw):
-    r, err, thr = pair(bench, i, key, draw)
+def test_a_precise_map_stays_confident(family_bench, i, key, draw):
+    r, err, thr = pair(family_bench, i, key, draw)
     assert err < thr and r.confidence >= 0.25, 'map %.2f %% off, confidence %.2f' % (err, r.confidence)
     assert r.standard_error < 0.005, 'standard error %.4f' % r.standard_error
 

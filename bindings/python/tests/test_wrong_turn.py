@@ -9,30 +9,22 @@ import pytest
 
 pytest.importorskip('cv2')
 pytest.importorskip('skimage')
-import family_pairs  # noqa: E402  (beside this file)
+from family_pairs import pair  # noqa: E402  (beside this file)
 
 # (procedural shape, condition, draw): the wrong + confident pairs of the families sweep
 WRONG_TURNS = [(1, 'touching0.2', 1), (1, 'touching0.3', 1), (1, 'touching0.3', 3), (1, 'touching0.3', 6),
                (27, 'touching0.3', 4), (27, 'bite0.4', 3)]
 
 
-@pytest.fixture(scope='module')
-def bench():
-    return family_pairs.bench()
-
-
-pair = family_pairs.pair
-
-
 @pytest.mark.parametrize('i,key,draw', WRONG_TURNS)
-def test_a_wrong_turn_is_not_confident(bench, i, key, draw):
-    r, err, _ = pair(bench, i, key, draw)
+def test_a_wrong_turn_is_not_confident(family_bench, i, key, draw):
+    r, err, _ = pair(family_bench, i, key, draw)
     assert err < 2.0 or r.confidence < 0.25, 'map %.1f %% off, confidence %.2f' % (err, r.confidence)
     if err >= 2.0:  # the symmetry check says it, unless the standard error said it first
         assert r.symmetry_ambiguity == 1.0 or (math.isnan(r.symmetry_ambiguity) and r.standard_error > 0.005)
 
 
 @pytest.mark.parametrize('key', ['clean', 'touching0.1'])
-def test_the_right_turn_stays_confident(bench, key):
-    r, err, _ = pair(bench, 1, key, 1)
+def test_the_right_turn_stays_confident(family_bench, key):
+    r, err, _ = pair(family_bench, 1, key, 1)
     assert err < 2.0 and r.confidence >= 0.25, 'map %.2f %% off, confidence %.2f' % (err, r.confidence)
