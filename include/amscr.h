@@ -2215,7 +2215,8 @@ AMSCR_API double amscr_result_backward_error(const amscr_result *r);
  * @brief The map's standard error, from the data: the source's samples fall into floor(sqrt(N))
  *        blocks of consecutive samples along the curve; each block in turn is left out and the
  *        map solved again (one point-to-line step from the reported map, on the other blocks'
- *        samples within 5 % of the target's size of its boundary); the value is the block
+ *        samples within 5 % of the target's size of its boundary and within 5 times the median
+ *        closest-point distance, the pairs the final fit keeps); the value is the block
  *        jackknife's RMS displacement of the source's samples, in units of the target's RMS
  *        radius (in the affine-normalized frame). A map every part of the boundary agrees on
  *        reads about 0.001; 0.01 halves the confidence (a map resting on one part that pulls

@@ -4,7 +4,7 @@
  * (blocks as long as they are many: a residual that runs along a part of the curve, a thin
  * part traced a pixel off, stays in one block). Each block in turn is left out and the map
  * re-solved, one linearized point-to-line step from the reported map on the other blocks'
- * inliers; the spread of those B maps is the jackknife's variance of the map. The standard
+ * pairs (the inliers the polish's trimming keeps: correspond.c); the spread of those B maps is the jackknife's variance of the map. The standard
  * error is its RMS displacement of the source samples, in units of the target's RMS radius:
  * the scale of the forward-backward error. */
 #include "dense.h"
@@ -12,7 +12,6 @@
 
 #include <math.h>
 #include <stdlib.h>
-#include <string.h>
 
 /* Fewer blocks than this (fewer than 9 samples) give no variance worth reading. */
 #define AMSCR__JK_MIN_BLOCKS 3
