@@ -2173,7 +2173,7 @@ AMSCR_API double amscr_result_threshold(const amscr_result *r);
  *        the target registered back onto the source on its own does not undo the map, or the
  *        map rests on a few parts of the boundary that disagree with the rest. Reject maps
  *        below 0.25. It flags wrong and imprecise maps, not a bias the whole boundary shares
- *        (a map a few percent of the size off can still read high). A partial match (no
+ *        (such a map can still read high). A partial match (no
  *        region, no way back) reads (1 - ambiguity) x inlier fraction / (1 + (s / 0.01)^2).
  * @return the value; NaN for NULL.
  * Ownership: none.
@@ -2219,7 +2219,7 @@ AMSCR_API double amscr_result_backward_error(const amscr_result *r);
  *        closest-point distance, the pairs the final fit keeps); the value is the block
  *        jackknife's RMS displacement of the source's samples, in units of the target's RMS
  *        radius (in the affine-normalized frame). A map every part of the boundary agrees on
- *        reads about 0.001; 0.01 halves the confidence (a map resting on one part that pulls
+ *        reads near 0; 0.01 halves the confidence (a map resting on one part that pulls
  *        it, as a thin part traced at low resolution or a touching object does). It measures
  *        how firmly the data fix the map, not its distance from the truth: a bias the whole
  *        boundary shares is not seen. The map itself does not change.
@@ -2688,8 +2688,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  *       amscr_index_build with candidates 0), the first call after shapes were added enters
  *       them (n pair distances a new shape), and each call then costs n pair distances and
  *       the re-ranking of one row, as amscr_index_query_scores with candidates 0.
- * Memory: the kept index, about 20 KB a shape with the retrieval preset (channel and inner
- *       features, signature, lists; not a copy of the shapes), until amscr_db_free.
+ * Memory: the kept index (channel and inner features, signature, lists; not a copy of the
+ *       shapes; its bytes a shape: docs/measurements.md), until amscr_db_free.
  * Prefer an amscr_index to save the preparation in a file or to query with a shortlist.
  * The query is scored as a new shape even when it is a member's copy (no member rule:
  * amscr_db_search_retrieval applies it).
@@ -2761,11 +2761,11 @@ typedef struct amscr_index amscr_index;
  *        shapes (docs/collections.md, "The index file").
  * Cost: candidates 0: n^2 pair distances; M > 0: O(n (M + K^2)) pair distances.
  * Memory: the index holds a compact copy of the shapes (each shape's input samples
- *         and outline, ~3 KB at the defaults; a prepared shape is recomputed from them, bit for
- *         bit, when first read, e.g. through amscr_index_db, and then kept), the channel features
- *         and signature (~18 KB a shape at the defaults), about 24 bytes a listed
- *         neighbour and, with the inner graph, about 2.2 KB of inner features a shape; the
- *         build's scratch is n^2 doubles with candidates 0, at most 12 n M bytes with M.
+ *         and outline; a prepared shape is recomputed from them, bit for bit, when first
+ *         read, e.g. through amscr_index_db, and then kept), the channel features and
+ *         signature, the listed neighbours and, with the inner graph, the inner features
+ *         (the bytes of each: docs/measurements.md, "Bytes a shape, in memory and on disk");
+ *         the build's scratch is n^2 doubles with candidates 0, at most 12 n M bytes with M.
  * Threads: amscr_params_set_num_threads of the db's params; the index is the same for any
  *          thread count.
  * @param[in]  db  the collection (copied; may be freed afterwards).
@@ -3010,9 +3010,8 @@ AMSCR_API const char *amscr_index_group(const amscr_index *x, size_t i);
  * @brief Writes the index, whole before it takes its name (as amscr_contour_write_text): the
  *        collection file format (amscr_db_load of it gives the collection) with an index
  *        section holding the lists, each shape's channel features (so a load does not rebuild
- *        them) and, with the inner graph, each shape's inner features (about 2.2 KB) and its
- *        lists; amscr_index_load_with reads it and every earlier format version
- *        (docs/collections.md).
+ *        them) and, with the inner graph, each shape's inner features and its lists;
+ *        amscr_index_load_with reads it and every earlier format version (docs/collections.md).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none. Thread-safety: const.
  * @since 0.4
