@@ -81,20 +81,20 @@ amscr_status amscr__correspond(const amscr_params *prm, const amscr_descriptor *
         c[2] = fmod(((double)seg + t) / (double)nedge, 1.0);
         c[3] = iv[0] * qx + iv[1] * qy + iv[2];
         c[4] = iv[3] * qx + iv[4] * qy + iv[5];
-        double el = sqrt(l2), *s = nr + 3 * a;
-        int in = sqrt(d2) <= AMSCR__INLIER_DIST && el > 0.0;
-        s[0] = in ? -ey / el : 0.0;
-        s[1] = in ? ex / el : 0.0;
+        int near = sqrt(d2) <= AMSCR__INLIER_DIST;
+        double el = near && l2 > 0.0 ? sqrt(l2) : 0.0, *s = nr + 3 * a;
+        s[0] = el > 0.0 ? -ey / el : 0.0; /* an inlier's unit normal; 0: not used */
+        s[1] = el > 0.0 ? ex / el : 0.0;
         s[2] = s[0] * (px - qx) + s[1] * (py - qy);
         nr[3 * n + a] = d2;
-        if (sqrt(d2) <= AMSCR__INLIER_DIST)
-            inl++;
+        inl += (size_t)near;
     }
     /* the jackknife re-solves an affine map (other groups' maps have fewer freedoms) from the
-     * inliers the polish's trimming keeps */
+     * inliers the polish's trimming keeps; a check's own registration (r->backward) reports
+     * no confidence and skips it */
     r->se = NAN;
     amscr_status st = AMSCR_OK;
-    if (prm->invariance == AMSCR_INVARIANCE_AFFINE) {
+    if (prm->invariance == AMSCR_INVARIANCE_AFFINE && !r->backward) {
         trim_pairs(nr, n);
         st = amscr__map_precision(f, nr, n, &r->se);
     }
