@@ -9,7 +9,9 @@
  *                 source on its own: the two maps must compose to the identity. Their
  *                 forward-backward error is the RMS displacement of the source samples under
  *                 the composition, in units of the source's RMS radius (normalized frames).
- * The confidence combines them (amscr__confidence). None of it changes the map. */
+ * The confidence combines them (amscr__confidence, result.c). None of it changes the map; it
+ * runs once the stages have finished a result (register.c), never for the check's own
+ * registrations. */
 #include "match.h"
 
 #include <math.h>
@@ -106,15 +108,6 @@ static amscr_status map_overlap(const amscr_descriptor *f, const amscr_descripto
     return st;
 }
 
-double amscr__confidence(const amscr_result *r)
-{
-    double fb = isfinite(r->fb) ? r->fb / AMSCR__FB_SCALE : 0.0;
-    double se = isfinite(r->se) ? r->se / AMSCR__FB_SCALE : 0.0;
-    double share = r->overlap < r->inlier ? r->overlap : r->inlier;
-    double amb = r->amb_conv > r->m.ambiguity ? r->amb_conv : r->m.ambiguity;
-    return (1.0 - amb) * share / (1.0 + fb * fb) / (1.0 + se * se);
-}
-
 /* The source's own distinct turns: the source registered onto itself ranks its candidate
  * turns, each refined to convergence (S[1..], cost[1..]; S[0] the identity). Returns how many
  * in all (1: none), or 0 with the status in *st. */
@@ -207,7 +200,7 @@ amscr_status amscr__check(const amscr_params *prm, const amscr_descriptor *f, co
     if (prm->partial || !f->params.closed || !h->params.closed)
         return AMSCR_OK;
     amscr_status st = map_overlap(f, h, r);
-    if (st != AMSCR_OK || r->backward)
+    if (st != AMSCR_OK)
         return st;
     /* the dearer evidence only where the cheap one leaves doubt: a map confident without it whose
      * boundary or region agree over less than AMSCR__SYM_SHARE (the symmetry test; a clean

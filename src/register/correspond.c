@@ -19,20 +19,6 @@
  * window that followed an extra object's outline would lose the shape's boundary for good). */
 #define AMSCR__CORR_WINDOW_DIV 32
 
-double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6])
-{
-    const double *mo = f->mom; /* level 0: the base samples */
-    double M9[9], s = 0.0;
-    amscr__moment_matrix(mo, M9);
-    for (int i = 0; i < 2; i++) {
-        double d[3] = {X1[3 * i] - X2[3 * i], X1[3 * i + 1] - X2[3 * i + 1], X1[3 * i + 2] - X2[3 * i + 2]};
-        for (int r = 0; r < 3; r++)
-            for (int c = 0; c < 3; c++)
-                s += d[r] * M9[3 * r + c] * d[c];
-    }
-    return s / (double)f->n;
-}
-
 /* The pairs whose residual lies beyond AMSCR__TRIM_K times the median squared distance (the n
  * values at nr + 3n, reordered) lose their normal: the jackknife leaves them out, as the
  * polish's fit does. */

@@ -21,9 +21,9 @@
  *   even.c              the polish's even-spacing stage: points taken evenly along it (even.h)
  *   alternatives.c      the distinct maps that fit about as well as the chosen one
  *   correspond.c        inliers, the part covered, dense correspondences
- *   precision.c         the map's standard error: a block jackknife of its closest points
- *   check.c             the overlap, the symmetry test, the forward-backward check, the confidence
- *   result.c            the result object and its getters
+ *   precision.c         the gap between two maps; the standard error: a jackknife of the fit
+ *   check.c             the overlap, the symmetry test, the forward-backward check (register.c runs them)
+ *   result.c            the result object, its getters and the confidence
  * and workspace.c, the caller-owned scratch of all of the above. */
 #ifndef AMSCR_MATCH_H
 #define AMSCR_MATCH_H
@@ -289,8 +289,6 @@ amscr_status amscr__refine_adaptive(const amscr_params *prm, const amscr_descrip
  * and scored by the recovery's two-way trimmed cost into cost. */
 amscr_status amscr__rank_converged(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                    double X[][6], size_t count, double *cost);
-/* Mean squared displacement between the maps X1 and X2 over the samples of f's base level. */
-double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6]);
 /* A candidate map differing from the chosen one by more than this RMS displacement (10 % of
  * the normalized frame's RMS radius sqrt 2) is a different answer for the ambiguity. */
 #define AMSCR__DISTINCT_GAP2 0.02
@@ -377,6 +375,9 @@ amscr_status amscr__correspond(const amscr_params *prm, const amscr_descriptor *
  * boundary at its closest point and its residual along it; a zero normal: not used); NaN when
  * too few blocks or samples fix the map. Fails only for want of memory. */
 amscr_status amscr__map_precision(const amscr_descriptor *f, const double *nr, size_t n, double *out);
+/* precision.c: the mean squared displacement between the maps X1 and X2 over the samples of
+ * f's base level. */
+double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6]);
 
 /* check.c (docs/method.md §11.5). A confidence at or above this is a confident answer: the
  * limit the documentation tells callers to reject below (1 - AMSCR__ALT_RATIO). */
@@ -393,11 +394,12 @@ amscr_status amscr__map_precision(const amscr_descriptor *f, const double *nr, s
 #define AMSCR__FB_SCALE 0.01
 /* The intersection over union of the closed polygons P (n vertices) and Q (m), even-odd rule. */
 amscr_status amscr__overlap(const double *P, size_t n, const double *Q, size_t m, double *out);
-/* The overlap and, when it leaves doubt, the forward-backward error of a finished result r of
- * f -> h (fills r->overlap, r->fb; a way back's own result, r->backward, only its overlap). */
+/* The overlap and, when it leaves doubt, the ambiguity near a symmetry and the forward-backward
+ * error of a result r of f -> h that the stages finished (fills r->overlap, r->amb_conv, r->fb;
+ * amscr_register runs it; the check's own registrations, r->backward, are not checked). */
 amscr_status amscr__check(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                           amscr_workspace *ws, amscr_result *r);
-/* (1 - max(ambiguity, the ambiguity near a symmetry)) x min(inlier fraction, overlap)
+/* result.c: (1 - max(ambiguity, the ambiguity near a symmetry)) x min(inlier fraction, overlap)
  * / (1 + (fb / AMSCR__FB_SCALE)^2) / (1 + (se / AMSCR__FB_SCALE)^2). */
 double amscr__confidence(const amscr_result *r);
 

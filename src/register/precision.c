@@ -1,12 +1,15 @@
-/* precision.c — how precisely the data pin a finished map down (docs/method.md §11.5): the
- * block jackknife of the point-to-line fit at the map's closest points. The source's samples,
- * in their order along the curve, fall into B = floor(sqrt(n)) blocks of consecutive samples
- * (blocks as long as they are many: a residual that runs along a part of the curve, a thin
- * part traced a pixel off, stays in one block). Each block in turn is left out and the map
- * re-solved, one linearized point-to-line step from the reported map on the other blocks'
- * pairs (the inliers the polish's trimming keeps: correspond.c); the spread of those B maps is the jackknife's variance of the map. The standard
- * error is its RMS displacement of the source samples, in units of the target's RMS radius:
- * the scale of the forward-backward error. */
+/* precision.c — how far apart maps lie, and how precisely the data pin a finished map down
+ * (docs/method.md §11.5). The gap between two maps is their mean squared displacement of the
+ * source's samples (amscr__map_gap2): every stage that tells maps apart reads it. The
+ * standard error is a block jackknife of the point-to-line fit at the map's closest points.
+ * The source's samples, in their order along the curve, fall into B = floor(sqrt(n)) blocks of
+ * consecutive samples (blocks as long as they are many: a residual that runs along a part of
+ * the curve, a thin part traced a pixel off, stays in one block). Each block in turn is left
+ * out and the map re-solved, one linearized point-to-line step from the reported map on the
+ * other blocks' pairs (the inliers the polish's trimming keeps: correspond.c); the spread of
+ * those B maps is the jackknife's variance of the map. The standard error is its RMS
+ * displacement of the source samples, in units of the target's RMS radius: the scale of the
+ * forward-backward error. */
 #include "dense.h"
 #include "match.h"
 
@@ -18,6 +21,20 @@
 
 /* The normal equations of block b: 36 entries of N, then 6 of the right-hand side. */
 #define AMSCR__JK_ROW 42
+
+double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6])
+{
+    const double *mo = f->mom; /* level 0: the base samples */
+    double M9[9], s = 0.0;
+    amscr__moment_matrix(mo, M9);
+    for (int i = 0; i < 2; i++) {
+        double d[3] = {X1[3 * i] - X2[3 * i], X1[3 * i + 1] - X2[3 * i + 1], X1[3 * i + 2] - X2[3 * i + 2]};
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                s += d[r] * M9[3 * r + c] * d[c];
+    }
+    return s / (double)f->n;
+}
 
 static void accumulate(const double *f, const double *nr, size_t n, size_t nb, double *acc)
 {

@@ -43,6 +43,8 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
         r->se = NAN;
     if (st == AMSCR_OK)
         st = amscr__run_stages(p, src, tgt, w, r);
+    if (st == AMSCR_OK) /* how far the result can be trusted: its overlap and checks (check.c) */
+        st = amscr__check(p, src, tgt, w, r);
     if (!ws)
         amscr__ws_release(&local);
     if (st != AMSCR_OK) {

@@ -103,6 +103,15 @@ amscr_status amscr_result_mixture(const amscr_result *r, double *out_weights, do
 }
 
 /* ---- robust registration: confidence, part, dense correspondences ---- */
+double amscr__confidence(const amscr_result *r)
+{
+    double fb = isfinite(r->fb) ? r->fb / AMSCR__FB_SCALE : 0.0;
+    double se = isfinite(r->se) ? r->se / AMSCR__FB_SCALE : 0.0;
+    double share = r->overlap < r->inlier ? r->overlap : r->inlier;
+    double amb = r->amb_conv > r->m.ambiguity ? r->amb_conv : r->m.ambiguity;
+    return (1.0 - amb) * share / (1.0 + fb * fb) / (1.0 + se * se);
+}
+
 double amscr_result_ambiguity(const amscr_result *r) { return r ? r->m.ambiguity : NAN; }
 double amscr_result_inlier_fraction(const amscr_result *r) { return r ? r->inlier : NAN; }
 double amscr_result_confidence(const amscr_result *r) { return r ? amscr__confidence(r) : NAN; }

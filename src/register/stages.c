@@ -124,11 +124,7 @@ static amscr_status run_alternatives(stage_ctx *c)
     amscr__alternatives(c->f, c->h, c->r);
     return AMSCR_OK;
 }
-static amscr_status run_correspond(stage_ctx *c)
-{
-    amscr_status st = amscr__correspond(c->prm, c->f, c->h, c->r);
-    return st == AMSCR_OK ? amscr__check(c->prm, c->f, c->h, c->ws, c->r) : st;
-}
+static amscr_status run_correspond(stage_ctx *c) { return amscr__correspond(c->prm, c->f, c->h, c->r); }
 
 /* The pipeline, in order (indexed by AMSCR__STAGE_*). */
 static const stage_t STAGES[AMSCR__NUM_STAGES] = {
