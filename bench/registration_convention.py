@@ -58,7 +58,7 @@ def cases(data, curve, noise, draws):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    ap.add_argument('--data', default=os.environ.get('AMSCR_HELDOUT_DATA', '/work/shared/datasets/mpeg7-dev'))
+    ap.add_argument('--data', default=H.default_data())
     ap.add_argument('--curve', choices=['plain', 'smooth', 'four'], default='smooth')
     ap.add_argument('--noise', type=float, default=0.02)
     ap.add_argument('--draws', type=int, default=4)

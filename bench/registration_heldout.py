@@ -36,6 +36,14 @@ import time
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def default_data(name='mpeg7-dev'):
+    """$AMSCR_HELDOUT_DATA, else NAME in $AMSCR_DATASETS, else in ../shared/datasets beside the checkout."""
+    return os.environ.get('AMSCR_HELDOUT_DATA') or os.path.join(
+        os.environ.get('AMSCR_DATASETS') or os.path.join(HERE, '..', '..', 'shared', 'datasets'), name)
+
+
 try:  # the installed package (scripts/setup.sh puts it into .venv)
     import amscr  # noqa: E402
 except ImportError:  # else this checkout's, with AMSCR_LIBRARY naming build/libamscr.so.0
@@ -295,7 +303,7 @@ def sets_table(args, conds):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    ap.add_argument('--data', default=os.environ.get('AMSCR_HELDOUT_DATA', '/work/shared/datasets/mpeg7-dev'))
+    ap.add_argument('--data', default=default_data())
     ap.add_argument('--classes', type=int, default=35)
     ap.add_argument('--draws', type=int, default=2)
     ap.add_argument('--ecc', action='store_true', help='also run OpenCV ECC (slow)')

@@ -34,7 +34,7 @@ def uneven(xy, m, density, rng):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    ap.add_argument('--data', default=os.environ.get('AMSCR_HELDOUT_DATA', '/work/shared/datasets/mpeg7-dev'))
+    ap.add_argument('--data', default=H.default_data())
     ap.add_argument('--density', type=float, default=6.0)
     ap.add_argument('--noise', type=float, default=0.02)
     ap.add_argument('--draws', type=int, default=4)
