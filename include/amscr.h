@@ -1580,9 +1580,9 @@ AMSCR_API double amscr_params_get_channel_band(const amscr_params *p);
 /**
  * @brief Sets the band of the channel's whitened frame when it is the second frame (the
  *        similarity frame with an affine share > 0), as a fraction of N in (0, 0.5]
- *        (default 0.08: that frame serves affine views rather than articulation, and a
- *        channel distance's time grows with the band). A file that holds one band for both
- *        frames loads with this one equal to amscr_params_set_channel_band's.
+ *        (default 0.08; the table of constants chosen on data: docs/decisions.md). A file that
+ *        holds one band for both frames loads with this one equal to
+ *        amscr_params_set_channel_band's.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -1791,7 +1791,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_params_ranking(const amscr_params *
  * _get_bounds: one key per number or flag of amscr_params. Each key sets the same value, with the
  * same validation, as its named pair (AMSCR_OPT_NUM_SAMPLES and amscr_params_set_num_samples);
  * the ranges, units and defaults below are those of the pair. The values are pinned forever:
- * new keys are only appended, and options added from now on get a key and no named pair.
+ * new keys are only appended, and a key may have no named pair.
  * Integer keys (flags are 0 or 1; enumerations take their enum's values) go through the _int
  * calls, real keys through the _real calls.
  * @since 0.13
@@ -2783,8 +2783,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_build(const amscr_db *db, siz
                                                          amscr_progress_fn progress, void *user, amscr_index **out);
 
 /** The largest collection whose index amscr_index_default_candidates builds from every pair:
- *  up to this size the exact build takes seconds; above it its cost grows as n^2 while a
- *  shortlist build's grows as n. @since 0.13 */
+ *  the exact build's cost grows as n^2, a shortlist build's as n (times:
+ *  docs/measurements.md). @since 0.13 */
 #define AMSCR_INDEX_EXACT_MAX 2000
 
 /**
@@ -2831,9 +2831,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_add(amscr_index *x, const ams
  *        its build's coarse quantizer of the signatures (kept in its file): its
  *        queries with candidates M take the M nearest among the shapes of the quantizer's
  *        clusters nearest the query (a few of the M signature-nearest may be missed) and drop
- *        the re-ranking diffusion's entries below 1e-3 of the largest at every step, so a
- *        query's cost grows far slower than the collection (docs/collections.md, "Queries at
- *        scale"). The query is scored as a new shape even when it is a
+ *        the re-ranking diffusion's entries below 1e-3 of the largest at every step
+ *        (docs/collections.md, "Queries at scale"). The query is scored as a new shape even when it is a
  *        member's copy (no member rule: amscr_index_search_scores applies it).
  * @param[in]  q  a shape prepared with params compatible with the index's.
  * @param[out] out_scores  n scores, lower is better.
