@@ -14,7 +14,6 @@
  * reports the QR solve; tests check they agree. */
 #include "match.h"
 
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,8 +38,6 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
     amscr_result *r = calloc(1, sizeof *r);
     if (!r)
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_register: out of memory");
-    else
-        r->se = NAN;
     if (st == AMSCR_OK)
         st = amscr__run_stages(p, src, tgt, w, r);
     if (st == AMSCR_OK) /* how far the result can be trusted: its overlap and checks (check.c) */
