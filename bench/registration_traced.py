@@ -232,7 +232,8 @@ CLOCK = time.perf_counter  # --cpu-time: time.process_time
 def lib_register_ms(src, tgt, breakdown=None):
     """Wall time (ms) of the library alone on the pair: both traces and the registration.
     breakdown: a list that receives the ms of (the two traces, the registration, the
-    registration without the polish, without the polish and the refinement)."""
+    registration without the pixel_grid stage, without the polish, without the polish and the
+    refinement)."""
     try:
         import amscr
     except ImportError:
@@ -244,7 +245,7 @@ def lib_register_ms(src, tgt, breakdown=None):
     t2 = CLOCK()
     if breakdown is not None:
         times = [t1 - t0, t2 - t1]
-        for opts in ({'polish': False}, {'polish': False, 'refine': 0}):
+        for opts in ({'stages': {'pixel_grid': False}}, {'polish': False}, {'polish': False, 'refine': 0}):
             t3 = CLOCK()
             amscr.register(ps, pt, **opts)
             times.append(CLOCK() - t3)
@@ -378,7 +379,8 @@ def main():
     ap.add_argument('--families', action='store_true', help="the check's conditions swept (see above)")
     ap.add_argument('--quick', action='store_true', help='--families at the check\'s points only')
     ap.add_argument('--procedural', type=int, default=None, help='N procedural shapes (35 with --families, else 0)')
-    ap.add_argument('--breakdown', action='store_true', help="lib ms split: traces, register, no polish, no refine")
+    ap.add_argument('--breakdown', action='store_true',
+                    help="lib ms split: traces, register, no pixel_grid, no polish, no refine")
     ap.add_argument('--cpu-time', action='store_true', help="lib ms as CPU time (with OPENBLAS_NUM_THREADS=1)")
     ap.add_argument('--reference', action='store_true', help="add the calibration: find_contours lists to the tool")
     ap.add_argument('--classes', type=int, default=0, help='the first N classes only (0: all)')
@@ -455,7 +457,8 @@ def main():
             if any(res[fold][k]['sub'] for k in keys):
                 print_table('%s, %s' % (title, what.split(' (')[0]), res[fold], conds, methods, measure)
     if split:
-        print('\nlibrary ms, medians over the run: traces | register | no polish | no polish, no refine')
+        print('\nlibrary ms, medians over the run: traces | register | no pixel_grid | no polish | no polish, '
+              'no refine')
         for key in keys:
             if key in split:
                 print('%-10s' % key + ' | '.join('%7.2f' % v for v in np.median(np.array(split[key]), axis=0)))

@@ -19,7 +19,8 @@
 #endif
 
 static const char *const PIPELINE[] = {"despike", "search", "method", "recovery", "final_solve", "symmetric",
-                                       "polish", "order", "even_spacing", "alternatives", "correspondences"};
+                                       "polish", "order", "even_spacing", "alternatives", "correspondences",
+                                       "pixel_grid"};
 enum { NSTAGES = sizeof PIPELINE / sizeof PIPELINE[0] };
 
 /* A polygon's outline (nv vertices) with m points (m / nv per edge); a test map applied. */
@@ -99,7 +100,7 @@ START_TEST(stage_list_in_pipeline_order)
     /* a clean pair under the preset: the always-stages and the polish; nothing to recover, no
      * symmetric distance; the opt-in stages off */
     const char *yes[] = {"search", "method", "final_solve", "polish", "alternatives", "correspondences"};
-    const char *no[] = {"despike", "recovery", "symmetric", "order", "even_spacing"};
+    const char *no[] = {"despike", "recovery", "symmetric", "order", "even_spacing", "pixel_grid"};
     for (size_t i = 0; i < sizeof yes / sizeof *yes; i++)
         ck_assert_msg(ran(r, yes[i]) == 1, "%s did not run", yes[i]);
     for (size_t i = 0; i < sizeof no / sizeof *no; i++)
@@ -130,7 +131,8 @@ START_TEST(paper_method_runs_no_optional_stage)
 }
 END_TEST
 
-/* Opt-in (default off in every preset): despike, order, even_spacing; on: recovery, polish. */
+/* Opt-in (default off in every preset): despike, order, even_spacing; on: recovery, polish,
+ * pixel_grid. */
 START_TEST(default_switches)
 {
     amscr_params *p[3] = {NULL, NULL, NULL};
@@ -143,6 +145,7 @@ START_TEST(default_switches)
         ck_assert_int_eq(amscr_params_get_stage(p[i], "even_spacing"), 0);
         ck_assert_int_eq(amscr_params_get_stage(p[i], "recovery"), 1);
         ck_assert_int_eq(amscr_params_get_stage(p[i], "polish"), 1);
+        ck_assert_int_eq(amscr_params_get_stage(p[i], "pixel_grid"), 1);
         amscr_params_free(p[i]);
     }
 }
@@ -184,7 +187,7 @@ START_TEST(switches)
 {
     amscr_params *p = NULL;
     ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
-    const char *opt[] = {"despike", "recovery", "polish", "order", "even_spacing"};
+    const char *opt[] = {"despike", "recovery", "polish", "order", "even_spacing", "pixel_grid"};
     for (size_t i = 0; i < sizeof opt / sizeof *opt; i++) {
         ck_assert_int_eq(amscr_params_set_stage(p, opt[i], 0), AMSCR_OK);
         ck_assert_int_eq(amscr_params_get_stage(p, opt[i]), 0);

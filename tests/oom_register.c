@@ -3,7 +3,8 @@
  * Linked with -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free against the static
  * library, so every allocation the library makes passes through the wrappers below. For each
  * scenario (a noisy target, which runs the polish with its order and even-spacing steps; a target
- * with a missing run, which runs the recovery; a partial match; a symmetric match) the test
+ * with a missing run, which runs the recovery; a partial match; a symmetric match; a target traced
+ * from a small binary image, which runs the pixel_grid stage) the test
  * counts the allocations of one amscr_register_contours call, then fails each of them in turn
  * and checks that the call returns AMSCR_E_NOMEM (nothing swallowed: no stage falls back
  * silently) and frees everything it allocated (no leak on any error path). The allocations of
@@ -92,7 +93,28 @@ typedef struct {
     double sigma;
     int partial, symmetric;
     const char *must_run; /* a stage the scenario exists for */
+    int traced;           /* the target traced from its binary image (LATTICE_SIDE px square) */
 } scenario;
+
+enum { LATTICE_SIDE = 40 };
+
+/* The binary image of the closed polygon b (n points) scaled by 8 about the image's centre (the
+ * pixels whose centre it contains), traced at sub-pixel accuracy: points on the pixel lattice. */
+static amscr_status traced_target(const double *b, size_t n, amscr_contour **out)
+{
+    static unsigned char img[LATTICE_SIDE * LATTICE_SIDE];
+    for (int j = 0; j < LATTICE_SIDE; j++)
+        for (int i = 0; i < LATTICE_SIDE; i++) {
+            double x = (i - LATTICE_SIDE / 2) / 8.0, y = (j - LATTICE_SIDE / 2) / 8.0;
+            int in = 0;
+            for (size_t k = 0, l = n - 1; k < n; l = k++)
+                if ((b[2 * k + 1] > y) != (b[2 * l + 1] > y) &&
+                    x < b[2 * k] + (y - b[2 * k + 1]) * (b[2 * l] - b[2 * k]) / (b[2 * l + 1] - b[2 * k + 1]))
+                    in = !in;
+            img[j * LATTICE_SIDE + i] = in ? 255 : 0;
+        }
+    return amscr_contour_from_image(img, LATTICE_SIDE, LATTICE_SIDE, LATTICE_SIDE, 8, 127.5, 0, out);
+}
 
 static amscr_status run(const scenario *s, amscr_result **out)
 {
@@ -115,7 +137,7 @@ static amscr_status run(const scenario *s, amscr_result **out)
     if (st == AMSCR_OK)
         st = amscr_contour_new(a, ns, &src);
     if (st == AMSCR_OK)
-        st = amscr_contour_new(b + 2 * s->drop, nt, &tgt);
+        st = s->traced ? traced_target(b, nt, &tgt) : amscr_contour_new(b + 2 * s->drop, nt, &tgt);
     if (st == AMSCR_OK)
         st = amscr_register_contours(p, src, tgt, out);
     amscr_contour_free(src);
@@ -174,10 +196,11 @@ static int check_scenario(const scenario *s)
 int main(void)
 {
     static const scenario scenarios[] = {
-        {"noisy target (polish, order, even spacing)", 400, 1600, 0, 0.01, 0, 0, "even_spacing"},
-        {"missing run (recovery)", 300, 300, 75, 0.0, 0, 0, "recovery"},
-        {"partial fragment", 300, 300, 0, 0.0, 1, 0, "polish"},
-        {"symmetric distance", 300, 300, 0, 0.0, 0, 1, "symmetric"},
+        {"noisy target (polish, order, even spacing)", 400, 1600, 0, 0.01, 0, 0, "even_spacing", 0},
+        {"missing run (recovery)", 300, 300, 75, 0.0, 0, 0, "recovery", 0},
+        {"partial fragment", 300, 300, 0, 0.0, 1, 0, "polish", 0},
+        {"symmetric distance", 300, 300, 0, 0.0, 0, 1, "symmetric", 0},
+        {"small binary image (pixel grid)", 300, 300, 0, 0.0, 0, 0, "pixel_grid", 1},
     };
     int bad = 0;
     for (size_t i = 0; i < sizeof scenarios / sizeof scenarios[0]; i++)

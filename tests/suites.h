@@ -36,5 +36,6 @@ Suite *amscr_suite_protocols(void);
 Suite *amscr_suite_subpixel(void);
 Suite *amscr_suite_stages(void);
 Suite *amscr_suite_inner(void);
+Suite *amscr_suite_pixel_grid(void);
 
 #endif

@@ -117,6 +117,7 @@ enum {
     AMSCR__STAGE_EVEN,
     AMSCR__STAGE_ALTERNATIVES,
     AMSCR__STAGE_CORRESPOND,
+    AMSCR__STAGE_PIXEL_GRID,
     AMSCR__NUM_STAGES
 };
 /* The bit of stage i in params->stages_off. */
@@ -163,6 +164,14 @@ amscr_status amscr__close_curve(const double *xy, size_t n, double c, double **o
  * k-th: the grid's pixels are coarser). AMSCR_E_DEGENERATE when the curve bounds no area; AMSCR_E_NOMEM. */
 amscr_status amscr__outline(const double *xy, size_t n, double c, double *V);
 void amscr__affine_compose(const double a[6], const double b[6], double out[6]);
+/* rasterize.c: a closed polygon P (n vertices) on the w x h pixel grid whose pixel (i, j) is
+ * centred at (x0 + i, y0 + j), even-odd rule, out[j w + i] 255 or 0. */
+/* The horizontal line y's crossings of P, sorted into xs (room for n); returns an even count. */
+size_t amscr__crossings(const double *P, size_t n, double y, double *xs);
+/* The pixels P covers by at least half their area (a camera and a threshold at half level). */
+amscr_status amscr__raster_cover(const double *P, size_t n, long x0, long y0, size_t w, size_t h, uint8_t *out);
+/* The pixels whose centre P contains. */
+amscr_status amscr__raster_centres(const double *P, size_t n, long x0, long y0, size_t w, size_t h, uint8_t *out);
 void amscr__params_defaults(amscr_params *p);
 void amscr__params_registration(amscr_params *p);
 void amscr__params_retrieval(amscr_params *p);

@@ -21,6 +21,7 @@ static const struct {
     [AMSCR__STAGE_EVEN] = {"even_spacing", 1},
     [AMSCR__STAGE_ALTERNATIVES] = {"alternatives", 0},
     [AMSCR__STAGE_CORRESPOND] = {"correspondences", 0},
+    [AMSCR__STAGE_PIXEL_GRID] = {"pixel_grid", 1},
 };
 
 const char *amscr__stage_name(size_t i) { return i < AMSCR__NUM_STAGES ? NAMES[i].name : NULL; }

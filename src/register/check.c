@@ -23,26 +23,6 @@
  * constant chosen on data. */
 #define AMSCR__OVERLAP_LINES 256
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* The sorted crossings of the closed polygon P (n vertices) with the line y (even-odd rule). */
-static size_t crossings(const double *P, size_t n, double y, double *xs)
-{
-    size_t c = 0;
-    for (size_t i = 0; i < n; i++) {
-        size_t j = i + 1 == n ? 0 : i + 1;
-        double yi = P[2 * i + 1], yj = P[2 * j + 1];
-        if ((yi <= y) != (yj <= y))
-            xs[c++] = P[2 * i] + (y - yi) * (P[2 * j] - P[2 * i]) / (yj - yi);
-    }
-    qsort(xs, c, sizeof *xs, cmp_double);
-    return c & ~(size_t)1;
-}
-
 static double covered(const double *xs, size_t c)
 {
     double s = 0.0;
@@ -81,7 +61,7 @@ amscr_status amscr__overlap(const double *P, size_t n, const double *Q, size_t m
     double inter = 0.0, uni = 0.0, dy = (hi - lo) / AMSCR__OVERLAP_LINES;
     for (int k = 0; k < AMSCR__OVERLAP_LINES && dy > 0.0; k++) {
         double y = lo + (k + 0.5) * dy;
-        size_t na = crossings(P, n, y, xs), nb = crossings(Q, m, y, xs + n);
+        size_t na = amscr__crossings(P, n, y, xs), nb = amscr__crossings(Q, m, y, xs + n);
         double c = common(xs, na, xs + n, nb);
         inter += c;
         uni += covered(xs, na) + covered(xs + n, nb) - c;

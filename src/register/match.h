@@ -21,6 +21,7 @@
  *   even.c              the polish's even-spacing stage: points taken evenly along it (even.h)
  *   alternatives.c      the distinct maps that fit about as well as the chosen one
  *   correspond.c        inliers, the part covered, dense correspondences
+ *   pixel_grid.c        a binary image's target: its tracing's bias simulated, the map found again
  *   precision.c         the gap between two maps; the standard error: a jackknife of the fit
  *   check.c             the overlap, the symmetry test, the forward-backward check (register.c runs them)
  *   result.c            the result object, its getters and the confidence
@@ -378,6 +379,14 @@ amscr_status amscr__map_precision(const amscr_descriptor *f, const double *nr, s
 /* precision.c: the mean squared displacement between the maps X1 and X2 over the samples of
  * f's base level. */
 double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6]);
+
+/* pixel_grid.c (docs/method.md §11.7): whether h's input points lie on a binary image's pixel
+ * lattice at a resolution where the tracing's bias counts, for h and for f under the map X; the
+ * stage itself, which may give r the map found again on the target corrected for that bias (r
+ * keeps its stages' record). */
+int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
+amscr_status amscr__pixel_grid(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                               amscr_workspace *ws, amscr_result *r);
 
 /* check.c (docs/method.md §11.5). A confidence at or above this is a confident answer: the
  * limit the documentation tells callers to reject below (1 - AMSCR__ALT_RATIO). */

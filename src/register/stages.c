@@ -6,7 +6,7 @@
  * symmetric way back only.
  *
  * Switchable stages (amscr_params_set_stage) are the optional ones: despike, recovery, polish,
- * order, even_spacing. The despike runs when a shape is prepared (amscr_descriptor_new); its
+ * order, even_spacing, pixel_grid. The despike runs when a shape is prepared (amscr_descriptor_new); its
  * entry records that it did for either shape. */
 #include "match.h"
 
@@ -62,6 +62,14 @@ static int when_order(const stage_ctx *c)
 static int when_even(const stage_ctx *c)
 {
     return c->pol && is_on(c, AMSCR__STAGE_EVEN) && amscr__polish_steps_apply(c->pol);
+}
+/* A closed pair under affine invariance whose input points the polish kept, the target's on the
+ * pixel lattice of a small binary image (pixel_grid.c); never within a check's or this stage's
+ * own registrations. */
+static int when_pixel_grid(const stage_ctx *c)
+{
+    return !c->r->backward && c->r->ran[AMSCR__STAGE_POLISH] && !c->prm->partial && is_on(c, AMSCR__STAGE_PIXEL_GRID) &&
+           amscr__pixel_grid_applies(c->f, c->h, c->r->m.X);
 }
 
 /* ---- stages ---- */
@@ -125,6 +133,7 @@ static amscr_status run_alternatives(stage_ctx *c)
     return AMSCR_OK;
 }
 static amscr_status run_correspond(stage_ctx *c) { return amscr__correspond(c->prm, c->f, c->h, c->r); }
+static amscr_status run_pixel_grid(stage_ctx *c) { return amscr__pixel_grid(c->prm, c->f, c->h, c->ws, c->r); }
 
 /* The pipeline, in order (indexed by AMSCR__STAGE_*). */
 static const stage_t STAGES[AMSCR__NUM_STAGES] = {
@@ -139,6 +148,7 @@ static const stage_t STAGES[AMSCR__NUM_STAGES] = {
     [AMSCR__STAGE_EVEN] = {run_even, when_even},
     [AMSCR__STAGE_ALTERNATIVES] = {run_alternatives, always},
     [AMSCR__STAGE_CORRESPOND] = {run_correspond, always},
+    [AMSCR__STAGE_PIXEL_GRID] = {run_pixel_grid, when_pixel_grid},
 };
 
 amscr_status amscr__run_stages(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,

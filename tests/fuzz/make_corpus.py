@@ -150,6 +150,11 @@ put('register', 'self-n32-binary', reg(0x05, 0x34, src))
 put('register', 'open-similarity', reg(0x40 | 0x02, 0x01 | 0x10, src[:12], dst[:15]))
 put('register', 'reflect-refine', reg(0x20 | 0x18, 0x0e | 0x40, src, [(-x, y) for x, y in dst]))
 put('register', 'square-vs-ellipse', reg(0x80, 0x20, [(0, 0), (4, 0), (4, 4), (0, 4), (0, 2), (2, 2)], polygon(10)))
+# a target traced from a small binary image (pixels x 1-6, y 1-4 but (6, 1)): its points on the
+# pixel lattice, so the polished registration runs the pixel_grid stage
+lattice = [(x, 0.5) for x in range(1, 6)] + [(5.5, 1), (6, 1.5)] + [(6.5, y) for y in (2, 3, 4)] + \
+    [(x, 4.5) for x in range(6, 0, -1)] + [(0.5, y) for y in (4, 3, 2, 1)]
+put('register', 'pixel-lattice', reg(0x06, 0x30, polygon(24, 3.0, 2.0, wobble=0.2), lattice))
 
 # ------------------------------------------------------------------ dbload
 build = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, 'build')

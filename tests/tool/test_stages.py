@@ -7,7 +7,7 @@ import math
 from imgutil import run, write_points
 
 PIPELINE = ["despike", "search", "method", "recovery", "final_solve", "symmetric", "polish", "order",
-            "even_spacing", "alternatives", "correspondences"]
+            "even_spacing", "alternatives", "correspondences", "pixel_grid"]
 MAP = ((1.3, 0.4, 15.0), (-0.2, 0.8, -7.0))
 
 

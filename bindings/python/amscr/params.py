@@ -74,7 +74,7 @@ class _Option(Generic[T]):
 
 
 #: The stages of ``amscr_register`` a Params can switch (C ``amscr_params_set_stage``).
-SWITCHABLE_STAGES: Tuple[str, ...] = ('despike', 'recovery', 'polish', 'order', 'even_spacing')
+SWITCHABLE_STAGES: Tuple[str, ...] = ('despike', 'recovery', 'polish', 'order', 'even_spacing', 'pixel_grid')
 
 
 class _StagesOption(_Option[Dict[str, bool]]):
@@ -132,9 +132,10 @@ class Params:
                      'cleaner (register; on in the registration preset; its order and even-spacing steps for '
                      'markedly noisy point lists are opt-in: stages)')
     stages = _StagesOption("the optional stages of register on or off, a dict {name: bool} over "
-                           "'despike', 'recovery', 'polish', 'order', 'even_spacing' (setting one leaves the others; "
-                           "default: despike, order and even_spacing off, for point lists with stray points or "
-                           "synthetic noise; Registration.stages says which ran)")
+                           "'despike', 'recovery', 'polish', 'order', 'even_spacing', 'pixel_grid' (setting one leaves "
+                           "the others; default: despike, order and even_spacing off, for point lists with stray "
+                           "points or synthetic noise; pixel_grid: a target traced from a small binary image "
+                           "registered again with its tracing's bias removed; Registration.stages says which ran)")
     channel_weight = _Option('channel_weight', _FLOAT,
                              'share of the shape channel in Collection.retrieval_matrix, 0..1 (0 = the AMSCR '
                              'distance alone, the default; 1 = the channel alone, the retrieval preset)')

@@ -92,7 +92,7 @@ class Registration:
             fall on (where a fragment lies, with partial=True).
         stages: dict {stage name: whether it ran}, in pipeline order (despike, search, method,
             recovery, final_solve, symmetric, polish, order, even_spacing, alternatives,
-            correspondences; C ``amscr_result_stage``).
+            correspondences, pixel_grid; C ``amscr_result_stage``).
         alternatives: list of :class:`Alternative` (A, B, cost): the distinct maps that fit
             about as well, the chosen map first (always there; its cost NaN when the
             registration ranked no starts), then each map that moves the source samples by more

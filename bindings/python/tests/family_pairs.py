@@ -20,12 +20,12 @@ def bench():
     return B
 
 
-def pair(B, i, key, draw):
+def pair(B, i, key, draw, **options):
     """(registration, RMS error % of R, success threshold %) of procedural shape i under the
-    families condition `key`, draw `draw`."""
+    families condition `key`, draw `draw` (options: amscr.register's)."""
     _, _, kind, level, thr, seed = [c for c in B.family_conditions() if c[0] == key][0]
     src = B.load_source(shapegen.silhouette(1, i))
     f = B.subpixel_contour(src)
     tgt, T = B.family_target(src, f, kind, level, np.random.default_rng([1000 + i, seed, draw, 2024]))
-    r = amscr.register(amscr.contour_from_mask(src, join=True), amscr.contour_from_mask(tgt, join=True))
+    r = amscr.register(amscr.contour_from_mask(src, join=True), amscr.contour_from_mask(tgt, join=True), **options)
     return r, B.errors(np.hstack([np.asarray(r.A), np.asarray(r.B)[:, None]]), T, f)[0], thr

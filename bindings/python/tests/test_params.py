@@ -14,7 +14,8 @@ CHANGED = {
     'partial': True, 'channel_weight': 0.5, 'channel_invariance': 'affine', 'channel_affine_share': 0.5,
     'channel_band': 0.2, 'channel_affine_band': 0.1, 'channel_skip': 0.5, 'channel_locality': 8.0, 'rerank_k': 3, 'rerank_iterations': 4,
     'rerank_inner_share': 0.125, 'inner_closing': 0.25, 'channel_affine_view': 3.5, 'polish': True,
-    'stages': {'despike': True, 'recovery': False, 'polish': False, 'order': True, 'even_spacing': True},
+    'stages': {'despike': True, 'recovery': False, 'polish': False, 'order': True, 'even_spacing': True,
+               'pixel_grid': False},
 }
 # the presets disagree on these flags: each preset gets the other value
 FLIPPED = {'polish'}

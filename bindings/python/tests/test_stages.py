@@ -8,7 +8,7 @@ import pytest
 import amscr
 
 PIPELINE = ['despike', 'search', 'method', 'recovery', 'final_solve', 'symmetric', 'polish', 'order',
-            'even_spacing', 'alternatives', 'correspondences']
+            'even_spacing', 'alternatives', 'correspondences', 'pixel_grid']
 A = np.array([[1.3, 0.4], [-0.2, 0.9]])
 B = np.array([3.0, 1.0])
 

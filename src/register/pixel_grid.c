@@ -1,0 +1,318 @@
+/* pixel_grid.c — the pixel_grid stage: a target traced from a binary image (docs/method.md §11.7).
+ *
+ * Such a target's points lie on the pixel lattice, halfway between a foreground and a background
+ * pixel centre: each has one integer and one half-integer coordinate (a sub-pixel trace of a
+ * two-valued image: amscr_contour_from_image, scikit-image's find_contours at level 0.5). Where
+ * the grid is coarse against the shape, the tracing is biased: corners are cut, a thin part is
+ * narrowed or lost. The stage simulates that bias under the map found: the source under the map
+ * is rendered on the target's grid as a camera and a threshold at half level would
+ * (amscr__raster_cover), traced as the target was, and each target point moved back by the bias
+ * its nearest synthetic point shows against the mapped source. The source is registered again
+ * onto the corrected points, and the new map kept only when its rendering differs from the target
+ * image (the pixels whose centre the traced target contains) in fewer pixels than the first
+ * map's. A kept map's inliers, correspondences and standard error are then measured on the target
+ * as traced (correspond.c), as its check is (check.c): the corrected points would flatter it. */
+#include "dense.h"
+#include "match.h"
+#include "nearest.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The stage runs where the target, and the source under the map found, have an RMS radius of at
+ * most this many pixels (a shape up to about 120 px across): there the tracing's bias (about a
+ * quarter pixel RMS) is a measurable share of the radius. Chosen on data (docs/decisions.md,
+ * the constants table): below it the stage gains on the three sets at 30-80 px across (radii up
+ * to 38 px); at 200 px (radii from 58 px) it gains and loses alike under damage and costs 70 %
+ * more time. The mapped source counts too: a large target cut to a small piece is damaged, not
+ * coarse, and the pixels it differs in would favour a map shrunk onto the piece. */
+#define AMSCR__GRID_RADIUS_MAX 40.0
+
+/* Every point has one integer and one half-integer coordinate. */
+static int on_lattice(const double *p, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        double x = 2.0 * p[2 * i], y = 2.0 * p[2 * i + 1];
+        if (!(fabs(x) < 1e15 && fabs(y) < 1e15) || x != floor(x) || y != floor(y))
+            return 0;
+        int hx = fmod(fabs(x), 2.0) == 1.0, hy = fmod(fabs(y), 2.0) == 1.0;
+        if (hx == hy)
+            return 0;
+    }
+    return n > 0;
+}
+
+/* The map in input coordinates of a map of normalized frames X (f onto a target of inverse
+ * frame inv). */
+static void input_map(const amscr_descriptor *f, const double inv[6], const double X[6], double A[6])
+{
+    double t[6];
+    amscr__affine_compose(X, f->fwd, t);
+    amscr__affine_compose(inv, t, A);
+}
+
+static void map_points(const double A[6], const double *p, size_t n, double *out)
+{
+    for (size_t i = 0; i < n; i++) {
+        double x = p[2 * i], y = p[2 * i + 1];
+        out[2 * i] = A[0] * x + A[1] * y + A[2];
+        out[2 * i + 1] = A[3] * x + A[4] * y + A[5];
+    }
+}
+
+/* The source's points under a map of normalized frames X (f onto a target of inverse frame inv):
+ * *out (2 f->nraw, caller frees). */
+static amscr_status mapped_source(const amscr_descriptor *f, const double inv[6], const double X[6], double **out)
+{
+    double A[6];
+    input_map(f, inv, X, A);
+    *out = amscr__malloc_array(2 * f->nraw, sizeof **out);
+    if (!*out)
+        return amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
+    map_points(A, f->raw, f->nraw, *out);
+    return AMSCR_OK;
+}
+
+/* The RMS radius of the n points p under the linear part of A: sqrt(trace(A C A^T)), C their
+ * covariance (no allocation: a stage's condition cannot fail). */
+static double mapped_radius(const double A[6], const double *p, size_t n)
+{
+    double cx, cy, sxx = 0.0, sxy = 0.0, syy = 0.0;
+    amscr__centroid(p, n, &cx, &cy);
+    for (size_t i = 0; i < n; i++) {
+        double x = p[2 * i] - cx, y = p[2 * i + 1] - cy;
+        sxx += x * x, sxy += x * y, syy += y * y;
+    }
+    double r2 = 0.0;
+    for (int k = 0; k < 2; k++) {
+        double a = A[3 * k], b = A[3 * k + 1];
+        r2 += a * a * sxx + 2.0 * a * b * sxy + b * b * syy;
+    }
+    return sqrt(r2 / (double)n);
+}
+
+int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6])
+{
+    static const double I[6] = {1, 0, 0, 0, 1, 0};
+    if (!f->raw || !h->raw || !on_lattice(h->raw, h->nraw) ||
+        !(mapped_radius(I, h->raw, h->nraw) <= AMSCR__GRID_RADIUS_MAX))
+        return 0;
+    double A[6];
+    input_map(f, h->inv, X, A);
+    return mapped_radius(A, f->raw, f->nraw) <= AMSCR__GRID_RADIUS_MAX;
+}
+
+/* ---- the grid ---- */
+typedef struct {
+    long x0, y0;
+    size_t w, h;
+} box_t;
+
+static void extent(const double *p, size_t n, double lo[2], double hi[2])
+{
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 2; k++) {
+            lo[k] = fmin(lo[k], p[2 * i + k]);
+            hi[k] = fmax(hi[k], p[2 * i + k]);
+        }
+}
+
+/* The pixels around the target (T) and the mapped source (M), two pixels beyond either, at most
+ * the target's own extent beyond the target (a map far off is far off by any count). */
+static box_t grid_box(const double *T, size_t nt, const double *M, size_t nm)
+{
+    double tl[2] = {INFINITY, INFINITY}, th[2] = {-INFINITY, -INFINITY};
+    extent(T, nt, tl, th);
+    double lo[2] = {tl[0], tl[1]}, hi[2] = {th[0], th[1]};
+    extent(M, nm, lo, hi);
+    long b[2][2];
+    for (int k = 0; k < 2; k++) {
+        double span = th[k] - tl[k];
+        b[k][0] = (long)floor(fmax(lo[k], tl[k] - span)) - 2;
+        b[k][1] = (long)ceil(fmin(hi[k], th[k] + span)) + 2;
+    }
+    box_t box = {b[0][0], b[1][0], (size_t)(b[0][1] - b[0][0] + 1), (size_t)(b[1][1] - b[1][0] + 1)};
+    return box;
+}
+
+/* The pixels where the rendering of M differs from the target image (T's pixel centres). */
+static amscr_status pixels_differing(const double *M, size_t nm, const double *T, size_t nt, size_t *out)
+{
+    box_t b = grid_box(T, nt, M, nm);
+    uint8_t *img = amscr__malloc_array(b.w, 2 * b.h);
+    if (!img)
+        return amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
+    uint8_t *tgt = img + b.w * b.h;
+    amscr_status st = amscr__raster_cover(M, nm, b.x0, b.y0, b.w, b.h, img);
+    if (st == AMSCR_OK)
+        st = amscr__raster_centres(T, nt, b.x0, b.y0, b.w, b.h, tgt);
+    size_t d = 0;
+    for (size_t i = 0; st == AMSCR_OK && i < b.w * b.h; i++)
+        d += img[i] != tgt[i];
+    *out = d;
+    free(img);
+    return st;
+}
+
+/* The mapped source M rendered on the target's grid and traced as the target was: *out (2 *out_n,
+ * input coordinates, caller frees). AMSCR_E_NOT_FOUND or AMSCR_E_DEGENERATE when nothing of it
+ * survives the grid. */
+static amscr_status synthetic_trace(const double *M, size_t nm, const double *T, size_t nt, double **out,
+                                    size_t *out_n)
+{
+    box_t b = grid_box(T, nt, M, nm);
+    uint8_t *img = amscr__malloc_array(b.w, b.h);
+    if (!img)
+        return amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
+    amscr_contour *c = NULL;
+    amscr_status st = amscr__raster_cover(M, nm, b.x0, b.y0, b.w, b.h, img);
+    if (st == AMSCR_OK)
+        st = amscr_contour_from_image(img, b.w, b.h, b.w, 8, 127.5, AMSCR_TRACE_JOIN, &c);
+    free(img);
+    if (st != AMSCR_OK)
+        return st;
+    for (size_t i = 0; i < c->n; i++) {
+        c->xy[2 * i] += (double)b.x0;
+        c->xy[2 * i + 1] += (double)b.y0;
+    }
+    *out = c->xy;
+    *out_n = c->n;
+    c->xy = NULL;
+    amscr_contour_free(c);
+    return AMSCR_OK;
+}
+
+/* Each synthetic point's bias against the mapped source M: its offset from its closest point on
+ * M's polygon, into bias (2 nc). */
+static amscr_status trace_bias(const double *M, size_t nm, const double *C, size_t nc, double *bias)
+{
+    amscr__grid g = {0};
+    int ok = amscr__grid_build(&g, M, nm);
+    if (ok <= 0) {
+        amscr__grid_free(&g);
+        return ok < 0 ? amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory")
+                      : amscr__fail(AMSCR_E_DEGENERATE, "pixel grid: the mapped source is not finite");
+    }
+    for (size_t k = 0; k < nc; k++) {
+        double qx = C[2 * k], qy = C[2 * k + 1], d2, t;
+        size_t seg, v = amscr__grid_nearest(&g, M, qx, qy, &d2);
+        amscr__edge_foot(M, nm, v, qx, qy, &seg, &t);
+        size_t nx = seg + 1 == nm ? 0 : seg + 1;
+        bias[2 * k] = qx - (M[2 * seg] + t * (M[2 * nx] - M[2 * seg]));
+        bias[2 * k + 1] = qy - (M[2 * seg + 1] + t * (M[2 * nx + 1] - M[2 * seg + 1]));
+    }
+    amscr__grid_free(&g);
+    return AMSCR_OK;
+}
+
+/* The target's points T moved back by the bias of their nearest synthetic point: *out (a new
+ * contour). AMSCR_E_NOT_FOUND / AMSCR_E_DEGENERATE: nothing to correct by. */
+static amscr_status corrected_target(const double *M, size_t nm, const double *T, size_t nt, amscr_contour **out)
+{
+    double *C = NULL, *bias = NULL, *xy = amscr__malloc_array(2 * nt, sizeof *xy);
+    size_t nc = 0;
+    amscr__grid g = {0};
+    amscr_status st = xy ? synthetic_trace(M, nm, T, nt, &C, &nc) : AMSCR_E_NOMEM;
+    if (st == AMSCR_OK)
+        st = (bias = amscr__malloc_array(2 * nc, sizeof *bias)) ? trace_bias(M, nm, C, nc, bias) : AMSCR_E_NOMEM;
+    if (st == AMSCR_OK && amscr__grid_build(&g, C, nc) < 0)
+        st = AMSCR_E_NOMEM;
+    if (st == AMSCR_E_NOMEM)
+        amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
+    for (size_t i = 0; st == AMSCR_OK && i < nt; i++) {
+        double d2;
+        size_t k = amscr__grid_nearest(&g, C, T[2 * i], T[2 * i + 1], &d2);
+        xy[2 * i] = T[2 * i] - bias[2 * k];
+        xy[2 * i + 1] = T[2 * i + 1] - bias[2 * k + 1];
+    }
+    amscr__grid_free(&g);
+    free(C);
+    free(bias);
+    if (st == AMSCR_OK)
+        return amscr__contour_wrap(xy, nt, out); /* takes xy */
+    free(xy);
+    return st;
+}
+
+/* The first map's result r gives way to the second's, r2 (of f onto h2, the corrected target):
+ * its map carried into h's normalized frame, its correspondences and standard error measured on
+ * h. r keeps its record of the stages that ran. */
+static amscr_status adopt(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                          const amscr_descriptor *h2, amscr_result *r, amscr_result *r2)
+{
+    unsigned char ran[AMSCR__NUM_STAGES];
+    memcpy(ran, r->ran, sizeof ran);
+    free(r->corr);
+    *r = *r2;
+    r2->corr = NULL;
+    memcpy(r->ran, ran, sizeof ran);
+    r->backward = 0;
+    double t[6];
+    amscr__affine_compose(h2->inv, r->m.X, t);
+    amscr__affine_compose(h->fwd, t, r->m.X);
+    return amscr__correspond(prm, f, h, r);
+}
+
+/* The source registered onto the corrected target h2: a second result into *out (NULL when the
+ * registration fails there: no evidence to change the map by). */
+static amscr_status register_again(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h2,
+                                   amscr_workspace *ws, amscr_result **out)
+{
+    amscr_result *r2 = calloc(1, sizeof *r2);
+    if (!r2)
+        return amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
+    r2->backward = 1; /* no standard error, and no pixel_grid stage of its own */
+    amscr_status st = amscr__run_stages(prm, f, h2, ws, r2);
+    if (st != AMSCR_OK) {
+        amscr_result_free(r2);
+        r2 = NULL;
+    }
+    *out = r2;
+    return st;
+}
+
+/* The corrected target prepared as h was, registered onto, and the better of the two maps kept. */
+static amscr_status second_map(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                               amscr_workspace *ws, amscr_result *r, const double *M, size_t first_differ)
+{
+    amscr_contour *c = NULL;
+    amscr_descriptor *h2 = NULL;
+    amscr_result *r2 = NULL;
+    double *M2 = NULL;
+    size_t second_differ = 0;
+    amscr_status st = corrected_target(M, f->nraw, h->raw, h->nraw, &c);
+    if (st == AMSCR_OK)
+        st = amscr_descriptor_new(&h->params, c, &h2);
+    if (st == AMSCR_OK)
+        st = register_again(prm, f, h2, ws, &r2);
+    if (st == AMSCR_OK)
+        st = mapped_source(f, h2->inv, r2->m.X, &M2);
+    if (st == AMSCR_OK)
+        st = pixels_differing(M2, f->nraw, h->raw, h->nraw, &second_differ);
+    if (st == AMSCR_OK && second_differ < first_differ)
+        st = adopt(prm, f, h, h2, r, r2);
+    free(M2);
+    amscr_result_free(r2);
+    amscr_descriptor_free(h2);
+    amscr_contour_free(c);
+    return st;
+}
+
+amscr_status amscr__pixel_grid(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                               amscr_workspace *ws, amscr_result *r)
+{
+    double *M = NULL;
+    size_t first_differ = 0;
+    amscr_status st = mapped_source(f, h->inv, r->m.X, &M);
+    if (st == AMSCR_OK)
+        st = pixels_differing(M, f->nraw, h->raw, h->nraw, &first_differ);
+    if (st == AMSCR_OK)
+        st = second_map(prm, f, h, ws, r, M, first_differ);
+    free(M);
+    if (st != AMSCR_OK && st != AMSCR_E_NOMEM) {
+        st = AMSCR_OK; /* nothing survived the grid, or the second registration failed: the first map stays */
+        amscr__clear_error();
+    }
+    return st;
+}

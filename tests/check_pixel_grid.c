@@ -1,0 +1,283 @@
+/* check_pixel_grid.c — polygons on a pixel grid (src/shape/rasterize.c) and the pixel_grid stage
+ * (src/register/pixel_grid.c): a pixel is on when the polygon covers half its area or more; a
+ * sub-pixel trace of a binary image gives that image back by its pixel centres; the stage runs on
+ * targets traced from small binary images only, and the map it keeps differs from the target image
+ * in no more pixels than the first one, and is as often right. */
+#include <amscr.h>
+#include <check.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "suites.h"
+#include "testutil.h"
+
+enum { W = 48, NSRC = 600, ARMS = 5 };
+/* A star's arms meet at this radius (its tips at 0.6-1). */
+#define INNER 0.2
+/* The targets of kept_map_fits_the_image: radius 9 px, 30 draws. */
+#define RAD 9.0
+#define NSEED 30
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static size_t count_on(const uint8_t *img, size_t n)
+{
+    size_t c = 0;
+    for (size_t i = 0; i < n; i++)
+        c += img[i] != 0;
+    return c;
+}
+
+/* An axis-aligned square [a, b]^2 as a polygon. */
+static void square(double a, double b, double *P)
+{
+    const double v[8] = {a, a, b, a, b, b, a, b};
+    memcpy(P, v, sizeof v);
+}
+
+START_TEST(cover_by_half_area)
+{
+    double P[8];
+    uint8_t img[36];
+    /* [0.9, 4.1]: pixels 1..4 covered by 0.6 along a side, 0.36 at a corner */
+    square(0.9, 4.1, P);
+    ck_assert_int_eq(amscr__raster_cover(P, 4, 0, 0, 6, 6, img), AMSCR_OK);
+    for (int j = 0; j < 6; j++)
+        for (int i = 0; i < 6; i++) {
+            int inside = i >= 1 && i <= 4 && j >= 1 && j <= 4, corner = (i == 1 || i == 4) && (j == 1 || j == 4);
+            ck_assert_int_eq(img[6 * j + i], inside && !corner ? 255 : 0);
+        }
+    /* [1.1, 4.9]: pixels 1 and 5 covered by 0.4 only */
+    square(1.1, 4.9, P);
+    ck_assert_int_eq(amscr__raster_cover(P, 4, 0, 0, 6, 6, img), AMSCR_OK);
+    for (int j = 0; j < 6; j++)
+        for (int i = 0; i < 6; i++)
+            ck_assert_int_eq(img[6 * j + i], (i >= 2 && i <= 4 && j >= 2 && j <= 4) ? 255 : 0);
+    /* the grid's origin moves the pixels, not the polygon: (x0, y0) = (1, 1) */
+    ck_assert_int_eq(amscr__raster_cover(P, 4, 1, 1, 6, 6, img), AMSCR_OK);
+    ck_assert_int_eq(img[6 * 1 + 1], 255);
+    ck_assert_int_eq(img[6 * 0 + 0], 0);
+    ck_assert_uint_eq(count_on(img, 36), 9);
+    /* a polygon far off the grid covers nothing */
+    square(100.0, 104.0, P);
+    ck_assert_int_eq(amscr__raster_cover(P, 4, 0, 0, 6, 6, img), AMSCR_OK);
+    ck_assert_uint_eq(count_on(img, 36), 0);
+}
+END_TEST
+
+/* A random smooth shape (star: a five-armed star) of radius r px centred in a g x g grid, under the map M (about the
+ * centre), into out (2 NSRC). */
+static void shape_px(uint64_t seed, int star, double r, const double M[6], size_t g, double *out)
+{
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, seed);
+    double *p = malloc(2 * NSRC * sizeof *p);
+    ck_assert(p);
+    if (star) { /* five arms of random length and slant */
+        double v[2 * 2 * ARMS];
+        for (int k = 0; k < 2 * ARMS; k++) {
+            double a = 2.0 * M_PI * (k + 0.3 * (amscr_test_uniform(&rng) - 0.5)) / (2 * ARMS);
+            double rad = k % 2 ? INNER : 0.6 + 0.4 * amscr_test_uniform(&rng);
+            v[2 * k] = rad * cos(a);
+            v[2 * k + 1] = rad * sin(a);
+        }
+        ck_assert_uint_eq(amscr_test_polygon(v, 2 * ARMS, NSRC / (2 * ARMS), p), NSRC);
+    } else {
+        amscr_test_random_shape(&rng, NSRC, 4, p);
+    }
+    for (size_t i = 0; i < NSRC; i++) {
+        double x = r * p[2 * i], y = r * p[2 * i + 1];
+        out[2 * i] = M[0] * x + M[1] * y + M[2] + (double)g / 2.0;
+        out[2 * i + 1] = M[3] * x + M[4] * y + M[5] + (double)g / 2.0;
+    }
+    free(p);
+}
+
+/* The binary image of polygon P (NSRC points) on the g x g grid (img: g * g bytes), traced at
+ * sub-pixel accuracy. */
+static amscr_contour *traced(const double *P, size_t g, uint8_t *img)
+{
+    amscr_contour *c = NULL;
+    ck_assert_int_eq(amscr__raster_cover(P, NSRC, 0, 0, g, g, img), AMSCR_OK);
+    ck_assert_int_eq(amscr_contour_from_image(img, g, g, g, 8, 127.5, 0, &c), AMSCR_OK);
+    return c;
+}
+
+static const double ID[6] = {1, 0, 0, 0, 1, 0};
+
+START_TEST(centres_give_the_traced_image_back)
+{
+    for (uint64_t seed = 1; seed <= 12; seed++) {
+        double P[2 * NSRC];
+        uint8_t img[W * W], back[W * W];
+        shape_px(seed, 0, 8.0 + (double)seed, ID, W, P);
+        amscr_contour *c = traced(P, W, img);
+        ck_assert_int_eq(amscr__raster_centres(amscr_contour_xy(c), amscr_contour_size(c), 0, 0, W, W, back),
+                         AMSCR_OK);
+        ck_assert_msg(memcmp(img, back, sizeof img) == 0, "seed %d: the trace does not give the image back",
+                      (int)seed);
+        amscr_contour_free(c);
+    }
+}
+END_TEST
+
+static amscr_result *reg(const amscr_params *p, const double *a, const amscr_contour *t)
+{
+    amscr_contour *s = NULL;
+    amscr_result *r = NULL;
+    ck_assert_int_eq(amscr_contour_new(a, NSRC, &s), AMSCR_OK);
+    ck_assert_int_eq(amscr_register_contours(p, s, t, &r), AMSCR_OK);
+    amscr_contour_free(s);
+    return r;
+}
+
+/* Whether the last stage, pixel_grid, ran. */
+static int ran(const amscr_result *r)
+{
+    size_t n = amscr_result_num_stages(r);
+    const char *name = NULL;
+    int on = -1;
+    ck_assert_int_eq(amscr_result_stage(r, n - 1, &name, &on), AMSCR_OK);
+    ck_assert_str_eq(name, "pixel_grid");
+    return on;
+}
+
+/* A pair: the source shape `seed` at 60 px (S) and its image under a random map (M, about the
+ * grid's centre) rendered with radius about r px on a g x g grid and traced (returned). */
+static amscr_contour *pair(uint64_t seed, double r, size_t g, double *S, double M[6])
+{
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, 1000 + seed);
+    amscr_test_random_affine(&rng, 1.6, 0.3, 0.0, 0, M);
+    double k = 1.0 / sqrt(fabs(M[0] * M[4] - M[1] * M[3]));
+    for (int i = 0; i < 6; i++)
+        M[i] *= i % 3 == 2 ? 1.0 : k;
+    double P[2 * NSRC];
+    shape_px(seed, 1, 60.0, ID, 160, S);
+    shape_px(seed, 1, r, M, g, P);
+    uint8_t *img = malloc(g * g);
+    ck_assert(img);
+    amscr_contour *t = traced(P, g, img);
+    free(img);
+    return t;
+}
+
+START_TEST(runs_on_small_binary_tracings_only)
+{
+    double S[2 * NSRC], M[6];
+    amscr_contour *t = pair(3, 12.0, W, S, M);
+    amscr_result *r = reg(NULL, S, t);
+    ck_assert_int_eq(ran(r), 1);
+    amscr_result_free(r);
+    /* off the lattice by a thousandth of a pixel: a point list, not a tracing */
+    size_t n = amscr_contour_size(t);
+    double *q = malloc(2 * n * sizeof *q);
+    ck_assert(q);
+    memcpy(q, amscr_contour_xy(t), 2 * n * sizeof *q);
+    q[0] += 1e-3;
+    amscr_contour *u = NULL;
+    ck_assert_int_eq(amscr_contour_new(q, n, &u), AMSCR_OK);
+    r = reg(NULL, S, u);
+    ck_assert_int_eq(ran(r), 0);
+    amscr_result_free(r);
+    amscr_contour_free(u);
+    free(q);
+    /* switched off */
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_stage(p, "pixel_grid", 0), AMSCR_OK);
+    r = reg(p, S, t);
+    ck_assert_int_eq(ran(r), 0);
+    amscr_result_free(r);
+    amscr_params_free(p);
+    amscr_contour_free(t);
+    /* the same shape in a large image: its radius over 40 px */
+    t = pair(3, 120.0, 300, S, M);
+    r = reg(NULL, S, t);
+    ck_assert_int_eq(ran(r), 0);
+    amscr_result_free(r);
+    amscr_contour_free(t);
+}
+END_TEST
+
+/* The pixels where the source under r's map, rendered on the grid, differs from the target
+ * image (t's pixel centres). */
+static size_t differing(const amscr_result *r, const double *S, const amscr_contour *t, size_t g)
+{
+    double A[6], P[2 * NSRC];
+    ck_assert_int_eq(amscr_result_affine(r, A), AMSCR_OK);
+    amscr_test_apply_affine(A, S, NSRC, P);
+    uint8_t *a = malloc(2 * g * g), *b = a + g * g;
+    ck_assert(a);
+    ck_assert_int_eq(amscr__raster_cover(P, NSRC, 0, 0, g, g, a), AMSCR_OK);
+    ck_assert_int_eq(amscr__raster_centres(amscr_contour_xy(t), amscr_contour_size(t), 0, 0, g, g, b), AMSCR_OK);
+    size_t d = 0;
+    for (size_t i = 0; i < g * g; i++)
+        d += a[i] != b[i];
+    free(a);
+    return d;
+}
+
+/* The RMS error of r's map against the truth M over the source S, % of the target's radius. */
+static double error_pct(const amscr_result *r, const double *S, const double M[6], size_t g)
+{
+    double A[6], T[6];
+    ck_assert_int_eq(amscr_result_affine(r, A), AMSCR_OK);
+    /* the truth from S (a 60-px shape about (80, 80)) to the target: x -> M (x - 80) / 5 + g/2 */
+    const double k = RAD / 60.0, c = 80.0, o = (double)g / 2.0;
+    T[0] = k * M[0], T[1] = k * M[1], T[2] = M[2] + o - k * (M[0] * c + M[1] * c);
+    T[3] = k * M[3], T[4] = k * M[4], T[5] = M[5] + o - k * (M[3] * c + M[4] * c);
+    double s2 = 0.0, P[2 * NSRC];
+    amscr_test_apply_affine(T, S, NSRC, P);
+    for (size_t i = 0; i < NSRC; i++) {
+        double x = S[2 * i], y = S[2 * i + 1];
+        double ex = A[0] * x + A[1] * y + A[2] - P[2 * i], ey = A[3] * x + A[4] * y + A[5] - P[2 * i + 1];
+        s2 += ex * ex + ey * ey;
+    }
+    return 100.0 * sqrt(s2 / NSRC) / amscr_test_shape_size(P, NSRC);
+}
+
+/* Stars of radius 9 px: with the stage on, the map kept never differs from the image in more
+ * pixels than the first map, and it is right (within 4 % of the radius) at least as often. */
+START_TEST(kept_map_fits_the_image)
+{
+    amscr_params *off = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&off), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_stage(off, "pixel_grid", 0), AMSCR_OK);
+    int ok_on = 0, ok_off = 0, changed = 0;
+    for (uint64_t seed = 1; seed <= NSEED; seed++) {
+        double S[2 * NSRC], M[6];
+        amscr_contour *t = pair(seed, RAD, W, S, M);
+        amscr_result *a = reg(NULL, S, t), *b = reg(off, S, t);
+        ck_assert_int_eq(ran(a), 1);
+        size_t da = differing(a, S, t, W), db = differing(b, S, t, W);
+        ck_assert_msg(da <= db, "seed %d: %zu pixels differ, %zu without the stage", (int)seed, da, db);
+        changed += da < db;
+        ok_on += error_pct(a, S, M, W) < 4.0;
+        ok_off += error_pct(b, S, M, W) < 4.0;
+        amscr_result_free(a);
+        amscr_result_free(b);
+        amscr_contour_free(t);
+    }
+    ck_assert_int_gt(changed, 0);
+    ck_assert_int_ge(ok_on, ok_off);
+    ck_assert_int_ge(ok_off, 10);
+    amscr_params_free(off);
+}
+END_TEST
+
+Suite *amscr_suite_pixel_grid(void)
+{
+    Suite *s = suite_create("pixel_grid");
+    TCase *tc = tcase_create("pixel_grid");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, cover_by_half_area);
+    tcase_add_test(tc, centres_give_the_traced_image_back);
+    tcase_add_test(tc, runs_on_small_binary_tracings_only);
+    tcase_add_test(tc, kept_map_fits_the_image);
+    suite_add_tcase(s, tc);
+    return s;
+}
