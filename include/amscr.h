@@ -1455,8 +1455,8 @@ AMSCR_API int amscr_params_get_polish(const amscr_params *p);
  *        onto again with its tracing's bias simulated and removed; the map whose rendering
  *        differs from the target image in fewer pixels is kept). Default in every preset:
  *        recovery, polish and pixel_grid on; despike, order and even_spacing off (switch them
- *        on for point lists with stray points or synthetic noise; docs/method.md §11). A stage switched on still runs only when its
- *        condition holds (amscr_result_stage).
+ *        on for point lists with stray points or synthetic noise; docs/method.md §11). A stage
+ *        switched on still runs only when its condition holds (amscr_result_stage).
  * @param on  1 on, 0 off.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, unknown or mandatory stage, on not 0 or 1).
  * Ownership: none.
@@ -2318,8 +2318,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_correspondences(const amscr_
 /**
  * @brief The number of stages of amscr_register's pipeline (the same for every result): in
  *        order despike, search, method, recovery, final_solve, symmetric, polish, order,
- *        even_spacing, alternatives, correspondences, pixel_grid (since 0.19; docs/method.md §12). New stages may be
- *        added in later versions; read them by index with amscr_result_stage.
+ *        even_spacing, alternatives, correspondences, pixel_grid (@since 0.19; docs/method.md
+ *        §12). New stages may be added in later versions; read them by index with
+ *        amscr_result_stage.
  * @return the count; 0 for NULL.
  * Ownership: none.
  * Thread-safety: const.

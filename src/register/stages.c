@@ -6,8 +6,8 @@
  * symmetric way back only.
  *
  * Switchable stages (amscr_params_set_stage) are the optional ones: despike, recovery, polish,
- * order, even_spacing, pixel_grid. The despike runs when a shape is prepared (amscr_descriptor_new); its
- * entry records that it did for either shape. */
+ * order, even_spacing, pixel_grid. The despike runs when a shape is prepared
+ * (amscr_descriptor_new); its entry records that it did for either shape. */
 #include "match.h"
 
 #include <math.h>
@@ -68,8 +68,8 @@ static int when_even(const stage_ctx *c)
  * own registrations. */
 static int when_pixel_grid(const stage_ctx *c)
 {
-    return !c->r->backward && c->r->ran[AMSCR__STAGE_POLISH] && !c->prm->partial && is_on(c, AMSCR__STAGE_PIXEL_GRID) &&
-           amscr__pixel_grid_applies(c->f, c->h, c->r->m.X);
+    return !c->r->backward && c->r->ran[AMSCR__STAGE_POLISH] && !c->prm->partial &&
+           is_on(c, AMSCR__STAGE_PIXEL_GRID) && amscr__pixel_grid_applies(c->f, c->h, c->r->m.X);
 }
 
 /* ---- stages ---- */
