@@ -21,7 +21,8 @@
  *   even.c              the polish's even-spacing stage: points taken evenly along it (even.h)
  *   alternatives.c      the distinct maps that fit about as well as the chosen one
  *   correspond.c        inliers, the part covered, dense correspondences
- *   pixel_grid.c        a binary image's target: its tracing's bias simulated, the map found again
+ *   pixel_grid.c        a small binary image's target: its tracing's bias simulated (register.c
+ *                       finds the map again)
  *   precision.c         the gap between two maps; the standard error: a jackknife of the fit
  *   check.c             the overlap, the symmetry test, the forward-backward check (register.c runs them)
  *   result.c            the result object, its getters and the confidence
@@ -380,13 +381,22 @@ amscr_status amscr__map_precision(const amscr_descriptor *f, const double *nr, s
  * f's base level. */
 double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6]);
 
-/* pixel_grid.c (docs/method.md §11.7): whether h's input points lie on a binary image's pixel
- * lattice at a resolution where the tracing's bias counts, for h and for f under the map X; the
- * stage itself, which may give r the map found again on the target corrected for that bias (r
- * keeps its stages' record). */
+/* pixel_grid.c (docs/method.md §11.7). Whether h's input points lie on a binary image's pixel
+ * lattice at a resolution where the tracing's bias counts, for h and for f under the map X (the
+ * stage's condition). */
 int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
-amscr_status amscr__pixel_grid(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                               amscr_workspace *ws, amscr_result *r);
+/* For the finished result r of f -> h: the pixels where the source under r's map, rendered on
+ * h's grid, differs from h's image (*out_differ), and h corrected for the tracing's bias under
+ * that map, prepared as h was (*out_h2, caller frees; NULL when nothing of the mapped source
+ * survives the grid). Fails only for want of memory. */
+amscr_status amscr__grid_target(const amscr_descriptor *f, const amscr_descriptor *h, const amscr_result *r,
+                                amscr_descriptor **out_h2, size_t *out_differ);
+/* r2, the registration of f onto h2, replaces r's map when its rendering differs from h's image in
+ * fewer pixels than first_differ: its map carried into h's frame, its correspondences and
+ * standard error measured on h (r keeps its stages' record). Fails only for want of memory. */
+amscr_status amscr__grid_choose(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                const amscr_descriptor *h2, size_t first_differ, amscr_result *r,
+                                amscr_result *r2);
 
 /* check.c (docs/method.md §11.5). A confidence at or above this is a confident answer: the
  * limit the documentation tells callers to reject below (1 - AMSCR__ALT_RATIO). */

@@ -11,7 +11,9 @@
  * onto the corrected points, and the new map kept only when its rendering differs from the target
  * image (the pixels whose centre the traced target contains) in fewer pixels than the first
  * map's. A kept map's inliers, correspondences and standard error are then measured on the target
- * as traced (correspond.c), as its check is (check.c): the corrected points would flatter it. */
+ * as traced (correspond.c), as its check is (check.c): the corrected points would flatter it.
+ * register.c runs the second registration between amscr__grid_target and amscr__grid_choose, once
+ * the stage table has finished (the table records whether the stage's condition held). */
 #include "dense.h"
 #include "match.h"
 #include "nearest.h"
@@ -254,65 +256,39 @@ static amscr_status adopt(const amscr_params *prm, const amscr_descriptor *f, co
     return amscr__correspond(prm, f, h, r);
 }
 
-/* The source registered onto the corrected target h2: a second result into *out (NULL when the
- * registration fails there: no evidence to change the map by). */
-static amscr_status register_again(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h2,
-                                   amscr_workspace *ws, amscr_result **out)
-{
-    amscr_result *r2 = calloc(1, sizeof *r2);
-    if (!r2)
-        return amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
-    r2->backward = 1; /* no standard error, and no pixel_grid stage of its own */
-    amscr_status st = amscr__run_stages(prm, f, h2, ws, r2);
-    if (st != AMSCR_OK) {
-        amscr_result_free(r2);
-        r2 = NULL;
-    }
-    *out = r2;
-    return st;
-}
-
-/* The corrected target prepared as h was, registered onto, and the better of the two maps kept. */
-static amscr_status second_map(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                               amscr_workspace *ws, amscr_result *r, const double *M, size_t first_differ)
-{
-    amscr_contour *c = NULL;
-    amscr_descriptor *h2 = NULL;
-    amscr_result *r2 = NULL;
-    double *M2 = NULL;
-    size_t second_differ = 0;
-    amscr_status st = corrected_target(M, f->nraw, h->raw, h->nraw, &c);
-    if (st == AMSCR_OK)
-        st = amscr_descriptor_new(&h->params, c, &h2);
-    if (st == AMSCR_OK)
-        st = register_again(prm, f, h2, ws, &r2);
-    if (st == AMSCR_OK)
-        st = mapped_source(f, h2->inv, r2->m.X, &M2);
-    if (st == AMSCR_OK)
-        st = pixels_differing(M2, f->nraw, h->raw, h->nraw, &second_differ);
-    if (st == AMSCR_OK && second_differ < first_differ)
-        st = adopt(prm, f, h, h2, r, r2);
-    free(M2);
-    amscr_result_free(r2);
-    amscr_descriptor_free(h2);
-    amscr_contour_free(c);
-    return st;
-}
-
-amscr_status amscr__pixel_grid(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                               amscr_workspace *ws, amscr_result *r)
+amscr_status amscr__grid_target(const amscr_descriptor *f, const amscr_descriptor *h, const amscr_result *r,
+                                amscr_descriptor **out_h2, size_t *out_differ)
 {
     double *M = NULL;
-    size_t first_differ = 0;
+    amscr_contour *c = NULL;
+    *out_h2 = NULL;
     amscr_status st = mapped_source(f, h->inv, r->m.X, &M);
     if (st == AMSCR_OK)
-        st = pixels_differing(M, f->nraw, h->raw, h->nraw, &first_differ);
+        st = pixels_differing(M, f->nraw, h->raw, h->nraw, out_differ);
     if (st == AMSCR_OK)
-        st = second_map(prm, f, h, ws, r, M, first_differ);
+        st = corrected_target(M, f->nraw, h->raw, h->nraw, &c);
+    if (st == AMSCR_OK)
+        st = amscr_descriptor_new(&h->params, c, out_h2);
     free(M);
+    amscr_contour_free(c);
     if (st != AMSCR_OK && st != AMSCR_E_NOMEM) {
-        st = AMSCR_OK; /* nothing survived the grid, or the second registration failed: the first map stays */
+        st = AMSCR_OK; /* nothing of the mapped source survived the grid: no correction */
         amscr__clear_error();
     }
+    return st;
+}
+
+amscr_status amscr__grid_choose(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
+                                const amscr_descriptor *h2, size_t first_differ, amscr_result *r,
+                                amscr_result *r2)
+{
+    double *M2 = NULL;
+    size_t second_differ = 0;
+    amscr_status st = mapped_source(f, h2->inv, r2->m.X, &M2);
+    if (st == AMSCR_OK)
+        st = pixels_differing(M2, f->nraw, h->raw, h->nraw, &second_differ);
+    free(M2);
+    if (st == AMSCR_OK && second_differ < first_differ)
+        st = adopt(prm, f, h, h2, r, r2);
     return st;
 }

@@ -5,7 +5,9 @@
  * register.c — matching a prepared source onto a prepared target (docs/method.md §3, §9), top-down:
  *   amscr_register    checks the pair, runs the stage table (stages.c: despike, search, method,
  *                     recovery, final solve, symmetric, polish, order, even spacing,
- *                     alternatives, correspondences) and fills the result's maps;
+ *                     alternatives, correspondences, pixel_grid), registers a small binary
+ *                     image's target again when the pixel_grid stage's condition held
+ *                     (pixel_grid.c), checks the result (check.c) and fills the result's maps;
  *   amscr_distance    checks the pair, then match_pair: one direction f -> h by
  *                     amscr__match_dir (shift_search.c: candidate start points ranked by one
  *                     rule, the winner through the method and the refinement) and, symmetric,
@@ -22,6 +24,8 @@ static amscr_status check_partial(const amscr_params *prm, const amscr_descripto
 static amscr_status check_pair(const amscr_params **prm, const amscr_descriptor *src, const amscr_descriptor *tgt);
 static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                amscr_workspace *ws, match_t *m);
+static amscr_status again_on_pixel_grid(const amscr_params *prm, const amscr_descriptor *src,
+                                        const amscr_descriptor *tgt, amscr_workspace *ws, amscr_result *r);
 
 amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
                             amscr_workspace *ws, amscr_result **out_result)
@@ -40,6 +44,8 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_register: out of memory");
     if (st == AMSCR_OK)
         st = amscr__run_stages(p, src, tgt, w, r);
+    if (st == AMSCR_OK && r->ran[AMSCR__STAGE_PIXEL_GRID]) /* a small binary image's target (pixel_grid.c) */
+        st = again_on_pixel_grid(p, src, tgt, w, r);
     if (st == AMSCR_OK) /* how far the result can be trusted: its overlap and checks (check.c) */
         st = amscr__check(p, src, tgt, w, r);
     if (!ws)
@@ -83,6 +89,36 @@ amscr_status amscr__distance_ws(const amscr_params *prm, const amscr_descriptor 
     amscr_status st = match_pair(prm, src, tgt, ws, &m);
     if (st == AMSCR_OK)
         *out = m.dist;
+    return st;
+}
+
+/* The pixel_grid stage (docs/method.md §11.7): the source registered again onto the target
+ * corrected for its tracing's bias, through the same stages (r2->backward: no standard error, and
+ * no pixel_grid stage of its own), and the map that matches the target's image better kept in r. A
+ * registration that fails there leaves r as it was: no evidence to change the map by. */
+static amscr_status again_on_pixel_grid(const amscr_params *prm, const amscr_descriptor *src,
+                                        const amscr_descriptor *tgt, amscr_workspace *ws, amscr_result *r)
+{
+    amscr_descriptor *h2 = NULL;
+    amscr_result *r2 = NULL;
+    size_t first_differ = 0;
+    amscr_status st = amscr__grid_target(src, tgt, r, &h2, &first_differ);
+    if (st == AMSCR_OK && h2) {
+        r2 = calloc(1, sizeof *r2);
+        st = r2 ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
+    }
+    if (r2) {
+        r2->backward = 1;
+        st = amscr__run_stages(prm, src, h2, ws, r2);
+        if (st == AMSCR_OK)
+            st = amscr__grid_choose(prm, src, tgt, h2, first_differ, r, r2);
+        else if (st != AMSCR_E_NOMEM) {
+            st = AMSCR_OK;
+            amscr__clear_error();
+        }
+    }
+    amscr_result_free(r2);
+    amscr_descriptor_free(h2);
     return st;
 }
 

@@ -7,7 +7,9 @@
  *
  * Switchable stages (amscr_params_set_stage) are the optional ones: despike, recovery, polish,
  * order, even_spacing, pixel_grid. The despike runs when a shape is prepared
- * (amscr_descriptor_new); its entry records that it did for either shape. */
+ * (amscr_descriptor_new); its entry records that it did for either shape. The pixel_grid stage
+ * registers the pair again: register.c runs it once the table has finished, when its entry here
+ * records that its condition held. */
 #include "match.h"
 
 #include <math.h>
@@ -27,7 +29,9 @@ typedef struct {
 /* A stage's function and condition; its name and whether it is switchable are in
  * base/stage_names.c, under the same index. */
 typedef struct {
-    amscr_status (*run)(stage_ctx *c); /* NULL: runs when a shape is prepared */
+    amscr_status (*run)(stage_ctx *c); /* NULL: its work runs outside the table (despike: when a
+                                          shape is prepared; pixel_grid: register.c, once the table
+                                          has finished, as it registers the pair again) */
     int (*when)(const stage_ctx *c);
 } stage_t;
 
@@ -133,7 +137,6 @@ static amscr_status run_alternatives(stage_ctx *c)
     return AMSCR_OK;
 }
 static amscr_status run_correspond(stage_ctx *c) { return amscr__correspond(c->prm, c->f, c->h, c->r); }
-static amscr_status run_pixel_grid(stage_ctx *c) { return amscr__pixel_grid(c->prm, c->f, c->h, c->ws, c->r); }
 
 /* The pipeline, in order (indexed by AMSCR__STAGE_*). */
 static const stage_t STAGES[AMSCR__NUM_STAGES] = {
@@ -148,7 +151,7 @@ static const stage_t STAGES[AMSCR__NUM_STAGES] = {
     [AMSCR__STAGE_EVEN] = {run_even, when_even},
     [AMSCR__STAGE_ALTERNATIVES] = {run_alternatives, always},
     [AMSCR__STAGE_CORRESPOND] = {run_correspond, always},
-    [AMSCR__STAGE_PIXEL_GRID] = {run_pixel_grid, when_pixel_grid},
+    [AMSCR__STAGE_PIXEL_GRID] = {NULL, when_pixel_grid},
 };
 
 amscr_status amscr__run_stages(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
