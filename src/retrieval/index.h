@@ -160,8 +160,19 @@ amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const ams
  * features of shapes first..n-1, on the params' threads; drops the lists' reverse, and rebuilds
  * it when have_sig and first == 0 (a load: the lists are in place). */
 amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig);
+
+/* ------------------------------------------ the mirrored features' pool (index_mirror.c) */
+
+/* Bytes of one frame's mirrored orientation in the pool at N samples (its heights, then its
+ * spectra, each rounded up to 16 bytes). */
+size_t amscr__index_pool_frame(size_t N);
+/* The mirrored orientation of a shape's features (nf frames) freed; what points into pool
+ * (pool_len bytes; NULL, 0: none) only forgotten. */
+void amscr__index_mirror_free(amscr__hf *hf, int nf, const unsigned char *pool, size_t pool_len);
+/* Shape i's mirrored features moved into x's pool (their own blocks freed). */
+void amscr__index_mirror_to_pool(amscr_index *x, size_t i);
 /* The mirrored orientation of the channel features of shapes first..n-1 freed, once their rows
- * are built (index_features.c: the pairs that read it make it), and the mirror pool with it. */
+ * are built (the pairs that read it make it), and the mirror pool with it. */
 void amscr__index_drop_mirrors(amscr_index *x, size_t first);
 
 /* ------------------------------------------------------------------- the neighbour lists */

@@ -22,7 +22,7 @@ if pkg-config --exists libpng; then
 fi
 mkdir -p "$OUT/obj"
 
-HEADERS="include/amscr.h src/*/*.h tools/cli/image.h tools/cli/util.h tools/cli/collection.h tests/fuzz/fuzz_common.h tests/fuzz/fuzz_image.h"
+HEADERS="include/amscr.h src/*/*.h tools/cli/image.h tools/cli/image_codec.h tools/cli/util.h tools/cli/collection.h tests/fuzz/fuzz_common.h tests/fuzz/fuzz_image.h"
 newest_header=$(ls -t $HEADERS | head -1)
 
 # compile SRC OBJ EXTRA_FLAGS...: only when the object is missing or older than SRC or a header.
@@ -48,7 +48,7 @@ for src in src/*/*.c; do
   lib_objs+=("$obj")
 done
 tool_objs=()
-for src in tools/cli/image.c tools/cli/image_pgm.c tools/cli/image_png.c tools/cli/util.c tools/cli/collection.c; do
+for src in tools/cli/image.c tools/cli/image_codec.c tools/cli/image_pgm.c tools/cli/image_png.c tools/cli/util.c tools/cli/collection.c; do
   obj="$OUT/obj/tool_$(basename "${src%.c}").o"
   throttle
   # shellcheck disable=SC2086

@@ -8,15 +8,8 @@
 #include <stdint.h>
 
 #include "amscr.h"
+#include "image_codec.h" /* tool_image, image_free */
 
-/* An 8-bit luminance image, rows packed (stride == width); pix16: the same image with 16-bit
- * samples when the file had more than 8 bits a sample (16-bit PNG without alpha, PGM with
- * maxval > 255), else NULL. */
-typedef struct tool_image {
-    uint8_t *pix;
-    size_t width, height;
-    uint16_t *pix16;
-} tool_image;
 
 typedef enum tool_format {
     TOOL_FMT_TEXT = 0, /* anything that is not an image magic: a text point list */
@@ -30,7 +23,6 @@ typedef enum tool_format {
  * magic bytes said. A file that is not an image returns 1 without a message when `text_ok`
  * is non-zero (the caller reads it as a point list), else -1 with a message. */
 int image_read(const char *path, int text_ok, tool_image *out, tool_format *out_format);
-void image_free(tool_image *img);
 
 /* Loads a shape: an image (traced with amscr_contour_from_image at the level of `threshold`,
  * 0..254 or AMSCR_THRESHOLD_AUTO: see image_level) or a text point list. On failure prints
