@@ -40,7 +40,7 @@ size_t amscr__crossings(const double *P, size_t n, double y, double *xs)
 static size_t first_at(double x, double offset, double k, size_t cells)
 {
     double q = ceil((x - offset) * k);
-    return q <= 0.0 ? 0 : q >= (double)cells ? cells : (size_t)q;
+    return !(q > 0.0) ? 0 : q >= (double)cells ? cells : (size_t)q; /* NaN: none */
 }
 
 /* Adds the samples of one sample line inside [xs[k], xs[k+1]) to the row's pixels: `part` holds
