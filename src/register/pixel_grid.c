@@ -238,8 +238,9 @@ static amscr_status corrected_target(const double *M, size_t nm, const double *T
 }
 
 /* The first map's result r gives way to the second's, r2 (of f onto h2, the corrected target):
- * its map carried into h's normalized frame, its correspondences and standard error measured on
- * h. r keeps its record of the stages that ran. */
+ * its map carried into h's normalized frame (the first alternative is that map, bit for bit as
+ * the result reports it), its correspondences and standard error measured on h. r keeps its
+ * record of the stages that ran. */
 static amscr_status adopt(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                           const amscr_descriptor *h2, amscr_result *r, amscr_result *r2)
 {
@@ -253,6 +254,7 @@ static amscr_status adopt(const amscr_params *prm, const amscr_descriptor *f, co
     double t[6];
     amscr__affine_compose(h2->inv, r->m.X, t);
     amscr__affine_compose(h->fwd, t, r->m.X);
+    input_map(f, h->inv, r->m.X, r->alt[0]); /* the chosen map first, as the result reports it */
     return amscr__correspond(prm, f, h, r);
 }
 
