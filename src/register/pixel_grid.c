@@ -31,10 +31,6 @@
  * coarse, and the pixels it differs in would favour a map shrunk onto the piece. */
 #define AMSCR__GRID_RADIUS_MAX 40.0
 
-/* How a target's points were traced from a binary image, when they were: a sub-pixel trace
- * (the lattice) or a chain of boundary pixel centres. */
-enum { GRID_NONE, GRID_LATTICE, GRID_CHAIN };
-
 /* Every point has one integer and one half-integer coordinate. */
 static int on_lattice(const double *p, size_t n)
 {
@@ -47,28 +43,6 @@ static int on_lattice(const double *p, size_t n)
             return 0;
     }
     return n > 0;
-}
-
-/* Every point on integer coordinates and next to the one before (8-neighbours; the last next to
- * the first): the boundary pixel centres of a pixel-chain tracer (amscr_contour_from_mask, the
- * tool's --pixel-chain, OpenCV's findContours without approximation). */
-static int on_chain(const double *p, size_t n)
-{
-    for (size_t i = 0; i < n; i++) {
-        size_t j = i + 1 == n ? 0 : i + 1;
-        double x = p[2 * i], y = p[2 * i + 1], dx = fabs(p[2 * j] - x), dy = fabs(p[2 * j + 1] - y);
-        if (!(fabs(x) < 1e15 && fabs(y) < 1e15) || x != floor(x) || y != floor(y) || fmax(dx, dy) != 1.0)
-            return 0;
-    }
-    return n > 2;
-}
-
-static int grid_kind(const amscr_descriptor *h)
-{
-    return !h->raw ? GRID_NONE
-           : on_lattice(h->raw, h->nraw) ? GRID_LATTICE
-           : on_chain(h->raw, h->nraw)   ? GRID_CHAIN
-                                         : GRID_NONE;
 }
 
 /* The map in input coordinates of a map of normalized frames X (f onto a target of inverse
@@ -123,7 +97,8 @@ static double mapped_radius(const double A[6], const double *p, size_t n)
 int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6])
 {
     static const double I[6] = {1, 0, 0, 0, 1, 0};
-    if (!f->raw || grid_kind(h) == GRID_NONE || !(mapped_radius(I, h->raw, h->nraw) <= AMSCR__GRID_RADIUS_MAX))
+    if (!f->raw || !h->raw || !on_lattice(h->raw, h->nraw) ||
+        !(mapped_radius(I, h->raw, h->nraw) <= AMSCR__GRID_RADIUS_MAX))
         return 0;
     double A[6];
     input_map(f, h->inv, X, A);
@@ -163,21 +138,8 @@ static box_t grid_box(const double *T, size_t nt, const double *M, size_t nm)
     return box;
 }
 
-/* The target image of T (traced as `kind`) on the grid b: the pixels whose centre T contains and,
- * for a chain, T's own pixels. */
-static amscr_status target_image(const double *T, size_t nt, int kind, box_t b, uint8_t *out)
-{
-    amscr_status st = amscr__raster_centres(T, nt, b.x0, b.y0, b.w, b.h, out);
-    for (size_t i = 0; st == AMSCR_OK && kind == GRID_CHAIN && i < nt; i++) {
-        double x = T[2 * i] - (double)b.x0, y = T[2 * i + 1] - (double)b.y0;
-        if (x >= 0.0 && y >= 0.0 && x < (double)b.w && y < (double)b.h)
-            out[(size_t)y * b.w + (size_t)x] = 255;
-    }
-    return st;
-}
-
-/* The pixels where the rendering of M differs from the target image of T (traced as `kind`). */
-static amscr_status pixels_differing(const double *M, size_t nm, const double *T, size_t nt, int kind, size_t *out)
+/* The pixels where the rendering of M differs from the target image (T's pixel centres). */
+static amscr_status pixels_differing(const double *M, size_t nm, const double *T, size_t nt, size_t *out)
 {
     box_t b = grid_box(T, nt, M, nm);
     uint8_t *img = amscr__malloc_array(b.w, 2 * b.h);
@@ -186,7 +148,7 @@ static amscr_status pixels_differing(const double *M, size_t nm, const double *T
     uint8_t *tgt = img + b.w * b.h;
     amscr_status st = amscr__raster_cover(M, nm, b.x0, b.y0, b.w, b.h, img);
     if (st == AMSCR_OK)
-        st = target_image(T, nt, kind, b, tgt);
+        st = amscr__raster_centres(T, nt, b.x0, b.y0, b.w, b.h, tgt);
     size_t d = 0;
     for (size_t i = 0; st == AMSCR_OK && i < b.w * b.h; i++)
         d += img[i] != tgt[i];
@@ -195,10 +157,10 @@ static amscr_status pixels_differing(const double *M, size_t nm, const double *T
     return st;
 }
 
-/* The mapped source M rendered on the target's grid and traced as the target was (`kind`): *out
- * (2 *out_n, input coordinates, caller frees). AMSCR_E_NOT_FOUND or AMSCR_E_DEGENERATE when
- * nothing of it survives the grid. */
-static amscr_status synthetic_trace(const double *M, size_t nm, const double *T, size_t nt, int kind, double **out,
+/* The mapped source M rendered on the target's grid and traced as the target was: *out (2 *out_n,
+ * input coordinates, caller frees). AMSCR_E_NOT_FOUND or AMSCR_E_DEGENERATE when nothing of it
+ * survives the grid. */
+static amscr_status synthetic_trace(const double *M, size_t nm, const double *T, size_t nt, double **out,
                                     size_t *out_n)
 {
     box_t b = grid_box(T, nt, M, nm);
@@ -208,8 +170,7 @@ static amscr_status synthetic_trace(const double *M, size_t nm, const double *T,
     amscr_contour *c = NULL;
     amscr_status st = amscr__raster_cover(M, nm, b.x0, b.y0, b.w, b.h, img);
     if (st == AMSCR_OK)
-        st = amscr_contour_from_image(img, b.w, b.h, b.w, 8, 127.5,
-                                      kind == GRID_CHAIN ? AMSCR_TRACE_PIXEL_CHAIN : AMSCR_TRACE_JOIN, &c);
+        st = amscr_contour_from_image(img, b.w, b.h, b.w, 8, 127.5, AMSCR_TRACE_JOIN, &c);
     free(img);
     if (st != AMSCR_OK)
         return st;
@@ -249,13 +210,12 @@ static amscr_status trace_bias(const double *M, size_t nm, const double *C, size
 
 /* The target's points T moved back by the bias of their nearest synthetic point: *out (a new
  * contour). AMSCR_E_NOT_FOUND / AMSCR_E_DEGENERATE: nothing to correct by. */
-static amscr_status corrected_target(const double *M, size_t nm, const double *T, size_t nt, int kind,
-                                     amscr_contour **out)
+static amscr_status corrected_target(const double *M, size_t nm, const double *T, size_t nt, amscr_contour **out)
 {
     double *C = NULL, *bias = NULL, *xy = amscr__malloc_array(2 * nt, sizeof *xy);
     size_t nc = 0;
     amscr__grid g = {0};
-    amscr_status st = xy ? synthetic_trace(M, nm, T, nt, kind, &C, &nc) : AMSCR_E_NOMEM;
+    amscr_status st = xy ? synthetic_trace(M, nm, T, nt, &C, &nc) : AMSCR_E_NOMEM;
     if (st == AMSCR_OK)
         st = (bias = amscr__malloc_array(2 * nc, sizeof *bias)) ? trace_bias(M, nm, C, nc, bias) : AMSCR_E_NOMEM;
     if (st == AMSCR_OK && amscr__grid_build(&g, C, nc) < 0)
@@ -306,9 +266,9 @@ amscr_status amscr__grid_target(const amscr_descriptor *f, const amscr_descripto
     *out_h2 = NULL;
     amscr_status st = mapped_source(f, h->inv, r->m.X, &M);
     if (st == AMSCR_OK)
-        st = pixels_differing(M, f->nraw, h->raw, h->nraw, grid_kind(h), out_differ);
+        st = pixels_differing(M, f->nraw, h->raw, h->nraw, out_differ);
     if (st == AMSCR_OK)
-        st = corrected_target(M, f->nraw, h->raw, h->nraw, grid_kind(h), &c);
+        st = corrected_target(M, f->nraw, h->raw, h->nraw, &c);
     if (st == AMSCR_OK)
         st = amscr_descriptor_new(&h->params, c, out_h2);
     free(M);
@@ -328,7 +288,7 @@ amscr_status amscr__grid_choose(const amscr_params *prm, const amscr_descriptor 
     size_t second_differ = 0;
     amscr_status st = mapped_source(f, h2->inv, r2->m.X, &M2);
     if (st == AMSCR_OK)
-        st = pixels_differing(M2, f->nraw, h->raw, h->nraw, grid_kind(h), &second_differ);
+        st = pixels_differing(M2, f->nraw, h->raw, h->nraw, &second_differ);
     free(M2);
     if (st == AMSCR_OK && second_differ < first_differ)
         st = adopt(prm, f, h, h2, r, r2);
