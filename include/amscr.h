@@ -1450,10 +1450,10 @@ AMSCR_API int amscr_params_get_polish(const amscr_params *p);
  *        placed as further starts when part of the target is missing), "polish" (both this
  *        switch and amscr_params_set_polish must be on; prefer amscr_params_set_polish, as
  *        this one is on by default), "order" and "even_spacing" (the polish's steps on
- *        markedly noisy points), "pixel_grid" (@since 0.19: a target traced from a binary image
- *        of a shape up to about 120 px across, its points on the pixel lattice, is registered
- *        onto again with its tracing's bias simulated and removed; the map whose rendering
- *        differs from the target image in fewer pixels is kept). Default in every preset:
+ *        markedly noisy points), "pixel_grid" (a target traced from a small binary image, its
+ *        points on the pixel lattice, is registered onto again with its tracing's bias
+ *        simulated and removed; the map whose rendering differs from the target image in fewer
+ *        pixels is kept; which targets: docs/method.md §11.7). Default in every preset:
  *        recovery, polish and pixel_grid on; despike, order and even_spacing off (switch them
  *        on for point lists with stray points or synthetic noise; docs/method.md §11). A stage
  *        switched on still runs only when its condition holds (amscr_result_stage).
@@ -2318,9 +2318,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_correspondences(const amscr_
 /**
  * @brief The number of stages of amscr_register's pipeline (the same for every result): in
  *        order despike, search, method, recovery, final_solve, symmetric, polish, order,
- *        even_spacing, alternatives, correspondences, pixel_grid (@since 0.19; docs/method.md
- *        §12). New stages may be added in later versions; read them by index with
- *        amscr_result_stage.
+ *        even_spacing, alternatives, correspondences, pixel_grid (docs/method.md §12). New
+ *        stages may be added in later versions; read them by index with amscr_result_stage.
  * @return the count; 0 for NULL.
  * Ownership: none.
  * Thread-safety: const.
