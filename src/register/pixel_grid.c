@@ -138,40 +138,45 @@ static box_t grid_box(const double *T, size_t nt, const double *M, size_t nm)
     return box;
 }
 
-/* The pixels where the rendering of M differs from the target image (T's pixel centres). */
-static amscr_status pixels_differing(const double *M, size_t nm, const double *T, size_t nt, size_t *out)
+/* The mapped source M as the camera would see it on the target T's grid: the box around both
+ * and its pixels (img, b.w * b.h bytes, caller frees). */
+typedef struct {
+    box_t b;
+    uint8_t *img;
+} rendering_t;
+
+static amscr_status render(const double *M, size_t nm, const double *T, size_t nt, rendering_t *out)
 {
-    box_t b = grid_box(T, nt, M, nm);
-    uint8_t *img = amscr__malloc_array(b.w, 2 * b.h);
-    if (!img)
+    out->b = grid_box(T, nt, M, nm);
+    out->img = amscr__malloc_array(out->b.w, out->b.h);
+    if (!out->img)
         return amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
-    uint8_t *tgt = img + b.w * b.h;
-    amscr_status st = amscr__raster_cover(M, nm, b.x0, b.y0, b.w, b.h, img);
-    if (st == AMSCR_OK)
-        st = amscr__raster_centres(T, nt, b.x0, b.y0, b.w, b.h, tgt);
+    return amscr__raster_cover(M, nm, out->b.x0, out->b.y0, out->b.w, out->b.h, out->img);
+}
+
+/* The pixels where the rendering differs from the target image (T's pixel centres). */
+static amscr_status pixels_differing(const rendering_t *rd, const double *T, size_t nt, size_t *out)
+{
+    box_t b = rd->b;
+    uint8_t *tgt = amscr__malloc_array(b.w, b.h);
+    if (!tgt)
+        return amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
+    amscr_status st = amscr__raster_centres(T, nt, b.x0, b.y0, b.w, b.h, tgt);
     size_t d = 0;
     for (size_t i = 0; st == AMSCR_OK && i < b.w * b.h; i++)
-        d += img[i] != tgt[i];
+        d += rd->img[i] != tgt[i];
     *out = d;
-    free(img);
+    free(tgt);
     return st;
 }
 
-/* The mapped source M rendered on the target's grid and traced as the target was: *out (2 *out_n,
- * input coordinates, caller frees). AMSCR_E_NOT_FOUND or AMSCR_E_DEGENERATE when nothing of it
- * survives the grid. */
-static amscr_status synthetic_trace(const double *M, size_t nm, const double *T, size_t nt, double **out,
-                                    size_t *out_n)
+/* The rendering traced as the target was: *out (2 *out_n, input coordinates, caller frees).
+ * AMSCR_E_NOT_FOUND or AMSCR_E_DEGENERATE when nothing of the mapped source survives the grid. */
+static amscr_status synthetic_trace(const rendering_t *rd, double **out, size_t *out_n)
 {
-    box_t b = grid_box(T, nt, M, nm);
-    uint8_t *img = amscr__malloc_array(b.w, b.h);
-    if (!img)
-        return amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
+    box_t b = rd->b;
     amscr_contour *c = NULL;
-    amscr_status st = amscr__raster_cover(M, nm, b.x0, b.y0, b.w, b.h, img);
-    if (st == AMSCR_OK)
-        st = amscr_contour_from_image(img, b.w, b.h, b.w, 8, 127.5, AMSCR_TRACE_JOIN, &c);
-    free(img);
+    amscr_status st = amscr_contour_from_image(rd->img, b.w, b.h, b.w, 8, 127.5, AMSCR_TRACE_JOIN, &c);
     if (st != AMSCR_OK)
         return st;
     for (size_t i = 0; i < c->n; i++) {
@@ -208,14 +213,16 @@ static amscr_status trace_bias(const double *M, size_t nm, const double *C, size
     return AMSCR_OK;
 }
 
-/* The target's points T moved back by the bias of their nearest synthetic point: *out (a new
- * contour). AMSCR_E_NOT_FOUND / AMSCR_E_DEGENERATE: nothing to correct by. */
-static amscr_status corrected_target(const double *M, size_t nm, const double *T, size_t nt, amscr_contour **out)
+/* The target's points T moved back by the bias of their nearest synthetic point (the rendering
+ * rd of the mapped source M traced): *out (a new contour). AMSCR_E_NOT_FOUND /
+ * AMSCR_E_DEGENERATE: nothing to correct by. */
+static amscr_status corrected_target(const double *M, size_t nm, const rendering_t *rd, const double *T, size_t nt,
+                                     amscr_contour **out)
 {
     double *C = NULL, *bias = NULL, *xy = amscr__malloc_array(2 * nt, sizeof *xy);
     size_t nc = 0;
     amscr__grid g = {0};
-    amscr_status st = xy ? synthetic_trace(M, nm, T, nt, &C, &nc) : AMSCR_E_NOMEM;
+    amscr_status st = xy ? synthetic_trace(rd, &C, &nc) : AMSCR_E_NOMEM;
     if (st == AMSCR_OK)
         st = (bias = amscr__malloc_array(2 * nc, sizeof *bias)) ? trace_bias(M, nm, C, nc, bias) : AMSCR_E_NOMEM;
     if (st == AMSCR_OK && amscr__grid_build(&g, C, nc) < 0)
@@ -263,14 +270,18 @@ amscr_status amscr__grid_target(const amscr_descriptor *f, const amscr_descripto
 {
     double *M = NULL;
     amscr_contour *c = NULL;
+    rendering_t rd = {{0, 0, 0, 0}, NULL};
     *out_h2 = NULL;
     amscr_status st = mapped_source(f, h->inv, r->m.X, &M);
     if (st == AMSCR_OK)
-        st = pixels_differing(M, f->nraw, h->raw, h->nraw, out_differ);
+        st = render(M, f->nraw, h->raw, h->nraw, &rd);
     if (st == AMSCR_OK)
-        st = corrected_target(M, f->nraw, h->raw, h->nraw, &c);
+        st = pixels_differing(&rd, h->raw, h->nraw, out_differ);
+    if (st == AMSCR_OK)
+        st = corrected_target(M, f->nraw, &rd, h->raw, h->nraw, &c);
     if (st == AMSCR_OK)
         st = amscr_descriptor_new(&h->params, c, out_h2);
+    free(rd.img);
     free(M);
     amscr_contour_free(c);
     if (st != AMSCR_OK && st != AMSCR_E_NOMEM) {
@@ -285,10 +296,14 @@ amscr_status amscr__grid_choose(const amscr_params *prm, const amscr_descriptor 
                                 amscr_result *r2)
 {
     double *M2 = NULL;
+    rendering_t rd = {{0, 0, 0, 0}, NULL};
     size_t second_differ = 0;
     amscr_status st = mapped_source(f, h2->inv, r2->m.X, &M2);
     if (st == AMSCR_OK)
-        st = pixels_differing(M2, f->nraw, h->raw, h->nraw, &second_differ);
+        st = render(M2, f->nraw, h->raw, h->nraw, &rd);
+    if (st == AMSCR_OK)
+        st = pixels_differing(&rd, h->raw, h->nraw, &second_differ);
+    free(rd.img);
     free(M2);
     if (st == AMSCR_OK && second_differ < first_differ)
         st = adopt(prm, f, h, h2, r, r2);
