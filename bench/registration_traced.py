@@ -21,7 +21,8 @@ of |M(f_i) - T(f_i)| (the primary table: the reference evaluation's figures, by 
 are RMS ones; docs/measurements.md) and the max (stricter, the figures before 0.5). Success: < 2 %
 (4 % at low resolution). Wrong + confident (w+c): a failure reported with confidence >= 0.25;
 ok+c: the successes' share with confidence >= 0.25. ms: wall time a pair (the tool's with process
-start and PNG decoding). --json OUT: a row a pair, each method [RMS %, max %, confidence, ms].
+start and PNG decoding). --json OUT: a row a pair, each method [RMS %, max %, confidence, ms, the evidence:
+the --json fields of the confidence (docs/method.md §11.5) and whether pixel_grid ran].
 "lib ms": the library alone in this process (amscr.contour_from_mask(join=True), amscr.register),
 the median; skipped with --families or without the amscr package. Every draw is seeded by (shape
 index, condition, draw). Usage: nice .venv/bin/python bench/registration_traced.py --help
@@ -253,15 +254,20 @@ def lib_register_ms(src, tgt, breakdown=None):
     return 1000 * (t2 - t0)
 
 
+EVIDENCE = ('ambiguity', 'symmetry_ambiguity', 'inlier_fraction', 'overlap', 'backward_error', 'standard_error')
+
+
 def tool_register(tool, sp, tp, extra):
     t0 = time.perf_counter()
     r = subprocess.run([tool, 'register', sp, tp, '--json'] + extra, capture_output=True, text=True)
     ms = 1000 * (time.perf_counter() - t0)
     if r.returncode != 0:
-        return None, 0.0, ms
+        return None, 0.0, ms, None
     j = json.loads(r.stdout)
     M = np.hstack([np.array(j['A'], float), np.array(j['B'], float)[:, None]])
-    return M, float(j.get('confidence', 0.0)), ms
+    evidence = {k: j.get(k) for k in EVIDENCE}
+    evidence['pixel_grid'] = j.get('stages', {}).get('pixel_grid')
+    return M, float(j.get('confidence', 0.0)), ms, evidence
 
 
 def ecc_register(a8, b8):
@@ -300,12 +306,12 @@ def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=
     cv2.imwrite(sp, src), cv2.imwrite(tp, tgt)
     out = {}
     for m, extra in [('sub', [])] + ([('chain', ['--pixel-chain'])] if use_chain else []):
-        M, conf, ms = tool_register(tool, sp, tp, extra)
-        out[m] = (*errors(M, T, f), conf, ms)
+        M, conf, ms, ev = tool_register(tool, sp, tp, extra)
+        out[m] = (*errors(M, T, f), conf, ms, ev)
     if use_ref:  # the calibration: both images traced by find_contours, to the tool as point lists
         np.savetxt(sp + '.txt', subpixel_contour(src)), np.savetxt(tp + '.txt', subpixel_contour(tgt))
-        M, conf, ms = tool_register(tool, sp + '.txt', tp + '.txt', [])
-        out['ref'] = (*errors(M, T, f), conf, ms)
+        M, conf, ms, ev = tool_register(tool, sp + '.txt', tp + '.txt', [])
+        out['ref'] = (*errors(M, T, f), conf, ms, ev)
     out['lib'] = (0.0, 0.0, 0.0, lib_register_ms(src, tgt, breakdown) if lib else math.nan)
     if use_ecc:
         t0 = time.perf_counter()
