@@ -397,8 +397,6 @@ amscr_status amscr__grid_target(const amscr_descriptor *f, const amscr_descripto
 amscr_status amscr__grid_choose(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                 const amscr_descriptor *h2, size_t first_differ, amscr_result *r,
                                 amscr_result *r2);
-amscr_status amscr__grid_precision(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                   amscr_result *r);
 
 /* check.c (docs/method.md §11.5). A confidence at or above this is a confident answer: the
  * limit the documentation tells callers to reject below (1 - AMSCR__ALT_RATIO). */

@@ -309,26 +309,3 @@ amscr_status amscr__grid_choose(const amscr_params *prm, const amscr_descriptor 
         st = adopt(prm, f, h, h2, r, r2);
     return st;
 }
-
-/* The standard error of r's map (of f onto h) read on h with the tracing's bias under that map
- * removed: the grid's own share of the residuals is not the map's imprecision. */
-amscr_status amscr__grid_precision(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                   amscr_result *r)
-{
-    amscr_descriptor *h3 = NULL;
-    size_t differ = 0;
-    amscr_status st = amscr__grid_target(f, h, r, &h3, &differ);
-    if (st != AMSCR_OK || !h3)
-        return st;
-    amscr_result tmp;
-    memset(&tmp, 0, sizeof tmp);
-    double t[6];
-    amscr__affine_compose(h->inv, r->m.X, t);
-    amscr__affine_compose(h3->fwd, t, tmp.m.X);
-    st = amscr__correspond(prm, f, h3, &tmp);
-    if (st == AMSCR_OK && getenv("AMSCR_EXP_SE") && isfinite(tmp.se) && isfinite(r->se))
-        r->se = getenv("AMSCR_EXP_GM") ? sqrt(r->se * tmp.se) : tmp.se;
-    free(tmp.corr);
-    amscr_descriptor_free(h3);
-    return st;
-}

@@ -110,11 +110,9 @@ static amscr_status again_on_pixel_grid(const amscr_params *prm, const amscr_des
     if (r2) {
         r2->backward = 1;
         st = amscr__run_stages(prm, src, h2, ws, r2);
-        if (st == AMSCR_OK) {
+        if (st == AMSCR_OK)
             st = amscr__grid_choose(prm, src, tgt, h2, first_differ, r, r2);
-            if (st == AMSCR_OK)
-                st = amscr__grid_precision(prm, src, tgt, r);
-        } else if (st != AMSCR_E_NOMEM) {
+        else if (st != AMSCR_E_NOMEM) {
             st = AMSCR_OK;
             amscr__clear_error();
         }
