@@ -2,7 +2,8 @@
  * (src/register/pixel_grid.c): a pixel is on when the polygon covers half its area or more; a
  * sub-pixel trace of a binary image gives that image back by its pixel centres; the stage runs on
  * targets traced from small binary images only, and the map it keeps differs from the target image
- * in no more pixels than the first one, and is as often right. */
+ * in no more pixels than the first one, and is as often right; a small image's pixel chain is
+ * registered as the image traced at sub-pixel (src/register/pixel_chain.c). */
 #include <amscr.h>
 #include <check.h>
 #include <math.h>
@@ -147,7 +148,18 @@ static int ran(const amscr_result *r)
 
 /* A pair: the source shape `seed` at 60 px (S) and its image under a random map (M, about the
  * grid's centre) rendered with radius about r px on a g x g grid and traced (returned). */
+static amscr_contour *pair_image(uint64_t seed, double r, size_t g, double *S, double M[6], uint8_t *img);
 static amscr_contour *pair(uint64_t seed, double r, size_t g, double *S, double M[6])
+{
+    uint8_t *img = malloc(g * g);
+    ck_assert(img);
+    amscr_contour *t = pair_image(seed, r, g, S, M, img);
+    free(img);
+    return t;
+}
+
+/* pair(), the target's binary image kept in img (g * g bytes). */
+static amscr_contour *pair_image(uint64_t seed, double r, size_t g, double *S, double M[6], uint8_t *img)
 {
     amscr_test_rng rng;
     amscr_test_rng_seed(&rng, 1000 + seed);
@@ -158,11 +170,7 @@ static amscr_contour *pair(uint64_t seed, double r, size_t g, double *S, double 
     double P[2 * NSRC];
     shape_px(seed, 1, 60.0, ID, 160, S);
     shape_px(seed, 1, r, M, g, P);
-    uint8_t *img = malloc(g * g);
-    ck_assert(img);
-    amscr_contour *t = traced(P, g, img);
-    free(img);
-    return t;
+    return traced(P, g, img);
 }
 
 START_TEST(runs_on_small_binary_tracings_only)
@@ -269,6 +277,80 @@ START_TEST(kept_map_fits_the_image)
 }
 END_TEST
 
+/* Whether two results report the same map, bit for bit. */
+static int same_map(const amscr_result *a, const amscr_result *b)
+{
+    double A[6], B[6];
+    ck_assert_int_eq(amscr_result_affine(a, A), AMSCR_OK);
+    ck_assert_int_eq(amscr_result_affine(b, B), AMSCR_OK);
+    return memcmp(A, B, sizeof A) == 0;
+}
+
+/* A target given as a pixel chain (the boundary pixel centres of a small binary image) is
+ * registered as that image traced at sub-pixel: the same map bit for bit, the pixel_grid stage
+ * run; the chain onto itself reads the identity. Not with the stage off, nor for a chain with a
+ * gap, nor for a large image's chain. */
+START_TEST(chain_registers_as_its_image_traced)
+{
+    amscr_params *off = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&off), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_stage(off, "pixel_grid", 0), AMSCR_OK);
+    for (uint64_t seed = 1; seed <= 8; seed++) {
+        double S[2 * NSRC], M[6];
+        uint8_t img[W * W];
+        amscr_contour *t = pair_image(seed, RAD + (double)seed, W, S, M, img), *chain = NULL;
+        ck_assert_int_eq(amscr_contour_from_mask(img, W, W, W, 127, &chain), AMSCR_OK);
+        amscr_result *a = reg(NULL, S, chain), *b = reg(NULL, S, t), *c = reg(off, S, chain);
+        ck_assert_msg(same_map(a, b), "seed %d: the chain's map is not its trace's", (int)seed);
+        ck_assert_int_eq(ran(a), 1);
+        ck_assert_int_eq(ran(c), 0);
+        ck_assert_msg(!same_map(a, c), "seed %d: the chain registered as given", (int)seed);
+        amscr_result_free(a);
+        /* the chain onto itself: both traced again, the identity */
+        ck_assert_int_eq(amscr_register_contours(NULL, chain, chain, &a), AMSCR_OK);
+        ck_assert_int_eq(ran(a), 1);
+        ck_assert_double_lt(amscr_result_distance(a), 1e-9);
+        double A[6];
+        ck_assert_int_eq(amscr_result_affine(a, A), AMSCR_OK);
+        for (int k = 0; k < 6; k++)
+            ck_assert_double_eq_tol(A[k], ID[k], 1e-9);
+        amscr_result_free(a);
+        amscr_result_free(b);
+        amscr_result_free(c);
+        /* every other point of the chain: integer points with gaps, a point list */
+        size_t n = amscr_contour_size(chain) / 2;
+        double *q = malloc(2 * n * sizeof *q);
+        ck_assert(q);
+        for (size_t i = 0; i < n; i++)
+            memcpy(q + 2 * i, amscr_contour_xy(chain) + 4 * i, 2 * sizeof *q);
+        amscr_contour *gaps = NULL;
+        ck_assert_int_eq(amscr_contour_new(q, n, &gaps), AMSCR_OK);
+        a = reg(NULL, S, gaps);
+        ck_assert_int_eq(ran(a), 0);
+        amscr_result_free(a);
+        amscr_contour_free(gaps);
+        free(q);
+        amscr_contour_free(chain);
+        amscr_contour_free(t);
+    }
+    /* a large image's chain (radius over 40 px) is registered as given */
+    double S[2 * NSRC], M[6];
+    uint8_t *img = malloc(300 * 300);
+    ck_assert(img);
+    amscr_contour *t = pair_image(3, 120.0, 300, S, M, img), *chain = NULL;
+    ck_assert_int_eq(amscr_contour_from_mask(img, 300, 300, 300, 127, &chain), AMSCR_OK);
+    amscr_result *a = reg(NULL, S, chain), *c = reg(off, S, chain);
+    ck_assert(same_map(a, c));
+    ck_assert_int_eq(ran(a), 0);
+    amscr_result_free(a);
+    amscr_result_free(c);
+    amscr_contour_free(chain);
+    amscr_contour_free(t);
+    free(img);
+    amscr_params_free(off);
+}
+END_TEST
+
 Suite *amscr_suite_pixel_grid(void)
 {
     Suite *s = suite_create("pixel_grid");
@@ -278,6 +360,7 @@ Suite *amscr_suite_pixel_grid(void)
     tcase_add_test(tc, centres_give_the_traced_image_back);
     tcase_add_test(tc, runs_on_small_binary_tracings_only);
     tcase_add_test(tc, kept_map_fits_the_image);
+    tcase_add_test(tc, chain_registers_as_its_image_traced);
     suite_add_tcase(s, tc);
     return s;
 }

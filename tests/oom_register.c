@@ -4,7 +4,8 @@
  * library, so every allocation the library makes passes through the wrappers below. For each
  * scenario (a noisy target, which runs the polish with its order and even-spacing steps; a target
  * with a missing run, which runs the recovery; a partial match; a symmetric match; a target traced
- * from a small binary image, which runs the pixel_grid stage) the test
+ * from a small binary image, which runs the pixel_grid stage, and the same image's pixel chain
+ * onto itself, which traces both again first) the test
  * counts the allocations of one amscr_register_contours call, then fails each of them in turn
  * (every AMSCR_OOM_STRIDE-th and the last when that is set: the valgrind setup sets 3) and checks
  * that the call returns AMSCR_E_NOMEM (nothing swallowed: no stage falls back
@@ -94,14 +95,16 @@ typedef struct {
     double sigma;
     int partial, symmetric;
     const char *must_run; /* a stage the scenario exists for */
-    int traced;           /* the target traced from its binary image (LATTICE_SIDE px square) */
+    int traced;           /* the target traced from its binary image (LATTICE_SIDE px square): 1 at
+                           * sub-pixel accuracy, 2 as a pixel chain */
 } scenario;
 
 enum { LATTICE_SIDE = 40 };
 
 /* The binary image of the closed polygon b (n points) scaled by 8 about the image's centre (the
- * pixels whose centre it contains), traced at sub-pixel accuracy: points on the pixel lattice. */
-static amscr_status traced_target(const double *b, size_t n, amscr_contour **out)
+ * pixels whose centre it contains), traced with `flags`: at sub-pixel accuracy (0), points on the
+ * pixel lattice, or as a pixel chain (AMSCR_TRACE_PIXEL_CHAIN). */
+static amscr_status traced_target(const double *b, size_t n, int flags, amscr_contour **out)
 {
     static unsigned char img[LATTICE_SIDE * LATTICE_SIDE];
     for (int j = 0; j < LATTICE_SIDE; j++)
@@ -114,7 +117,7 @@ static amscr_status traced_target(const double *b, size_t n, amscr_contour **out
                     in = !in;
             img[j * LATTICE_SIDE + i] = in ? 255 : 0;
         }
-    return amscr_contour_from_image(img, LATTICE_SIDE, LATTICE_SIDE, LATTICE_SIDE, 8, 127.5, 0, out);
+    return amscr_contour_from_image(img, LATTICE_SIDE, LATTICE_SIDE, LATTICE_SIDE, 8, 127.5, flags, out);
 }
 
 static amscr_status run(const scenario *s, amscr_result **out)
@@ -136,9 +139,12 @@ static amscr_status run(const scenario *s, amscr_result **out)
     for (size_t i = 0; i < 3 && st == AMSCR_OK; i++)
         st = amscr_params_set_stage(p, opt_in[i], 1);
     if (st == AMSCR_OK)
+        st = s->traced ? traced_target(b, nt, s->traced == 2 ? AMSCR_TRACE_PIXEL_CHAIN : 0, &tgt)
+                       : amscr_contour_new(b + 2 * s->drop, nt, &tgt);
+    if (st == AMSCR_OK && s->traced == 2) /* the chain onto itself: both traced again */
+        st = amscr_contour_new(amscr_contour_xy(tgt), amscr_contour_size(tgt), &src);
+    else if (st == AMSCR_OK)
         st = amscr_contour_new(a, ns, &src);
-    if (st == AMSCR_OK)
-        st = s->traced ? traced_target(b, nt, &tgt) : amscr_contour_new(b + 2 * s->drop, nt, &tgt);
     if (st == AMSCR_OK)
         st = amscr_register_contours(p, src, tgt, out);
     amscr_contour_free(src);
@@ -205,6 +211,7 @@ int main(void)
         {"partial fragment", 300, 300, 0, 0.0, 1, 0, "polish", 0},
         {"symmetric distance", 300, 300, 0, 0.0, 0, 1, "symmetric", 0},
         {"small binary image (pixel grid)", 300, 300, 0, 0.0, 0, 0, "pixel_grid", 1},
+        {"small binary image's pixel chain onto itself (both traced again)", 300, 300, 0, 0.0, 0, 0, "pixel_grid", 2},
     };
     const char *env = getenv("AMSCR_OOM_STRIDE");
     long stride = env ? strtol(env, NULL, 10) : 1;

@@ -385,6 +385,10 @@ double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const doub
  * lattice at a resolution where the tracing's bias counts, for h and for f under the map X (the
  * stage's condition). */
 int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
+/* Whether n points have an RMS radius within the pixel_grid stage's limit; whether f's input
+ * points under the map X (onto h) have. */
+int amscr__grid_small(const double *p, size_t n);
+int amscr__grid_mapped_small(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
 /* For the finished result r of f -> h: the pixels where the source under r's map, rendered on
  * h's grid, differs from h's image (*out_differ), and h corrected for the tracing's bias under
  * that map, prepared as h was (*out_h2, caller frees; NULL when nothing of the mapped source
@@ -397,6 +401,12 @@ amscr_status amscr__grid_target(const amscr_descriptor *f, const amscr_descripto
 amscr_status amscr__grid_choose(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
                                 const amscr_descriptor *h2, size_t first_differ, amscr_result *r,
                                 amscr_result *r2);
+/* pixel_chain.c (docs/method.md §11.7). Whether d's input points are a closed pixel chain (integer,
+ * each 8-adjacent to the next); whether h's are and, with f under the map X, within the grid's
+ * limit; the image a chain h bounds traced again at sub-pixel, prepared as h was (*out). */
+int amscr__is_pixel_chain(const amscr_descriptor *d);
+int amscr__pixel_chain_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
+amscr_status amscr__chain_retrace(const amscr_descriptor *h, amscr_descriptor **out);
 
 /* check.c (docs/method.md §11.5). A confidence at or above this is a confident answer: the
  * limit the documentation tells callers to reject below (1 - AMSCR__ALT_RATIO). */

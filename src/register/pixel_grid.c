@@ -94,15 +94,23 @@ static double mapped_radius(const double A[6], const double *p, size_t n)
     return sqrt(r2 / (double)n);
 }
 
-int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6])
+int amscr__grid_small(const double *p, size_t n)
 {
     static const double I[6] = {1, 0, 0, 0, 1, 0};
-    if (!f->raw || !h->raw || !on_lattice(h->raw, h->nraw) ||
-        !(mapped_radius(I, h->raw, h->nraw) <= AMSCR__GRID_RADIUS_MAX))
-        return 0;
+    return mapped_radius(I, p, n) <= AMSCR__GRID_RADIUS_MAX;
+}
+
+int amscr__grid_mapped_small(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6])
+{
     double A[6];
     input_map(f, h->inv, X, A);
-    return mapped_radius(A, f->raw, f->nraw) <= AMSCR__GRID_RADIUS_MAX;
+    return f->raw && mapped_radius(A, f->raw, f->nraw) <= AMSCR__GRID_RADIUS_MAX;
+}
+
+int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6])
+{
+    return f->raw && h->raw && on_lattice(h->raw, h->nraw) && amscr__grid_small(h->raw, h->nraw) &&
+           amscr__grid_mapped_small(f, h, X);
 }
 
 /* ---- the grid ---- */

@@ -5,9 +5,11 @@
  * register.c — matching a prepared source onto a prepared target (docs/method.md §3, §9), top-down:
  *   amscr_register    checks the pair, runs the stage table (stages.c: despike, search, method,
  *                     recovery, final solve, symmetric, polish, order, even spacing,
- *                     alternatives, correspondences, pixel_grid), registers a small binary
- *                     image's target again when the pixel_grid stage's condition held
- *                     (pixel_grid.c), checks the result (check.c) and fills the result's maps;
+ *                     alternatives, correspondences, pixel_grid), registers afresh onto the
+ *                     image a small pixel chain target bounds, traced at sub-pixel
+ *                     (pixel_chain.c), registers a small binary image's target again when the
+ *                     pixel_grid stage's condition held (pixel_grid.c), checks the result
+ *                     (check.c) and fills the result's maps;
  *   amscr_distance    checks the pair, then match_pair: one direction f -> h by
  *                     amscr__match_dir (shift_search.c: candidate start points ranked by one
  *                     rule, the winner through the method and the refinement) and, symmetric,
@@ -26,6 +28,9 @@ static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *
                                amscr_workspace *ws, match_t *m);
 static amscr_status again_on_pixel_grid(const amscr_params *prm, const amscr_descriptor *src,
                                         const amscr_descriptor *tgt, amscr_workspace *ws, amscr_result *r);
+static amscr_status again_on_chain_image(const amscr_params *prm, const amscr_descriptor *src,
+                                         const amscr_descriptor *tgt, amscr_workspace *ws, amscr_result **r,
+                                         amscr_descriptor *g[2]);
 
 amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
                             amscr_workspace *ws, amscr_result **out_result)
@@ -37,6 +42,7 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
     amscr_status st = check_pair(&p, src, tgt);
     if (st != AMSCR_OK)
         return st;
+    amscr_descriptor *g[2] = {NULL, NULL}; /* pixel chains' images traced at sub-pixel (pixel_chain.c) */
     amscr_workspace local = {0};
     amscr_workspace *w = ws ? ws : &local;
     amscr_result *r = calloc(1, sizeof *r);
@@ -44,24 +50,67 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_register: out of memory");
     if (st == AMSCR_OK)
         st = amscr__run_stages(p, src, tgt, w, r);
+    if (st == AMSCR_OK)
+        st = again_on_chain_image(p, src, tgt, w, &r, g);
+    const amscr_descriptor *f = g[0] ? g[0] : src, *h = g[1] ? g[1] : tgt;
     if (st == AMSCR_OK && r->ran[AMSCR__STAGE_PIXEL_GRID]) /* a small binary image's target (pixel_grid.c) */
-        st = again_on_pixel_grid(p, src, tgt, w, r);
+        st = again_on_pixel_grid(p, f, h, w, r);
     if (st == AMSCR_OK) /* how far the result can be trusted: its overlap and checks (check.c) */
-        st = amscr__check(p, src, tgt, w, r);
+        st = amscr__check(p, f, h, w, r);
     if (!ws)
         amscr__ws_release(&local);
-    if (st != AMSCR_OK) {
+    if (st == AMSCR_OK) {
+        r->method = p->method;
+        memcpy(r->affine_norm, r->m.X, sizeof r->affine_norm);
+        /* input coordinates: inv_h ∘ X ∘ fwd_f */
+        double t[6];
+        amscr__affine_compose(r->m.X, f->fwd, t);
+        amscr__affine_compose(h->inv, t, r->affine_in);
+        *out_result = r;
+    } else {
         amscr_result_free(r);
+    }
+    amscr_descriptor_free(g[0]);
+    amscr_descriptor_free(g[1]);
+    return st;
+}
+
+/* A target given as a small pixel chain, the source under the first map (*r's) as small (the
+ * pixel_grid stage's condition; pixel_chain.c): the image the chain bounds traced at sub-pixel
+ * (g[1]), a source given as a pixel chain too (g[0]), and the source registered afresh onto the
+ * target (*r replaced). A chain whose image cannot be traced or registered again keeps *r (g
+ * NULL). */
+static amscr_status again_on_chain_image(const amscr_params *prm, const amscr_descriptor *src,
+                                         const amscr_descriptor *tgt, amscr_workspace *ws, amscr_result **r,
+                                         amscr_descriptor *g[2])
+{
+    g[0] = g[1] = NULL;
+    if (prm->partial || !AMSCR__STAGE_ON(prm, AMSCR__STAGE_PIXEL_GRID) || !(*r)->ran[AMSCR__STAGE_POLISH] ||
+        !amscr__pixel_chain_applies(src, tgt, (*r)->m.X))
+        return AMSCR_OK;
+    amscr_result *r2 = NULL;
+    amscr_status st = amscr__chain_retrace(tgt, &g[1]);
+    if (st == AMSCR_OK && amscr__is_pixel_chain(src))
+        st = amscr__chain_retrace(src, &g[0]);
+    if (st == AMSCR_OK && !(r2 = calloc(1, sizeof *r2)))
+        st = amscr__fail(AMSCR_E_NOMEM, "amscr_register: out of memory");
+    if (st == AMSCR_OK)
+        st = amscr__run_stages(prm, g[0] ? g[0] : src, g[1], ws, r2);
+    if (st == AMSCR_OK) {
+        amscr_result_free(*r);
+        *r = r2;
         return st;
     }
-    r->method = p->method;
-    memcpy(r->affine_norm, r->m.X, sizeof r->affine_norm);
-    /* input coordinates: inv_h ∘ X ∘ fwd_f */
-    double t[6];
-    amscr__affine_compose(r->m.X, src->fwd, t);
-    amscr__affine_compose(tgt->inv, t, r->affine_in);
-    *out_result = r;
-    return AMSCR_OK;
+    amscr_result_free(r2);
+    for (int k = 0; k < 2; k++) {
+        amscr_descriptor_free(g[k]);
+        g[k] = NULL;
+    }
+    if (st != AMSCR_E_NOMEM) {
+        st = AMSCR_OK;
+        amscr__clear_error();
+    }
+    return st;
 }
 
 amscr_status amscr_distance(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,

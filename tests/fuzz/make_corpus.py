@@ -155,6 +155,10 @@ put('register', 'square-vs-ellipse', reg(0x80, 0x20, [(0, 0), (4, 0), (4, 4), (0
 lattice = [(x, 0.5) for x in range(1, 6)] + [(5.5, 1), (6, 1.5)] + [(6.5, y) for y in (2, 3, 4)] + \
     [(x, 4.5) for x in range(6, 0, -1)] + [(0.5, y) for y in (4, 3, 2, 1)]
 put('register', 'pixel-lattice', reg(0x06, 0x30, polygon(24, 3.0, 2.0, wobble=0.2), lattice))
+# the same image's pixel chain (its boundary pixel centres): traced again at sub-pixel first
+chain = [(x, 1) for x in range(1, 6)] + [(6, y) for y in (2, 3, 4)] + [(x, 4) for x in range(5, 0, -1)] + \
+    [(1, 3), (1, 2)]
+put('register', 'pixel-chain', reg(0x06, 0x30, polygon(24, 3.0, 2.0, wobble=0.2), chain))
 
 # ------------------------------------------------------------------ dbload
 build = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, 'build')

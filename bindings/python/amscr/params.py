@@ -135,7 +135,9 @@ class Params:
                            "'despike', 'recovery', 'polish', 'order', 'even_spacing', 'pixel_grid' (setting one leaves "
                            "the others; default: despike, order and even_spacing off, for point lists with stray "
                            "points or synthetic noise; pixel_grid: a target traced from a small binary image "
-                           "registered again with its tracing's bias removed; Registration.stages says which ran)")
+                           "registered again with its tracing's bias removed, a small image's pixel chain (as "
+                           "cv2.findContours gives) traced again at sub-pixel first; Registration.stages says "
+                           "which ran)")
     channel_weight = _Option('channel_weight', _FLOAT,
                              'share of the shape channel in Collection.retrieval_matrix, 0..1 (0 = the AMSCR '
                              'distance alone, the default; 1 = the channel alone, the retrieval preset)')

@@ -20,12 +20,23 @@ def bench():
     return B
 
 
-def pair(B, i, key, draw, **options):
+def opencv_chain(img):
+    """The largest outer contour of img as cv2.findContours gives it without approximation: the
+    boundary pixel centres, (n, 2) float."""
+    import cv2
+    binary = (img > 127).astype(np.uint8)
+    cs, _ = cv2.findContours(binary, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    return max(cs, key=len)[:, 0, :].astype(float)
+
+
+def pair(B, i, key, draw, chain=False, **options):
     """(registration, RMS error % of R, success threshold %) of procedural shape i under the
-    families condition `key`, draw `draw` (options: amscr.register's)."""
+    families condition `key`, draw `draw` (chain: the target as OpenCV's pixel chain; options:
+    amscr.register's)."""
     _, _, kind, level, thr, seed = [c for c in B.family_conditions() if c[0] == key][0]
     src = B.load_source(shapegen.silhouette(1, i))
     f = B.subpixel_contour(src)
     tgt, T = B.family_target(src, f, kind, level, np.random.default_rng([1000 + i, seed, draw, 2024]))
-    r = amscr.register(amscr.contour_from_mask(src, join=True), amscr.contour_from_mask(tgt, join=True), **options)
+    t = opencv_chain(tgt) if chain else amscr.contour_from_mask(tgt, join=True)
+    r = amscr.register(amscr.contour_from_mask(src, join=True), t, **options)
     return r, B.errors(np.hstack([np.asarray(r.A), np.asarray(r.B)[:, None]]), T, f)[0], thr
