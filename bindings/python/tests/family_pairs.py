@@ -40,3 +40,19 @@ def pair(B, i, key, draw, chain=False, **options):
     t = opencv_chain(tgt) if chain else amscr.contour_from_mask(tgt, join=True)
     r = amscr.register(amscr.contour_from_mask(src, join=True), t, **options)
     return r, B.errors(np.hstack([np.asarray(r.A), np.asarray(r.B)[:, None]]), T, f)[0], thr
+
+
+LOW = [(key, draw) for key in ('lowres30', 'lowres40') for draw in (0, 1)]
+
+
+def low_pairs(B, chain=False):
+    """The procedural shapes (35) at binary 30 and 40 px, draws 0-1, with and without the
+    pixel_grid stage: {(shape, key, draw): (error with it, its confidence, whether it ran, error
+    without, success threshold)}."""
+    out = {}
+    for i in range(35):
+        for key, draw in LOW:
+            on, err_on, thr = pair(B, i, key, draw, chain=chain)
+            _, err_off, _ = pair(B, i, key, draw, chain=chain, stages={'pixel_grid': False})
+            out[(i, key, draw)] = (err_on, on.confidence, on.stages['pixel_grid'], err_off, thr)
+    return out

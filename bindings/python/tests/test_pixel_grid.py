@@ -10,22 +10,14 @@ import amscr
 
 pytest.importorskip('cv2')
 pytest.importorskip('skimage')
-from family_pairs import pair  # noqa: E402  (beside this file)
-
-SHAPES = range(35)
-LOW = [(key, draw) for key in ('lowres30', 'lowres40') for draw in (0, 1)]
+import family_pairs  # noqa: E402  (beside this file)
+from family_pairs import pair  # noqa: E402
 
 
 @pytest.fixture(scope='module')
 def low_pairs(family_bench):
-    """{(shape, key, draw): (error with the stage, its confidence, whether it ran, error without)}."""
-    out = {}
-    for i in SHAPES:
-        for key, draw in LOW:
-            on, err_on, thr = pair(family_bench, i, key, draw)
-            _, err_off, _ = pair(family_bench, i, key, draw, stages={'pixel_grid': False})
-            out[(i, key, draw)] = (err_on, on.confidence, on.stages['pixel_grid'], err_off, thr)
-    return out
+    """family_pairs.low_pairs."""
+    return family_pairs.low_pairs(family_bench)
 
 
 def test_runs_on_every_small_binary_target(low_pairs):
