@@ -402,10 +402,10 @@ amscr_status amscr__grid_choose(const amscr_params *prm, const amscr_descriptor 
                                 const amscr_descriptor *h2, size_t first_differ, amscr_result *r,
                                 amscr_result *r2);
 /* pixel_chain.c (docs/method.md §11.7). Whether d's input points are a closed pixel chain (integer,
- * each 8-adjacent to the next); whether h's are and, with f under the map X, within the grid's
- * limit; the image a chain h bounds traced again at sub-pixel, prepared as h was (*out). */
+ * each 8-adjacent to the next); the image a chain h bounds traced again at sub-pixel, started
+ * and run as h was given, prepared as h was (*out). register.c decides where (with
+ * amscr__grid_small and amscr__grid_mapped_small). */
 int amscr__is_pixel_chain(const amscr_descriptor *d);
-int amscr__pixel_chain_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
 amscr_status amscr__chain_retrace(const amscr_descriptor *h, amscr_descriptor **out);
 
 /* check.c (docs/method.md §11.5). A confidence at or above this is a confident answer: the

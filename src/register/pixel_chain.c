@@ -9,8 +9,8 @@
  * centre lies between two 8-adjacent ones). That image traced at half level is the sub-pixel
  * target amscr_contour_from_image makes, and the pixel_grid stage's correction then applies to it
  * (pixel_grid.c). Where the pixel_grid stage is on and its condition holds for the chain (the
- * chain and the source under the first map within the grid's limit), register.c registers the
- * source afresh onto that trace, and the pixel_grid stage runs on it; a source given as a pixel
+ * chain and the source under the search's map within the grid's limit), register.c registers the
+ * source onto that trace instead, and the pixel_grid stage runs on it; a source given as a pixel
  * chain is traced again too, so that a chain registered onto itself still reads the identity. */
 #include "match.h"
 
@@ -37,11 +37,6 @@ static int is_chain(const double *p, size_t n)
 int amscr__is_pixel_chain(const amscr_descriptor *d)
 {
     return d->raw && d->params.closed && is_chain(d->raw, d->nraw);
-}
-
-int amscr__pixel_chain_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6])
-{
-    return amscr__is_pixel_chain(h) && amscr__grid_small(h->raw, h->nraw) && amscr__grid_mapped_small(f, h, X);
 }
 
 /* The image the chain bounds, in a box one pixel beyond it: *out (w * h bytes, 255 foreground). */

@@ -5,11 +5,11 @@
  * register.c — matching a prepared source onto a prepared target (docs/method.md §3, §9), top-down:
  *   amscr_register    checks the pair, runs the stage table (stages.c: despike, search, method,
  *                     recovery, final solve, symmetric, polish, order, even spacing,
- *                     alternatives, correspondences, pixel_grid), registers afresh onto the
- *                     image a small pixel chain target bounds, traced at sub-pixel
- *                     (pixel_chain.c), registers a small binary image's target again when the
- *                     pixel_grid stage's condition held (pixel_grid.c), checks the result
- *                     (check.c) and fills the result's maps;
+ *                     alternatives, correspondences, pixel_grid) — onto the image a small
+ *                     pixel chain target bounds, traced at sub-pixel (pixel_chain.c) —,
+ *                     registers a small binary image's target again when the pixel_grid
+ *                     stage's condition held (pixel_grid.c), checks the result (check.c) and
+ *                     fills the result's maps;
  *   amscr_distance    checks the pair, then match_pair: one direction f -> h by
  *                     amscr__match_dir (shift_search.c: candidate start points ranked by one
  *                     rule, the winner through the method and the refinement) and, symmetric,
@@ -28,9 +28,8 @@ static amscr_status match_pair(const amscr_params *prm, const amscr_descriptor *
                                amscr_workspace *ws, match_t *m);
 static amscr_status again_on_pixel_grid(const amscr_params *prm, const amscr_descriptor *src,
                                         const amscr_descriptor *tgt, amscr_workspace *ws, amscr_result *r);
-static amscr_status again_on_chain_image(const amscr_params *prm, const amscr_descriptor *src,
-                                         const amscr_descriptor *tgt, amscr_workspace *ws, amscr_result **r,
-                                         amscr_descriptor *g[2]);
+static amscr_status chain_images(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                                 amscr_workspace *ws, amscr_descriptor *g[2]);
 
 amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
                             amscr_workspace *ws, amscr_result **out_result)
@@ -49,10 +48,10 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
     if (!r)
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_register: out of memory");
     if (st == AMSCR_OK)
-        st = amscr__run_stages(p, src, tgt, w, r);
-    if (st == AMSCR_OK)
-        st = again_on_chain_image(p, src, tgt, w, &r, g);
+        st = chain_images(p, src, tgt, w, g);
     const amscr_descriptor *f = g[0] ? g[0] : src, *h = g[1] ? g[1] : tgt;
+    if (st == AMSCR_OK)
+        st = amscr__run_stages(p, f, h, w, r);
     if (st == AMSCR_OK && r->ran[AMSCR__STAGE_PIXEL_GRID]) /* a small binary image's target (pixel_grid.c) */
         st = again_on_pixel_grid(p, f, h, w, r);
     if (st == AMSCR_OK) /* how far the result can be trusted: its overlap and checks (check.c) */
@@ -75,33 +74,28 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
     return st;
 }
 
-/* A target given as a small pixel chain, the source under the first map (*r's) as small (the
+/* A target given as a small pixel chain, the source under the search's map as small (the
  * pixel_grid stage's condition; pixel_chain.c): the image the chain bounds traced at sub-pixel
- * (g[1]), a source given as a pixel chain too (g[0]), and the source registered afresh onto the
- * target (*r replaced). A chain whose image cannot be traced or registered again keeps *r (g
- * NULL). */
-static amscr_status again_on_chain_image(const amscr_params *prm, const amscr_descriptor *src,
-                                         const amscr_descriptor *tgt, amscr_workspace *ws, amscr_result **r,
-                                         amscr_descriptor *g[2])
+ * (g[1]) and a source given as a pixel chain traced again too (g[0]), to register instead. Else,
+ * or where the search fails or an image cannot be traced again, g NULL: the pair as given. */
+static amscr_status chain_images(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
+                                 amscr_workspace *ws, amscr_descriptor *g[2])
 {
     g[0] = g[1] = NULL;
-    if (prm->partial || !AMSCR__STAGE_ON(prm, AMSCR__STAGE_PIXEL_GRID) || !(*r)->ran[AMSCR__STAGE_POLISH] ||
-        !amscr__pixel_chain_applies(src, tgt, (*r)->m.X))
+    if (prm->partial || !prm->polish || !AMSCR__STAGE_ON(prm, AMSCR__STAGE_POLISH) ||
+        !AMSCR__STAGE_ON(prm, AMSCR__STAGE_PIXEL_GRID) || !src->raw || !amscr__is_pixel_chain(tgt) ||
+        !amscr__grid_small(tgt->raw, tgt->nraw))
         return AMSCR_OK;
-    amscr_result *r2 = NULL;
-    amscr_status st = amscr__chain_retrace(tgt, &g[1]);
+    match_t m;
+    amscr_status st = amscr__match_dir(prm, src, tgt, ws, &m);
+    if (st == AMSCR_OK && !amscr__grid_mapped_small(src, tgt, m.X))
+        return AMSCR_OK;
+    if (st == AMSCR_OK)
+        st = amscr__chain_retrace(tgt, &g[1]);
     if (st == AMSCR_OK && amscr__is_pixel_chain(src))
         st = amscr__chain_retrace(src, &g[0]);
-    if (st == AMSCR_OK && !(r2 = calloc(1, sizeof *r2)))
-        st = amscr__fail(AMSCR_E_NOMEM, "amscr_register: out of memory");
     if (st == AMSCR_OK)
-        st = amscr__run_stages(prm, g[0] ? g[0] : src, g[1], ws, r2);
-    if (st == AMSCR_OK) {
-        amscr_result_free(*r);
-        *r = r2;
         return st;
-    }
-    amscr_result_free(r2);
     for (int k = 0; k < 2; k++) {
         amscr_descriptor_free(g[k]);
         g[k] = NULL;
