@@ -2287,7 +2287,9 @@ AMSCR_API double amscr_result_inlier_fraction(const amscr_result *r);
  * @brief Where the source lies on the target: the boundary parameters, as fractions in
  *        [0, 1) of the target's boundary, of the target points matched to the source's first
  *        and last samples. The parameter runs along the target's samples (its
- *        parametrization) from the target's first input point in its input direction. For a
+ *        parametrization) from the target's first input point in its input direction; a
+ *        closed target is prepared counter-clockwise (y up), so one given clockwise runs from
+ *        its last input point against its input direction. For a
  *        partial match: where the fragment starts and ends (end < start when it wraps; for
  *        a fragment whose points run against the target's direction the fragment covers the
  *        boundary from end to start).

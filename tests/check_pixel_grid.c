@@ -353,6 +353,53 @@ START_TEST(chain_registers_as_its_image_traced)
 }
 END_TEST
 
+/* A chain traced again keeps the start it was given: registered onto its own copy reversed and
+ * started a third of the way round, a chain reads the identity, and where its first point lies
+ * along the target (amscr_result_part) is where it lies along the chain as given (the stage off). */
+START_TEST(chain_keeps_its_start)
+{
+    amscr_params *off = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&off), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_stage(off, "pixel_grid", 0), AMSCR_OK);
+    for (uint64_t seed = 1; seed <= 4; seed++) {
+        double S[2 * NSRC], M[6];
+        uint8_t img[W * W];
+        amscr_contour *t = pair_image(seed, RAD + 4.0, W, S, M, img), *chain = NULL, *moved = NULL;
+        ck_assert_int_eq(amscr_contour_from_mask(img, W, W, W, 127, &chain), AMSCR_OK);
+        size_t n = amscr_contour_size(chain), k = n / 3;
+        const double *c = amscr_contour_xy(chain);
+        double *q = malloc(2 * n * sizeof *q);
+        ck_assert(q);
+        for (size_t i = 0; i < n; i++) { /* q[i] = reversed chain [(i + k) mod n] */
+            size_t j = n - 1 - (i + k) % n;
+            q[2 * i] = c[2 * j], q[2 * i + 1] = c[2 * j + 1];
+        }
+        ck_assert_int_eq(amscr_contour_new(q, n, &moved), AMSCR_OK);
+        amscr_result *r = NULL;
+        ck_assert_int_eq(amscr_register_contours(NULL, chain, moved, &r), AMSCR_OK);
+        ck_assert_int_eq(ran(r), 1);
+        double A[6], start, end;
+        ck_assert_int_eq(amscr_result_affine(r, A), AMSCR_OK);
+        for (int i = 0; i < 6; i++)
+            ck_assert_double_eq_tol(A[i], ID[i], 1e-4);
+        ck_assert_int_eq(amscr_result_part(r, &start, &end), AMSCR_OK);
+        amscr_result_free(r);
+        double given;
+        ck_assert_int_eq(amscr_register_contours(off, chain, moved, &r), AMSCR_OK);
+        ck_assert_int_eq(amscr_result_part(r, &given, &end), AMSCR_OK);
+        double d = fabs(start - given);
+        ck_assert_msg(fmin(d, 1.0 - d) < 0.02, "seed %d: the source starts at %g of the target, %g as given",
+                      (int)seed, start, given);
+        amscr_result_free(r);
+        amscr_contour_free(moved);
+        amscr_contour_free(chain);
+        amscr_contour_free(t);
+        free(q);
+    }
+    amscr_params_free(off);
+}
+END_TEST
+
 Suite *amscr_suite_pixel_grid(void)
 {
     Suite *s = suite_create("pixel_grid");
@@ -363,6 +410,7 @@ Suite *amscr_suite_pixel_grid(void)
     tcase_add_test(tc, runs_on_small_binary_tracings_only);
     tcase_add_test(tc, kept_map_fits_the_image);
     tcase_add_test(tc, chain_registers_as_its_image_traced);
+    tcase_add_test(tc, chain_keeps_its_start);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -403,7 +403,7 @@ amscr_status amscr__grid_choose(const amscr_params *prm, const amscr_descriptor 
                                 amscr_result *r2);
 /* pixel_chain.c (docs/method.md §11.7). Whether d's input points are a closed pixel chain (integer,
  * each 8-adjacent to the next); the image a chain h bounds traced again at sub-pixel, started
- * and run as h was given, prepared as h was (*out). register.c decides where (with
+ * where h's samples start, prepared as h was (*out). register.c decides where (with
  * amscr__grid_small and amscr__grid_mapped_small). */
 int amscr__is_pixel_chain(const amscr_descriptor *d);
 amscr_status amscr__chain_retrace(const amscr_descriptor *h, amscr_descriptor **out);

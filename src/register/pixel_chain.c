@@ -51,13 +51,11 @@ static amscr_status chain_image(const double *p, size_t n, long x0, long y0, siz
     return st;
 }
 
-/* The trace c given h's start and direction (the target's boundary parameter runs from its first
- * input point in its input direction: amscr_result_part): reversed where its turn differs from
- * h's samples', then started at its point nearest h's first sample. */
+/* The trace c started as h was: at its point nearest h's first sample (the boundary parameter
+ * of amscr_result_part runs from there; both run counter-clockwise, as every closed curve is
+ * prepared). */
 static void as_given(const amscr_descriptor *h, amscr_contour *c)
 {
-    if ((amscr__signed_area(c->xy, c->n) > 0.0) != (amscr__signed_area(h->input, h->n) > 0.0))
-        amscr__reverse_points(c->xy, c->n);
     size_t k = 0;
     double best = INFINITY;
     for (size_t i = 0; i < c->n; i++) {
