@@ -125,6 +125,15 @@ START_TEST(centres_give_the_traced_image_back)
 }
 END_TEST
 
+/* Registration params with the pixel_grid stage off. */
+static amscr_params *stage_off(void)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_stage(p, "pixel_grid", 0), AMSCR_OK);
+    return p;
+}
+
 static amscr_result *reg(const amscr_params *p, const double *a, const amscr_contour *t)
 {
     amscr_contour *s = NULL;
@@ -201,9 +210,7 @@ START_TEST(runs_on_small_binary_tracings_only)
     ck_assert_int_eq(ran_onto(S, q, n), 0);
     free(q);
     /* switched off */
-    amscr_params *p = NULL;
-    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
-    ck_assert_int_eq(amscr_params_set_stage(p, "pixel_grid", 0), AMSCR_OK);
+    amscr_params *p = stage_off();
     r = reg(p, S, t);
     ck_assert_int_eq(ran(r), 0);
     amscr_result_free(r);
@@ -259,9 +266,7 @@ static double error_pct(const amscr_result *r, const double *S, const double M[6
  * pixels than the first map, and it is right (within 4 % of the radius) at least as often. */
 START_TEST(kept_map_fits_the_image)
 {
-    amscr_params *off = NULL;
-    ck_assert_int_eq(amscr_params_new_registration(&off), AMSCR_OK);
-    ck_assert_int_eq(amscr_params_set_stage(off, "pixel_grid", 0), AMSCR_OK);
+    amscr_params *off = stage_off();
     int ok_on = 0, ok_off = 0, changed = 0;
     for (uint64_t seed = 1; seed <= NSEED; seed++) {
         double S[2 * NSRC], M[6];
@@ -293,20 +298,27 @@ static int same_map(const amscr_result *a, const amscr_result *b)
     return memcmp(A, B, sizeof A) == 0;
 }
 
+/* pair()'s target of radius r px as its image's pixel chain (returned) and its sub-pixel trace
+ * (*trace). */
+static amscr_contour *small_chain(uint64_t seed, double r, double *S, double M[6], amscr_contour **trace)
+{
+    uint8_t img[W * W];
+    amscr_contour *chain = NULL;
+    *trace = pair_image(seed, r, W, S, M, img);
+    ck_assert_int_eq(amscr_contour_from_mask(img, W, W, W, 127, &chain), AMSCR_OK);
+    return chain;
+}
+
 /* A target given as a pixel chain (the boundary pixel centres of a small binary image) is
  * registered as that image traced at sub-pixel: the same map bit for bit, the pixel_grid stage
  * run; the chain onto itself reads the identity. Not with the stage off, nor for a chain with a
  * gap, nor for a large image's chain. */
 START_TEST(chain_registers_as_its_image_traced)
 {
-    amscr_params *off = NULL;
-    ck_assert_int_eq(amscr_params_new_registration(&off), AMSCR_OK);
-    ck_assert_int_eq(amscr_params_set_stage(off, "pixel_grid", 0), AMSCR_OK);
+    amscr_params *off = stage_off();
     for (uint64_t seed = 1; seed <= 3; seed++) {
         double S[2 * NSRC], M[6];
-        uint8_t img[W * W];
-        amscr_contour *t = pair_image(seed, RAD + (double)seed, W, S, M, img), *chain = NULL;
-        ck_assert_int_eq(amscr_contour_from_mask(img, W, W, W, 127, &chain), AMSCR_OK);
+        amscr_contour *t = NULL, *chain = small_chain(seed, RAD + (double)seed, S, M, &t);
         amscr_result *a = reg(NULL, S, chain), *b = reg(NULL, S, t), *c = reg(off, S, chain);
         ck_assert_msg(same_map(a, b), "seed %d: the chain's map is not its trace's", (int)seed);
         ck_assert_int_eq(ran(a), 1);
@@ -358,14 +370,10 @@ END_TEST
  * along the target (amscr_result_part) is where it lies along the chain as given (the stage off). */
 START_TEST(chain_keeps_its_start)
 {
-    amscr_params *off = NULL;
-    ck_assert_int_eq(amscr_params_new_registration(&off), AMSCR_OK);
-    ck_assert_int_eq(amscr_params_set_stage(off, "pixel_grid", 0), AMSCR_OK);
+    amscr_params *off = stage_off();
     for (uint64_t seed = 1; seed <= 2; seed++) {
         double S[2 * NSRC], M[6];
-        uint8_t img[W * W];
-        amscr_contour *t = pair_image(seed, RAD + 4.0, W, S, M, img), *chain = NULL, *moved = NULL;
-        ck_assert_int_eq(amscr_contour_from_mask(img, W, W, W, 127, &chain), AMSCR_OK);
+        amscr_contour *t = NULL, *chain = small_chain(seed, RAD + 4.0, S, M, &t), *moved = NULL;
         size_t n = amscr_contour_size(chain), k = n / 3;
         const double *c = amscr_contour_xy(chain);
         double *q = malloc(2 * n * sizeof *q);
