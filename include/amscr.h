@@ -1585,7 +1585,7 @@ AMSCR_API double amscr_params_get_channel_band(const amscr_params *p);
 /**
  * @brief Sets the band of the channel's whitened frame when it is the second frame (the
  *        similarity frame with an affine share > 0), as a fraction of N in (0, 0.5]
- *        (default 0.08; the table of constants chosen on data: docs/decisions.md). A file that
+ *        (default 0.08). A file that
  *        holds one band for both frames loads with this one equal to
  *        amscr_params_set_channel_band's.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
@@ -2696,7 +2696,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  *       them (n pair distances a new shape), and each call then costs n pair distances and
  *       the re-ranking of one row, as amscr_index_query_scores with candidates 0.
  * Memory: the kept index (channel and inner features, signature, lists; not a copy of the
- *       shapes; its bytes a shape: docs/measurements.md), until amscr_db_free.
+ *       shapes), until amscr_db_free.
  * Prefer an amscr_index to save the preparation in a file or to query with a shortlist.
  * The query is scored as a new shape even when it is a member's copy (no member rule:
  * amscr_db_search_retrieval applies it).
@@ -2770,8 +2770,7 @@ typedef struct amscr_index amscr_index;
  * Memory: the index holds a compact copy of the shapes (each shape's input samples
  *         and outline; a prepared shape is recomputed from them, bit for bit, when first
  *         read, e.g. through amscr_index_db, and then kept), the channel features and
- *         signature, the listed neighbours and, with the inner graph, the inner features
- *         (the bytes of each: docs/measurements.md, "Bytes a shape, in memory and on disk");
+ *         signature, the listed neighbours and, with the inner graph, the inner features;
  *         the build's scratch is n^2 doubles with candidates 0, at most 12 n M bytes with M.
  * Threads: amscr_params_set_num_threads of the db's params; the index is the same for any
  *          thread count.
@@ -2790,8 +2789,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_build(const amscr_db *db, siz
                                                          amscr_progress_fn progress, void *user, amscr_index **out);
 
 /** The largest collection whose index amscr_index_default_candidates builds from every pair:
- *  the exact build's cost grows as n^2, a shortlist build's as n (times:
- *  docs/measurements.md). @since 0.13 */
+ *  the exact build's cost grows as n^2, a shortlist build's as n. @since 0.13 */
 #define AMSCR_INDEX_EXACT_MAX 2000
 
 /**
