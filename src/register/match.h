@@ -389,6 +389,8 @@ int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor 
  * points under the map X (onto h) have. */
 int amscr__grid_small(const double *p, size_t n);
 int amscr__grid_mapped_small(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
+/* lo and hi widened to hold the n points p (per coordinate). */
+void amscr__points_extent(const double *p, size_t n, double lo[2], double hi[2]);
 /* For the finished result r of f -> h: the pixels where the source under r's map, rendered on
  * h's grid, differs from h's image (*out_differ), and h corrected for the tracing's bias under
  * that map, prepared as h was (*out_h2, caller frees; NULL when nothing of the mapped source

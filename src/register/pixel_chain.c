@@ -72,12 +72,8 @@ amscr_status amscr__chain_retrace(const amscr_descriptor *h, amscr_descriptor **
 {
     const double *p = h->raw;
     size_t n = h->nraw;
-    double lo[2] = {p[0], p[1]}, hi[2] = {p[0], p[1]};
-    for (size_t i = 1; i < n; i++)
-        for (int k = 0; k < 2; k++) {
-            lo[k] = fmin(lo[k], p[2 * i + k]);
-            hi[k] = fmax(hi[k], p[2 * i + k]);
-        }
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    amscr__points_extent(p, n, lo, hi);
     long x0 = (long)lo[0] - 1, y0 = (long)lo[1] - 1;
     size_t w = (size_t)(hi[0] - lo[0]) + 3, hh = (size_t)(hi[1] - lo[1]) + 3;
     uint8_t *img = NULL;

@@ -119,7 +119,7 @@ typedef struct {
     size_t w, h;
 } box_t;
 
-static void extent(const double *p, size_t n, double lo[2], double hi[2])
+void amscr__points_extent(const double *p, size_t n, double lo[2], double hi[2])
 {
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 2; k++) {
@@ -133,9 +133,9 @@ static void extent(const double *p, size_t n, double lo[2], double hi[2])
 static box_t grid_box(const double *T, size_t nt, const double *M, size_t nm)
 {
     double tl[2] = {INFINITY, INFINITY}, th[2] = {-INFINITY, -INFINITY};
-    extent(T, nt, tl, th);
+    amscr__points_extent(T, nt, tl, th);
     double lo[2] = {tl[0], tl[1]}, hi[2] = {th[0], th[1]};
-    extent(M, nm, lo, hi);
+    amscr__points_extent(M, nm, lo, hi);
     long b[2][2];
     for (int k = 0; k < 2; k++) {
         double span = th[k] - tl[k];
