@@ -29,10 +29,11 @@ want() { case " ${STEPS[*]} " in *" $1 "*) return 0 ;; esac; return 1; }
 
 # Valgrind runs every unit suite except these slow ones (20-50x slower than native there):
 # accuracy (datasets: minutes), db and threads (about 70 s each: they run under ASan and
-# ThreadSanitizer instead), robust, polish and index (100-175 s each: many registrations;
-# they run under ASan+UBSan, and the index loader's corpus replays under valgrind below).
+# ThreadSanitizer instead), robust, polish, index and pixel_grid (100-175 s each: many
+# registrations; they run under ASan+UBSan, and the index loader's corpus replays under valgrind
+# below). oom_register runs with every fifth allocation failed (AMSCR_OOM_STRIDE, tests/meson.build).
 # New areas are included automatically.
-VALGRIND_SKIP=(accuracy db threads robust polish index)
+VALGRIND_SKIP=(accuracy db threads robust polish index pixel_grid)
 
 T0=$(date +%s)
 summary=()

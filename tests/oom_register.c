@@ -7,7 +7,7 @@
  * from a small binary image, which runs the pixel_grid stage, and the same image's pixel chain
  * onto itself, which traces both again first) the test
  * counts the allocations of one amscr_register_contours call, then fails each of them in turn
- * (every AMSCR_OOM_STRIDE-th and the last when that is set: the valgrind setup sets 3) and checks
+ * (every AMSCR_OOM_STRIDE-th and the last when that is set: the valgrind setup sets 5) and checks
  * that the call returns AMSCR_E_NOMEM (nothing swallowed: no stage falls back
  * silently) and frees everything it allocated (no leak on any error path). The allocations of
  * the shared libraries (LAPACK, BLAS) are not wrapped. Not thread-safe: a single thread. */
