@@ -15,6 +15,8 @@ set side by side (RMS measure); --json OUT writes {draws, table, pairs}. The pai
 by the tool, `amscr register SRC TGT --json` (--tool or $AMSCR_TOOL; also --pixel-chain), and by
 cv2.findTransformECC (MOTION_AFFINE, 8 starting rotations, centroid and area matched, the best
 correlation kept); --reference: find_contours point lists of both images through the tool.
+--swap: the other direction, the damaged image registered onto the clean one (the tool and the
+library; its map inverted before it is measured), so a small image is the source.
 
 Error over the clean source's sub-pixel contour f, % of R = size(T(f)) (the RMS radius): the RMS
 of |M(f_i) - T(f_i)| (the primary table: the reference evaluation's figures, by its calibration,
@@ -241,6 +243,8 @@ def lib_register_ms(src, tgt, breakdown=None):
         return math.nan
     t0 = CLOCK()
     ps, pt = amscr.contour_from_mask(src, join=True), amscr.contour_from_mask(tgt, join=True)  # as the tool
+    if SWAP:
+        ps, pt = pt, ps
     t1 = CLOCK()
     amscr.register(ps, pt)
     t2 = CLOCK()
@@ -257,14 +261,21 @@ def lib_register_ms(src, tgt, breakdown=None):
 EVIDENCE = ('ambiguity', 'symmetry_ambiguity', 'inlier_fraction', 'overlap', 'backward_error', 'standard_error')
 
 
+SWAP = False  # --swap: the target registered onto the source, the map inverted
+
+
 def tool_register(tool, sp, tp, extra):
+    """(map source -> target or None, confidence, wall ms, evidence); --swap: tp onto sp, inverted."""
     t0 = time.perf_counter()
-    r = subprocess.run([tool, 'register', sp, tp, '--json'] + extra, capture_output=True, text=True)
+    r = subprocess.run([tool, 'register'] + ([tp, sp] if SWAP else [sp, tp]) + ['--json'] + extra,
+                       capture_output=True, text=True)
     ms = 1000 * (time.perf_counter() - t0)
     if r.returncode != 0:
         return None, 0.0, ms, None
     j = json.loads(r.stdout)
     M = np.hstack([np.array(j['A'], float), np.array(j['B'], float)[:, None]])
+    if SWAP:
+        M = inv_affine(M) if abs(np.linalg.det(M[:, :2])) > 1e-12 else None
     evidence = {k: j.get(k) for k in EVIDENCE}
     evidence['pixel_grid'] = j.get('stages', {}).get('pixel_grid')
     return M, float(j.get('confidence', 0.0)), ms, evidence
@@ -371,7 +382,7 @@ def family_table(res, conds, methods):
 
 
 def main():
-    global CLOCK, SPAN, CANVAS
+    global CLOCK, SPAN, CANVAS, SWAP
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--data', default=os.path.join(os.environ.get('AMSCR_DATASETS') or
                                                    os.path.join(ROOT, '..', 'shared', 'datasets'), 'mpeg7-dev'))
@@ -391,8 +402,10 @@ def main():
     ap.add_argument('--reference', action='store_true', help="add the calibration: find_contours lists to the tool")
     ap.add_argument('--classes', type=int, default=0, help='the first N classes only (0: all)')
     ap.add_argument('--low-px', type=float, default=SPAN / REDUCE, help='lowres / grey: the shape N px across')
+    ap.add_argument('--swap', action='store_true', help='the damaged image registered onto the clean one')
     ap.add_argument('--json', default=None)
     a = ap.parse_args()
+    SWAP = a.swap
     if a.cpu_time:
         CLOCK = time.process_time
     if a.low_px != SPAN / REDUCE:
@@ -413,7 +426,7 @@ def main():
         classes.append(('proc%02d' % i, shapegen.silhouette(1, i), 'P'))
     if a.fold:
         classes = [c for c in classes if c[2] == a.fold]
-    use_ecc = not a.no_ecc
+    use_ecc = not a.no_ecc and not a.swap  # ECC aligns images: one direction
     use_chain = not a.no_chain
     allconds = (family_conditions(a.quick) if a.families else
                 [(k, lab, k, None, t, i) for i, (k, lab, t) in enumerate(CONDITIONS)])

@@ -98,7 +98,7 @@ extern "C" {
 
 /** Compile-time version; amscr_version_number() gives the runtime one. */
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 20
+#define AMSCR_VERSION_MINOR 21
 #define AMSCR_VERSION_PATCH 0
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
@@ -1454,8 +1454,9 @@ AMSCR_API int amscr_params_get_polish(const amscr_params *p);
  *        points on the pixel lattice, is registered onto again with its tracing's bias
  *        simulated and removed; the map whose rendering differs from the target image in fewer
  *        pixels is kept; a target given as such an image's pixel chain is first traced again
- *        at sub-pixel, and the result is read against that trace; which targets:
- *        docs/method.md §11.7). Default in every preset:
+ *        at sub-pixel, and the result is read against that trace; so is a source given as a
+ *        small image's pixel chain when the target was traced from an image too; which
+ *        targets and sources: docs/method.md §11.7). Default in every preset:
  *        recovery, polish and pixel_grid on; despike, order and even_spacing off (switch them
  *        on for point lists with stray points or synthetic noise; docs/method.md §11). A stage
  *        switched on still runs only when its condition holds (amscr_result_stage).

@@ -243,11 +243,10 @@ static size_t differing(const amscr_result *r, const double *S, const amscr_cont
     return d;
 }
 
-/* The RMS error of r's map against the truth M over the source S, % of the target's radius. */
-static double error_pct(const amscr_result *r, const double *S, const double M[6], size_t g)
+/* The RMS error of the map A against the truth M over the source S, % of the target's radius. */
+static double map_error_pct(const double A[6], const double *S, const double M[6], size_t g)
 {
-    double A[6], T[6];
-    ck_assert_int_eq(amscr_result_affine(r, A), AMSCR_OK);
+    double T[6];
     /* the truth from S (a 60-px shape about (80, 80)) to the target: x -> M (x - 80) / 5 + g/2 */
     const double k = RAD / 60.0, c = 80.0, o = (double)g / 2.0;
     T[0] = k * M[0], T[1] = k * M[1], T[2] = M[2] + o - k * (M[0] * c + M[1] * c);
@@ -260,6 +259,14 @@ static double error_pct(const amscr_result *r, const double *S, const double M[6
         s2 += ex * ex + ey * ey;
     }
     return 100.0 * sqrt(s2 / NSRC) / amscr_test_shape_size(P, NSRC);
+}
+
+/* The RMS error of r's map against the truth M over the source S, % of the target's radius. */
+static double error_pct(const amscr_result *r, const double *S, const double M[6], size_t g)
+{
+    double A[6];
+    ck_assert_int_eq(amscr_result_affine(r, A), AMSCR_OK);
+    return map_error_pct(A, S, M, g);
 }
 
 /* Stars of radius 9 px: with the stage on, the map kept never differs from the image in more
@@ -408,6 +415,59 @@ START_TEST(chain_keeps_its_start)
 }
 END_TEST
 
+/* The other way round: c (a small image's chain or trace) registered onto t, the map inverted,
+ * then measured against the truth M over S (map_error_pct); *A (when not NULL) the map found. */
+static double onto_error_pct(const amscr_params *p, const amscr_contour *c, const amscr_contour *t, const double *S,
+                             const double M[6], double *A)
+{
+    amscr_result *r = NULL;
+    ck_assert_int_eq(amscr_register_contours(p, c, t, &r), AMSCR_OK);
+    double X[6], inv[6];
+    ck_assert_int_eq(amscr_result_affine(r, X), AMSCR_OK);
+    amscr_result_free(r);
+    if (A)
+        memcpy(A, X, sizeof X);
+    double det = X[0] * X[4] - X[1] * X[3];
+    ck_assert(fabs(det) > 1e-12);
+    inv[0] = X[4] / det, inv[1] = -X[1] / det, inv[3] = -X[3] / det, inv[4] = X[0] / det;
+    inv[2] = -(inv[0] * X[2] + inv[1] * X[5]), inv[5] = -(inv[3] * X[2] + inv[4] * X[5]);
+    return map_error_pct(inv, S, M, W);
+}
+
+/* A source given as a small image's pixel chain, registered onto an image's tracing (the 60-px
+ * shape S rendered and traced: over the grid's limit, so the target's condition never holds), is
+ * traced again: right (within 4 % of the radius) as often as the image's sub-pixel trace, and far
+ * more often than the chain as given (the stage off), a pixel thinner. Onto S's points themselves
+ * (a target not traced from an image) the chain is registered as given. */
+START_TEST(small_chain_source_traced_again)
+{
+    amscr_params *off = stage_off();
+    int ok_chain = 0, ok_trace = 0, ok_given = 0;
+    for (uint64_t seed = 1; seed <= NSEED; seed++) {
+        double S[2 * NSRC], M[6], A[6], B[6];
+        uint8_t *img = malloc(160 * 160);
+        ck_assert(img);
+        amscr_contour *t = NULL, *chain = small_chain(seed, RAD, S, M, &t), *big = traced(S, 160, img), *pts = NULL;
+        ok_chain += onto_error_pct(NULL, chain, big, S, M, NULL) < 4.0;
+        ok_trace += onto_error_pct(NULL, t, big, S, M, NULL) < 4.0;
+        ok_given += onto_error_pct(off, chain, big, S, M, NULL) < 4.0;
+        ck_assert_int_eq(amscr_contour_new(S, NSRC, &pts), AMSCR_OK);
+        onto_error_pct(NULL, chain, pts, S, M, A);
+        onto_error_pct(off, chain, pts, S, M, B);
+        ck_assert_msg(memcmp(A, B, sizeof A) == 0, "seed %d: the chain traced again onto a point list", (int)seed);
+        amscr_contour_free(pts);
+        amscr_contour_free(big);
+        amscr_contour_free(chain);
+        amscr_contour_free(t);
+        free(img);
+    }
+    ck_assert_msg(ok_chain >= ok_trace - 1 && ok_chain >= ok_given + 5,
+                  "right of %d: chain %d, its image's trace %d, the chain as given %d", NSEED, ok_chain, ok_trace,
+                  ok_given);
+    amscr_params_free(off);
+}
+END_TEST
+
 Suite *amscr_suite_pixel_grid(void)
 {
     Suite *s = suite_create("pixel_grid");
@@ -419,6 +479,7 @@ Suite *amscr_suite_pixel_grid(void)
     tcase_add_test(tc, kept_map_fits_the_image);
     tcase_add_test(tc, chain_registers_as_its_image_traced);
     tcase_add_test(tc, chain_keeps_its_start);
+    tcase_add_test(tc, small_chain_source_traced_again);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -385,6 +385,9 @@ double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const doub
  * lattice at a resolution where the tracing's bias counts, for h and for f under the map X (the
  * stage's condition). */
 int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
+/* Whether d's input points lie on a binary image's pixel lattice (a sub-pixel tracing at half
+ * level: each point one integer and one half-integer coordinate), whatever its size. */
+int amscr__on_pixel_lattice(const amscr_descriptor *d);
 /* Whether n points have an RMS radius within the pixel_grid stage's limit; whether f's input
  * points under the map X (onto h) have. */
 int amscr__grid_small(const double *p, size_t n);

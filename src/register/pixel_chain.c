@@ -1,4 +1,4 @@
-/* pixel_chain.c — a target given as a pixel chain, traced again at sub-pixel (docs/method.md §11.7).
+/* pixel_chain.c — a target (or source) given as a pixel chain, traced again at sub-pixel (docs/method.md §11.7).
  *
  * A pixel chain is the sequence of a binary image's boundary pixel centres: integer points, each
  * 8-adjacent to the next and the last to the first (OpenCV's findContours without approximation,
@@ -11,7 +11,8 @@
  * (pixel_grid.c). Where the pixel_grid stage is on and its condition holds for the chain (the
  * chain and the source under the search's map within the grid's limit), register.c registers the
  * source onto that trace instead, and the pixel_grid stage runs on it; a source given as a pixel
- * chain is traced again too, so that a chain registered onto itself still reads the identity. */
+ * chain is traced again too, so that a chain registered onto itself still reads the identity. A
+ * small chain source is traced again onto any target traced from an image (register.c). */
 #include "match.h"
 
 #include <math.h>

@@ -107,6 +107,11 @@ int amscr__grid_mapped_small(const amscr_descriptor *f, const amscr_descriptor *
     return f->raw && mapped_radius(A, f->raw, f->nraw) <= AMSCR__GRID_RADIUS_MAX;
 }
 
+int amscr__on_pixel_lattice(const amscr_descriptor *d)
+{
+    return d->raw && on_lattice(d->raw, d->nraw);
+}
+
 int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6])
 {
     return f->raw && h->raw && on_lattice(h->raw, h->nraw) && amscr__grid_small(h->raw, h->nraw) &&

@@ -6,7 +6,8 @@
  *   amscr_register    checks the pair, runs the stage table (stages.c: despike, search, method,
  *                     recovery, final solve, symmetric, polish, order, even spacing,
  *                     alternatives, correspondences, pixel_grid) — onto the image a small
- *                     pixel chain target bounds, traced at sub-pixel (pixel_chain.c) —,
+ *                     pixel chain target bounds, traced at sub-pixel, from a small pixel
+ *                     chain source's onto a traced target (pixel_chain.c) —,
  *                     registers a small binary image's target again when the pixel_grid
  *                     stage's condition held (pixel_grid.c), checks the result (check.c) and
  *                     fills the result's maps;
@@ -30,6 +31,7 @@ static amscr_status again_on_pixel_grid(const amscr_params *prm, const amscr_des
                                         const amscr_descriptor *tgt, amscr_workspace *ws, amscr_result *r);
 static amscr_status chain_images(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                  amscr_workspace *ws, amscr_descriptor *g[2]);
+static int source_retraced(const amscr_descriptor *src, const amscr_descriptor *tgt, int target);
 
 amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
                             amscr_workspace *ws, amscr_result **out_result)
@@ -74,25 +76,40 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
     return st;
 }
 
-/* A target given as a small pixel chain, the source under the search's map as small (the
- * pixel_grid stage's condition; pixel_chain.c): the image the chain bounds traced at sub-pixel
- * (g[1]) and a source given as a pixel chain traced again too (g[0]), to register instead. Else,
- * or where the search fails or an image cannot be traced again, g NULL: the pair as given. */
+/* Whether a source given as a pixel chain is traced again: with the target (target: its
+ * condition held), or, small itself (its RMS radius within the grid's limit), onto a target traced
+ * from an image too (a pixel chain or a binary image's sub-pixel tracing, of any size); a target
+ * made from the chain's own points (a warped copy) keeps the chain as given. */
+static int source_retraced(const amscr_descriptor *src, const amscr_descriptor *tgt, int target)
+{
+    if (!amscr__is_pixel_chain(src))
+        return 0;
+    return target || ((amscr__is_pixel_chain(tgt) || amscr__on_pixel_lattice(tgt)) &&
+                      amscr__grid_small(src->raw, src->nraw));
+}
+
+/* Pixel chains traced again (pixel_chain.c), with the pixel_grid stage on: a target given as a
+ * small pixel chain, the source under the search's map as small (the stage's condition), is
+ * replaced by the image the chain bounds traced at sub-pixel (g[1]); a source given as a pixel
+ * chain too where source_retraced says (g[0]). Else, or where the search fails or an image cannot
+ * be traced again, g NULL: the pair as given. */
 static amscr_status chain_images(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                  amscr_workspace *ws, amscr_descriptor *g[2])
 {
     g[0] = g[1] = NULL;
     if (prm->partial || !prm->polish || !AMSCR__STAGE_ON(prm, AMSCR__STAGE_POLISH) ||
-        !AMSCR__STAGE_ON(prm, AMSCR__STAGE_PIXEL_GRID) || !src->raw || !amscr__is_pixel_chain(tgt) ||
-        !amscr__grid_small(tgt->raw, tgt->nraw))
+        !AMSCR__STAGE_ON(prm, AMSCR__STAGE_PIXEL_GRID) || !src->raw)
         return AMSCR_OK;
-    match_t m;
-    amscr_status st = amscr__match_dir(prm, src, tgt, ws, &m);
-    if (st == AMSCR_OK && !amscr__grid_mapped_small(src, tgt, m.X))
-        return AMSCR_OK;
-    if (st == AMSCR_OK)
+    amscr_status st = AMSCR_OK;
+    int target = 0; /* the target's condition held */
+    if (amscr__is_pixel_chain(tgt) && amscr__grid_small(tgt->raw, tgt->nraw)) {
+        match_t m;
+        st = amscr__match_dir(prm, src, tgt, ws, &m);
+        target = st == AMSCR_OK && amscr__grid_mapped_small(src, tgt, m.X);
+    }
+    if (st == AMSCR_OK && target)
         st = amscr__chain_retrace(tgt, &g[1]);
-    if (st == AMSCR_OK && amscr__is_pixel_chain(src))
+    if (st == AMSCR_OK && source_retraced(src, tgt, target))
         st = amscr__chain_retrace(src, &g[0]);
     if (st == AMSCR_OK)
         return st;

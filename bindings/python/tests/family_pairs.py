@@ -29,30 +29,33 @@ def opencv_chain(img):
     return max(cs, key=len)[:, 0, :].astype(float)
 
 
-def pair(B, i, key, draw, chain=False, **options):
+def pair(B, i, key, draw, chain=False, swap=False, **options):
     """(registration, RMS error % of R, success threshold %) of procedural shape i under the
-    families condition `key`, draw `draw` (chain: the target as OpenCV's pixel chain; options:
+    families condition `key`, draw `draw` (chain: the target as OpenCV's pixel chain; swap: the
+    target registered onto the source, its map inverted before it is measured; options:
     amscr.register's)."""
     _, _, kind, level, thr, seed = [c for c in B.family_conditions() if c[0] == key][0]
     src = B.load_source(shapegen.silhouette(1, i))
     f = B.subpixel_contour(src)
     tgt, T = B.family_target(src, f, kind, level, np.random.default_rng([1000 + i, seed, draw, 2024]))
     t = opencv_chain(tgt) if chain else amscr.contour_from_mask(tgt, join=True)
-    r = amscr.register(amscr.contour_from_mask(src, join=True), t, **options)
-    return r, B.errors(np.hstack([np.asarray(r.A), np.asarray(r.B)[:, None]]), T, f)[0], thr
+    s = amscr.contour_from_mask(src, join=True)
+    r = amscr.register(t, s, **options) if swap else amscr.register(s, t, **options)
+    M = np.hstack([np.asarray(r.A), np.asarray(r.B)[:, None]])
+    return r, B.errors(B.inv_affine(M) if swap else M, T, f)[0], thr
 
 
 LOW = [(key, draw) for key in ('lowres30', 'lowres40') for draw in (0, 1)]
 
 
-def low_pairs(B, chain=False):
-    """The procedural shapes (35) at binary 30 and 40 px, draws 0-1, with and without the
-    pixel_grid stage: {(shape, key, draw): (error with it, its confidence, whether it ran, error
-    without, success threshold)}."""
+def low_pairs(B, chain=False, swap=False, off=True):
+    """The procedural shapes (35) at binary 30 and 40 px, draws 0-1, with and without (off) the
+    pixel_grid stage (swap: the small image the source): {(shape, key, draw): (error with it, its
+    confidence, whether it ran, error without or nan, success threshold)}."""
     out = {}
     for i in range(35):
         for key, draw in LOW:
-            on, err_on, thr = pair(B, i, key, draw, chain=chain)
-            _, err_off, _ = pair(B, i, key, draw, chain=chain, stages={'pixel_grid': False})
+            on, err_on, thr = pair(B, i, key, draw, chain=chain, swap=swap)
+            err_off = pair(B, i, key, draw, chain=chain, swap=swap, stages={'pixel_grid': False})[1] if off else np.nan
             out[(i, key, draw)] = (err_on, on.confidence, on.stages['pixel_grid'], err_off, thr)
     return out
