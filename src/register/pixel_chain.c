@@ -1,4 +1,5 @@
-/* pixel_chain.c — a target (or source) given as a pixel chain, traced again at sub-pixel (docs/method.md §11.7).
+/* pixel_chain.c — a target (or source) given as a pixel chain, traced again at sub-pixel
+ * (docs/method.md §11.7).
  *
  * A pixel chain is the sequence of a binary image's boundary pixel centres: integer points, each
  * 8-adjacent to the next and the last to the first (OpenCV's findContours without approximation,
