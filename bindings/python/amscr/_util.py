@@ -36,13 +36,15 @@ def as_order(order: Any) -> str:
     return order
 
 
-def as_points(x: Any, name: str = 'points', order: str = 'xy') -> np.ndarray:
+def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: bool = False) -> np.ndarray:
     """The one conversion of user points: array-like -> C-contiguous float64 (n, 2) array of
     (x, y) rows, n >= 1, all finite.
 
     Accepts (n, 2) arrays of any real dtype, and OpenCV contours ((n, 1, 2) int32 from
     ``cv2.findContours``, already (x, y)). ``order='rc'`` takes (row, col) points (scikit-image's
-    ``measure.find_contours``) and swaps them: x = column, y = row.
+    ``measure.find_contours``) and swaps them: x = column, y = row. closed_shape (the points
+    become a closed prepared shape): an OpenCV contour compressed by ``CHAIN_APPROX_SIMPLE`` is
+    expanded to the pixel chain it stands for (:func:`expand_chain`).
     """
     order = as_order(order)
     if hasattr(x, 'input_points') and hasattr(x, 'scale_points'):
@@ -56,6 +58,8 @@ def as_points(x: Any, name: str = 'points', order: str = 'xy') -> np.ndarray:
         raise bad('%s: expected real numbers, got an array of dtype %s' % (name, a.dtype))
     if a.ndim == 3 and a.shape[1:] == (1, 2):  # an OpenCV contour
         a = a[:, 0, :]
+        if closed_shape and a.dtype.kind in 'iu':
+            a = expand_chain(a)
     if a.ndim != 2 or a.shape[1] != 2:
         hint = (' (a list of OpenCV contours? pass one of them, e.g. max(contours, key=cv2.contourArea))'
                 if a.ndim == 4 and a.shape[2:] == (1, 2) else '')
@@ -71,6 +75,22 @@ def as_points(x: Any, name: str = 'points', order: str = 'xy') -> np.ndarray:
         i = int(np.argmin(finite))
         raise bad('%s: point %d is not finite: (%r, %r)' % (name, i, float(a[i, 0]), float(a[i, 1])))
     return a
+
+
+def expand_chain(a: np.ndarray) -> np.ndarray:
+    """The closed pixel chain an integer (n, 2) contour compressed by OpenCV's
+    ``CHAIN_APPROX_SIMPLE`` stands for: each step to the next point (the last to the first
+    included) along one of the 8 grid directions, split into unit steps (the points the
+    compression dropped: the same outline, as ``CHAIN_APPROX_NONE`` gives it). `a` itself when
+    some step is not along a grid direction or every step is already a unit step."""
+    d = np.roll(a, -1, axis=0).astype(np.int64) - a
+    k = np.abs(d).max(axis=1)
+    along = (k > 0) & ((d[:, 0] == 0) | (d[:, 1] == 0) | (np.abs(d[:, 0]) == np.abs(d[:, 1])))
+    if a.shape[0] < 2 or not along.all() or k.max() <= 1:
+        return a
+    i = np.repeat(np.arange(a.shape[0]), k)
+    j = np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k)
+    return a[i] + (d // k[:, None])[i] * j[:, None]
 
 
 def points_in_order(xy: np.ndarray, order: str) -> np.ndarray:

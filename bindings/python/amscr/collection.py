@@ -108,7 +108,7 @@ class Collection:
             if isinstance(shape, Shape):
                 _check(lib.amscr_db_add_descriptor(self._db, shape._d, code, idx))
             else:
-                c = contour_new(as_points(shape, 'shape', order))
+                c = contour_new(as_points(shape, 'shape', order, closed_shape=self.params.closed))
                 _check(lib.amscr_db_add_contour(self._db, c, code, idx))
             return int(idx[0])
 
@@ -136,7 +136,9 @@ class Collection:
             raise bad('extend: %d shapes but %d labels' % (len(shapes), len(labels)))
         if not shapes or any(isinstance(s, Shape) for s in shapes):
             return [self.add(s, lab, order=order) for s, lab in zip(shapes, labels)]
-        contours = [contour_new(as_points(s, 'shapes[%d]' % i, order)) for i, s in enumerate(shapes)]
+        closed = self.params.closed
+        contours = [contour_new(as_points(s, 'shapes[%d]' % i, order, closed_shape=closed))
+                    for i, s in enumerate(shapes)]
         with self._lock.write():
             kept = (None if self._label_names is None else list(self._label_names), dict(self._label_codes),
                     self._int_labels)

@@ -218,7 +218,8 @@ def register(src: PointsLike, tgt: PointsLike, *, method: Optional[str] = None, 
 
     Args:
         src, tgt: the two shapes: (n, 2) point arrays (contours, closed by default; OpenCV
-            (n, 1, 2) contours are accepted as they are) or prepared :class:`Shape` s.
+            (n, 1, 2) contours are accepted as they are, ``CHAIN_APPROX_SIMPLE`` ones read as
+            the pixel chain they stand for) or prepared :class:`Shape` s.
         method: 'multiclass-em' (default), 'binary-em', 'amscr' or 'acma'.
         points: N, samples per scale (None: 256, the registration preset; see below).
         scales: the smoothing scales sigma_k (samples of the N-point curve).

@@ -17,7 +17,9 @@ class Shape:
 
     Args:
         contour: the shape's points: an (n, 2) array of (x, y) rows (any real dtype), or an
-            OpenCV contour ((n, 1, 2), as ``cv2.findContours`` gives it).
+            OpenCV contour ((n, 1, 2), as ``cv2.findContours`` gives it; closed, one compressed by
+            ``CHAIN_APPROX_SIMPLE`` is read as the pixel chain it stands for, as
+            ``CHAIN_APPROX_NONE`` gives it).
         params: a :class:`Params` to start from (None: the library defaults).
         order: 'xy' (default) or 'rc' for (row, col) points such as scikit-image's
             ``measure.find_contours`` gives; they are taken as x = column, y = row, so every
@@ -30,8 +32,8 @@ class Shape:
 
     def __init__(self, contour: ArrayLike, /, params: Optional[Params] = None, *, order: str = 'xy',
                  **options: Any):
-        pts = as_points(contour, 'contour', order)
         p = make_params(params, options)
+        pts = as_points(contour, 'contour', order, closed_shape=p.closed)
         self._d = new_object('amscr_descriptor', lib.amscr_descriptor_new, lib.amscr_descriptor_free,
                              p._p, contour_new(pts))
         self._owner = None
@@ -123,4 +125,4 @@ def as_shape(x: PointsLike, params: Params, name: str, order: str = 'xy') -> Sha
     """`x` itself when it is a Shape, else the points `x` (in `order`) prepared with `params`."""
     if isinstance(x, Shape):
         return x
-    return Shape(as_points(x, name, order), params)
+    return Shape(as_points(x, name, order, closed_shape=params.closed), params)

@@ -115,6 +115,47 @@ def test_a_bad_order_is_refused(order):
         amscr.as_points(src, order=order)
 
 
+def _small_mask(seed):
+    """A binary image of blob(seed) about 30 px across."""
+    yy, xx = np.mgrid[0:40, 0:40]
+    b = blob(400, seed=seed)
+    ang = np.arctan2(yy - 20.0, xx - 20.0)
+    r = np.interp(ang, np.arctan2(b[:, 1], b[:, 0]), np.hypot(b[:, 0], b[:, 1]), period=2 * np.pi)
+    return (np.hypot(yy - 20.0, xx - 20.0) <= 13.0 * r).astype(np.uint8) * 255
+
+
+def _compressed(chain):
+    """The chain as OpenCV's CHAIN_APPROX_SIMPLE gives it: the points inside a straight run
+    (the steps before and after equal) dropped; (n, 1, 2) int32."""
+    c = np.asarray(chain, dtype=np.int32)
+    d = np.diff(c, axis=0, append=c[:1])
+    keep = np.any(d != np.roll(d, 1, axis=0), axis=1)
+    keep[0] = True
+    return c[keep].reshape(-1, 1, 2)
+
+
+def test_a_compressed_opencv_chain_is_read_as_the_chain():
+    """An OpenCV contour compressed by CHAIN_APPROX_SIMPLE registers, closed, exactly as the
+    pixel chain it stands for (so a small image's chain is traced again: the pixel_grid stage);
+    open, or where it is applied to points, it is taken as given."""
+    src = amscr.contour_from_mask(_small_mask(1), join=True) * 6.0
+    for seed in (2, 3):
+        chain = amscr.contour_from_mask(_small_mask(seed), subpixel=False)
+        full = chain.astype(np.int32).reshape(-1, 1, 2)
+        simple = _compressed(chain)
+        assert len(simple) < 0.75 * len(full)
+        assert np.array_equal(amscr._util.expand_chain(simple[:, 0, :]), full[:, 0, :])
+        r, r_full, r_given = (amscr.register(src, t) for t in (simple, full, simple[:, 0, :].astype(float)))
+        assert np.array_equal(r.matrix, r_full.matrix) and r.stages['pixel_grid']
+        assert not np.array_equal(r.matrix, r_given.matrix)
+        assert r.apply(simple).shape == (len(simple), 2)
+        assert np.array_equal(amscr.Shape(simple, closed=False).points,
+                              amscr.Shape(simple[:, 0, :].astype(float), closed=False).points)
+    # a step off the 8 grid directions: not a compressed chain, taken as given
+    poly = np.array([[0, 0], [5, 1], [3, 4]], dtype=np.int32)
+    assert amscr._util.expand_chain(poly) is poly
+
+
 # -- with OpenCV ------------------------------------------------------------------------------
 @needs_pair
 @pytest.mark.parametrize('approx', ['CHAIN_APPROX_NONE', 'CHAIN_APPROX_SIMPLE'])
