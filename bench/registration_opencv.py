@@ -23,22 +23,14 @@ import family_pairs  # noqa: E402
 import amscr  # noqa: E402
 
 
-def contour(img, method):
-    found = cv2.findContours((img > 127).astype(np.uint8), cv2.RETR_EXTERNAL, method)[0]
-    return max(found, key=len)
-
-
 def main():
     B = family_pairs.bench()
     kinds = ('CHAIN_APPROX_NONE', 'CHAIN_APPROX_SIMPLE', 'CHAIN_APPROX_SIMPLE as floats')
     right, wc, same, n = dict.fromkeys(kinds, 0), dict.fromkeys(kinds, 0), 0, 0
     for i in range(35):
         for key, draw in family_pairs.LOW:
-            _, _, kind, level, thr, seed = [c for c in B.family_conditions() if c[0] == key][0]
-            src = B.load_source(family_pairs.shapegen.silhouette(1, i))
-            f = B.subpixel_contour(src)
-            tgt, T = B.family_target(src, f, kind, level, np.random.default_rng([1000 + i, seed, draw, 2024]))
-            none, simple = contour(tgt, cv2.CHAIN_APPROX_NONE), contour(tgt, cv2.CHAIN_APPROX_SIMPLE)
+            src, f, tgt, T, thr = family_pairs.images(B, i, key, draw)
+            none, simple = (family_pairs.opencv_contour(tgt, m) for m in (cv2.CHAIN_APPROX_NONE, cv2.CHAIN_APPROX_SIMPLE))
             s = amscr.contour_from_mask(src, join=True)
             maps = []
             for k, t in zip(kinds, (none, simple, simple[:, 0, :].astype(float))):

@@ -114,8 +114,7 @@ int amscr__on_pixel_lattice(const amscr_descriptor *d)
 
 int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6])
 {
-    return f->raw && h->raw && on_lattice(h->raw, h->nraw) && amscr__grid_small(h->raw, h->nraw) &&
-           amscr__grid_mapped_small(f, h, X);
+    return amscr__on_pixel_lattice(h) && amscr__grid_small(h->raw, h->nraw) && amscr__grid_mapped_small(f, h, X);
 }
 
 /* ---- the grid ---- */

@@ -5,9 +5,9 @@
  * register.c — matching a prepared source onto a prepared target (docs/method.md §3, §9), top-down:
  *   amscr_register    checks the pair, runs the stage table (stages.c: despike, search, method,
  *                     recovery, final solve, symmetric, polish, order, even spacing,
- *                     alternatives, correspondences, pixel_grid) — onto the image a small
- *                     pixel chain target bounds, traced at sub-pixel, from a small pixel
- *                     chain source's onto a traced target (pixel_chain.c) —,
+ *                     alternatives, correspondences, pixel_grid) on the pair, a small pixel
+ *                     chain (target, or source onto a target traced from an image) replaced
+ *                     by the image it bounds traced at sub-pixel (pixel_chain.c),
  *                     registers a small binary image's target again when the pixel_grid
  *                     stage's condition held (pixel_grid.c), checks the result (check.c) and
  *                     fills the result's maps;

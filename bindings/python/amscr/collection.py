@@ -108,7 +108,7 @@ class Collection:
             if isinstance(shape, Shape):
                 _check(lib.amscr_db_add_descriptor(self._db, shape._d, code, idx))
             else:
-                c = contour_new(as_points(shape, 'shape', order, closed_shape=self.params.closed))
+                c = contour_new(as_points(shape, 'shape', order, closed_shape=self._closed()))
                 _check(lib.amscr_db_add_contour(self._db, c, code, idx))
             return int(idx[0])
 
@@ -136,7 +136,7 @@ class Collection:
             raise bad('extend: %d shapes but %d labels' % (len(shapes), len(labels)))
         if not shapes or any(isinstance(s, Shape) for s in shapes):
             return [self.add(s, lab, order=order) for s, lab in zip(shapes, labels)]
-        closed = self.params.closed
+        closed = self._closed()
         contours = [contour_new(as_points(s, 'shapes[%d]' % i, order, closed_shape=closed))
                     for i, s in enumerate(shapes)]
         with self._lock.write():
@@ -179,6 +179,10 @@ class Collection:
     def params(self) -> Params:
         """A copy of the collection's options."""
         return Params._copy_of(lib.amscr_db_params(self._db))
+
+    def _closed(self) -> bool:
+        """Whether the collection's shapes are closed curves (its params, without a copy)."""
+        return bool(lib.amscr_params_get_closed(lib.amscr_db_params(self._db)))
 
     def shape(self, i: int) -> Shape:
         """A copy of the prepared shape i (a copy, because the C collection's own descriptors

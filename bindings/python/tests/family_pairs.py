@@ -20,13 +20,29 @@ def bench():
     return B
 
 
-def opencv_chain(img):
-    """The largest outer contour of img as cv2.findContours gives it without approximation: the
-    boundary pixel centres, (n, 2) float."""
+def opencv_contour(img, method=None):
+    """The largest outer contour of img as cv2.findContours returns it ((n, 1, 2) int32), with
+    `method` (None: cv2.CHAIN_APPROX_NONE, the boundary pixel centres)."""
     import cv2
     binary = (img > 127).astype(np.uint8)
-    cs, _ = cv2.findContours(binary, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
-    return max(cs, key=len)[:, 0, :].astype(float)
+    cs, _ = cv2.findContours(binary, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE if method is None else method)
+    return max(cs, key=len)
+
+
+def opencv_chain(img):
+    """opencv_contour(img) as (n, 2) floats."""
+    return opencv_contour(img)[:, 0, :].astype(float)
+
+
+def images(B, i, key, draw):
+    """(source image, its sub-pixel contour f, damaged target image, true map T, success
+    threshold %) of procedural shape i under the families condition `key`, draw `draw`, seeded
+    as the bench seeds it."""
+    _, _, kind, level, thr, seed = [c for c in B.family_conditions() if c[0] == key][0]
+    src = B.load_source(shapegen.silhouette(1, i))
+    f = B.subpixel_contour(src)
+    tgt, T = B.family_target(src, f, kind, level, np.random.default_rng([1000 + i, seed, draw, 2024]))
+    return src, f, tgt, T, thr
 
 
 def pair(B, i, key, draw, chain=False, swap=False, **options):
@@ -34,10 +50,7 @@ def pair(B, i, key, draw, chain=False, swap=False, **options):
     families condition `key`, draw `draw` (chain: the target as OpenCV's pixel chain; swap: the
     target registered onto the source, its map inverted before it is measured; options:
     amscr.register's)."""
-    _, _, kind, level, thr, seed = [c for c in B.family_conditions() if c[0] == key][0]
-    src = B.load_source(shapegen.silhouette(1, i))
-    f = B.subpixel_contour(src)
-    tgt, T = B.family_target(src, f, kind, level, np.random.default_rng([1000 + i, seed, draw, 2024]))
+    src, f, tgt, T, thr = images(B, i, key, draw)
     t = opencv_chain(tgt) if chain else amscr.contour_from_mask(tgt, join=True)
     s = amscr.contour_from_mask(src, join=True)
     r = amscr.register(t, s, **options) if swap else amscr.register(s, t, **options)

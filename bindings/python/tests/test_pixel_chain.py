@@ -74,10 +74,6 @@ def test_opencv_compressed_chains_are_read_as_full_ones(family_bench):
     B = family_bench
     for i in range(35):
         for key, draw in family_pairs.LOW:
-            _, _, kind, level, _, seed = [c for c in B.family_conditions() if c[0] == key][0]
-            src = B.load_source(family_pairs.shapegen.silhouette(1, i))
-            tgt, _ = B.family_target(src, B.subpixel_contour(src), kind, level,
-                                     np.random.default_rng([1000 + i, seed, draw, 2024]))
-            found = [max(cv2.findContours((tgt > 127).astype(np.uint8), cv2.RETR_EXTERNAL, m)[0], key=len)
-                     for m in (cv2.CHAIN_APPROX_SIMPLE, cv2.CHAIN_APPROX_NONE)]
+            tgt = family_pairs.images(B, i, key, draw)[2]
+            found = [family_pairs.opencv_contour(tgt, m) for m in (cv2.CHAIN_APPROX_SIMPLE, cv2.CHAIN_APPROX_NONE)]
             assert np.array_equal(amscr._util.expand_chain(found[0][:, 0, :]), found[1][:, 0, :]), (i, key, draw)
