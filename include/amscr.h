@@ -98,7 +98,7 @@ extern "C" {
 
 /** Compile-time version; amscr_version_number() gives the runtime one. */
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 21
+#define AMSCR_VERSION_MINOR 22
 #define AMSCR_VERSION_PATCH 0
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
@@ -1453,10 +1453,12 @@ AMSCR_API int amscr_params_get_polish(const amscr_params *p);
  *        markedly noisy points), "pixel_grid" (a target traced from a small binary image, its
  *        points on the pixel lattice, is registered onto again with its tracing's bias
  *        simulated and removed; the map whose rendering differs from the target image in fewer
- *        pixels is kept; a target given as such an image's pixel chain is first traced again
- *        at sub-pixel, and the result is read against that trace; so is a source given as a
- *        small image's pixel chain when the target was traced from an image too; which
- *        targets and sources: docs/method.md §11.7). Default in every preset:
+ *        pixels is kept; likewise a source traced from a small binary image when the target,
+ *        too large for that, was traced from an image too; a target given as such an image's
+ *        pixel chain is first traced again at sub-pixel, and the result is read against that
+ *        trace; so is a source given as a small image's pixel chain when the target was traced
+ *        from an image too; which targets and sources: docs/method.md §11.7). Default in every
+ *        preset:
  *        recovery, polish and pixel_grid on; despike, order and even_spacing off (switch them
  *        on for point lists with stray points or synthetic noise; docs/method.md §11). A stage
  *        switched on still runs only when its condition holds (amscr_result_stage).
@@ -2264,7 +2266,9 @@ AMSCR_API double amscr_result_symmetry_ambiguity(const amscr_result *r);
  *        of the best clearly different candidate map (one moving the source samples by more
  *        than 10 % of the shape's RMS radius on average). 1 = two different maps fit equally
  *        well (symmetry); near 0 = the runner-up is far worse; 0 when no different candidate
- *        was evaluated.
+ *        was evaluated. Where the "pixel_grid" stage replaced the map by a clearly different
+ *        one, at least the ratio of the pixels in which each differs from the small image,
+ *        the chosen map's over the first map's (the image decided between them).
  * @return the value; NaN for NULL.
  * Ownership: none.
  * Thread-safety: const.

@@ -1,16 +1,19 @@
 /* check_pixel_grid.c — polygons on a pixel grid (src/shape/rasterize.c) and the pixel_grid stage
  * (src/register/pixel_grid.c): a pixel is on when the polygon covers half its area or more; a
  * sub-pixel trace of a binary image gives that image back by its pixel centres; the stage runs on
- * targets traced from small binary images only, and the map it keeps differs from the target image
- * in no more pixels than the first one, and is as often right; a small image's pixel chain is
- * registered as the image traced at sub-pixel (src/register/pixel_chain.c). */
+ * targets traced from small binary images only (or, onto a large image's tracing, on such a
+ * source), and the map it keeps differs from the small image in no more pixels than the first one,
+ * and is as often right; a small image's pixel chain is registered as the image traced at
+ * sub-pixel (src/register/pixel_chain.c). */
 #include <amscr.h>
 #include <check.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+#include "match.h"
 #include "suites.h"
 #include "testutil.h"
 
@@ -225,6 +228,8 @@ START_TEST(runs_on_small_binary_tracings_only)
 }
 END_TEST
 
+static size_t pixels_apart(const double *P, size_t n, const amscr_contour *t, size_t g);
+
 /* The pixels where the source under r's map, rendered on the grid, differs from the target
  * image (t's pixel centres). */
 static size_t differing(const amscr_result *r, const double *S, const amscr_contour *t, size_t g)
@@ -232,9 +237,16 @@ static size_t differing(const amscr_result *r, const double *S, const amscr_cont
     double A[6], P[2 * NSRC];
     ck_assert_int_eq(amscr_result_affine(r, A), AMSCR_OK);
     amscr_test_apply_affine(A, S, NSRC, P);
+    return pixels_apart(P, NSRC, t, g);
+}
+
+/* The pixels of the g x g grid where the polygon P (n points), rendered, differs from the image
+ * of the trace t (its pixel centres). */
+static size_t pixels_apart(const double *P, size_t n, const amscr_contour *t, size_t g)
+{
     uint8_t *a = malloc(2 * g * g), *b = a + g * g;
     ck_assert(a);
-    ck_assert_int_eq(amscr__raster_cover(P, NSRC, 0, 0, g, g, a), AMSCR_OK);
+    ck_assert_int_eq(amscr__raster_cover(P, n, 0, 0, g, g, a), AMSCR_OK);
     ck_assert_int_eq(amscr__raster_centres(amscr_contour_xy(t), amscr_contour_size(t), 0, 0, g, g, b), AMSCR_OK);
     size_t d = 0;
     for (size_t i = 0; i < g * g; i++)
@@ -435,8 +447,8 @@ static double onto_error_pct(const amscr_params *p, const amscr_contour *c, cons
 }
 
 /* A source given as a small image's pixel chain, registered onto an image's tracing (the 60-px
- * shape S rendered and traced: over the grid's limit, so the target's condition never holds), is
- * traced again: right (within 4 % of the radius) as often as the image's sub-pixel trace, and far
+ * star S rendered and traced; its RMS radius within the grid's limit, so the stage then runs on the
+ * target's side), is traced again: right (within 4 % of the radius) as often as the image's sub-pixel trace, and far
  * more often than the chain as given (the stage off), a pixel thinner. Onto S's points themselves
  * (a target not traced from an image) the chain is registered as given. */
 START_TEST(small_chain_source_traced_again)
@@ -468,6 +480,157 @@ START_TEST(small_chain_source_traced_again)
 }
 END_TEST
 
+/* The source's pixel grid is W x W; the large target is S scaled by BIG about S's centre (80, 80)
+ * onto a BIG * 160 px square grid: an RMS radius well over the stage's 40 px. */
+#define BIG 3.0
+
+/* S (60-px shapes about (80, 80)) scaled by BIG onto the large grid, into out (2 NSRC). */
+static void enlarged(const double *S, double *out)
+{
+    for (size_t i = 0; i < 2 * NSRC; i++)
+        out[i] = BIG * (S[i] - 80.0) + BIG * 80.0;
+}
+
+/* The map X of a small source onto the large target inverted and carried back to S's frame: the
+ * map from S to the source, measured against the truth M (map_error_pct); *inv the inverse. */
+static double enlarged_error_pct(const double X[6], const double *S, const double M[6], double inv[6])
+{
+    ck_assert_int_eq(amscr_affine_invert(X, inv), AMSCR_OK);
+    const double K[6] = {BIG, 0, 0, 0, BIG, 0}; /* S -> the large grid (the offsets cancel) */
+    double A[6];
+    amscr__affine_compose(inv, K, A);
+    return map_error_pct(A, S, M, W);
+}
+
+/* The pixels where the target t under the map inv (onto the source's g x g grid), rendered
+ * there, differs from the source image (the pixel centres of the trace c). */
+static size_t differing_on_source(const double inv[6], const amscr_contour *t, const amscr_contour *c, size_t g)
+{
+    size_t n = amscr_contour_size(t);
+    double *P = malloc(2 * n * sizeof *P);
+    ck_assert(P);
+    amscr_test_apply_affine(inv, amscr_contour_xy(t), n, P);
+    size_t d = pixels_apart(P, n, c, g);
+    free(P);
+    return d;
+}
+
+/* The map of c onto t with params p (NULL: the preset), and whether the pixel_grid stage ran. */
+static int map_onto(const amscr_params *p, const amscr_contour *c, const amscr_contour *t, double X[6])
+{
+    amscr_result *r = NULL;
+    ck_assert_int_eq(amscr_register_contours(p, c, t, &r), AMSCR_OK);
+    ck_assert_int_eq(amscr_result_affine(r, X), AMSCR_OK);
+    int on = ran(r);
+    amscr_result_free(r);
+    return on;
+}
+
+/* The stage on the source's side: a small image's sub-pixel trace (radius 9 px) registered onto
+ * a large image's (its RMS radius over the stage's limit, so the target's condition never holds).
+ * The stage runs; the map kept never differs from the source image in more pixels than the first
+ * map (the target under its inverse, rendered on the source's grid); it is right at least as often
+ * as with the stage off (these stars seldom change: the families' procedural shapes do,
+ * test_pixel_chain.py). Onto a target not traced from an image (the large shape's points), the
+ * stage does not run. */
+START_TEST(small_source_corrected_on_its_grid)
+{
+    amscr_params *off = stage_off();
+    int ok_on = 0, ok_off = 0, changed = 0;
+    const size_t g = (size_t)(BIG * 160.0);
+    uint8_t *img = malloc(g * g);
+    ck_assert(img);
+    for (uint64_t seed = 1; seed <= NSEED; seed++) {
+        double S[2 * NSRC], L[2 * NSRC], M[6], A[6], B[6], ia[6], ib[6];
+        amscr_contour *t = pair(seed, RAD, W, S, M), *pts = NULL;
+        enlarged(S, L);
+        amscr_contour *big = traced(L, g, img);
+        ck_assert_msg(map_onto(NULL, t, big, A), "seed %d: the stage did not run on the small source", (int)seed);
+        ck_assert(!map_onto(off, t, big, B));
+        ok_on += enlarged_error_pct(A, S, M, ia) < 4.0;
+        ok_off += enlarged_error_pct(B, S, M, ib) < 4.0;
+        size_t da = differing_on_source(ia, big, t, W), db = differing_on_source(ib, big, t, W);
+        ck_assert_msg(da <= db, "seed %d: %zu pixels differ, %zu without the stage", (int)seed, da, db);
+        changed += da < db;
+        ck_assert_int_eq(amscr_contour_new(L, NSRC, &pts), AMSCR_OK);
+        ck_assert(!map_onto(NULL, t, pts, A));
+        amscr_contour_free(pts);
+        amscr_contour_free(big);
+        amscr_contour_free(t);
+    }
+    printf("small source: right %d with the stage, %d without, %d maps changed, of %d\n", ok_on, ok_off, changed,
+           NSEED);
+    ck_assert_int_ge(ok_on, ok_off);
+    free(img);
+    amscr_params_free(off);
+}
+END_TEST
+
+/* The pixels in which the map of r differs from the small side's image, as the stage counts them. */
+static size_t stage_differing(const amscr_descriptor *f, const amscr_descriptor *h, const amscr_result *r, int side)
+{
+    amscr_descriptor *d2 = NULL;
+    size_t n = 0;
+    ck_assert_int_eq(amscr__grid_correct(f, h, r, side, &d2, &n), AMSCR_OK);
+    amscr_descriptor_free(d2);
+    return n;
+}
+
+/* The stage's choice (amscr__grid_choose) on the source's side, the second registration's points
+ * given as the source itself: a first map a quarter turn off is replaced by the second map, and
+ * the image that decided is the ambiguity: the ratio of their differing pixels, the second's over
+ * the first's (the second's own ambiguity set to 0); a first map only slightly off (not a distinct
+ * map) is replaced with the second's ambiguity kept. */
+START_TEST(distinct_map_chosen_by_pixels_is_ambiguous)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+    const size_t g = (size_t)(BIG * 160.0);
+    uint8_t *img = malloc(g * g);
+    ck_assert(img);
+    for (uint64_t seed = 1; seed <= 4; seed++) {
+        double S[2 * NSRC], L[2 * NSRC], M[6];
+        amscr_contour *t = pair(seed, RAD, W, S, M);
+        enlarged(S, L);
+        amscr_contour *big = traced(L, g, img);
+        amscr_descriptor *f = NULL, *h = NULL;
+        ck_assert_int_eq(amscr_descriptor_new(p, t, &f), AMSCR_OK);
+        ck_assert_int_eq(amscr_descriptor_new(p, big, &h), AMSCR_OK);
+        for (int distinct = 0; distinct < 2; distinct++) {
+            amscr_result *first = NULL, *second = NULL;
+            ck_assert_int_eq(amscr_register(p, f, h, NULL, &first), AMSCR_OK);
+            ck_assert_int_eq(amscr_register(p, f, h, NULL, &second), AMSCR_OK);
+            double X2[6], *X = first->m.X;
+            memcpy(X2, second->m.X, sizeof X2);
+            if (distinct) { /* a quarter turn in the normalized frame */
+                double t2[6] = {-X[3], -X[4], -X[5], X[0], X[1], X[2]};
+                memcpy(X, t2, sizeof t2);
+            } else {
+                X[2] += 0.08; /* 6 % of the RMS radius: within the 10 % of a distinct map */
+            }
+            second->m.ambiguity = 0.0;
+            size_t d1 = stage_differing(f, h, first, AMSCR__GRID_SOURCE);
+            size_t d2 = stage_differing(f, h, second, AMSCR__GRID_SOURCE);
+            ck_assert_msg(d2 < d1, "seed %d: %zu pixels for the second map, %zu for the first", (int)seed, d2, d1);
+            ck_assert_int_eq(amscr__grid_choose(p, f, h, f, AMSCR__GRID_SOURCE, d1, first, second), AMSCR_OK);
+            for (int k = 0; k < 6; k++) /* X2 o fwd(f) o inv(f): X2 to rounding */
+                ck_assert_msg(fabs(first->m.X[k] - X2[k]) < 1e-9, "seed %d: the second map not kept", (int)seed);
+            double want = distinct ? (double)d2 / (double)d1 : 0.0;
+            ck_assert_msg(first->m.ambiguity == want, "seed %d: ambiguity %g, want %g", (int)seed,
+                          first->m.ambiguity, want);
+            amscr_result_free(first);
+            amscr_result_free(second);
+        }
+        amscr_descriptor_free(f);
+        amscr_descriptor_free(h);
+        amscr_contour_free(big);
+        amscr_contour_free(t);
+    }
+    free(img);
+    amscr_params_free(p);
+}
+END_TEST
+
 Suite *amscr_suite_pixel_grid(void)
 {
     Suite *s = suite_create("pixel_grid");
@@ -480,6 +643,8 @@ Suite *amscr_suite_pixel_grid(void)
     tcase_add_test(tc, chain_registers_as_its_image_traced);
     tcase_add_test(tc, chain_keeps_its_start);
     tcase_add_test(tc, small_chain_source_traced_again);
+    tcase_add_test(tc, small_source_corrected_on_its_grid);
+    tcase_add_test(tc, distinct_map_chosen_by_pixels_is_ambiguous);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -4,8 +4,9 @@
  * library, so every allocation the library makes passes through the wrappers below. For each
  * scenario (a noisy target, which runs the polish with its order and even-spacing steps; a target
  * with a missing run, which runs the recovery; a partial match; a symmetric match; a target traced
- * from a small binary image, which runs the pixel_grid stage, and the same image's pixel chain
- * onto itself, which traces both again first) the test
+ * from a small binary image, which runs the pixel_grid stage, the same image's pixel chain onto
+ * itself, which traces both again first, and the small image as the source onto a large image's
+ * trace, which runs the stage on the source's side) the test
  * counts the allocations of one amscr_register_contours call, then fails each of them in turn
  * (every AMSCR_OOM_STRIDE-th and the last when that is set: the valgrind setup sets 5) and checks
  * that the call returns AMSCR_E_NOMEM (nothing swallowed: no stage falls back
@@ -96,7 +97,8 @@ typedef struct {
     int partial, symmetric;
     const char *must_run; /* a stage the scenario exists for */
     int traced;           /* the target traced from its binary image (LATTICE_SIDE px square): 1 at
-                           * sub-pixel accuracy, 2 as a pixel chain */
+                           * sub-pixel accuracy, 2 as a pixel chain; 3: the source so traced, the
+                           * target a large image's trace */
 } scenario;
 
 enum { LATTICE_SIDE = 40 };
@@ -104,20 +106,56 @@ enum { LATTICE_SIDE = 40 };
 /* The binary image of the closed polygon b (n points) scaled by 8 about the image's centre (the
  * pixels whose centre it contains), traced with `flags`: at sub-pixel accuracy (0), points on the
  * pixel lattice, or as a pixel chain (AMSCR_TRACE_PIXEL_CHAIN). */
+static amscr_status traced_at(const double *b, size_t n, int side, double scale, int flags, amscr_contour **out);
 static amscr_status traced_target(const double *b, size_t n, int flags, amscr_contour **out)
 {
-    static unsigned char img[LATTICE_SIDE * LATTICE_SIDE];
-    for (int j = 0; j < LATTICE_SIDE; j++)
-        for (int i = 0; i < LATTICE_SIDE; i++) {
-            double x = (i - LATTICE_SIDE / 2) / 8.0, y = (j - LATTICE_SIDE / 2) / 8.0;
+    return traced_at(b, n, LATTICE_SIDE, 8.0, flags, out);
+}
+
+/* The same on a side x side grid at `scale` pixels a unit. */
+static amscr_status traced_at(const double *b, size_t n, int side, double scale, int flags, amscr_contour **out)
+{
+    unsigned char *img = __real_malloc((size_t)side * (size_t)side);
+    if (!img)
+        return AMSCR_E_NOMEM;
+    for (int j = 0; j < side; j++)
+        for (int i = 0; i < side; i++) {
+            double x = (i - side / 2) / scale, y = (j - side / 2) / scale;
             int in = 0;
             for (size_t k = 0, l = n - 1; k < n; l = k++)
                 if ((b[2 * k + 1] > y) != (b[2 * l + 1] > y) &&
                     x < b[2 * k] + (y - b[2 * k + 1]) * (b[2 * l] - b[2 * k]) / (b[2 * l + 1] - b[2 * k + 1]))
                     in = !in;
-            img[j * LATTICE_SIDE + i] = in ? 255 : 0;
+            img[j * side + i] = in ? 255 : 0;
         }
-    return amscr_contour_from_image(img, LATTICE_SIDE, LATTICE_SIDE, LATTICE_SIDE, 8, 127.5, flags, out);
+    amscr_status st = amscr_contour_from_image(img, (size_t)side, (size_t)side, (size_t)side, 8, 127.5, flags, out);
+    __real_free(img);
+    return st;
+}
+
+/* A large image's trace (the curve b, n points, at 40 px a unit: an RMS radius over the
+ * pixel_grid stage's 40 px) as a new contour: traced once, outside the counted allocations (the
+ * tracing is not this scenario's concern), copied on each call. */
+static amscr_status large_trace(const double *b, size_t n, amscr_contour **out)
+{
+    static double *xy;
+    static size_t m;
+    if (!xy) {
+        int was = armed;
+        amscr_contour *c = NULL;
+        armed = 0;
+        if (traced_at(b, n, 400, 40.0, 0, &c) == AMSCR_OK) {
+            m = amscr_contour_size(c);
+            xy = __real_malloc(2 * m * sizeof *xy);
+            if (xy)
+                memcpy(xy, amscr_contour_xy(c), 2 * m * sizeof *xy);
+        }
+        amscr_contour_free(c);
+        armed = was;
+        if (!xy)
+            return AMSCR_E_NOMEM;
+    }
+    return amscr_contour_new(xy, m, out);
 }
 
 static amscr_status run(const scenario *s, amscr_result **out)
@@ -138,11 +176,15 @@ static amscr_status run(const scenario *s, amscr_result **out)
     const char *opt_in[] = {"despike", "order", "even_spacing"}; /* every stage on */
     for (size_t i = 0; i < 3 && st == AMSCR_OK; i++)
         st = amscr_params_set_stage(p, opt_in[i], 1);
-    if (st == AMSCR_OK)
+    if (st == AMSCR_OK && s->traced == 3) /* the small image the source, onto a large image's trace */
+        st = large_trace(b, nt, &tgt);
+    else if (st == AMSCR_OK)
         st = s->traced ? traced_target(b, nt, s->traced == 2 ? AMSCR_TRACE_PIXEL_CHAIN : 0, &tgt)
                        : amscr_contour_new(b + 2 * s->drop, nt, &tgt);
     if (st == AMSCR_OK && s->traced == 2) /* the chain onto itself: both traced again */
         st = amscr_contour_new(amscr_contour_xy(tgt), amscr_contour_size(tgt), &src);
+    else if (st == AMSCR_OK && s->traced == 3)
+        st = traced_target(a, ns, 0, &src);
     else if (st == AMSCR_OK)
         st = amscr_contour_new(a, ns, &src);
     if (st == AMSCR_OK)
@@ -212,6 +254,8 @@ int main(void)
         {"symmetric distance", 300, 300, 0, 0.0, 0, 1, "symmetric", 0},
         {"small binary image (pixel grid)", 300, 300, 0, 0.0, 0, 0, "pixel_grid", 1},
         {"small binary image's pixel chain onto itself (both traced again)", 300, 300, 0, 0.0, 0, 0, "pixel_grid", 2},
+        {"small binary image as the source, onto a large image's trace (pixel grid)", 300, 300, 0, 0.0, 0, 0,
+         "pixel_grid", 3},
     };
     const char *env = getenv("AMSCR_OOM_STRIDE");
     long stride = env ? strtol(env, NULL, 10) : 1;

@@ -164,6 +164,9 @@ amscr_status amscr__close_curve(const double *xy, size_t n, double c, double **o
  * k-th: the grid's pixels are coarser). AMSCR_E_DEGENERATE when the curve bounds no area; AMSCR_E_NOMEM. */
 amscr_status amscr__outline(const double *xy, size_t n, double c, double *V);
 void amscr__affine_compose(const double a[6], const double b[6], double out[6]);
+/* The inverse of the affine map m into out (may be m); 0 when it is singular or not finite (out
+ * unchanged, no error set: amscr_affine_invert is the public call, with its own test). */
+int amscr__affine_inverse(const double m[6], double out[6]);
 /* rasterize.c: a closed polygon P (n vertices) on the w x h pixel grid whose pixel (i, j) is
  * centred at (x0 + i, y0 + j), even-odd rule, out[j w + i] 255 or 0. */
 /* The horizontal line y's crossings of P, sorted into xs (room for n); returns an even count. */

@@ -66,10 +66,19 @@ amscr_status amscr_affine_invert(const double m6[6], double out_m6[6])
     double scale = fabs(m6[0]) + fabs(m6[1]) + fabs(m6[3]) + fabs(m6[4]);
     if (!(fabs(det) > 1e-14 * scale * scale))
         return amscr__fail(AMSCR_E_DEGENERATE, "amscr_affine_invert: singular map (det = %g)", det);
-    double i0 = m6[4] / det, i1 = -m6[1] / det, i3 = -m6[3] / det, i4 = m6[0] / det;
-    double r[6] = {i0, i1, -(i0 * m6[2] + i1 * m6[5]), i3, i4, -(i3 * m6[2] + i4 * m6[5])};
-    memcpy(out_m6, r, sizeof r);
+    (void)amscr__affine_inverse(m6, out_m6);
     return AMSCR_OK;
+}
+
+int amscr__affine_inverse(const double m[6], double out[6])
+{
+    double det = m[0] * m[4] - m[1] * m[3];
+    if (!(fabs(det) > 0.0) || !isfinite(det))
+        return 0;
+    double i0 = m[4] / det, i1 = -m[1] / det, i3 = -m[3] / det, i4 = m[0] / det;
+    double r[6] = {i0, i1, -(i0 * m[2] + i1 * m[5]), i3, i4, -(i3 * m[2] + i4 * m[5])};
+    memcpy(out, r, sizeof r);
+    return 1;
 }
 
 /* out = a ∘ b (apply b first). */

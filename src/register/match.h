@@ -21,7 +21,7 @@
  *   even.c              the polish's even-spacing stage: points taken evenly along it (even.h)
  *   alternatives.c      the distinct maps that fit about as well as the chosen one
  *   correspond.c        inliers, the part covered, dense correspondences
- *   pixel_grid.c        a small binary image's target: its tracing's bias simulated (register.c
+ *   pixel_grid.c        a small binary image's target or source: its tracing's bias simulated (register.c
  *                       finds the map again)
  *   precision.c         the gap between two maps; the standard error: a jackknife of the fit
  *   check.c             the overlap, the symmetry test, the forward-backward check (register.c runs them)
@@ -381,10 +381,13 @@ amscr_status amscr__map_precision(const amscr_descriptor *f, const double *nr, s
  * f's base level. */
 double amscr__map_gap2(const amscr_descriptor *f, const double X1[6], const double X2[6]);
 
-/* pixel_grid.c (docs/method.md §11.7). Whether h's input points lie on a binary image's pixel
- * lattice at a resolution where the tracing's bias counts, for h and for f under the map X (the
- * stage's condition). */
-int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
+/* pixel_grid.c (docs/method.md §11.7). The side the stage corrects for the pair f -> h under the
+ * map X (the stage's condition): AMSCR__GRID_TARGET where h's input points lie on a binary image's
+ * pixel lattice at a resolution where the tracing's bias counts, for h and for f under X;
+ * else AMSCR__GRID_SOURCE where f's do, for f and for h under X's inverse, and h was traced from
+ * an image too (on the lattice, or a pixel chain); else 0. */
+enum { AMSCR__GRID_TARGET = 1, AMSCR__GRID_SOURCE = 2 };
+int amscr__pixel_grid_side(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
 /* Whether d's input points lie on a binary image's pixel lattice (a sub-pixel tracing at half
  * level: each point one integer and one half-integer coordinate), whatever its size. */
 int amscr__on_pixel_lattice(const amscr_descriptor *d);
@@ -394,17 +397,20 @@ int amscr__grid_small(const double *p, size_t n);
 int amscr__grid_mapped_small(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
 /* lo and hi widened to hold the n points p (per coordinate). */
 void amscr__points_extent(const double *p, size_t n, double lo[2], double hi[2]);
-/* For the finished result r of f -> h: the pixels where the source under r's map, rendered on
- * h's grid, differs from h's image (*out_differ), and h corrected for the tracing's bias under
- * that map, prepared as h was (*out_h2, caller frees; NULL when nothing of the mapped source
- * survives the grid). Fails only for want of memory. */
-amscr_status amscr__grid_target(const amscr_descriptor *f, const amscr_descriptor *h, const amscr_result *r,
-                                amscr_descriptor **out_h2, size_t *out_differ);
-/* r2, the registration of f onto h2, replaces r's map when its rendering differs from h's image in
- * fewer pixels than first_differ: its map carried into h's frame, its correspondences and
- * standard error measured on h (r keeps its stages' record). Fails only for want of memory. */
+/* For the finished result r of f -> h and the side the stage corrects (the small shape: h for
+ * AMSCR__GRID_TARGET, f for AMSCR__GRID_SOURCE): the pixels where the other shape under r's map
+ * (its inverse for the source), rendered on the small shape's grid, differs from the small
+ * shape's image (*out_differ), and the small shape corrected for the tracing's bias under that
+ * map, prepared as it was (*out_d2, caller frees; NULL when nothing of the mapped shape survives
+ * the grid). Fails only for want of memory. */
+amscr_status amscr__grid_correct(const amscr_descriptor *f, const amscr_descriptor *h, const amscr_result *r, int side,
+                                 amscr_descriptor **out_d2, size_t *out_differ);
+/* r2, the registration of the pair with the small side replaced by d2 (f onto d2, or d2 onto h),
+ * replaces r's map when its rendering differs from the small shape's image in fewer pixels than
+ * first_differ: its map carried into the frames of f and h, its correspondences and standard
+ * error measured on f and h (r keeps its stages' record). Fails only for want of memory. */
 amscr_status amscr__grid_choose(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                const amscr_descriptor *h2, size_t first_differ, amscr_result *r,
+                                const amscr_descriptor *d2, int side, size_t first_differ, amscr_result *r,
                                 amscr_result *r2);
 /* pixel_chain.c (docs/method.md §11.7). Whether d's input points are a closed pixel chain (integer,
  * each 8-adjacent to the next); the image a chain h bounds traced again at sub-pixel, started

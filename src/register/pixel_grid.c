@@ -1,19 +1,22 @@
-/* pixel_grid.c — the pixel_grid stage: a target traced from a binary image (docs/method.md §11.7).
+/* pixel_grid.c — the pixel_grid stage: a shape traced from a small binary image (docs/method.md
+ * §11.7), the target or, where the target is not one, the source.
  *
- * Such a target's points lie on the pixel lattice, halfway between a foreground and a background
+ * Such a shape's points lie on the pixel lattice, halfway between a foreground and a background
  * pixel centre: each has one integer and one half-integer coordinate (a sub-pixel trace of a
  * two-valued image: amscr_contour_from_image, scikit-image's find_contours at level 0.5). Where
  * the grid is coarse against the shape, the tracing is biased: corners are cut, a thin part is
- * narrowed or lost. The stage simulates that bias under the map found: the source under the map
- * is rendered on the target's grid as a camera and a threshold at half level would
- * (amscr__raster_cover), traced as the target was, and each target point moved back by the bias
- * its nearest synthetic point shows against the mapped source. The source is registered again
- * onto the corrected points, and the new map kept only when its rendering differs from the target
- * image (the pixels whose centre the traced target contains) in fewer pixels than the first
- * map's. A kept map's inliers, correspondences and standard error are then measured on the target
- * as traced (correspond.c), as its check is (check.c): the corrected points would flatter it.
- * register.c runs the second registration between amscr__grid_target and amscr__grid_choose, once
- * the stage table has finished (the table records whether the stage's condition held). */
+ * narrowed or lost. The stage simulates that bias under the map found: the other shape under the
+ * map (the source, or the target under its inverse) is rendered on the small shape's grid as a
+ * camera and a threshold at half level would (amscr__raster_cover), traced as the small shape
+ * was, and each of the small shape's points moved back by the bias its nearest synthetic point
+ * shows against the mapped shape. The pair is registered again with the corrected points, and
+ * the new map kept only when its rendering differs from the small shape's image (the pixels whose
+ * centre its trace contains) in fewer pixels than the first map's. A kept map's inliers,
+ * correspondences and standard error are then measured on the pair as traced (correspond.c), as
+ * its check is (check.c): the corrected points would flatter it. register.c runs the second
+ * registration between amscr__grid_correct and amscr__grid_choose, once the stage table has
+ * finished (the table records whether the stage's condition held; amscr__pixel_grid_side says
+ * for which side). */
 #include "dense.h"
 #include "match.h"
 #include "nearest.h"
@@ -22,12 +25,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The stage runs where the target, and the source under the map found, have an RMS radius of at
- * most this many pixels (a shape up to about 120 px across): there the tracing's bias (about a
+/* The stage runs where the small shape, and the other under the map found, have an RMS radius of
+ * at most this many pixels (a shape up to about 120 px across): there the tracing's bias (about a
  * quarter pixel RMS) is a measurable share of the radius. Chosen on data (docs/decisions.md,
  * the constants table): below it the stage gains on the three sets at 30-80 px across (radii up
  * to 38 px); at 200 px (radii from 58 px) it gains and loses alike under damage and costs 70 %
- * more time. The mapped source counts too: a large target cut to a small piece is damaged, not
+ * more time. The mapped shape counts too: a large target cut to a small piece is damaged, not
  * coarse, and the pixels it differs in would favour a map shrunk onto the piece. */
 #define AMSCR__GRID_RADIUS_MAX 40.0
 
@@ -61,19 +64,6 @@ static void map_points(const double A[6], const double *p, size_t n, double *out
         out[2 * i] = A[0] * x + A[1] * y + A[2];
         out[2 * i + 1] = A[3] * x + A[4] * y + A[5];
     }
-}
-
-/* The source's points under a map of normalized frames X (f onto a target of inverse frame inv):
- * *out (2 f->nraw, caller frees). */
-static amscr_status mapped_source(const amscr_descriptor *f, const double inv[6], const double X[6], double **out)
-{
-    double A[6];
-    input_map(f, inv, X, A);
-    *out = amscr__malloc_array(2 * f->nraw, sizeof **out);
-    if (!*out)
-        return amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
-    map_points(A, f->raw, f->nraw, *out);
-    return AMSCR_OK;
 }
 
 /* The RMS radius of the n points p under the linear part of A: sqrt(trace(A C A^T)), C their
@@ -112,9 +102,31 @@ int amscr__on_pixel_lattice(const amscr_descriptor *d)
     return d->raw && on_lattice(d->raw, d->nraw);
 }
 
-int amscr__pixel_grid_applies(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6])
+/* The map X (f onto h) in input coordinates, from the other shape into the small side's: inverted
+ * when the side is the source. 0 when it cannot be inverted (no allocation, no error). */
+static int side_map(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6], int side, double A[6])
 {
-    return amscr__on_pixel_lattice(h) && amscr__grid_small(h->raw, h->nraw) && amscr__grid_mapped_small(f, h, X);
+    input_map(f, h->inv, X, A);
+    return side != AMSCR__GRID_SOURCE || amscr__affine_inverse(A, A);
+}
+
+/* Whether the shape d, small and on the pixel lattice, can be corrected against the other, o,
+ * under the map A from o into d (the stage's condition for that side). */
+static int side_small(const amscr_descriptor *d, const amscr_descriptor *o, const double A[6])
+{
+    return amscr__on_pixel_lattice(d) && amscr__grid_small(d->raw, d->nraw) && o->raw &&
+           mapped_radius(A, o->raw, o->nraw) <= AMSCR__GRID_RADIUS_MAX;
+}
+
+int amscr__pixel_grid_side(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6])
+{
+    double A[6];
+    if (side_map(f, h, X, AMSCR__GRID_TARGET, A) && side_small(h, f, A))
+        return AMSCR__GRID_TARGET;
+    if ((amscr__on_pixel_lattice(h) || amscr__is_pixel_chain(h)) && side_map(f, h, X, AMSCR__GRID_SOURCE, A) &&
+        side_small(f, h, A))
+        return AMSCR__GRID_SOURCE;
+    return 0;
 }
 
 /* ---- the grid ---- */
@@ -132,8 +144,8 @@ void amscr__points_extent(const double *p, size_t n, double lo[2], double hi[2])
         }
 }
 
-/* The pixels around the target (T) and the mapped source (M), two pixels beyond either, at most
- * the target's own extent beyond the target (a map far off is far off by any count). */
+/* The pixels around the small shape (T) and the other mapped (M), two pixels beyond either, at
+ * most T's own extent beyond T (a map far off is far off by any count). */
 static box_t grid_box(const double *T, size_t nt, const double *M, size_t nm)
 {
     double tl[2] = {INFINITY, INFINITY}, th[2] = {-INFINITY, -INFINITY};
@@ -150,7 +162,7 @@ static box_t grid_box(const double *T, size_t nt, const double *M, size_t nm)
     return box;
 }
 
-/* The mapped source M as the camera would see it on the target T's grid: the box around both
+/* The mapped shape M as the camera would see it on the small shape T's grid: the box around both
  * and its pixels (img, b.w * b.h bytes, caller frees). */
 typedef struct {
     box_t b;
@@ -166,7 +178,7 @@ static amscr_status render(const double *M, size_t nm, const double *T, size_t n
     return amscr__raster_cover(M, nm, out->b.x0, out->b.y0, out->b.w, out->b.h, out->img);
 }
 
-/* The pixels where the rendering differs from the target image (T's pixel centres). */
+/* The pixels where the rendering differs from the small shape's image (T's pixel centres). */
 static amscr_status pixels_differing(const rendering_t *rd, const double *T, size_t nt, size_t *out)
 {
     box_t b = rd->b;
@@ -182,8 +194,8 @@ static amscr_status pixels_differing(const rendering_t *rd, const double *T, siz
     return st;
 }
 
-/* The rendering traced as the target was: *out (2 *out_n, input coordinates, caller frees).
- * AMSCR_E_NOT_FOUND or AMSCR_E_DEGENERATE when nothing of the mapped source survives the grid. */
+/* The rendering traced as the small shape was: *out (2 *out_n, input coordinates, caller frees).
+ * AMSCR_E_NOT_FOUND or AMSCR_E_DEGENERATE when nothing of the mapped shape survives the grid. */
 static amscr_status synthetic_trace(const rendering_t *rd, double **out, size_t *out_n)
 {
     box_t b = rd->b;
@@ -202,7 +214,7 @@ static amscr_status synthetic_trace(const rendering_t *rd, double **out, size_t 
     return AMSCR_OK;
 }
 
-/* Each synthetic point's bias against the mapped source M: its offset from its closest point on
+/* Each synthetic point's bias against the mapped shape M: its offset from its closest point on
  * M's polygon, into bias (2 nc). */
 static amscr_status trace_bias(const double *M, size_t nm, const double *C, size_t nc, double *bias)
 {
@@ -211,7 +223,7 @@ static amscr_status trace_bias(const double *M, size_t nm, const double *C, size
     if (ok <= 0) {
         amscr__grid_free(&g);
         return ok < 0 ? amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory")
-                      : amscr__fail(AMSCR_E_DEGENERATE, "pixel grid: the mapped source is not finite");
+                      : amscr__fail(AMSCR_E_DEGENERATE, "pixel grid: the mapped shape is not finite");
     }
     for (size_t k = 0; k < nc; k++) {
         double qx = C[2 * k], qy = C[2 * k + 1], d2, t;
@@ -225,10 +237,10 @@ static amscr_status trace_bias(const double *M, size_t nm, const double *C, size
     return AMSCR_OK;
 }
 
-/* The target's points T moved back by the bias of their nearest synthetic point (the rendering
- * rd of the mapped source M traced): *out (a new contour). AMSCR_E_NOT_FOUND /
+/* The small shape's points T moved back by the bias of their nearest synthetic point (the
+ * rendering rd of the other shape mapped, M, traced): *out (a new contour). AMSCR_E_NOT_FOUND /
  * AMSCR_E_DEGENERATE: nothing to correct by. */
-static amscr_status corrected_target(const double *M, size_t nm, const rendering_t *rd, const double *T, size_t nt,
+static amscr_status corrected_points(const double *M, size_t nm, const rendering_t *rd, const double *T, size_t nt,
                                      amscr_contour **out)
 {
     double *C = NULL, *bias = NULL, *xy = amscr__malloc_array(2 * nt, sizeof *xy);
@@ -256,12 +268,54 @@ static amscr_status corrected_target(const double *M, size_t nm, const rendering
     return st;
 }
 
-/* The first map's result r gives way to the second's, r2 (of f onto h2, the corrected target):
- * its map carried into h's normalized frame (the first alternative is that map, bit for bit as
- * the result reports it), its correspondences and standard error measured on h. r keeps its
- * record of the stages that ran. */
+/* The small side's descriptor (the one corrected) and the other's. */
+static const amscr_descriptor *small_of(const amscr_descriptor *f, const amscr_descriptor *h, int side)
+{
+    return side == AMSCR__GRID_SOURCE ? f : h;
+}
+static const amscr_descriptor *other_of(const amscr_descriptor *f, const amscr_descriptor *h, int side)
+{
+    return side == AMSCR__GRID_SOURCE ? h : f;
+}
+
+/* The other shape's points under the map X (f onto h) in the small side's coordinates: *out
+ * (2 nraw of the other, caller frees); AMSCR_E_DEGENERATE when the map cannot be inverted. */
+static amscr_status mapped_other(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6], int side,
+                                 double **out)
+{
+    const amscr_descriptor *o = other_of(f, h, side);
+    double A[6];
+    *out = NULL;
+    if (!side_map(f, h, X, side, A))
+        return amscr__fail(AMSCR_E_DEGENERATE, "pixel grid: the map cannot be inverted");
+    *out = amscr__malloc_array(2 * o->nraw, sizeof **out);
+    if (!*out)
+        return amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
+    map_points(A, o->raw, o->nraw, *out);
+    return AMSCR_OK;
+}
+
+/* The map X2 of the pair with the small side replaced by d2, carried into the frames of f and h
+ * (in place). */
+static void carried(const amscr_descriptor *f, const amscr_descriptor *h, const amscr_descriptor *d2, int side,
+                    double X[6])
+{
+    double t[6];
+    if (side == AMSCR__GRID_SOURCE) { /* X' = X2 o fwd(f2) o inv(f) */
+        amscr__affine_compose(d2->fwd, f->inv, t);
+        amscr__affine_compose(X, t, X);
+    } else { /* X' = fwd(h) o inv(h2) o X2 */
+        amscr__affine_compose(d2->inv, X, t);
+        amscr__affine_compose(h->fwd, t, X);
+    }
+}
+
+/* The first map's result r gives way to the second's, r2 (of the pair with the small side
+ * corrected, d2): its map carried into the frames of f and h (the first alternative is that map,
+ * bit for bit as the result reports it), its correspondences and standard error measured on f and
+ * h. r keeps its record of the stages that ran. */
 static amscr_status adopt(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                          const amscr_descriptor *h2, amscr_result *r, amscr_result *r2)
+                          const amscr_descriptor *d2, int side, amscr_result *r, amscr_result *r2)
 {
     unsigned char ran[AMSCR__NUM_STAGES];
     memcpy(ran, r->ran, sizeof ran);
@@ -270,54 +324,72 @@ static amscr_status adopt(const amscr_params *prm, const amscr_descriptor *f, co
     r2->corr = NULL;
     memcpy(r->ran, ran, sizeof ran);
     r->backward = 0;
-    double t[6];
-    amscr__affine_compose(h2->inv, r->m.X, t);
-    amscr__affine_compose(h->fwd, t, r->m.X);
+    carried(f, h, d2, side, r->m.X);
     input_map(f, h->inv, r->m.X, r->alt[0]); /* the chosen map first, as the result reports it */
     return amscr__correspond(prm, f, h, r);
 }
 
-amscr_status amscr__grid_target(const amscr_descriptor *f, const amscr_descriptor *h, const amscr_result *r,
-                                amscr_descriptor **out_h2, size_t *out_differ)
+amscr_status amscr__grid_correct(const amscr_descriptor *f, const amscr_descriptor *h, const amscr_result *r, int side,
+                                 amscr_descriptor **out_d2, size_t *out_differ)
 {
+    const amscr_descriptor *d = small_of(f, h, side), *o = other_of(f, h, side);
     double *M = NULL;
     amscr_contour *c = NULL;
     rendering_t rd = {{0, 0, 0, 0}, NULL};
-    *out_h2 = NULL;
-    amscr_status st = mapped_source(f, h->inv, r->m.X, &M);
+    *out_d2 = NULL;
+    amscr_status st = mapped_other(f, h, r->m.X, side, &M);
     if (st == AMSCR_OK)
-        st = render(M, f->nraw, h->raw, h->nraw, &rd);
+        st = render(M, o->nraw, d->raw, d->nraw, &rd);
     if (st == AMSCR_OK)
-        st = pixels_differing(&rd, h->raw, h->nraw, out_differ);
+        st = pixels_differing(&rd, d->raw, d->nraw, out_differ);
     if (st == AMSCR_OK)
-        st = corrected_target(M, f->nraw, &rd, h->raw, h->nraw, &c);
+        st = corrected_points(M, o->nraw, &rd, d->raw, d->nraw, &c);
     if (st == AMSCR_OK)
-        st = amscr_descriptor_new(&h->params, c, out_h2);
+        st = amscr_descriptor_new(&d->params, c, out_d2);
     free(rd.img);
     free(M);
     amscr_contour_free(c);
     if (st != AMSCR_OK && st != AMSCR_E_NOMEM) {
-        st = AMSCR_OK; /* nothing of the mapped source survived the grid: no correction */
+        st = AMSCR_OK; /* nothing of the mapped shape survived the grid: no correction */
         amscr__clear_error();
     }
     return st;
 }
 
+/* A second map that cannot be inverted is not kept. */
+static amscr_status keep_first(void)
+{
+    amscr__clear_error();
+    return AMSCR_OK;
+}
+
 amscr_status amscr__grid_choose(const amscr_params *prm, const amscr_descriptor *f, const amscr_descriptor *h,
-                                const amscr_descriptor *h2, size_t first_differ, amscr_result *r,
+                                const amscr_descriptor *d2, int side, size_t first_differ, amscr_result *r,
                                 amscr_result *r2)
 {
+    const amscr_descriptor *d = small_of(f, h, side), *o = other_of(f, h, side);
     double *M2 = NULL;
     rendering_t rd = {{0, 0, 0, 0}, NULL};
     size_t second_differ = 0;
-    amscr_status st = mapped_source(f, h2->inv, r2->m.X, &M2);
+    amscr_status st = side == AMSCR__GRID_SOURCE ? mapped_other(d2, h, r2->m.X, side, &M2)
+                                                 : mapped_other(f, d2, r2->m.X, side, &M2);
     if (st == AMSCR_OK)
-        st = render(M2, f->nraw, h->raw, h->nraw, &rd);
+        st = render(M2, o->nraw, d->raw, d->nraw, &rd);
     if (st == AMSCR_OK)
-        st = pixels_differing(&rd, h->raw, h->nraw, &second_differ);
+        st = pixels_differing(&rd, d->raw, d->nraw, &second_differ);
     free(rd.img);
     free(M2);
-    if (st == AMSCR_OK && second_differ < first_differ)
-        st = adopt(prm, f, h, h2, r, r2);
+    if (st != AMSCR_OK || second_differ >= first_differ)
+        return st == AMSCR_E_DEGENERATE ? keep_first() : st;
+    double X[6];
+    memcpy(X, r2->m.X, sizeof X);
+    carried(f, h, d2, side, X);
+    /* a clearly different map chosen by the image: the first is its alternative, by pixels */
+    double amb = amscr__map_gap2(f, X, r->m.X) > AMSCR__DISTINCT_GAP2 ? (double)second_differ / (double)first_differ
+                                                                      : 0.0;
+    st = adopt(prm, f, h, d2, side, r, r2);
+    if (st == AMSCR_OK && amb > r->m.ambiguity)
+        r->m.ambiguity = amb;
     return st;
 }
+

@@ -72,18 +72,6 @@ static void load_curve(const amscr_descriptor *d, curve_t *c)
     }
 }
 
-/* The inverse of the affine map m (2x3); returns 0 when it is singular (out unchanged). */
-static int invert(const double m[6], double out[6])
-{
-    double det = m[0] * m[4] - m[1] * m[3];
-    if (!(fabs(det) > 0.0) || !isfinite(det))
-        return 0;
-    double i0 = m[4] / det, i1 = -m[1] / det, i3 = -m[3] / det, i4 = m[0] / det;
-    double r[6] = {i0, i1, -(i0 * m[2] + i1 * m[5]), i3, i4, -(i3 * m[2] + i4 * m[5])};
-    memcpy(out, r, sizeof r);
-    return 1;
-}
-
 void amscr__polish_to_frames(const polish_t *w, const amscr_descriptor *f, const amscr_descriptor *h, const double X[6],
                              double Y[6])
 {
@@ -92,7 +80,7 @@ void amscr__polish_to_frames(const polish_t *w, const amscr_descriptor *f, const
     amscr__affine_compose(a, w->src.unsim, b);
     amscr__affine_compose(h->inv, b, a);
     amscr__affine_compose(w->tgt.sim, a, b);
-    if (w->a == &w->src || !invert(b, Y))
+    if (w->a == &w->src || !amscr__affine_inverse(b, Y))
         memcpy(Y, b, sizeof b);
 }
 
@@ -100,7 +88,7 @@ void amscr__polish_from_frames(const polish_t *w, const amscr_descriptor *f, con
                                const double Y[6], double X[6])
 {
     double a[6], b[6];
-    if (w->a == &w->src || !invert(Y, b))
+    if (w->a == &w->src || !amscr__affine_inverse(Y, b))
         memcpy(b, Y, sizeof b);
     amscr__affine_compose(b, w->src.sim, a);
     amscr__affine_compose(a, f->inv, b);

@@ -8,8 +8,8 @@
  *                     alternatives, correspondences, pixel_grid) on the pair, a small pixel
  *                     chain (target, or source onto a target traced from an image) replaced
  *                     by the image it bounds traced at sub-pixel (pixel_chain.c),
- *                     registers a small binary image's target again when the pixel_grid
- *                     stage's condition held (pixel_grid.c), checks the result (check.c) and
+ *                     registers a small binary image's target (or source) again when the
+ *                     pixel_grid stage's condition held (pixel_grid.c), checks the result (check.c) and
  *                     fills the result's maps;
  *   amscr_distance    checks the pair, then match_pair: one direction f -> h by
  *                     amscr__match_dir (shift_search.c: candidate start points ranked by one
@@ -54,7 +54,7 @@ amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, 
     const amscr_descriptor *f = g[0] ? g[0] : src, *h = g[1] ? g[1] : tgt;
     if (st == AMSCR_OK)
         st = amscr__run_stages(p, f, h, w, r);
-    if (st == AMSCR_OK && r->ran[AMSCR__STAGE_PIXEL_GRID]) /* a small binary image's target (pixel_grid.c) */
+    if (st == AMSCR_OK && r->ran[AMSCR__STAGE_PIXEL_GRID]) /* a small binary image (pixel_grid.c) */
         st = again_on_pixel_grid(p, f, h, w, r);
     if (st == AMSCR_OK) /* how far the result can be trusted: its overlap and checks (check.c) */
         st = amscr__check(p, f, h, w, r);
@@ -152,33 +152,36 @@ amscr_status amscr__distance_ws(const amscr_params *prm, const amscr_descriptor 
     return st;
 }
 
-/* The pixel_grid stage (docs/method.md §11.7): the source registered again onto the target
- * corrected for its tracing's bias, through the same stages (r2->backward: no standard error, and
- * no pixel_grid stage of its own), and the map that matches the target's image better kept in r. A
- * registration that fails there leaves r as it was: no evidence to change the map by. */
+/* The pixel_grid stage (docs/method.md §11.7): the pair registered again with its small binary
+ * image's side (pixel_grid.c says which) corrected for its tracing's bias, through the same stages
+ * (r2->backward: no standard error, and no pixel_grid stage of its own), and the map that matches
+ * that image better kept in r. A registration that fails there leaves r as it was: no evidence to
+ * change the map by. */
 static amscr_status again_on_pixel_grid(const amscr_params *prm, const amscr_descriptor *src,
                                         const amscr_descriptor *tgt, amscr_workspace *ws, amscr_result *r)
 {
-    amscr_descriptor *h2 = NULL;
+    amscr_descriptor *d2 = NULL;
     amscr_result *r2 = NULL;
     size_t first_differ = 0;
-    amscr_status st = amscr__grid_target(src, tgt, r, &h2, &first_differ);
-    if (st == AMSCR_OK && h2) {
+    int side = amscr__pixel_grid_side(src, tgt, r->m.X);
+    amscr_status st = amscr__grid_correct(src, tgt, r, side, &d2, &first_differ);
+    if (st == AMSCR_OK && d2) {
         r2 = calloc(1, sizeof *r2);
         st = r2 ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "pixel grid: out of memory");
     }
     if (r2) {
         r2->backward = 1;
-        st = amscr__run_stages(prm, src, h2, ws, r2);
+        int source = side == AMSCR__GRID_SOURCE;
+        st = amscr__run_stages(prm, source ? d2 : src, source ? tgt : d2, ws, r2);
         if (st == AMSCR_OK)
-            st = amscr__grid_choose(prm, src, tgt, h2, first_differ, r, r2);
+            st = amscr__grid_choose(prm, src, tgt, d2, side, first_differ, r, r2);
         else if (st != AMSCR_E_NOMEM) {
             st = AMSCR_OK;
             amscr__clear_error();
         }
     }
     amscr_result_free(r2);
-    amscr_descriptor_free(h2);
+    amscr_descriptor_free(d2);
     return st;
 }
 

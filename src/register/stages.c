@@ -67,13 +67,13 @@ static int when_even(const stage_ctx *c)
 {
     return c->pol && is_on(c, AMSCR__STAGE_EVEN) && amscr__polish_steps_apply(c->pol);
 }
-/* A closed pair under affine invariance whose input points the polish kept, the target's on the
- * pixel lattice of a small binary image (pixel_grid.c); never within a check's or this stage's
- * own registrations. */
+/* A closed pair under affine invariance whose input points the polish kept, the target's or the
+ * source's on the pixel lattice of a small binary image (pixel_grid.c); never within a check's or
+ * this stage's own registrations. */
 static int when_pixel_grid(const stage_ctx *c)
 {
     return !c->r->backward && c->r->ran[AMSCR__STAGE_POLISH] && !c->prm->partial &&
-           is_on(c, AMSCR__STAGE_PIXEL_GRID) && amscr__pixel_grid_applies(c->f, c->h, c->r->m.X);
+           is_on(c, AMSCR__STAGE_PIXEL_GRID) && amscr__pixel_grid_side(c->f, c->h, c->r->m.X) != 0;
 }
 
 /* ---- stages ---- */

@@ -2,9 +2,9 @@
 /* Regenerate with: python3 scripts/gen_cdef.py -o bindings/python/amscr/_cdef.h */
 
 #define AMSCR_VERSION_MAJOR 0
-#define AMSCR_VERSION_MINOR 21
+#define AMSCR_VERSION_MINOR 22
 #define AMSCR_VERSION_PATCH 0
-#define AMSCR_VERSION_NUMBER 2100
+#define AMSCR_VERSION_NUMBER 2200
 #define AMSCR_MAX_IMAGE_SIDE 32768
 #define AMSCR_MAX_IMAGE_PIXELS 268435456
 #define AMSCR_MAX_POINTS 16777216

@@ -135,7 +135,8 @@ class Params:
                            "'despike', 'recovery', 'polish', 'order', 'even_spacing', 'pixel_grid' (setting one leaves "
                            "the others; default: despike, order and even_spacing off, for point lists with stray "
                            "points or synthetic noise; pixel_grid: a target traced from a small binary image "
-                           "registered again with its tracing's bias removed, a small image's pixel chain (as "
+                           "registered again with its tracing's bias removed (or such a source, onto a larger "
+                           "image's trace), a small image's pixel chain (as "
                            "cv2.findContours gives) traced again at sub-pixel first; Registration.stages says "
                            "which ran)")
     channel_weight = _Option('channel_weight', _FLOAT,

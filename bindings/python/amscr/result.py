@@ -71,7 +71,9 @@ class Registration:
             / (1 + (standard_error / 0.01)^2) (a value not measured, NaN, counts as no
             evidence against the map); reject maps below 0.25.
         ambiguity: cost of the chosen map over that of the best clearly different candidate
-            (1: a symmetric shape or a fragment that fits several places).
+            (1: a symmetric shape or a fragment that fits several places); where the pixel_grid
+            stage chose a clearly different map by a small image's pixels, at least the ratio of
+            the pixels each map gets wrong.
         inlier_fraction: share of source samples within 5 % of the target's size of its boundary.
         overlap: intersection over union of the two contours as regions under the map (NaN for
             a partial match).
