@@ -8,9 +8,10 @@
  *   amscr eval COLLECTION [--protocol all|bullseye|topk|nn] [--ranks K] [--json]
  *
  * Layout: cli.h (options.c: the options; commands.c: the command table and help; cmd_*.c: one
- * handler per command), params.c (library params from the options), retrieval.c (collection
- * steps of search/matrix/eval), names.c (name/value tables), json.c, matrix_file.c, and the
- * image, collection, drawing and utility modules.
+ * handler per command), cmd_params.c (library params from the options), shape_db.c and load_db.c
+ * (collection steps of search/matrix/eval), index_open.c and index_add.c (index files), names.c
+ * (name/value tables), json.c, matrix_file.c, and the image, collection, drawing and utility
+ * modules.
  *
  * Exit codes: 0 success, 1 bad input or failure (one line on stderr naming the file),
  * 2 usage error. */

@@ -7,7 +7,7 @@
 #include "cli.h"
 
 /* Builds the params of a command from its options. registration != 0: `register`'s defaults,
- * else the retrieval defaults of search/matrix/eval (see params.c); given options override
+ * else the retrieval defaults of search/matrix/eval (see cmd_params.c); given options override
  * both. Returns 0, or an exit code after printing the error. */
 int make_params(const opts *o, int registration, amscr_params **out);
 /* The params a command uses when no option is given (for the help). 0 or an exit code. */
