@@ -3492,6 +3492,29 @@ AMSCR_API size_t amscr_signature_size(void);
  */
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_signatures(const amscr_index *x, float *out, size_t n);
 
+/** Smallest exponent of a packed signature (amscr_index_signatures_packed). @since 0.22 */
+#define AMSCR_SIGNATURE_EXP_MIN (-126)
+/** Largest exponent of a packed signature: q * 2^e stays finite in float for every 16-bit q.
+ *  @since 0.22 */
+#define AMSCR_SIGNATURE_EXP_MAX 112
+
+/**
+ * @brief The stored signatures of x's shapes as the index holds them, in half the bytes of
+ *        amscr_index_signatures: each shape's amscr_signature_size() 16-bit values and one
+ *        exponent, value t being q[t] * 2^e (exactly amscr_index_signatures' float, both ways).
+ *        For a client that keeps the signatures of a collection spread over machines
+ *        (amscr_signature_shortlists_packed).
+ * @param[out] out_q  n * amscr_signature_size() values.
+ * @param[out] out_e  n exponents, each from AMSCR_SIGNATURE_EXP_MIN to AMSCR_SIGNATURE_EXP_MAX.
+ * @param[in]  n  must equal amscr_index_size(x) (the shapes).
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n).
+ * Ownership: none.
+ * Thread-safety: const on x.
+ * @since 0.22
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_signatures_packed(const amscr_index *x, uint16_t *out_q,
+                                                                     int32_t *out_e, size_t n);
+
 /**
  * @brief A prepared shape's signature, as an index computes a new query's (a member's is the one
  *        it stores: amscr_index_signatures).
@@ -3539,6 +3562,22 @@ AMSCR_API size_t amscr_index_build_shortlist(const amscr_params *p, size_t n, si
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_signature_shortlists(const float *sigs, size_t n, const float *qsigs,
                                                                   size_t nq, size_t first, size_t m, unsigned threads,
                                                                   size_t *out, size_t out_len);
+
+/**
+ * @brief amscr_signature_shortlists over packed signatures (amscr_index_signatures_packed of the
+ *        shards, concatenated: n shapes' q, n * amscr_signature_size() values, and their n
+ *        exponents e): exactly the shortlists of their floats, from half the memory.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, m, first, out_len, an exponent out of range, a
+ *         query not finite); AMSCR_E_NOMEM.
+ * Cost: as amscr_signature_shortlists.
+ * Ownership: none.
+ * Thread-safety: safe.
+ * @since 0.22
+ */
+AMSCR_API AMSCR_NODISCARD amscr_status amscr_signature_shortlists_packed(const uint16_t *q, const int32_t *e,
+                                                                         size_t n, const float *qsigs, size_t nq,
+                                                                         size_t first, size_t m, unsigned threads,
+                                                                         size_t *out, size_t out_len);
 
 /**
  * @brief Re-ranks a whole distance matrix by affinity diffusion on a k-nearest-neighbour

@@ -172,6 +172,38 @@ END_TEST
 START_TEST(two_blocks_one_graph) { sharded_case(0.0); }
 END_TEST
 
+/* The packed signatures of x (n shapes, d values each) are its float signatures sigs exactly,
+ * and their shortlists are the floats' (every shape's 6 nearest, left out; 3 new queries); a
+ * wrong count, an exponent out of range or NULL rows are refused. */
+static void check_packed(const amscr_index *x, const float *sigs, size_t n, size_t d)
+{
+    uint16_t *q = malloc(n * d * sizeof *q);
+    int32_t *e = malloc(n * sizeof *e);
+    size_t *a = malloc(n * 6 * sizeof *a), *b = malloc(n * 6 * sizeof *b);
+    ck_assert(q && e && a && b);
+    ck_assert_int_eq(amscr_index_signatures_packed(x, q, e, n), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_signatures_packed(x, q, e, n - 1), AMSCR_E_INVALID_ARG);
+    for (size_t i = 0; i < n; i++) {
+        ck_assert(e[i] >= AMSCR_SIGNATURE_EXP_MIN && e[i] <= AMSCR_SIGNATURE_EXP_MAX);
+        for (size_t t = 0; t < d; t++)
+            ck_assert_float_eq(ldexpf((float)q[i * d + t], e[i]), sigs[i * d + t]);
+    }
+    ck_assert_int_eq(amscr_signature_shortlists(sigs, n, sigs, n, 0, 6, 2, a, n * 6), AMSCR_OK);
+    ck_assert_int_eq(amscr_signature_shortlists_packed(q, e, n, sigs, n, 0, 6, 2, b, n * 6), AMSCR_OK);
+    ck_assert(memcmp(a, b, n * 6 * sizeof *a) == 0);
+    ck_assert_int_eq(amscr_signature_shortlists(sigs, n, sigs + 2 * d, 3, SIZE_MAX, 6, 1, a, 18), AMSCR_OK);
+    ck_assert_int_eq(amscr_signature_shortlists_packed(q, e, n, sigs + 2 * d, 3, SIZE_MAX, 6, 1, b, 18), AMSCR_OK);
+    ck_assert(memcmp(a, b, 18 * sizeof *a) == 0);
+    ck_assert_int_eq(amscr_signature_shortlists_packed(q, NULL, n, sigs, 1, 0, 6, 1, b, 6), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_signature_shortlists_packed(q, e, n, sigs, 1, 0, 6, 1, b, 5), AMSCR_E_INVALID_ARG);
+    e[1] = AMSCR_SIGNATURE_EXP_MAX + 1;
+    ck_assert_int_eq(amscr_signature_shortlists_packed(q, e, n, sigs, 1, 0, 6, 1, b, 6), AMSCR_E_INVALID_ARG);
+    free(q);
+    free(e);
+    free(a);
+    free(b);
+}
+
 /* amscr_index_pair_distances_at equals amscr_index_pair_distances on its shapes; the signatures
  * of an index are its shapes' (amscr_shape_signature) and their shortlists those the index
  * ranks by; bad arguments are errors. */
@@ -208,6 +240,7 @@ START_TEST(shortlists_and_chosen_pairs)
     ck_assert_int_eq(self, 1);
     ck_assert_int_eq(amscr_signature_shortlists(sigs, n, sigs, 1, 0, n, 1, sl, n), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_signature_shortlists(sigs, n, sigs, 1, 0, 4, 1, sl, 3), AMSCR_E_INVALID_ARG);
+    check_packed(x, sigs, n, d);
     sigs[3] = NAN;
     ck_assert_int_eq(amscr_signature_shortlists(sigs, n, sigs + 5 * d, 1, 5, 4, 1, sl, 4), AMSCR_E_INVALID_ARG);
     /* the chosen pairs of shape 3 (as itself) equal its row's cells */

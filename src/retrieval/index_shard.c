@@ -177,8 +177,24 @@ size_t amscr_index_build_shortlist(const amscr_params *p, size_t n, size_t candi
     return mb + 1 < k ? k - 1 : mb;
 }
 
+amscr_status amscr_index_signatures_packed(const amscr_index *x, uint16_t *out_q, int32_t *out_e, size_t n)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(x);
+    size_t size = amscr_db_size(x->db);
+    if (n != size || (n > 0 && (!out_q || !out_e || !x->sigq || x->sig_dim != AMSCR__SIG_DIM)))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_signatures_packed: room for %zu shapes, the index has "
+                                                "%zu", n, size);
+    if (n > 0) {
+        memcpy(out_q, x->sigq, n * AMSCR__SIG_DIM * sizeof *out_q);
+        memcpy(out_e, x->sige, n * sizeof *out_e);
+    }
+    return AMSCR_OK;
+}
+
 typedef struct {
-    const float *sigs, *lbs, *qsigs;
+    amscr__sig_rows rows;
+    const float *lbs, *qsigs;
     size_t n, first, m;
     size_t *out;
 } near_ctx;
@@ -190,39 +206,77 @@ static amscr_status near_row(void *ctx, size_t r, void *scratch)
     float lb[AMSCR__SIG_LB_DIM];
     const float *sig = c->qsigs + r * AMSCR__SIG_DIM;
     amscr__sig_bound_vector(sig, lb);
-    amscr__sig_rows rows = {c->sigs, NULL, NULL};
-    size_t got = amscr__sig_nearest(&rows, c->lbs, c->n, sig, lb, c->m, c->first == SIZE_MAX ? SIZE_MAX : c->first + r,
-                                    c->out + r * c->m);
+    size_t got = amscr__sig_nearest(&c->rows, c->lbs, c->n, sig, lb, c->m,
+                                    c->first == SIZE_MAX ? SIZE_MAX : c->first + r, c->out + r * c->m);
     return got == c->m ? AMSCR_OK : AMSCR_E_NOMEM;
+}
+
+/* The arguments of the shortlists: the counts and the queries (finite). */
+static amscr_status check_shortlists(const char *fn, size_t n, const float *qsigs, size_t nq, size_t first, size_t m,
+                                     const size_t *out, size_t out_len)
+{
+    size_t avail = first == SIZE_MAX ? n : n - 1;
+    if ((nq > 0 && (!qsigs || !out)) || (first != SIZE_MAX && (first > n || nq > n - first)) || m == 0 ||
+        m > avail || out_len != nq * m)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %zu nearest of %zu signatures for %zu queries from %zu, the "
+                                                "output holds %zu", fn, m, n, nq, first, out_len);
+    for (size_t t = 0; t < nq * AMSCR__SIG_DIM; t++)
+        if (!isfinite(qsigs[t]))
+            return amscr__fail(AMSCR_E_INVALID_ARG, "%s: query %zu is not finite", fn, t / AMSCR__SIG_DIM);
+    return AMSCR_OK;
+}
+
+/* The shortlists over the rows (checked): each row's bound vector, then the queries on threads. */
+static amscr_status shortlists(const char *fn, const amscr__sig_rows *rows, size_t n, const float *qsigs, size_t nq,
+                               size_t first, size_t m, unsigned threads, size_t *out)
+{
+    float *lbs = amscr__malloc_array(n ? n : 1, AMSCR__SIG_LB_DIM * sizeof *lbs);
+    if (!lbs)
+        return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", fn);
+    float row[AMSCR__SIG_DIM];
+    for (size_t j = 0; j < n; j++) {
+        const float *sig = rows->f ? rows->f + j * AMSCR__SIG_DIM : row;
+        if (!rows->f)
+            amscr__sig_dequantize(rows->q + j * AMSCR__SIG_DIM, rows->e[j], row);
+        amscr__sig_bound_vector(sig, lbs + j * AMSCR__SIG_LB_DIM);
+    }
+    near_ctx c = {*rows, lbs, qsigs, n, first, m, out};
+    amscr__rows_fn rf = {NULL, NULL, near_row, &c, fn};
+    amscr_status st = amscr__run_rows(&rf, 0, nq, amscr__resolve_threads(threads), NULL, NULL);
+    free(lbs);
+    return st == AMSCR_E_NOMEM ? amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", fn) : st;
 }
 
 amscr_status amscr_signature_shortlists(const float *sigs, size_t n, const float *qsigs, size_t nq, size_t first,
                                         size_t m, unsigned threads, size_t *out, size_t out_len)
 {
+    static const char fn[] = "amscr_signature_shortlists";
     amscr__clear_error();
-    size_t avail = first == SIZE_MAX ? n : n - 1;
-    if ((n > 0 && !sigs) || (nq > 0 && (!qsigs || !out)) || (first != SIZE_MAX && (first > n || nq > n - first)) ||
-        m == 0 || m > avail || out_len != nq * m)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_signature_shortlists: %zu nearest of %zu signatures for %zu "
-                                                "queries from %zu, the output holds %zu", m, n, nq, first, out_len);
-    for (size_t t = 0; t < n * AMSCR__SIG_DIM; t++)
+    if (n > 0 && !sigs)
+        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: NULL signatures", fn);
+    amscr_status st = check_shortlists(fn, n, qsigs, nq, first, m, out, out_len);
+    for (size_t t = 0; st == AMSCR_OK && t < n * AMSCR__SIG_DIM; t++)
         if (!isfinite(sigs[t]))
-            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_signature_shortlists: signature %zu is not finite",
-                               t / AMSCR__SIG_DIM);
-    for (size_t t = 0; t < nq * AMSCR__SIG_DIM; t++)
-        if (!isfinite(qsigs[t]))
-            return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_signature_shortlists: query %zu is not finite",
-                               t / AMSCR__SIG_DIM);
-    float *lbs = amscr__malloc_array(n ? n : 1, AMSCR__SIG_LB_DIM * sizeof *lbs);
-    if (!lbs)
-        return amscr__fail(AMSCR_E_NOMEM, "amscr_signature_shortlists: out of memory");
-    for (size_t j = 0; j < n; j++)
-        amscr__sig_bound_vector(sigs + j * AMSCR__SIG_DIM, lbs + j * AMSCR__SIG_LB_DIM);
-    near_ctx c = {sigs, lbs, qsigs, n, first, m, out};
-    amscr__rows_fn fn = {NULL, NULL, near_row, &c, "amscr_signature_shortlists"};
-    amscr_status st = amscr__run_rows(&fn, 0, nq, amscr__resolve_threads(threads), NULL, NULL);
-    free(lbs);
-    return st == AMSCR_E_NOMEM ? amscr__fail(AMSCR_E_NOMEM, "amscr_signature_shortlists: out of memory") : st;
+            st = amscr__fail(AMSCR_E_INVALID_ARG, "%s: signature %zu is not finite", fn, t / AMSCR__SIG_DIM);
+    amscr__sig_rows rows = {sigs, NULL, NULL};
+    return st == AMSCR_OK ? shortlists(fn, &rows, n, qsigs, nq, first, m, threads, out) : st;
+}
+
+amscr_status amscr_signature_shortlists_packed(const uint16_t *q, const int32_t *e, size_t n, const float *qsigs,
+                                               size_t nq, size_t first, size_t m, unsigned threads, size_t *out,
+                                               size_t out_len)
+{
+    static const char fn[] = "amscr_signature_shortlists_packed";
+    amscr__clear_error();
+    if (n > 0 && (!q || !e))
+        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: NULL signatures", fn);
+    amscr_status st = check_shortlists(fn, n, qsigs, nq, first, m, out, out_len);
+    for (size_t j = 0; st == AMSCR_OK && j < n; j++)
+        if (e[j] < AMSCR_SIGNATURE_EXP_MIN || e[j] > AMSCR_SIGNATURE_EXP_MAX)
+            st = amscr__fail(AMSCR_E_INVALID_ARG, "%s: signature %zu has the exponent %ld (%d to %d)", fn, j,
+                             (long)e[j], AMSCR_SIGNATURE_EXP_MIN, AMSCR_SIGNATURE_EXP_MAX);
+    amscr__sig_rows rows = {NULL, q, e};
+    return st == AMSCR_OK ? shortlists(fn, &rows, n, qsigs, nq, first, m, threads, out) : st;
 }
 
 void amscr_index_graph_widths(const amscr_params *p, size_t n, size_t *out_k, size_t *out_k2)

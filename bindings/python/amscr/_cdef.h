@@ -16,6 +16,8 @@
 #define AMSCR_INDEX_CANDIDATES 256
 #define AMSCR_INDEX_EXACT_MAX 2000
 #define AMSCR_INDEX_LAZY 1
+#define AMSCR_SIGNATURE_EXP_MIN -126
+#define AMSCR_SIGNATURE_EXP_MAX 112
 
 typedef enum amscr_status {
     AMSCR_OK = 0,
@@ -351,7 +353,9 @@ void amscr_index_graph_free(amscr_index_graph *g);
 amscr_status amscr_index_pair_distances_at(const amscr_index *x, const amscr_descriptor *q, size_t qpos, const size_t *cand, size_t m, double *out_base, double *out_inner);
 size_t amscr_signature_size(void);
 amscr_status amscr_index_signatures(const amscr_index *x, float *out, size_t n);
+amscr_status amscr_index_signatures_packed(const amscr_index *x, uint16_t *out_q, int32_t *out_e, size_t n);
 amscr_status amscr_shape_signature(const amscr_descriptor *q, float *out, size_t n);
 size_t amscr_index_build_shortlist(const amscr_params *p, size_t n, size_t candidates);
 amscr_status amscr_signature_shortlists(const float *sigs, size_t n, const float *qsigs, size_t nq, size_t first, size_t m, unsigned threads, size_t *out, size_t out_len);
+amscr_status amscr_signature_shortlists_packed(const uint16_t *q, const int32_t *e, size_t n, const float *qsigs, size_t nq, size_t first, size_t m, unsigned threads, size_t *out, size_t out_len);
 amscr_status amscr_rerank_diffusion(const double *dist, size_t n, size_t k, unsigned iterations, double *out_dist);

@@ -10,7 +10,7 @@ from typing import List, Tuple
 import numpy as np
 
 from ._lib import ffi, lib
-from ._shard_tasks import _pairs_at, _shortlists, _signatures
+from ._shard_tasks import _floats, _joined, _pairs_at, _shortlists, _signatures
 from .params import Params
 
 
@@ -78,10 +78,10 @@ def _shortlist_lists(client, params: Params, n: int, bounds, rows, idx, placed, 
     later shape's shard. Returns the graph's arrays, the signatures and the pairs matched."""
     k, k2 = widths(params, n)
     starts = np.array([lo for lo, _ in bounds], dtype=np.int64)
-    sigs = np.concatenate(client.gather([client.submit(_signatures, idx[s], pure=False, workers=[placed[s]])
-                                         for s in range(len(bounds))]))
-    sf = client.scatter(sigs, broadcast=True, hash=False)
-    S = np.concatenate(client.gather([client.submit(_shortlists, sf, sigs[lo:hi], lo, mb, th, pure=False,
+    sigs = _joined(client.gather([client.submit(_signatures, idx[s], pure=False, workers=[placed[s]])
+                                  for s in range(len(bounds))]))
+    sf = client.scatter([sigs], broadcast=True, hash=False)[0]  # one future of the pair
+    S = np.concatenate(client.gather([client.submit(_shortlists, sf, _floats(sigs, lo, hi), lo, mb, th, pure=False,
                                                     workers=[placed[s]]) for s, (lo, hi) in enumerate(bounds)]))
     base, inner = _Store(), _Store()
 

@@ -1,8 +1,9 @@
 """What the workers of a shard set compute (``amscr.distributed``; :mod:`amscr._shards` places the
 tasks and gathers their results): a shard built from its block's bytes, the distances of a block's
 pairs and of queries to a shard's shapes (C ``amscr_index_pair_distances``,
-``amscr_index_pair_distances_at``), each row's best candidates, a shard's members and signatures,
-and the signature shortlists (``amscr_signature_shortlists``).
+``amscr_index_pair_distances_at``), each row's best candidates, a shard's members and signatures
+(packed: 16-bit values and an exponent a shape), and the signature shortlists
+(``amscr_signature_shortlists_packed``).
 """
 from __future__ import annotations
 
@@ -105,27 +106,44 @@ def _members(index: Index, qdata: bytes) -> List[int]:
     return res
 
 
-def _signatures(index: Index) -> np.ndarray:
-    """A shard's signatures (len x amscr_signature_size floats, C ``amscr_index_signatures``)."""
-    d = int(lib.amscr_signature_size())
-    out = np.zeros((len(index), d), dtype=np.float32)
+Signatures = Tuple[np.ndarray, np.ndarray]  # packed: (n, d) uint16 values and n int32 exponents
+
+
+def _signatures(index: Index) -> Signatures:
+    """A shard's signatures as the index holds them (C ``amscr_index_signatures_packed``): 2 bytes a
+    value and an exponent a shape, half the floats' bytes."""
+    n, d = len(index), int(lib.amscr_signature_size())
+    q = np.zeros((n, d), dtype=np.uint16)
+    e = np.zeros(n, dtype=np.int32)
     with index._lock.read():
-        _check(lib.amscr_index_signatures(index._x, ffi.from_buffer('float[]', out) if out.size else ffi.NULL,
-                                          out.size))
-    return out
+        _check(lib.amscr_index_signatures_packed(index._x, ffi.from_buffer('uint16_t[]', q) if n else ffi.NULL,
+                                                 ffi.from_buffer('int32_t[]', e) if n else ffi.NULL, n))
+    return q, e
 
 
-def _shortlists(sigs: np.ndarray, qsigs: np.ndarray, first: int, m: int, threads) -> np.ndarray:
-    """Each query's m signature-nearest of sigs (C ``amscr_signature_shortlists``); query r is shape
-    first + r of sigs (left out), or a new shape (first QPOS_AFTER)."""
+def _joined(parts: List[Signatures]) -> Signatures:
+    """The shards' signatures, in order."""
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+
+def _floats(sigs: Signatures, lo: int, hi: int) -> np.ndarray:
+    """Signatures lo..hi-1 as floats (exactly amscr_index_signatures')."""
+    q, e = sigs
+    return np.ldexp(q[lo:hi].astype(np.float32), e[lo:hi, None])
+
+
+def _shortlists(sigs: Signatures, qsigs: np.ndarray, first: int, m: int, threads) -> np.ndarray:
+    """Each query's m signature-nearest of sigs (C ``amscr_signature_shortlists_packed``); query r is
+    shape first + r of sigs (left out), or a new shape (first QPOS_AFTER)."""
     nq = len(qsigs)
     out = np.zeros((nq, m), dtype=np.uintp)
     if nq == 0:
         return out.astype(np.int64)
-    sigs = np.ascontiguousarray(sigs, dtype=np.float32)
+    q, e = np.ascontiguousarray(sigs[0], dtype=np.uint16), np.ascontiguousarray(sigs[1], dtype=np.int32)
     qsigs = np.ascontiguousarray(qsigs, dtype=np.float32)
-    _check(lib.amscr_signature_shortlists(ffi.from_buffer('float[]', sigs), len(sigs), ffi.from_buffer('float[]', qsigs),
-                                          nq, first, m, _threads(threads), ffi.from_buffer('size_t[]', out), out.size))
+    _check(lib.amscr_signature_shortlists_packed(ffi.from_buffer('uint16_t[]', q), ffi.from_buffer('int32_t[]', e),
+                                                 len(e), ffi.from_buffer('float[]', qsigs), nq, first, m,
+                                                 _threads(threads), ffi.from_buffer('size_t[]', out), out.size))
     return out.astype(np.int64)
 
 

@@ -6,8 +6,9 @@ of ``amscr.Index(collection, candidates=M)``. M 0 (every pair): every pair of bl
 matched once on the worker holding shard t (C ``amscr_index_pair_distances``, each pair computed
 as its cell of the whole collection's matrix), each block keeps its rows' and columns' best
 candidates, and the client merges them. M > 0 (the default above 2,000 shapes): the client
-gathers the signatures (C ``amscr_index_signatures``), the workers find each shape's
-signature-nearest shapes of the whole collection (``amscr_signature_shortlists``), and the rounds
+gathers the signatures as the shards hold them, 16 bits a value (C ``amscr_index_signatures_packed``:
+about 2 KB a shape), the workers find each shape's signature-nearest shapes of the whole collection
+(``amscr_signature_shortlists_packed``), and the rounds
 of the single shortlist build (the shortlists' pairs, the neighbours' neighbours, the inner lists)
 are matched on the worker holding each pair's later shape (``amscr_index_pair_distances_at``). The
 lists, without any shape, make the *graph* (C ``amscr_index_graph``). A query is matched with
@@ -39,8 +40,8 @@ from .shape import Shape
 from ._placement import _block, _threads_by_host
 from ._shard_build import _merge_lists, _shortlist_lists, widths
 from ._shard_files import ShardSetError, read_set, write_set
-from ._shard_tasks import (QPOS_AFTER, _index_bytes, _members, _pair_block, _query_block, _shard_from_file_bytes,
-                           _shard_index, _shortlists, _signatures)
+from ._shard_tasks import (QPOS_AFTER, Signatures, _floats, _index_bytes, _joined, _members, _pair_block,
+                           _query_block, _shard_from_file_bytes, _shard_index, _shortlists, _signatures)
 
 PathLike = Union[str, 'os.PathLike[str]']
 
@@ -145,7 +146,7 @@ class ShardedIndex:
     """
 
     def __init__(self, client, shards: List[Any], bounds: List[Tuple[int, int]], graph: _Graph, params: Params,
-                 workers: List[str], candidates: int = 0, sigs: Optional[np.ndarray] = None):
+                 workers: List[str], candidates: int = 0, sigs: Optional[Signatures] = None):
         self.client = client
         self.candidates = candidates  # the build's shortlist M (0: every pair), the queries' default
         self.pairs: Optional[int] = None  # the pairs a build matched (None for a loaded set)
@@ -191,11 +192,11 @@ class ShardedIndex:
                                 % ('s' if len(lost) > 1 else '', ', '.join(map(str, lost)),
                                    'their' if len(lost) > 1 else 'its', type(e).__name__, e), lib.AMSCR_E_STATE) from e
 
-    def _signatures(self) -> np.ndarray:
+    def _signatures(self) -> Signatures:
         if self._sigs is None:
-            self._sigs = np.concatenate(self._gather([self.client.submit(_signatures, sh, pure=False,
-                                                                         workers=[self._workers[s]])
-                                                      for s, sh in enumerate(self._shards)]))
+            self._sigs = _joined(self._gather([self.client.submit(_signatures, sh, pure=False,
+                                                                  workers=[self._workers[s]])
+                                               for s, sh in enumerate(self._shards)]))
         return self._sigs
 
     def _want(self, candidates: Optional[int]) -> int:
@@ -257,7 +258,7 @@ class ShardedIndex:
         for i in mem:
             j = int(member[i])
             C[i] = np.r_[np.arange(j), np.arange(j + 1, n)] if want == 0 else \
-                _shortlists(self._signatures(), self._signatures()[j:j + 1], j, want, self.params.threads)[0]
+                _shortlists(self._signatures(), _floats(self._signatures(), j, j + 1), j, want, self.params.threads)[0]
         todo = np.r_[new, mem].astype(np.int64)
         if len(todo) == 0:
             return out

@@ -92,6 +92,16 @@ def test_global_shortlists_equal_single_index_above_2000_shapes(client):
     assert same >= 0.99 * N_QUERIES
     # every shape a candidate on the same lists
     np.testing.assert_allclose(sx.scores(qs[0], candidates=0), single.scores(qs[0], candidates=0), rtol=0, atol=1e-9)
+    # the client holds the signatures packed (16-bit values, an exponent a shape): exactly the
+    # single index's floats in half their bytes
+    q, e = sx._signatures()
+    d = int(amscr._lib.lib.amscr_signature_size())
+    assert q.dtype == np.uint16 and e.dtype == np.int32 and q.shape == (n, d) and e.shape == (n,)
+    assert (q.nbytes + e.nbytes) / n == 2 * d + 4
+    ref = np.zeros((n, d), dtype=np.float32)
+    amscr.errors._check(amscr._lib.lib.amscr_index_signatures(single._x, amscr._lib.ffi.from_buffer('float[]', ref),
+                                                              ref.size))
+    assert np.array_equal(_shards._floats((q, e), 0, n), ref)
 
 
 def test_shortlist_build_with_the_inner_graph_member_rule_saved_and_loaded(client, tmp_path):
