@@ -415,6 +415,9 @@ def main():
         SPAN, CANVAS = 200.0, 280
     nproc = a.procedural if a.procedural is not None else (35 if a.families else 0)
     classes = load_classes(a.data) if os.path.isdir(a.data) else []
+    if not classes and nproc:  # said, not silent: the folds' columns would read as empty
+        print('registration_traced: no data at %s (set --data or AMSCR_DATASETS): the procedural set only'
+              % a.data, file=sys.stderr)
     if not classes and not nproc:
         print('registration_traced: no data at %s (skipped)' % a.data)
         return 0
