@@ -1716,7 +1716,7 @@ AMSCR_API double amscr_params_get_rerank_inner_share(const amscr_params *p);
  *        units of the square root of the area the curve bounds, in [0, 1] (default 0; 0.04 in
  *        the retrieval preset). With c > 0 the inner distance's paths run inside the region
  *        the curve bounds closed morphologically by a disk of radius c sqrt(area): cracks,
- *        slots and gaps narrower than the disk no longer force a path around them, while
+ *        slots and gaps narrower than the disk do not force a path around them, while
  *        parts and wider inlets stay. A cut that reaches the outline then changes the inner
  *        distance as little as it changes the shape. Only the inner-distance graph uses it
  *        (amscr_params_set_rerank_inner_share); a curve that bounds no area is taken as it
@@ -3499,11 +3499,10 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_signatures(const amscr_index 
 #define AMSCR_SIGNATURE_EXP_MAX 112
 
 /**
- * @brief The stored signatures of x's shapes as the index holds them, in half the bytes of
- *        amscr_index_signatures: each shape's amscr_signature_size() 16-bit values and one
- *        exponent, value t being q[t] * 2^e (exactly amscr_index_signatures' float, both ways).
- *        For a client that keeps the signatures of a collection spread over machines
- *        (amscr_signature_shortlists_packed).
+ * @brief The stored signatures of x's shapes as the index holds them: each shape's
+ *        amscr_signature_size() 16-bit values q and one exponent e, value t being q[t] * 2^e
+ *        (exactly amscr_index_signatures' float). The shortlists of packed signatures:
+ *        amscr_signature_shortlists_packed.
  * @param[out] out_q  n * amscr_signature_size() values.
  * @param[out] out_e  n exponents, each from AMSCR_SIGNATURE_EXP_MIN to AMSCR_SIGNATURE_EXP_MAX.
  * @param[in]  n  must equal amscr_index_size(x) (the shapes).
@@ -3566,7 +3565,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_signature_shortlists(const float *s
 /**
  * @brief amscr_signature_shortlists over packed signatures (amscr_index_signatures_packed of the
  *        shards, concatenated: n shapes' q, n * amscr_signature_size() values, and their n
- *        exponents e): exactly the shortlists of their floats, from half the memory.
+ *        exponents e): exactly the shortlists of their floats.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, m, first, out_len, an exponent out of range, a
  *         query not finite); AMSCR_E_NOMEM.
  * Cost: as amscr_signature_shortlists.
