@@ -3,9 +3,11 @@
 hold them (C amscr_index_signatures_packed: 16-bit values and an exponent a shape) against floats
 (amscr_index_signatures). Prints the bytes a shape of each, the time of every shape's M
 signature-nearest (amscr_signature_shortlists_packed against amscr_signature_shortlists, one
-thread, best of the runs) and whether the lists are the same (they must be).
+thread, best of the runs) and whether the lists are the same (they must be); then a batch of member
+queries' shortlists (a sharded query that is a member's copy): one search a member against one pass
+for the batch (_member_shortlists), and whether they are the same.
 
-    OPENBLAS_NUM_THREADS=1 .venv/bin/python bench/shard_signatures.py [--shapes 3000] [--m 192] [--runs 3]
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python bench/shard_signatures.py [--shapes 3000] [--m 192] [--runs 3] [--members 200]
 """
 import argparse
 import os
@@ -35,6 +37,7 @@ def main():
     ap.add_argument('--shapes', type=int, default=3000)
     ap.add_argument('--m', type=int, default=192, help='the nearest a shape (a shortlist build: 192)')
     ap.add_argument('--runs', type=int, default=3)
+    ap.add_argument('--members', type=int, default=200, help='member queries (every shapes/members-th shape)')
     a = ap.parse_args()
     coll = amscr.Collection(amscr.Params.retrieval(points=32, threads=0))
     coll.extend(*shapes_of(a.shapes))
@@ -52,7 +55,15 @@ def main():
     print('shapes %d, %d nearest each: floats %d bytes a shape, %.2f s; packed %d bytes a shape, %.2f s '
           '(%.2fx); the same lists: %s' % (n, a.m, floats.nbytes // n, tf, (packed[0].nbytes + packed[1].nbytes) // n,
                                           tp, tp / tf, np.array_equal(lf, lp)))
-    return 0 if np.array_equal(lf, lp) else 1
+    js = np.arange(0, n, max(1, n // a.members))[:a.members]
+    t0 = time.perf_counter()
+    each = np.array([tasks._shortlists(packed, floats[j:j + 1], j, a.m, 1)[0] for j in js])
+    t1 = time.perf_counter()
+    batch = tasks._member_shortlists(packed, js, a.m, 1)
+    t2 = time.perf_counter()
+    print('%d member queries, %d nearest each: one search a member %.2f s, one pass %.2f s (%.1fx); the same '
+          'lists: %s' % (len(js), a.m, t1 - t0, t2 - t1, (t1 - t0) / (t2 - t1), np.array_equal(each, batch)))
+    return 0 if np.array_equal(lf, lp) and np.array_equal(each, batch) else 1
 
 
 if __name__ == '__main__':

@@ -2172,9 +2172,9 @@ AMSCR_API double amscr_result_threshold(const amscr_result *r);
 /**
  * @brief How sure the registration is, in [0, 1]: (1 - a) x min(inlier fraction, overlap) /
  *        (1 + (e / 0.01)^2) / (1 + (s / 0.01)^2), a the larger of amscr_result_ambiguity and
- *        amscr_result_symmetry_ambiguity (when measured), e the forward-backward error (0 when
+ *        amscr_result_symmetry_ambiguity (when computed), e the forward-backward error (0 when
  *        the check did not run; amscr_result_backward_error), s the map's standard error (0
- *        when not measured; amscr_result_standard_error). Near 0: reject the map, because
+ *        when not computed; amscr_result_standard_error). Near 0: reject the map, because
  *        another, clearly different map explains the target almost as well (a symmetric shape,
  *        a symmetric shape with a part missing, a fragment too short to place), most source
  *        samples found no target boundary near them, the registered regions overlap little,
@@ -2231,7 +2231,7 @@ AMSCR_API double amscr_result_backward_error(const amscr_result *r);
  *        it, as a thin part traced at low resolution or a touching object does). It measures
  *        how firmly the data fix the map, not its distance from the truth: a bias the whole
  *        boundary shares is not seen. The map itself does not change.
- * @return the value; NaN when not measured (an invariance other than affine, fewer than 9
+ * @return the value; NaN when not computed (an invariance other than affine, fewer than 9
  *         samples, too few inliers to solve without one block) or for NULL.
  * Ownership: none.
  * Thread-safety: const.
@@ -2253,7 +2253,7 @@ AMSCR_API double amscr_result_standard_error(const amscr_result *r);
  *        the chosen map (below 0.9 times its cost: the map is not the best fit of a
  *        near-symmetric source); 0: the source has no symmetry, or none fits. The confidence
  *        uses the larger of the two ambiguities.
- * @return the value; NaN when it was not measured (a clean match, an unconfident map, a partial
+ * @return the value; NaN when it was not computed (a clean match, an unconfident map, a partial
  *         match) or for NULL.
  * Ownership: none.
  * Thread-safety: const.

@@ -147,6 +147,18 @@ def _shortlists(sigs: Signatures, qsigs: np.ndarray, first: int, m: int, threads
     return out.astype(np.int64)
 
 
+def _member_shortlists(sigs: Signatures, members: np.ndarray, m: int, threads) -> np.ndarray:
+    """Each member j's m signature-nearest other shapes, as ``_shortlists`` with j left out gives
+    them, in one pass over the rows for all members: the m + 1 nearest of j's own signature, less j
+    (at distance 0; when m + 1 exact copies of lower index come first, j is not among them and the
+    last of them goes)."""
+    members = np.asarray(members, dtype=np.int64)
+    q, e = sigs
+    own = np.ldexp(q[members].astype(np.float32), e[members, None])
+    near = _shortlists(sigs, own, QPOS_AFTER, m + 1, threads)
+    return np.array([row[row != j][:m] for row, j in zip(near, members)], dtype=np.int64).reshape(len(members), m)
+
+
 def _pairs_at(rows_data: Optional[bytes], index: Index, a: np.ndarray, b: np.ndarray, qpos: Optional[int],
               base: bool, inner: bool) -> Tuple[np.ndarray, np.ndarray]:
     """Distances of pairs (a[t], b[t]) on shard b's worker: a local to the rows' block (rows_data's

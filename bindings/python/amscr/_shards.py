@@ -40,7 +40,7 @@ from .shape import Shape
 from ._placement import _block, _threads_by_host
 from ._shard_build import _merge_lists, _shortlist_lists, widths
 from ._shard_files import ShardSetError, read_set, write_set
-from ._shard_tasks import (QPOS_AFTER, Signatures, _floats, _index_bytes, _joined, _members, _pair_block,
+from ._shard_tasks import (QPOS_AFTER, Signatures, _index_bytes, _joined, _member_shortlists, _members, _pair_block,
                            _query_block, _shard_from_file_bytes, _shard_index, _shortlists, _signatures)
 
 PathLike = Union[str, 'os.PathLike[str]']
@@ -255,10 +255,10 @@ class ShardedIndex:
                                                  ffi.from_buffer('float[]', qs[r]), d))
             for r, c in zip(new, _shortlists(self._signatures(), qs, QPOS_AFTER, want, self.params.threads)):
                 C[r] = c
-        for i in mem:
+        near = _member_shortlists(self._signatures(), member[mem], want, self.params.threads) if want > 0 else None
+        for r, i in enumerate(mem):
             j = int(member[i])
-            C[i] = np.r_[np.arange(j), np.arange(j + 1, n)] if want == 0 else \
-                _shortlists(self._signatures(), _floats(self._signatures(), j, j + 1), j, want, self.params.threads)[0]
+            C[i] = np.r_[np.arange(j), np.arange(j + 1, n)] if want == 0 else near[r]
         todo = np.r_[new, mem].astype(np.int64)
         if len(todo) == 0:
             return out

@@ -16,7 +16,7 @@ distributed = pytest.importorskip(
 
 import amscr  # noqa: E402
 import amscr.distributed as ad  # noqa: E402
-from amscr import _shards  # noqa: E402
+from amscr import _shard_tasks, _shards  # noqa: E402
 from helpers import blob  # noqa: E402
 
 POINTS = 32  # small N keeps the file fast; the sharding does not depend on N
@@ -101,7 +101,7 @@ def test_global_shortlists_equal_single_index_above_2000_shapes(client):
     ref = np.zeros((n, d), dtype=np.float32)
     amscr.errors._check(amscr._lib.lib.amscr_index_signatures(single._x, amscr._lib.ffi.from_buffer('float[]', ref),
                                                               ref.size))
-    assert np.array_equal(_shards._floats((q, e), 0, n), ref)
+    assert np.array_equal(_shard_tasks._floats((q, e), 0, n), ref)
 
 
 def test_shortlist_build_with_the_inner_graph_member_rule_saved_and_loaded(client, tmp_path):
@@ -134,6 +134,23 @@ def test_shortlist_build_with_the_inner_graph_member_rule_saved_and_loaded(clien
     np.testing.assert_array_equal(loaded.scores_many(qs[:3]), S[:3])
     with pytest.raises(amscr.InvalidArgumentError, match='candidates'):
         ad.build_index(client, coll, candidates=-1)
+
+
+def test_members_shortlists_in_one_pass_are_each_members_own():
+    """A batch of member queries finds its shortlists in one pass over the signatures (the m + 1
+    nearest of each member's own, less the member): the lists of one search a member, with the
+    member left out, to the index, also where more than m + 1 exact copies tie at distance 0."""
+    shapes = _shapes(N_SMALL, 100)
+    coll = _collection(amscr.Params.retrieval(points=POINTS, threads=1), shapes + [shapes[0]] * 6)
+    sigs = _shard_tasks._signatures(amscr.Index(coll, candidates=40))
+    n = len(coll)
+    members = np.r_[np.arange(0, n, 7), n - 6:n]  # shape 0's copies: 152 (in _shapes) and n - 6 .. n - 1
+    for m in (3, 16, 40, n - 1):
+        got = _shard_tasks._member_shortlists(sigs, members, m, 2)
+        ref = [_shard_tasks._shortlists(sigs, _shard_tasks._floats(sigs, j, j + 1), j, m, 1)[0] for j in members]
+        assert got.shape == (len(members), m)
+        assert np.array_equal(got, np.array(ref)), m
+    assert list(_shard_tasks._member_shortlists(sigs, [n - 1], 3, 1)[0]) == [0, 152, n - 6]
 
 
 def test_scores_equal_with_the_inner_graph(small):
