@@ -132,6 +132,8 @@ int amscr__stage_switch(const char *name);
 /* ---- geometry internals (contour.c, smooth.c, resample.c, affine.c) ---- */
 double amscr__signed_area(const double *xy, size_t n);
 void amscr__reverse_points(double *xy, size_t n);
+/* lo and hi widened to hold the n points p (per coordinate). */
+void amscr__points_extent(const double *p, size_t n, double lo[2], double hi[2]);
 /* Copies xy dropping repeated consecutive points (and, closed, a repeated closing point);
  * returns the count. out: room for 2n doubles. */
 size_t amscr__dedupe_points(const double *xy, size_t n, int closed, double *out);

@@ -395,8 +395,6 @@ int amscr__on_pixel_lattice(const amscr_descriptor *d);
  * points under the map X (onto h) have. */
 int amscr__grid_small(const double *p, size_t n);
 int amscr__grid_mapped_small(const amscr_descriptor *f, const amscr_descriptor *h, const double X[6]);
-/* lo and hi widened to hold the n points p (per coordinate). */
-void amscr__points_extent(const double *p, size_t n, double lo[2], double hi[2]);
 /* For the finished result r of f -> h and the side the stage corrects (the small shape: h for
  * AMSCR__GRID_TARGET, f for AMSCR__GRID_SOURCE): the pixels where the other shape under r's map
  * (its inverse for the source), rendered on the small shape's grid, differs from the small

@@ -135,15 +135,6 @@ typedef struct {
     size_t w, h;
 } box_t;
 
-void amscr__points_extent(const double *p, size_t n, double lo[2], double hi[2])
-{
-    for (size_t i = 0; i < n; i++)
-        for (int k = 0; k < 2; k++) {
-            lo[k] = fmin(lo[k], p[2 * i + k]);
-            hi[k] = fmax(hi[k], p[2 * i + k]);
-        }
-}
-
 /* The pixels around the small shape (T) and the other mapped (M), two pixels beyond either, at
  * most T's own extent beyond T (a map far off is far off by any count). */
 static box_t grid_box(const double *T, size_t nt, const double *M, size_t nm)

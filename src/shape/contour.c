@@ -94,6 +94,15 @@ amscr_status amscr_contour_orient_ccw(amscr_contour *c)
     return AMSCR_OK;
 }
 
+void amscr__points_extent(const double *p, size_t n, double lo[2], double hi[2])
+{
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 2; k++) {
+            lo[k] = fmin(lo[k], p[2 * i + k]);
+            hi[k] = fmax(hi[k], p[2 * i + k]);
+        }
+}
+
 size_t amscr__dedupe_points(const double *xy, size_t n, int closed, double *out)
 {
     size_t m = 0;
