@@ -60,11 +60,11 @@ fail=0
 for p in "${pids[@]}"; do wait "$p" || fail=1; done
 [ $fail = 0 ] || { echo "fuzz/build.sh: compilation failed" >&2; exit 1; }
 
-targets=(text pgm png mask register dbload contours index subpixel)
+targets=(text pgm png mask register dbload contours index subpixel manifest)
 for t in "${targets[@]}"; do
   src=tests/fuzz/fuzz_$t.c
   extra=()
-  case $t in pgm|png) extra=("${tool_objs[@]}") ;; esac
+  case $t in pgm|png|manifest) extra=("${tool_objs[@]}") ;; esac
   exe="$OUT/fuzz_$t"
   rebuild=0
   [ -f "$exe" ] || rebuild=1

@@ -52,6 +52,14 @@ put('text', 'exponents', '1e3 -2.5E-3\n+4.0 .5\n-0 0x1p3\n1e-320 7\n')
 put('text', 'bad-line', '0 0\n1 0\n1 1 1\n')
 put('text', 'ellipse', text(polygon(24, wobble=0.2)))
 
+put('manifest', 'file-class', 'file\tclass\nbird-1.png\tbird\nbird-2.png\tbird\nbone-1.txt\tbone\n')
+put('manifest', 'class-first-groups', '# comment\r\nclass\tgroup\tfile\r\n\r\ncup\tcup1\tcup/1.png\r\n'
+    'car\tcar1\t/abs/car.png\r\ncup\tcup2\tcup/2.png\r\n')
+put('manifest', 'header-only', 'file\tclass\n')
+put('manifest', 'short-row', 'file\tclass\tgroup\na.png\tx\n')
+put('manifest', 'no-header', 'a.png\tx\n')
+put('manifest', 'nul-byte', 'file\tclass\na\0.png\tx\n')
+
 # ------------------------------------------------------------------ pgm
 img = shape_img()
 put('pgm', 'p5-8bit.pgm', pgm_bytes(img))

@@ -13,7 +13,7 @@ cd "$(dirname "$0")/../.."
 OUT=${AMSCR_FUZZ_BUILD:-build-fuzz}
 SECS=${1:-${AMSCR_FUZZ_SECONDS:-30}}
 [ $# -gt 0 ] && shift
-ALL=(text pgm png mask register dbload contours index subpixel)
+ALL=(text pgm png mask register dbload contours index subpixel manifest)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -gt 0 ] || TARGETS=("${ALL[@]}")
 JOBS=${AMSCR_FUZZ_JOBS:-$(nproc 2>/dev/null || echo 1)}
@@ -23,7 +23,7 @@ tests/fuzz/build.sh || exit 1
 
 maxlen() {
   case $1 in
-    text|register) echo 4096 ;;
+    text|register|manifest) echo 4096 ;;
     pgm|png|mask|subpixel) echo 8192 ;;
     dbload) echo 16384 ;;
   esac
