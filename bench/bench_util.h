@@ -1,5 +1,5 @@
-/* bench_util.h — the benchmarks' error exit, clocks, qsort comparison and seeded random numbers (splitmix64; one
- * generator per program: each benchmark is single-threaded where it draws). */
+/* bench_util.h — the benchmarks' error exit (with allocation and preparation), clocks, qsort comparison and
+ * seeded random numbers (splitmix64; one generator per program: each benchmark is single-threaded where it draws). */
 #ifndef AMSCR_BENCH_UTIL_H
 #define AMSCR_BENCH_UTIL_H
 
@@ -18,6 +18,24 @@ static inline void die(const char *what)
 {
     fprintf(stderr, "%s: %s: %s\n", BENCH_PROGRAM, what, amscr_last_error_detail());
     exit(1);
+}
+
+/* malloc that dies when out of memory. */
+static inline void *xmalloc(size_t n)
+{
+    void *p = malloc(n ? n : 1);
+    if (!p)
+        die("out of memory");
+    return p;
+}
+
+/* c prepared with p; dies on failure. */
+static inline amscr_descriptor *prepare(const amscr_params *p, const amscr_contour *c)
+{
+    amscr_descriptor *d = NULL;
+    if (amscr_descriptor_new(p, c, &d) != AMSCR_OK)
+        die("prepare");
+    return d;
 }
 #endif
 

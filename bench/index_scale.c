@@ -37,7 +37,6 @@
 #include <sys/resource.h>
 
 #define BENCH_PROGRAM "amscr-index-bench"
-#include "affine_warp.h"
 #include "amscr.h"
 #include "bench_util.h"
 #include "db_io.h"
@@ -73,7 +72,7 @@ static double max_rss_mb(void)
     return (double)u.ru_maxrss / 1e3;
 }
 
-/* A random affine copy of c (affine_warp.h), prepared with p. */
+/* A random affine copy of c (mcd_set.h), prepared with p. */
 static amscr_descriptor *warped(const amscr_params *p, const amscr_contour *c, unsigned long long *seed)
 {
     amscr_contour *ct = warp_affine(c, seed);
@@ -81,14 +80,6 @@ static amscr_descriptor *warped(const amscr_params *p, const amscr_contour *c, u
     if (!ct || amscr_descriptor_new(p, ct, &d) != AMSCR_OK)
         die("affine copy");
     amscr_contour_free(ct);
-    return d;
-}
-
-static amscr_descriptor *plain(const amscr_params *p, const amscr_contour *c)
-{
-    amscr_descriptor *d = NULL;
-    if (amscr_descriptor_new(p, c, &d) != AMSCR_OK)
-        die("prepare");
     return d;
 }
 
@@ -115,6 +106,15 @@ static amscr_index *build(const amscr_db *db, size_t cand, double secs[2])
     secs[0] = now() - t;
     secs[1] = cpu() - c;
     return x;
+}
+
+/* Adds to *in the members of b (nb) in a (TOP) and to *first whether both start alike. */
+static void overlap(const size_t *a, const size_t *b, size_t nb, size_t *in, size_t *first)
+{
+    for (size_t u = 0; u < nb; u++)
+        for (size_t v = 0; v < TOP; v++)
+            *in += a[v] == b[u];
+    *first += a[0] == b[0];
 }
 
 /* One query's wall and CPU time into w[q], c[q]. */
@@ -204,10 +204,10 @@ static void index_bytes(const amscr_index *x, double b[4])
  * the % of the exact shortlist the quantizer finds. */
 static void search_cost(const amscr_index *x, size_t m, double out[3])
 {
-    size_t n = amscr_db_size(x->db), *a = malloc(m * sizeof *a), *b = malloc(m * sizeof *b), same = 0;
+    size_t n = amscr_db_size(x->db), *a = xmalloc(m * sizeof *a), *b = xmalloc(m * sizeof *b), same = 0;
     amscr__sig_ivf v = x->ivf; /* the index's own from AMSCR__INDEX_IVF_MIN shapes */
     amscr__sig_rows rows = {NULL, x->sigq, x->sige};
-    if (!a || !b || (v.nc == 0 && amscr__sig_ivf_build(x->sig_lb, n, &v) != AMSCR_OK))
+    if (v.nc == 0 && amscr__sig_ivf_build(x->sig_lb, n, &v) != AMSCR_OK)
         die("out of memory");
     double te = 0.0, ti = 0.0;
     for (size_t r = 0; r < SEARCH_ROWS; r++) {
@@ -246,7 +246,7 @@ static void part_mixed(const amscr_params *p, const shape_set *s)
     if (amscr_db_new(p, &db) != AMSCR_OK)
         die("db");
     for (size_t i = 0; i < s->n; i++)
-        add(db, plain(p, s->c[i]), s->labels[i]);
+        add(db, prepare(p, s->c[i]), s->labels[i]);
     for (size_t i = 0; i < s->n; i++)
         add(db, warped(p, s->c[i], &seed), s->labels[i]);
     size_t n = amscr_db_size(db), M = AMSCR_INDEX_CANDIDATES;
@@ -257,15 +257,12 @@ static void part_mixed(const amscr_params *p, const shape_set *s)
     size_t top_in = 0, same_first = 0;
     for (size_t q = 0; q < NQ; q++) {
         amscr_descriptor *d = warped(p, s->c[(size_t)(warp_urand(&qseed) * (double)s->n) % s->n], &qseed);
-        size_t a[TOP], b[TOP], ca = TOP, cb = 0;
+        size_t a[TOP], b[TOP], cb = 0;
         double sa[TOP], sb[TOP];
         timed_query(x, d, M, a, sa, &times[q], &ctimes[q]);
         if (amscr_index_query(full, d, 0, TOP, b, sb, &cb) != AMSCR_OK)
             die("exact query");
-        for (size_t u = 0; u < cb; u++)
-            for (size_t v = 0; v < ca; v++)
-                top_in += a[v] == b[u];
-        same_first += a[0] == b[0];
+        overlap(a, b, cb, &top_in, &same_first);
         amscr_descriptor_free(d);
     }
     printf("| mpeg7-dev + affine copies | %zu | %zu | %.1f s (%.1f) | %.1f s (%.1f) | %.2f s, %.0f MB | %.1f ms (%.1f) | "
@@ -308,19 +305,11 @@ static void part_scale(const amscr_params *p, const shape_set *s, size_t n)
         double sa[TOP], sb[TOP];
         timed_query(x, d, M, a, sa, &times[q], &ctimes[q]);
         x->ivf = none; /* the query without the quantizer: every bound scanned, the diffusion not pruned */
-        if (ivf.nc > 0 && amscr_index_query(x, d, M, TOP, b, sb, &cb) == AMSCR_OK) {
-            for (size_t u = 0; u < TOP; u++)
-                for (size_t v = 0; v < TOP; v++)
-                    scan_in += a[u] == b[v];
-            scan_first += a[0] == b[0];
-        }
+        if (ivf.nc > 0 && amscr_index_query(x, d, M, TOP, b, sb, &cb) == AMSCR_OK)
+            overlap(a, b, TOP, &scan_in, &scan_first);
         x->ivf = ivf;
-        if (q < NQ_EXACT && amscr_index_query(x, d, 0, TOP, b, sb, &cb) == AMSCR_OK) { /* every shape matched */
-            for (size_t u = 0; u < TOP; u++)
-                for (size_t v = 0; v < TOP; v++)
-                    top_in += a[u] == b[v];
-            same_first += a[0] == b[0];
-        }
+        if (q < NQ_EXACT && amscr_index_query(x, d, 0, TOP, b, sb, &cb) == AMSCR_OK) /* every shape matched */
+            overlap(a, b, TOP, &top_in, &same_first);
         amscr_descriptor_free(d);
     }
     search_cost(x, BUILD_M, sc);
@@ -367,16 +356,11 @@ int main(int argc, char **argv)
            "same first hit (%d queries) | the scan's top %d kept / same first hit | build shortlist (%d) a row: exact / "
            "quantizer, recall |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n", NQ_SCALE, TOP, NQ_EXACT, TOP,
            BUILD_M);
-    for (int a = 2; a < argc || a == 2; a++) {
-        size_t sizes[2] = {1000, 10000};
-        if (argc > 2)
-            part_scale(p, &s, (size_t)strtoul(argv[a], NULL, 10));
-        else
-            for (int t = 0; t < 2; t++)
-                part_scale(p, &s, sizes[t]);
-        if (argc <= 2)
-            break;
-    }
+    for (int a = 2; a < argc; a++)
+        part_scale(p, &s, (size_t)strtoul(argv[a], NULL, 10));
+    if (argc == 2) /* the default sizes */
+        for (size_t n = 1000; n <= 10000; n *= 10)
+            part_scale(p, &s, n);
     amscr_params_free(p);
     shape_set_free(&s);
     return 0;

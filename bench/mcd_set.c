@@ -1,16 +1,55 @@
-/* mcd_set.c — labelled shape sets for the benchmark: a collection as listed, and the
- * MCD-style affine set built from one (see mcd_set.h). */
+/* mcd_set.c — labelled shape sets for the benchmarks: a collection as listed, its class folds, the MCD-style
+ * affine set built from one, and the index benches' affine-warped copies (see mcd_set.h). */
 #include "mcd_set.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
-#include "affine_warp.h"
 #include "collection.h"
 #include "image.h"
 
-/* Standard normal from affine_warp.h's xorshift64* generator. */
+double warp_urand(unsigned long long *s)
+{
+    *s ^= *s >> 12;
+    *s ^= *s << 25;
+    *s ^= *s >> 27;
+    return (double)((*s * 2685821657736338717ull) >> 11) / 9007199254740992.0;
+}
+
+amscr_contour *warp_affine(const amscr_contour *c, unsigned long long *seed)
+{
+    size_t n = amscr_contour_size(c);
+    const double *xy = amscr_contour_xy(c);
+    double th = 6.283185307179586 * warp_urand(seed);
+    double sx = exp(log(0.5) + log(4.0) * warp_urand(seed)), sy = exp(log(0.5) + log(4.0) * warp_urand(seed));
+    double sh = -0.5 + warp_urand(seed), cs = cos(th), sn = sin(th);
+    double A[4] = {cs * sx, cs * sx * sh - sn * sy, sn * sx, sn * sx * sh + cs * sy};
+    double *out = malloc(2 * n * sizeof *out), cx = 0, cy = 0, r = 0;
+    if (!out)
+        return NULL;
+    for (size_t i = 0; i < n; i++) {
+        out[2 * i] = A[0] * xy[2 * i] + A[1] * xy[2 * i + 1];
+        out[2 * i + 1] = A[2] * xy[2 * i] + A[3] * xy[2 * i + 1];
+        cx += out[2 * i] / (double)n;
+        cy += out[2 * i + 1] / (double)n;
+    }
+    for (size_t i = 0; i < n; i++)
+        r += ((out[2 * i] - cx) * (out[2 * i] - cx) + (out[2 * i + 1] - cy) * (out[2 * i + 1] - cy)) / (double)n;
+    r = sqrt(r);
+    for (size_t i = 0; i < 2 * n; i++) {
+        double u = warp_urand(seed), w = warp_urand(seed);
+        out[i] += 0.005 * r * sqrt(-2.0 * log(u > 1e-300 ? u : 1e-300)) * cos(6.283185307179586 * w);
+    }
+    amscr_contour *ct = NULL;
+    if (amscr_contour_new(out, n, &ct) != AMSCR_OK)
+        ct = NULL;
+    free(out);
+    return ct;
+}
+
+/* Standard normal from warp_urand's xorshift64* generator. */
 static double nrand(unsigned long long *s)
 {
     double u = warp_urand(s), v = warp_urand(s);
@@ -115,4 +154,32 @@ void shape_set_free(shape_set *s)
     s->c = NULL;
     s->labels = NULL;
     s->n = 0;
+}
+
+/* Fold (0 A, 1 B) of every class of the manifest from folds.tsv beside it; -1 without it. */
+int folds_tsv_read(const char *manifest, int32_t *fold_of_class, size_t cap)
+{
+    char path[4096], line[256];
+    collection col;
+    snprintf(path, sizeof path, "%.*s/folds.tsv", (int)(strrchr(manifest, '/') - manifest), manifest);
+    FILE *f = fopen(path, "r");
+    if (!f || collection_open(manifest, &col) != 0) {
+        if (f)
+            fclose(f);
+        return -1;
+    }
+    for (size_t k = 0; k < cap; k++)
+        fold_of_class[k] = 0;
+    while (fgets(line, sizeof line, f)) {
+        char *tab = strchr(line, '\t');
+        if (!tab)
+            continue;
+        *tab = '\0';
+        for (size_t k = 0; k < col.nclasses && k < cap; k++)
+            if (strcmp(col.classes[k], line) == 0)
+                fold_of_class[k] = tab[1] == 'B';
+    }
+    fclose(f);
+    collection_free(&col);
+    return 0;
 }

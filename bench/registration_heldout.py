@@ -130,6 +130,9 @@ def with_strays(src, share, rng):
 
 
 def map_error(M, T, src, size, rms=False):
+    """The largest (rms: the RMS) |M(f_i) - T(f_i)| over src, a share of size; inf without a map."""
+    if M is None:
+        return math.inf
     d = apply(M, src) - apply(T, src)
     d = np.sqrt((d * d).sum(axis=1))
     return float((np.sqrt((d * d).mean()) if rms else d.max()) / size)
@@ -137,11 +140,7 @@ def map_error(M, T, src, size, rms=False):
 
 def preset_error(src, tgt, T, size):
     """The map error (% of the size) of amscr.register(src, tgt) against T; inf when it fails."""
-    try:
-        r = amscr.register(src, tgt)
-    except amscr.AmscrError:
-        return np.inf
-    return 100 * map_error(np.hstack([r.A, r.B[:, None]]), T, src, size)
+    return 100 * map_error(amscr_register(src, tgt, False)[0], T, src, size)
 
 
 def error_summary(errs):
@@ -258,46 +257,49 @@ def load_sets(data, sets, subpixel=False):
     return out
 
 
-def sets_table(args, conds):
-    """The check's view: the sets side by side, both success rules and wrong + confident."""
-    sets = args.sets.split(',')
-    shapes = load_sets(args.data, sets, args.tracer == 'subpixel')
+def run(args, shapes, conds, cv2=None):
+    """{(set, condition key): [(ok, ok under the RMS rule, confidence or None, ms, ECC ok)]} of every seeded
+    draw; shapes: [(set, class, contour, seed index)]."""
     stages = {k: True for k in args.stages.split(',')} if args.stages else None
-    res, fails = {}, []
-    for key, label, amount, _ in conds:
+    res = {}
+    for key, _, amount, _ in conds:
         ci = [c[0] for c in CONDITIONS].index(key)
         for fold, cls, f, si in shapes:
             for d in range(args.draws):
-                rng = np.random.default_rng([14, ci, si, d])
-                src, tgt, T, size, partial = make_case(f, key, amount, rng)
+                src, tgt, T, size, partial = make_case(f, key, amount, np.random.default_rng([14, ci, si, d]))
                 if partial and args.reversed:
                     src = src[::-1].copy()
+                seen = with_strays(src, args.stray, np.random.default_rng([15, ci, si, d]))
                 t0 = time.perf_counter()
-                M, r = amscr_register(src, tgt, partial, stages)
+                M, r = amscr_register(seen, tgt, partial, stages)
                 ms = 1e3 * (time.perf_counter() - t0)
-                em, er = ((map_error(M, T, src, size), map_error(M, T, src, size, rms=True)) if M is not None
-                          else (math.inf, math.inf))
-                conf = r.confidence if r is not None else 0.0
-                res.setdefault((fold, key), []).append((em < 0.02, er < 0.02, er >= 0.02 and conf >= CONFIDENT, ms,
-                                                        er < 0.02 and conf >= CONFIDENT))
-                if er >= 0.02:
-                    fails.append('%s %s %s d%d: rms %.2f %% max %.2f %% conf %.3f' % (key, fold, cls, d, 100 * er,
-                                                                                       100 * em, conf))
+                ok_ecc = cv2 is not None and map_error(ecc_register(src, tgt, cv2), T, src, size) < 0.02
+                res.setdefault((fold, key), []).append((map_error(M, T, src, size) < 0.02,
+                                                        map_error(M, T, src, size, rms=True) < 0.02,
+                                                        r.confidence if r is not None else None, ms, ok_ecc))
         print('.', end='', file=sys.stderr, flush=True)
     print(file=sys.stderr)
+    return res
+
+
+def sets_table(args, conds):
+    """The check's view: the sets side by side, both success rules and wrong + confident."""
+    sets = args.sets.split(',')
+    res = run(args, load_sets(args.data, sets, args.tracer == 'subpixel'), conds)
     names = {'A': 'fold A', 'B': 'fold B', 'P': 'procedural'}
     print('ok %% max rule / ok %% RMS rule / wrong + confident %% / successes confident %% (%d draws%s)' %
           (args.draws, ', stages ' + args.stages if args.stages else ''))
     print('| condition | ' + ' | '.join('%s (%d)' % (names[k], len(res[(k, conds[0][0])])) for k in sets) + ' | ms |')
     print('|---|' + '---|' * len(sets) + '---|')
     for key, label, _, _ in conds:
-        cells = ['%.1f / %.1f / %.1f / %.1f' % (*(100 * np.mean([r[i] for r in res[(k, key)]]) for i in range(3)),
-                                                100 * sum(r[4] for r in res[(k, key)]) / max(1, sum(r[1] for r in res[(k, key)])))
-                 for k in sets]
+        cells = []
+        for k in sets:  # a failed call: confidence 0
+            ok, ok_rms, conf = np.array([(r[0], r[1], (r[2] or 0.0) >= CONFIDENT) for r in res[(k, key)]]).T
+            cells.append('%.1f / %.1f / %.1f / %.1f' % (100 * ok.mean(), 100 * ok_rms.mean(),
+                                                        100 * (conf & ~ok_rms).mean(),
+                                                        100 * (conf & ok_rms).sum() / max(1, ok_rms.sum())))
         ms = np.mean([r[3] for k in sets for r in res[(k, key)]])
         print('| %s | %s | %.1f |' % (label, ' | '.join(cells), ms))
-    if args.failures:
-        print('\n'.join(fails))
     return 0
 
 
@@ -314,58 +316,35 @@ def main():
     ap.add_argument('--tracer', choices=['pixel-chain', 'subpixel'], default='pixel-chain',
                     help='how the source silhouettes are traced (the published table: pixel-chain)')
     ap.add_argument('--sets', help="comma-separated sets side by side: A, B (folds.tsv), P (procedural)")
-    ap.add_argument('--stages', default='', help='comma-separated optional stages switched on (--sets)')
-    ap.add_argument('--failures', action='store_true', help='list the RMS failures (--sets)')
-    ap.add_argument('--reversed', action='store_true', help="fragments given against the target's way (--sets)")
+    ap.add_argument('--stages', default='', help='comma-separated optional stages switched on')
+    ap.add_argument('--reversed', action='store_true', help="fragments given against the target's way")
     args = ap.parse_args()
     if not os.path.exists(os.path.join(args.data, 'manifest.tsv')):
         print('no manifest in %s: skipped' % args.data)
         return 0
+    conds = [c for c in CONDITIONS if not args.only or c[0] in args.only.split(',')]
     if args.sets:
-        return sets_table(args, [c for c in CONDITIONS if not args.only or c[0] in args.only.split(',')])
+        return sets_table(args, conds)
     cv2 = None
     if args.ecc:
         try:
             import cv2
         except ImportError:
             print('opencv not installed: ECC column skipped')
-    shapes = load_shapes(args.data, args.classes, args.tracer == 'subpixel')
-    conds = [c for c in CONDITIONS if not args.only or c[0] in args.only.split(',')]
-    rows = []
-    for ci, (key, label, amount, goal) in enumerate(CONDITIONS):
-        if (key, label, amount, goal) not in conds:
-            continue
-        ok_a = ok_e = total = 0
-        t_reg = 0.0
-        conf_ok, conf_bad = [], []
-        for si, (_, f) in enumerate(shapes):
-            for d in range(args.draws):
-                rng = np.random.default_rng([14, ci, si, d])
-                src, tgt, T, size, partial = make_case(f, key, amount, rng)
-                seen = with_strays(src, args.stray, np.random.default_rng([15, ci, si, d]))
-                t0 = time.perf_counter()
-                M, res = amscr_register(seen, tgt, partial)
-                t_reg += time.perf_counter() - t0
-                ea = map_error(M, T, src, size) if M is not None else math.inf
-                if cv2 is not None:
-                    W = ecc_register(src, tgt, cv2)
-                    ee = map_error(W, T, src, size) if W is not None else math.inf
-                    ok_e += ee < 0.02
-                ok_a += ea < 0.02
-                total += 1
-                conf = getattr(res, 'confidence', None) if res is not None else None
-                if conf is not None:
-                    (conf_ok if ea < 0.02 else conf_bad).append(conf)
-        rows.append((label, 100.0 * ok_a / total, 100.0 * ok_e / total if cv2 is not None else None, goal,
-                     1e3 * t_reg / total, conf_ok, conf_bad))
-        sys.stdout.flush()
+    shapes = [('', cls, f, si) for si, (cls, f) in enumerate(load_shapes(args.data, args.classes,
+                                                                        args.tracer == 'subpixel'))]
+    res = run(args, shapes, conds, cv2)
     print('| condition | amscr | ECC multi-start | goal | ms/registration (Python call) |')
     print('|---|---|---|---|---|')
-    for label, a, e, goal, ms, _, _ in rows:
-        print('| %s | %.1f %% | %s | >= %.1f %% | %.2f |' % (label, a, '-' if e is None else '%.1f %%' % e, goal, ms))
-    if any(r[5] or r[6] for r in rows):
+    for key, label, _, goal in conds:
+        rs = res[('', key)]
+        ecc = '%.1f %%' % (100.0 * np.mean([r[4] for r in rs])) if cv2 is not None else '-'
+        print('| %s | %.1f %% | %s | >= %.1f %% | %.2f |' % (label, 100.0 * np.mean([r[0] for r in rs]), ecc, goal,
+                                                          np.mean([r[3] for r in rs])))
+    if any(r[2] is not None for rs in res.values() for r in rs):
         print('\nconfidence (median) of successes / failures per condition:')
-        for label, _, _, _, _, good, bad in rows:
+        for key, label, _, _ in conds:
+            good, bad = ([r[2] for r in res[('', key)] if r[2] is not None and r[0] == ok] for ok in (True, False))
             print('  %-14s %s / %s' % (label, '%.3f' % np.median(good) if good else '-',
                                       '%.3f' % np.median(bad) if bad else '-'))
     return 0

@@ -203,21 +203,16 @@ def low_map(side):
 
 
 def set_low_px(px):
-    """The lowres / grey shapes `px` across (35: the 4x reduction): the reduced canvas and S_LOW."""
+    """The lowres / grey shapes `px` across (35: the 4x reduction): the reduced canvas and S_LOW (low-res
+    pixel x = (x - 1.5) / 4 for a 4x area reduction)."""
     global LOW_SIDE, S_LOW
     LOW_SIDE = int(round(CANVAS * px / SPAN))
     S_LOW = low_map(LOW_SIDE)
 
 
-LOW_SIDE = CANVAS // REDUCE
-
-
 def reduce(img, binary, side=None):
     small = cv2.resize(img, (side or LOW_SIDE,) * 2, interpolation=cv2.INTER_AREA)
     return np.where(small > 127, 255, 0).astype(np.uint8) if binary else small
-
-
-S_LOW = low_map(LOW_SIDE)  # low-res pixel x = (x - 1.5) / 4 for a 4x area reduction
 
 
 def errors(M, T, f):
@@ -304,7 +299,6 @@ def load_classes(data):
 METHODS = [('sub', 'amscr sub-pixel'), ('chain', 'amscr --pixel-chain'), ('ref', 'skimage lists (reference)'),
            ('ecc', 'OpenCV ECC')]
 EXTRA = [('lib', 'library alone')]  # timing only
-MEASURES = [(0, 'RMS'), (1, 'max')]  # index into a record (rms %, max %, confidence, ms)
 
 
 def run_pair(tool, tmp, key, src, tgt, f, T, use_ecc, use_chain=True, breakdown=None, use_ref=False, lib=True):
@@ -408,8 +402,7 @@ def main():
     SWAP = a.swap
     if a.cpu_time:
         CLOCK = time.process_time
-    if a.low_px != SPAN / REDUCE:
-        set_low_px(a.low_px)
+    set_low_px(a.low_px)  # before --families' frame: 35 px (the default) is the 4x reduction of the 200-px canvas
     a.families = a.families or a.quick
     if a.families:
         SPAN, CANVAS = 200.0, 280

@@ -17,7 +17,6 @@
 #include "channel.h"
 #include "inner.h"
 #include "internal.h"
-#include "folds_tsv.h"
 #include "mcd_set.h"
 #include "collection.h"
 
@@ -79,9 +78,7 @@ typedef struct {
 static double offdiag_median(const double *M, size_t n, const unsigned char *held)
 {
     size_t m = 0;
-    double *v = malloc(n * n * sizeof *v);
-    if (!v)
-        die("memory");
+    double *v = xmalloc(n * n * sizeof *v);
     for (size_t i = 0; i < n; i++)
         for (size_t j = 0; j < n; j++)
             if (i != j && !(held && (held[i] || held[j])))
@@ -115,9 +112,7 @@ static void compute_bases(set_run *r)
                 die("prepare");
         if (b == 0)
             r->t_prep = now() - t0;
-        r->base[b] = malloc(n * n * sizeof(double));
-        if (!r->base[b])
-            die("memory");
+        r->base[b] = xmalloc(n * n * sizeof(double));
         t0 = now();
         amscr_status st = b == M_AMSCR   ? amscr_db_distance_matrix(db, NULL, NULL, r->base[b])
                           : b >= M_INNER ? amscr__inner_matrix(db, amscr__resolve_threads(0), NULL, NULL, r->base[b])
@@ -135,15 +130,12 @@ static void compute_bases(set_run *r)
 static void compose(const set_run *r, const row_t *w, const unsigned char *held, double *out)
 {
     size_t n = r->s.n, nn = n * n;
-    double *H = malloc(nn * sizeof *H);
-    if (!H)
-        die("memory");
     int ch = w->use[M_SIM] || w->use[M_AFF];
     if (!ch && !w->use[M_AMSCR]) { /* the inner distance alone */
         memcpy(out, r->base[M_INNER], nn * sizeof *out);
-        free(H);
         return;
     }
+    double *H = xmalloc(nn * sizeof *H);
     amscr_params vp; /* the frames' rule of the row: its share and affine-view factor */
     memset(&vp, 0, sizeof vp);
     vp.channel_affine_view = w->view;
@@ -197,10 +189,8 @@ static void score_one(set_run *r, const double *D, int k)
 {
     size_t n = r->s.n, m = 0;
     const int32_t *units = r->kind == 2 ? r->groups : r->s.labels;
-    int32_t *cls = malloc(n * sizeof *cls), *lab = malloc(n * sizeof *lab);
-    double *u = malloc(n * sizeof *u);
-    if (!cls || !lab || !u)
-        die("memory");
+    int32_t *cls = xmalloc(n * sizeof *cls), *lab = xmalloc(n * sizeof *lab);
+    double *u = xmalloc(n * sizeof *u);
     m = n;
     if (amscr_score_classes(units, n, cls, NULL, &m) != AMSCR_OK)
         die("classes");
@@ -238,10 +228,8 @@ static void score_one(set_run *r, const double *D, int k)
 static void score_rows(set_run *r)
 {
     size_t n = r->s.n;
-    double *D = malloc(n * n * sizeof *D), *G = malloc(n * n * sizeof *G);
-    unsigned char *held = calloc(n, 1);
-    if (!D || !G || !held)
-        die("memory");
+    double *D = xmalloc(n * n * sizeof *D), *G = xmalloc(n * n * sizeof *G);
+    unsigned char *held = xmalloc(n); /* set for every shape before each use */
     for (int k = 0; k < NROWS; k++) {
         double t0 = now();
         compose(r, &ROWS[k], NULL, D);
@@ -283,19 +271,15 @@ static void free_bases(set_run *r)
 static void fold_set(const set_run *all, const int32_t *fold_of_class, int which, set_run *f)
 {
     size_t n = all->s.n, m = 0;
-    size_t *idx = malloc(n * sizeof *idx);
-    if (!idx)
-        die("memory");
+    size_t *idx = xmalloc(n * sizeof *idx);
     for (size_t i = 0; i < n; i++)
         if (fold_of_class[all->s.labels[i]] == which)
             idx[m++] = i;
     f->s.c = NULL;
     f->s.n = m;
-    f->s.labels = malloc(m * sizeof *f->s.labels);
+    f->s.labels = xmalloc(m * sizeof *f->s.labels);
     for (int b = 0; b < NBASE; b++) {
-        f->base[b] = malloc(m * m * sizeof(double));
-        if (!f->base[b] || !f->s.labels)
-            die("memory");
+        f->base[b] = xmalloc(m * m * sizeof(double));
         for (size_t i = 0; i < m; i++)
             for (size_t j = 0; j < m; j++)
                 f->base[b][i * m + j] = all->base[b][idx[i] * n + idx[j]];

@@ -35,35 +35,13 @@ static amscr_db *prepare_set(const amscr_params *p, const shape_set *s, double *
     return db;
 }
 
-/* Bull's eye in % (kind 0) or the top-k sum (kind 1: 10 ranks, 11 above 100 shapes). */
-static double score(int kind, const double *D, const shape_set *s)
-{
-    if (kind == 1) {
-        size_t counts[16] = {0}, kmax = s->n > 100 ? 11 : 10, sum = 0;
-        if (amscr_score_topk_table(D, s->n, s->labels, kmax, counts) != AMSCR_OK)
-            die("top-k");
-        for (size_t r = 0; r < kmax; r++)
-            sum += counts[r];
-        return (double)sum;
-    }
-    double sc = 0;
-    if (amscr_score_bullseye(D, s->n, s->labels, 0, &sc) != AMSCR_OK)
-        die("bull's eye");
-    return 100.0 * sc;
-}
-
 /* ------------------------------------------------------------------ timing */
 
-/* Progress of amscr_db_retrieval_matrix: the time the channel stage ends (its last report). */
-typedef struct {
-    double t_end;
-} stage_clock;
-
+/* Progress of amscr_db_retrieval_matrix: the time the channel stage ends (its last report) into *user. */
 static int clock_cb(void *user, size_t done, size_t total)
 {
-    stage_clock *c = user;
     if (done == total)
-        c->t_end = now();
+        *(double *)user = now();
     return 0;
 }
 
@@ -75,14 +53,10 @@ static void time_setting(const char *name, const shape_set *s, double t_load, do
     double t_prep;
     amscr_db *db = prepare_set(p, s, &t_prep);
     size_t n = s->n;
-    double *R = malloc(n * n * sizeof *R);
-    if (!R)
-        die("memory");
-    stage_clock ck = {0};
-    double t0 = now();
-    if (amscr_db_retrieval_matrix(db, clock_cb, &ck, R) != AMSCR_OK)
+    double *R = xmalloc(n * n * sizeof *R), t_end = 0.0, t0 = now();
+    if (amscr_db_retrieval_matrix(db, clock_cb, &t_end, R) != AMSCR_OK)
         die("retrieval matrix");
-    double t1 = now(), t_ch = ck.t_end - t0, t_rest = t1 - ck.t_end;
+    double t1 = now(), t_ch = t_end - t0, t_rest = t1 - t_end;
     double frames = share > 0.0 ? 2.0 : 1.0, pairs = frames * (double)n * (double)(n - 1) / 2.0;
     printf("| %s | %zu | %.1f | %.1f | %.1f | %.2f | %.1f | %.0f |\n", name, n, t_load, t_prep, t_ch, t_rest,
            t_load + t_prep + (t1 - t0), pairs / t_ch);
@@ -117,13 +91,12 @@ static void time_tool(const char *manifest)
         die("load");
     double t1 = now();
     size_t n = a.n;
-    double *R = malloc(n * n * sizeof *R);
-    stage_clock ck = {0};
-    if (!R || amscr_db_retrieval_matrix(db, clock_cb, &ck, R) != AMSCR_OK)
+    double *R = xmalloc(n * n * sizeof *R), t_end = 0.0;
+    if (amscr_db_retrieval_matrix(db, clock_cb, &t_end, R) != AMSCR_OK)
         die("retrieval matrix");
     double t2 = now(), pairs = 2.0 * (double)n * (double)(n - 1) / 2.0;
     printf("| the tool's path (load on threads, default) | %zu | %.1f (decode, trace, prepare) | | %.1f | %.2f | %.1f | %.0f |\n",
-           n, t1 - t0, ck.t_end - t1, t2 - ck.t_end, t2 - t0, pairs / (ck.t_end - t1));
+           n, t1 - t0, t_end - t1, t2 - t_end, t2 - t0, pairs / (t_end - t1));
     fflush(stdout);
     free(R);
     amscr_db_free(db);
@@ -205,10 +178,12 @@ static int run_mcd_check(const char *manifest)
         die("params");
     double tp;
     amscr_db *db = prepare_set(p, &s, &tp);
-    double *R = malloc(s.n * s.n * sizeof *R);
-    if (!R || amscr_db_retrieval_matrix(db, NULL, NULL, R) != AMSCR_OK)
+    double *R = xmalloc(s.n * s.n * sizeof *R), be = 0.0;
+    if (amscr_db_retrieval_matrix(db, NULL, NULL, R) != AMSCR_OK)
         die("retrieval matrix");
-    double be = score(0, R, &s);
+    if (amscr_score_bullseye(R, s.n, s.labels, 0, &be) != AMSCR_OK)
+        die("bull's eye");
+    be *= 100.0;
     printf("MCD-style set of %s (%zu shapes): bull's eye %.2f %% with the retrieval preset (>= 99 required)\n",
            manifest, s.n, be);
     free(R);

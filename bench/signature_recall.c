@@ -12,23 +12,13 @@
 #include <time.h>
 
 #include "affine_signature.h"
-#include "affine_warp.h"
 #define BENCH_PROGRAM "amscr-signature-recall"
 #include "bench_util.h"
 #include "channel.h"
-#include "folds_tsv.h"
 #include "mcd_set.h"
 
 enum { DIM = AMSCR__AFFINE_SIG_DIM, TOP = 10, NM = 5, TIMED = 15 };
 static const size_t MS[NM] = {16, 32, 64, 128, 256};
-
-static void *xmalloc(size_t n)
-{
-    void *p = malloc(n ? n : 1);
-    if (!p)
-        die("out of memory");
-    return p;
-}
 
 /* The library's signature (affine_signature.h); the variants measured against it: docs/decisions.md. */
 static const char *const SIG_NAME = "height-bins, share 0.2 (channel's)";
@@ -40,14 +30,6 @@ typedef struct {
     double *sig; /* n x DIM */
 } prepared;
 
-static amscr_descriptor *prepare_one(const amscr_params *p, const amscr_contour *c)
-{
-    amscr_descriptor *d = NULL;
-    if (amscr_descriptor_new(p, c, &d) != AMSCR_OK)
-        die("prepare");
-    return d;
-}
-
 static void prepare_set(const amscr_params *p, amscr_contour *const *c, size_t n, prepared *s)
 {
     s->n = n;
@@ -56,7 +38,7 @@ static void prepare_set(const amscr_params *p, amscr_contour *const *c, size_t n
         s->hf[f] = xmalloc(n * sizeof *s->hf[f]);
     s->sig = xmalloc(n * DIM * sizeof(double));
     for (size_t i = 0; i < n; i++) {
-        s->d[i] = prepare_one(p, c[i]);
+        s->d[i] = prepare(p, c[i]);
         for (int f = 0; f < 2; f++)
             if (amscr__hf_of_descriptor(p, f ? AMSCR_INVARIANCE_AFFINE : AMSCR_INVARIANCE_SIMILARITY, s->d[i],
                                         &s->hf[f][i]) != AMSCR_OK)
@@ -165,7 +147,7 @@ static void query_parts(const amscr_params *p, const prepared *c, amscr_contour 
     for (size_t k = 0; k < nq; k++) {
         amscr__hf h[2], b[2];
         double t0 = cpu_now(), acc = 0.0;
-        amscr_descriptor *dq = prepare_one(p, qc[k]);
+        amscr_descriptor *dq = prepare(p, qc[k]);
         for (int f = 0; f < 2; f++)
             if (amscr__hf_of_descriptor(p, f ? AMSCR_INVARIANCE_AFFINE : AMSCR_INVARIANCE_SIMILARITY, dq, &h[f]))
                 die("height functions");
