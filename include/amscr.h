@@ -278,8 +278,9 @@ AMSCR_API const double *amscr_contour_xy(const amscr_contour *c);
 
 /**
  * @brief Checks that a contour can be registered: finite coordinates, at least 8 distinct
- *        points after dropping repeated consecutive points, and (closed) non-zero area or
- *        (open) not all collinear.
+ *        points after dropping repeated consecutive points, an extent (the larger side of the
+ *        bounding box) from 1e-60 to 1e60, and (closed) non-zero area or (open) not all
+ *        collinear.
  * @param[in] c       the contour.
  * @param[in] closed  1 to check as a closed curve, 0 as an open one.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, non-finite); AMSCR_E_DEGENERATE.

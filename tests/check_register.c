@@ -964,6 +964,15 @@ START_TEST(degenerate_inputs)
         expect_desc_failure(p, xy, 32, AMSCR_E_INVALID_ARG, "NaN");
         xy[11] = INFINITY;
         expect_desc_failure(p, xy, 32, AMSCR_E_INVALID_ARG, "infinity");
+        /* an extent beyond the floating-point range the moments need: refused, saying so (at 1e80
+         * and 1e-80 the normalization itself failed, calling the curve collinear) */
+        for (int big = 0; big < 2; big++) {
+            amscr_test_ellipse(32, 2.0, 1.0, 0.0, xy);
+            for (int i = 0; i < 64; i++)
+                xy[i] *= big ? 1e80 : 1e-80;
+            expect_desc_failure(p, xy, 32, AMSCR_E_DEGENERATE, big ? "extent 1e80" : "extent 1e-80");
+            ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), "rescale"));
+        }
     }
     /* a zero-area loop: out along an L and back the same way (closed curves only) */
     size_t m = 0;
@@ -983,6 +992,39 @@ START_TEST(degenerate_inputs)
     expect_desc_failure(closed, xy, m, AMSCR_E_DEGENERATE, "zero-area loop");
     amscr_params_free(closed);
     amscr_params_free(open);
+}
+END_TEST
+
+/* Shapes at the ends of the accepted extent register as well as at unit size: the map's
+ * relative error the same to 1e-9 (the refusal beyond them: degenerate_inputs). */
+START_TEST(extreme_extents_register)
+{
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, 77);
+    double f[2 * 150], h[2 * 150], m6[6];
+    amscr_test_random_shape(&rng, 150, 5, f);
+    amscr_test_random_affine(&rng, 1.6, 0.3, 0.0, 0, m6);
+    amscr_test_apply_affine(m6, f, 150, h);
+    for (int k = 0; k < 2; k++) {
+        double s = k ? 1e55 : 1e-55, fs[2 * 150], hs[2 * 150], got[6];
+        for (int i = 0; i < 300; i++) {
+            fs[i] = s * f[i];
+            hs[i] = s * h[i];
+        }
+        amscr_contour *a = NULL, *b = NULL;
+        amscr_result *r = NULL;
+        ck_assert_int_eq(amscr_contour_new(fs, 150, &a), AMSCR_OK);
+        ck_assert_int_eq(amscr_contour_new(hs, 150, &b), AMSCR_OK);
+        ck_assert_msg(amscr_register_contours(NULL, a, b, &r) == AMSCR_OK, "scale %g: %s", s,
+                      amscr_last_error_detail());
+        ck_assert_int_eq(amscr_result_affine(r, got), AMSCR_OK);
+        for (int j = 0; j < 6; j++)
+            ck_assert_msg(fabs(got[j] - m6[j]) <= 1e-9 * (j % 3 == 2 ? s : 1.0), "scale %g: m[%d] %g, true %g", s,
+                          j, got[j], m6[j]);
+        amscr_result_free(r);
+        amscr_contour_free(a);
+        amscr_contour_free(b);
+    }
 }
 END_TEST
 
@@ -1389,6 +1431,7 @@ Suite *amscr_suite_register(void)
     suite_add_tcase(s, det);
     TCase *err = tcase_create("errors");
     tcase_add_test(err, degenerate_inputs);
+    tcase_add_test(err, extreme_extents_register);
     tcase_add_test(err, incompatible_params);
     tcase_add_test(err, null_arguments);
     suite_add_tcase(s, err);

@@ -142,6 +142,13 @@ size_t amscr__dedupe_points(const double *xy, size_t n, int closed, double *out)
 size_t amscr__despike(double *p, size_t n, int closed, double *scratch);
 /* The median edge length of the list p (n >= 2 points; scratch: n doubles, reordered). */
 double amscr__median_edge(const double *p, size_t n, int closed, double *scratch);
+/* The extent (the larger side of the bounding box) a shape may have: the moments of the
+ * normalization multiply four coordinates, and beyond about 1e75 (below 1e-75) they overflow
+ * (underflow); every face works at 1e70 and 1e-70. Set by the floating-point range, not on data. */
+#define AMSCR__EXTENT_MIN 1e-60
+#define AMSCR__EXTENT_MAX 1e60
+/* Finite, at least 8 distinct points, an extent within the range above, not collinear, and
+ * (closed) a non-zero area; else AMSCR_E_INVALID_ARG or AMSCR_E_DEGENERATE with a detail. */
 amscr_status amscr__validate_points(const double *xy, size_t n, int closed, const char *what);
 size_t amscr__kernel_radius(double sigma);
 void amscr__kernel_fill(double sigma, size_t r, double *taps);

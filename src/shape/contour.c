@@ -144,6 +144,9 @@ amscr_status amscr__validate_points(const double *xy, size_t n, int closed, cons
     double ext = fmax(maxx - minx, maxy - miny);
     if (!(ext > 0.0))
         return amscr__fail(AMSCR_E_DEGENERATE, "%s: all points coincide", what);
+    if (!(ext >= AMSCR__EXTENT_MIN && ext <= AMSCR__EXTENT_MAX))
+        return amscr__fail(AMSCR_E_DEGENERATE, "%s: the points span %g, outside %g to %g: rescale them", what, ext,
+                           AMSCR__EXTENT_MIN, AMSCR__EXTENT_MAX);
     /* second moments: collinear points have a singular covariance */
     double cx, cy, cov[3];
     amscr__centroid(xy, n, &cx, &cy);
