@@ -261,8 +261,8 @@ def validate_contour(points: ArrayLike, closed: bool = True) -> None:
         points: (n, 2) points (or an OpenCV contour).
         closed: True for a closed curve, False for an open one.
     Raises:
-        DegenerateError: too few distinct points, zero area when closed, all collinear when
-        open; InvalidArgumentError: bad points.
+        DegenerateError: too few distinct points, an extent outside 1e-60 to 1e60, zero area when
+        closed, all collinear when open; InvalidArgumentError: bad points.
     """
     c = contour_new(_as_points(points))
     _check(lib.amscr_contour_validate(c, as_bool(closed, 'closed')))
