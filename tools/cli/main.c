@@ -1,4 +1,4 @@
-/* amscr.c — the amscr command-line tool (docs/method.md §6): dispatch through the command table.
+/* main.c — the amscr command-line tool (docs/method.md §6): dispatch through the command table.
  * Uses the public API only (STYLE.md rule 25): no src/ internals.
  *
  *   amscr contour IMG [-o FILE]
