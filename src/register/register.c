@@ -31,7 +31,6 @@ static amscr_status again_on_pixel_grid(const amscr_params *prm, const amscr_des
                                         const amscr_descriptor *tgt, amscr_workspace *ws, amscr_result *r);
 static amscr_status chain_images(const amscr_params *prm, const amscr_descriptor *src, const amscr_descriptor *tgt,
                                  amscr_workspace *ws, amscr_descriptor *g[2]);
-static int source_retraced(const amscr_descriptor *src, const amscr_descriptor *tgt, int target);
 
 amscr_status amscr_register(const amscr_params *p, const amscr_descriptor *src, const amscr_descriptor *tgt,
                             amscr_workspace *ws, amscr_result **out_result)
