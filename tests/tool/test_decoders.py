@@ -224,5 +224,25 @@ def test_threshold_option(tmp_path):
     r = run("contour", img)  # default 127: nothing is on
     assert r.returncode == 1
     assert "dim.pgm" in r.stderr
+    assert "the brightest is 100 of 255" in r.stderr and "--threshold below 100" in r.stderr  # what to set
     check_rect(read_points(run("contour", img, "--threshold", "50", "--pixel-chain").stdout))
     check_rect(read_points(run("contour", img, "--threshold=auto", "--pixel-chain").stdout))
+    r = run("contour", img, "--all")  # every contour: the same message
+    assert r.returncode == 1 and "the brightest is 100" in r.stderr
+
+
+@pytest.mark.parametrize("maxval", [255, 65535])
+@pytest.mark.parametrize("fg,bg", [(1, 0), (0, 1)])
+def test_zero_one_mask_by_default(tmp_path, maxval, fg, bg):
+    # an image whose samples are all 0 or 1 (NumPy's mask.astype(np.uint8), label images) is a
+    # 0/1 mask by default: traced at 0.5, either polarity, at 8 and 16 bits
+    img = tmp_path / "m01.pgm"
+    img.write_bytes(pgm_bytes(rect_mask(fg=fg, bg=bg), maxval=maxval))
+    check_rect(contour_of(tmp_path, img.read_bytes(), "m01.pgm"))
+    r = run("contour", img, "--threshold", "127")  # asked for: nothing is above it
+    assert r.returncode == 1 and "the brightest is 1 of %d" % maxval in r.stderr
+    assert ("--threshold below 1," if maxval == 255 else "use --threshold auto") in r.stderr
+    ones = tmp_path / "ones.pgm"
+    ones.write_bytes(pgm_bytes(blank(10, 10, 1), maxval=maxval))
+    r = run("contour", ones)
+    assert r.returncode == 1 and "foreground everywhere" in r.stderr

@@ -29,6 +29,7 @@ enum {
  * library's, see cmd_params.c). */
 enum {
     TOOL_THRESHOLD_DEFAULT = 127, /* pixels > 127 are 'on': mid-grey of 8 bits */
+    TOOL_THRESHOLD_UNSET = -2,    /* no --threshold: 127, or 0 on an image of only 0s and 1s */
     TOOL_THRESHOLD_MAX = 254,     /* > 254 leaves no pixel on */
     TOOL_TOP_DEFAULT = 10,        /* search results */
     TOOL_RANKS_DEFAULT = 10,      /* ranks of the top-k table (Kimia-99's table has 10) */

@@ -25,7 +25,8 @@ static const char HELP_CONTOUR[] =
     "coloured image on a transparent background is traced by its alpha channel.\n"
     "\n"
     "  -o, --output FILE       write the points to FILE instead of stdout\n"
-    "  --threshold N|auto      pixels > N are 'on' (0..254, default 127); auto = Otsu\n"
+    "  --threshold N|auto      pixels > N are 'on' (0..254, default 127, or 0 on an\n"
+    "                          image of only 0s and 1s); auto = Otsu\n"
     "  --pixel-chain           the chain of boundary pixel centres instead of the iso-line\n"
     "  --join                  also the other large pieces near the largest (at least 5 %\n"
     "                          of its pixels, within its RMS radius, not in its holes),\n"
@@ -271,7 +272,8 @@ static void print_shape_options(const amscr_params *reg, const amscr_params *ret
     char methods[200], params[200], invs[200];
     const int none = -1; /* no "(default)" mark */
     printf("image options:\n"
-           "  --threshold N|auto      pixels > N are 'on' (0..%d, default %d); auto = Otsu.\n"
+           "  --threshold N|auto      pixels > N are 'on' (0..%d, default %d, or 0 on an image\n"
+           "                          of only 0s and 1s: a 0/1 mask); auto = Otsu.\n"
            "                          Polarity is automatic: the image border is background.\n"
            "                          16-bit samples: the level N + 0.5 is scaled by 257.\n"
            "  --pixel-chain           trace the chain of boundary pixel centres instead of the\n"

@@ -20,16 +20,12 @@ int shape_contours(const char *path, int threshold, double min_area, amscr_conto
     double level = image_level(&img, threshold, &bits, &pixels);
     amscr_status st = amscr_contours_from_image(pixels, img.width, img.height, img.width, bits, level,
                                                 image_trace_flags() & AMSCR_TRACE_PIXEL_CHAIN, min_area, out);
+    if (st == AMSCR_E_NOT_FOUND)
+        image_no_shape_error(path, &img, threshold, "no contour", lib_detail());
+    else if (st != AMSCR_OK)
+        tool_lib_error(path, st);
     image_free(&img);
-    if (st != AMSCR_OK) {
-        const char *d = lib_detail();
-        if (st == AMSCR_E_NOT_FOUND)
-            tool_error(path, "no contour: %s", d[0] ? d : "no foreground");
-        else
-            tool_lib_error(path, st);
-        return -1;
-    }
-    return 0;
+    return st == AMSCR_OK ? 0 : -1;
 }
 
 int shape_load_opts(const opts *o, const char *path, amscr_contour **out)

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "cli.h" /* TOOL_THRESHOLD_* */
 #include "image_codec.h"
 #include "util.h"
 
@@ -152,13 +153,53 @@ void image_set_trace_flags(int flags) { trace_flags = flags; }
 
 int image_trace_flags(void) { return trace_flags; }
 
+/* The largest sample of img: of its 16-bit samples when it has them and `wide`, else of its
+ * 8-bit ones. */
+static unsigned image_max(const tool_image *img, int wide)
+{
+    size_t n = img->width * img->height;
+    unsigned m = 0;
+    for (size_t i = 0; i < n; i++) {
+        unsigned v = wide && img->pix16 ? img->pix16[i] : img->pix[i];
+        m = v > m ? v : m;
+    }
+    return m;
+}
+
 double image_level(const tool_image *img, int threshold, int *out_bits, const void **out_pixels)
 {
     *out_bits = img->pix16 ? 16 : 8;
     *out_pixels = img->pix16 ? (const void *)img->pix16 : (const void *)img->pix;
     if (threshold == AMSCR_THRESHOLD_AUTO)
         return AMSCR_LEVEL_AUTO;
+    if (threshold == TOOL_THRESHOLD_UNSET && image_max(img, 1) <= 1)
+        return 0.5; /* a 0/1 mask, as NumPy and many label images store one */
+    if (threshold == TOOL_THRESHOLD_UNSET)
+        threshold = TOOL_THRESHOLD_DEFAULT;
     return img->pix16 ? (threshold + 0.5) * 257.0 : threshold + 0.5;
+}
+
+void image_no_shape_error(const char *path, const tool_image *img, int threshold, const char *what,
+                          const char *detail)
+{
+    int zero_one = threshold == TOOL_THRESHOLD_UNSET && image_max(img, 1) <= 1; /* traced at 0.5 */
+    int t = threshold == TOOL_THRESHOLD_UNSET ? TOOL_THRESHOLD_DEFAULT : threshold;
+    unsigned m = image_max(img, 1), top = img->pix16 ? 65535u : 255u;
+    double scale = img->pix16 ? 257.0 : 1.0;          /* image_level: (T + 0.5) * scale */
+    unsigned below = (unsigned)ceil(m / scale - 0.5); /* the thresholds T < below leave m on */
+    int dark = threshold != AMSCR_THRESHOLD_AUTO && !zero_one && m > 0 && m < (t + 0.5) * scale;
+    if (dark && below > 0)
+        tool_error(path, "%s: no pixel is above the threshold %d (the brightest is %u of %u): set --threshold "
+                   "below %u, or --threshold auto", what, t, m, top, below);
+    else if (dark)
+        tool_error(path, "%s: no pixel is above the threshold %d (the brightest is %u of %u): use --threshold auto",
+                   what, t, m, top);
+    else if (detail[0])
+        tool_error(path, "%s: %s", what, detail);
+    else if (threshold == AMSCR_THRESHOLD_AUTO)
+        tool_error(path, "%s at threshold auto", what);
+    else
+        tool_error(path, "%s at threshold %d", what, t);
 }
 
 int shape_load(const char *path, int threshold, amscr_contour **out)
@@ -195,17 +236,9 @@ int shape_load(const char *path, int threshold, amscr_contour **out)
     amscr_status st = amscr_contour_from_image(pixels, img.width, img.height, img.width, bits, level, trace_flags, out);
     if (st != AMSCR_OK) {
         const char *d = lib_detail();
-        char thr[32];
-        if (threshold == AMSCR_THRESHOLD_AUTO)
-            snprintf(thr, sizeof thr, "auto");
-        else
-            snprintf(thr, sizeof thr, "%d", threshold);
         switch (st) {
         case AMSCR_E_NOT_FOUND:
-            if (d[0])
-                tool_error(path, "no foreground shape: %s", d);
-            else
-                tool_error(path, "no foreground shape at threshold %s", thr);
+            image_no_shape_error(path, &img, threshold, "no foreground shape", d);
             break;
         case AMSCR_E_DEGENERATE:
             tool_error(path, "the shape is too small to trace%s%s", d[0] ? ": " : "", d);

@@ -36,8 +36,16 @@ int image_trace_flags(void);
 
 /* The iso-level of amscr_contour_from_image for the tool's 8-bit `threshold` on img: T + 0.5
  * (the pixels > T), scaled by 257 for 16-bit samples; AMSCR_LEVEL_AUTO for
- * AMSCR_THRESHOLD_AUTO. *out_bits and *out_pixels: the samples to trace. */
+ * AMSCR_THRESHOLD_AUTO; for TOOL_THRESHOLD_UNSET (no --threshold), 0.5 when every sample is 0
+ * or 1 (a 0/1 mask), else the level of TOOL_THRESHOLD_DEFAULT. *out_bits and *out_pixels: the
+ * samples to trace. */
 double image_level(const tool_image *img, int threshold, int *out_bits, const void **out_pixels);
+
+/* The error line for an image where the tracing found no shape (AMSCR_E_NOT_FOUND): "path:
+ * what: ...", with the library's `detail`, or, when every pixel is dark but not black (the
+ * brightest at or below the threshold, above 1), the brightest value and what to set. */
+void image_no_shape_error(const char *path, const tool_image *img, int threshold, const char *what,
+                          const char *detail);
 
 /* Non-zero when the file starts with PNG or PGM (P2/P5) magic bytes. */
 int file_is_image(const char *path);

@@ -122,7 +122,7 @@ void opts_init(opts *o, const tool_command *c)
     memset(o, 0, sizeof *o);
     o->cmd = c->name;
     o->cmd_bit = c->bit;
-    o->threshold = TOOL_THRESHOLD_DEFAULT;
+    o->threshold = TOOL_THRESHOLD_UNSET;
     o->reflections = -1;
     o->top = TOOL_TOP_DEFAULT;
     o->protocol_id = PROTO_ALL;

@@ -36,9 +36,10 @@ def as_order(order: Any) -> str:
     return order
 
 
-def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: bool = False) -> np.ndarray:
+def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: bool = False,
+              allow_empty: bool = False) -> np.ndarray:
     """The one conversion of user points: array-like -> C-contiguous float64 (n, 2) array of
-    (x, y) rows, n >= 1, all finite.
+    (x, y) rows, n >= 1 (n >= 0 with allow_empty), all finite.
 
     Accepts (n, 2) arrays of any real dtype, and OpenCV contours ((n, 1, 2) int32 from
     ``cv2.findContours``, already (x, y)). ``order='rc'`` takes (row, col) points (scikit-image's
@@ -65,7 +66,7 @@ def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: boo
                 if a.ndim == 4 and a.shape[2:] == (1, 2) else '')
         raise bad('%s: expected an array of shape (n, 2) (one x, y row per point) or (n, 1, 2) (OpenCV), '
                   'got shape %s%s' % (name, a.shape, hint))
-    if a.shape[0] == 0:
+    if a.shape[0] == 0 and not allow_empty:
         raise bad('%s: no points' % name)
     if order == 'rc':
         a = a[:, ::-1]

@@ -16,7 +16,7 @@ import numpy as np
 from ._lib import ffi, lib
 from ._util import ArrayLike, as_bool, as_count, as_scalar, bad, copy_points, dbuf, new_object
 from ._util import as_points as _as_points
-from .errors import _check
+from .errors import NotFoundError, _check
 
 
 def _new_contour(make: Any, *args: Any):
@@ -72,6 +72,7 @@ def _image_and_level(mask: ArrayLike, threshold: Union[int, float, str, None],
     elif a.dtype.kind == 'f':
         if a.size and not np.all(np.isfinite(a)):
             raise bad('mask: non-finite values')
+        a = a.astype(np.float64)  # float16 cannot hold the scale to 65535
         lo, hi = (float(a.min()), float(a.max())) if a.size else (0.0, 1.0)
         scale = (lo, hi)
         a = np.zeros(a.shape, np.uint16) if hi <= lo else np.rint((a - lo) * (65535.0 / (hi - lo))).astype(np.uint16)
@@ -96,10 +97,26 @@ def _image_and_level(mask: ArrayLike, threshold: Union[int, float, str, None],
         if not 0.0 <= level < 65535.0:
             raise bad('threshold: %g is outside the values of the image (%g..%g)' % (t, lo, hi))
         return a, bits, level, flags
+    if threshold is None and a.size and int(a.max()) <= 1:  # a 0/1 mask (mask.astype(np.uint8))
+        return a, bits, 0.5, flags
     thr = (top // 2) if threshold is None else as_count(threshold, 'threshold', 0)
     if thr > top - 1:
         raise bad('threshold: expected 0..%d, got %d' % (top - 1, thr))
     return a, bits, thr + 0.5, flags
+
+
+def _traced(a: np.ndarray, level: float, call: Any, *args: Any) -> Any:
+    """call(*args), whose NotFoundError on the integer image `a` traced at `level` (a threshold
+    T at T + 0.5), with no value above the threshold but some above 0, names the brightest value
+    and what to pass instead."""
+    try:
+        return call(*args)
+    except NotFoundError as e:
+        m = int(a.max()) if a.size else 0
+        if level < 0 or not 0 < m < level:
+            raise
+        raise NotFoundError("mask: no value is above the threshold %d (the brightest is %d): pass a threshold "
+                            "below %d, or threshold='auto'" % (int(level), m, m), e.status, e.detail) from None
 
 
 def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] = None,
@@ -111,7 +128,8 @@ def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] =
             ``uint16`` (other integer arrays with values in 0..65535 are accepted too), or
             ``float`` (any range: mapped linearly onto 16 bits).
         threshold: integer images: a pixel is "on" when its value is > threshold (0..254 for
-            8 bits, 0..65534 for 16 bits; None: 127, the ``amscr`` tool's default, or 32767);
+            8 bits, 0..65534 for 16 bits; None: 0 when every value is 0 or 1, a 0/1 mask as
+            ``mask.astype(np.uint8)`` gives, else 127, the ``amscr`` tool's default, or 32767);
             float images: the level in the array's units (None: 0.5); ``'auto'`` for Otsu's
             split (the level halfway between the two classes' medians). The polarity is
             automatic: if most of the image border is "on", on and off are swapped.
@@ -135,7 +153,8 @@ def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] =
     if as_bool(join, 'join'):
         flags |= lib.AMSCR_TRACE_JOIN
     h, w = a.shape
-    return _take(_new_contour(lib.amscr_contour_from_image, ffi.from_buffer(a), w, h, w, bits, level, flags))
+    return _take(_traced(a, level, _new_contour, lib.amscr_contour_from_image, ffi.from_buffer(a), w, h, w, bits,
+                         level, flags))
 
 
 class ImageContour(NamedTuple):
@@ -170,7 +189,8 @@ def contours_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] 
     area = as_scalar(min_area, 'min_area')
     h, w = a.shape
     out = ffi.new('amscr_contour_set **')
-    _check(lib.amscr_contours_from_image(ffi.from_buffer(a), w, h, w, bits, level, flags, area, out))
+    _traced(a, level, lambda: _check(lib.amscr_contours_from_image(ffi.from_buffer(a), w, h, w, bits, level, flags,
+                                                                  area, out)))
     cs = ffi.gc(out[0], lib.amscr_contour_set_free)
     result = []
     for i in range(int(lib.amscr_contour_set_size(cs))):

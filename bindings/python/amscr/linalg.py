@@ -64,16 +64,17 @@ def affine_apply(matrix: ArrayLike, points: ArrayLike) -> np.ndarray:
 
     Args:
         matrix: 3x3 (last row 0, 0, 1), 2x3 or flat 6 affine matrix.
-        points: (n, 2) points (or an OpenCV contour).
+        points: (n, 2) points (or an OpenCV contour); n may be 0.
     Returns:
         (n, 2) float array.
     Raises:
         InvalidArgumentError: a bad matrix or points.
     """
     m = to_m6(matrix)
-    pts = as_points(points)
+    pts = as_points(points, allow_empty=True)
     out = np.empty_like(pts)
-    _check(lib.amscr_affine_apply(dbuf(m), dbuf(pts), pts.shape[0], dbuf(out)))
+    if pts.shape[0]:
+        _check(lib.amscr_affine_apply(dbuf(m), dbuf(pts), pts.shape[0], dbuf(out)))
     return out
 
 

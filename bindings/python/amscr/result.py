@@ -149,7 +149,8 @@ class Registration:
         """Maps points of the source onto the target: ``points @ A.T + B``.
 
         Args:
-            points: (n, 2) points (or an OpenCV (n, 1, 2) contour) in source coordinates.
+            points: (n, 2) points (or an OpenCV (n, 1, 2) contour) in source coordinates; n
+                may be 0.
             order: 'xy' (default) or 'rc': the order of the given points' columns, kept in
                 the returned array.
         Returns:
@@ -157,7 +158,8 @@ class Registration:
         Raises:
             InvalidArgumentError: bad points or order.
         """
-        return points_in_order(as_points(points, 'points', order) @ self.A.T + self.B, order)
+        pts = as_points(points, 'points', order, allow_empty=True)
+        return points_in_order(pts @ self.A.T + self.B, order)
 
     def __repr__(self) -> str:
         return ('Registration(distance=%.6g, method=%r, kept %d/%d scales, k=%d, shift=%d, reflected=%s)'

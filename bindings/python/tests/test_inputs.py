@@ -40,6 +40,7 @@ def test_matrix_is_homogeneous_3x3():
     assert np.array_equal(r.matrix[:2, :2], r.A) and np.array_equal(r.matrix[:2, 2], r.B)
     homog = np.column_stack([src, np.ones(len(src))]) @ r.matrix.T
     assert np.allclose(homog[:, :2], r.apply(src)) and np.allclose(homog[:, 2], 1.0)
+    assert r.apply(np.zeros((0, 2))).shape == (0, 2)  # no points: none mapped
     assert np.allclose(r.matrix[:2], np.column_stack([A_TRUE, B_TRUE]), atol=1e-3)
 
 

@@ -63,6 +63,10 @@ def test_affine_apply_and_invert():
     np.testing.assert_allclose(amscr.affine_apply(M, pts), affine(pts, A_TRUE, B_TRUE), rtol=1e-14, atol=1e-14)
     np.testing.assert_allclose(amscr.affine_apply(M[:2], pts), affine(pts, A_TRUE, B_TRUE), rtol=1e-14)
     np.testing.assert_allclose(amscr.affine_invert(M), np.linalg.inv(M), rtol=1e-12, atol=1e-14)
+    for none in (np.zeros((0, 2)), np.zeros((0, 1, 2), np.int32)):  # no points: none mapped
+        assert amscr.affine_apply(M, none).shape == (0, 2)
+    with pytest.raises(amscr.InvalidArgumentError, match="not finite"):
+        amscr.affine_apply(M, [[0.0, np.nan]])
     with pytest.raises(amscr.DegenerateError):
         amscr.affine_invert([[1, 2, 0], [2, 4, 0], [0, 0, 1]])
 

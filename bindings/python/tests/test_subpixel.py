@@ -13,11 +13,31 @@ def _rect(dtype, fg):
 
 
 @pytest.mark.parametrize("dtype,fg", [(bool, True), (np.uint8, 255), (np.uint16, 65535), (np.float64, 1.0),
-                                      (np.float32, 7.5), (np.int32, 255)])
+                                      (np.float32, 7.5), (np.int32, 255), (np.float16, 1.0),
+                                      (np.uint8, 1), (np.uint16, 1), (np.int64, 1)])
 def test_every_dtype_gives_the_same_binary_contour(dtype, fg):
     c = amscr.contour_from_mask(_rect(dtype, fg), threshold='auto' if dtype == np.float32 else None)
     assert c.min(axis=0).tolist() == [7.5, 5.5] and c.max(axis=0).tolist() == [31.5, 22.5]
     assert amscr.signed_area(c) == pytest.approx(24 * 17 - 0.5)
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.int64])
+def test_a_zero_one_mask_is_traced_by_default_and_a_dark_one_says_what_to_pass(dtype):
+    """0/1 integer masks (mask.astype(np.uint8)) are traced at 0.5 unless a threshold is given,
+    either polarity, by both tracers; an image whose values stay under the threshold names its
+    brightest value."""
+    inverted = 1 - _rect(dtype, 1)
+    c = amscr.contour_from_mask(inverted)
+    assert c.min(axis=0).tolist() == [7.5, 5.5] and c.max(axis=0).tolist() == [31.5, 22.5]
+    assert [x.area for x in amscr.contours_from_mask(_rect(dtype, 1), subpixel=False)] == [24 * 17 - 24 - 17 + 1]
+    with pytest.raises(amscr.NotFoundError, match=r"threshold 127 \(the brightest is 1\): pass a threshold below 1"):
+        amscr.contour_from_mask(_rect(dtype, 1), threshold=127)
+    for f in (amscr.contour_from_mask, amscr.contours_from_mask):
+        with pytest.raises(amscr.NotFoundError, match=r"the brightest is 100\): pass a threshold below 100"):
+            f(_rect(dtype, 100))
+        assert len(f(_rect(dtype, 100), threshold=99)) > 0
+    with pytest.raises(amscr.NotFoundError, match="no foreground"):  # black: the library's own message
+        amscr.contour_from_mask(np.zeros((8, 8), dtype))
 
 
 def test_subpixel_false_is_the_pixel_chain():
