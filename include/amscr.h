@@ -2816,13 +2816,15 @@ AMSCR_API size_t amscr_index_default_candidates(size_t n);
  *        index built with candidates), and the older lists it enters; runs on the threads of
  *        the index's params. With candidates 0 and a channel weight of 0 or 1 the result
  *        equals a rebuild's; with a channel weight strictly between 0 and 1 the fusion keeps
- *        the medians of the build.
+ *        the medians of the build. An index of fewer shapes than twice its re-ranking k,
+ *        whose lists' length K grows with its size, is built again on its shapes and the new
+ *        ones instead (the same index as amscr_index_build of them all, its names, groups and
+ *        class names kept; since 0.22.2: before, AMSCR_E_STATE, "rebuild it"); on failure it
+ *        is left as it was.
  * @param[in] shapes  prepared with exactly the index's params (threads aside).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL; params that differ: the detail names the
- *         option); AMSCR_E_STATE (the index holds fewer neighbours a shape than its K at the
- *         new size: rebuild it); AMSCR_E_LIMIT; AMSCR_E_CANCELLED; AMSCR_E_NOMEM. After
- *         AMSCR_E_CANCELLED or AMSCR_E_NOMEM the index holds the shapes but not all their
- *         lists: free it.
+ *         option); AMSCR_E_LIMIT; AMSCR_E_CANCELLED; AMSCR_E_NOMEM. After AMSCR_E_CANCELLED or
+ *         AMSCR_E_NOMEM the index holds the shapes but not all their lists: free it.
  * Ownership: none (shapes is copied).
  * Thread-safety: exclusive on x.
  * @since 0.4

@@ -1113,6 +1113,57 @@ START_TEST(add_shapes)
 }
 END_TEST
 
+/* Shapes added to an index of fewer than twice its re-ranking k, whose lists grow with its size:
+ * the index is built again on its shapes and the new ones (the queries a build's), its names,
+ * groups and class names kept; one shape at a time from an empty index too. */
+START_TEST(add_grows_the_lists)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_db *first = db_of(p, 3), *all = db_of(p, 12), *more = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &more), AMSCR_OK);
+    for (size_t i = 3; i < 12; i++)
+        ck_assert_int_eq(amscr_db_add_descriptor(more, amscr_db_descriptor(all, i), amscr_db_label(all, i), NULL),
+                         AMSCR_OK);
+    amscr_index *x = NULL, *ref = NULL, *one = NULL;
+    ck_assert_int_eq(amscr_index_build(first, 0, NULL, NULL, &x), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_set_name(x, 1, "one.png"), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_set_group(x, 2, "object-2"), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_set_class_name(x, 0, "bone"), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_add(x, more, NULL, NULL), AMSCR_OK);
+    ck_assert_uint_eq(amscr_index_size(x), 12);
+    ck_assert_str_eq(amscr_index_name(x, 1), "one.png");
+    ck_assert_str_eq(amscr_index_group(x, 2), "object-2");
+    ck_assert_str_eq(amscr_index_class_name(x, 0), "bone");
+    ck_assert_ptr_null(amscr_index_name(x, 5));
+    ck_assert_int_eq(amscr_index_build(all, 0, NULL, NULL, &ref), AMSCR_OK);
+    amscr_db *empty = db_of(p, 0), *single = NULL;
+    ck_assert_int_eq(amscr_index_build(empty, 0, NULL, NULL, &one), AMSCR_OK);
+    for (size_t i = 0; i < 12; i++) { /* one at a time: K = 1, 1, 1, 2, ... */
+        ck_assert_int_eq(amscr_db_new(p, &single), AMSCR_OK);
+        ck_assert_int_eq(amscr_db_add_descriptor(single, amscr_db_descriptor(all, i), amscr_db_label(all, i), NULL),
+                         AMSCR_OK);
+        ck_assert_int_eq(amscr_index_add(one, single, NULL, NULL), AMSCR_OK);
+        amscr_db_free(single);
+    }
+    amscr_descriptor *q = shape(p, 3000);
+    double a[12], b[12], c[12];
+    ck_assert_int_eq(amscr_index_query_scores(x, q, 0, a, 12), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_query_scores(ref, q, 0, b, 12), AMSCR_OK);
+    ck_assert_int_eq(amscr_index_query_scores(one, q, 0, c, 12), AMSCR_OK);
+    assert_close(a, b, 12, 1e-12);
+    assert_close(c, b, 12, 1e-12);
+    amscr_descriptor_free(q);
+    amscr_index_free(x);
+    amscr_index_free(ref);
+    amscr_index_free(one);
+    amscr_db_free(first);
+    amscr_db_free(all);
+    amscr_db_free(more);
+    amscr_db_free(empty);
+    amscr_params_free(p);
+}
+END_TEST
+
 /* The saved bytes do not depend on the thread count (full and shortlist builds). */
 START_TEST(thread_independence)
 {
@@ -1513,6 +1564,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, stored_features);
     tcase_add_test(tc, bad_files);
     tcase_add_test(tc, add_shapes);
+    tcase_add_test(tc, add_grows_the_lists);
     tcase_add_test(tc, thread_independence);
     tcase_add_test(tc, top_and_shortlist);
     tcase_add_test(tc, default_shortlist_first_hit);

@@ -117,6 +117,49 @@ static amscr_status add_rows(add_ctx *c, size_t j1, size_t n0)
     return st;
 }
 
+/* Moves the names, groups and class names of x's first n0 shapes into y, built on them and more. */
+static void move_names(amscr_index *x, amscr_index *y, size_t n0)
+{
+    for (size_t i = 0; i < n0; i++) {
+        y->names[i] = x->names[i];
+        y->groups[i] = x->groups[i];
+        x->names[i] = x->groups[i] = NULL;
+    }
+    char **classes = y->classes;
+    size_t nclasses = y->nclasses;
+    y->classes = x->classes;
+    y->nclasses = x->nclasses;
+    x->classes = classes;
+    x->nclasses = nclasses;
+}
+
+/* x built again on its shapes and `shapes`, its names, groups and class names kept: the lists of
+ * an index of fewer than twice its re-ranking k grow with its size (amscr__rerank_k), which an
+ * add cannot give the old rows. x is left as it was on failure. */
+static amscr_status add_rebuilding(amscr_index *x, const amscr_db *shapes, amscr_progress_fn progress, void *user)
+{
+    size_t n0 = amscr_db_size(x->db), n = n0 + amscr_db_size(shapes);
+    amscr_db *all = NULL;
+    amscr_index *y = NULL;
+    amscr_status st = amscr_db_new(amscr_db_params(x->db), &all);
+    for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
+        const amscr_db *from = i < n0 ? x->db : shapes;
+        size_t j = i < n0 ? i : i - n0;
+        st = amscr_db_add_descriptor(all, amscr_db_descriptor(from, j), amscr_db_label(from, j), NULL);
+    }
+    if (st == AMSCR_OK)
+        st = amscr_index_build(all, x->candidates, progress, user, &y);
+    amscr_db_free(all);
+    if (st != AMSCR_OK)
+        return st;
+    move_names(x, y, n0);
+    amscr_index old = *x;
+    *x = *y;
+    *y = old;
+    amscr_index_free(y);
+    return AMSCR_OK;
+}
+
 amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progress_fn progress, void *user)
 {
     amscr__clear_error();
@@ -130,9 +173,8 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
     size_t n0 = amscr_db_size(x->db), add = amscr_db_size(shapes), n = n0 + add;
     amscr_status st = amscr__index_check_db(shapes, "amscr_index_add");
     size_t kp = amscr__rerank_k(p, n);
-    if (st == AMSCR_OK && kp != x->k && n0 > 0) /* a list grows with the collection: rebuild */
-        return amscr__fail(AMSCR_E_STATE, "amscr_index_add: the index holds %zu neighbours a shape and needs %zu "
-                                          "with %zu shapes; rebuild it", x->k, kp, n);
+    if (st == AMSCR_OK && kp != x->k && n0 > 0) /* a list grows with the collection */
+        return add_rebuilding(x, shapes, progress, user);
     if (st == AMSCR_OK && n0 == 0) {
         x->k = kp;
         x->k2 = amscr__index_k2(p, kp);

@@ -275,7 +275,7 @@ static amscr_status read_header(amscr__rbuf *r, amscr_index *x)
     x->k2 = amscr__index_k2(p, x->k);
     x->candidates = (size_t)m;
     uint64_t need = (uint64_t)n * (4u * sig_dim + 12u * k);
-    if (need / (n ? n : 1) != 4u * sig_dim + 12u * k || need > r->len - r->pos)
+    if ((n && need / n != 4u * sig_dim + 12u * k) || need > r->len - r->pos) /* an empty index: need 0 */
         return amscr__fail(AMSCR_E_FORMAT, "index file: the index section is truncated");
     return amscr__index_reserve(x, n);
 }
@@ -481,8 +481,9 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int
     amscr__rbuf r = {buf, len - 8, pos, 0};
     uint64_t sec = amscr__db_is_index(version) ? amscr__r_u64(&r) : 0;
     if (!amscr__db_is_index(version))
-        st = amscr__fail(AMSCR_E_FORMAT, "a collection file without an index (format version %u): build one with "
-                                         "amscr_index_build", (unsigned)version);
+        st = amscr__fail(AMSCR_E_FORMAT, "a collection file without an index (format version %u): build an index "
+                                         "of it (amscr_index_build; `amscr index`, Python amscr.Index)",
+                         (unsigned)version);
     else if (r.bad || sec != r.len - r.pos)
         st = amscr__fail(AMSCR_E_FORMAT, "index file: bad index section length");
     if (st == AMSCR_OK)

@@ -216,7 +216,8 @@ class Index:
     def add(self, points: PointsLike, label: Any = 0, name: Optional[str] = None, *, order: str = 'xy') -> int:
         """Prepares a shape with the index's params and adds it (its list and the lists it
         enters are updated; with every shape a candidate and a channel weight of 0 or 1 the
-        result equals a rebuild).
+        result equals a rebuild; an index of fewer shapes than twice its re-ranking k, whose
+        lists grow with its size, is built again, its names and classes kept).
 
         Args:
             points: (n, 2) points, an OpenCV contour, or a :class:`Shape` prepared with the
@@ -229,8 +230,7 @@ class Index:
             the index of the new shape.
         Raises:
             InvalidArgumentError: bad points or label, or a Shape prepared with other params
-            (the message names the option); StateError: the index must be rebuilt (it holds
-            fewer neighbours a shape than its re-ranking needs).
+            (the message names the option).
         """
         with self._lock.write():
             q = as_shape(points, self.collection_params(), 'points', order)

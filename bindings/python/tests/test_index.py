@@ -103,6 +103,23 @@ def test_add():
         index.add(amscr.Shape(q, amscr.Params.retrieval(points=128)), label='class0')
 
 
+def test_add_one_at_a_time_from_an_empty_index(tmp_path):
+    """An index grown one shape at a time from empty (its lists' K grows with its size up to
+    twice the re-ranking k: the small index is built again) scores as a build of them all, and
+    an empty index saves, loads and pickles."""
+    params = amscr.Params.retrieval(points=64)
+    coll = synthetic(params, 20)
+    index = amscr.Index(amscr.Collection(params))
+    index.save(str(tmp_path / 'empty.idx'))
+    assert len(amscr.Index.load(str(tmp_path / 'empty.idx'))) == 0
+    assert len(pickle.loads(pickle.dumps(index))) == 0
+    for i in range(20):
+        assert index.add(coll.shape(i), label=coll.labels[i], name='shape%d' % i) == i
+    assert index.names[3] == 'shape3' and list(index.labels) == list(coll.labels)
+    q = blob(300, seed=1)
+    np.testing.assert_allclose(index.scores(q), amscr.Index(coll).scores(q), rtol=0, atol=1e-12)
+
+
 def dataset_shapes(name, count):
     """`count` shapes of a dataset spread over its classes: (points, class) pairs."""
     cv2 = pytest.importorskip('cv2')
