@@ -173,6 +173,45 @@ def test_overlay_open_png(tmp_path):
     assert "no elbow" in (tmp_path / "p.svg").read_text()
 
 
+def test_partial_reports_no_scale_selection(tmp_path):
+    """--partial: the report says how the fragment was placed, not scale-selection figures the
+    partial match does not compute; the overlay draws the fragment open; no plot."""
+    src = smooth_shape(300)
+    frag = src[40:220]
+    s, t = tmp_path / "frag.txt", tmp_path / "whole.txt"
+    write_points(s, frag)
+    write_points(t, affine(TRUE, src))
+    r = run("register", s, t, "--partial", "--overlay", tmp_path / "o.svg")
+    assert r.returncode == 0, r.stderr
+    assert "method      partial" in r.stdout and "part " in r.stdout
+    for absent in ("kept ", "residuals", "threshold", "shift"):
+        assert absent not in r.stdout, r.stdout
+    svg = (tmp_path / "o.svg").read_text()
+    assert svg.count("<polyline") == 2 and svg.count("<polygon") == 1  # before, after open; the target
+    j = register_json(s, t, "--partial")
+    assert j["partial"] is True and j["residuals"] is None and j["kept"] == [] and j["threshold"] is None
+    assert rel_err_A(j["A"], TRUE) < 1e-2
+    r = run("register", s, t, "--partial", "--plot", tmp_path / "p.svg")
+    assert r.returncode == 2 and "--plot" in r.stderr and not (tmp_path / "p.svg").exists()
+
+
+def test_outputs_checked_before_any_is_written(pair, tmp_path):
+    """A picture that cannot be written fails the run before the other is written; an output
+    that names an input is refused, the input left as it was."""
+    s, t, _ = pair
+    ov = tmp_path / "ov.svg"
+    r = run("register", s, t, "--overlay", ov, "--plot", tmp_path / "no" / "p.svg")
+    assert r.returncode == 1 and "p.svg" in r.stderr and not ov.exists() and r.stdout == ""
+    before = s.read_bytes()
+    r = run("register", s, t, "--overlay", tmp_path / "." / "src.svg")  # a new file: fine
+    assert r.returncode == 0, r.stderr
+    sv = tmp_path / "src.svg"
+    r = run("register", sv, t, "--overlay", sv)  # the source itself
+    assert r.returncode == 1 and "would overwrite an input" in r.stderr
+    r = run("contour", s, "-o", s)
+    assert r.returncode == 1 and "would overwrite an input" in r.stderr and s.read_bytes() == before
+
+
 def test_image_pair(tmp_path):
     # the smooth shape, rasterized, and its affine image: the map is recovered approximately
     src = [(x + 100, y + 100) for x, y in smooth_shape(400)]

@@ -108,6 +108,8 @@ static int contour_all(opts *o)
 
 int cmd_contour(opts *o)
 {
+    if (tool_out_not_input("-o", o->out, (const char *const *)o->pos, 1) != 0)
+        return TOOL_EXIT_FAIL;
     if (o->json && !o->all)
         return usage_error("--json", "only with --all (the single contour is a plain point list)");
     if (o->join && (o->all || (image_trace_flags() & AMSCR_TRACE_PIXEL_CHAIN)))

@@ -196,6 +196,22 @@ static int read_report(const amscr_result *res, const amscr_params *p, reg_repor
     return 0;
 }
 
+/* --overlay and --plot: neither an input file, and both can be made (checked before the
+ * registration, so a failure leaves neither). */
+static int pictures_writable(const opts *o)
+{
+    const char *outs[2][2] = {{"--overlay", o->overlay}, {"--plot", o->plot}};
+    for (int i = 0; i < 2; i++)
+        if (outs[i][1] && (tool_out_not_input(outs[i][0], outs[i][1], (const char *const *)o->pos, 2) != 0 ||
+                           tool_out_probe(outs[i][1]) != 0))
+            return -1;
+    if (o->overlay && o->plot && strcmp(o->overlay, o->plot) == 0) {
+        tool_error(o->plot, "--overlay and --plot name the same file");
+        return -1;
+    }
+    return 0;
+}
+
 /* --overlay and --plot: drawn before anything is printed, so a failure there comes first. */
 static int draw_pictures(const opts *o, const amscr_contour *src, const amscr_contour *tgt, const reg_report *r)
 {
@@ -213,10 +229,14 @@ static int draw_pictures(const opts *o, const amscr_contour *src, const amscr_co
             return -1;
         }
         char cap[200];
-        snprintf(cap, sizeof cap, "distance %s, %s, %zu of %zu scales kept%s", fmt_num(d1, r->dist), r->mname,
-                 r->nkept, r->np, r->refl ? ", reflected" : "");
+        if (o->partial)
+            snprintf(cap, sizeof cap, "distance %s, partial: %.3f .. %.3f of the target's boundary%s",
+                     fmt_num(d1, r->dist), r->part[0], r->part[1], r->refl ? ", reflected" : "");
+        else
+            snprintf(cap, sizeof cap, "distance %s, %s, %zu of %zu scales kept%s", fmt_num(d1, r->dist), r->mname,
+                     r->nkept, r->np, r->refl ? ", reflected" : "");
         overlay_input ov = {amscr_contour_xy(tgt), amscr_contour_size(tgt), amscr_contour_xy(src), ns, after, ns,
-                            !o->open, tpath, spath, cap};
+                            !o->open, o->partial, tpath, spath, cap};
         int drawn = draw_overlay(o->overlay, &ov);
         free(after);
         if (drawn != 0)
@@ -310,8 +330,11 @@ static void format_json(sbuf *b, const opts *o, const amscr_contour *src, const 
     sb_json_str(b, r->mname);
     sb_puts(b, ", \"scales\": ");
     sb_json_nums(b, r->scales, NULL, r->np);
-    sb_puts(b, ", \"residuals\": ");
-    sb_json_nums(b, r->resid, NULL, r->np);
+    sb_puts(b, ", \"residuals\": "); /* a partial match has no per-scale systems */
+    if (o->partial)
+        sb_puts(b, "null");
+    else
+        sb_json_nums(b, r->resid, NULL, r->np);
     sb_puts(b, ", \"kept\": ");
     sb_json_nums(b, r->scales, r->kept, r->np);
     sb_printf(b, ", \"shift\": %zu, \"reflected\": %s, \"k\": %zu, \"threshold\": ", r->shift,
@@ -332,18 +355,10 @@ static void format_json(sbuf *b, const opts *o, const amscr_contour *src, const 
     sb_puts(b, "}\n");
 }
 
-static void format_text(sbuf *b, const opts *o, const amscr_contour *src, const amscr_contour *tgt,
-                        const reg_report *r)
+/* The scale selection's lines: K, the threshold, the kept scales, the residuals, the shift. */
+static void text_scales(sbuf *b, const reg_report *r)
 {
-    const double *m = r->m;
     char n1[32], n2[32];
-    sb_printf(b, "source      %s (%zu points)\n", o->pos[0], amscr_contour_size(src));
-    sb_printf(b, "target      %s (%zu points)\n", o->pos[1], amscr_contour_size(tgt));
-    sb_printf(b, "method      %s (N = %zu samples, %s curves)\n", r->mname, r->N, o->open ? "open" : "closed");
-    sb_printf(b, "distance    %s\n", fmt_num(n1, r->dist));
-    sb_printf(b, "A           [ %12.6g %12.6g ]\n", m[0], m[1]);
-    sb_printf(b, "            [ %12.6g %12.6g ]\n", m[3], m[4]);
-    sb_printf(b, "B           [ %12.6g %12.6g ]   (target = A * source + B)\n", m[2], m[5]);
     if (r->K > 0)
         sb_printf(b, "K           %zu (elbow over K = 1..%zu)\n", r->K, r->nsse);
     if (isfinite(r->thr))
@@ -360,6 +375,26 @@ static void format_text(sbuf *b, const opts *o, const amscr_contour *src, const 
         sb_printf(b, " %s:%s%s", fmt_num(n1, r->scales[k]), fmt_num(n2, r->resid[k]), r->kept[k] ? "*" : "");
     sb_puts(b, "   (scale:residual, * = kept)\n");
     sb_printf(b, "shift       %zu (of %zu samples)\n", r->shift, r->N);
+}
+
+static void format_text(sbuf *b, const opts *o, const amscr_contour *src, const amscr_contour *tgt,
+                        const reg_report *r)
+{
+    const double *m = r->m;
+    char n1[32];
+    sb_printf(b, "source      %s (%zu points)\n", o->pos[0], amscr_contour_size(src));
+    sb_printf(b, "target      %s (%zu points)\n", o->pos[1], amscr_contour_size(tgt));
+    if (o->partial)
+        sb_printf(b, "method      partial: the open source placed along the closed target (N = %zu samples; "
+                     "no scale selection)\n", r->N);
+    else
+        sb_printf(b, "method      %s (N = %zu samples, %s curves)\n", r->mname, r->N, o->open ? "open" : "closed");
+    sb_printf(b, "distance    %s\n", fmt_num(n1, r->dist));
+    sb_printf(b, "A           [ %12.6g %12.6g ]\n", m[0], m[1]);
+    sb_printf(b, "            [ %12.6g %12.6g ]\n", m[3], m[4]);
+    sb_printf(b, "B           [ %12.6g %12.6g ]   (target = A * source + B)\n", m[2], m[5]);
+    if (!o->partial)
+        text_scales(b, r);
     sb_printf(b, "reflected   %s\n", r->refl ? "yes" : "no");
     sb_printf(b, "confidence  %.3f (ambiguity %.3f, inliers %.1f %%", r->conf, r->amb, 100.0 * r->inl);
     if (isfinite(r->overlap))
@@ -393,10 +428,12 @@ int cmd_register(opts *o)
     memset(&rep, 0, sizeof rep);
     sb_init(&b);
 
+    if (o->partial && o->plot)
+        return usage_error("--plot", "a partial registration selects no scales: there is no plot to draw");
     int r = make_params(o, 1, &p);
     if (r != 0)
         return r;
-    if (register_pair(o, p, &src, &tgt, &res) != 0 || read_report(res, p, &rep) != 0 ||
+    if (pictures_writable(o) != 0 || register_pair(o, p, &src, &tgt, &res) != 0 || read_report(res, p, &rep) != 0 ||
         draw_pictures(o, src, tgt, &rep) != 0)
         goto done;
     if (o->json)

@@ -119,10 +119,10 @@ static int overlay_png(const char *path, const overlay_input *in, const layout *
     cov_composite(&r, COL_TARGET);
     const double dash[2] = {7.0, 5.0};
     cov_clear(&r);
-    cov_polyline(&r, cb, in->nb, in->closed, 2.0, dash);
+    cov_polyline(&r, cb, in->nb, in->closed && !in->source_open, 2.0, dash);
     cov_composite(&r, COL_BEFORE);
     cov_clear(&r);
-    cov_polyline(&r, ca, in->na, in->closed, 2.0, NULL);
+    cov_polyline(&r, ca, in->na, in->closed && !in->source_open, 2.0, NULL);
     cov_composite(&r, COL_AFTER);
 
     /* legend */
@@ -177,8 +177,8 @@ static int overlay_svg(const char *path, const overlay_input *in, const layout *
               "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
               L->width, L->height, L->width, L->height);
     svg_poly(&b, L, in->target, in->nt, in->closed, SVG_TARGET, in->closed ? SVG_TARGET_FILL : "none", NULL);
-    svg_poly(&b, L, in->before, in->nb, in->closed, SVG_BEFORE, "none", " stroke-dasharray=\"7 5\"");
-    svg_poly(&b, L, in->after, in->na, in->closed, SVG_AFTER, "none", NULL);
+    svg_poly(&b, L, in->before, in->nb, in->closed && !in->source_open, SVG_BEFORE, "none", " stroke-dasharray=\"7 5\"");
+    svg_poly(&b, L, in->after, in->na, in->closed && !in->source_open, SVG_AFTER, "none", NULL);
     const char *labels[3] = {"target", "source (before)", "source registered (after)"};
     const char *cols[3] = {SVG_TARGET, SVG_BEFORE, SVG_AFTER};
     const char *names[3] = {in->target_name, in->source_name, in->source_name};

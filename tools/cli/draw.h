@@ -14,6 +14,7 @@ typedef struct overlay_input {
     const double *after; /* the source mapped by (A, B) */
     size_t na;
     int closed;
+    int source_open; /* the source is an open fragment of the closed target (--partial) */
     const char *target_name;
     const char *source_name;
     const char *caption; /* one line under the legend, may be NULL */

@@ -263,6 +263,28 @@ void tool_out_abort(tool_out *o)
     o->fp = NULL;
 }
 
+int tool_out_probe(const char *path)
+{
+    tool_out t;
+    if (tool_out_open(&t, path) != 0)
+        return -1;
+    tool_out_abort(&t);
+    return 0;
+}
+
+int tool_out_not_input(const char *opt, const char *path, const char *const *inputs, size_t n)
+{
+    struct stat so, si;
+    if (path == NULL || strcmp(path, "-") == 0 || stat(path, &so) != 0)
+        return 0;
+    for (size_t i = 0; i < n; i++)
+        if (inputs[i] && stat(inputs[i], &si) == 0 && si.st_dev == so.st_dev && si.st_ino == so.st_ino) {
+            tool_error(path, "%s would overwrite an input file: give another name", opt);
+            return -1;
+        }
+    return 0;
+}
+
 /* ------------------------------------------------------------ strings */
 void sb_init(sbuf *b)
 {

@@ -62,6 +62,12 @@ int tool_out_open(tool_out *o, const char *path);
 int tool_out_commit(tool_out *o);
 /* Closes and removes the temporary (no-op when not open). */
 void tool_out_abort(tool_out *o);
+/* 0 when an output file can be made at `path` (opened, then abandoned: nothing is left); else
+ * -1 after the error line. Checks every output of a command before the first is written. */
+int tool_out_probe(const char *path);
+/* -1 after an error line when the output `path`, given with option `opt`, is the same file as
+ * one of the n inputs (device and inode); else 0. */
+int tool_out_not_input(const char *opt, const char *path, const char *const *inputs, size_t n);
 
 /* ------------------------------------------------------------ strings */
 typedef struct sbuf {
