@@ -31,7 +31,7 @@ from typing import Any, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import dbuf
+from ._util import as_count, dbuf
 from .collection import Collection
 from .errors import AmscrError, FormatError, InvalidArgumentError, _check
 from .index import Index
@@ -303,9 +303,7 @@ class ShardedIndex:
     def query_many(self, queries: Sequence[Any], top: int = 10,
                    candidates: Optional[int] = None) -> Tuple[np.ndarray, np.ndarray]:
         """(indices, scores), each (len(queries), min(top, len(self))), best first, ties by index."""
-        top = int(top)
-        if top < 0:
-            raise InvalidArgumentError('top: %d is negative' % top)
+        top = as_count(top, 'top', 0)
         S = self.scores_many(queries, candidates)
         k = min(top, S.shape[1])
         order = np.argsort(S, axis=1, kind='stable')[:, :k]

@@ -327,6 +327,8 @@ def progress_call(fn, args_before: tuple, args_after: tuple, progress: ProgressA
     from the main thread. An exception raised by a user's progress callable cancels the call
     and is re-raised here; a callable returning True cancels it (CancelledError).
     """
+    if not (progress is None or isinstance(progress, (bool, np.bool_)) or callable(progress)):
+        raise bad('progress: expected True, False, None or a callable(done, total), got %r' % (progress,))
     state = _ProgressState(progress)
     handle = ffi.new_handle(state)
     _callback_errors.error = None

@@ -8,7 +8,7 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ProgressArg, RWLock, as_points, bad, dbuf, factorize, new_object, progress_call, saved_bytes
+from ._util import ProgressArg, RWLock, as_points, as_uint, bad, dbuf, factorize, new_object, progress_call, saved_bytes
 from .contour import contour_new
 from .errors import _check
 from .params import Params, make_params
@@ -212,7 +212,7 @@ class Collection:
     # -- matching ---------------------------------------------------------------------
     def _with_threads(self, threads: Optional[int]) -> Tuple['Collection', bool]:
         """(a collection computing with `threads`, whether it is a temporary copy)."""
-        if threads is None or int(threads) == self.params.threads:
+        if threads is None or as_uint(threads, 'threads') == self.params.threads:
             return self, False
         tmp = Collection(self.params, threads=threads)
         tmp._add_copies(self, range(len(self)))
@@ -251,6 +251,8 @@ class Collection:
         """
         with self._lock.read():
             p = self.params
+            if threads is not None:
+                as_uint(threads, 'threads')
             q = as_shape(shape, p, 'shape', order)
             out = np.zeros(len(self), dtype=np.float64)
             if p.ranking == 'retrieval':  # the collection's kept index (a copy would build its own)

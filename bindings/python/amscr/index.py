@@ -7,7 +7,7 @@ from typing import Any, List, Optional, Tuple, Union
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ProgressArg, RWLock, bad, dbuf, new_object, progress_call, saved_bytes
+from ._util import ProgressArg, RWLock, as_count, bad, dbuf, new_object, progress_call, saved_bytes
 from .collection import Collection, _new_db
 from .errors import _check
 from .shape import PointsLike, as_shape
@@ -21,10 +21,7 @@ def _candidates(candidates: Optional[int]) -> int:
     """The shortlist size the C calls take: None is the library's default."""
     if candidates is None:
         return int(lib.AMSCR_INDEX_CANDIDATES)
-    c = int(candidates)
-    if c < 0:
-        raise bad('candidates: %d is negative' % c)
-    return c
+    return as_count(candidates, 'candidates', 0)
 
 
 def _text(p) -> Optional[str]:
@@ -308,9 +305,7 @@ class Index:
         Raises:
             InvalidArgumentError: bad points or `top` < 0.
         """
-        top = int(top)
-        if top < 0:
-            raise bad('top: %d is negative' % top)
+        top = as_count(top, 'top', 0)
         with self._lock.read():
             q = as_shape(points, self.collection_params(), 'points', order)
             idx = np.zeros(max(top, 1), dtype=np.uintp)

@@ -41,7 +41,8 @@ class Alternative(NamedTuple):
 
 class Registration:
     """The result of :func:`register`: the affine map taking the source onto the target and the
-    diagnostics of scale selection. Every array is a NumPy copy (nothing refers to C memory).
+    diagnostics of scale selection. Every array is a read-only NumPy copy (nothing refers to C
+    memory; ``r.A.copy()`` gives one to modify), so the attributes stay one consistent map.
 
     All maps are in the (x, y) frame of the input points (x = column, y = row for image
     contours, also when they were given with ``order='rc'``), the frame of OpenCV and of
@@ -144,6 +145,17 @@ class Registration:
         self.source_samples, self.correspondences, self.target_points = _correspondences(r)
         self.stages = _stages(r)
         self.alternatives = _alternatives(r)
+        self._freeze()
+
+    def _freeze(self) -> None:
+        """Every array of the result read-only (the mixture's and the alternatives' too)."""
+        arrays = [v for v in vars(self).values() if isinstance(v, np.ndarray)] + list(self.mixture)
+        for a in arrays + [x for alt in self.alternatives for x in (alt.A, alt.B)]:
+            a.setflags(write=False)
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        self.__dict__.update(state)  # unpickled arrays are writable again
+        self._freeze()
 
     def apply(self, points: ArrayLike, order: str = 'xy') -> np.ndarray:
         """Maps points of the source onto the target: ``points @ A.T + B``.

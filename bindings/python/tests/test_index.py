@@ -120,6 +120,25 @@ def test_add_one_at_a_time_from_an_empty_index(tmp_path):
     np.testing.assert_allclose(index.scores(q), amscr.Index(coll).scores(q), rtol=0, atol=1e-12)
 
 
+def test_arguments_are_checked():
+    """top, candidates, threads and progress: the wrong kind of value is refused by name, not
+    converted (top='2', threads=1.5) or ignored (threads=-1 on retrieval scores)."""
+    params = amscr.Params.retrieval(points=64)
+    coll = synthetic(params, 12)
+    index = amscr.Index(coll)
+    q = blob(300, seed=2)
+    for kw in ({'top': '2'}, {'top': None}, {'top': -1}, {'top': 1.5}, {'candidates': '5'}, {'candidates': -3}):
+        with pytest.raises(amscr.InvalidArgumentError, match=list(kw)[0]):
+            index.query(q, **kw)
+    for bad in (5, 'yes'):
+        with pytest.raises(amscr.InvalidArgumentError, match='progress'):
+            amscr.Index(coll, progress=bad)
+    for bad in (-1, 1.5, '2', True):
+        with pytest.raises(amscr.InvalidArgumentError, match='threads'):
+            coll.query(q, threads=bad)
+    assert len(coll.query(q, threads=1)) == 12 and len(index.query(q, top=np.int64(3))[0]) == 3
+
+
 def dataset_shapes(name, count):
     """`count` shapes of a dataset spread over its classes: (points, class) pairs."""
     cv2 = pytest.importorskip('cv2')

@@ -159,6 +159,22 @@ def test_shape_prepared_once(pair):
     np.testing.assert_array_equal(s2.points, s.points)
 
 
+def test_result_arrays_are_read_only_and_pickle():
+    """A result is one map: its arrays cannot be changed in place (A *= 2 would leave matrix and
+    apply() disagreeing), before and after pickling; a copy can."""
+    src = blob(200, seed=3)
+    r = amscr.register(src, affine(src, A_TRUE, B_TRUE))
+    for r2 in (r, pickle.loads(pickle.dumps(r))):
+        for a in (r2.A, r2.B, r2.matrix, r2.residuals, r2.kept, r2.mixture.means, r2.target_points,
+                  r2.alternatives[0].A):
+            with pytest.raises(ValueError, match='read-only'):
+                a[...] = 0
+        np.testing.assert_array_equal(r2.apply(src), src @ r.A.T + r.B)
+    A = r.A.copy()
+    A *= 2
+    assert np.allclose(A, 2 * r.A)
+
+
 def test_params_roundtrip():
     p = amscr.Params(points=96, scales=[0, 1, 2, 4], method='binary_em', reflections=True, closed=True,
                      refine=2, symmetric=True, threads=2, parametrization='whitened', invariance='similarity')
