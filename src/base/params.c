@@ -164,7 +164,7 @@ amscr_status amscr_params_set_stage(amscr_params *p, const char *name, int on)
     if (i < 0)
         return amscr__fail(AMSCR_E_INVALID_ARG,
                            "amscr_params_set_stage: '%s' is not a switchable stage (despike, recovery, polish, "
-                           "order, even_spacing)", name);
+                           "order, even_spacing, pixel_grid)", name);
     if (on != 0 && on != 1)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_params_set_stage: %d is not 0 or 1", on);
     if (on)

@@ -3,7 +3,8 @@
  * to a temporary file first (the reader takes a path; the files it lists are not opened).
  * Properties on success: at least one shape; each shape's path and name non-empty, its class
  * an index into the classes, its group an index into the groups, or -1 for every shape exactly
- * when there is no group column; the class and group names non-empty and distinct. */
+ * when there is no group column; the class and group names non-empty and distinct; no file
+ * listed twice (a repeated entry is refused). */
 #include <string.h>
 #include <unistd.h>
 
@@ -24,10 +25,20 @@ static int names_ok(char **names, size_t n)
     return 1;
 }
 
+/* Whether the shapes' names (the files as listed) are distinct. */
+static int items_distinct(const collection *c)
+{
+    for (size_t i = 0; i < c->n; i++)
+        for (size_t j = 0; j < i; j++)
+            if (strcmp(c->items[i].name, c->items[j].name) == 0)
+                return 0;
+    return 1;
+}
+
 static void check(const collection *c)
 {
     FUZZ_CHECK(c->n >= 1 && c->nclasses >= 1 && c->nclasses <= c->n && c->ngroups <= c->n);
-    FUZZ_CHECK(names_ok(c->classes, c->nclasses) && names_ok(c->groups, c->ngroups));
+    FUZZ_CHECK(names_ok(c->classes, c->nclasses) && names_ok(c->groups, c->ngroups) && items_distinct(c));
     for (size_t i = 0; i < c->n; i++) {
         const coll_item *it = &c->items[i];
         FUZZ_CHECK(it->path && it->path[0] && it->name && it->name[0]);

@@ -59,6 +59,8 @@ put('manifest', 'header-only', 'file\tclass\n')
 put('manifest', 'short-row', 'file\tclass\tgroup\na.png\tx\n')
 put('manifest', 'no-header', 'a.png\tx\n')
 put('manifest', 'nul-byte', 'file\tclass\na\0.png\tx\n')
+put('manifest', 'utf8-bom', b'\xef\xbb\xbffile\tclass\r\nb\xc3\xa9-1.png\tb\xc3\xa9\r\n')
+put('manifest', 'listed-twice', 'file\tclass\na.png\tx\nb.png\ty\na.png\ty\n')
 
 # ------------------------------------------------------------------ pgm
 img = shape_img()

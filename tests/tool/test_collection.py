@@ -313,3 +313,112 @@ def test_retrieval_joins_broken_pieces(tmp_path):
     assert broken[0] < broken[2], broken  # nearer the whole shape than the body alone
     body = run("contour", d / ("b_broken" + ext)).stdout
     assert body == run("contour", d / ("c_body" + ext)).stdout  # contour keeps the largest piece
+
+
+def folder_of_points(d, names):
+    """A folder of point lists, one affine copy of a base shape per name ("star-1.txt": star)."""
+    d.mkdir(exist_ok=True)
+    shapes = base_shapes()
+    for k, name in enumerate(names):
+        cls = [c for c in shapes if name.startswith(c)][0]
+        write_points(d / name, affine(MAPS[k % len(MAPS)], shapes[cls]))
+    return d
+
+
+@pytest.mark.parametrize("kind", ["image", "points", "jpeg"])
+def test_a_shape_given_as_the_collection(tmp_path, kind):
+    """A single image or point list where a COLLECTION is expected says what it is, not that a
+    manifest's header is missing."""
+    q = tmp_path / "q.txt"
+    write_points(q, base_shapes()["star"])
+    coll = {"image": tmp_path / ("s" + img_ext()), "points": tmp_path / "p.txt", "jpeg": tmp_path / "a.jpg"}[kind]
+    if kind == "image":
+        coll.write_bytes(image_bytes(rasterize(base_shapes()["star"], 120, 120), coll.name))
+    elif kind == "points":
+        coll.write_text("# a shape\n" + q.read_text())
+    else:
+        coll.write_bytes(b"\xff\xd8\xff\xe0" + bytes(40))
+    what = {"image": "a PNG or PGM image", "points": "a point list", "jpeg": "a JPEG image"}[kind]
+    for args in (("search", q, coll), ("eval", coll), ("index", coll, "-o", tmp_path / "x.idx")):
+        r = run(*args)
+        assert r.returncode == 1 and r.stdout == "" and len(r.stderr.splitlines()) == 1, r.stderr
+        assert "%s: %s, not a collection" % (coll, what) in r.stderr and "header" not in r.stderr, r.stderr
+    assert not (tmp_path / "x.idx").exists()
+
+
+def test_an_index_given_to_index_as_the_collection(tmp_path):
+    d = folder_of_points(tmp_path / "set", ["star-1.txt", "blob-1.txt", "wave-1.txt"])
+    idx = tmp_path / "s.idx"
+    assert run("index", d, "-o", idx).returncode == 0
+    r = run("index", idx, "-o", tmp_path / "t.idx")
+    assert r.returncode == 1 and "an amscr index or collection file" in r.stderr, r.stderr
+
+
+def test_a_folder_with_its_manifest_beside_the_shapes(tmp_path):
+    """A folder whose shapes are in a subfolder beside its manifest.tsv: the error says to pass
+    the manifest."""
+    folder_of_points(tmp_path / "shapes", ["star-1.txt", "blob-1.txt"])
+    (tmp_path / "manifest.tsv").write_text("file\tclass\nshapes/star-1.txt\tstar\nshapes/blob-1.txt\tblob\n")
+    r = run("eval", tmp_path)
+    assert r.returncode == 1 and len(r.stderr.splitlines()) == 1, r.stderr
+    assert "no shapes in this folder" in r.stderr and "pass %s" % (tmp_path / "manifest.tsv") in r.stderr
+    r = run("eval", tmp_path / "shapes")  # without a manifest: no hint
+    assert r.returncode == 0, r.stderr
+
+
+def test_manifest_with_a_byte_order_mark(tmp_path):
+    """A UTF-8 byte order mark before the header (Excel's and Notepad's exports) is skipped."""
+    folder_of_points(tmp_path / "shapes", ["star-1.txt", "star-2.txt", "blob-1.txt", "blob-2.txt"])
+    rows = "file\tclass\r\n" + "".join("shapes/%s-%d.txt\t%s\r\n" % (c, k, c) for c in ("star", "blob")
+                                         for k in (1, 2))
+    plain, bom = tmp_path / "plain.tsv", tmp_path / "bom.tsv"
+    plain.write_bytes(rows.encode())
+    bom.write_bytes(b"\xef\xbb\xbf" + rows.encode())
+    a, b = run("eval", plain, "--json", *AFFINE), run("eval", bom, "--json", *AFFINE)
+    assert b.returncode == 0, b.stderr
+    ja, jb = json.loads(a.stdout), json.loads(b.stdout)
+    assert jb["n"] == 4 and jb["per_class"] == ja["per_class"]
+
+
+def test_manifest_listing_a_file_twice(tmp_path):
+    folder_of_points(tmp_path / "shapes", ["star-1.txt", "blob-1.txt", "blob-2.txt"])
+    mf = tmp_path / "m.tsv"
+    mf.write_text("file\tclass\nshapes/star-1.txt\tstar\nshapes/blob-1.txt\tblob\n# again\n"
+                  "shapes/blob-2.txt\tblob\nshapes/star-1.txt\tstar\n")
+    for args in (("eval", mf), ("index", mf, "-o", tmp_path / "x.idx")):
+        r = run(*args)
+        assert r.returncode == 1 and r.stdout == "" and len(r.stderr.splitlines()) == 1, r.stderr
+        assert "m.tsv: line 6: 'shapes/star-1.txt' is already listed on line 2" in r.stderr, r.stderr
+    assert not (tmp_path / "x.idx").exists()
+
+
+def test_folder_warns_of_images_it_cannot_read(tmp_path):
+    """Images of formats the tool does not read are skipped with one warning line naming how
+    many and one of them; other files (notes, manifests) are skipped silently."""
+    d = folder_of_points(tmp_path / "set", ["star-1.txt", "star-2.txt", "blob-1.txt", "blob-2.txt"])
+    (d / "notes.md").write_text("# not a shape\n")
+    (d / "list.tsv").write_text("file\tclass\n")
+    r = run("eval", d, "--json", *AFFINE)
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    (d / "b.jpg").write_bytes(b"\xff\xd8\xff\xe0" + bytes(40))
+    (d / "a.tif").write_bytes(b"II*\x00" + bytes(40))
+    (d / "c.bmp").write_bytes(b"BM" + struct.pack("<I", 46) + bytes(40))
+    r = run("eval", d, "--json", *AFFINE)
+    assert r.returncode == 0 and json.loads(r.stdout)["n"] == 4
+    assert r.stderr == "amscr: %s: 3 files skipped: not PNG, PGM or a point list (e.g. a.tif)\n" % d, r.stderr
+    (d / "a.tif").unlink()
+    (d / "c.bmp").unlink()
+    r = run("eval", d, *AFFINE)
+    assert r.returncode == 0 and r.stderr == "amscr: %s: 1 file skipped: not PNG, PGM or a point list (e.g. b.jpg)\n" % d
+
+
+def test_class_names_drop_trailing_separators(tmp_path):
+    """'star 3.txt' is of class star, as star-1.txt is; the other names keep their classes."""
+    d = folder_of_points(tmp_path / "set", ["star-1.txt", "star 3.txt", "star - 4.txt", "blob01.txt",
+                                           "blob_2.txt", "wave.txt", "wave-.txt"])
+    names = tmp_path / "names.tsv"
+    r = run("matrix", d, "-o", tmp_path / "d.tsv", "--names", names, *AFFINE)
+    assert r.returncode == 0, r.stderr
+    classes = dict(line.split("\t") for line in names.read_text().splitlines()[1:])  # after the header
+    assert classes == {"star-1.txt": "star", "star 3.txt": "star", "star - 4.txt": "star", "blob01.txt": "blob",
+                       "blob_2.txt": "blob", "wave.txt": "wave", "wave-.txt": "wave-"}

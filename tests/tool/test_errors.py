@@ -251,3 +251,13 @@ def test_mutated_files_never_crash(tmp_path, name):
             lines = r.stderr.splitlines()
             assert len(lines) == 1 and lines[0].startswith("amscr: ") and p.name in lines[0], r.stderr
         p.unlink()
+
+
+@pytest.mark.parametrize("value", ["1000000,1000", "0", "5,0", "5,1001", "x"])
+def test_rerank_range_is_stated(tmp_path, value):
+    """--rerank's error states both ranges, K's upper limit included."""
+    d = tmp_path / "set"
+    d.mkdir()
+    for k in range(3):
+        write_points(d / ("s-%d.txt" % k), smooth_shape(seed=k))
+    check_fail(run("eval", d, "--rerank", value), 2, "--rerank", "1 <= K <= 1000", "1 <= ITER <= 1000", value)

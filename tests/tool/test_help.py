@@ -1,6 +1,7 @@
 """The help text tells the truth: the names it lists are the names the parser accepts (and lists
 in its error messages), and the defaults it names are the ones a command uses."""
 import json
+import os
 import re
 
 import pytest
@@ -86,3 +87,29 @@ def test_main_help_lists_every_command():
     assert missing.returncode == 2 and "contour, register, search, matrix, eval or index" in missing.stderr
     for c in cmds:
         assert run("help", c).stdout == run(c, "--help").stdout
+
+
+def test_stage_names_are_the_parsers(pair):
+    """--stage lists every stage it accepts, pixel_grid included, in its error and its help."""
+    r = run("register", pair[0], pair[1], "--stage", "no_such=off")
+    assert r.returncode == 2 and r.stdout == ""
+    m = re.search(r"not a switchable stage \((.*)\)", r.stderr)
+    assert m, r.stderr
+    names = re.split(r", | or ", m.group(1))
+    assert sorted(names) == ["despike", "even_spacing", "order", "pixel_grid", "polish", "recovery"]
+    help_text = " ".join(run("register", "--help").stdout.split())
+    for name in names:
+        assert name in help_text, name
+        assert run("register", pair[0], pair[1], "--stage", name + "=off").returncode == 0, name
+
+
+def test_index_help_says_tracing_options_are_not_kept():
+    """An index keeps no image-tracing option: the help and the docs say so, and no longer claim
+    --add takes the build's --threshold."""
+    from imgutil import REPO
+    text = " ".join(run("index", "--help").stdout.split())
+    assert "does not keep the image-tracing options (--threshold, --pixel-chain)" in text, text
+    assert "--threshold included" not in text
+    docs = " ".join(open(os.path.join(REPO, "docs", "collections.md")).read().split())
+    assert "`--threshold` included" not in docs
+    assert "`--threshold` and `--pixel-chain` are not stored in it" in docs

@@ -83,18 +83,115 @@ def test_add_equals_a_rebuild(tmp_path):
     assert r.returncode == 1 and "already in the index" in r.stderr and part.read_bytes() == before
 
 
-def test_add_to_an_index_smaller_than_its_lists_is_refused(tmp_path):
+def test_add_to_an_index_smaller_than_its_lists_rebuilds_it(tmp_path):
     """An index of fewer than twice its re-ranking K holds shorter lists (at most half the
-    collection): --add says to rebuild."""
+    collection): --add builds it again on the old and new shapes, as collections.md says, with
+    the names, classes and groups of both: the index of all the files."""
     m = make_manifest(tmp_path)
     rows = m.read_text().splitlines()
     (tmp_path / "a.tsv").write_text("\n".join(rows[:3]) + "\n")
     (tmp_path / "b.tsv").write_text("\n".join([rows[0]] + rows[3:]) + "\n")
+    whole = build(tmp_path, m, "--refine", "0", name="whole.idx")
     part = build(tmp_path, tmp_path / "a.tsv", "--refine", "0", name="part.idx")
-    before = part.read_bytes()
     r = run("index", tmp_path / "b.tsv", "-o", part, "--add")
-    assert r.returncode == 1 and "rebuild" in r.stderr and r.stderr.count("\n") == 1
-    assert part.read_bytes() == before
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    assert "9 shapes, 3 classes" in r.stdout and "object in the wrong state" not in r.stdout + r.stderr
+    assert part.read_bytes() == whole.read_bytes()
+    for q in ("star_3.txt", "blob_1.txt"):
+        a = json.loads(run("search", tmp_path / "shapes" / q, part, "--json").stdout)["results"]
+        b = json.loads(run("search", tmp_path / "shapes" / q, m, "--json", "--refine", "0").stdout)["results"]
+        same_results(a, b)
+    ja = json.loads(run("eval", part, "--json", "--protocol", "groups").stdout)
+    jb = json.loads(run("eval", m, "--json", "--protocol", "groups", "--refine", "0").stdout)
+    assert ja["groups"] == jb["groups"] and ja["per_class"] == jb["per_class"]
+
+
+@pytest.mark.parametrize("index_groups", [True, False])
+def test_add_with_and_without_a_group_column(tmp_path, index_groups):
+    """A group column on one side only: the message says which side has one."""
+    grouped, plain = make_manifest(tmp_path), make_manifest(tmp_path, with_group=False)
+    rows = (grouped if index_groups else plain).read_text().splitlines()
+    (tmp_path / "a.tsv").write_text("\n".join(rows[:7]) + "\n")
+    other = (plain if index_groups else grouped).read_text().splitlines()
+    (tmp_path / "b.tsv").write_text("\n".join([other[0]] + other[7:]) + "\n")
+    idx = build(tmp_path, tmp_path / "a.tsv", "--refine", "0")
+    before = idx.read_bytes()
+    r = run("index", tmp_path / "b.tsv", "-o", idx, "--add")
+    want = ("the index has groups and the new shapes' manifest has no group column" if index_groups else
+            "the index has no groups and the new shapes' manifest has a group column")
+    assert r.returncode == 1 and want in r.stderr and r.stderr.count("\n") == 1, r.stderr
+    assert idx.read_bytes() == before
+
+
+PYTHON = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), ".venv", "bin",
+                      "python")
+
+PY_INDEX = """
+import sys, amscr
+out, step, files = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
+db = amscr.Collection(amscr.Params.retrieval())
+for k, f in enumerate(files):
+    db.add(amscr.read_points(f), label=step * (1 + k // 3))
+db.save(out + ".coll")
+amscr.Index(db).save(out)
+"""
+
+
+def python_index(tmp_path, step):
+    """An index saved by Python whose labels are 1, 2, 3 or 10, 20, 30 (not the tool's 0..k-1),
+    and its collection file. Skipped when the project's Python or its amscr is missing."""
+    if not os.access(PYTHON, os.X_OK):
+        pytest.skip("no project Python at %s to write an index with amscr.Index" % PYTHON)
+    import subprocess
+    if subprocess.run([PYTHON, "-c", "import amscr; amscr.Index"], capture_output=True).returncode:
+        pytest.skip("%s cannot import amscr (with amscr.Index)" % PYTHON)
+    make_manifest(tmp_path)
+    files = [str(tmp_path / "shapes" / ("%s_%d.txt" % (c, k))) for c in ("blob", "wave", "star") for k in (1, 2, 3)]
+    out = tmp_path / ("py%d.idx" % step)
+    r = subprocess.run([PYTHON, "-c", PY_INDEX, str(out), str(step)] + files, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return out
+
+
+@pytest.mark.parametrize("step", [1, 10])
+def test_eval_of_an_index_with_other_labels(tmp_path, step):
+    """eval takes any index: the classes are its distinct labels (3 here), named by their number
+    when the index does not name them, whatever the labels' values; an --add of a named class
+    keeps them and adds one."""
+    idx = python_index(tmp_path, step)
+    names = ["1", "2", "3"] if step == 1 else ["10", "20", "30"]
+    for proto in ("all", "topk", "nn"):
+        r = run("eval", idx, "--json", "--protocol", proto)
+        assert r.returncode == 0, r.stderr
+        j = json.loads(r.stdout)
+        assert j["n"] == 9 and j["classes"] == 3, j
+        assert [c["class"] for c in j["per_class"]] == names and all(c["n"] == 3 for c in j["per_class"])
+    r = run("eval", idx, "--protocol", "topk")
+    assert "(9 shapes, 3 classes)" in r.stdout, r.stdout
+    res = json.loads(run("search", tmp_path / "shapes" / "wave_2.txt", idx, "--json", "--top", "3").stdout)
+    assert [x["class"] for x in res["results"]] == [names[1]] * 3
+    r = run("index", make_add_manifest(tmp_path), "-o", idx, "--add")
+    assert r.returncode == 0 and "10 shapes, 4 classes" in r.stdout, r.stdout + r.stderr
+    j = json.loads(run("eval", idx, "--json", "--protocol", "nn").stdout)
+    assert [c["class"] for c in j["per_class"]] == names + ["new"]
+
+
+def make_add_manifest(tmp_path):
+    """A manifest of one new shape of a new class."""
+    write_points(tmp_path / "new.txt", affine(((0.8, 0.3, 4.0), (-0.2, 1.2, 1.0)), base_shapes()["star"][::2]))
+    mf = tmp_path / "new.tsv"
+    mf.write_text("file\tclass\nnew.txt\tnew\n")
+    return mf
+
+
+def test_a_collection_file_where_an_index_is_expected(tmp_path):
+    """A collection file without an index (Python's Collection.save): the message says how to
+    build an index from the tool or Python, not from C."""
+    idx = python_index(tmp_path, 1)
+    coll = str(idx) + ".coll"
+    r = run("eval", coll)
+    assert r.returncode == 1 and r.stderr.count("\n") == 1, r.stderr
+    assert "amscr index" in r.stderr and "amscr.Index" in r.stderr and "build one with" not in r.stderr, r.stderr
 
 
 def test_old_tool_index_is_refused(tmp_path):

@@ -65,10 +65,7 @@ int cmd_index(opts *o)
         }
     }
     if (r == 0) {
-        size_t nclasses = 0;
-        for (size_t i = 0; i < amscr_index_size(x); i++)
-            if ((size_t)amscr_index_label(x, i) + 1 > nclasses)
-                nclasses = (size_t)amscr_index_label(x, i) + 1;
+        size_t nclasses = index_num_classes(x);
         const amscr_params *ip = amscr_db_params(amscr_index_db(x));
         double share = amscr_params_get_rerank_inner_share(ip), closing = amscr_params_get_inner_closing(ip);
         printf("index %s: %zu shapes, %zu classes, %zu neighbours per shape", o->out, amscr_index_size(x), nclasses,

@@ -3,6 +3,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,6 +11,19 @@
 
 #include "image.h"
 #include "util.h"
+
+/* A separator a derived class name does not end with: "star 3" -> "star", "bird--3" -> "bird". */
+static int is_name_sep(char ch) { return ch == ' ' || ch == '\t' || ch == '-' || ch == '_'; }
+
+/* The length of base[0..len) without trailing blanks (and, when digits were dropped, trailing
+ * separators); len itself when nothing would be left. */
+static size_t trim_class(const char *base, size_t len, int digits_dropped)
+{
+    size_t n = len;
+    while (n > 0 && (digits_dropped ? is_name_sep(base[n - 1]) : base[n - 1] == ' ' || base[n - 1] == '\t'))
+        n--;
+    return n > 0 ? n : len;
+}
 
 void class_from_name(const char *filename, char *out, size_t cap)
 {
@@ -28,6 +42,7 @@ void class_from_name(const char *filename, char *out, size_t cap)
         else if (base[end - 1] != '-' && base[end - 1] != '_')
             cls = end; /* "Bone01" -> "Bone" */
     }
+    cls = cls < len ? trim_class(base, cls, 1) : trim_class(base, len, 0);
     if (cls >= cap)
         cls = cap - 1;
     memcpy(out, base, cls);
@@ -119,53 +134,98 @@ static int cmp_str(const void *a, const void *b)
     return strcmp(*(const char *const *)a, *(const char *const *)b);
 }
 
-static int open_folder(const char *dir, collection *c)
+/* The files of a folder the tool does not read although they are images: how many, and the
+ * first by name. */
+typedef struct {
+    size_t n;
+    char example[256];
+} skipped_files;
+
+/* 1 when the folder entry `name` is a shape file (a regular file: PNG or PGM magic bytes, or a
+ * .txt / .csv name); 0 when not (an image of a format the tool cannot read is counted in sk);
+ * -1 out of memory. */
+static int take_entry(const char *dir, const char *name, skipped_files *sk)
+{
+    char *path = path_join(dir, name);
+    if (path == NULL)
+        return -1;
+    struct stat st;
+    char ext[16];
+    path_ext(name, ext);
+    int reg = stat(path, &st) == 0 && S_ISREG(st.st_mode);
+    int take = reg && (strcmp(ext, ".txt") == 0 || strcmp(ext, ".csv") == 0 || file_is_image(path));
+    if (reg && !take && file_image_other(path) != NULL) {
+        if (sk->n++ == 0 || strcmp(name, sk->example) < 0)
+            snprintf(sk->example, sizeof sk->example, "%s", name);
+    }
+    free(path);
+    return take;
+}
+
+/* Appends a copy of name to the list (names, *n; capacity *cap); -1 out of memory (printed). */
+static int push_name(char ***names, size_t *n, size_t *cap, const char *name)
+{
+    if (*n == *cap) {
+        size_t ncap = *cap ? *cap * 2 : 64;
+        char **p = realloc(*names, ncap * sizeof *p);
+        if (p == NULL) {
+            tool_error(NULL, "out of memory");
+            return -1;
+        }
+        *names = p;
+        *cap = ncap;
+    }
+    if (((*names)[*n] = xstrdup(name)) == NULL)
+        return -1;
+    (*n)++;
+    return 0;
+}
+
+/* The names of the shape files of a folder (unsorted); 0, or -1 after printing the error. */
+static int folder_names(const char *dir, char ***names, size_t *n, skipped_files *sk)
 {
     DIR *d = opendir(dir);
     if (d == NULL) {
         tool_error(dir, "cannot open folder: %s", strerror(errno));
         return -1;
     }
-    char **names = NULL;
-    size_t n = 0, cap = 0;
+    size_t cap = 0;
     struct dirent *e;
     int ok = 1;
-    while ((e = readdir(d)) != NULL) {
+    while (ok && (e = readdir(d)) != NULL) {
         if (e->d_name[0] == '.')
             continue;
-        char *path = path_join(dir, e->d_name);
-        if (path == NULL) {
-            ok = 0;
-            break;
-        }
-        struct stat st;
-        char ext[16];
-        path_ext(e->d_name, ext);
-        int take = stat(path, &st) == 0 && S_ISREG(st.st_mode) &&
-                   (strcmp(ext, ".txt") == 0 || strcmp(ext, ".csv") == 0 || file_is_image(path));
-        free(path);
-        if (!take)
-            continue;
-        if (n == cap) {
-            cap = cap ? cap * 2 : 64;
-            char **p = realloc(names, cap * sizeof *p);
-            if (p == NULL) {
-                tool_error(NULL, "out of memory");
-                ok = 0;
-                break;
-            }
-            names = p;
-        }
-        names[n] = xstrdup(e->d_name);
-        if (names[n] == NULL) {
-            ok = 0;
-            break;
-        }
-        n++;
+        int take = take_entry(dir, e->d_name, sk);
+        ok = take >= 0 && (take == 0 || push_name(names, n, &cap, e->d_name) == 0);
     }
     closedir(d);
-    if (ok && n == 0) {
+    return ok ? 0 : -1;
+}
+
+/* The error of a folder without shapes; a manifest.tsv in it is what the user meant. */
+static void no_shapes_error(const char *dir)
+{
+    char *m = path_join(dir, "manifest.tsv");
+    struct stat st;
+    if (m != NULL && stat(m, &st) == 0 && S_ISREG(st.st_mode))
+        tool_error(dir, "no shapes in this folder (PNG or PGM images, .txt or .csv point lists); it holds a "
+                        "manifest: pass %s", m);
+    else
         tool_error(dir, "no shapes in this folder (PNG or PGM images, .txt or .csv point lists)");
+    free(m);
+}
+
+static int open_folder(const char *dir, collection *c)
+{
+    char **names = NULL;
+    size_t n = 0;
+    skipped_files sk = {0, ""};
+    int ok = folder_names(dir, &names, &n, &sk) == 0;
+    if (sk.n > 0) /* a warning, not an error: the folder's shapes are read */
+        fprintf(stderr, "amscr: %s: %zu file%s skipped: not PNG, PGM or a point list (e.g. %s)\n", dir, sk.n,
+                sk.n == 1 ? "" : "s", sk.example);
+    if (ok && n == 0) {
+        no_shapes_error(dir);
         ok = 0;
     }
     if (ok)
@@ -252,15 +312,20 @@ static int read_line(FILE *fp, char **line, size_t *lcap, size_t *out_len)
     return 1;
 }
 
-/* A manifest being read: where it is, its columns (from the header line) and the capacities of
- * the collection's growing arrays. */
+/* A manifest being read: where it is, its columns (from the header line), the capacities of
+ * the collection's growing arrays and the line of each shape. */
 typedef struct {
     const char *path;
-    const char *dir;             /* the manifest's folder: file names are relative to it */
-    int header;                  /* 1 until the header line is read */
-    long fcol, ccol, gcol;       /* the columns file, class and (optional, else -1) group */
+    const char *dir;       /* the manifest's folder: file names are relative to it */
+    int header;            /* 1 until the header line is read */
+    long fcol, ccol, gcol; /* the columns file, class and (optional, else -1) group */
     size_t lineno, icap, ccap, gcap;
+    size_t *lines, lines_cap; /* lines[i]: the line of shape i */
 } manifest_reader;
+
+/* What a file given as a collection is when it is not one (a folder, a manifest, an index). */
+#define NOT_COLLECTION                                                                                       \
+    "not a collection (a folder of shapes, a manifest .tsv with the columns file and class, or an index)"
 
 /* The header line: finds the columns named file, class and group. */
 static int manifest_header(manifest_reader *r, char **f, size_t nf)
@@ -283,6 +348,23 @@ static int manifest_header(manifest_reader *r, char **f, size_t nf)
     return 0;
 }
 
+/* Notes the line of the shape just added (shape c->n - 1). */
+static int note_line(manifest_reader *r, const collection *c)
+{
+    if (c->n > r->lines_cap) {
+        size_t ncap = r->lines_cap ? r->lines_cap * 2 : 64;
+        size_t *p = realloc(r->lines, ncap * sizeof *p);
+        if (p == NULL) {
+            tool_error(NULL, "out of memory");
+            return -1;
+        }
+        r->lines = p;
+        r->lines_cap = ncap;
+    }
+    r->lines[c->n - 1] = r->lineno;
+    return 0;
+}
+
 /* A shape line: its file, class and group added to the collection. */
 static int manifest_row(manifest_reader *r, char **f, size_t nf, collection *c)
 {
@@ -300,14 +382,46 @@ static int manifest_row(manifest_reader *r, char **f, size_t nf, collection *c)
         tool_error(r->path, "line %zu: empty file or class", r->lineno);
         return -1;
     }
-    if (add_item(c, &r->icap, &r->ccap, r->dir, file, cls) != 0)
+    if (add_item(c, &r->icap, &r->ccap, r->dir, file, cls) != 0 || note_line(r, c) != 0)
         return -1;
     if (r->gcol >= 0 && set_group(c, f[r->gcol], &r->gcap, r->path, r->lineno) != 0)
         return -1;
     return 0;
 }
 
-/* Every line of the manifest: blank lines and '#' comments skipped, the header, then the shapes. */
+/* 1 when s (a trimmed line) is a point of a point list: two numbers, "x y" or "x,y", then
+ * nothing but a comment. */
+static int is_point_line(const char *s)
+{
+    char *end;
+    (void)strtod(s, &end);
+    if (end == s)
+        return 0;
+    while (*end == ' ' || *end == '\t' || *end == ',')
+        end++;
+    const char *y = end;
+    (void)strtod(y, &end);
+    if (end == y)
+        return 0;
+    while (*end == ' ' || *end == '\t')
+        end++;
+    return *end == '\0' || *end == '#';
+}
+
+/* One line with content (trimmed, not a comment): the header or a shape. */
+static int manifest_line(manifest_reader *r, char *line, collection *c)
+{
+    if (r->header && is_point_line(line)) {
+        tool_error(r->path, "a point list, " NOT_COLLECTION);
+        return -1;
+    }
+    char *f[64];
+    size_t nf = split_tabs(line, f, 64);
+    return r->header ? manifest_header(r, f, nf) : manifest_row(r, f, nf, c);
+}
+
+/* Every line of the manifest: a UTF-8 byte order mark (an export of Excel or Notepad) before the
+ * first dropped, blank lines and '#' comments skipped, the header, then the shapes. */
 static int manifest_lines(manifest_reader *r, FILE *fp, collection *c)
 {
     size_t lcap = 4096, len = 0;
@@ -316,54 +430,114 @@ static int manifest_lines(manifest_reader *r, FILE *fp, collection *c)
         tool_error(NULL, "out of memory");
         return -1;
     }
-    int ok = 1, got;
-    while ((got = read_line(fp, &line, &lcap, &len)) > 0) {
-        r->lineno++;
+    int ok = 1, got = 0;
+    while (ok && (got = read_line(fp, &line, &lcap, &len)) > 0) {
+        if (r->lineno++ == 0 && len >= 3 && memcmp(line, "\xEF\xBB\xBF", 3) == 0) {
+            memmove(line, line + 3, len - 2); /* the rest and its '\0' */
+            len -= 3;
+        }
         if (memchr(line, '\0', len) != NULL) {
             tool_error(r->path, "line %zu: not a text manifest", r->lineno);
             ok = 0;
             break;
         }
         trim(line);
-        if (line[0] == '\0' || line[0] == '#')
-            continue;
-        char *f[64];
-        size_t nf = split_tabs(line, f, 64);
-        if ((r->header ? manifest_header(r, f, nf) : manifest_row(r, f, nf, c)) != 0) {
-            ok = 0;
-            break;
-        }
+        if (line[0] != '\0' && line[0] != '#')
+            ok = manifest_line(r, line, c) == 0;
     }
     free(line);
     return ok && got >= 0 ? 0 : -1;
 }
 
+/* A shape's file name and its position, sorted to find a file listed twice. */
+typedef struct {
+    const char *name;
+    size_t i;
+} listed_file;
+
+static int cmp_listed(const void *a, const void *b)
+{
+    const listed_file *x = a, *y = b;
+    int d = strcmp(x->name, y->name);
+    return d ? d : (x->i > y->i) - (x->i < y->i);
+}
+
+/* 0 when every file is listed once; else the error naming the first repeat's two lines. */
+static int check_repeats(const manifest_reader *r, const collection *c)
+{
+    listed_file *v = xmalloc_array(c->n ? c->n : 1, sizeof *v);
+    if (v == NULL)
+        return -1;
+    for (size_t i = 0; i < c->n; i++)
+        v[i] = (listed_file){c->items[i].name, i};
+    qsort(v, c->n, sizeof *v, cmp_listed);
+    size_t first = 0, again = SIZE_MAX; /* the repeat on the earliest line, and its first listing */
+    for (size_t k = 1; k < c->n; k++)
+        if (strcmp(v[k].name, v[k - 1].name) == 0 && (again == SIZE_MAX || v[k].i < again)) {
+            again = v[k].i;
+            first = v[k - 1].i;
+        }
+    free(v);
+    if (again == SIZE_MAX)
+        return 0;
+    tool_error(r->path, "line %zu: '%s' is already listed on line %zu (list each file once)", r->lines[again],
+               c->items[again].name, r->lines[first]);
+    return -1;
+}
+
+/* What is wrong with a manifest read to its end: no header, no shapes, a file listed twice. */
+static int manifest_complete(const manifest_reader *r, const collection *c)
+{
+    if (r->header) {
+        tool_error(r->path, r->lineno == 0 ? "empty file" : "no header line with 'file' and 'class' columns");
+        return -1;
+    }
+    if (c->n == 0) {
+        tool_error(r->path, "the manifest lists no shapes");
+        return -1;
+    }
+    return check_repeats(r, c);
+}
+
+/* -1 after the error when the file's first bytes say it is an image or an amscr file, which
+ * the manifest reader would misread as a manifest without a header. */
+static int manifest_is_other(const char *mpath)
+{
+    unsigned char m[8];
+    FILE *fp = fopen(mpath, "rb");
+    size_t n = fp ? fread(m, 1, sizeof m, fp) : 0;
+    if (fp)
+        fclose(fp);
+    const char *kind = file_image_other(mpath);
+    if (file_is_image(mpath))
+        tool_error(mpath, "a PNG or PGM image, " NOT_COLLECTION);
+    else if (kind != NULL)
+        tool_error(mpath, "a %s image, " NOT_COLLECTION, kind);
+    else if (n >= 8 && (memcmp(m, "AMSCRDB", 7) == 0 || memcmp(m, "AMSCRIDX", 8) == 0))
+        tool_error(mpath, "an amscr index or collection file, not a folder of shapes or a manifest .tsv");
+    else
+        return 0;
+    return -1;
+}
+
 static int open_manifest(const char *mpath, collection *c)
 {
+    if (manifest_is_other(mpath) != 0)
+        return -1;
     FILE *fp = fopen(mpath, "rb");
     if (fp == NULL) {
         tool_error(mpath, "cannot open: %s", strerror(errno));
         return -1;
     }
     char *dir = path_dir(mpath);
-    if (dir == NULL) {
-        fclose(fp);
-        return -1;
-    }
-    manifest_reader r = {mpath, dir, 1, -1, -1, -1, 0, 0, 0, 0};
-    int ok = manifest_lines(&r, fp, c) == 0;
+    manifest_reader r = {mpath, dir, 1, -1, -1, -1, 0, 0, 0, 0, NULL, 0};
+    int ok = dir != NULL && manifest_lines(&r, fp, c) == 0;
     if (ok && ferror(fp)) {
         tool_error(mpath, "read error");
         ok = 0;
     }
-    if (ok && r.header) {
-        tool_error(mpath, r.lineno == 0 ? "empty file" : "no header line with 'file' and 'class' columns");
-        ok = 0;
-    }
-    if (ok && c->n == 0) {
-        tool_error(mpath, "the manifest lists no shapes");
-        ok = 0;
-    }
+    ok = ok && manifest_complete(&r, c) == 0;
+    free(r.lines);
     free(dir);
     fclose(fp);
     return ok ? 0 : -1;

@@ -3,16 +3,21 @@
  *
  * Folder: the regular, non-hidden files whose magic bytes say PNG or PGM, or whose name
  * ends in .txt or .csv (other files, e.g. manifest.tsv or stats.json, are skipped), sorted
- * by name (byte order, strcmp). The class of a file is its name without the extension,
- * cut before a final '-' or '_' followed by digits ("bird-3.png" -> "bird",
+ * by name (byte order, strcmp). Images of formats the tool cannot read (JPEG, GIF, TIFF,
+ * WebP, BMP, other Netpbm: by their magic bytes) are skipped with one warning line on stderr
+ * naming how many and the first by name. The class of a file is its name without the
+ * extension, cut before a final '-' or '_' followed by digits ("bird-3.png" -> "bird",
  * "leaf_12.txt" -> "leaf"); failing that, trailing digits are dropped ("Bone01" -> "Bone");
- * failing that, the whole name is the class.
+ * failing that, the whole name is the class. Trailing blanks are dropped, and with the digits
+ * the separators ' ', '-', '_' before them ("star 3" -> "star"), unless nothing is left.
  *
  * Manifest: a tab-separated file with a header line naming (at least) the columns `file`
  * and `class`, in any order; paths are relative to the manifest's folder (absolute paths
- * are kept); blank lines and lines starting with '#' are skipped. Rows keep their order.
- * An optional column `group` names the object or source each shape belongs to (eval
- * --protocol groups leaves one group out at a time). */
+ * are kept); a UTF-8 byte order mark before the header is dropped; blank lines and lines
+ * starting with '#' are skipped. Rows keep their order; a file listed twice (the same
+ * entry) is an error naming both lines. An optional column `group` names the object or
+ * source each shape belongs to (eval --protocol groups leaves one group out at a time).
+ * An image, a point list or an amscr file given as a manifest is an error saying so. */
 #ifndef AMSCR_TOOL_COLLECTION_H
 #define AMSCR_TOOL_COLLECTION_H
 

@@ -59,9 +59,11 @@ static const char HELP_REGISTER[] =
     "                          threshold, sse, mixture, stages, alternatives, ...)\n"
     "  --overlay FILE          picture (.png or .svg): target, source before and after\n"
     "  --plot FILE             SVG: residual per scale with the Bayes threshold and the\n"
-    "                          kept scales, and the elbow curve SSE(K)\n"
-    "  --partial               SRC is an open fragment of TGT's closed boundary: also\n"
-    "                          prints where on TGT it lies (start, end as fractions)\n"
+    "                          kept scales, and the elbow curve SSE(K) (not with\n"
+    "                          --partial)\n"
+    "  --partial               SRC is an open fragment of TGT's closed boundary: prints\n"
+    "                          where on TGT it lies (start, end as fractions) instead of\n"
+    "                          the scales (JSON residuals null)\n"
     "  --no-polish             skip the final fit on the input points themselves (it\n"
     "                          fits the noisier curve onto the cleaner one; on by default)\n"
     "  --stage NAME=on|off     switch an optional stage of the registration (repeatable):\n"
@@ -167,12 +169,15 @@ static const char HELP_INDEX[] =
     "                          2000 shapes; 256 above)\n"
     "  --add                   append the shapes of COLLECTION to the index FILE: only the\n"
     "                          new shapes are prepared, and only pairs with a new shape\n"
-    "                          matched; the options (re-ranking and --threshold\n"
+    "                          matched; the shape and retrieval options (re-ranking\n"
     "                          included) must be the index's\n"
     "A command given an index uses the index's shape options; an option that differs from\n"
     "them is an error (rebuild the index); --rerank K[,ITER] and --no-rerank may differ\n"
     "(a search then ranks by the collection's matrix). search --candidates M (default\n"
-    "256) matches the M shapes whose signatures are nearest the query's (0: every shape).\n";
+    "256) matches the M shapes whose signatures are nearest the query's (0: every shape).\n"
+    "An index does not keep the image-tracing options (--threshold, --pixel-chain): give\n"
+    "a search of an image and --add the same ones as the build, or the images are traced\n"
+    "differently (nothing checks them).\n";
 
 static const tool_command COMMANDS[] = {
     {"contour", C_CONTOUR, 1, "IMG [-o FILE]", "trace a silhouette's outer contour, or every contour (--all)", HELP_CONTOUR, 0,

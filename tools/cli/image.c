@@ -89,6 +89,18 @@ int file_is_image(const char *path)
     return sniff(m, n, &other) != TOOL_FMT_TEXT;
 }
 
+const char *file_image_other(const char *path)
+{
+    unsigned char m[8];
+    FILE *fp = fopen(path, "rb");
+    size_t n = fp ? fread(m, 1, sizeof m, fp) : 0;
+    if (fp)
+        fclose(fp);
+    const char *other;
+    sniff(m, n, &other);
+    return other;
+}
+
 int image_read(const char *path, int text_ok, tool_image *out, tool_format *out_format)
 {
     out->pix = NULL;

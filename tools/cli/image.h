@@ -49,6 +49,10 @@ void image_no_shape_error(const char *path, const tool_image *img, int threshold
 
 /* Non-zero when the file starts with PNG or PGM (P2/P5) magic bytes. */
 int file_is_image(const char *path);
+/* The name of the image format the file's first bytes say the tool cannot read ("JPEG",
+ * "GIF", "TIFF", ...: the name `unsupported image format` errors give); NULL for PNG, PGM,
+ * text, anything else, or a file that cannot be read. */
+const char *file_image_other(const char *path);
 
 /* Non-zero when the tool was built with libpng. */
 int image_have_png(void);

@@ -1,6 +1,8 @@
 /* index_add.c — `amscr index COLLECTION -o FILE --add`: the new files' names, classes and
  * groups merged into the index's, their shapes prepared with the index's params and added by
- * the library (amscr_index_add: the old shapes are not prepared again). */
+ * the library (amscr_index_add: the old shapes are not prepared again; an index of fewer shapes
+ * than twice its re-ranking K is built again on the old and new shapes, names kept). */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -9,12 +11,16 @@
 #include "index_tool.h"
 #include "shape_db.h"
 
-/* The index's label of class `name` (a new one, named, when absent); -1 on error. */
+/* The index's label of class `name` (a new one, named, when absent); -1 on error. A label the
+ * index does not name is named by its number, as the index's classes are shown
+ * (index_collection). */
 static int32_t class_label(amscr_index *x, const char *name, int32_t *nlabels)
 {
     for (int32_t l = 0; l < *nlabels; l++) {
+        char num[24];
         const char *s = amscr_index_class_name(x, l);
-        if (s != NULL && strcmp(s, name) == 0)
+        snprintf(num, sizeof num, "%d", (int)l);
+        if (strcmp(s != NULL ? s : num, name) == 0)
             return l;
     }
     if (amscr_index_set_class_name(x, *nlabels, name) != AMSCR_OK) {
@@ -36,8 +42,8 @@ static int merge_names(const char *ipath, amscr_index *x, collection *c)
         nlabels = amscr_index_label(x, j) + 1 > nlabels ? amscr_index_label(x, j) + 1 : nlabels;
     }
     if (n > 0 && groups != (c->ngroups > 0)) {
-        tool_error(ipath, "the index %s a group column and the new shapes' manifest %s", groups ? "has" : "has no",
-                   c->ngroups ? "has one" : "has none");
+        tool_error(ipath, groups ? "the index has groups and the new shapes' manifest has no group column"
+                                 : "the index has no groups and the new shapes' manifest has a group column");
         return TOOL_EXIT_FAIL;
     }
     for (size_t i = 0; i < c->n; i++)
@@ -53,6 +59,17 @@ static int merge_names(const char *ipath, amscr_index *x, collection *c)
         c->items[i].label = l; /* the new shapes are prepared with the index's labels */
     }
     return 0;
+}
+
+/* The error of amscr_index_add: a state error as the library's detail alone (it says what to
+ * do), without the status's name. */
+static void add_error(const char *ipath, amscr_status st)
+{
+    const char *d = lib_detail();
+    if (st == AMSCR_E_STATE && d[0] != '\0')
+        tool_error(ipath, "%s", d);
+    else
+        tool_lib_error(ipath, st);
 }
 
 int index_add(const opts *o, amscr_index *x, collection *c)
@@ -78,7 +95,7 @@ int index_add(const opts *o, amscr_index *x, collection *c)
         amscr_status st = amscr_index_add(x, dnew, progress_cb, &pr);
         progress_end(&pr);
         if (st != AMSCR_OK) {
-            tool_lib_error(o->out, st);
+            add_error(o->out, st);
             r = TOOL_EXIT_FAIL;
         }
     }

@@ -117,40 +117,79 @@ int index_open(const char *path, int lazy, amscr_index **out)
     return 0;
 }
 
-/* The classes of the index: label L is named by the index or "L". */
-static int index_classes(const amscr_index *x, collection *c)
+static int cmp_label(const void *a, const void *b)
 {
-    size_t n = amscr_index_size(x), k = 0;
-    for (size_t i = 0; i < n; i++) {
-        int32_t l = amscr_index_label(x, i);
-        if (l < 0) {
-            tool_error(NULL, "shape %zu of the index has no class (label %d)", i, (int)l);
-            return -1;
-        }
-        k = (size_t)l + 1 > k ? (size_t)l + 1 : k;
+    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* The index's distinct labels, ascending (malloc'ed, *k of them); NULL when out of memory
+ * (printed). */
+static int32_t *label_set(const amscr_index *x, size_t *k)
+{
+    size_t n = amscr_index_size(x), m = 0;
+    int32_t *l = xmalloc_array(n ? n : 1, sizeof *l);
+    if (l == NULL)
+        return NULL;
+    for (size_t i = 0; i < n; i++)
+        l[i] = amscr_index_label(x, i);
+    qsort(l, n, sizeof *l, cmp_label);
+    for (size_t i = 0; i < n; i++)
+        if (m == 0 || l[i] != l[m - 1])
+            l[m++] = l[i];
+    *k = m;
+    return l;
+}
+
+size_t index_num_classes(const amscr_index *x)
+{
+    size_t k = 0;
+    free(label_set(x, &k));
+    return k;
+}
+
+/* The classes of the index: its distinct labels in ascending order, label L named by the index
+ * or "L"; set[*k] are the labels (malloc'ed), class c of the collection is label set[c]. */
+static int32_t *index_classes(const amscr_index *x, collection *c, size_t *k)
+{
+    int32_t *set = label_set(x, k);
+    if (set == NULL)
+        return NULL;
+    if (*k > 0 && set[0] < 0) {
+        tool_error(NULL, "a shape of the index has no class (label %d)", (int)set[0]);
+        free(set);
+        return NULL;
     }
-    for (size_t l = 0; l < k; l++) {
+    c->classes = xcalloc_array(*k ? *k : 1, sizeof *c->classes);
+    for (size_t j = 0; c->classes != NULL && j < *k; j++) {
         char num[24];
-        const char *name = amscr_index_class_name(x, (int32_t)l);
-        snprintf(num, sizeof num, "%zu", l);
-        char **p = realloc(c->classes, (l + 1) * sizeof *p), *s = NULL;
-        if (p != NULL)
-            c->classes = p;
-        if (p == NULL || (s = xstrdup(name ? name : num)) == NULL) {
-            tool_error(NULL, "out of memory");
-            return -1;
-        }
-        c->classes[c->nclasses++] = s;
+        const char *name = amscr_index_class_name(x, set[j]);
+        snprintf(num, sizeof num, "%d", (int)set[j]);
+        if ((c->classes[j] = xstrdup(name ? name : num)) == NULL)
+            break;
+        c->nclasses = j + 1;
     }
-    return 0;
+    if (c->nclasses != *k) {
+        free(set);
+        return NULL;
+    }
+    return set;
+}
+
+/* The class of label l: its position in the ascending set of k labels. */
+static int32_t dense_label(const int32_t *set, size_t k, int32_t l)
+{
+    const int32_t *p = bsearch(&l, set, k, sizeof *set, cmp_label);
+    return p ? (int32_t)(p - set) : -1;
 }
 
 int index_collection(const amscr_index *x, collection *c)
 {
-    size_t n = amscr_index_size(x), gcap = 0;
+    size_t n = amscr_index_size(x), gcap = 0, k = 0;
     memset(c, 0, sizeof *c);
     c->items = xcalloc_array(n ? n : 1, sizeof *c->items);
-    int ok = c->items != NULL && index_classes(x, c) == 0, groups = 0;
+    int32_t *set = c->items != NULL ? index_classes(x, c, &k) : NULL;
+    int ok = set != NULL, groups = 0;
     for (size_t i = 0; ok && i < n; i++)
         groups |= amscr_index_group(x, i) != NULL;
     for (size_t i = 0; ok && i < n; i++) {
@@ -160,11 +199,12 @@ int index_collection(const amscr_index *x, collection *c)
         coll_item *it = &c->items[i];
         it->name = xstrdup(name ? name : num);
         it->path = xstrdup(name ? name : num);
-        it->label = amscr_index_label(x, i);
+        it->label = dense_label(set, k, amscr_index_label(x, i)); /* eval's classes are 0..k-1 */
         it->group = groups ? coll_name_index(&c->groups, &c->ngroups, g ? g : "", &gcap) : -1;
         c->n = i + 1;
         ok = it->name && it->path && (!groups || it->group >= 0);
     }
+    free(set);
     if (!ok) {
         collection_free(c);
         return -1;

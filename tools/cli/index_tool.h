@@ -17,8 +17,13 @@ int index_file_is(const char *path);
  * only reads its collection); 0, or -1 after printing one error line (the library's: a
  * collection file without an index or an old tool index says to rebuild it). */
 int index_open(const char *path, int lazy, amscr_index **out);
-/* The index's file names, classes and groups as a collection (item paths are the names). */
+/* The index's file names, classes and groups as a collection (item paths are the names). The
+ * classes are the index's distinct labels in ascending order, as the collection's labels
+ * 0..k-1 (an index from Python may label its shapes 1..4 or 10, 20, ...), each named by the
+ * index's class name or the label's number. */
 int index_collection(const amscr_index *x, collection *out);
+/* The number of distinct labels of the index (0 when out of memory, printed). */
+size_t index_num_classes(const amscr_index *x);
 /* Stores the file names and groups of collection c into shapes from..from+c->n-1 of the
  * index. 0 or -1 (error printed). */
 int index_store_names(amscr_index *x, const collection *c, size_t from);

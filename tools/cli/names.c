@@ -33,10 +33,28 @@ static const tool_name PROTOCOLS[] = {
     {"groups", PROTO_GROUPS},
 };
 
+static const tool_name STAGES[] = {
+    {"recovery", 1},
+    {"polish", 1},
+    {"pixel_grid", 1},
+    {"despike", 0},
+    {"order", 0},
+    {"even_spacing", 0},
+};
+
 const name_table METHOD_NAMES = TABLE(METHODS);
 const name_table PARAM_NAMES = TABLE(PARAMS);
 const name_table INVARIANCE_NAMES = TABLE(INVARIANCES);
 const name_table PROTOCOL_NAMES = TABLE(PROTOCOLS);
+const name_table STAGE_NAMES = TABLE(STAGES);
+
+int stage_lookup(const char *s)
+{
+    for (size_t i = 0; i < STAGE_NAMES.n; i++)
+        if (strcmp(s, STAGE_NAMES.v[i].name) == 0)
+            return STAGE_NAMES.v[i].value;
+    return -1;
+}
 
 int name_is(const char *s, const char *name)
 {

@@ -23,6 +23,9 @@ extern const name_table METHOD_NAMES;     /* amscr_method */
 extern const name_table PARAM_NAMES;      /* amscr_parametrization */
 extern const name_table INVARIANCE_NAMES; /* amscr_invariance */
 extern const name_table PROTOCOL_NAMES;   /* PROTO_* */
+/* The stages of amscr_register that --stage switches (amscr_params_set_stage), each with 1 when
+ * it is on by default; named exactly (stage_lookup), as the library names them. */
+extern const name_table STAGE_NAMES;
 
 /* Case-insensitive match in which '_' equals '-' ("Binary_EM" is binary-em). */
 int name_is(const char *s, const char *name);
@@ -30,6 +33,8 @@ int name_is(const char *s, const char *name);
 int name_lookup(const name_table *t, const char *s, int *out);
 /* The name of a value; "unknown" when none. */
 const char *name_of(const name_table *t, int value);
+/* The stage named exactly s: its on-by-default flag (STAGE_NAMES), -1 when none. */
+int stage_lookup(const char *s);
 /* The names joined for an error message: "a, b or c". */
 const char *name_list(const name_table *t, char *buf, size_t cap);
 /* The names joined for a help line, " (default)" after the one of value dflt (none when

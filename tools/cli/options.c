@@ -146,8 +146,8 @@ static int parse_size(const char *opt, const char *s, size_t lo, size_t hi, size
     return 0;
 }
 
-/* parse_size into an unsigned field, setting *set. */
-/* --stage NAME=on|off (repeatable): the name is checked by the library (amscr_params_set_stage). */
+/* --stage NAME=on|off (repeatable): NAME one of STAGE_NAMES, the stages the help lists (the
+ * library checks it again: amscr_params_set_stage). */
 static int parse_stage(const char *opt, const char *s, opts *o)
 {
     const char *eq = strchr(s, '=');
@@ -158,10 +158,16 @@ static int parse_stage(const char *opt, const char *s, opts *o)
         return usage_error(opt, "at most %d stages", TOOL_STAGES_MAX);
     memcpy(o->stage_name[o->nstages], s, len);
     o->stage_name[o->nstages][len] = '\0';
+    if (stage_lookup(o->stage_name[o->nstages]) < 0) {
+        char list[200];
+        return usage_error(opt, "'%s' is not a switchable stage (%s)", o->stage_name[o->nstages],
+                           name_list(&STAGE_NAMES, list, sizeof list));
+    }
     o->stage_on[o->nstages++] = strcmp(eq + 1, "on") == 0;
     return 0;
 }
 
+/* parse_size into an unsigned field, setting *set. */
 static int parse_unsigned(const char *opt, const char *s, size_t lo, size_t hi, int *set, unsigned *out)
 {
     size_t t;
@@ -220,8 +226,8 @@ static int parse_rerank(const char *opt, const char *v, opts *o)
     }
     if (!end || *end != '\0' || k < 1 || k > TOOL_RERANK_K_MAX || it < 1 || it > TOOL_RERANK_ITERS_MAX ||
         v[0] == '-')
-        return usage_error(opt, "expected K[,ITER] with K >= 1 and 1 <= ITER <= %d, got '%s'",
-                           TOOL_RERANK_ITERS_MAX, v);
+        return usage_error(opt, "expected K[,ITER] with 1 <= K <= %d and 1 <= ITER <= %d, got '%s'",
+                           TOOL_RERANK_K_MAX, TOOL_RERANK_ITERS_MAX, v);
     o->rerank_set = 1;
     o->rerank_k = (size_t)k;
     o->rerank_iters = (unsigned)it;
