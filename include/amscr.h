@@ -99,7 +99,7 @@ extern "C" {
 /** Compile-time version; amscr_version_number() gives the runtime one. */
 #define AMSCR_VERSION_MAJOR 0
 #define AMSCR_VERSION_MINOR 22
-#define AMSCR_VERSION_PATCH 1
+#define AMSCR_VERSION_PATCH 2
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
 
@@ -314,6 +314,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_orient_ccw(amscr_contour *c
 /**
  * @brief Reads a text point list: one "x y" or "x,y" per line (tabs/spaces/one comma),
  *        '#' starts a comment, blank lines are ignored. An empty list is AMSCR_E_FORMAT.
+ *        A UTF-8 byte order mark at the start is skipped (since 0.22.2; before, line 1 was
+ *        AMSCR_E_FORMAT).
  * @param[in]  path  file name.
  * @param[out] out   new contour.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO (cannot open/read); AMSCR_E_FORMAT (bad

@@ -102,6 +102,20 @@ START_TEST(parse_comments_blank_crlf)
 }
 END_TEST
 
+/* A UTF-8 byte order mark is skipped at the start only: anywhere else it is a bad line. */
+START_TEST(parse_byte_order_mark)
+{
+    amscr_contour *c;
+    const double xy[] = {1, 2, 3, 4, 5, 7};
+    ck_assert_int_eq(parse("\xEF\xBB\xBF" "1 2\r\n3 4\r\n5 7\r\n", &c), AMSCR_OK);
+    assert_points(c, xy, 3);
+    amscr_contour_free(c);
+    ck_assert_int_eq(parse("\xEF\xBB\xBF", &c), AMSCR_E_FORMAT); /* nothing but the mark: no points */
+    ck_assert_int_eq(parse("1 2\n\xEF\xBB\xBF" "3 4\n", &c), AMSCR_E_FORMAT);
+    ck_assert_str_eq(amscr_last_error_detail(), "line 2: expected 2 numbers");
+}
+END_TEST
+
 START_TEST(parse_scientific_and_no_final_newline)
 {
     amscr_contour *c;
@@ -305,6 +319,7 @@ Suite *amscr_suite_contour_io(void)
     TCase *tc = tcase_create("parse");
     tcase_add_test(tc, parse_separators);
     tcase_add_test(tc, parse_comments_blank_crlf);
+    tcase_add_test(tc, parse_byte_order_mark);
     tcase_add_test(tc, parse_scientific_and_no_final_newline);
     tcase_add_test(tc, parse_not_nul_terminated);
     tcase_add_loop_test(tc, parse_bad_line, 0, (int)(sizeof bad_cases / sizeof bad_cases[0]));

@@ -3,7 +3,8 @@
  * Written through amscr__file_write_atomic (file_io.c): the whole list or nothing.
  *
  * Format: one point per line, "x y", "x,y", "x, y" or tab-separated; '#' starts a
- * comment anywhere on a line; blank lines are ignored; CRLF line ends are accepted.
+ * comment anywhere on a line; blank lines are ignored; CRLF line ends are accepted; a UTF-8
+ * byte order mark before the first line (Excel's and Notepad's text exports) is skipped.
  * Numbers are read with strtod (the "C" locale is assumed) and must be finite. */
 #include "internal.h"
 
@@ -74,6 +75,8 @@ static amscr_status ct_parse_buffer(char *buf, size_t len, const char *path, ams
     size_t n = 0, cap = 0;
     size_t line = 0;
     char *p = buf, *end = buf + len;
+    if (len >= 3 && memcmp(buf, "\xEF\xBB\xBF", 3) == 0)
+        p += 3;
     while (p < end) {
         char *nl = memchr(p, '\n', (size_t)(end - p));
         char *le = nl ? nl : end;

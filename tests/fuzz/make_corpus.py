@@ -50,6 +50,7 @@ put('text', 'square', '0 0\n1 0\n1 1\n0 1\n')
 put('text', 'commas-crlf', '# a comment\r\n0,0\r\n2, 0 # trailing\r\n\r\n2,\t2\r\n0 ,2\r\n')
 put('text', 'exponents', '1e3 -2.5E-3\n+4.0 .5\n-0 0x1p3\n1e-320 7\n')
 put('text', 'bad-line', '0 0\n1 0\n1 1 1\n')
+put('text', 'utf8-bom', b'\xef\xbb\xbf0 0\r\n1 0\r\n1 1\r\n')
 put('text', 'ellipse', text(polygon(24, wobble=0.2)))
 
 put('manifest', 'file-class', 'file\tclass\nbird-1.png\tbird\nbird-2.png\tbird\nbone-1.txt\tbone\n')

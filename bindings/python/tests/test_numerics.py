@@ -358,6 +358,10 @@ def test_points_text_roundtrip(tmp_path):
     np.testing.assert_array_equal(amscr.read_points(p), pts)
     np.testing.assert_array_equal(amscr.read_points(str(p)), pts)
     np.testing.assert_array_equal(amscr.parse_points('# c\n1 2\n3,4\n\n5\t6\n'), [[1, 2], [3, 4], [5, 6]])
+    # a byte order mark (Excel's and Notepad's exports) is skipped, as str and as a file
+    np.testing.assert_array_equal(amscr.parse_points('\ufeff1 2\r\n3 4\r\n'), [[1, 2], [3, 4]])
+    (tmp_path / 'bom.csv').write_bytes(b'\xef\xbb\xbf5,6\r\n7,8\r\n')
+    np.testing.assert_array_equal(amscr.read_points(tmp_path / 'bom.csv'), [[5, 6], [7, 8]])
 
 
 def test_signed_area_and_orient():
