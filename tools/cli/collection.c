@@ -70,14 +70,11 @@ void collection_free(collection *c)
     c->n = c->nclasses = c->ngroups = 0;
 }
 
-/* The index of `name` in the list (*names, *n), appended when new. */
-int32_t coll_name_index(char ***names, size_t *n, const char *name, size_t *cap)
+/* Appends a copy of name to the list (names, *n; capacity *cap); -1 out of memory (printed). */
+static int push_name(char ***names, size_t *n, size_t *cap, const char *name)
 {
-    for (size_t i = 0; i < *n; i++)
-        if (strcmp((*names)[i], name) == 0)
-            return (int32_t)i;
     if (*n == *cap) {
-        size_t ncap = *cap ? *cap * 2 : 16;
+        size_t ncap = *cap ? *cap * 2 : 64;
         char **p = realloc(*names, ncap * sizeof *p);
         if (p == NULL) {
             tool_error(NULL, "out of memory");
@@ -86,11 +83,19 @@ int32_t coll_name_index(char ***names, size_t *n, const char *name, size_t *cap)
         *names = p;
         *cap = ncap;
     }
-    char *s = xstrdup(name);
-    if (s == NULL)
+    if (((*names)[*n] = xstrdup(name)) == NULL)
         return -1;
-    (*names)[*n] = s;
-    return (int32_t)(*n)++;
+    (*n)++;
+    return 0;
+}
+
+/* The index of `name` in the list (*names, *n), appended when new. */
+int32_t coll_name_index(char ***names, size_t *n, const char *name, size_t *cap)
+{
+    for (size_t i = 0; i < *n; i++)
+        if (strcmp((*names)[i], name) == 0)
+            return (int32_t)i;
+    return push_name(names, n, cap, name) == 0 ? (int32_t)(*n - 1) : -1;
 }
 
 /* Appends the entry `entry` (a name in dir's listing or a manifest's file column) of class cls. */
@@ -160,25 +165,6 @@ static int take_entry(const char *dir, const char *name, skipped_files *sk)
     }
     free(path);
     return take;
-}
-
-/* Appends a copy of name to the list (names, *n; capacity *cap); -1 out of memory (printed). */
-static int push_name(char ***names, size_t *n, size_t *cap, const char *name)
-{
-    if (*n == *cap) {
-        size_t ncap = *cap ? *cap * 2 : 64;
-        char **p = realloc(*names, ncap * sizeof *p);
-        if (p == NULL) {
-            tool_error(NULL, "out of memory");
-            return -1;
-        }
-        *names = p;
-        *cap = ncap;
-    }
-    if (((*names)[*n] = xstrdup(name)) == NULL)
-        return -1;
-    (*n)++;
-    return 0;
 }
 
 /* The names of the shape files of a folder (unsorted); 0, or -1 after printing the error. */
