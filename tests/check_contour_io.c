@@ -140,25 +140,28 @@ START_TEST(parse_not_nul_terminated)
 }
 END_TEST
 
-/* Bad inputs: each must fail with FORMAT naming the right line. */
+/* Bad inputs: each must fail with FORMAT naming the right line and what is wrong. */
+#define NOT_TWO "expected 2 numbers"
+#define NOT_FINITE "a coordinate is not a finite number"
 static const struct {
     const char *text;
     int line;
+    const char *what;
 } bad_cases[] = {
-    {"1 2\n3 4 5\n", 2},          /* three numbers */
-    {"1 2\n\n7\n", 3},            /* one number */
-    {"# c\nabc def\n", 2},        /* garbage */
-    {"1 2\n3 nan\n", 2},          /* NaN */
-    {"inf 1\n", 1},               /* infinity */
-    {"1 2\n1e999 3\n", 2},        /* overflow to infinity */
-    {"1,,2\n", 1},                /* two commas */
-    {"1, ,2\n", 1},               /* comma, blank, comma-less gap */
-    {"1-2\n", 1},                 /* no separator */
-    {"1 2,\n", 1},                /* trailing comma */
-    {",1 2\n", 1},                /* leading comma */
-    {"1 2\n3 4\n5 6x\n", 3},      /* trailing garbage */
-    {"1 2\r\n3\r\n", 2},          /* CRLF and one number */
-    {"1;2\n", 1},                 /* wrong separator */
+    {"1 2\n3 4 5\n", 2, NOT_TWO},          /* three numbers */
+    {"1 2\n\n7\n", 3, NOT_TWO},            /* one number */
+    {"# c\nabc def\n", 2, NOT_TWO},        /* garbage */
+    {"1 2\n3 nan\n", 2, NOT_FINITE},       /* NaN */
+    {"inf 1\n", 1, NOT_FINITE},            /* infinity */
+    {"1 2\n1e999 3\n", 2, NOT_FINITE},     /* overflow to infinity */
+    {"1,,2\n", 1, NOT_TWO},                /* two commas */
+    {"1, ,2\n", 1, NOT_TWO},               /* comma, blank, comma-less gap */
+    {"1-2\n", 1, NOT_TWO},                 /* no separator */
+    {"1 2,\n", 1, NOT_TWO},                /* trailing comma */
+    {",1 2\n", 1, NOT_TWO},                /* leading comma */
+    {"1 2\n3 4\n5 6x\n", 3, NOT_TWO},      /* trailing garbage */
+    {"1 2\r\n3\r\n", 2, NOT_TWO},          /* CRLF and one number */
+    {"1;2\n", 1, NOT_TWO},                 /* wrong separator */
 };
 
 START_TEST(parse_bad_line)
@@ -169,7 +172,7 @@ START_TEST(parse_bad_line)
     ck_assert_int_eq(amscr_contour_parse_text(text, strlen(text), &c), AMSCR_E_FORMAT);
     ck_assert_ptr_eq(c, sentinel);
     char want[64];
-    snprintf(want, sizeof want, "line %d: expected 2 numbers", bad_cases[_i].line);
+    snprintf(want, sizeof want, "line %d: %s", bad_cases[_i].line, bad_cases[_i].what);
     ck_assert_str_eq(amscr_last_error_detail(), want);
 }
 END_TEST

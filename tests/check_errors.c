@@ -217,6 +217,39 @@ START_TEST(test_detail_concurrent_threads)
 }
 END_TEST
 
+/* Asserts that call fails with status st and exactly the detail want. */
+#define FAILS_WITH(call, st, want)                                                                                   \
+    do {                                                                                                           \
+        ck_assert_int_eq((call), (st));                                                                            \
+        ck_assert_str_eq(amscr_last_error_detail(), (want));                                                      \
+    } while (0)
+
+/* A detail names the public call the caller made (not a helper of it) and the value as given. */
+START_TEST(test_detail_names_the_call_and_the_value)
+{
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new(&p), AMSCR_OK);
+    FAILS_WITH(amscr_params_set_invariance(p, (amscr_invariance)-1), AMSCR_E_INVALID_ARG,
+               "amscr_params_set_invariance: invariance -1 is not in 0..2");
+    FAILS_WITH(amscr_params_set_channel_weight(p, 1.0000001), AMSCR_E_INVALID_ARG,
+               "amscr_params_set_channel_weight: channel_weight 1.0000001 is not in [0, 1]");
+    amscr_params_free(p);
+    amscr_index *x = NULL;
+    amscr_contour_set *cs = NULL;
+    FAILS_WITH(amscr_index_load_memory(NULL, 0, &x), AMSCR_E_INVALID_ARG, "amscr_index_load_memory: buf is NULL");
+    FAILS_WITH(amscr_index_load(NULL, &x), AMSCR_E_INVALID_ARG, "amscr_index_load: path is NULL");
+    FAILS_WITH(amscr_db_query_retrieval(NULL, NULL, NULL, NULL, NULL, 0), AMSCR_E_INVALID_ARG,
+               "amscr_db_query_retrieval: db is NULL");
+    FAILS_WITH(amscr_contours_from_mask(NULL, 4, 4, 4, -1, 0.0, &cs), AMSCR_E_INVALID_ARG,
+               "amscr_contours_from_mask: pixels is NULL");
+    ck_assert_int_eq(amscr_index_load(".", &x), AMSCR_E_IO); /* a folder: the reason, not "read error" alone */
+    ck_assert_msg(strstr(amscr_last_error_detail(), "read error: ") != NULL &&
+                      strlen(strstr(amscr_last_error_detail(), "read error: ")) > strlen("read error: "),
+                  "%s", amscr_last_error_detail());
+    ck_assert_ptr_null(x);
+}
+END_TEST
+
 Suite *amscr_suite_errors(void)
 {
     Suite *s = suite_create("errors");
@@ -233,6 +266,7 @@ Suite *amscr_suite_errors(void)
     tcase_add_test(td, test_detail_set_after_failure);
     tcase_add_test(td, test_detail_is_per_thread);
     tcase_add_test(td, test_detail_concurrent_threads);
+    tcase_add_test(td, test_detail_names_the_call_and_the_value);
     suite_add_tcase(s, td);
     return s;
 }

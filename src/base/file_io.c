@@ -162,6 +162,7 @@ amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out
     cap = cap ? cap + 1 : (size_t)1 << 16; /* one more byte: the end is seen without a second buffer */
     unsigned char *buf = malloc(cap);
     amscr_status st = AMSCR_OK;
+    int rerr = 0; /* errno of a failed read (EISDIR: a folder) */
     while (buf) {
         if (len == cap) {
             if (cap > ((size_t)1 << 40)) {
@@ -179,15 +180,17 @@ amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out
         }
         size_t got = fread(buf + len, 1, cap - len, f);
         len += got;
-        if (got == 0)
+        if (got == 0) {
+            rerr = errno;
             break;
+        }
     }
     int err = ferror(f);
     fclose(f);
     if (!buf)
         return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", path);
     if (st == AMSCR_OK && err)
-        st = amscr__fail(AMSCR_E_IO, "%s: read error", path);
+        st = amscr__fail(AMSCR_E_IO, "%s: read error: %s", path, amscr__errstr(rerr, eb, sizeof eb));
     if (st != AMSCR_OK) {
         free(buf);
         return st;

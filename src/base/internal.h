@@ -25,6 +25,13 @@ void amscr__clear_error(void);
             return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %s is NULL", __func__, #ptr);         \
     } while (0)
 
+/* As AMSCR_CHECK_NULL in a helper of the public function named by the string fn. */
+#define AMSCR_CHECK_NULL_IN(fn, ptr)                                                           \
+    do {                                                                                       \
+        if ((ptr) == NULL)                                                                     \
+            return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %s is NULL", (fn), #ptr);             \
+    } while (0)
+
 /* AMSCR_OK when cond holds, else AMSCR_E_INVALID_ARG with the printf-style detail given. */
 #define AMSCR__REQUIRE(cond, ...) ((cond) ? AMSCR_OK : amscr__fail(AMSCR_E_INVALID_ARG, __VA_ARGS__))
 /* Defines the validating setter `amscr_status fn(obj_t *obj, vtype v)` of obj->field: it clears

@@ -5,6 +5,9 @@
  * _get_real / _get_bounds. Options added from now on get a key here and no new pair. */
 #include "internal.h"
 
+#include <stdio.h>
+#include <stdlib.h>
+
 enum { KIND_INT, KIND_REAL };
 /* Which values in [lo, hi] are accepted. */
 enum {
@@ -62,17 +65,34 @@ static const option_t *find(amscr_option key)
     return i < NUM_ROWS && TABLE[i].name ? &TABLE[i] : NULL;
 }
 
-/* AMSCR_OK when o accepts v (NaN never), else AMSCR_E_INVALID_ARG with a detail naming `who`. */
-static amscr_status check(const option_t *o, double v, const char *who)
+/* v in the fewest digits that read back as v ("1.0000001", not %g's "1"). */
+static const char *exact(double v, char buf[32])
+{
+    for (int prec = 6; prec <= 17; prec++) {
+        snprintf(buf, 32, "%.*g", prec, v);
+        if (strtod(buf, NULL) == v)
+            break;
+    }
+    return buf;
+}
+
+/* AMSCR_OK when o accepts v (NaN never), else AMSCR_E_INVALID_ARG with a detail naming `who`.
+ * wrapped: v came through an unsigned 32-bit type (an enum or unsigned field), so a value of
+ * 2^31 or more is shown as the int the caller most likely passed (-1, not 4294967295). */
+static amscr_status check(const option_t *o, double v, const char *who, int wrapped)
 {
     int zero = o->rule == RULE_ZERO_OR && v == 0.0;
     int above = o->rule == RULE_OPEN_LO ? v > o->lo : v >= o->lo;
     int below = o->rule == RULE_OPEN_HI ? v < o->hi : v <= o->hi;
     if (zero || (above && below))
         return AMSCR_OK;
-    if (o->kind == KIND_INT)
-        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %s %.0f is not in %.0f..%.0f", who, o->name, v, o->lo, o->hi);
-    return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %s %g is not %sin %c%g, %g%c", who, o->name, v,
+    if (o->kind == KIND_INT) {
+        double shown = wrapped && v >= 2147483648.0 ? v - 4294967296.0 : v;
+        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %s %.0f is not in %.0f..%.0f", who, o->name, shown, o->lo,
+                           o->hi);
+    }
+    char b[32];
+    return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %s %s is not %sin %c%g, %g%c", who, o->name, exact(v, b),
                        o->rule == RULE_ZERO_OR ? "0 or " : "", o->rule == RULE_OPEN_LO ? '(' : '[', o->lo, o->hi,
                        o->rule == RULE_OPEN_HI ? ')' : ']');
 }
@@ -80,7 +100,7 @@ static amscr_status check(const option_t *o, double v, const char *who)
 /* ---- the named pairs: amscr_params_set_<name> and amscr_params_get_<name> ---- */
 #define NAMED(KEY, name, type, kind, lo, hi, rule)                                                                  \
     AMSCR__SETTER(amscr_params_set_##name, amscr_params, p, type, name,                                          \
-                  check(&TABLE[AMSCR_OPT_##KEY], (double)v, __func__))                                            \
+                  check(&TABLE[AMSCR_OPT_##KEY], (double)v, __func__, sizeof(type) == 4 && (type)-1 > 0))                                            \
     AMSCR__GETTER(amscr_params_get_##name, amscr_params, type, name)
 OPTIONS(NAMED)
 
@@ -130,7 +150,7 @@ static amscr_status set_keyed(amscr_params *p, amscr_option key, int kind, doubl
     const option_t *o = NULL;
     amscr_status st = find_kind(key, kind, who, &o);
     if (st == AMSCR_OK)
-        st = check(o, v, who);
+        st = check(o, v, who, 0);
     if (st == AMSCR_OK)
         store(p, key, v);
     return st;

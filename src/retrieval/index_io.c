@@ -520,7 +520,10 @@ amscr_status amscr_index_load_memory_with(const void *buf, size_t len, unsigned 
 
 amscr_status amscr_index_load_memory(const void *buf, size_t len, amscr_index **out)
 {
-    return amscr_index_load_memory_with(buf, len, 0, out);
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(buf);
+    AMSCR_CHECK_NULL(out);
+    return load_memory(buf, len, 0, 0, out);
 }
 
 amscr_status amscr__index_load_mapped(unsigned char *buf, size_t len, unsigned flags, amscr_index **out)
@@ -531,18 +534,13 @@ amscr_status amscr__index_load_mapped(unsigned char *buf, size_t len, unsigned f
     return st;
 }
 
-amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index **out)
+/* amscr_index_load_with after its arguments' checks. */
+static amscr_status load_file(const char *path, unsigned flags, amscr_index **out)
 {
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(path);
-    AMSCR_CHECK_NULL(out);
-    amscr_status st = check_flags(flags, "amscr_index_load_with");
-    if (st != AMSCR_OK)
-        return st;
     unsigned char *buf = NULL;
     size_t len = 0;
     int mapped = 0;
-    st = amscr__file_map(path, &buf, &len, &mapped);
+    amscr_status st = amscr__file_map(path, &buf, &len, &mapped);
     if (st != AMSCR_OK)
         return st;
     st = mapped ? amscr__index_load_mapped(buf, len, flags, out) : load_memory(buf, len, flags, 0, out);
@@ -556,7 +554,19 @@ amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index
     return st;
 }
 
+amscr_status amscr_index_load_with(const char *path, unsigned flags, amscr_index **out)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(path);
+    AMSCR_CHECK_NULL(out);
+    amscr_status st = check_flags(flags, "amscr_index_load_with");
+    return st == AMSCR_OK ? load_file(path, flags, out) : st;
+}
+
 amscr_status amscr_index_load(const char *path, amscr_index **out)
 {
-    return amscr_index_load_with(path, 0, out);
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(path);
+    AMSCR_CHECK_NULL(out);
+    return load_file(path, 0, out);
 }

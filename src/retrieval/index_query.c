@@ -192,11 +192,11 @@ static amscr_status best_hits(const amscr_index *x, const amscr_descriptor *q, s
                               int member, size_t *out_idx, double *out_scores, size_t *out_count, const char *fn)
 {
     amscr__clear_error();
-    AMSCR_CHECK_NULL(x);
-    AMSCR_CHECK_NULL(q);
-    AMSCR_CHECK_NULL(out_idx);
-    AMSCR_CHECK_NULL(out_scores);
-    AMSCR_CHECK_NULL(out_count);
+    AMSCR_CHECK_NULL_IN(fn, x);
+    AMSCR_CHECK_NULL_IN(fn, q);
+    AMSCR_CHECK_NULL_IN(fn, out_idx);
+    AMSCR_CHECK_NULL_IN(fn, out_scores);
+    AMSCR_CHECK_NULL_IN(fn, out_count);
     amscr_status st = check_query(x, q, NULL, 0, fn);
     size_t n = amscr_db_size(x->db), k = top < n ? top : n;
     double *all = st == AMSCR_OK ? amscr__malloc_array(n, sizeof *all) : NULL;

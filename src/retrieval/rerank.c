@@ -14,8 +14,8 @@ enum { NORM_ROW_MAX = 0, NORM_UNIT = 1 };
 static amscr_status check_args(const double *dist, size_t n, size_t k, unsigned iterations, const double *out_dist,
                                const char *what)
 {
-    AMSCR_CHECK_NULL(dist);
-    AMSCR_CHECK_NULL(out_dist);
+    AMSCR_CHECK_NULL_IN(what, dist);
+    AMSCR_CHECK_NULL_IN(what, out_dist);
     if (n == 0 || k < 1 || k > n || iterations < 1 || iterations > 1000)
         return amscr__fail(AMSCR_E_INVALID_ARG, "%s: need n >= 1, 1 <= k <= n, 1 <= iterations "
                                                 "<= 1000 (n=%zu k=%zu iterations=%u)",

@@ -92,9 +92,9 @@ static amscr_status db_query(const amscr_db *db, const amscr_descriptor *q, amsc
                              double *out_scores, size_t n, int member, const char *what)
 {
     amscr__clear_error();
-    AMSCR_CHECK_NULL(db);
-    AMSCR_CHECK_NULL(q);
-    AMSCR_CHECK_NULL(out_scores);
+    AMSCR_CHECK_NULL_IN(what, db);
+    AMSCR_CHECK_NULL_IN(what, q);
+    AMSCR_CHECK_NULL_IN(what, out_scores);
     if (n != amscr_db_size(db))
         return amscr__fail(AMSCR_E_INVALID_ARG, "%s: the output holds %zu scores, the collection %zu shapes", what,
                            n, amscr_db_size(db));

@@ -19,7 +19,8 @@ static int ct_is_space(char ch) { return ch == ' ' || ch == '\t' || ch == '\r' |
 
 /* Parses one line [s, e) (NUL at *e is guaranteed by the caller).
  * Returns 1 when it holds a point (written to p), 0 when it is blank or a comment,
- * -1 when it is malformed. */
+ * -1 when it is malformed, -2 when it holds two numbers of which one is not finite (NaN,
+ * infinity, or beyond the range of a double). */
 static int ct_parse_line(char *s, char *e, double p[2])
 {
     for (char *q = s; q < e; q++)
@@ -56,15 +57,15 @@ static int ct_parse_line(char *s, char *e, double p[2])
         if (sep && q < e && !ct_is_space(*q) && *q != ',') {
             char *end2 = NULL;
             double y = strtod(q, &end2);
-            if (end2 != q && end2 == e && isfinite(x) && isfinite(y)) {
+            if (end2 != q && end2 == e) {
                 p[0] = x;
                 p[1] = y;
-                ok = 1;
+                ok = isfinite(x) && isfinite(y) ? 1 : -2;
             }
         }
     }
     *e = saved;
-    return ok ? 1 : -1;
+    return ok ? ok : -1;
 }
 
 /* Parses a NUL-terminated, writable buffer of len bytes (the NUL at buf[len] is extra).
@@ -84,10 +85,11 @@ static amscr_status ct_parse_buffer(char *buf, size_t len, const char *path, ams
         double pt[2];
         int r = ct_parse_line(p, le, pt);
         if (r < 0) {
+            const char *what = r == -1 ? "expected 2 numbers" : "a coordinate is not a finite number";
             free(xy);
             if (path)
-                return amscr__fail(AMSCR_E_FORMAT, "%s:%zu: expected 2 numbers", path, line);
-            return amscr__fail(AMSCR_E_FORMAT, "line %zu: expected 2 numbers", line);
+                return amscr__fail(AMSCR_E_FORMAT, "%s:%zu: %s", path, line, what);
+            return amscr__fail(AMSCR_E_FORMAT, "line %zu: %s", line, what);
         }
         if (r > 0) {
             if (n >= AMSCR_MAX_POINTS) {

@@ -297,8 +297,8 @@ static amscr_status chain_tracer(void *vctx, const regions *R, size_t r, double 
 static amscr_status check_args(const uint8_t *pixels, size_t width, size_t height, size_t stride, int threshold,
                                double min_area, amscr_contour_set **out)
 {
-    AMSCR_CHECK_NULL(pixels);
-    AMSCR_CHECK_NULL(out);
+    AMSCR_CHECK_NULL_IN("amscr_contours_from_mask", pixels);
+    AMSCR_CHECK_NULL_IN("amscr_contours_from_mask", out);
     if (width == 0 || height == 0)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_contours_from_mask: empty image (%zu x %zu)", width, height);
     if (width > AMSCR_MAX_IMAGE_SIDE || height > AMSCR_MAX_IMAGE_SIDE || width * height > AMSCR_MAX_IMAGE_PIXELS)
