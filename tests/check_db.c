@@ -813,6 +813,8 @@ START_TEST(cancel_writes_no_output)
     prog_rec r;
     prog_init(&r, 2); /* one row is done before the stop */
     ck_assert_int_eq(amscr_db_distance_matrix(db, prog_cb, &r, m), AMSCR_E_CANCELLED);
+    /* the detail counts in the callback's unit: distances (cells), not rows */
+    ck_assert_msg(strstr(amscr_last_error_detail(), "of 144 distances") != NULL, "%s", amscr_last_error_detail());
     size_t written = 0;
     for (size_t i = 0; i < n * n; i++)
         written += !isnan(m[i]);
@@ -822,6 +824,52 @@ START_TEST(cancel_writes_no_output)
     free_descs(d, n);
     amscr_db_free(db);
     amscr_params_free(p);
+}
+END_TEST
+
+/* Every one of the n values is -7 (untouched) or not NaN: counts the NaN ones. */
+static size_t count_nan(const double *v, size_t n)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++)
+        k += isnan(v[i]) != 0;
+    return k;
+}
+
+/* The NaN rule holds for argument errors too (an incompatible or NULL query, a collection of
+ * open curves for the channel, a single group), not only for cancellation. */
+START_TEST(argument_errors_write_nan)
+{
+    const size_t n = 6;
+    amscr_params *p = small_params(1), *p64 = make_params(64, SCALES3, 3, 1), *open = small_params(1);
+    ck_assert_int_eq(amscr_params_set_closed(open, 0), AMSCR_OK);
+    amscr_descriptor **d = make_descs(p, n, 1401), **d64 = make_descs(p64, 2, 1402), **dopen = make_descs(open, n, 1403);
+    amscr_db *db = db_from(p, d, n), *db64 = db_from(p64, d64, 2), *dbopen = db_from(open, dopen, n);
+    double m[36];
+    const int32_t one_group[6] = {0, 0, 0, 0, 0, 0};
+    for (int c = 0; c < 5; c++) {
+        for (size_t i = 0; i < 36; i++)
+            m[i] = -7.0;
+        size_t cells = c == 0 || c == 1 ? n : c == 2 ? 2 * n : n * n;
+        amscr_status st = c == 0   ? amscr_db_query(db, d64[0], NULL, NULL, m)
+                          : c == 1 ? amscr_db_query(db, NULL, NULL, NULL, m)
+                          : c == 2 ? amscr_db_cross_distances(db64, db, NULL, NULL, m)
+                          : c == 3 ? amscr_db_channel_matrix(dbopen, NULL, NULL, m)
+                                   : amscr_db_retrieval_matrix_heldout(db, one_group, n, NULL, NULL, m);
+        ck_assert_msg(st == AMSCR_E_INVALID_ARG, "case %d: %s", c, amscr_strerror(st));
+        ck_assert_msg(count_nan(m, cells) == cells, "case %d: %zu of %zu cells NaN", c, count_nan(m, cells), cells);
+        for (size_t i = cells; i < 36; i++) /* nothing past the output */
+            ck_assert_double_eq(m[i], -7.0);
+    }
+    amscr_db_free(db);
+    amscr_db_free(db64);
+    amscr_db_free(dbopen);
+    free_descs(d, n);
+    free_descs(d64, 2);
+    free_descs(dopen, n);
+    amscr_params_free(p);
+    amscr_params_free(p64);
+    amscr_params_free(open);
 }
 END_TEST
 
@@ -1854,6 +1902,7 @@ Suite *amscr_suite_db(void)
     tcase_add_test(tc, progress_contract);
     tcase_add_test(tc, cancellation);
     tcase_add_test(tc, cancel_writes_no_output);
+    tcase_add_test(tc, argument_errors_write_nan);
     tcase_add_test(tc, progress_first_report_is_zero);
     suite_add_tcase(s, tc);
 

@@ -96,6 +96,14 @@ void *amscr__calloc_array(size_t n, size_t size)
     return calloc(n, size);
 }
 
+amscr_status amscr__nan_on_failure(amscr_status st, double *out, size_t rows, size_t cols)
+{
+    if (st != AMSCR_OK && out && (cols == 0 || rows <= SIZE_MAX / cols))
+        for (size_t i = 0; i < rows * cols; i++)
+            out[i] = NAN;
+    return st;
+}
+
 int amscr__all_finite(const double *v, size_t n)
 {
     for (size_t i = 0; i < n; i++)

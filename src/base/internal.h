@@ -57,6 +57,9 @@ void amscr__clear_error(void);
 void *amscr__malloc_array(size_t n, size_t size);
 void *amscr__calloc_array(size_t n, size_t size);
 int amscr__all_finite(const double *v, size_t n);
+/* st, after setting every element of the rows x cols output out to NaN when st is a failure (a
+ * batch call's contract: never a stale or partial output); out NULL: nothing set. */
+amscr_status amscr__nan_on_failure(amscr_status st, double *out, size_t rows, size_t cols);
 
 /* ---- objects ---------------------------------------------------------- */
 struct amscr_contour {

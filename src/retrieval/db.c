@@ -370,13 +370,11 @@ const amscr_descriptor *amscr_db_descriptor(const amscr_db *db, size_t i)
 
 const amscr_params *amscr_db_params(const amscr_db *db) { return db ? &db->params : NULL; }
 
-amscr_status amscr_db_query(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress, void *user,
-                            double *out_dist)
+/* amscr_db_query once db and out_dist are known. */
+static amscr_status db_query(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress, void *user,
+                             double *out_dist)
 {
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(db);
-    AMSCR_CHECK_NULL(q);
-    AMSCR_CHECK_NULL(out_dist);
+    AMSCR_CHECK_NULL_IN("amscr_db_query", q);
     if (!amscr__params_compatible(&db->params, &q->params, "amscr_db_query"))
         return AMSCR_E_INVALID_ARG;
     amscr_status st = amscr__db_decode_all(db);
@@ -386,6 +384,15 @@ amscr_status amscr_db_query(const amscr_db *db, const amscr_descriptor *q, amscr
                                  out_dist);
 }
 
+amscr_status amscr_db_query(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress, void *user,
+                            double *out_dist)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(db);
+    AMSCR_CHECK_NULL(out_dist);
+    return amscr__nan_on_failure(db_query(db, q, progress, user, out_dist), out_dist, 1, db->n);
+}
+
 amscr_status amscr_db_distance_matrix(const amscr_db *db, amscr_progress_fn progress, void *user, double *out_dist)
 {
     amscr__clear_error();
@@ -393,7 +400,7 @@ amscr_status amscr_db_distance_matrix(const amscr_db *db, amscr_progress_fn prog
     AMSCR_CHECK_NULL(out_dist);
     amscr_status st = amscr__db_decode_all(db);
     if (st != AMSCR_OK)
-        return st;
+        return amscr__nan_on_failure(st, out_dist, db->n, db->n);
     if (db->n == 1) {
         if (progress && progress(user, 1, 1) != 0) {
             out_dist[0] = NAN;
@@ -406,13 +413,10 @@ amscr_status amscr_db_distance_matrix(const amscr_db *db, amscr_progress_fn prog
     return amscr__distance_cells(&db->params, all, db->n, all, db->n, 1, progress, user, out_dist);
 }
 
-amscr_status amscr_db_cross_distances(const amscr_db *queries, const amscr_db *targets, amscr_progress_fn progress,
-                                      void *user, double *out_dist)
+/* amscr_db_cross_distances once its arguments are known. */
+static amscr_status cross_distances(const amscr_db *queries, const amscr_db *targets, amscr_progress_fn progress,
+                                    void *user, double *out_dist)
 {
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(queries);
-    AMSCR_CHECK_NULL(targets);
-    AMSCR_CHECK_NULL(out_dist);
     if (!amscr__params_compatible(&queries->params, &targets->params, "amscr_db_cross_distances"))
         return AMSCR_E_INVALID_ARG;
     amscr_status st = amscr__db_decode_all(queries);
@@ -422,4 +426,15 @@ amscr_status amscr_db_cross_distances(const amscr_db *queries, const amscr_db *t
         return st;
     return amscr__distance_cells(&queries->params, (const amscr_descriptor *const *)queries->d, queries->n,
                                  (const amscr_descriptor *const *)targets->d, targets->n, 0, progress, user, out_dist);
+}
+
+amscr_status amscr_db_cross_distances(const amscr_db *queries, const amscr_db *targets, amscr_progress_fn progress,
+                                      void *user, double *out_dist)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(queries);
+    AMSCR_CHECK_NULL(targets);
+    AMSCR_CHECK_NULL(out_dist);
+    return amscr__nan_on_failure(cross_distances(queries, targets, progress, user, out_dist), out_dist, queries->n,
+                                 targets->n);
 }

@@ -115,6 +115,12 @@ static void batch_setup(batch_t *b)
     b->detail[0] = '\0';
 }
 
+/* The cells of `done` items: the unit of the progress callback and of the cancel's detail. */
+static size_t batch_cells(const batch_t *b, size_t done)
+{
+    return b->nrows == 1 ? (done * b->cols_per_item < b->ncols ? done * b->cols_per_item : b->ncols) : done * b->ncols;
+}
+
 /* The calling thread's report of the cells done so far, when it changed since *last (a
  * callback asking to stop sets b->cancel). */
 static void batch_report(batch_t *b, amscr_progress_fn progress, void *user, size_t *last)
@@ -125,9 +131,7 @@ static void batch_report(batch_t *b, amscr_progress_fn progress, void *user, siz
     if (done == *last)
         return;
     *last = done;
-    size_t cells = b->nrows == 1 ? (done * b->cols_per_item < b->ncols ? done * b->cols_per_item : b->ncols)
-                                 : done * b->ncols;
-    if (progress(user, cells, b->nrows * b->ncols) != 0) {
+    if (progress(user, batch_cells(b, done), b->nrows * b->ncols) != 0) {
         pthread_mutex_lock(&b->lock);
         b->cancel = 1;
         pthread_mutex_unlock(&b->lock);
@@ -167,8 +171,9 @@ static amscr_status batch_result(batch_t *b, amscr_progress_fn progress, void *u
             b->out[i] = NAN;
         if (b->status != AMSCR_OK)
             return amscr__fail(b->status, "%s", b->detail);
-        return amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback after %zu of %zu items", b->done,
-                           b->nitems);
+        return amscr__fail(AMSCR_E_CANCELLED,
+                           "cancelled by the progress callback after %zu of %zu distances (every output set to NaN)",
+                           batch_cells(b, b->done), total_cells);
     }
     if (progress && last != b->nitems)
         if (progress(user, total_cells, total_cells) != 0)

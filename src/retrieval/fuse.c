@@ -232,10 +232,7 @@ static amscr_status channel_matrix(const amscr_db *db, amscr_progress_fn progres
         st = matrix_in_frame(db, frames[1], 1, progress ? stage_cb : NULL, &sp, second);
     for (size_t i = 0; st == AMSCR_OK && i < n * n; i++)
         out[i] = amscr__channel_combine(p, nf, share, out[i], second[i]);
-    if (st != AMSCR_OK)
-        for (size_t i = 0; i < n * n; i++)
-            out[i] = NAN;
-    free(second);
+    free(second); /* NaN on failure: amscr_db_channel_matrix */
     return st;
 }
 
@@ -244,7 +241,8 @@ amscr_status amscr_db_channel_matrix(const amscr_db *db, amscr_progress_fn progr
     amscr__clear_error();
     AMSCR_CHECK_NULL(db);
     AMSCR_CHECK_NULL(out_dist);
-    return channel_matrix(db, progress, user, out_dist);
+    size_t n = amscr_db_size(db);
+    return amscr__nan_on_failure(channel_matrix(db, progress, user, out_dist), out_dist, n, n);
 }
 
 /* ------------------------------------------------------------ fusion */
@@ -378,8 +376,5 @@ amscr_status amscr_db_retrieval_matrix(const amscr_db *db, amscr_progress_fn pro
     amscr_status st = amscr__base_matrix(db, progress, user, out_dist, med);
     if (st == AMSCR_OK && n > 0 && p->rerank_k > 0)
         st = rerank_base(db, n, out_dist);
-    if (st != AMSCR_OK)
-        for (size_t i = 0; i < n * n; i++)
-            out_dist[i] = NAN;
-    return st;
+    return amscr__nan_on_failure(st, out_dist, n, n);
 }

@@ -133,16 +133,11 @@ static amscr_status ho_group(const amscr_db *db, const int32_t *groups, int32_t 
     return st;
 }
 
-amscr_status amscr_db_retrieval_matrix_heldout(const amscr_db *db, const int32_t *groups, size_t n,
-                                               amscr_progress_fn progress, void *user, double *out_dist)
+/* amscr_db_retrieval_matrix_heldout once its arguments are checked. */
+static amscr_status heldout(const amscr_db *db, const int32_t *groups, size_t n, amscr_progress_fn progress,
+                            void *user, double *out_dist)
 {
     static const char fn[] = "amscr_db_retrieval_matrix_heldout";
-    amscr__clear_error();
-    AMSCR_CHECK_NULL(db);
-    AMSCR_CHECK_NULL(groups);
-    AMSCR_CHECK_NULL(out_dist);
-    if (n != amscr_db_size(db))
-        return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %zu groups for %zu shapes", fn, n, amscr_db_size(db));
     size_t distinct = 0;
     for (size_t i = 0; i < n && distinct < 2; i++)
         distinct = groups[i] != groups[0] ? 2 : 1;
@@ -165,8 +160,18 @@ amscr_status amscr_db_retrieval_matrix_heldout(const amscr_db *db, const int32_t
     }
     free(done);
     ho_free(&b);
-    if (st != AMSCR_OK)
-        for (size_t i = 0; i < n * n; i++)
-            out_dist[i] = NAN;
     return st;
+}
+
+amscr_status amscr_db_retrieval_matrix_heldout(const amscr_db *db, const int32_t *groups, size_t n,
+                                               amscr_progress_fn progress, void *user, double *out_dist)
+{
+    amscr__clear_error();
+    AMSCR_CHECK_NULL(db);
+    AMSCR_CHECK_NULL(groups);
+    AMSCR_CHECK_NULL(out_dist);
+    if (n != amscr_db_size(db)) /* the output's size is not known: nothing set */
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_db_retrieval_matrix_heldout: %zu groups for %zu shapes", n,
+                           amscr_db_size(db));
+    return amscr__nan_on_failure(heldout(db, groups, n, progress, user, out_dist), out_dist, n, n);
 }
