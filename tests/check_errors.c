@@ -1,6 +1,7 @@
 /* check_errors.c — status codes, their descriptions, and the per-thread error detail. */
 #include <amscr.h>
 #include <check.h>
+#include <math.h>
 #include <pthread.h>
 #include <string.h>
 
@@ -250,6 +251,37 @@ START_TEST(test_detail_names_the_call_and_the_value)
 }
 END_TEST
 
+/* Flags are int 0 or 1 (the header's Conventions): every call taking `closed` refuses 2 and -1
+ * by name, as amscr_params_set_closed does. */
+START_TEST(test_flags_are_zero_or_one)
+{
+    double xy[32], out[64], total;
+    for (int i = 0; i < 16; i++) { /* an ellipse of 16 points */
+        xy[2 * i] = 20.0 * cos(0.39269908169872414 * i);
+        xy[2 * i + 1] = 9.0 * sin(0.39269908169872414 * i);
+    }
+    amscr_contour *c = NULL;
+    ck_assert_int_eq(amscr_contour_new(xy, 16, &c), AMSCR_OK);
+    const int bad[2] = {2, -1};
+    for (int i = 0; i < 2; i++) {
+        int f = bad[i];
+        FAILS_WITH(amscr_contour_validate(c, f), AMSCR_E_INVALID_ARG,
+                   f == 2 ? "amscr_contour_validate: closed = 2 is not 0 or 1"
+                          : "amscr_contour_validate: closed = -1 is not 0 or 1");
+        ck_assert_int_eq(amscr_smooth_gaussian(xy, 16, f, 1.0, out), AMSCR_E_INVALID_ARG);
+        ck_assert_int_eq(amscr_resample_euclidean(xy, 16, f, 16, out), AMSCR_E_INVALID_ARG);
+        ck_assert_int_eq(amscr_affine_arclength(xy, 16, f, 0.0, out, &total), AMSCR_E_INVALID_ARG);
+        ck_assert_int_eq(amscr_resample_affine(xy, 16, f, 0.0, 1, 16, out), AMSCR_E_INVALID_ARG);
+    }
+    for (int f = 0; f <= 1; f++) {
+        ck_assert_int_eq(amscr_contour_validate(c, f), AMSCR_OK);
+        ck_assert_int_eq(amscr_smooth_gaussian(xy, 16, f, 1.0, out), AMSCR_OK);
+        ck_assert_int_eq(amscr_resample_euclidean(xy, 16, f, 16, out), AMSCR_OK);
+    }
+    amscr_contour_free(c);
+}
+END_TEST
+
 Suite *amscr_suite_errors(void)
 {
     Suite *s = suite_create("errors");
@@ -267,6 +299,7 @@ Suite *amscr_suite_errors(void)
     tcase_add_test(td, test_detail_is_per_thread);
     tcase_add_test(td, test_detail_concurrent_threads);
     tcase_add_test(td, test_detail_names_the_call_and_the_value);
+    tcase_add_test(td, test_flags_are_zero_or_one);
     suite_add_tcase(s, td);
     return s;
 }

@@ -25,6 +25,15 @@ void amscr__clear_error(void);
             return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %s is NULL", __func__, #ptr);         \
     } while (0)
 
+/* Returns AMSCR_E_INVALID_ARG from the calling public function when the flag v is not 0 or 1
+ * (flags are int 0 or 1: amscr.h, Conventions). */
+#define AMSCR_CHECK_FLAG(v)                                                                    \
+    do {                                                                                       \
+        if ((v) != 0 && (v) != 1)                                                              \
+            return amscr__fail(AMSCR_E_INVALID_ARG, "%s: %s = %d is not 0 or 1", __func__, #v,   \
+                               (int)(v));                                                      \
+    } while (0)
+
 /* As AMSCR_CHECK_NULL in a helper of the public function named by the string fn. */
 #define AMSCR_CHECK_NULL_IN(fn, ptr)                                                           \
     do {                                                                                       \

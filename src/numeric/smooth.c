@@ -124,13 +124,14 @@ amscr_status amscr_smooth_gaussian(const double *xy, size_t n, int closed, doubl
     amscr__clear_error();
     AMSCR_CHECK_NULL(xy);
     AMSCR_CHECK_NULL(out_xy);
+    AMSCR_CHECK_FLAG(closed);
     if (n == 0)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_smooth_gaussian: no points");
     if (!(sigma >= 0.0) || !(sigma <= 1e6))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_smooth_gaussian: sigma = %g must be in [0, 1e6]", sigma);
     if (!amscr__all_finite(xy, 2 * n))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_smooth_gaussian: non-finite coordinates");
-    return amscr__smooth(xy, n, closed ? 1 : 0, sigma, out_xy);
+    return amscr__smooth(xy, n, closed, sigma, out_xy);
 }
 
 /* Box smoothing of one pass: out[i] = mean of in[i-r .. i+r] (circular, or mirrored at open

@@ -167,5 +167,6 @@ amscr_status amscr_contour_validate(const amscr_contour *c, int closed)
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(c);
+    AMSCR_CHECK_FLAG(closed);
     return amscr__validate_points(c->xy, c->n, closed, "contour");
 }

@@ -76,11 +76,12 @@ amscr_status amscr_resample_euclidean(const double *xy, size_t n, int closed, si
     amscr__clear_error();
     AMSCR_CHECK_NULL(xy);
     AMSCR_CHECK_NULL(out_xy);
+    AMSCR_CHECK_FLAG(closed);
     if (n < 2 || m < 2)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_resample_euclidean: n = %zu and m = %zu must be >= 2", n, m);
     if (!amscr__all_finite(xy, 2 * n))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_resample_euclidean: non-finite coordinates");
-    return amscr__resample_euclid(xy, n, closed ? 1 : 0, m, out_xy);
+    return amscr__resample_euclid(xy, n, closed, m, out_xy);
 }
 
 /* Affine speed at each sample of an (already smoothed) uniformly indexed curve, and the
@@ -142,6 +143,7 @@ amscr_status amscr_affine_arclength(const double *xy, size_t n, int closed, doub
     AMSCR_CHECK_NULL(xy);
     AMSCR_CHECK_NULL(out_cumulative);
     AMSCR_CHECK_NULL(out_total);
+    AMSCR_CHECK_FLAG(closed);
     if (n < 5)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_affine_arclength: %zu points, at least 5 needed", n);
     if (!(sigma0 >= 0.0) || !(sigma0 <= 1e6))
@@ -370,6 +372,7 @@ amscr_status amscr_resample_affine(const double *xy, size_t n, int closed, doubl
     amscr__clear_error();
     AMSCR_CHECK_NULL(xy);
     AMSCR_CHECK_NULL(out_xy);
+    AMSCR_CHECK_FLAG(closed);
     if (n < 5 || m < 4)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_resample_affine: n = %zu (>= 5) and m = %zu (>= 4)", n, m);
     if (!(sigma0 >= 0.0) || !(sigma0 <= 0.25))
