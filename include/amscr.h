@@ -2199,7 +2199,8 @@ AMSCR_API double amscr_result_confidence(const amscr_result *r);
  *        under the map and the target's, computed from the sampled contours without images.
  *        1 for a perfect match; about 1 - the damaged share of the area when part of the
  *        target is missing or an object touches it; low for a wrong map.
- * @return the value; NaN for NULL or a partial match (an open source encloses no region).
+ * @return the value; NaN for NULL, a partial match or open curves (closed 0: an open curve
+ *         encloses no region).
  * Ownership: none.
  * Thread-safety: const.
  * @since 0.14
@@ -2312,7 +2313,11 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_part(const amscr_result *r, 
 
 /**
  * @brief Dense correspondences: for each of the N source samples, the matched target point,
- *        the closest point of the target's boundary to the sample's image under the map.
+ *        the closest point of the target's boundary to the sample's image under the map. The
+ *        boundary is the target's N samples joined by straight edges: its points lie on the
+ *        target's input polygon at the samples, and between them cut its corners by up to
+ *        about a sample spacing at a sharp corner (most visible in a partial match, whose
+ *        fragment is sampled more densely than the target).
  * @param[out]    out_src_xy  2N values: the source samples, input coordinates (may be NULL).
  * @param[out]    out_param   N values: the target boundary parameters, fractions as in
  *                            amscr_result_part (may be NULL).

@@ -77,7 +77,7 @@ class Registration:
             the pixels each map gets wrong.
         inlier_fraction: share of source samples within 5 % of the target's size of its boundary.
         overlap: intersection over union of the two contours as regions under the map (NaN for
-            a partial match).
+            a partial match or open curves).
         backward_error: when the map is confident but less than 85 % of the shape agrees, the
             target registered onto the source on its own and composed with the map: the RMS
             displacement of the source samples, in units of its RMS radius (about 0 when the
@@ -107,7 +107,9 @@ class Registration:
             (the start-point search's cap): a circle or an ellipse lists 12 (24 with reflections).
         correspondences: (N,) target boundary parameter (fraction) matched to each source sample.
         source_samples: (N, 2) the source samples (input coordinates).
-        target_points: (N, 2) the matched target boundary points (input coordinates).
+        target_points: (N, 2) the matched target boundary points (input coordinates): on the
+            target's N samples joined by straight edges, which cut the input polygon's sharp
+            corners by up to about a sample spacing.
     """
 
     def __init__(self, handle, scales: np.ndarray):
