@@ -136,7 +136,7 @@ class ShardedIndex:
     """An index split in shards held by the workers of a Dask cluster (see
     :func:`amscr.distributed.build_index`). Its scores equal the single index's
     (``amscr.Index(collection, candidates=M)`` queried with ``candidates=M``, M the build's),
-    to rounding, but for a member's copy (scored as a new shape: no member rule).
+    to rounding; a member's copy is scored as that member (the member rule), as there.
 
     Attributes:
         bounds: each shard's (first, end) shapes in the whole collection.

@@ -10,7 +10,7 @@ import numpy as np
 from ._lib import ffi, lib
 from ._util import ProgressArg, RWLock, as_points, as_uint, bad, dbuf, factorize, new_object, progress_call, saved_bytes
 from .contour import contour_new
-from .errors import _check
+from .errors import AmscrError, _check
 from .params import Params, make_params
 from .shape import PointsLike, Shape, as_shape
 
@@ -134,8 +134,10 @@ class Collection:
         labels = [0] * len(shapes) if labels is None else list(labels)
         if len(labels) != len(shapes):
             raise bad('extend: %d shapes but %d labels' % (len(shapes), len(labels)))
-        if not shapes or any(isinstance(s, Shape) for s in shapes):
-            return [self.add(s, lab, order=order) for s, lab in zip(shapes, labels)]
+        if not shapes:
+            return []
+        if any(isinstance(s, Shape) for s in shapes):
+            return self._extend_shapes(shapes, labels, order)
         closed = self._closed()
         contours = [contour_new(as_points(s, 'shapes[%d]' % i, order, closed_shape=closed))
                     for i, s in enumerate(shapes)]
@@ -151,6 +153,33 @@ class Collection:
                 self._label_names, self._label_codes, self._int_labels = kept
                 raise
             return list(range(first, first + len(contours)))
+
+    def _extend_shapes(self, shapes: List[Any], labels: List[Any], order: str) -> List[int]:
+        """extend of a list holding prepared Shapes: every point array is prepared and every
+        shape is tried in a scratch collection (the params must be the collection's) before
+        one is added, so a bad shape adds none and is named by its position."""
+        params, scratch = self.params, _new_db(lib.amscr_db_new, self.params._p)
+        prepared = []
+        for i, s in enumerate(shapes):
+            try:
+                prepared.append(as_shape(s, params, 'shapes[%d]' % i, order))
+                _check(lib.amscr_db_add_descriptor(scratch, prepared[-1]._d, 0, ffi.NULL))
+            except AmscrError as e:
+                where = 'shapes[%d]' % i
+                msg = e.message if where in e.message else '%s: %s' % (where, e.message)
+                raise type(e)(msg, e.status, e.detail) from None
+        with self._lock.write():
+            kept = (None if self._label_names is None else list(self._label_names), dict(self._label_codes),
+                    self._int_labels)
+            try:
+                codes = [self._label_code(lab) for lab in labels]
+                first = len(self)
+                for s, code in zip(prepared, codes):
+                    _check(lib.amscr_db_add_descriptor(self._db, s._d, code, ffi.NULL))
+            except BaseException:
+                self._label_names, self._label_codes, self._int_labels = kept
+                raise
+            return list(range(first, first + len(prepared)))
 
     # -- reading ----------------------------------------------------------------------
     def __len__(self) -> int:

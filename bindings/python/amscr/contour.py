@@ -59,29 +59,58 @@ def _take(c) -> np.ndarray:
     return pts
 
 
-def _image_and_level(mask: ArrayLike, threshold: Union[int, float, str, None],
-                     subpixel: bool) -> Tuple[np.ndarray, int, float, int]:
-    """A C-contiguous uint8 or uint16 copy of `mask`, its bits, the C level and flags (see
-    :func:`contour_from_mask`)."""
+class _Image(NamedTuple):
+    """A mask made ready for the C tracer: its samples, their bits, the iso-level, the trace
+    flags, and the offset to take off the traced points (1 when a bool mask was padded)."""
+    a: np.ndarray
+    bits: int
+    level: float
+    flags: int
+    offset: int
+
+
+def _float_level(lo: float, hi: float, threshold: Any) -> float:
+    """The 16-bit level of a float image of values lo..hi mapped onto 0..65535: `threshold` in
+    the array's units, by default 0.5 for values in 0..1 (scikit-image's float images), else
+    halfway between 0 (or lo, when negative) and hi (127.5 for a 0..255 image)."""
+    if threshold is None:
+        t = 0.5 if hi <= 1.0 else (hi / 2.0 if lo >= 0.0 else (lo + hi) / 2.0)
+    else:
+        t = as_scalar(threshold, 'threshold')
+    level = 32767.5 if hi <= lo else (t - lo) * 65535.0 / (hi - lo)
+    if not 0.0 <= level < 65535.0:
+        raise bad('threshold: %g is outside the values of the image (%g..%g)' % (t, lo, hi))
+    return level
+
+
+def _as_samples(mask: ArrayLike, threshold: Any) -> Tuple[np.ndarray, Optional[Tuple[float, float]], int]:
+    """(uint8 or uint16 samples, the (lo, hi) of a float image mapped onto 16 bits or None, the
+    padding): a bool mask becomes 0/255 padded with one pixel of background, since True is the
+    foreground even where it covers the image border (no automatic polarity)."""
     a = np.asarray(mask)
     if a.ndim != 2:
         raise bad('mask: expected a 2-D array, got shape %s' % (a.shape,))
-    scale = None  # float images: (lo, hi) mapped to 0..65535
     if a.dtype == np.bool_:
-        a = np.where(a, np.uint8(255), np.uint8(0))
-    elif a.dtype.kind == 'f':
+        return np.pad(a.astype(np.uint8) * np.uint8(255), 1), None, 1
+    if a.dtype.kind == 'f':
         if a.size and not np.all(np.isfinite(a)):
             raise bad('mask: non-finite values')
         a = a.astype(np.float64)  # float16 cannot hold the scale to 65535
         lo, hi = (float(a.min()), float(a.max())) if a.size else (0.0, 1.0)
-        scale = (lo, hi)
-        a = np.zeros(a.shape, np.uint16) if hi <= lo else np.rint((a - lo) * (65535.0 / (hi - lo))).astype(np.uint16)
-    elif a.dtype not in (np.uint8, np.uint16):
-        if a.dtype.kind not in 'iu':
-            raise bad('mask: expected a bool, integer or float array, got dtype %s' % a.dtype)
-        if a.size and (a.min() < 0 or a.max() > 65535):
-            raise bad('mask: values must be in 0..65535 for dtype %s (got %d..%d)' % (a.dtype, a.min(), a.max()))
-        a = a.astype(np.uint8 if not a.size or a.max() <= 255 else np.uint16)
+        scaled = np.zeros(a.shape, np.uint16) if hi <= lo else np.rint((a - lo) * (65535.0 / (hi - lo)))
+        return scaled.astype(np.uint16), (lo, hi), 0
+    if a.dtype.kind not in 'iu':
+        raise bad('mask: expected a bool, integer or float array, got dtype %s' % a.dtype)
+    if a.dtype != np.uint8 and a.size and (a.min() < 0 or a.max() > 65535):
+        raise bad('mask: values must be in 0..65535 for dtype %s (got %d..%d)' % (a.dtype, a.min(), a.max()))
+    if a.dtype == np.uint8 or (a.dtype == np.uint16 and threshold is not None):  # a 16-bit level given
+        return a, None, 0
+    return a.astype(np.uint8 if not a.size or a.max() <= 255 else np.uint16), None, 0
+
+
+def _image_and_level(mask: ArrayLike, threshold: Union[int, float, str, None], subpixel: bool) -> _Image:
+    """The mask ready for the C tracer (see :func:`contour_from_mask`)."""
+    a, scale, pad = _as_samples(mask, threshold)
     a = np.ascontiguousarray(a)
     bits = 16 if a.dtype == np.uint16 else 8
     top = 65535 if bits == 16 else 255
@@ -89,20 +118,15 @@ def _image_and_level(mask: ArrayLike, threshold: Union[int, float, str, None],
     if isinstance(threshold, str):
         if threshold.strip().lower() not in ('auto', 'otsu'):
             raise bad("threshold: expected a level, 'auto' or None, got %r" % threshold)
-        return a, bits, -1.0, flags
+        return _Image(a, bits, -1.0, flags, pad)
     if scale is not None:  # a level in the array's units
-        lo, hi = scale
-        t = 0.5 if threshold is None else as_scalar(threshold, 'threshold')
-        level = 32767.5 if hi <= lo else (t - lo) * 65535.0 / (hi - lo)
-        if not 0.0 <= level < 65535.0:
-            raise bad('threshold: %g is outside the values of the image (%g..%g)' % (t, lo, hi))
-        return a, bits, level, flags
+        return _Image(a, bits, _float_level(scale[0], scale[1], threshold), flags, pad)
     if threshold is None and a.size and int(a.max()) <= 1:  # a 0/1 mask (mask.astype(np.uint8))
-        return a, bits, 0.5, flags
+        return _Image(a, bits, 0.5, flags, pad)
     thr = (top // 2) if threshold is None else as_count(threshold, 'threshold', 0)
     if thr > top - 1:
         raise bad('threshold: expected 0..%d, got %d' % (top - 1, thr))
-    return a, bits, thr + 0.5, flags
+    return _Image(a, bits, 127.5 if pad else thr + 0.5, flags, pad)  # a bool: every threshold the same
 
 
 def _traced(a: np.ndarray, level: float, call: Any, *args: Any) -> Any:
@@ -124,15 +148,20 @@ def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] =
     """Outer boundary of the largest 8-connected foreground component of a 2-D image.
 
     Args:
-        mask: 2-D NumPy array, any strides or order: ``bool`` (True = foreground), ``uint8``,
-            ``uint16`` (other integer arrays with values in 0..65535 are accepted too), or
-            ``float`` (any range: mapped linearly onto 16 bits).
+        mask: 2-D NumPy array, any strides or order: ``bool`` (True = foreground, also where
+            it covers most of the image border), ``uint8``, ``uint16`` (other integer arrays
+            with values in 0..65535 are accepted too), or ``float`` (any range: mapped linearly
+            onto 16 bits).
         threshold: integer images: a pixel is "on" when its value is > threshold (0..254 for
             8 bits, 0..65534 for 16 bits; None: 0 when every value is 0 or 1, a 0/1 mask as
-            ``mask.astype(np.uint8)`` gives, else 127, the ``amscr`` tool's default, or 32767);
-            float images: the level in the array's units (None: 0.5); ``'auto'`` for Otsu's
-            split (the level halfway between the two classes' medians). The polarity is
-            automatic: if most of the image border is "on", on and off are swapped.
+            ``mask.astype(np.uint8)`` gives, else 127, the ``amscr`` tool's default, or 32767
+            for values past 255); float images: the level in the array's units (None: 0.5 for
+            values in 0..1, scikit-image's float images, else halfway between 0 and the largest
+            value: 127.5 for ``img.astype(np.float32)`` of an 8-bit image); ``'auto'`` for
+            Otsu's split (the level halfway between the two classes' medians); no effect on a
+            bool mask, traced halfway between its pixels. The polarity of integer and float
+            images is automatic: if most of the image border is "on", on and off are swapped
+            (a bool mask is never swapped).
         subpixel: True (default): the iso-line at the level (threshold + 0.5 for integer
             images) by marching squares, to sub-pixel accuracy on grey and antialiased edges
             (a binary edge lies halfway between pixel centres); False: the chain of boundary
@@ -146,15 +175,16 @@ def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] =
         (n, 2) float array (x = column, y = row; pixel centres at integers), with positive
         signed area (counter-clockwise in a y-up frame), no repeated end point.
     Raises:
-        NotFoundError: no foreground (or foreground everywhere); DegenerateError: too small;
+        NotFoundError: no foreground (or, but for a bool mask, foreground everywhere);
+        DegenerateError: too small;
         LimitError: image too large; InvalidArgumentError: a bad mask or threshold.
     """
-    a, bits, level, flags = _image_and_level(mask, threshold, subpixel)
-    if as_bool(join, 'join'):
-        flags |= lib.AMSCR_TRACE_JOIN
-    h, w = a.shape
-    return _take(_traced(a, level, _new_contour, lib.amscr_contour_from_image, ffi.from_buffer(a), w, h, w, bits,
-                         level, flags))
+    im = _image_and_level(mask, threshold, subpixel)
+    flags = im.flags | (lib.AMSCR_TRACE_JOIN if as_bool(join, 'join') else 0)
+    h, w = im.a.shape
+    pts = _take(_traced(im.a, im.level, _new_contour, lib.amscr_contour_from_image, ffi.from_buffer(im.a), w, h, w,
+                        im.bits, im.level, flags))
+    return pts - im.offset if im.offset else pts
 
 
 class ImageContour(NamedTuple):
@@ -185,17 +215,17 @@ def contours_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] 
         NotFoundError: no foreground, foreground everywhere, or no contour of `min_area`;
         InvalidArgumentError: a bad mask, threshold or min_area; LimitError: image too large.
     """
-    a, bits, level, flags = _image_and_level(mask, threshold, subpixel)
+    im = _image_and_level(mask, threshold, subpixel)
     area = as_scalar(min_area, 'min_area')
-    h, w = a.shape
+    h, w = im.a.shape
     out = ffi.new('amscr_contour_set **')
-    _traced(a, level, lambda: _check(lib.amscr_contours_from_image(ffi.from_buffer(a), w, h, w, bits, level, flags,
-                                                                  area, out)))
+    _traced(im.a, im.level, lambda: _check(lib.amscr_contours_from_image(ffi.from_buffer(im.a), w, h, w, im.bits,
+                                                                        im.level, im.flags, area, out)))
     cs = ffi.gc(out[0], lib.amscr_contour_set_free)
     result = []
     for i in range(int(lib.amscr_contour_set_size(cs))):
         parent = int(lib.amscr_contour_set_parent(cs, i))
-        result.append(ImageContour(contour_points(lib.amscr_contour_set_contour(cs, i)),
+        result.append(ImageContour(contour_points(lib.amscr_contour_set_contour(cs, i)) - im.offset,
                                    None if parent == int(ffi.cast('size_t', -1)) else parent,
                                    bool(lib.amscr_contour_set_is_hole(cs, i)),
                                    float(lib.amscr_contour_set_area(cs, i))))

@@ -4,12 +4,15 @@ Each class also derives from the built-in exception a Python user would catch fo
 failure (``ValueError`` for bad input, ``OSError`` for files, ``MemoryError``...), so both
 ``except amscr.AmscrError`` and ``except ValueError`` work.
 """
-from typing import Dict, Optional, Type
+import errno as _errno
+import os
+from typing import Dict, Optional, Tuple, Type
 
 from ._lib import ffi, lib
 
 __all__ = [
-    'AmscrError', 'Error', 'InvalidArgumentError', 'NoMemoryError', 'FileError', 'IOError_', 'FormatError',
+    'AmscrError', 'Error', 'InvalidArgumentError', 'NoMemoryError', 'FileError', 'IOError_', 'FileNotFound',
+    'FilePermissionError', 'FileIsADirectoryError', 'FormatError',
     'UnsupportedError', 'DegenerateError', 'NumericError', 'NumericalError', 'NotConvergedError',
     'NotFoundError', 'StateError', 'InternalError', 'CancelledError', 'LimitError', 'STATUS_EXCEPTIONS',
 ]
@@ -58,6 +61,25 @@ class FileError(AmscrError, OSError):
 
 
 IOError_ = FileError
+
+
+class FileNotFound(FileError, FileNotFoundError):
+    """AMSCR_E_IO for a file that does not exist: also a ``FileNotFoundError``."""
+
+
+class FilePermissionError(FileError, PermissionError):
+    """AMSCR_E_IO for a file the process may not read or write: also a ``PermissionError``."""
+
+
+class FileIsADirectoryError(FileError, IsADirectoryError):
+    """AMSCR_E_IO for a folder given as a file: also an ``IsADirectoryError``."""
+
+
+#: errno -> the FileError subclass that is also the built-in OSError subclass for it.
+_FILE_ERRORS: Dict[int, Type[FileError]] = {
+    _errno.ENOENT: FileNotFound, _errno.EACCES: FilePermissionError, _errno.EPERM: FilePermissionError,
+    _errno.EISDIR: FileIsADirectoryError,
+}
 
 
 class FormatError(AmscrError, ValueError):
@@ -125,12 +147,30 @@ def _decode(p) -> str:
     return ffi.string(p).decode('utf-8', 'replace') if p != ffi.NULL else ''
 
 
+def _file_errno(detail: str) -> Tuple[Optional[int], str]:
+    """(errno, its text) of a file error's detail, which ends in the system's message for it
+    ("path: No such file or directory"); (None, '') when it names none."""
+    for e in (_errno.ENOENT, _errno.EACCES, _errno.EPERM, _errno.EISDIR, _errno.ENOTDIR, _errno.ENOSPC,
+              _errno.EROFS, _errno.EEXIST):
+        text = os.strerror(e)
+        if detail.endswith(': ' + text):
+            return e, text
+    return None, ''
+
+
 def error_from_status(status: int, detail: str = '') -> AmscrError:
-    """The exception for a non-zero status code, with the library's message and ``detail``."""
+    """The exception for a non-zero status code, with the library's message and ``detail``. A
+    file error whose detail names the system's reason carries its ``errno`` and ``strerror``,
+    and is also ``FileNotFoundError``, ``PermissionError`` or ``IsADirectoryError`` when it is
+    one of those."""
     status = int(status)
     message = _decode(lib.amscr_strerror(status))
     cls = STATUS_EXCEPTIONS.get(status, AmscrError)
-    return cls('%s: %s' % (message, detail) if detail else message, status, detail)
+    code, text = _file_errno(detail) if cls is FileError else (None, '')
+    err = _FILE_ERRORS.get(code, cls)('%s: %s' % (message, detail) if detail else message, status, detail)
+    if code is not None:
+        err.errno, err.strerror = code, text  # type: ignore[attr-defined]
+    return err
 
 
 def _check(status: int) -> None:

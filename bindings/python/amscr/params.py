@@ -13,7 +13,7 @@ import numpy as np
 from ._lib import ffi, lib
 from ._util import as_bool, as_count, as_float_array, as_scalar, as_uint, dbuf, new_object, sized_arrays
 from .enums import INVARIANCES, METHODS, PARAMETRIZATIONS, RANKINGS, enum_in, enum_out
-from .errors import InternalError, _check
+from .errors import InternalError, InvalidArgumentError, _check, error_from_status
 
 T = TypeVar('T')
 
@@ -52,7 +52,7 @@ class _Option(Generic[T]):
 
     def __init__(self, c_name: str, conv: _Conv[T], doc: str):
         self.conv, self.__doc__ = conv, doc
-        self.name = c_name
+        self.name = self.c_name = c_name
         self.c_get = getattr(lib, 'amscr_params_get_' + c_name)
         self.c_set = getattr(lib, 'amscr_params_set_' + c_name)
 
@@ -70,7 +70,13 @@ class _Option(Generic[T]):
         return self.conv.read(self.c_get, obj._p)
 
     def __set__(self, obj: 'Params', value: Any) -> None:
-        _check(self.c_set(obj._p, *self.conv.write(value, self.name)))
+        try:
+            _check(self.c_set(obj._p, *self.conv.write(value, self.name)))
+        except InvalidArgumentError as e:  # the library's range, under the option's Python name
+            c = 'amscr_params_set_%s: %s ' % (self.c_name, self.c_name)
+            if not e.detail.startswith(c):
+                raise
+            raise error_from_status(e.status, '%s: %s' % (self.name, e.detail[len(c):])) from None
 
 
 #: The stages of ``amscr_register`` a Params can switch (C ``amscr_params_set_stage``).

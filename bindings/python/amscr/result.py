@@ -41,8 +41,9 @@ class Alternative(NamedTuple):
 
 class Registration:
     """The result of :func:`register`: the affine map taking the source onto the target and the
-    diagnostics of scale selection. Every array is a read-only NumPy copy (nothing refers to C
-    memory; ``r.A.copy()`` gives one to modify), so the attributes stay one consistent map.
+    diagnostics of scale selection. Read-only: every array is a read-only NumPy copy (nothing
+    refers to C memory; ``r.A.copy()`` gives one to modify) and no attribute can be set, so the
+    attributes stay one consistent map.
 
     All maps are in the (x, y) frame of the input points (x = column, y = row for image
     contours, also when they were given with ``order='rc'``), the frame of OpenCV and of
@@ -150,10 +151,21 @@ class Registration:
         self._freeze()
 
     def _freeze(self) -> None:
-        """Every array of the result read-only (the mixture's and the alternatives' too)."""
+        """Every array of the result read-only (the mixture's and the alternatives' too), and
+        every attribute fixed."""
         arrays = [v for v in vars(self).values() if isinstance(v, np.ndarray)] + list(self.mixture)
         for a in arrays + [x for alt in self.alternatives for x in (alt.A, alt.B)]:
             a.setflags(write=False)
+        object.__setattr__(self, '_frozen', True)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if self.__dict__.get('_frozen'):
+            raise AttributeError('Registration is read-only: %s cannot be set (the attributes are one map; '
+                                 'copy the arrays to change them)' % name)
+        object.__setattr__(self, name, value)
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError('Registration is read-only: %s cannot be deleted' % name)
 
     def __setstate__(self, state: Dict[str, Any]) -> None:
         self.__dict__.update(state)  # unpickled arrays are writable again

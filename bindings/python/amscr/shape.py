@@ -13,7 +13,8 @@ from .params import Params, make_params
 
 class Shape:
     """A prepared shape (C ``amscr_descriptor``): resampled, parametrized, whitened and smoothed at
-    every scale once, then matched any number of times. Immutable; shareable between threads.
+    every scale once, then matched any number of times. Immutable (its point arrays are new
+    copies at every call); shareable between threads.
 
     Args:
         contour: the shape's points: an (n, 2) array of (x, y) rows (any real dtype), or an

@@ -1,4 +1,7 @@
 """Bad inputs raise the right exception types, with the C library's message."""
+import errno
+import os
+
 import numpy as np
 import pytest
 
@@ -132,3 +135,23 @@ def test_error_detail_is_per_thread():
     t1.start(), t2.start()
     t1.join(), t2.join()
     assert len(errs['a']) == 1 and len(errs['b']) == 1 and errs['a'] != errs['b']
+
+
+def test_file_errors_are_the_builtin_os_errors(tmp_path):
+    """A missing file is a FileNotFoundError (and a FileError) with its errno; a folder an
+    IsADirectoryError; every face's reader alike."""
+    missing = str(tmp_path / 'missing.txt')
+    for read in (amscr.read_points, amscr.Collection.load, amscr.Index.load):
+        with pytest.raises(FileNotFoundError) as e:
+            read(missing)
+        assert isinstance(e.value, amscr.FileError) and e.value.errno == errno.ENOENT
+        assert e.value.strerror == os.strerror(errno.ENOENT) and missing in str(e.value)
+    with pytest.raises(IsADirectoryError):
+        amscr.read_points(str(tmp_path))
+
+
+def test_option_errors_name_the_python_option():
+    with pytest.raises(amscr.InvalidArgumentError, match=r'^invalid argument: points: 3 is not in 16\.\.65536$'):
+        amscr.Params(points=3)
+    with pytest.raises(amscr.InvalidArgumentError, match=r'^invalid argument: channel_weight: 1\.5 is not in \[0, 1\]$'):
+        amscr.Params(channel_weight=1.5)

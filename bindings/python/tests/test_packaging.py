@@ -204,6 +204,15 @@ def test_command_version_and_help_of_every_subcommand():
 
 
 @installed
+def test_python_m_amscr_runs_the_tool():
+    """``python -m amscr`` is the ``amscr`` command (an environment whose bin/ is not on PATH)."""
+    r = subprocess.run([sys.executable, '-m', 'amscr', '--version'], capture_output=True, text=True)
+    assert r.returncode == 0 and r.stdout.strip() == amscr.library_version(), r.stderr
+    r = subprocess.run([sys.executable, '-m', 'amscr', 'no-such-command'], capture_output=True, text=True)
+    assert r.returncode == 2 and 'no-such-command' in r.stderr
+
+
+@installed
 def test_command_registers_like_the_package(tmp_path):
     exe = _env_command() or pytest.skip('no amscr command beside %s' % sys.executable)
     src, tgt = os.path.join(EXAMPLES, 'pair-source.txt'), os.path.join(EXAMPLES, 'pair-target.txt')

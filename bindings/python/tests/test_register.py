@@ -173,6 +173,11 @@ def test_result_arrays_are_read_only_and_pickle():
     A = r.A.copy()
     A *= 2
     assert np.allclose(A, 2 * r.A)
+    for name in ('A', 'distance', 'new_attribute'):  # nor can an attribute be set: one map
+        with pytest.raises(AttributeError, match='read-only'):
+            setattr(r, name, np.eye(2))
+    with pytest.raises(AttributeError, match='read-only'):
+        del r.B
 
 
 def test_params_roundtrip():
@@ -313,6 +318,13 @@ def test_extend_on_threads_is_add_one_by_one_and_all_or_nothing(shapes):
         assert len(many) == 12 and list(many.labels) == names
         assert many.extend([pts[0]], ['new']) == [12] and many.labels[12] == 'new'
         assert int(many.label_codes[12]) == 3  # 'new' got the next code: the failed batch left none
+        # prepared Shapes mixed in: the same rule (nothing added, the position named), also for
+        # a Shape prepared with other options
+        for bad, where in ((line, 'shapes\\[2\\]'), (amscr.Shape(pts[4], points=64), 'shapes\\[2\\].*N differs')):
+            with pytest.raises(amscr.AmscrError, match=where):
+                many.extend([amscr.Shape(pts[0], many.params), pts[1], bad], ['x', 'y', 'z'])
+            assert len(many) == 13 and 'x' not in list(many.labels)
+        assert many.extend([amscr.Shape(pts[5], many.params), pts[6]], ['bird', 'x']) == [13, 14]
 
 
 def test_collection_add_shape_and_mismatch(shapes):

@@ -40,6 +40,35 @@ def test_a_zero_one_mask_is_traced_by_default_and_a_dark_one_says_what_to_pass(d
         amscr.contour_from_mask(np.zeros((8, 8), dtype))
 
 
+def test_a_bool_mask_is_its_true_pixels_also_on_the_border():
+    """True is the foreground of a bool mask even where it covers most of the image border (an
+    integer image's automatic polarity would trace the False pixels instead); the points stay in
+    the mask's frame."""
+    m = np.zeros((80, 120), bool)
+    m[:, 10:] = True  # a tight crop: the object touches three sides
+    c = amscr.contour_from_mask(m)
+    assert amscr.signed_area(c) == pytest.approx(m.sum() - 0.5)
+    assert c.min(axis=0).tolist() == [9.5, -0.5] and c.max(axis=0).tolist() == [119.5, 79.5]
+    assert amscr.signed_area(amscr.contour_from_mask(m.astype(np.uint8) * 255)) < 1000  # swapped: the strip
+    chain = amscr.contour_from_mask(m, subpixel=False)
+    assert chain.min(axis=0).tolist() == [10, 0] and chain.max(axis=0).tolist() == [119, 79]
+    assert [c.area for c in amscr.contours_from_mask(m)] == [m.sum() - 0.5]
+    for t in (0, 127, 'auto'):  # a threshold changes nothing on a bool mask
+        np.testing.assert_array_equal(amscr.contour_from_mask(m, threshold=t), c)
+    full = amscr.contour_from_mask(np.ones((20, 30), bool))  # every pixel: the frame
+    assert amscr.signed_area(full) == pytest.approx(20 * 30 - 0.5)
+
+
+@pytest.mark.parametrize("make", [lambda m: m.astype(np.float32), lambda m: m.astype(np.float64) / 255 * 7.5,
+                                  lambda m: m.astype(np.uint16), lambda m: m.astype(np.int32)])
+def test_an_8_bit_mask_in_another_dtype_is_traced_as_the_8_bit_one(make):
+    """img.astype(np.float32) of a 0/255 mask is traced halfway, as the uint8 mask (not at 0.5, half
+    a pixel out); so is a float mask of any largest value, and a uint16 0/255 mask (a 16-bit level
+    of 32767 would find nothing)."""
+    m = _rect(np.uint8, 255)
+    np.testing.assert_allclose(amscr.contour_from_mask(make(m)), amscr.contour_from_mask(m), atol=1e-6)
+
+
 def test_subpixel_false_is_the_pixel_chain():
     m = _rect(np.uint8, 255)
     chain = amscr.contour_from_mask(m, subpixel=False)
