@@ -105,7 +105,8 @@ def _as_samples(mask: ArrayLike, threshold: Any) -> Tuple[np.ndarray, Optional[T
         raise bad('mask: values must be in 0..65535 for dtype %s (got %d..%d)' % (a.dtype, a.min(), a.max()))
     if a.dtype == np.uint8 or (a.dtype == np.uint16 and threshold is not None):  # a 16-bit level given
         return a, None, 0
-    return a.astype(np.uint8 if not a.size or a.max() <= 255 else np.uint16), None, 0
+    want = np.uint8 if not a.size or int(a.max()) <= 255 else np.uint16  # values up to 255: 8 bits
+    return (a if a.dtype == want else a.astype(want)), None, 0
 
 
 def _image_and_level(mask: ArrayLike, threshold: Union[int, float, str, None], subpixel: bool) -> _Image:
@@ -209,10 +210,12 @@ def contours_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] 
         A list of :class:`ImageContour` in raster order of their first pixel, so a parent
         comes before its children. Outer contours run counter-clockwise (positive signed area),
         holes clockwise: iso-lines (subpixel=True), or with subpixel=False through the
-        component's boundary pixel centres and the hole's own boundary (background) pixels. A hole's parent is the component around
-        it; a component's parent is the hole it lies in, or None.
+        component's boundary pixel centres and the hole's own boundary (background) pixels. A
+        hole's parent is the component around it; a component's parent is the hole it lies in,
+        or None.
     Raises:
-        NotFoundError: no foreground, foreground everywhere, or no contour of `min_area`;
+        NotFoundError: no foreground, foreground everywhere (but for a bool mask), or no
+        contour of `min_area`;
         InvalidArgumentError: a bad mask, threshold or min_area; LimitError: image too large.
     """
     im = _image_and_level(mask, threshold, subpixel)
