@@ -843,7 +843,8 @@ START_TEST(argument_errors_write_nan)
     const size_t n = 6;
     amscr_params *p = small_params(1), *p64 = make_params(64, SCALES3, 3, 1), *open = small_params(1);
     ck_assert_int_eq(amscr_params_set_closed(open, 0), AMSCR_OK);
-    amscr_descriptor **d = make_descs(p, n, 1401), **d64 = make_descs(p64, 2, 1402), **dopen = make_descs(open, n, 1403);
+    amscr_descriptor **d = make_descs(p, n, 1401), **d64 = make_descs(p64, 2, 1402);
+    amscr_descriptor **dopen = make_descs(open, n, 1403);
     amscr_db *db = db_from(p, d, n), *db64 = db_from(p64, d64, 2), *dbopen = db_from(open, dopen, n);
     double m[36];
     const int32_t one_group[6] = {0, 0, 0, 0, 0, 0};

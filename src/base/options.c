@@ -99,8 +99,8 @@ static amscr_status check(const option_t *o, double v, const char *who, int wrap
 
 /* ---- the named pairs: amscr_params_set_<name> and amscr_params_get_<name> ---- */
 #define NAMED(KEY, name, type, kind, lo, hi, rule)                                                                  \
-    AMSCR__SETTER(amscr_params_set_##name, amscr_params, p, type, name,                                          \
-                  check(&TABLE[AMSCR_OPT_##KEY], (double)v, __func__, sizeof(type) == 4 && (type)-1 > 0))                                            \
+    AMSCR__SETTER(amscr_params_set_##name, amscr_params, p, type, name,                                             \
+                  check(&TABLE[AMSCR_OPT_##KEY], (double)v, __func__, sizeof(type) == 4 && (type)-1 > 0))           \
     AMSCR__GETTER(amscr_params_get_##name, amscr_params, type, name)
 OPTIONS(NAMED)
 

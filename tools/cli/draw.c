@@ -177,8 +177,9 @@ static int overlay_svg(const char *path, const overlay_input *in, const layout *
               "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
               L->width, L->height, L->width, L->height);
     svg_poly(&b, L, in->target, in->nt, in->closed, SVG_TARGET, in->closed ? SVG_TARGET_FILL : "none", NULL);
-    svg_poly(&b, L, in->before, in->nb, in->closed && !in->source_open, SVG_BEFORE, "none", " stroke-dasharray=\"7 5\"");
-    svg_poly(&b, L, in->after, in->na, in->closed && !in->source_open, SVG_AFTER, "none", NULL);
+    int source_closed = in->closed && !in->source_open;
+    svg_poly(&b, L, in->before, in->nb, source_closed, SVG_BEFORE, "none", " stroke-dasharray=\"7 5\"");
+    svg_poly(&b, L, in->after, in->na, source_closed, SVG_AFTER, "none", NULL);
     const char *labels[3] = {"target", "source (before)", "source registered (after)"};
     const char *cols[3] = {SVG_TARGET, SVG_BEFORE, SVG_AFTER};
     const char *names[3] = {in->target_name, in->source_name, in->source_name};

@@ -153,5 +153,6 @@ def test_file_errors_are_the_builtin_os_errors(tmp_path):
 def test_option_errors_name_the_python_option():
     with pytest.raises(amscr.InvalidArgumentError, match=r'^invalid argument: points: 3 is not in 16\.\.65536$'):
         amscr.Params(points=3)
-    with pytest.raises(amscr.InvalidArgumentError, match=r'^invalid argument: channel_weight: 1\.5 is not in \[0, 1\]$'):
+    with pytest.raises(amscr.InvalidArgumentError,
+                       match=r'^invalid argument: channel_weight: 1\.5 is not in \[0, 1\]$'):
         amscr.Params(channel_weight=1.5)
