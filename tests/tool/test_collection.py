@@ -409,7 +409,8 @@ def test_folder_warns_of_images_it_cannot_read(tmp_path):
     (d / "a.tif").unlink()
     (d / "c.bmp").unlink()
     r = run("eval", d, *AFFINE)
-    assert r.returncode == 0 and r.stderr == "amscr: %s: 1 file skipped: not PNG, PGM or a point list (e.g. b.jpg)\n" % d
+    one = "amscr: %s: 1 file skipped: not PNG, PGM or a point list (e.g. b.jpg)\n" % d
+    assert r.returncode == 0 and r.stderr == one, r.stderr
 
 
 def test_class_names_drop_trailing_separators(tmp_path):
