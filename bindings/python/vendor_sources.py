@@ -2,16 +2,19 @@
 
 In a checkout, subprojects/amscr is a link to the repository root; `meson dist` archives the link
 itself, which would dangle in the sdist. This replaces it with the files the library and the tool
-are built from (the ones git tracks), so `pip install amscr-X.tar.gz` builds on its own.
+are built from, as committed (git's HEAD, as `meson dist` takes the package's own files: an
+uncommitted change is in neither), so `pip install amscr-X.tar.gz` builds on its own.
 """
+import io
 import os
 import shutil
 import subprocess
 import sys
+import tarfile
 
 # What the root meson.build reads when it is the package's subproject (tests and benchmarks are
-# skipped there).
-PATHS = ['meson.build', 'meson_options.txt', 'include', 'src', 'tools', 'scripts']
+# skipped there), and the licence the package installs.
+PATHS = ['meson.build', 'meson_options.txt', 'include', 'src', 'tools', 'scripts', 'LICENSE']
 
 
 def main():
@@ -22,16 +25,17 @@ def main():
         os.remove(target)
     elif os.path.isdir(target):
         shutil.rmtree(target)
-    files = subprocess.run(['git', 'ls-files', '-z', '--', *PATHS], cwd=repo, check=True,
-                           capture_output=True).stdout.decode().split('\0')
-    files = [f for f in files if f and os.path.isfile(os.path.join(repo, f))]
-    missing = [p for p in PATHS if not any(f == p or f.startswith(p + '/') for f in files)]
-    if missing:
-        sys.exit('vendor_sources.py: not tracked by git in %s: %s' % (repo, ', '.join(missing)))
-    for f in files:
-        dst = os.path.join(target, f)
-        os.makedirs(os.path.dirname(dst), exist_ok=True)
-        shutil.copy2(os.path.join(repo, f), dst)
+    tar_bytes = subprocess.run(['git', 'archive', '--format=tar', 'HEAD', '--', *PATHS], cwd=repo, check=True,
+                               capture_output=True).stdout
+    with tarfile.open(fileobj=io.BytesIO(tar_bytes)) as tar:
+        files = [m.name for m in tar.getmembers() if m.isfile()]
+        missing = [p for p in PATHS if not any(f == p or f.startswith(p + '/') for f in files)]
+        if missing:
+            sys.exit('vendor_sources.py: not committed in %s: %s' % (repo, ', '.join(missing)))
+        if hasattr(tarfile, 'data_filter'):
+            tar.extractall(target, filter='data')
+        else:
+            tar.extractall(target)
     print('vendor_sources.py: %d files of %s copied into the sdist' % (len(files), repo))
 
 

@@ -204,6 +204,12 @@ def test_command_version_and_help_of_every_subcommand():
 
 
 @installed
+def test_the_package_carries_its_licence():
+    with open(os.path.join(PKG_DIR, 'LICENSE')) as f:
+        assert f.read().startswith('MIT License')
+
+
+@installed
 def test_python_m_amscr_runs_the_tool():
     """``python -m amscr`` is the ``amscr`` command (an environment whose bin/ is not on PATH)."""
     r = subprocess.run([sys.executable, '-m', 'amscr', '--version'], capture_output=True, text=True)
@@ -254,3 +260,6 @@ def test_sdist_script_copies_the_c_sources(tmp_path):
         assert (sub / f).is_file(), f
     assert len(list((sub / 'src').glob('*/*.c'))) >= 10
     assert not (sub / 'bindings').exists() and not (sub / 'tests').exists()
+    for f in ('meson.build', 'include/amscr.h'):  # as committed, as meson dist takes the rest
+        head = subprocess.run(['git', '-C', REPO_ROOT, 'show', 'HEAD:' + f], capture_output=True, check=True).stdout
+        assert (sub / f).read_bytes() == head, f
