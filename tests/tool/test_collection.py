@@ -423,3 +423,32 @@ def test_class_names_drop_trailing_separators(tmp_path):
     classes = dict(line.split("\t") for line in names.read_text().splitlines()[1:])  # after the header
     assert classes == {"star-1.txt": "star", "star 3.txt": "star", "star - 4.txt": "star", "blob01.txt": "blob",
                        "blob_2.txt": "blob", "wave.txt": "wave", "wave-.txt": "wave-"}
+
+
+def test_no_output_overwrites_a_file_the_command_reads(tmp_path):
+    """search --sheet, matrix -o / --names and index -o refuse a file the command reads (the
+    query, the manifest, a shape of the folder or the manifest), leaving it as it was; an index
+    is not read shape by shape, and index --add rewrites its own FILE."""
+    d = folder_of_points(tmp_path / "set", ["star-1.txt", "star-2.txt", "blob-1.txt", "blob-2.txt"])
+    pic = d / ("star-3" + img_ext())
+    pic.write_bytes(image_bytes(rasterize(base_shapes()["star"], 120, 120), pic.name))
+    mf = tmp_path / "m.tsv"
+    mf.write_text("file\tclass\n" + "".join("set/%s\t%s\n" % (f, f.split("-")[0]) for f in
+                                            ("star-1.txt", "star-2.txt", "blob-1.txt", "blob-2.txt", pic.name)))
+    q, member = d / "star-1.txt", d / "blob-2.txt"
+    before = {f: f.read_bytes() for f in (q, member, mf, pic)}
+    for args in (("search", pic, d, "--sheet", pic), ("search", q, mf, "--sheet", tmp_path / "set" / "." / pic.name),
+                 ("matrix", mf, "-o", mf), ("matrix", d, "-o", member),
+                 ("matrix", d, "-o", tmp_path / "x.tsv", "--names", member),
+                 ("matrix", d, "-o", tmp_path / "y.tsv", "--names", tmp_path / "y.tsv"),
+                 ("index", d, "-o", member), ("index", mf, "-o", mf)):
+        r = run(*args, *AFFINE)
+        assert r.returncode == 1 and r.stdout == "" and len(r.stderr.splitlines()) == 1, (args, r.stderr)
+        assert "would overwrite an input" in r.stderr or "name the same file" in r.stderr, (args, r.stderr)
+    assert {f: f.read_bytes() for f in before} == before
+    assert not (tmp_path / "x.tsv").exists() and not (tmp_path / "y.tsv").exists()
+    idx = tmp_path / "s.idx"
+    assert run("index", mf, "-o", idx, *AFFINE).returncode == 0
+    r = run("index", d, "-o", idx, "--add", *AFFINE)  # --add: FILE is the index itself (here a repeat)
+    assert "would overwrite" not in r.stderr, r.stderr
+    assert run("search", q, idx, "--sheet", tmp_path / "sheet.svg").returncode == 0

@@ -9,6 +9,7 @@
 #include "cli.h"
 #include "collection.h"
 #include "eval_plot.h"
+#include "index_tool.h"
 #include "json.h"
 #include "names.h"
 #include "cmd_params.h"
@@ -318,6 +319,9 @@ static int split_check(const collection *c, size_t train)
 /* What the protocol needs of the collection, checked before any shape is prepared. */
 static int check_collection(const opts *o, const collection *c)
 {
+    const char *in = o->pos[0];
+    if (collection_out_not_input("--plot", o->plot, index_file_is(in) ? NULL : c, &in, 1) != 0)
+        return TOOL_EXIT_FAIL;
     if (c->n < 2) {
         tool_error(o->pos[0], "eval needs at least 2 shapes, found %zu", c->n);
         return TOOL_EXIT_FAIL;

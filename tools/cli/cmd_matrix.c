@@ -9,7 +9,24 @@
 #include "collection.h"
 #include "matrix_file.h"
 #include "cmd_params.h"
+#include "index_tool.h"
 #include "shape_db.h"
+
+/* -o and --names: neither a file the command reads (the collection, its shapes) nor one file. */
+static int outputs_checked(const opts *o, const collection *c)
+{
+    const char *in = o->pos[0];
+    const collection *shapes = index_file_is(in) ? NULL : c;
+    if (collection_out_not_input("-o", o->out, shapes, &in, 1) != 0 ||
+        collection_out_not_input("--names", o->names, shapes, &in, 1) != 0)
+        return TOOL_EXIT_FAIL;
+    if (o->names && strcmp(o->names, o->out) == 0) {
+        tool_error(o->names, "-o and --names name the same file");
+        return TOOL_EXIT_FAIL;
+    }
+    return 0;
+}
+
 int cmd_matrix(opts *o)
 {
     const char *cpath = o->pos[0];
@@ -27,7 +44,7 @@ int cmd_matrix(opts *o)
     double *d = NULL;
     int ret = TOOL_EXIT_FAIL;
     memset(&c, 0, sizeof c);
-    int r = open_collection_db(o, cpath, NULL, &p, &c, &db);
+    int r = open_collection_db(o, cpath, outputs_checked, &p, &c, &db);
     if (r != 0) {
         ret = r;
         goto done;

@@ -172,9 +172,12 @@ static int open_target(const opts *o, amscr_index **x, amscr_params **p, collect
     if (!index_file_is(cpath)) {
         if ((r = make_params(o, 0, p)) != 0)
             return r;
-        return collection_open(cpath, c) == 0 && load_db(*p, c, o->threshold, db) == 0 ? 0 : TOOL_EXIT_FAIL;
+        return collection_open(cpath, c) == 0 && collection_out_not_input("--sheet", o->sheet, c, o->pos, 2) == 0 &&
+                       load_db(*p, c, o->threshold, db) == 0
+                   ? 0
+                   : TOOL_EXIT_FAIL;
     }
-    if (index_open(cpath, 1, x) != 0)
+    if (collection_out_not_input("--sheet", o->sheet, NULL, o->pos, 2) != 0 || index_open(cpath, 1, x) != 0)
         return TOOL_EXIT_FAIL;
     if ((r = index_params(o, cpath, amscr_db_params(amscr_index_db(*x)), p)) != 0)
         return r;

@@ -542,3 +542,16 @@ int collection_open(const char *path, collection *out)
         collection_free(out);
     return r;
 }
+
+int collection_out_not_input(const char *opt, const char *path, const collection *c, const char *const *inputs,
+                             size_t n)
+{
+    if (tool_out_not_input(opt, path, inputs, n) != 0)
+        return -1;
+    for (size_t i = 0; c != NULL && i < c->n; i++) {
+        const char *item = c->items[i].path;
+        if (tool_out_not_input(opt, path, &item, 1) != 0)
+            return -1;
+    }
+    return 0;
+}

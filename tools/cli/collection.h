@@ -44,6 +44,12 @@ typedef struct collection {
 int collection_open(const char *path, collection *out);
 void collection_free(collection *c);
 
+/* -1 after an error line when the output `path` (given with option `opt`) is a file the command
+ * reads: one of the n `inputs` (the collection file or folder, a query, ...) or, c not NULL (a
+ * folder or a manifest, not an index), one of c's shape files; else 0. */
+int collection_out_not_input(const char *opt, const char *path, const collection *c, const char *const *inputs,
+                             size_t n);
+
 /* The index of `name` in the list (*names, *n; capacity *cap), appended when new; -1 when out
  * of memory (printed). */
 int32_t coll_name_index(char ***names, size_t *n, const char *name, size_t *cap);
