@@ -315,7 +315,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_orient_ccw(amscr_contour *c
  * @brief Reads a text point list: one "x y" or "x,y" per line (tabs/spaces/one comma),
  *        '#' starts a comment, blank lines are ignored. An empty list is AMSCR_E_FORMAT.
  *        A UTF-8 byte order mark at the start is skipped (since 0.22.2; before, line 1 was
- *        AMSCR_E_FORMAT).
+ *        AMSCR_E_FORMAT). The decimal point is '.' whatever locale the program set with
+ *        setlocale (since 0.22.3; before, under a locale whose decimal point is ',', every
+ *        line with a fraction was AMSCR_E_FORMAT); the program's locale is left as it is.
  * @param[in]  path  file name.
  * @param[out] out   new contour.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO (cannot open/read); AMSCR_E_FORMAT (bad
@@ -338,7 +340,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_read_text(const char *path,
 AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_parse_text(const char *text, size_t len, amscr_contour **out);
 
 /**
- * @brief Writes a contour as a text point list ("%.17g %.17g" per line). The file is
+ * @brief Writes a contour as a text point list ("%.17g %.17g" per line, with '.' as the
+ *        decimal point whatever locale the program set: since 0.22.3, before which a
+ *        locale's ',' was written). The file is
  *        written whole before it takes its name (an unnamed file of the folder, O_TMPFILE,
  *        linked in; where the system has none, a temporary name renamed), so a failure never
  *        leaves a partial file (and, with unnamed files, a killed process leaves none at all).

@@ -1,6 +1,7 @@
 /* check_contour_io.c — text point lists: parsing, reading, atomic writing. */
 #include <check.h>
 #include <dirent.h>
+#include <locale.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -316,6 +317,53 @@ START_TEST(write_missing_dir)
 }
 END_TEST
 
+/* A program that set a locale whose decimal point is ',' (setlocale(LC_ALL, "") in a German
+ * session, as GUI toolkits do) still reads and writes point lists with '.', and keeps its
+ * locale. The locale is compiled into the build folder (tests/meson.build, AMSCR_TEST_LOCPATH). */
+START_TEST(text_in_a_comma_locale)
+{
+    const char *dir = getenv("AMSCR_TEST_LOCPATH");
+    if (!dir || !*dir) {
+        printf("SKIP: contour_io: no locale with a decimal comma was built (Debian: apt-get install locales)\n");
+        return;
+    }
+    ck_assert_int_eq(setenv("LOCPATH", dir, 1), 0);
+    ck_assert_ptr_nonnull(setlocale(LC_ALL, "de_DE.UTF-8"));
+    char num[16];
+    snprintf(num, sizeof num, "%.1f", 0.5);
+    ck_assert_str_eq(num, "0,5"); /* the premise: this locale writes a comma */
+
+    amscr_contour *c = NULL;
+    ck_assert_int_eq(parse("0 0\n10.5 0\n10.5, 10.25\n-0.125 1e-3\n", &c), AMSCR_OK);
+    const double xy[] = {0, 0, 10.5, 0, 10.5, 10.25, -0.125, 1e-3};
+    assert_points(c, xy, 4);
+
+    char *tmp = make_tmpdir();
+    char path[4200];
+    snprintf(path, sizeof path, "%s/pts.txt", tmp);
+    ck_assert_int_eq(amscr_contour_write_text(c, path), AMSCR_OK);
+    FILE *f = fopen(path, "rb");
+    char text[256] = {0};
+    ck_assert_ptr_nonnull(f);
+    ck_assert_uint_gt(fread(text, 1, sizeof text - 1, f), 0);
+    fclose(f);
+    ck_assert_str_eq(text, "0 0\n10.5 0\n10.5 10.25\n-0.125 0.001\n");
+    amscr_contour *back = NULL;
+    ck_assert_int_eq(amscr_contour_read_text(path, &back), AMSCR_OK);
+    assert_points(back, xy, 4);
+
+    /* The program's locale is as it set it. */
+    ck_assert_ptr_eq(uselocale((locale_t)0), LC_GLOBAL_LOCALE);
+    snprintf(num, sizeof num, "%.1f", 0.5);
+    ck_assert_str_eq(num, "0,5");
+    setlocale(LC_ALL, "C");
+    unsetenv("LOCPATH");
+    amscr_contour_free(back);
+    amscr_contour_free(c);
+    rm_tree(tmp);
+}
+END_TEST
+
 Suite *amscr_suite_contour_io(void)
 {
     Suite *s = suite_create("contour_io");
@@ -333,6 +381,7 @@ Suite *amscr_suite_contour_io(void)
     tcase_add_test(tf, read_file_and_errors);
     tcase_add_test(tf, write_read_round_trip);
     tcase_add_test(tf, write_missing_dir);
+    tcase_add_test(tf, text_in_a_comma_locale);
     suite_add_tcase(s, tf);
     return s;
 }

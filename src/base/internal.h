@@ -4,6 +4,7 @@
 
 #include "amscr.h"
 
+#include <locale.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -12,6 +13,16 @@
 #else
 #define AMSCR_PRINTF(a, b)
 #endif
+
+/* ---- numbers in the "C" locale (c_numeric.c) ------------------------ */
+/* The calling thread reads and writes numbers with '.' between enter and leave, whatever
+ * setlocale the program made (uselocale: the thread's only). */
+typedef struct {
+    locale_t c, prev;
+} amscr__c_numeric;
+/* AMSCR_OK, or AMSCR_E_NOMEM with its detail (then no leave). */
+amscr_status amscr__c_numeric_enter(amscr__c_numeric *s);
+void amscr__c_numeric_leave(amscr__c_numeric *s);
 
 /* ---- errors (errors.c) ------------------------------------------------ */
 /* Sets the calling thread's detail and returns `st`. */

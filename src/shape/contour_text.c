@@ -5,7 +5,8 @@
  * Format: one point per line, "x y", "x,y", "x, y" or tab-separated; '#' starts a
  * comment anywhere on a line; blank lines are ignored; CRLF line ends are accepted; a UTF-8
  * byte order mark before the first line (Excel's and Notepad's text exports) is skipped.
- * Numbers are read with strtod (the "C" locale is assumed) and must be finite. */
+ * Numbers are read with strtod and written with "%.17g" in the "C" locale whatever locale the
+ * program set (c_numeric.c: the decimal point is always '.'), and must be finite. */
 #include "internal.h"
 
 #include <errno.h>
@@ -68,9 +69,9 @@ static int ct_parse_line(char *s, char *e, double p[2])
     return ok ? ok : -1;
 }
 
-/* Parses a NUL-terminated, writable buffer of len bytes (the NUL at buf[len] is extra).
- * `path` names the source in details ("path:line"); NULL gives "line N". */
-static amscr_status ct_parse_buffer(char *buf, size_t len, const char *path, amscr_contour **out)
+/* Parses a NUL-terminated, writable buffer of len bytes (the NUL at buf[len] is extra) in the
+ * calling thread's locale. `path` names the source in details ("path:line"); NULL gives "line N". */
+static amscr_status ct_parse_points(char *buf, size_t len, const char *path, amscr_contour **out)
 {
     double *xy = NULL;
     size_t n = 0, cap = 0;
@@ -133,6 +134,18 @@ static amscr_status ct_parse_buffer(char *buf, size_t len, const char *path, ams
     }
     /* amscr__contour_wrap takes ownership of xy (also on failure). */
     return amscr__contour_wrap(xy, n, out);
+}
+
+/* As ct_parse_points, its numbers read in the "C" locale. */
+static amscr_status ct_parse_buffer(char *buf, size_t len, const char *path, amscr_contour **out)
+{
+    amscr__c_numeric loc;
+    amscr_status st = amscr__c_numeric_enter(&loc);
+    if (st != AMSCR_OK)
+        return st;
+    st = ct_parse_points(buf, len, path, out);
+    amscr__c_numeric_leave(&loc);
+    return st;
 }
 
 amscr_status amscr_contour_parse_text(const char *text, size_t len, amscr_contour **out)
@@ -216,10 +229,17 @@ amscr_status amscr_contour_write_text(const amscr_contour *c, const char *path)
     char *buf = amscr__malloc_array(c->n + 1, LINE_MAX_CHARS); /* room for the last NUL */
     if (!buf)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_contour_write_text: out of memory");
+    amscr__c_numeric loc;
+    amscr_status st = amscr__c_numeric_enter(&loc);
+    if (st != AMSCR_OK) {
+        free(buf);
+        return st;
+    }
     size_t len = 0;
     for (size_t i = 0; i < c->n; i++)
         len += (size_t)snprintf(buf + len, LINE_MAX_CHARS + 1, "%.17g %.17g\n", c->xy[2 * i], c->xy[2 * i + 1]);
-    amscr_status st = amscr__file_write_atomic(path, buf, len); /* the file's whole text, or nothing */
+    amscr__c_numeric_leave(&loc);
+    st = amscr__file_write_atomic(path, buf, len); /* the file's whole text, or nothing */
     free(buf);
     return st;
 }

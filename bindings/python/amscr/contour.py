@@ -239,6 +239,8 @@ def contours_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] 
 def read_points(path: Union[str, os.PathLike]) -> np.ndarray:
     """Reads a text point list ("x y" or "x,y" per line, '#' comments).
 
+    The decimal point is '.', whatever locale the program set (``locale.setlocale``).
+
     Args:
         path: the file (``amscr contour IMG -o FILE`` writes one from a PNG or PGM).
     Returns:
@@ -264,7 +266,8 @@ def parse_points(text: Union[str, bytes]) -> np.ndarray:
 
 
 def write_points(path: Union[str, os.PathLike], points: ArrayLike) -> None:
-    """Writes points as a text point list, atomically (whole before it takes its name).
+    """Writes points as a text point list, atomically (whole before it takes its name), with '.'
+    as the decimal point whatever locale the program set.
 
     Args:
         path: the file to write.

@@ -1,6 +1,10 @@
 """Numerical cross-checks of the building blocks against NumPy / SciPy / brute force."""
 import itertools
 import math
+import os
+import shutil
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -363,6 +367,44 @@ def test_points_text_roundtrip(tmp_path):
     np.testing.assert_array_equal(amscr.parse_points('\ufeff1 2\r\n3 4\r\n'), [[1, 2], [3, 4]])
     (tmp_path / 'bom.csv').write_bytes(b'\xef\xbb\xbf5,6\r\n7,8\r\n')
     np.testing.assert_array_equal(amscr.read_points(tmp_path / 'bom.csv'), [[5, 6], [7, 8]])
+
+
+@pytest.fixture
+def comma_locale(tmp_path):
+    """A folder for LOCPATH holding de_DE.UTF-8, whose decimal point is ','."""
+    built = os.environ.get('AMSCR_TEST_LOCPATH')  # tests/meson.build compiles it
+    if built:
+        return built
+    localedef = shutil.which('localedef')
+    if not localedef or not os.path.isfile('/usr/share/i18n/locales/de_DE'):
+        pytest.skip('no locale with a decimal comma can be built (Debian: apt-get install locales)')
+    subprocess.run([localedef, '-i', 'de_DE', '-f', 'UTF-8', str(tmp_path / 'de_DE.UTF-8')], check=True)
+    return str(tmp_path)
+
+
+def test_points_text_in_a_comma_locale(tmp_path, comma_locale):
+    # A program that set a German locale (locale.setlocale(locale.LC_ALL, '') in a German session)
+    # still reads and writes point lists with '.', and keeps its locale.
+    script = """
+import locale, sys
+import numpy as np
+import amscr
+locale.setlocale(locale.LC_ALL, 'de_DE.UTF-8')
+assert locale.localeconv()['decimal_point'] == ','
+path = sys.argv[1]
+pts = amscr.parse_points('0 0\\n10.5 0\\n10.5, 10.25\\n-0.125 1e-3\\n')
+np.testing.assert_array_equal(pts, [[0, 0], [10.5, 0], [10.5, 10.25], [-0.125, 1e-3]])
+amscr.write_points(path, pts)
+np.testing.assert_array_equal(amscr.read_points(path), pts)
+assert locale.localeconv()['decimal_point'] == ','
+print(locale.format_string('%.1f', 0.5))
+"""
+    path = tmp_path / 'pts.txt'
+    env = dict(os.environ, LOCPATH=comma_locale)
+    out = subprocess.run([sys.executable, '-c', script, str(path)], env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout == '0,5\n'
+    assert path.read_text() == '0 0\n10.5 0\n10.5 10.25\n-0.125 0.001\n'
 
 
 def test_signed_area_and_orient():
