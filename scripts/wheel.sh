@@ -6,7 +6,8 @@
 #      (amscr.libs/), then tagged cp38-abi3: meson-python names an abi3 wheel after the building
 #      interpreter, but the extension is compiled for the Limited API of 3.8 (Py_LIMITED_API =
 #      0x03080000), so one wheel serves every CPython >= 3.8;
-#   3. `auditwheel show`, then the repaired wheel installed on its own into a temporary folder:
+#   3. the bundled libraries' licence notices added (scripts/wheel_licences.py: amscr.libs/LICENSES/);
+#   4. `auditwheel show`, then the repaired wheel installed on its own into a temporary folder:
 #      `import amscr` (API mode, from there) and its `amscr --version`.
 # Output: dist/amscr-V.tar.gz, dist/amscr-V-cp3XX-abi3-linux_x86_64.whl,
 #         dist/wheelhouse/amscr-V-cp38-abi3-manylinux_2_NN_x86_64.whl
@@ -31,6 +32,7 @@ if ! auditwheel repair -w dist/wheelhouse "$whl" >"$log" 2>&1; then
 fi
 python3 -m wheel tags --python-tag cp38 --remove dist/wheelhouse/amscr-*.whl >/dev/null
 repaired=$(ls dist/wheelhouse/amscr-*.whl)
+python3 scripts/wheel_licences.py "$repaired"
 ls -l dist/*.tar.gz "$whl" "$repaired" | awk '{print "wheel: " $5 " bytes  " $NF}'
 auditwheel show "$repaired"
 
@@ -42,6 +44,10 @@ assert amscr.__file__.startswith(here), amscr.__file__
 assert amscr.API_MODE and amscr.LIBRARY_PATH.endswith(".abi3.so"), amscr.LIBRARY_PATH
 libs = sorted(os.listdir(os.path.join(here, "amscr.libs")))
 assert any("openblas" in n for n in libs) and any("lapacke" in n for n in libs) and any("png" in n for n in libs), libs
+notices = os.listdir(os.path.join(here, "amscr.libs", "LICENSES"))
+for want in ("libopenblas", "liblapacke", "libpng", "libgfortran"):
+    assert any(n.startswith(want) and n.endswith(".copyright") for n in notices), (want, notices)
+libs.remove("LICENSES")
 print("wheel: installed on its own: import amscr %s (API mode), amscr.libs: %s" % (amscr.__version__, " ".join(libs)))
 ' "$tmp")
 echo "wheel: amscr --version: $(cd "$tmp" && PYTHONPATH="$tmp/site" "$tmp/site/bin/amscr" --version)"
