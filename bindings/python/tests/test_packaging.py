@@ -263,3 +263,61 @@ def test_sdist_script_copies_the_c_sources(tmp_path):
     for f in ('meson.build', 'include/amscr.h'):  # as committed, as meson dist takes the rest
         head = subprocess.run(['git', '-C', REPO_ROOT, 'show', 'HEAD:' + f], capture_output=True, check=True).stdout
         assert (sub / f).read_bytes() == head, f
+
+
+def _record_hash(data):
+    import base64
+    import hashlib
+    return base64.urlsafe_b64encode(hashlib.sha256(data).digest()).rstrip(b'=').decode()
+
+
+def _wheel_with_sbom(tmp_path, package):
+    """A minimal repaired-looking wheel: one bundled library and an SBOM naming `package`."""
+    import json
+    import zipfile
+    info = 'amscr-9.9.9.dist-info'
+    files = {
+        'amscr/__init__.py': b'',
+        'amscr.libs/libdemo-0123abcd.so.1': b'\x7fELF',
+        info + '/METADATA': b'Metadata-Version: 2.1\nName: amscr\nVersion: 9.9.9\n',
+        info + '/WHEEL': b'Wheel-Version: 1.0\nGenerator: test\nRoot-Is-Purelib: false\nTag: cp38-abi3-linux_x86_64\n',
+        info + '/sboms/auditwheel.cdx.json': json.dumps({'components': [
+            {'name': 'amscr', 'version': '9.9.9', 'purl': 'pkg:pypi/amscr@9.9.9'},
+            {'name': package, 'version': '1.0+x', 'purl': 'pkg:deb/debian/%s@1.0%%2Bx' % package}]}).encode(),
+    }
+    whl = tmp_path / 'amscr-9.9.9-cp38-abi3-linux_x86_64.whl'
+    with zipfile.ZipFile(whl, 'w') as z:
+        for name, data in files.items():
+            z.writestr(name, data)
+        z.writestr(info + '/RECORD', ''.join('%s,sha256=%s,%d\n' % (n, _record_hash(d), len(d)) for n, d in files.items())
+                   + info + '/RECORD,,\n')
+    return whl
+
+
+@in_tree
+def test_wheel_licences_adds_the_bundled_packages_notices(tmp_path):
+    import zipfile
+    pytest.importorskip('wheel')
+    script = os.path.join(REPO_ROOT, 'scripts', 'wheel_licences.py')
+    pkg = next((p for p in ('libpng16-16', 'libc6', 'base-files')
+                if os.path.isfile('/usr/share/doc/%s/copyright' % p)), None)
+    if pkg is None:
+        pytest.skip('no Debian copyright file on this machine')
+    whl = _wheel_with_sbom(tmp_path, pkg)
+    r = subprocess.run([sys.executable, script, str(whl)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    with zipfile.ZipFile(whl) as z:
+        names = z.namelist()
+        with open('/usr/share/doc/%s/copyright' % pkg, 'rb') as f:
+            assert z.read('amscr.libs/LICENSES/%s.copyright' % pkg) == f.read()
+        readme = z.read('amscr.libs/LICENSES/README').decode()
+        record = z.read('amscr-9.9.9.dist-info/RECORD').decode()
+    assert 'libdemo-0123abcd.so.1' in readme and '%s 1.0+x' % pkg in readme
+    assert 'amscr.libs/LICENSES/%s.copyright,sha256=' % pkg in record
+    assert 'amscr.libs/libdemo-0123abcd.so.1' in names
+    # a package without a copyright file: an error, and the wheel is left as it was
+    bad = _wheel_with_sbom(tmp_path, 'no-such-package-amscr')
+    before = bad.read_bytes()
+    r = subprocess.run([sys.executable, script, str(bad)], capture_output=True, text=True)
+    assert r.returncode != 0 and 'no-such-package-amscr' in r.stderr
+    assert bad.read_bytes() == before
