@@ -148,7 +148,8 @@ int image_read(const char *path, int text_ok, tool_image *out, tool_format *out_
 #if defined(AMSCR_TOOL_HAVE_PNG)
         r = image_read_png(fp, path, out);
 #else
-        tool_error(path, "PNG input is not available: amscr was built without libpng");
+        tool_error(path, "PNG input is not available: this amscr was built without libpng (PGM and point "
+                         "lists are read; Debian/Ubuntu: apt-get install libpng-dev, then build or pip install again)");
         r = -1;
 #endif
     }
