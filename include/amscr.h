@@ -346,6 +346,10 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_parse_text(const char *text
  *        written whole before it takes its name (an unnamed file of the folder, O_TMPFILE,
  *        linked in; where the system has none, a temporary name renamed), so a failure never
  *        leaves a partial file (and, with unnamed files, a killed process leaves none at all).
+ *        A replaced file keeps its mode. Since 0.22.3 a symbolic link's target is replaced
+ *        (before, the link itself), and an existing file that is not a regular file (a device
+ *        such as /dev/null, a FIFO, /dev/stdout or /dev/fd/N) is written through, appending,
+ *        never replaced (before, it was replaced by a regular file).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, non-finite coordinates); AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: const.

@@ -1,11 +1,13 @@
 /* check_contour_io.c — text point lists: parsing, reading, atomic writing. */
 #include <check.h>
 #include <dirent.h>
+#include <fcntl.h>
 #include <locale.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "amscr.h"
@@ -364,6 +366,68 @@ START_TEST(text_in_a_comma_locale)
 }
 END_TEST
 
+/* Reads the whole small file at path into buf (NUL-terminated). */
+static void slurp(const char *path, char *buf, size_t cap)
+{
+    FILE *f = fopen(path, "rb");
+    ck_assert_ptr_nonnull(f);
+    size_t got = fread(buf, 1, cap - 1, f);
+    buf[got] = '\0';
+    fclose(f);
+}
+
+/* A symbolic link keeps pointing to the file written (its mode kept); a dangling one gets its
+ * file made; a FIFO is written through (its reader gets the text) and stays a FIFO. */
+START_TEST(write_through_links_and_fifos)
+{
+    char *dir = make_tmpdir();
+    char target[4200], link[4200], dangling[4200], made[4200], fifo[4200], text[256];
+    snprintf(target, sizeof target, "%s/target.txt", dir);
+    snprintf(link, sizeof link, "%s/link.txt", dir);
+    snprintf(dangling, sizeof dangling, "%s/dangling.txt", dir);
+    snprintf(made, sizeof made, "%s/made.txt", dir);
+    snprintf(fifo, sizeof fifo, "%s/fifo.txt", dir);
+    const double xy[] = {0, 0, 1.5, 0, 0, 2};
+    amscr_contour *c = NULL;
+    ck_assert_int_eq(amscr_contour_new(xy, 3, &c), AMSCR_OK);
+
+    FILE *f = fopen(target, "wb");
+    ck_assert_ptr_nonnull(f);
+    fclose(f);
+    ck_assert_int_eq(chmod(target, 0600), 0);
+    ck_assert_int_eq(symlink("target.txt", link), 0);
+    ck_assert_int_eq(amscr_contour_write_text(c, link), AMSCR_OK);
+    struct stat sb;
+    ck_assert_int_eq(lstat(link, &sb), 0);
+    ck_assert(S_ISLNK(sb.st_mode));
+    ck_assert_int_eq(stat(target, &sb), 0);
+    ck_assert_uint_eq(sb.st_mode & 0777, 0600);
+    slurp(target, text, sizeof text);
+    ck_assert_str_eq(text, "0 0\n1.5 0\n0 2\n");
+
+    ck_assert_int_eq(symlink("made.txt", dangling), 0);
+    ck_assert_int_eq(amscr_contour_write_text(c, dangling), AMSCR_OK);
+    ck_assert_int_eq(lstat(dangling, &sb), 0);
+    ck_assert(S_ISLNK(sb.st_mode));
+    slurp(made, text, sizeof text);
+    ck_assert_str_eq(text, "0 0\n1.5 0\n0 2\n");
+
+    ck_assert_int_eq(mkfifo(fifo, 0600), 0);
+    int rd = open(fifo, O_RDONLY | O_NONBLOCK); /* a reader, so the writer does not wait */
+    ck_assert_int_ge(rd, 0);
+    ck_assert_int_eq(amscr_contour_write_text(c, fifo), AMSCR_OK);
+    ssize_t n = read(rd, text, sizeof text - 1);
+    close(rd);
+    ck_assert_int_gt(n, 0);
+    text[n] = '\0';
+    ck_assert_str_eq(text, "0 0\n1.5 0\n0 2\n");
+    ck_assert_int_eq(lstat(fifo, &sb), 0);
+    ck_assert(S_ISFIFO(sb.st_mode));
+    amscr_contour_free(c);
+    rm_tree(dir);
+}
+END_TEST
+
 Suite *amscr_suite_contour_io(void)
 {
     Suite *s = suite_create("contour_io");
@@ -382,6 +446,7 @@ Suite *amscr_suite_contour_io(void)
     tcase_add_test(tf, write_read_round_trip);
     tcase_add_test(tf, write_missing_dir);
     tcase_add_test(tf, text_in_a_comma_locale);
+    tcase_add_test(tf, write_through_links_and_fifos);
     suite_add_tcase(s, tf);
     return s;
 }

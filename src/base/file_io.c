@@ -3,10 +3,13 @@
  * file_mode.c: into an unnamed file of the target's directory (O_TMPFILE, where the system has
  * it), named only once whole and on the disk, so a write cut off — the process killed, the disk
  * full — leaves nothing behind and never replaces the file; elsewhere through a temporary name
- * and a rename (a kill mid-write then leaves that temporary file). The collection, index and
- * point-list files use them (db_io.c, index_io.c, contour_text.c). */
+ * and a rename (a kill mid-write then leaves that temporary file). A path's symbolic links are
+ * followed (the file they point to is replaced); a device, a FIFO or /dev/stdout is written
+ * through (out_path.c). The collection, index and point-list files use them (db_io.c,
+ * index_io.c, contour_text.c). */
 #define _GNU_SOURCE /* O_TMPFILE, linkat; MAP_POPULATE, where the system has them */
 #include "internal.h"
+#include "out_path.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -130,16 +133,35 @@ static amscr_status write_named(const char *path, const void *buf, size_t len, c
     return amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, amscr__errstr(e, eb, sizeof eb));
 }
 
+/* A file that is not replaced (a device, a FIFO, /dev/stdout: out_path.h) written through. */
+static amscr_status write_through(const char *path, const void *buf, size_t len)
+{
+    char eb[128];
+    int fd = open(path, O_WRONLY | O_APPEND | O_NOCTTY | O_CLOEXEC);
+    int ok = fd >= 0 && write_all(fd, buf, len), e = errno;
+    if (fd >= 0 && close(fd) != 0 && ok)
+        ok = 0, e = errno;
+    return ok ? AMSCR_OK : amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, amscr__errstr(e, eb, sizeof eb));
+}
+
 amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t len)
 {
-    size_t tmp_len = strlen(path) + 64;
+    char eb[128], *target = NULL;
+    int stream = 0;
+    if (amscr__out_path(path, &stream, &target) != 0)
+        return amscr__fail(errno == ENOMEM ? AMSCR_E_NOMEM : AMSCR_E_IO, "%s: cannot write: %s", path,
+                           amscr__errstr(errno, eb, sizeof eb));
+    if (stream)
+        return write_through(path, buf, len);
+    size_t tmp_len = strlen(target) + 64;
     char *tmp = malloc(tmp_len);
-    if (!tmp)
-        return amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", path);
     amscr_status st = AMSCR_OK;
-    if (!write_unnamed(path, buf, len, tmp, tmp_len, &st))
-        st = write_named(path, buf, len, tmp, tmp_len);
+    if (!tmp)
+        st = amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", path);
+    else if (!write_unnamed(target, buf, len, tmp, tmp_len, &st))
+        st = write_named(target, buf, len, tmp, tmp_len);
     free(tmp);
+    free(target);
     return st;
 }
 

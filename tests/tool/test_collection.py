@@ -4,10 +4,12 @@ import json
 import math
 import os
 import struct
+import subprocess
 
 import pytest
 
-from imgutil import affine, blank, fill_rect, image_bytes, img_ext, rasterize, run, smooth_shape, write_points
+from imgutil import (affine, blank, fill_rect, image_bytes, img_ext, rasterize, run, smooth_shape, tool_path,
+                     write_points)
 
 MAPS = [((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
         ((0.9, 0.4, 10.0), (-0.3, 1.1, -5.0)),
@@ -452,3 +454,54 @@ def test_no_output_overwrites_a_file_the_command_reads(tmp_path):
     r = run("index", d, "-o", idx, "--add", *AFFINE)  # --add: FILE is the index itself (here a repeat)
     assert "would overwrite" not in r.stderr, r.stderr
     assert run("search", q, idx, "--sheet", tmp_path / "sheet.svg").returncode == 0
+
+
+def test_outputs_through_links_fifos_and_devices(tmp_path):
+    """An output that is a symbolic link replaces the file it points to (its mode kept), a FIFO is
+    written through and stays a FIFO, /dev/stdout appends to what stdout is; a replaced file keeps
+    its mode."""
+    import stat
+    import threading
+    d = folder_of_points(tmp_path / "set", ["star-1.txt", "star-2.txt", "blob-1.txt", "blob-2.txt"])
+    ref = tmp_path / "ref.tsv"
+    assert run("matrix", d, "-o", ref, *AFFINE).returncode == 0
+    want = ref.read_text()
+    target, link = tmp_path / "target.tsv", tmp_path / "link.tsv"
+    target.write_text("old\n")
+    target.chmod(0o600)
+    link.symlink_to("target.tsv")
+    assert run("matrix", d, "-o", link, *AFFINE).returncode == 0
+    assert link.is_symlink() and target.read_text() == want
+    assert stat.S_IMODE(target.stat().st_mode) == 0o600
+    assert run("matrix", d, "-o", target, *AFFINE).returncode == 0  # a replaced file keeps its mode
+    assert stat.S_IMODE(target.stat().st_mode) == 0o600
+    fifo = tmp_path / "fifo.tsv"
+    os.mkfifo(fifo)
+    got = []
+    reader = threading.Thread(target=lambda: got.append(open(fifo).read()))
+    reader.start()
+    r = run("matrix", d, "-o", fifo, *AFFINE, timeout=60)
+    reader.join(30)
+    assert r.returncode == 0, r.stderr
+    assert got == [want] and stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    pts, log = tmp_path / "pts.txt", tmp_path / "log.txt"
+    log.write_text("# before\n")
+    with open(log, "a") as out:  # the shell's >>
+        r = subprocess.run([tool_path(), "contour", str(d / "star-1.txt"), "-o", "/dev/stdout"], stdout=out)
+    assert r.returncode == 0
+    assert run("contour", d / "star-1.txt", "-o", pts).returncode == 0
+    assert log.read_text() == "# before\n" + pts.read_text()
+
+
+def test_lost_standard_output_is_an_error(tmp_path):
+    """Output lost on stdout (a full disk, a closed stdout) is an error line and exit status 1,
+    also past the stdio buffer."""
+    d = folder_of_points(tmp_path / "set", ["star-%d.txt" % i for i in range(1, 9)])
+    with open("/dev/full", "w") as full:
+        r = subprocess.run([tool_path(), "register", str(d / "star-1.txt"), str(d / "star-2.txt"), "--json"],
+                           stdout=full, stderr=subprocess.PIPE, text=True)
+    assert r.returncode == 1 and "write error" in r.stderr, r.stderr
+    r = subprocess.run([tool_path(), "search", str(d / "star-1.txt"), str(d), "--top", "8", *AFFINE],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, close_fds=True,
+                       pass_fds=(), preexec_fn=lambda: os.close(1))
+    assert r.returncode == 1 and "write error" in r.stderr, r.stderr

@@ -15,18 +15,37 @@
  *
  * Exit codes: 0 success, 1 bad input or failure (one line on stderr naming the file),
  * 2 usage error. */
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "amscr.h"
 #include "cli.h"
 
+/* `code` once standard output is flushed and closed: output lost to a write error (a full disk,
+ * a closed stdout, a pipe whose reader left while SIGPIPE is ignored) is a failure with its line,
+ * never exit 0. A closed stdout that was never written to is not an error. */
+static int finish(int code)
+{
+    int bad = fflush(stdout) != 0 || ferror(stdout);
+    int e = errno;
+    if (fclose(stdout) != 0 && !bad && errno != EBADF) {
+        bad = 1;
+        e = errno;
+    }
+    if (!bad)
+        return code;
+    tool_error("<stdout>", "write error: %s", strerror(e));
+    return code == TOOL_EXIT_OK ? TOOL_EXIT_FAIL : code;
+}
+
 static int is_any(const char *s, const char *a, const char *b, const char *c)
 {
     return strcmp(s, a) == 0 || strcmp(s, b) == 0 || strcmp(s, c) == 0;
 }
 
-int main(int argc, char **argv)
+/* The command's exit code, before standard output is closed. */
+static int run(int argc, char **argv)
 {
     char list[128];
     if (argc < 2)
@@ -55,3 +74,5 @@ int main(int argc, char **argv)
         return r;
     return c->run(&o);
 }
+
+int main(int argc, char **argv) { return finish(run(argc, argv)); }

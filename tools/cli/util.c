@@ -1,6 +1,7 @@
 /* util.c — helpers of the amscr tool (see util.h). */
 #define _GNU_SOURCE /* O_TMPFILE, where the system has it */
 #include "util.h"
+#include "out_path.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -173,6 +174,48 @@ static void out_free(tool_out *o)
     o->tmp = o->path = o->dir = NULL;
 }
 
+/* An existing file that is not replaced (out_path.h: a device, a FIFO, /dev/stdout), opened to
+ * write through it. */
+static int open_stream(tool_out *o, const char *path)
+{
+    int fd = open(path, O_WRONLY | O_APPEND | O_NOCTTY | O_CLOEXEC);
+    o->fp = fd >= 0 ? fdopen(fd, "wb") : NULL;
+    o->path = xstrdup(path);
+    o->stream = 1;
+    if (o->fp == NULL || o->path == NULL) {
+        if (o->fp == NULL)
+            tool_error(path, "cannot open output file: %s", strerror(errno));
+        if (o->fp)
+            fclose(o->fp);
+        else if (fd >= 0)
+            close(fd);
+        o->fp = NULL;
+        out_free(o);
+        return -1;
+    }
+    return 0;
+}
+
+/* A file for `target` in its folder: unnamed, or under a temporary name (o->tmp); its mode is
+ * the replaced file's, or 0666 less the umask for a new one. */
+static int open_replacement(tool_out *o, const char *target)
+{
+    int fd = open_unnamed(o->dir);
+    o->unnamed = fd >= 0;
+    if (fd < 0) {
+        snprintf(o->tmp, o->tmp_cap, "%s/.%s.XXXXXX", o->dir, path_base(target));
+        fd = mkstemp(o->tmp);
+        mode_t mask = umask(0); /* mkstemp makes 0600; give the usual 0666 & ~umask */
+        umask(mask);
+        if (fd >= 0)
+            (void)fchmod(fd, 0666 & ~mask);
+    }
+    struct stat st;
+    if (fd >= 0 && stat(target, &st) == 0 && S_ISREG(st.st_mode))
+        (void)fchmod(fd, st.st_mode & 07777); /* a replaced file keeps its mode */
+    return fd;
+}
+
 int tool_out_open(tool_out *o, const char *path)
 {
     memset(o, 0, sizeof *o);
@@ -180,29 +223,26 @@ int tool_out_open(tool_out *o, const char *path)
         o->fp = stdout;
         return 0;
     }
-    struct stat st;
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
-        tool_error(path, "is a directory");
+    int stream = 0;
+    char *target = NULL;
+    if (amscr__out_path(path, &stream, &target) != 0) {
+        if (errno == EISDIR)
+            tool_error(path, "is a directory");
+        else
+            tool_error(path, "cannot write output file: %s", strerror(errno));
         return -1;
     }
-    o->dir = path_dir(path);
-    o->tmp_cap = o->dir ? strlen(o->dir) + strlen(path_base(path)) + 64 : 0;
+    if (stream)
+        return open_stream(o, path);
+    o->path = target;
+    o->dir = path_dir(target);
+    o->tmp_cap = o->dir ? strlen(o->dir) + strlen(path_base(target)) + 64 : 0;
     o->tmp = o->dir ? xmalloc_array(o->tmp_cap, 1) : NULL;
-    o->path = xstrdup(path);
-    if (o->tmp == NULL || o->path == NULL) {
+    if (o->tmp == NULL) {
         out_free(o);
         return -1;
     }
-    int fd = open_unnamed(o->dir);
-    o->unnamed = fd >= 0;
-    if (fd < 0) {
-        snprintf(o->tmp, o->tmp_cap, "%s/.%s.XXXXXX", o->dir, path_base(path));
-        fd = mkstemp(o->tmp);
-        mode_t mask = umask(0); /* mkstemp makes 0600; give the usual 0666 & ~umask */
-        umask(mask);
-        if (fd >= 0)
-            (void)fchmod(fd, 0666 & ~mask);
-    }
+    int fd = open_replacement(o, target);
     o->fp = fd >= 0 ? fdopen(fd, "wb") : NULL;
     if (o->fp == NULL) {
         tool_error(path, "cannot create output file: %s", strerror(errno));
@@ -214,6 +254,22 @@ int tool_out_open(tool_out *o, const char *path)
         return -1;
     }
     return 0;
+}
+
+/* Flushes and closes a written-through file; -1 after the error line. */
+static int commit_stream(tool_out *o)
+{
+    int bad = fflush(o->fp) != 0 || ferror(o->fp);
+    int err = errno;
+    if (fclose(o->fp) != 0 && !bad) {
+        bad = 1;
+        err = errno;
+    }
+    o->fp = NULL;
+    if (bad)
+        tool_error(o->path, "cannot write output file: %s", strerror(err));
+    out_free(o);
+    return bad ? -1 : 0;
 }
 
 int tool_out_commit(tool_out *o)
@@ -229,6 +285,8 @@ int tool_out_commit(tool_out *o)
         }
         return 0;
     }
+    if (o->stream)
+        return commit_stream(o);
     int bad = fflush(o->fp) != 0 || ferror(o->fp);
     int err = errno;
     if (!bad && o->unnamed && name_unnamed(o, fileno(o->fp)) != 0) {
@@ -257,7 +315,7 @@ void tool_out_abort(tool_out *o)
 {
     if (o->fp != NULL && o->path != NULL)
         fclose(o->fp);
-    if (o->path != NULL && !o->unnamed)
+    if (o->path != NULL && !o->unnamed && !o->stream)
         unlink(o->tmp);
     out_free(o);
     o->fp = NULL;
@@ -265,6 +323,16 @@ void tool_out_abort(tool_out *o)
 
 int tool_out_probe(const char *path)
 {
+    int stream = 0;
+    char *target = NULL;
+    if (strcmp(path, "-") != 0 && amscr__out_path(path, &stream, &target) == 0 && stream) {
+        /* not opened: a FIFO's reader would see its end before the output is written */
+        if (access(path, W_OK) == 0)
+            return 0;
+        tool_error(path, "cannot open output file: %s", strerror(errno));
+        return -1;
+    }
+    free(target);
     tool_out t;
     if (tool_out_open(&t, path) != 0)
         return -1;
@@ -429,7 +497,8 @@ double now_seconds(void)
 /* ------------------------------------------------------------ progress */
 void progress_init(tool_progress *p, const char *label)
 {
-    p->enabled = isatty(2);
+    const char *term = getenv("TERM");
+    p->enabled = isatty(2) && !(term && strcmp(term, "dumb") == 0); /* a dumb terminal has no erase */
     p->label = label;
     p->start = now_seconds();
     p->last = 0.0;

@@ -45,8 +45,9 @@ char *xstrdup(const char *s);
 /* ----------------------------------------------------------- output files */
 /* An output written to an unnamed file in the destination's folder (O_TMPFILE), named on
  * commit — where the system has none, to a temporary file renamed over the destination — so a
- * failure never leaves a partial file, and a kill mid-write none at all. Path "-" means stdout
- * (no temporary). */
+ * failure never leaves a partial file, and a kill mid-write none at all. A replaced file keeps
+ * its mode; a symbolic link is followed (its target is replaced). Path "-" means stdout (no
+ * temporary); so does an existing device, FIFO or /dev/stdout, written through in place. */
 typedef struct tool_out {
     FILE *fp;
     char *tmp;      /* temporary path (or room for one), NULL for stdout */
@@ -54,6 +55,7 @@ typedef struct tool_out {
     char *path;     /* final path, NULL for stdout */
     char *dir;      /* its folder */
     int unnamed;    /* fp is an unnamed file */
+    int stream;     /* fp writes through path (a device, a FIFO, /dev/stdout: out_path.h) */
 } tool_out;
 
 /* Opens; on failure prints the error (naming `path`) and returns -1. */
