@@ -505,3 +505,24 @@ def test_lost_standard_output_is_an_error(tmp_path):
                        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, close_fds=True,
                        pass_fds=(), preexec_fn=lambda: os.close(1))
     assert r.returncode == 1 and "write error" in r.stderr, r.stderr
+
+
+def test_shapes_through_a_pipe_read_whole(tmp_path):
+    """A point list or an image given through a pipe (/dev/stdin) is read whole, as the file gives
+    it (its first bytes were lost to the format's sniffing); a collection through a pipe is
+    refused with its reason."""
+    d = folder_of_points(tmp_path / "set", ["star-1.txt", "star-2.txt", "blob-1.txt", "blob-2.txt"])
+    src, tgt = d / "star-1.txt", d / "star-2.txt"
+    pic = tmp_path / ("star" + img_ext())
+    pic.write_bytes(image_bytes(rasterize(base_shapes()["star"], 120, 120), pic.name))
+    for f in (src, pic):
+        want = run("register", f, tgt, "--json")
+        assert want.returncode == 0, want.stderr
+        r = subprocess.run([tool_path(), "register", "/dev/stdin", str(tgt), "--json"], input=f.read_bytes(),
+                           capture_output=True)
+        got = json.loads(r.stdout)
+        for key in ("source_points", "distance", "A", "B"):
+            assert got[key] == json.loads(want.stdout)[key], (f, key)
+    r = subprocess.run([tool_path(), "eval", "/dev/stdin"], input="file\tclass\nstar-1.txt\tstar\n",
+                       capture_output=True, text=True)  # a manifest through a pipe: its shapes need a folder
+    assert r.returncode == 1 and "a pipe or a device" in r.stderr, r.stderr

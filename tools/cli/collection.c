@@ -537,6 +537,10 @@ int collection_open(const char *path, collection *out)
         tool_error(path, "cannot open: %s", strerror(errno));
         return -1;
     }
+    if (!S_ISDIR(st.st_mode) && !S_ISREG(st.st_mode)) { /* its shapes' paths need a folder */
+        tool_error(path, "a pipe or a device: a collection is a folder, a manifest file or an index file");
+        return -1;
+    }
     int r = S_ISDIR(st.st_mode) ? open_folder(path, out) : open_manifest(path, out);
     if (r != 0)
         collection_free(out);

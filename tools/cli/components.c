@@ -12,6 +12,7 @@ int shape_contours(const char *path, int threshold, double min_area, amscr_conto
     if (r < 0)
         return -1;
     if (r > 0) {
+        image_free(&img);
         tool_error(path, "not an image: every contour (--all, --component) needs a PNG or PGM image");
         return -1;
     }

@@ -52,10 +52,49 @@ static tool_format sniff(const unsigned char *m, size_t n, const char **other)
     return TOOL_FMT_TEXT;
 }
 
-/* Opens `path` for reading after checking it is a non-empty regular file. */
-static FILE *open_input(const char *path)
+/* The most a stream (a pipe, /dev/stdin) may hold: it is read whole into memory. */
+#define TOOL_STREAM_MAX ((size_t)1 << 30)
+
+/* The whole of fp, a stream that cannot be read twice, into memory (*len bytes, NUL-terminated);
+ * NULL after an error line. */
+static char *read_stream(FILE *fp, const char *path, size_t *len)
+{
+    size_t cap = 1 << 16, n = 0;
+    char *buf = malloc(cap);
+    for (size_t got = 1; buf && got > 0;) {
+        if (cap - n < 2) {
+            char *nb = cap < TOOL_STREAM_MAX ? realloc(buf, 2 * cap) : NULL;
+            if (!nb) {
+                tool_error(path, cap < TOOL_STREAM_MAX ? "out of memory" : "more than 1 GiB through a pipe: give a file");
+                free(buf);
+                return NULL;
+            }
+            buf = nb;
+            cap *= 2;
+        }
+        got = fread(buf + n, 1, cap - n - 1, fp);
+        n += got;
+    }
+    if (buf && ferror(fp)) {
+        tool_error(path, "read error: %s", strerror(errno));
+        free(buf);
+        return NULL;
+    }
+    if (!buf)
+        tool_error(path, "out of memory");
+    else
+        buf[n] = '\0';
+    *len = n;
+    return buf;
+}
+
+/* Opens `path` for reading after checking it is a non-empty file. A stream that cannot be read
+ * twice (a pipe, a FIFO, a device: /dev/stdin) is read whole into *mem (freed by the caller) and
+ * opened from memory, so its format can be sniffed and the file read from its start. */
+static FILE *open_input(const char *path, char **mem, size_t *mem_len)
 {
     struct stat st;
+    *mem = NULL;
     if (stat(path, &st) != 0) {
         tool_error(path, "cannot open: %s", strerror(errno));
         return NULL;
@@ -69,7 +108,21 @@ static FILE *open_input(const char *path)
         tool_error(path, "cannot open: %s", strerror(errno));
         return NULL;
     }
-    if (S_ISREG(st.st_mode) && st.st_size == 0) {
+    if (!S_ISREG(st.st_mode)) {
+        *mem = read_stream(fp, path, mem_len);
+        fclose(fp);
+        fp = *mem && *mem_len ? fmemopen(*mem, *mem_len, "rb") : NULL;
+        if (*mem && *mem_len && !fp)
+            tool_error(path, "out of memory");
+        if (!fp && *mem && *mem_len == 0)
+            tool_error(path, "empty file");
+        if (!fp) {
+            free(*mem);
+            *mem = NULL;
+        }
+        return fp;
+    }
+    if (st.st_size == 0) {
         fclose(fp);
         tool_error(path, "empty file");
         return NULL;
@@ -101,19 +154,43 @@ const char *file_image_other(const char *path)
     return other;
 }
 
+/* 1 when the first n bytes m of a file that is no image (`other`: the format it is, if known)
+ * may start a point list; else -1 after the error line. */
+static int text_or_error(const char *path, const unsigned char *m, size_t n, const char *other, int text_ok)
+{
+    if (other != NULL) {
+        tool_error(path, "unsupported image format (%s): use PNG, PGM or a text point list", other);
+        return -1;
+    }
+    if (!text_ok) {
+        tool_error(path, "not a PNG or PGM image");
+        return -1;
+    }
+    size_t ctrl = 0;
+    for (size_t i = 0; i < n; i++)
+        if (m[i] < 32 && m[i] != '\n' && m[i] != '\r' && m[i] != '\t' && m[i] != '\f' && m[i] != '\v')
+            ctrl++;
+    if (memchr(m, '\0', n) != NULL || ctrl * 20 > n) {
+        tool_error(path, "unrecognized binary file: not a PNG or PGM image, nor a text point list");
+        return -1;
+    }
+    return 1;
+}
+
 int image_read(const char *path, int text_ok, tool_image *out, tool_format *out_format)
 {
-    out->pix = NULL;
-    out->pix16 = NULL;
-    out->width = out->height = 0;
+    memset(out, 0, sizeof *out);
     *out_format = TOOL_FMT_TEXT;
-    FILE *fp = open_input(path);
+    char *mem;
+    size_t mem_len = 0;
+    FILE *fp = open_input(path, &mem, &mem_len);
     if (fp == NULL)
         return -1;
     unsigned char m[512];
     size_t n = fread(m, 1, sizeof m, fp);
     if (n == 0) {
         fclose(fp);
+        free(mem);
         tool_error(path, "empty file");
         return -1;
     }
@@ -122,23 +199,14 @@ int image_read(const char *path, int text_ok, tool_image *out, tool_format *out_
     *out_format = f;
     if (f == TOOL_FMT_TEXT) {
         fclose(fp);
-        if (other != NULL) {
-            tool_error(path, "unsupported image format (%s): use PNG, PGM or a text point list", other);
-            return -1;
+        int r = text_or_error(path, m, n, other, text_ok);
+        if (r > 0 && mem) {
+            out->text = mem;
+            out->text_len = mem_len;
+        } else {
+            free(mem);
         }
-        if (!text_ok) {
-            tool_error(path, "not a PNG or PGM image");
-            return -1;
-        }
-        size_t ctrl = 0;
-        for (size_t i = 0; i < n; i++)
-            if (m[i] < 32 && m[i] != '\n' && m[i] != '\r' && m[i] != '\t' && m[i] != '\f' && m[i] != '\v')
-                ctrl++;
-        if (memchr(m, '\0', n) != NULL || ctrl * 20 > n) {
-            tool_error(path, "unrecognized binary file: not a PNG or PGM image, nor a text point list");
-            return -1;
-        }
-        return 1;
+        return r;
     }
     rewind(fp);
     int r;
@@ -154,6 +222,7 @@ int image_read(const char *path, int text_ok, tool_image *out, tool_format *out_
 #endif
     }
     fclose(fp);
+    free(mem);
     if (r < 0)
         image_free(out);
     return r;
@@ -224,8 +293,10 @@ int shape_load(const char *path, int threshold, amscr_contour **out)
     if (r < 0)
         return -1;
     if (r > 0) {
-        /* Not an image: a text point list. */
-        amscr_status st = amscr_contour_read_text(path, out);
+        /* Not an image: a text point list (read already when it came through a pipe). */
+        amscr_status st = img.text ? amscr_contour_parse_text(img.text, img.text_len, out)
+                                   : amscr_contour_read_text(path, out);
+        image_free(&img);
         if (st != AMSCR_OK) {
             const char *d = lib_detail();
             if (st == AMSCR_E_FORMAT && d[0] != '\0') {

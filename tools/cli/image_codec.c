@@ -12,8 +12,11 @@ void image_free(tool_image *img)
     if (img) {
         free(img->pix);
         free(img->pix16);
+        free(img->text);
         img->pix = NULL;
         img->pix16 = NULL;
+        img->text = NULL;
+        img->text_len = 0;
         img->width = img->height = 0;
     }
 }

@@ -16,6 +16,8 @@ typedef struct tool_image {
     uint8_t *pix;
     size_t width, height;
     uint16_t *pix16;
+    char *text;      /* a point list read from a stream (a pipe, /dev/stdin): its bytes, else NULL */
+    size_t text_len;
 } tool_image;
 
 /* Frees an image's samples (image_codec.c); the struct is left empty. */

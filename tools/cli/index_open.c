@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cmd_params.h"
 #include "index_tool.h"
@@ -98,6 +99,9 @@ int index_params(const opts *o, const char *path, const amscr_params *built, ams
 
 int index_file_is(const char *path)
 {
+    struct stat st;
+    if (stat(path, &st) != 0 || !S_ISREG(st.st_mode))
+        return 0; /* a pipe's first bytes would be gone: collection_open refuses it */
     FILE *f = fopen(path, "rb");
     char m[8] = {0};
     if (f == NULL)
