@@ -413,6 +413,13 @@ def test_folder_warns_of_images_it_cannot_read(tmp_path):
     r = run("eval", d, *AFFINE)
     one = "amscr: %s: 1 file skipped: not PNG, PGM or a point list (e.g. b.jpg)\n" % d
     assert r.returncode == 0 and r.stderr == one, r.stderr
+    (d / "b.jpg").unlink()  # named as images, and none: empty, text, a dangling link
+    (d / "empty.png").write_bytes(b"")
+    (d / "text.pgm").write_text("not an image\n")
+    (d / "broken.png").symlink_to("nowhere.png")
+    r = run("eval", d, "--json", *AFFINE)
+    assert r.returncode == 0 and json.loads(r.stdout)["n"] == 4
+    assert r.stderr == "amscr: %s: 3 files skipped: not PNG, PGM or a point list (e.g. broken.png)\n" % d, r.stderr
 
 
 def test_class_names_drop_trailing_separators(tmp_path):

@@ -147,8 +147,9 @@ typedef struct {
 } skipped_files;
 
 /* 1 when the folder entry `name` is a shape file (a regular file: PNG or PGM magic bytes, or a
- * .txt / .csv name); 0 when not (an image of a format the tool cannot read is counted in sk);
- * -1 out of memory. */
+ * .txt / .csv name); 0 when not (counted in sk when it looks meant as a shape: an image of a
+ * format the tool cannot read, or a file named as an image that is none — empty, damaged, a
+ * dangling link); -1 out of memory. */
 static int take_entry(const char *dir, const char *name, skipped_files *sk)
 {
     char *path = path_join(dir, name);
@@ -159,7 +160,8 @@ static int take_entry(const char *dir, const char *name, skipped_files *sk)
     path_ext(name, ext);
     int reg = stat(path, &st) == 0 && S_ISREG(st.st_mode);
     int take = reg && (strcmp(ext, ".txt") == 0 || strcmp(ext, ".csv") == 0 || file_is_image(path));
-    if (reg && !take && file_image_other(path) != NULL) {
+    int named = strcmp(ext, ".png") == 0 || strcmp(ext, ".pgm") == 0 || strcmp(ext, ".pnm") == 0;
+    if (!take && (named || (reg && file_image_other(path) != NULL))) {
         if (sk->n++ == 0 || strcmp(name, sk->example) < 0)
             snprintf(sk->example, sizeof sk->example, "%s", name);
     }
