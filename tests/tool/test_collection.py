@@ -533,3 +533,14 @@ def test_shapes_through_a_pipe_read_whole(tmp_path):
     r = subprocess.run([tool_path(), "eval", "/dev/stdin"], input="file\tclass\nstar-1.txt\tstar\n",
                        capture_output=True, text=True)  # a manifest through a pipe: its shapes need a folder
     assert r.returncode == 1 and "a pipe or a device" in r.stderr, r.stderr
+
+
+def test_matrix_to_a_device_and_names_a_tsv_cannot_hold(tmp_path):
+    """matrix -o /dev/stdout writes the TSV; a file name holding a tab or a line break is refused
+    with --names (a names file is TSV) before any shape is prepared, and allowed without it."""
+    d = folder_of_points(tmp_path / "set", ["star-1.txt", "star-2.txt", "blob-1.txt", "blob\t2.txt"])
+    r = run("matrix", d, "-o", "/dev/stdout", *AFFINE)
+    assert r.returncode == 0 and len(r.stdout.splitlines()) == 5, r.stderr
+    r = run("matrix", d, "-o", tmp_path / "d.tsv", "--names", tmp_path / "n.tsv", *AFFINE)
+    assert r.returncode == 1 and "tab or a line break" in r.stderr, r.stderr
+    assert not (tmp_path / "d.tsv").exists() and not (tmp_path / "n.tsv").exists()

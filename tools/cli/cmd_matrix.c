@@ -24,6 +24,12 @@ static int outputs_checked(const opts *o, const collection *c)
         tool_error(o->names, "-o and --names name the same file");
         return TOOL_EXIT_FAIL;
     }
+    for (size_t i = 0; o->names && i < c->n; i++) /* a names file is TSV: one line a shape */
+        if (strpbrk(c->items[i].name, "\t\n\r") || strpbrk(c->classes[c->items[i].label], "\t\n\r")) {
+            tool_error(o->names, "shape %zu's file or class name holds a tab or a line break, which a TSV names "
+                                 "file cannot: rename it", i + 1);
+            return TOOL_EXIT_FAIL;
+        }
     return 0;
 }
 
@@ -34,9 +40,10 @@ int cmd_matrix(opts *o)
         return usage_error("matrix", "missing -o FILE (.tsv, .npy, or - for stdout)");
     char ext[16];
     path_ext(o->out, ext);
-    int npy = strcmp(ext, ".npy") == 0;
-    if (!npy && strcmp(ext, ".tsv") != 0 && strcmp(ext, ".txt") != 0 && strcmp(o->out, "-") != 0)
-        return usage_error("-o", "'%s': the matrix file must end in .tsv or .npy (or be - for stdout)", o->out);
+    int npy = strcmp(ext, ".npy") == 0, device = strncmp(o->out, "/dev/", 5) == 0; /* /dev/stdout: TSV */
+    if (!npy && !device && strcmp(ext, ".tsv") != 0 && strcmp(ext, ".txt") != 0 && strcmp(o->out, "-") != 0)
+        return usage_error("-o", "'%s': the matrix file must end in .tsv, .txt or .npy (or be - or a device "
+                                 "such as /dev/stdout)", o->out);
     amscr_params *p = NULL;
     collection c;
     amscr_db *db = NULL;

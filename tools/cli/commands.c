@@ -108,10 +108,11 @@ static const char HELP_MATRIX[] =
     "Computes the n x n matrix D[i][j] = distance(shape i -> shape j) of a collection\n"
     "(rows in collection order: folder files sorted by name, or manifest order).\n"
     "FILE ending in .npy: NumPy .npy v1.0, little-endian float64, C order;\n"
-    "otherwise (.tsv, or - for stdout): tab-separated text, one row per line, after a\n"
+    "otherwise (.tsv, .txt, - for stdout, or a device such as /dev/stdout): tab-separated\n"
+    "text, one row per line, after a\n"
     "'#' comment line listing the files. Reflections are on by default.\n"
     "\n"
-    "  -o, --output FILE       the matrix file (.tsv, .npy or -)\n"
+    "  -o, --output FILE       the matrix file (.tsv, .txt, .npy, - or /dev/...)\n"
     "  --names FILE            also write the row order: 'file<TAB>class' lines\n";
 
 static const char HELP_EVAL[] =
