@@ -44,6 +44,12 @@ extern "C" {
  *              returned; the exceptions are stated where they apply (the batch calls
  *              fill their output with NaN on failure; amscr_bayes_threshold writes
  *              a fallback with AMSCR_E_NOT_FOUND).
+ * Floating point. The calls run under the caller's floating-point environment: a
+ *              rounding mode other than to-nearest or flush-to-zero moves results by
+ *              rounding only; traps on invalid or divide-by-zero (feenableexcept) are
+ *              not set off by registration, retrieval or tracing (since 0.22.3; a NaN
+ *              that marks "not computed" is compared quietly). The status flags
+ *              (fetestexcept) are left as the computation raised them.
  * Errors.      Every fallible function returns `amscr_status`. On failure
  *              amscr_last_error_detail() says what went wrong, for the
  *              calling thread. The library never prints and never aborts.
@@ -90,10 +96,15 @@ extern "C" {
 #  define AMSCR_API
 #endif
 
-#if defined(__GNUC__) && (__GNUC__ > 3 || (__GNUC__ == 3 && __GNUC_MINOR__ >= 4))
-#  define AMSCR_NODISCARD __attribute__((warn_unused_result))
-#else
-#  define AMSCR_NODISCARD
+/* A status must be looked at (warn_unused_result). GCC warns even when it is cast to void: a
+ * caller that discards statuses on purpose defines AMSCR_NODISCARD empty before including this
+ * header (-DAMSCR_NODISCARD=), since 0.22.3. */
+#if !defined(AMSCR_NODISCARD)
+#  if defined(__GNUC__) && (__GNUC__ > 3 || (__GNUC__ == 3 && __GNUC_MINOR__ >= 4))
+#    define AMSCR_NODISCARD __attribute__((warn_unused_result))
+#  else
+#    define AMSCR_NODISCARD
+#  endif
 #endif
 
 /** Compile-time version; amscr_version_number() gives the runtime one. */

@@ -37,5 +37,6 @@ Suite *amscr_suite_subpixel(void);
 Suite *amscr_suite_stages(void);
 Suite *amscr_suite_inner(void);
 Suite *amscr_suite_pixel_grid(void);
+Suite *amscr_suite_fenv(void);
 
 #endif
