@@ -1,6 +1,7 @@
 /* check_contour_io.c — text point lists: parsing, reading, atomic writing. */
 #include <check.h>
 #include <dirent.h>
+#include <errno.h>
 #include <fcntl.h>
 #include <locale.h>
 #include <math.h>
@@ -11,6 +12,7 @@
 #include <unistd.h>
 
 #include "amscr.h"
+#include "internal.h" /* amscr__fopen_read */
 #include "suites.h"
 #include "testutil.h"
 
@@ -428,6 +430,24 @@ START_TEST(write_through_links_and_fifos)
 }
 END_TEST
 
+/* The library's reads are close-on-exec (a program spawning another on a second thread does not
+ * hand it the library's files). */
+START_TEST(reads_are_close_on_exec)
+{
+    char *dir = make_tmpdir();
+    char path[4200];
+    snprintf(path, sizeof path, "%s/p.txt", dir);
+    write_file(path, "0 0\n1 0\n0 1\n");
+    FILE *f = amscr__fopen_read(path);
+    ck_assert_ptr_nonnull(f);
+    ck_assert_int_ne(fcntl(fileno(f), F_GETFD) & FD_CLOEXEC, 0);
+    fclose(f);
+    ck_assert_ptr_null(amscr__fopen_read(dir + strlen(dir))); /* "": no such file, errno set */
+    ck_assert_int_eq(errno, ENOENT);
+    rm_tree(dir);
+}
+END_TEST
+
 Suite *amscr_suite_contour_io(void)
 {
     Suite *s = suite_create("contour_io");
@@ -447,6 +467,7 @@ Suite *amscr_suite_contour_io(void)
     tcase_add_test(tf, write_missing_dir);
     tcase_add_test(tf, text_in_a_comma_locale);
     tcase_add_test(tf, write_through_links_and_fifos);
+    tcase_add_test(tf, reads_are_close_on_exec);
     suite_add_tcase(s, tf);
     return s;
 }

@@ -174,9 +174,21 @@ static size_t file_size(FILE *f)
                : 0;
 }
 
+FILE *amscr__fopen_read(const char *path)
+{
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    FILE *f = fd >= 0 ? fdopen(fd, "rb") : NULL;
+    if (fd >= 0 && !f) {
+        int e = errno;
+        close(fd);
+        errno = e;
+    }
+    return f;
+}
+
 amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out_len)
 {
-    FILE *f = fopen(path, "rb");
+    FILE *f = amscr__fopen_read(path);
     char eb[128];
     if (!f)
         return amscr__fail(AMSCR_E_IO, "%s: %s", path, amscr__errstr(errno, eb, sizeof eb));
@@ -225,7 +237,7 @@ amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out
 amscr_status amscr__file_map(const char *path, unsigned char **out, size_t *out_len, int *mapped)
 {
     *mapped = 0;
-    int fd = open(path, O_RDONLY);
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
     struct stat sb;
     if (fd >= 0 && fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0 &&
         (uintmax_t)sb.st_size < SIZE_MAX / 2) {

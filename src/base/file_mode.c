@@ -12,7 +12,7 @@
 /* The process's umask, or -1 when it cannot be read without changing it. */
 static int read_umask(void)
 {
-    FILE *f = fopen("/proc/self/status", "r");
+    FILE *f = amscr__fopen_read("/proc/self/status");
     if (!f)
         return -1;
     char line[256];

@@ -7,6 +7,7 @@
 #include <locale.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #if defined(__GNUC__)
 #define AMSCR_PRINTF(a, b) __attribute__((format(printf, a, b)))
@@ -355,6 +356,9 @@ unsigned amscr__resolve_threads(unsigned requested);
 unsigned amscr__file_mode(const char *path);
 /* strerror, thread-safe: the message of errno value err, in buf (size len) or static (file_io.c). */
 const char *amscr__errstr(int err, char *buf, size_t len);
+/* fopen(path, "rb") with close-on-exec: a program that starts another one while the library
+ * reads (posix_spawn on another thread) does not hand it the file. NULL with errno set. */
+FILE *amscr__fopen_read(const char *path);
 /* Whole files (file_io.c). buf written to path whole before it takes its name (an unnamed
  * O_TMPFILE file linked in, else a temporary name renamed). */
 amscr_status amscr__file_write_atomic(const char *path, const void *buf, size_t len);

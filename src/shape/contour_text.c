@@ -172,7 +172,7 @@ amscr_status amscr_contour_read_text(const char *path, amscr_contour **out)
     AMSCR_CHECK_NULL(path);
     AMSCR_CHECK_NULL(out);
     char eb[128];
-    FILE *f = fopen(path, "rb");
+    FILE *f = amscr__fopen_read(path);
     if (!f)
         return amscr__fail(AMSCR_E_IO, "%s: %s", path, amscr__errstr(errno, eb, sizeof eb));
     size_t cap = 1 << 16, len = 0;
