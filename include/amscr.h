@@ -50,6 +50,7 @@ extern "C" {
  *              not set off by registration, retrieval or tracing (since 0.22.3; a NaN
  *              that marks "not computed" is compared quietly). The status flags
  *              (fetestexcept) are left as the computation raised them.
+ * errno.       Not part of the interface: any call may change it, also on success.
  * Errors.      Every fallible function returns `amscr_status`. On failure
  *              amscr_last_error_detail() says what went wrong, for the
  *              calling thread. The library never prints and never aborts.
@@ -577,7 +578,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_gaussian_kernel(double sigma, doubl
  * @param[in]  closed  1 closed, 0 open.
  * @param[in]  sigma   in samples, >= 0.
  * @param[out] out_xy  2n doubles; must not overlap xy.
- * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_NOMEM.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (also out_xy overlapping xy, since 0.22.3: before,
+ *         the result was wrong); AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: safe.
  * @since 0.1
@@ -1505,7 +1507,9 @@ AMSCR_API int amscr_params_get_stage(const amscr_params *p, const char *name);
 
 /**
  * @brief Sets the threads of batch calls: 0 = all cores (default), else 1..1024. Results do
- *        not depend on the thread count.
+ *        not depend on the thread count. "All cores" are those the process may run on (its
+ *        CPU affinity on Linux: taskset, a container's cpuset; since 0.22.3, before which the
+ *        online cores were counted).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -3618,7 +3622,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_signature_shortlists_packed(const u
  * @param[in]  k     neighbours, 1..n (typical 10).
  * @param[in]  iterations  1..1000 (typical 20).
  * @param[out] out_dist  n x n; may equal dist (in place).
- * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_NOMEM.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_LIMIT (n above 65536); AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: safe.
  * @since 0.1

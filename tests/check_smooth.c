@@ -321,6 +321,14 @@ START_TEST(test_smooth_invalid)
     ck_assert(amscr_last_error_detail()[0] != '\0');
     for (int i = 0; i < 20; i++)
         ck_assert_msg(out[i] == -99.0, "out[%d] written on failure", i);
+    double big[24];
+    for (int i = 0; i < 24; i++)
+        big[i] = xy[i % 20];
+    ck_assert_int_eq(amscr_smooth_gaussian(big, 10, 1, 1.0, big), AMSCR_E_INVALID_ARG); /* in place */
+    ck_assert_int_eq(amscr_smooth_gaussian(big, 10, 1, 1.0, big + 2), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_smooth_gaussian(big + 2, 10, 1, 1.0, big), AMSCR_E_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), "overlaps"));
+    ck_assert_int_eq(amscr_smooth_gaussian(big, 2, 1, 1.0, big + 4), AMSCR_OK); /* side by side */
 }
 END_TEST
 

@@ -6,7 +6,12 @@
  *   internal.h      the shared internals of libamscr (never installed)
  *
  * amscr_common.c — errors, version, features, allocation helpers. */
+#define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT (Linux) */
 #include "internal.h"
+
+#if defined(__linux__)
+#include <sched.h>
+#endif
 
 #include <math.h>
 #include <stdarg.h>
@@ -117,6 +122,11 @@ unsigned amscr__resolve_threads(unsigned requested)
     if (requested > 0)
         return requested;
     long n = sysconf(_SC_NPROCESSORS_ONLN);
+#if defined(__linux__) && defined(CPU_COUNT)
+    cpu_set_t set; /* the cores this process may run on (taskset, a container's cpuset) */
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0)
+        n = CPU_COUNT(&set);
+#endif
     if (n < 1)
         n = 1;
     if (n > 1024)

@@ -1,6 +1,8 @@
 /* smooth.c — FIR Gaussian kernel and smoothing of curves (circular or mirrored). */
 #include "internal.h"
 
+#include <stdint.h>
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -131,6 +133,9 @@ amscr_status amscr_smooth_gaussian(const double *xy, size_t n, int closed, doubl
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_smooth_gaussian: sigma = %g must be in [0, 1e6]", sigma);
     if (!amscr__all_finite(xy, 2 * n))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_smooth_gaussian: non-finite coordinates");
+    uintptr_t in = (uintptr_t)xy, out = (uintptr_t)out_xy, bytes = 2 * n * sizeof *xy;
+    if (out < in + bytes && in < out + bytes) /* the passes read what they would overwrite */
+        return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_smooth_gaussian: out_xy overlaps xy");
     return amscr__smooth(xy, n, closed, sigma, out_xy);
 }
 
