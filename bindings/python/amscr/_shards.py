@@ -36,7 +36,6 @@ from .collection import Collection
 from .errors import AmscrError, FormatError, InvalidArgumentError, _check
 from .index import Index
 from .params import Params
-from .shape import Shape
 from ._placement import _block, _threads_by_host
 from ._shard_build import _merge_lists, _shortlist_lists, widths
 from ._shard_files import ShardSetError, read_set, write_set
@@ -165,11 +164,8 @@ class ShardedIndex:
 
     def _queries(self, queries: Sequence[Any]) -> Collection:
         q = Collection(self.params)
-        for x in queries:
-            if isinstance(x, Shape):
-                q.add(x)
-            else:
-                q.add(np.asarray(x, dtype=np.float64))
+        for x in queries:  # points (masked arrays refused) or Shapes, as Collection.add takes them
+            q.add(x)
         return q
 
     def _gather(self, futs: List[Any]) -> List[Any]:

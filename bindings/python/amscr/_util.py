@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import contextlib
+import operator
 import sys
 import threading
 import time
@@ -23,6 +24,35 @@ INT32_MIN, INT32_MAX = -(2 ** 31), 2 ** 31 - 1
 def bad(msg: str) -> InvalidArgumentError:
     """A Python-side validation error (also a ValueError)."""
     return InvalidArgumentError(msg, lib.AMSCR_E_INVALID_ARG, msg)
+
+
+class ArgumentTypeError(InvalidArgumentError, TypeError):
+    """An argument of the wrong type (a float or str index, a str option): a TypeError, and an
+    InvalidArgumentError (a ValueError) as the other bad arguments."""
+
+
+def bad_type(msg: str) -> ArgumentTypeError:
+    """A Python-side type error (also an InvalidArgumentError and a ValueError)."""
+    return ArgumentTypeError(msg, lib.AMSCR_E_INVALID_ARG, msg)
+
+
+def unmasked(x: Any, name: str, instead: str) -> Any:
+    """`x` itself, or the data of a ``numpy.ma`` array with nothing masked; a masked array with
+    masked values is refused (its masked values would be used as they are)."""
+    if not isinstance(x, np.ma.MaskedArray):
+        return x
+    masked = int(np.ma.getmaskarray(x).sum())
+    if masked:
+        raise bad('%s: masked values are not accepted (%d values of the numpy.ma array are masked); pass %s'
+                  % (name, masked, instead))
+    return x.data
+
+
+def not_real(name: str, a: np.ndarray) -> InvalidArgumentError:
+    """The error for an array that does not hold real numbers (with a hint for object arrays, as
+    a pandas nullable Float64 frame gives)."""
+    hint = ': convert it first, e.g. df.to_numpy(float)' if a.dtype == object else ''
+    return bad('%s: expected real numbers, got an array of dtype %s%s' % (name, a.dtype, hint))
 
 
 #: The point orders accepted by ``order=``: (x, y) columns, or (row, col) as scikit-image gives them.
@@ -50,13 +80,14 @@ def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: boo
     order = as_order(order)
     if hasattr(x, 'input_points') and hasattr(x, 'scale_points'):
         raise TypeError('%s: expected an array of points, got a prepared Shape' % name)
+    x = unmasked(x, name, 'the points to keep, e.g. points[~points.mask.any(axis=1)], or points.filled(value)')
     try:
         a = np.asarray(x)
     except ValueError as e:  # ragged nested lists, e.g. the whole tuple cv2.findContours returns
         raise bad('%s: expected an array of shape (n, 2) (or one OpenCV contour, (n, 1, 2)): %s'
                   % (name, e)) from None
     if a.dtype.kind not in 'iuf':
-        raise bad('%s: expected real numbers, got an array of dtype %s' % (name, a.dtype))
+        raise not_real(name, a)
     if a.ndim == 3 and a.shape[1:] == (1, 2):  # an OpenCV contour
         a = a[:, 0, :]
         if closed_shape and a.dtype.kind in 'iu':
@@ -105,7 +136,7 @@ def as_float_array(x: Any, name: str, ndim: Optional[Tuple[int, ...]] = None, fi
     except ValueError as e:
         raise bad('%s: not a regular array: %s' % (name, e)) from None
     if a.dtype.kind not in 'iuf':
-        raise bad('%s: expected real numbers, got an array of dtype %s' % (name, a.dtype))
+        raise not_real(name, a)
     if ndim is not None and a.ndim not in ndim:
         raise bad('%s: expected %s dimension(s), got shape %s' % (name, ' or '.join(map(str, ndim)), a.shape))
     a = np.ascontiguousarray(a, dtype=np.float64)
@@ -116,6 +147,8 @@ def as_float_array(x: Any, name: str, ndim: Optional[Tuple[int, ...]] = None, fi
 
 
 def as_scalar(x: Any, name: str) -> float:
+    if isinstance(x, (str, bytes, bool, np.bool_)):
+        raise bad_type('%s: expected a number, got %r' % (name, x))
     try:
         v = float(x)
     except (TypeError, ValueError):
@@ -123,10 +156,16 @@ def as_scalar(x: Any, name: str) -> float:
     return v
 
 
+def as_index(x: Any, name: str) -> int:
+    """An integer (int, a NumPy integer: operator.index), not a bool, float or str."""
+    if not isinstance(x, (bool, np.bool_)):
+        with contextlib.suppress(TypeError):
+            return operator.index(x)
+    raise bad_type('%s: expected an integer, got %r' % (name, x))
+
+
 def as_count(x: Any, name: str, minimum: int = 0) -> int:
-    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer)):
-        raise bad('%s: expected an integer, got %r' % (name, x))
-    v = int(x)
+    v = as_index(x, name)
     if v < minimum:
         raise bad('%s: must be >= %d, got %d' % (name, minimum, v))
     return v
@@ -324,7 +363,8 @@ def progress_call(fn, args_before: tuple, args_after: tuple, progress: ProgressA
     """Calls fn(*args_before, callback, user, *args_after) with a progress callback.
 
     The callback is always installed, so Ctrl-C (KeyboardInterrupt) cancels a long call made
-    from the main thread. An exception raised by a user's progress callable cancels the call
+    from the main thread (a registration under way returns first; at the default points it takes
+    milliseconds). An exception raised by a user's progress callable cancels the call
     and is re-raised here; a callable returning True cancels it (CancelledError).
     """
     if not (progress is None or isinstance(progress, (bool, np.bool_)) or callable(progress)):

@@ -8,7 +8,8 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ProgressArg, RWLock, as_points, as_uint, bad, dbuf, factorize, new_object, progress_call, saved_bytes
+from ._util import (ProgressArg, RWLock, as_index, as_points, as_uint, bad, dbuf, factorize, new_object, progress_call,
+                    saved_bytes)
 from .contour import contour_new
 from .errors import AmscrError, _check
 from .params import Params, make_params
@@ -29,6 +30,10 @@ class Collection:
     Labels are int32 values, or any other hashable values (e.g. strings), which are mapped to
     codes 0, 1, ... in order of first use (:attr:`labels` gives them back; saved files hold codes).
     Thread-safety: any number of threads may query at once; :meth:`add` waits for them.
+
+    A pickled collection (multiprocessing) holds its shapes but not the index that retrieval
+    queries keep (see :meth:`query`): the copy builds it again on its first retrieval query
+    (every pair, O(n²)); send an :class:`Index` to processes that run retrieval queries.
 
     Args:
         params: a :class:`Params` to start from (None: the library defaults, tuned for
@@ -218,15 +223,15 @@ class Collection:
         are only valid until it is modified).
 
         Args:
-            i: the index; negative indices count from the end.
+            i: the index, an integer; negative indices count from the end.
         Returns:
             a :class:`Shape`.
         Raises:
-            IndexError: `i` out of range.
+            IndexError: `i` out of range; TypeError: `i` not an integer (a float, str or bool).
         """
+        i = as_index(i, 'i')
         with self._lock.read():
             n = len(self)
-            i = int(i)
             if i < 0:
                 i += n
             if not 0 <= i < n:
@@ -276,7 +281,8 @@ class Collection:
             (len(self),) float array; rank it with :func:`topk` or ``numpy.argsort``.
         Raises:
             InvalidArgumentError: bad points; DegenerateError: a degenerate query;
-            CancelledError: cancelled by `progress`; KeyboardInterrupt: Ctrl-C.
+            CancelledError: cancelled by `progress`; KeyboardInterrupt: Ctrl-C (a registration under
+            way returns first; at the default points it takes milliseconds).
         """
         with self._lock.read():
             p = self.params
@@ -304,7 +310,8 @@ class Collection:
         Returns:
             (n, n) float array, ``D[i, j]`` = distance(shape i -> shape j); zero diagonal.
         Raises:
-            CancelledError: cancelled by `progress`; KeyboardInterrupt: Ctrl-C.
+            CancelledError: cancelled by `progress`; KeyboardInterrupt: Ctrl-C (a registration under
+            way returns first; at the default points it takes milliseconds).
         """
         with self._lock.read():
             src, _ = self._with_threads(threads)

@@ -14,7 +14,7 @@ from typing import Any, List, NamedTuple, Optional, Tuple, Union
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ArrayLike, as_bool, as_count, as_scalar, bad, copy_points, dbuf, new_object
+from ._util import ArrayLike, as_bool, as_count, as_scalar, bad, copy_points, dbuf, new_object, unmasked
 from ._util import as_points as _as_points
 from .errors import NotFoundError, _check
 
@@ -37,7 +37,8 @@ def as_points(points: ArrayLike, order: str = 'xy') -> np.ndarray:
         (n, 2) float64 array of (x, y) rows.
     Raises:
         InvalidArgumentError: not (n, 2) / (n, 1, 2), not real numbers, no points, a
-        non-finite value, or a bad `order`; TypeError: a prepared :class:`Shape`.
+        non-finite value, masked values (``numpy.ma``), or a bad `order`; TypeError: a prepared
+        :class:`Shape`.
     """
     return _as_points(points, 'points', order)
 
@@ -87,7 +88,7 @@ def _as_samples(mask: ArrayLike, threshold: Any) -> Tuple[np.ndarray, Optional[T
     """(uint8 or uint16 samples, the (lo, hi) of a float image mapped onto 16 bits or None, the
     padding): a bool mask becomes 0/255 padded with one pixel of background, since True is the
     foreground even where it covers the image border (no automatic polarity)."""
-    a = np.asarray(mask)
+    a = np.asarray(unmasked(mask, 'mask', 'mask.filled(0) (masked pixels as background)'))
     if a.ndim != 2:
         raise bad('mask: expected a 2-D array, got shape %s' % (a.shape,))
     if a.dtype == np.bool_:
@@ -178,7 +179,8 @@ def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] =
     Raises:
         NotFoundError: no foreground (or, but for a bool mask, foreground everywhere);
         DegenerateError: too small;
-        LimitError: image too large; InvalidArgumentError: a bad mask or threshold.
+        LimitError: image too large; InvalidArgumentError: a bad mask (one with masked values:
+        pass ``mask.filled(0)``) or threshold.
     """
     im = _image_and_level(mask, threshold, subpixel)
     flags = im.flags | (lib.AMSCR_TRACE_JOIN if as_bool(join, 'join') else 0)

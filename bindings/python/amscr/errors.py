@@ -4,9 +4,10 @@ Each class also derives from the built-in exception a Python user would catch fo
 failure (``ValueError`` for bad input, ``OSError`` for files, ``MemoryError``...), so both
 ``except amscr.AmscrError`` and ``except ValueError`` work.
 """
+import contextlib
 import errno as _errno
 import os
-from typing import Dict, Optional, Tuple, Type
+from typing import Dict, Iterator, Optional, Tuple, Type
 
 from ._lib import ffi, lib
 
@@ -182,3 +183,18 @@ def _check(status: int) -> None:
     if status:
         detail = _decode(lib.amscr_last_error_detail())
         raise error_from_status(status, detail)
+
+
+@contextlib.contextmanager
+def _reworded(*renames: Tuple[str, str]) -> Iterator[None]:
+    """The library's errors raised in the block with the C names in their detail replaced by the
+    Python layer's, ``(c_text, python_text)`` pairs: ``('amscr_topk: ', 'topk: ')``."""
+    try:
+        yield
+    except AmscrError as e:
+        detail = e.detail
+        for old, new in renames:
+            detail = detail.replace(old, new)
+        if detail == e.detail or e.status is None:
+            raise
+        raise error_from_status(e.status, detail) from None

@@ -9,7 +9,8 @@ import numpy as np
 from ._lib import ffi, lib
 from ._util import ProgressArg, RWLock, as_count, bad, dbuf, new_object, progress_call, saved_bytes
 from .collection import Collection, _new_db
-from .errors import _check
+from .errors import _check, _reworded
+from .params import Params
 from .shape import PointsLike, as_shape
 
 
@@ -17,11 +18,24 @@ def _new_index(make: Any, *args: Any):
     return new_object('amscr_index', make, lib.amscr_index_free, *args)
 
 
+def _loaded_index(make: Any, *args: Any):
+    """_new_index of a load: the index file format is a collection's with an index section, so
+    the library's "not an amscr collection" says index."""
+    with _reworded(('not an amscr collection', 'not an amscr index')):
+        return _new_index(make, *args)
+
+
 def _candidates(candidates: Optional[int]) -> int:
     """The shortlist size the C calls take: None is the library's default."""
     if candidates is None:
         return int(lib.AMSCR_INDEX_CANDIDATES)
     return as_count(candidates, 'candidates', 0)
+
+
+#: Index.add's errors under the Python names (the option a shape differs in, as Params names it).
+_ADD_NAMES = (*(('another %s ' % c, 'another %s ' % py) for c, py in Params.ALIASES.items()),
+              ('amscr_index_add: the shapes were prepared with another ', 'Index.add: the shape was prepared with '
+               'another value of '), ('amscr_index_add: ', 'Index.add: '))
 
 
 def _text(p) -> Optional[str]:
@@ -92,7 +106,7 @@ class Index:
             FileError: cannot read; FormatError: not an index file (a collection file without
             an index, an index of the tool before 0.4: build it again), or a corrupt one.
         """
-        return cls._wrap(_new_index(lib.amscr_index_load, os.fsencode(path)))
+        return cls._wrap(_loaded_index(lib.amscr_index_load, os.fsencode(path)))
 
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the index (its collection included; atomic rename). ``Collection.load`` of the
@@ -127,7 +141,7 @@ class Index:
             FormatError: not a serialized index, or a corrupt one.
         """
         b = bytes(data)
-        return cls._wrap(_new_index(lib.amscr_index_load_memory, ffi.from_buffer(b), len(b)))
+        return cls._wrap(_loaded_index(lib.amscr_index_load_memory, ffi.from_buffer(b), len(b)))
 
     def __reduce__(self):
         return (Index.from_bytes, (self.to_bytes(),))
@@ -231,11 +245,11 @@ class Index:
         """
         with self._lock.write():
             q = as_shape(points, self.collection_params(), 'points', order)
-            from .params import Params
             one = Collection(Params._copy_of(lib.amscr_descriptor_params(q._d)))  # the index names a differing option
             code = self._label_code(label)
             _check(lib.amscr_db_add_descriptor(one._db, q._d, code, ffi.NULL))
-            progress_call(lib.amscr_index_add, (self._x, one._db), (), False)
+            with _reworded(*_ADD_NAMES):
+                progress_call(lib.amscr_index_add, (self._x, one._db), (), False)
             i = len(self) - 1
             if name is not None:
                 _check(lib.amscr_index_set_name(self._x, i, str(name).encode('utf-8', 'surrogateescape')))
@@ -243,7 +257,6 @@ class Index:
 
     def collection_params(self):
         """A copy of the index's :class:`Params` (those of its collection)."""
-        from .params import Params
         return Params._copy_of(lib.amscr_db_params(lib.amscr_index_db(self._x)))
 
     def find_member(self, points: PointsLike, *, order: str = 'xy') -> Optional[int]:

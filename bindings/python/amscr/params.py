@@ -70,13 +70,20 @@ class _Option(Generic[T]):
         return self.conv.read(self.c_get, obj._p)
 
     def __set__(self, obj: 'Params', value: Any) -> None:
+        self._set(obj._p, *self.conv.write(value, self.name))
+
+    def _set(self, *args: Any) -> None:
+        """The C setter's call; its errors under the option's Python name ('amscr_params_set_num_samples:
+        num_samples 3 is not in 16..65536' -> 'points: 3 is not in 16..65536')."""
         try:
-            _check(self.c_set(obj._p, *self.conv.write(value, self.name)))
-        except InvalidArgumentError as e:  # the library's range, under the option's Python name
-            c = 'amscr_params_set_%s: %s ' % (self.c_name, self.c_name)
+            _check(self.c_set(*args))
+        except InvalidArgumentError as e:
+            c = 'amscr_params_set_%s: ' % self.c_name
             if not e.detail.startswith(c):
                 raise
-            raise error_from_status(e.status, '%s: %s' % (self.name, e.detail[len(c):])) from None
+            rest = e.detail[len(c):]
+            rest = rest[len(self.c_name) + 1:] if rest.startswith(self.c_name + ' ') else rest
+            raise error_from_status(e.status, '%s: %s' % (self.name, rest)) from None
 
 
 #: The stages of ``amscr_register`` a Params can switch (C ``amscr_params_set_stage``).
@@ -100,7 +107,7 @@ class _StagesOption(_Option[Dict[str, bool]]):
         for k, on in value.items():
             if not isinstance(k, str):
                 raise TypeError('stages: stage names are str, got %s' % type(k).__name__)
-            _check(self.c_set(obj._p, k.encode(), as_bool(on, 'stages[%r]' % k)))
+            self._set(obj._p, k.encode(), as_bool(on, 'stages[%r]' % k))
 
 
 def _new_params(make: Callable[..., int], *args: Any):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import threading
+import types
 from typing import Any, Dict, List, NamedTuple, Optional, Tuple
 
 import numpy as np
@@ -94,10 +95,10 @@ class Registration:
             symmetric turn fits the damaged target as well); NaN when not measured.
         part: (start, end) fractions of the target's boundary the source's first and last samples
             fall on (where a fragment lies, with partial=True).
-        stages: dict {stage name: whether it ran}, in pipeline order (despike, search, method,
-            recovery, final_solve, symmetric, polish, order, even_spacing, alternatives,
-            correspondences, pixel_grid; C ``amscr_result_stage``).
-        alternatives: list of :class:`Alternative` (A, B, cost): the distinct maps that fit
+        stages: read-only mapping {stage name: whether it ran}, in pipeline order (despike,
+            search, method, recovery, final_solve, symmetric, polish, order, even_spacing,
+            alternatives, correspondences, pixel_grid; C ``amscr_result_stage``).
+        alternatives: tuple of :class:`Alternative` (A, B, cost): the distinct maps that fit
             about as well, the chosen map first (always there; its cost NaN when the
             registration ranked no starts), then each map that moves the source samples by more
             than 10 % of the shape's RMS radius from those before and whose ranking cost is
@@ -151,8 +152,10 @@ class Registration:
         self._freeze()
 
     def _freeze(self) -> None:
-        """Every array of the result read-only (the mixture's and the alternatives' too), and
-        every attribute fixed."""
+        """Every array of the result read-only (the mixture's and the alternatives' too), stages a
+        read-only mapping, alternatives a tuple, and every attribute fixed."""
+        vars(self).update(stages=types.MappingProxyType(dict(self.stages)),
+                          alternatives=tuple(self.alternatives))
         arrays = [v for v in vars(self).values() if isinstance(v, np.ndarray)] + list(self.mixture)
         for a in arrays + [x for alt in self.alternatives for x in (alt.A, alt.B)]:
             a.setflags(write=False)
@@ -166,6 +169,9 @@ class Registration:
 
     def __delattr__(self, name: str) -> None:
         raise AttributeError('Registration is read-only: %s cannot be deleted' % name)
+
+    def __getstate__(self) -> Dict[str, Any]:
+        return dict(vars(self), stages=dict(self.stages))  # a mappingproxy does not pickle
 
     def __setstate__(self, state: Dict[str, Any]) -> None:
         self.__dict__.update(state)  # unpickled arrays are writable again

@@ -9,7 +9,7 @@ import numpy as np
 
 from ._lib import ffi, lib
 from ._util import ArrayLike, as_count, as_float_array, bad, dbuf, factorize
-from .errors import _check
+from .errors import _check, _reworded
 
 
 def _square(D: ArrayLike, name: str = 'D') -> np.ndarray:
@@ -35,7 +35,8 @@ def topk(dist: ArrayLike, k: int, exclude: Optional[int] = None) -> np.ndarray:
     k = as_count(k, 'k', 0)
     ex = ffi.cast('size_t', -1) if exclude is None else as_count(exclude, 'exclude', 0)
     out = np.zeros(k, dtype=np.uintp)
-    _check(lib.amscr_topk(dbuf(d), d.shape[0], k, ex, ffi.from_buffer('size_t[]', out)))
+    with _reworded(('amscr_topk: ', 'topk: ')):
+        _check(lib.amscr_topk(dbuf(d), d.shape[0], k, ex, ffi.from_buffer('size_t[]', out)))
     return out.astype(np.intp)
 
 

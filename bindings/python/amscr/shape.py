@@ -14,7 +14,9 @@ from .params import Params, make_params
 class Shape:
     """A prepared shape (C ``amscr_descriptor``): resampled, parametrized, whitened and smoothed at
     every scale once, then matched any number of times. Immutable (its point arrays are new
-    copies at every call); shareable between threads.
+    copies at every call); shareable between threads. Pickles (multiprocessing) as the same
+    prepared shape: one made from points is prepared again from them, one of
+    :meth:`Collection.shape` travels as its prepared samples.
 
     Args:
         contour: the shape's points: an (n, 2) array of (x, y) rows (any real dtype), or an
@@ -42,8 +44,8 @@ class Shape:
 
     @classmethod
     def _borrowed(cls, dptr, owner: Any) -> 'Shape':
-        """A view of a descriptor owned by `owner`, which the view keeps alive and which must
-        never be modified (see Collection.shape)."""
+        """A view of `dptr`, the shape 0 of `owner`, a one-shape Collection that the view keeps
+        alive (and pickles as) and which must never be modified (see Collection.shape)."""
         if dptr == ffi.NULL:
             raise IndexError('no such shape')
         self = cls.__new__(cls)
@@ -110,8 +112,9 @@ class Shape:
         return 'Shape(N=%d, scales=%d)' % (self.num_samples, self.num_scales)
 
     def __reduce__(self):
-        src = self._source if self._source is not None else self.input_points
-        return (_shape_from_state, (src, self.params))
+        if self._source is None:  # a collection's shape: its one-shape collection, bit for bit
+            return (_shape_of, (self._owner,))
+        return (_shape_from_state, (self._source, self.params))
 
 
 #: What the matching functions accept for a shape: an (n, 2) point array or a prepared Shape.
@@ -120,6 +123,11 @@ PointsLike = Union[ArrayLike, 'Shape']
 
 def _shape_from_state(points: np.ndarray, params: Params) -> Shape:
     return Shape(points, params)
+
+
+def _shape_of(owner: Any) -> Shape:
+    """The shape of `owner`, an unpickled one-shape Collection (see Collection.shape)."""
+    return Shape._borrowed(lib.amscr_db_descriptor(owner._db, 0), owner)
 
 
 def as_shape(x: PointsLike, params: Params, name: str, order: str = 'xy') -> Shape:

@@ -76,3 +76,16 @@ def test_public_name_is_documented(name, obj, holder):
         assert re.search(r'\breturns?\b', doc, re.I), '%s: the docstring does not say what it returns' % name
     if params and not (is_init and issubclass(getattr(amscr, name.split('.')[0]), Exception)):
         assert re.search(r'\braises?\b', doc, re.I), '%s: the docstring does not say what it raises' % name
+
+
+def test_ctrl_c_promises_say_a_registration_under_way_returns_first():
+    """Ctrl-C cancels a batch call between registrations: one under way is not interrupted."""
+    for fn in (amscr.Collection.query, amscr.Collection.distance_matrix):
+        doc = ' '.join(inspect.getdoc(fn).split())
+        assert 'KeyboardInterrupt: Ctrl-C (a registration under way returns first; at the default points it ' \
+               'takes milliseconds)' in doc
+
+
+def test_collection_docs_say_a_pickled_collection_rebuilds_its_retrieval_index():
+    doc = ' '.join(inspect.getdoc(amscr.Collection).split())
+    assert 'builds it again on its first retrieval query' in doc and 'send an :class:`Index`' in doc

@@ -156,3 +156,23 @@ def test_option_errors_name_the_python_option():
     with pytest.raises(amscr.InvalidArgumentError,
                        match=r'^invalid argument: channel_weight: 1\.5 is not in \[0, 1\]$'):
         amscr.Params(channel_weight=1.5)
+
+
+def test_messages_name_the_python_call_and_option():
+    """Errors the library reports under its C names say the Python ones."""
+    with pytest.raises(amscr.InvalidArgumentError, match=r'^invalid argument: scales: 0 scales \(1\.\.64 allowed\)$'):
+        amscr.Params(scales=[])
+    with pytest.raises(amscr.InvalidArgumentError, match=r"^invalid argument: stages: 'search' is not a switchable"):
+        amscr.Params(stages={'search': True})
+    with pytest.raises(amscr.InvalidArgumentError, match=r'^invalid argument: topk: k = 10 > 3 candidates$'):
+        amscr.topk(np.arange(3.0), 10)
+    with pytest.raises(amscr.FormatError, match=r'not an amscr index \(bad magic\)$'):
+        amscr.Index.from_bytes(b'')
+    db = amscr.Collection(amscr.Params.retrieval(points=64))
+    db.extend([GOOD, GOOD * [2, 1], GOOD[::-1] * [1, 3]])
+    index = amscr.Index(db)
+    with pytest.raises(amscr.InvalidArgumentError, match=r'^invalid argument: Index\.add: the shape was prepared '
+                                                         r'with another value of points than the index'):
+        index.add(amscr.Shape(GOOD, amscr.Params.retrieval(points=128)))
+    with pytest.raises(amscr.InvalidArgumentError, match='another value of presmooth than'):
+        index.add(amscr.Shape(GOOD, amscr.Params.retrieval(points=64, presmooth=0.02)))

@@ -99,7 +99,7 @@ def test_add():
     q = blob(300, seed=1)
     rebuilt = amscr.Index(coll)
     np.testing.assert_allclose(index.scores(q), rebuilt.scores(q), rtol=0, atol=1e-12)
-    with pytest.raises(amscr.InvalidArgumentError, match='num_samples'):
+    with pytest.raises(amscr.InvalidArgumentError, match='another value of points than the index'):
         index.add(amscr.Shape(q, amscr.Params.retrieval(points=128)), label='class0')
 
 

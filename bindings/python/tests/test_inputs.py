@@ -226,3 +226,35 @@ def test_contours_from_mask_bad_input():
         amscr.contours_from_mask(np.zeros((10, 10), np.uint8), min_area=-1)
     with pytest.raises(amscr.InvalidArgumentError):
         amscr.contours_from_mask(np.zeros(10, np.uint8))
+
+
+# -- NumPy masked arrays and object arrays -----------------------------------------------------
+def test_masked_values_are_refused_wherever_points_or_masks_are_taken():
+    """A numpy.ma array's masked values would be used as they are (an outlier hidden by the mask
+    registered): refused, with what to pass instead; nothing masked: its data."""
+    src, tgt = _pair_xy()
+    m = np.ma.masked_array(src.copy())
+    m[0] = np.ma.masked
+    r = amscr.register(src, tgt)
+    db = amscr.Collection(amscr.Params.retrieval(points=64))
+    db.extend([src, tgt])
+    index = amscr.Index(db)
+    for take in (lambda p: amscr.register(p, tgt), lambda p: amscr.register(src, p), amscr.Shape, db.add,
+                 lambda p: db.extend([src, p]), db.query, index.query, index.find_member, r.apply,
+                 amscr.as_points, amscr.signed_area):
+        with pytest.raises(ValueError, match=r'masked values are not accepted.*points\[~points\.mask\.any'):
+            take(m)
+    mask = np.zeros((20, 20), np.uint8)
+    mask[5:15, 4:16] = 255
+    for trace in (amscr.contour_from_mask, amscr.contours_from_mask):
+        with pytest.raises(ValueError, match=r'mask: masked values are not accepted.*mask\.filled\(0\)'):
+            trace(np.ma.masked_array(mask, mask=mask == 0))
+    np.testing.assert_array_equal(amscr.register(np.ma.masked_array(src), tgt).matrix, r.matrix)
+    np.testing.assert_array_equal(amscr.contour_from_mask(np.ma.masked_array(mask)), amscr.contour_from_mask(mask))
+
+
+def test_object_arrays_are_refused_with_how_to_convert_them():
+    """A pandas nullable Float64 frame is an object array to NumPy: the message says to convert it."""
+    src, _ = _pair_xy()
+    with pytest.raises(ValueError, match=r'dtype object: convert it first, e\.g\. df\.to_numpy\(float\)'):
+        amscr.Shape(src.astype(object))

@@ -101,3 +101,20 @@ def test_a_pickle_of_amscr_0_1_loads():
            b'sVkmax\np14\nI5\nsVsymmetric\np15\nI00\nsVrefine\np16\nI0\nsVthreads\np17\nI0\nsVinvariance\n'
            b'p18\nVaffine\np19\nsVpenalty\np20\nF0.5\nstp21\nRp22\n.')
     assert pickle.loads(old) == amscr.Params(points=96, method='acma', scales=[0.5, 2])
+
+
+FLOATS = [k for k in amscr.Params.OPTIONS if isinstance(CHANGED[k], float)]
+
+
+@pytest.mark.parametrize('name', FLOATS)
+def test_float_options_refuse_str_and_bool(name):
+    """As the integer options: a str or a bool is refused (TypeError, also an InvalidArgumentError),
+    not converted; a NumPy number is taken."""
+    for bad in (str(CHANGED[name]), True, np.bool_(False), b'0.1'):
+        with pytest.raises(TypeError, match=r'^%s: expected a number, got ' % name):
+            amscr.Params(**{name: bad})
+        with pytest.raises(amscr.InvalidArgumentError):
+            amscr.Params(**{name: bad})
+    assert getattr(amscr.Params(**{name: np.float32(CHANGED[name])}), name) == np.float32(CHANGED[name])
+    with pytest.raises(TypeError, match=r'^points: expected an integer, got 96\.0$'):
+        amscr.Params(points=96.0)

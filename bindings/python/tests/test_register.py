@@ -432,3 +432,32 @@ def test_confidence_evidence_on_an_exact_pair_and_a_bitten_cross(pair):
     np.testing.assert_allclose(r.A, A_TRUE, atol=0.01)
     assert min(r.inlier_fraction, r.overlap) < 0.85 and r.backward_error < 1e-3
     assert r.confidence > 0.5
+
+
+def test_a_collection_shape_unpickles_as_the_same_prepared_shape():
+    """Collection.shape(i) holds the collection's prepared samples, not the input points: a
+    pickled one (multiprocessing) is the same shape, found by the member rule, with the same
+    scores, distances and registrations."""
+    src, other = blob(300, seed=4), blob(300, seed=5)
+    db = amscr.Collection()
+    db.extend([src, other])
+    index = amscr.Index(db)
+    s = db.shape(0)
+    for u in (pickle.loads(pickle.dumps(s)), pickle.loads(pickle.dumps(pickle.loads(pickle.dumps(s))))):
+        assert index.find_member(u) == index.find_member(s) == 0
+        np.testing.assert_array_equal(index.scores(u), index.scores(s))
+        np.testing.assert_array_equal(db.query(u), db.query(s))
+        np.testing.assert_array_equal(u.points, s.points)
+        assert amscr.distance(u, other) == amscr.distance(s, other)
+        np.testing.assert_array_equal(amscr.register(u, other).matrix, amscr.register(s, other).matrix)
+        np.testing.assert_array_equal(amscr.register(other, u).matrix, amscr.register(other, s).matrix)
+
+
+@pytest.mark.parametrize('i', [1.7, 1.0, True, '1', np.float64(1.0)],
+                         ids=['float', 'whole_float', 'bool', 'str', 'numpy_float'])
+def test_collection_shape_takes_integer_indices_only(i):
+    db = amscr.Collection()
+    db.extend([blob(200, seed=1), blob(200, seed=2)])
+    with pytest.raises(TypeError, match=r'^i: expected an integer'):
+        db.shape(i)
+    np.testing.assert_array_equal(db.shape(np.int64(1)).points, db.shape(-1).points)

@@ -1,5 +1,6 @@
 """Registration.stages (which stages of the pipeline ran, in order), Params.stages (the optional
 stages' switches) and Registration.alternatives (the distinct maps that fit about as well)."""
+import copy
 import pickle
 
 import numpy as np
@@ -110,3 +111,17 @@ def test_asymmetric_shape_lists_the_chosen_map_only():
 def test_no_ranking_without_refinement():
     r = amscr.register(*pair(SQUARE), refine=0)
     assert len(r.alternatives) == 1 and np.isnan(r.alternatives[0].cost)
+
+
+def test_registration_stages_and_alternatives_cannot_be_changed():
+    """A Registration is read-only: stages a read-only mapping, alternatives a tuple, before and
+    after pickling and copying."""
+    r = amscr.register(*pair(ELL))
+    for r2 in (r, pickle.loads(pickle.dumps(r)), copy.deepcopy(r)):
+        with pytest.raises(TypeError):
+            r2.stages['polish'] = False
+        assert isinstance(r2.alternatives, tuple)
+        assert r2.stages == r.stages and list(r2.stages) == PIPELINE and dict(r2.stages) == dict(r.stages)
+        assert len(r2.alternatives) == len(r.alternatives) == 1
+        np.testing.assert_array_equal(r2.alternatives[0].A, r.A)
+        assert repr(r2) == repr(r)
