@@ -107,8 +107,9 @@ double amscr__confidence(const amscr_result *r)
 {
     double fb = isfinite(r->fb) ? r->fb / AMSCR__FB_SCALE : 0.0;
     double se = isfinite(r->se) ? r->se / AMSCR__FB_SCALE : 0.0;
-    double share = fmin(r->overlap, r->inlier); /* an open curve's overlap is NaN */
-    double amb = fmax(r->amb_conv, r->m.ambiguity); /* NaN: not computed (fmax: no invalid trap) */
+    /* isless/isgreater: NaN (not computed; an open curve's overlap) compared quietly */
+    double share = isless(r->overlap, r->inlier) ? r->overlap : r->inlier;
+    double amb = isgreater(r->amb_conv, r->m.ambiguity) ? r->amb_conv : r->m.ambiguity;
     return (1.0 - amb) * share / (1.0 + fb * fb) / (1.0 + se * se);
 }
 
