@@ -32,8 +32,9 @@ want() { case " ${STEPS[*]} " in *" $1 "*) return 0 ;; esac; return 1; }
 # ThreadSanitizer instead), robust, polish, index and pixel_grid (100-175 s each: many
 # registrations; they run under ASan+UBSan, and the index loader's corpus replays under valgrind
 # below). oom_register runs with every fifth allocation failed (AMSCR_OOM_STRIDE, tests/meson.build).
+# fenv enables floating-point traps, which valgrind's CPU does not keep (it runs under ASan).
 # New areas are included automatically.
-VALGRIND_SKIP=(accuracy db threads robust polish index pixel_grid)
+VALGRIND_SKIP=(accuracy db threads robust polish index pixel_grid fenv)
 
 T0=$(date +%s)
 summary=()

@@ -88,6 +88,23 @@ static char *read_stream(FILE *fp, const char *path, size_t *len)
     return buf;
 }
 
+/* The stream fp read whole into *mem and closed; the memory opened as a file in its place
+ * (NULL after an error line: empty, out of memory). */
+static FILE *reopen_in_memory(FILE *fp, const char *path, char **mem, size_t *mem_len)
+{
+    *mem = read_stream(fp, path, mem_len);
+    fclose(fp);
+    if (!*mem)
+        return NULL;
+    FILE *m = *mem_len ? fmemopen(*mem, *mem_len, "rb") : NULL;
+    if (!m) {
+        tool_error(path, *mem_len ? "out of memory" : "empty file");
+        free(*mem);
+        *mem = NULL;
+    }
+    return m;
+}
+
 /* Opens `path` for reading after checking it is a non-empty file. A stream that cannot be read
  * twice (a pipe, a FIFO, a device: /dev/stdin) is read whole into *mem (freed by the caller) and
  * opened from memory, so its format can be sniffed and the file read from its start. */
@@ -108,20 +125,8 @@ static FILE *open_input(const char *path, char **mem, size_t *mem_len)
         tool_error(path, "cannot open: %s", strerror(errno));
         return NULL;
     }
-    if (!S_ISREG(st.st_mode)) {
-        *mem = read_stream(fp, path, mem_len);
-        fclose(fp);
-        fp = *mem && *mem_len ? fmemopen(*mem, *mem_len, "rb") : NULL;
-        if (*mem && *mem_len && !fp)
-            tool_error(path, "out of memory");
-        if (!fp && *mem && *mem_len == 0)
-            tool_error(path, "empty file");
-        if (!fp) {
-            free(*mem);
-            *mem = NULL;
-        }
-        return fp;
-    }
+    if (!S_ISREG(st.st_mode))
+        return reopen_in_memory(fp, path, mem, mem_len);
     if (st.st_size == 0) {
         fclose(fp);
         tool_error(path, "empty file");
