@@ -23,7 +23,7 @@ void tool_errors_mute(int on) { g_muted = on; }
 static void print_line(const char *what, const char *msg)
 {
     /* One line, whatever the message contains. */
-    char line[1024];
+    char line[2 * 8192 + 16]; /* two paths of PATH_MAX and more */
     if (what != NULL && what[0] != '\0')
         snprintf(line, sizeof line, "amscr: %s: %s", what, msg);
     else
@@ -40,7 +40,7 @@ void tool_error(const char *what, const char *fmt, ...)
     if (g_muted || g_error_printed)
         return;
     g_error_printed = 1;
-    char msg[900];
+    char msg[8192];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
@@ -50,7 +50,7 @@ void tool_error(const char *what, const char *fmt, ...)
 
 int usage_error(const char *what, const char *fmt, ...)
 {
-    char msg[600];
+    char msg[8192];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
