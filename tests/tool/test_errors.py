@@ -130,6 +130,14 @@ def test_missing_file(tmp_path):
     check_fail(run("register", p, p), 1, "nope.png")
 
 
+def test_a_long_path_keeps_its_reason(tmp_path):
+    """An error line holds a long path whole and its reason after it (lines were cut at 1 KiB)."""
+    p = tmp_path.joinpath(*["d" * 200] * 6) / "nope.png"
+    r = run("contour", p)
+    assert r.returncode == 1 and r.stderr.endswith("cannot open: No such file or directory\n"), r.stderr[-80:]
+    assert str(p) in r.stderr
+
+
 def test_directory_as_shape(tmp_path):
     check_fail(run("contour", tmp_path), 1, str(tmp_path), "directory")
 
