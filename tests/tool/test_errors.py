@@ -178,6 +178,7 @@ USAGE = [
     ["register", "a.png", "b.png", "--overlay", "o.gif"],
     ["register", "a.png", "b.png", "--plot", "p.png"],
     ["register", "a.png", "b.png", "--json=1"],
+    ["contour", "a.png", "--help=foo"],
     ["register", "a.png", "b.png", "--top", "3"],
     ["search", "q.png"],
     ["search", "q.png", "dir", "--top", "0"],
@@ -192,6 +193,7 @@ USAGE = [
 def test_usage_errors(tmp_path, args):
     r = run(*args, cwd=tmp_path)
     assert r.returncode == 2, (r.returncode, r.stderr)
+    assert "unknown option '--help'" not in r.stderr, r.stderr
     if args:
         lines = r.stderr.splitlines()
         assert len(lines) == 1 and lines[0].startswith("amscr: "), r.stderr

@@ -451,6 +451,8 @@ int parse_args(opts *o, const tool_command *c, int argc, char **argv)
         if (!only_pos && a[0] == '-' && a[1] != '\0') {
             if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0)
                 return -1;
+            if (strncmp(a, "--help=", 7) == 0)
+                return usage_error(o->cmd, "option '--help' takes no value");
             int r = parse_option(o, argc, argv, &i);
             if (r != 0)
                 return r;
