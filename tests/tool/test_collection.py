@@ -544,3 +544,20 @@ def test_matrix_to_a_device_and_names_a_tsv_cannot_hold(tmp_path):
     r = run("matrix", d, "-o", tmp_path / "d.tsv", "--names", tmp_path / "n.tsv", *AFFINE)
     assert r.returncode == 1 and "tab or a line break" in r.stderr, r.stderr
     assert not (tmp_path / "d.tsv").exists() and not (tmp_path / "n.tsv").exists()
+
+
+def test_outputs_named_together_or_not_at_all(tmp_path):
+    """register --overlay/--plot and matrix -o/--names: when one output cannot be written (here a
+    link to /dev/full), the other is not left written either; an output that cannot be made fails
+    before any shape is prepared."""
+    d = folder_of_points(tmp_path / "set", ["star-1.txt", "star-2.txt", "blob-1.txt", "blob-2.txt"])
+    full = tmp_path / "full.svg"
+    full.symlink_to("/dev/full")
+    r = run("register", d / "star-1.txt", d / "star-2.txt", "--overlay", tmp_path / "o.svg", "--plot", full)
+    assert r.returncode == 1 and "No space left" in r.stderr, r.stderr
+    assert not (tmp_path / "o.svg").exists()
+    r = run("matrix", d, "-o", tmp_path / "m.tsv", "--names", full, *AFFINE)
+    assert r.returncode == 1 and not (tmp_path / "m.tsv").exists(), r.stderr
+    assert sorted(os.listdir(tmp_path)) == ["full.svg", "set"]
+    r = run("index", d, "-o", tmp_path / "no" / "x.idx", *AFFINE)  # before the work
+    assert r.returncode == 1 and "no/x.idx" in r.stderr and "index" not in r.stdout, r.stderr

@@ -55,7 +55,8 @@ int cmd_index(opts *o)
     int r = TOOL_EXIT_FAIL;
     if (o->add && index_open(o->out, 0, &x) != 0)
         return TOOL_EXIT_FAIL;
-    if (collection_open(o->pos[0], &c) == 0 && collection_out_not_input("-o", o->out, &c, o->pos, 1) == 0)
+    if (collection_open(o->pos[0], &c) == 0 && collection_out_not_input("-o", o->out, &c, o->pos, 1) == 0 &&
+        tool_out_probe(o->out) == 0) /* a file that cannot be written fails before the work */
         r = o->add ? index_add(o, x, &c) : build(o, &c, &x);
     if (r == 0) {
         amscr_status st = amscr_index_save(x, o->out);

@@ -24,6 +24,8 @@ static int outputs_checked(const opts *o, const collection *c)
         tool_error(o->names, "-o and --names name the same file");
         return TOOL_EXIT_FAIL;
     }
+    if ((strcmp(o->out, "-") != 0 && tool_out_probe(o->out) != 0) || (o->names && tool_out_probe(o->names) != 0))
+        return TOOL_EXIT_FAIL; /* before any shape is prepared */
     for (size_t i = 0; o->names && i < c->n; i++) /* a names file is TSV: one line a shape */
         if (strpbrk(c->items[i].name, "\t\n\r") || strpbrk(c->classes[c->items[i].label], "\t\n\r")) {
             tool_error(o->names, "shape %zu's file or class name holds a tab or a line break, which a TSV names "
@@ -60,6 +62,7 @@ int cmd_matrix(opts *o)
         goto done;
     size_t n = c.n;
     tool_out out;
+    tool_out_hold(); /* the matrix and --names named together, or neither */
     if (tool_out_open(&out, o->out) != 0)
         goto done;
     if ((npy ? write_npy(out.fp, d, n) : write_tsv(out.fp, d, n, &c)) != 0) {
@@ -81,12 +84,13 @@ int cmd_matrix(opts *o)
             goto done;
         }
     }
-    if (tool_out_commit(&out) != 0)
+    if (tool_out_commit(&out) != 0 || tool_out_release(1) != 0)
         goto done;
     if (isatty(2) && strcmp(o->out, "-") != 0)
         fprintf(stderr, "amscr: wrote %s (%zu x %zu)\n", o->out, n, n);
     ret = TOOL_EXIT_OK;
 done:
+    tool_out_release(0); /* after a failure: nothing named */
     free(d);
     amscr_db_free(db);
     collection_free(&c);

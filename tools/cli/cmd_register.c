@@ -212,8 +212,8 @@ static int pictures_writable(const opts *o)
     return 0;
 }
 
-/* --overlay and --plot: drawn before anything is printed, so a failure there comes first. */
-static int draw_pictures(const opts *o, const amscr_contour *src, const amscr_contour *tgt, const reg_report *r)
+/* --overlay and --plot, each written (see draw_pictures). */
+static int draw_each_picture(const opts *o, const amscr_contour *src, const amscr_contour *tgt, const reg_report *r)
 {
     const char *spath = o->pos[0], *tpath = o->pos[1];
     size_t ns = amscr_contour_size(src);
@@ -251,6 +251,15 @@ static int draw_pictures(const opts *o, const amscr_contour *src, const amscr_co
             return -1;
     }
     return 0;
+}
+
+/* --overlay and --plot: drawn before anything is printed, so a failure there comes first; named
+ * together once both are written (tool_out_hold), so a failure leaves neither. */
+static int draw_pictures(const opts *o, const amscr_contour *src, const amscr_contour *tgt, const reg_report *r)
+{
+    tool_out_hold();
+    int drawn = draw_each_picture(o, src, tgt, r);
+    return tool_out_release(drawn == 0) == 0 && drawn == 0 ? 0 : -1;
 }
 
 /* Confidence, part and correspondences ({"param": [...], "points": [[x, y], ...]}). */

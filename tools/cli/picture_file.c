@@ -1,6 +1,7 @@
 /* picture_file.c — the tool's pictures written to files (raster.h): PNG through libpng when the
  * tool has it, otherwise uncompressed (stored-deflate) PNG; SVG and other text; each written
  * atomically (temporary name + rename). */
+#include <errno.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -168,8 +169,12 @@ int write_png_file(const char *path, const unsigned char *rgb, int w, int h)
 #endif
     (void)write_png_stored; /* referenced in both builds */
     if (r != 0) {
+        int e = ferror(o.fp) ? errno : 0; /* a failed write, else the encoder's failure */
         tool_out_abort(&o);
-        tool_error(path, "cannot encode the PNG picture");
+        if (e)
+            tool_error(path, "cannot write the PNG picture: %s", strerror(e));
+        else
+            tool_error(path, "cannot encode the PNG picture");
         return -1;
     }
     return tool_out_commit(&o);
@@ -201,8 +206,9 @@ int write_text_file(const char *path, const sbuf *b)
     if (tool_out_open(&o, path) != 0)
         return -1;
     if (b->len && fwrite(b->s, 1, b->len, o.fp) != b->len) {
+        int e = errno;
         tool_out_abort(&o);
-        tool_error(path, "write error");
+        tool_error(path, "write error: %s", strerror(e));
         return -1;
     }
     return tool_out_commit(&o);

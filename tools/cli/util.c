@@ -272,24 +272,19 @@ static int commit_stream(tool_out *o)
     return bad ? -1 : 0;
 }
 
-int tool_out_commit(tool_out *o)
+/* Flushes o's file to the disk (named only once whole and on the disk); 0, or -1 with errno. */
+static int flush_out(tool_out *o)
 {
-    if (o->fp == NULL)
+    if (fflush(o->fp) != 0 || ferror(o->fp))
         return -1;
-    if (o->path == NULL) { /* stdout */
-        int bad = fflush(o->fp) != 0 || ferror(o->fp);
-        o->fp = NULL;
-        if (bad) {
-            tool_error("<stdout>", "write error: %s", strerror(errno));
-            return -1;
-        }
-        return 0;
-    }
-    if (o->stream)
-        return commit_stream(o);
-    int bad = fflush(o->fp) != 0 || ferror(o->fp);
-    int err = errno;
-    if (!bad && o->unnamed && name_unnamed(o, fileno(o->fp)) != 0) {
+    return fsync(fileno(o->fp)) == 0 || errno == EINVAL || errno == EROFS ? 0 : -1;
+}
+
+/* Names the flushed file o->path and closes it; -1 after the error line. */
+static int name_out(tool_out *o)
+{
+    int bad = 0, err = 0;
+    if (o->unnamed && name_unnamed(o, fileno(o->fp)) != 0) {
         bad = 1;
         err = errno;
     }
@@ -309,6 +304,61 @@ int tool_out_commit(tool_out *o)
     }
     out_free(o);
     return bad ? -1 : 0;
+}
+
+/* The outputs whose names wait for tool_out_release (tool_out_hold); the tool writes its outputs
+ * from its main thread only. */
+enum { TOOL_OUT_HELD_MAX = 4 };
+static tool_out g_held[TOOL_OUT_HELD_MAX];
+static size_t g_nheld;
+static int g_holding;
+
+void tool_out_hold(void)
+{
+    g_holding = 1;
+    g_nheld = 0;
+}
+
+int tool_out_release(int keep)
+{
+    int bad = 0;
+    for (size_t i = 0; i < g_nheld; i++) {
+        if (keep && !bad)
+            bad = name_out(&g_held[i]) != 0;
+        else
+            tool_out_abort(&g_held[i]);
+    }
+    g_nheld = 0;
+    g_holding = 0;
+    return bad ? -1 : 0;
+}
+
+int tool_out_commit(tool_out *o)
+{
+    if (o->fp == NULL)
+        return -1;
+    if (o->path == NULL) { /* stdout */
+        int bad = fflush(o->fp) != 0 || ferror(o->fp);
+        o->fp = NULL;
+        if (bad) {
+            tool_error("<stdout>", "write error: %s", strerror(errno));
+            return -1;
+        }
+        return 0;
+    }
+    if (o->stream)
+        return commit_stream(o);
+    if (flush_out(o) != 0) {
+        tool_error(o->path, "cannot write output file: %s", strerror(errno));
+        tool_out_abort(o);
+        return -1;
+    }
+    if (g_holding && g_nheld < TOOL_OUT_HELD_MAX) {
+        g_held[g_nheld++] = *o;
+        memset(o, 0, sizeof *o);
+        return 0;
+    }
+    return name_out(o);
 }
 
 void tool_out_abort(tool_out *o)

@@ -64,6 +64,11 @@ int tool_out_open(tool_out *o, const char *path);
 int tool_out_commit(tool_out *o);
 /* Closes and removes the temporary (no-op when not open). */
 void tool_out_abort(tool_out *o);
+/* Outputs committed from now on are written whole and flushed but named only by
+ * tool_out_release: all of them when `keep` (0, or -1 after the error line of the first that
+ * cannot be named), else none (their files removed) — a command's outputs, all or nothing. */
+void tool_out_hold(void);
+int tool_out_release(int keep);
 /* 0 when an output file can be made at `path` (opened, then abandoned: nothing is left); else
  * -1 after the error line. Checks every output of a command before the first is written. */
 int tool_out_probe(const char *path);
