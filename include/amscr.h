@@ -47,8 +47,8 @@ extern "C" {
  * Floating point. The calls run under the caller's floating-point environment: a
  *              rounding mode other than to-nearest or flush-to-zero moves results by
  *              rounding only; traps on invalid or divide-by-zero (feenableexcept) are
- *              not set off by registration, retrieval or tracing (since 0.22.3; a NaN
- *              that marks "not computed" is compared quietly). The status flags
+ *              not set off by registration, retrieval or tracing (a NaN that marks
+ *              "not computed" is compared quietly). The status flags
  *              (fetestexcept) are left as the computation raised them.
  * errno.       Not part of the interface: any call may change it, also on success.
  * Errors.      Every fallible function returns `amscr_status`. On failure
@@ -99,7 +99,7 @@ extern "C" {
 
 /* A status must be looked at (warn_unused_result). GCC warns even when it is cast to void: a
  * caller that discards statuses on purpose defines AMSCR_NODISCARD empty before including this
- * header (-DAMSCR_NODISCARD=), since 0.22.3. */
+ * header (-DAMSCR_NODISCARD=). */
 #if !defined(AMSCR_NODISCARD)
 #  if defined(__GNUC__) && (__GNUC__ > 3 || (__GNUC__ == 3 && __GNUC_MINOR__ >= 4))
 #    define AMSCR_NODISCARD __attribute__((warn_unused_result))
@@ -326,10 +326,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_orient_ccw(amscr_contour *c
 /**
  * @brief Reads a text point list: one "x y" or "x,y" per line (tabs/spaces/one comma),
  *        '#' starts a comment, blank lines are ignored. An empty list is AMSCR_E_FORMAT.
- *        A UTF-8 byte order mark at the start is skipped (since 0.22.2; before, line 1 was
- *        AMSCR_E_FORMAT). The decimal point is '.' whatever locale the program set with
- *        setlocale (since 0.22.3; before, under a locale whose decimal point is ',', every
- *        line with a fraction was AMSCR_E_FORMAT); the program's locale is left as it is.
+ *        A UTF-8 byte order mark at the start is skipped. The decimal point is '.' whatever
+ *        locale the program set with setlocale; the program's locale is left as it is.
  * @param[in]  path  file name.
  * @param[out] out   new contour.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_IO (cannot open/read); AMSCR_E_FORMAT (bad
@@ -353,15 +351,13 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_parse_text(const char *text
 
 /**
  * @brief Writes a contour as a text point list ("%.17g %.17g" per line, with '.' as the
- *        decimal point whatever locale the program set: since 0.22.3, before which a
- *        locale's ',' was written). The file is
+ *        decimal point whatever locale the program set). The file is
  *        written whole before it takes its name (an unnamed file of the folder, O_TMPFILE,
  *        linked in; where the system has none, a temporary name renamed), so a failure never
  *        leaves a partial file (and, with unnamed files, a killed process leaves none at all).
- *        A replaced file keeps its mode. Since 0.22.3 a symbolic link's target is replaced
- *        (before, the link itself), and an existing file that is not a regular file (a device
- *        such as /dev/null, a FIFO, /dev/stdout or /dev/fd/N) is written through, appending,
- *        never replaced (before, it was replaced by a regular file).
+ *        A replaced file keeps its mode; a symbolic link's target is replaced, not the link;
+ *        an existing file that is not a regular file (a device such as /dev/null, a FIFO,
+ *        /dev/stdout or /dev/fd/N) is written through, appending, never replaced.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, non-finite coordinates); AMSCR_E_IO; AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: const.
@@ -578,8 +574,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_gaussian_kernel(double sigma, doubl
  * @param[in]  closed  1 closed, 0 open.
  * @param[in]  sigma   in samples, >= 0.
  * @param[out] out_xy  2n doubles; must not overlap xy.
- * @return AMSCR_OK; AMSCR_E_INVALID_ARG (also out_xy overlapping xy, since 0.22.3: before,
- *         the result was wrong); AMSCR_E_NOMEM.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (also out_xy overlapping xy); AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: safe.
  * @since 0.1
@@ -1508,8 +1503,7 @@ AMSCR_API int amscr_params_get_stage(const amscr_params *p, const char *name);
 /**
  * @brief Sets the threads of batch calls: 0 = all cores (default), else 1..1024. Results do
  *        not depend on the thread count. "All cores" are those the process may run on (its
- *        CPU affinity on Linux: taskset, a container's cpuset; since 0.22.3, before which the
- *        online cores were counted).
+ *        CPU affinity on Linux: taskset, a container's cpuset).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -2849,7 +2843,7 @@ AMSCR_API size_t amscr_index_default_candidates(size_t n);
  *        the medians of the build. An index of fewer shapes than twice its re-ranking k,
  *        whose lists' length K grows with its size, is built again on its shapes and the new
  *        ones instead (the same index as amscr_index_build of them all, its names, groups and
- *        class names kept; since 0.22.2: before, AMSCR_E_STATE, "rebuild it"); on failure it
+ *        class names kept); on failure it
  *        is left as it was.
  * @param[in] shapes  prepared with exactly the index's params (threads aside).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL; params that differ: the detail names the
