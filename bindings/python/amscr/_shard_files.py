@@ -7,9 +7,12 @@ manifest.
 """
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import hashlib
 import json
 import os
+import re
 import tempfile
 from typing import Any, Dict, List, Tuple
 
@@ -21,6 +24,9 @@ from .params import Params, _params_from_dict
 FORMAT = 'amscr-sharded-index'
 VERSION = 1
 MANIFEST = 'manifest.json'
+#: The folder's lock: a save holds it alone, loads share it (flock), so saves into one folder at once
+#: follow each other and a load never reads a set half replaced.
+LOCK = '.amscr-lock'
 
 
 class ShardSetError(AmscrError, ValueError):
@@ -28,10 +34,47 @@ class ShardSetError(AmscrError, ValueError):
     altered) or built with other options than the manifest's. The message names the file."""
 
 
+@contextlib.contextmanager
+def _locked(d: str, exclusive: bool) -> Any:
+    """Directory d's lock (LOCK) held for the block: alone for a save, shared for a load (each waits
+    for the other). A folder where the lock cannot be made (read-only) is read without it."""
+    try:
+        fd = os.open(os.path.join(d, LOCK), os.O_RDWR | os.O_CREAT | getattr(os, 'O_CLOEXEC', 0), 0o666)
+    except OSError as e:
+        if exclusive:
+            raise FileError('%s: cannot lock the set\'s folder: %s' % (d, e.strerror), lib.AMSCR_E_IO) from None
+        yield
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
+        yield
+    finally:
+        os.close(fd)
+
+
+def prepare_dir(path: Any) -> str:
+    """The set's directory `path` made if needed and checked writable (before any work: a build
+    does not fail after its work for a folder it cannot write)."""
+    d = os.fspath(path)
+    try:
+        os.makedirs(d, exist_ok=True)
+    except OSError as e:
+        raise FileError('%s: cannot make the set\'s folder: %s' % (d or "''", e.strerror or e), lib.AMSCR_E_IO) from None
+    if not os.access(d, os.W_OK | os.X_OK):
+        raise FileError('%s: the set\'s folder is not writable' % d, lib.AMSCR_E_IO)
+    return d
+
+
 def write_set(d: str, datas: List[bytes], bounds: List[Tuple[int, int]], gdata: bytes, n: int, params: Params,
               candidates: int) -> None:
     """The shard files and the graph into directory d, then the manifest, then the files of the set
-    it replaces (and leftovers of cut-off writes) removed."""
+    it replaces (and leftovers of cut-off writes) removed; under the folder's lock."""
+    with _locked(d, True):
+        _write_set(d, datas, bounds, gdata, n, params, candidates)
+
+
+def _write_set(d: str, datas: List[bytes], bounds: List[Tuple[int, int]], gdata: bytes, n: int, params: Params,
+               candidates: int) -> None:
     entries = []
     keep = {MANIFEST}
     for s, data in enumerate(datas):
@@ -56,9 +99,12 @@ def write_set(d: str, datas: List[bytes], bounds: List[Tuple[int, int]], gdata: 
                 pass
 
 
+#: The names a save writes (write_set): shard-SSS-HEX16.amscr-index, graph-HEX16.npz, and its temporaries.
+_OURS = re.compile(r'(shard-[0-9]{3,}-[0-9a-f]{16}\.amscr-index|graph-[0-9a-f]{16}\.npz|\.amscr-tmp-.*)')
+
+
 def _ours(f: str) -> bool:
-    return ((f.startswith('shard-') and f.endswith('.amscr-index')) or (f.startswith('graph-') and f.endswith('.npz'))
-            or (f.startswith('.amscr-tmp-')))
+    return _OURS.fullmatch(f) is not None
 
 
 def _umask() -> int:
@@ -159,7 +205,15 @@ def _read_shard(d: str, s: int, entry: Dict[str, Any], params: Params) -> bytes:
 
 def read_set(d: str) -> Tuple[Params, int, List[Tuple[int, int]], int, str, bytes, List[bytes]]:
     """The set in directory d: its params, shape count, shard bounds, candidates, the graph's path
-    and bytes, and every shard's bytes, each checked against the manifest."""
+    and bytes, and every shard's bytes, each checked against the manifest; under the folder's
+    lock, shared (a save under way is waited for)."""
+    if not os.path.isdir(d):
+        return _read_set(d)  # _read_manifest's error
+    with _locked(d, False):
+        return _read_set(d)
+
+
+def _read_set(d: str) -> Tuple[Params, int, List[Tuple[int, int]], int, str, bytes, List[bytes]]:
     m = _read_manifest(d)
     try:
         params = _params_from_dict(m['params'])

@@ -24,6 +24,8 @@ and a manifest (:mod:`amscr._shard_files`).
 """
 from __future__ import annotations
 
+import asyncio
+import concurrent.futures
 import io
 import os
 from typing import Any, List, Optional, Sequence, Tuple, Union
@@ -38,7 +40,7 @@ from .index import Index
 from .params import Params
 from ._placement import _block, _threads_by_host
 from ._shard_build import _merge_lists, _shortlist_lists, widths
-from ._shard_files import ShardSetError, read_set, write_set
+from ._shard_files import ShardSetError, prepare_dir, read_set, write_set
 from ._shard_tasks import (QPOS_AFTER, Signatures, _index_bytes, _joined, _member_shortlists, _members, _pair_block,
                            _query_block, _shard_from_file_bytes, _shard_index, _shortlists, _signatures)
 
@@ -170,7 +172,26 @@ class ShardedIndex:
 
     def _gather(self, futs: List[Any]) -> List[Any]:
         """The results of one task a shard; a shard lost with its worker is a clear error."""
-        return self._guard(lambda: self.client.gather(futs))
+        return self._guard(lambda: self._gather_live(futs))
+
+    def _gather_live(self, futs: List[Any]) -> List[Any]:
+        """client.gather(futs), checking every second that the shards' workers are still in the
+        cluster: a task pinned to a worker that left (killed, or retired by the cluster) would wait
+        for it forever."""
+        from distributed import wait  # the cluster mode's own dependency
+        while True:
+            try:
+                wait(futs, timeout=_LIVENESS_SECONDS)
+                return self.client.gather(futs)
+            except _TIMEOUTS:
+                gone = self._gone()
+                if gone:
+                    raise _lost_error(gone, 'its worker left the cluster') from None
+
+    def _gone(self) -> List[int]:
+        """The shards whose worker is no longer in the cluster."""
+        live = set(self.client.run_on_scheduler(_worker_addresses))
+        return [s for s, w in enumerate(self._workers) if w not in live]
 
     def _guard(self, call: Any) -> Any:
         """call(); a failure while a shard's worker is gone is the clear error of a lost shard."""
@@ -183,10 +204,7 @@ class ShardedIndex:
             lost = lost or [s for s, sh in enumerate(self._shards) if sh.status != 'finished']
             if not lost:
                 raise
-            raise ShardSetError('amscr.distributed: shard%s %s lost with %s worker (%s: %s); load the saved set '
-                                'again (load_index) or build it again'
-                                % ('s' if len(lost) > 1 else '', ', '.join(map(str, lost)),
-                                   'their' if len(lost) > 1 else 'its', type(e).__name__, e), lib.AMSCR_E_STATE) from e
+            raise _lost_error(lost, '%s: %s' % (type(e).__name__, e)) from e
 
     def _signatures(self) -> Signatures:
         if self._sigs is None:
@@ -197,9 +215,7 @@ class ShardedIndex:
 
     def _want(self, candidates: Optional[int]) -> int:
         """The query's shortlist (0: every shape), as amscr_index_query_scores chooses it."""
-        c = self.candidates if candidates is None else int(candidates)
-        if c < 0:
-            raise InvalidArgumentError('candidates: %d is negative' % c)
+        c = self.candidates if candidates is None else as_count(candidates, 'candidates', 0)
         n = len(self)
         if c == 0 or c >= n:
             return 0
@@ -311,18 +327,39 @@ class ShardedIndex:
         graph first, each under a temporary name renamed into place, then the manifest by an
         atomic rename, then the files of the set it replaces are removed. A write cut off (the
         process killed, the disk full) leaves the previous set whole. Files follow the umask.
+        Saves into one folder at once follow each other, and a load waits for a save under way
+        (a lock on the folder's ``.amscr-lock``); other files in the folder are kept.
 
         Raises:
             FileError: a file cannot be written (the previous set, if any, is kept).
         """
-        d = os.fspath(path)
-        os.makedirs(d, exist_ok=True)
+        d = prepare_dir(path)
         datas = self._gather([self.client.submit(_index_bytes, sh, pure=False, workers=[self._workers[s]])
                               for s, sh in enumerate(self._shards)])
         write_set(d, datas, self.bounds, self._graph.to_bytes(), len(self), self.params, self.candidates)
 
 
+#: What distributed.wait raises at its timeout (Python and Dask versions differ).
+_TIMEOUTS = (TimeoutError, asyncio.TimeoutError, concurrent.futures.TimeoutError)
+#: How often a query waiting for its shards checks that their workers are still there (seconds).
+_LIVENESS_SECONDS = 1.0
+
+
+def _worker_addresses(dask_scheduler: Any) -> List[str]:
+    """The addresses of the cluster's workers (run on the scheduler)."""
+    return list(dask_scheduler.workers)
+
+
+def _lost_error(lost: List[int], why: str) -> ShardSetError:
+    return ShardSetError('amscr.distributed: shard%s %s lost with %s worker (%s); load the saved set again '
+                         '(load_index) or build it again'
+                         % ('s' if len(lost) > 1 else '', ', '.join(map(str, lost)),
+                            'their' if len(lost) > 1 else 'its', why), lib.AMSCR_E_STATE)
+
+
 def _workers(client) -> List[str]:
+    if not hasattr(client, 'nthreads') or not hasattr(client, 'submit'):
+        raise TypeError('client: expected a distributed.Client, got %s' % type(client).__name__)
     w = sorted(client.nthreads())
     if not w:
         raise InvalidArgumentError('amscr.distributed: the cluster has no workers')
@@ -356,6 +393,8 @@ def build_index(client, collection: Collection, path: Optional[PathLike] = None,
     """
     if not isinstance(collection, Collection):
         raise TypeError('collection: expected an amscr.Collection, got %s' % type(collection).__name__)
+    if path is not None:
+        prepare_dir(path)
     params = collection.params
     _check_params(params)
     workers = _workers(client)

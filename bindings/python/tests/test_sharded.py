@@ -6,6 +6,7 @@ built shard is an error naming its file, a write cut off never replaces a good s
 the umask. Skipped without Dask."""
 import contextlib
 import os
+import threading
 import time
 
 import numpy as np
@@ -178,6 +179,37 @@ def test_save_load_round_trip(small, client, tmp_path):
     assert len(shard) == sx.bounds[1][1] - sx.bounds[1][0]
 
 
+def test_saves_at_once_follow_each_other_and_keep_the_users_files(small, client, tmp_path):
+    """Two saves into one folder at once (threads of one client) leave one whole set, which loads
+    and answers as its index; files of the user that only look like a set's are kept."""
+    import threading
+    sx, _, coll = small
+    other = ad.build_index(client, coll, shards=2)
+    d = tmp_path / 'set'
+    d.mkdir()
+    mine = ['graph-my-results.npz', 'shard-backup.amscr-index', 'notes.txt']
+    for f in mine:
+        (d / f).write_text('mine\n')
+    errors = []
+
+    def save(x):
+        try:
+            x.save(d)
+        except Exception as e:  # noqa: BLE001 - collected and asserted below
+            errors.append(e)
+    for _ in range(3):
+        ts = [threading.Thread(target=save, args=(x,)) for x in (sx, other)]
+        for t in ts:
+            t.start()
+        for t in ts:
+            t.join()
+        assert errors == []
+        loaded = ad.load_index(client, d)
+        q = _queries(2, 7100)
+        assert any(np.array_equal(loaded.scores_many(q), x.scores_many(q)) for x in (sx, other))
+    assert all((d / f).read_text() == 'mine\n' for f in mine)
+
+
 def _shard_file(d, s):
     return [n for n in os.listdir(d) if n.startswith('shard-%03d-' % s)][0]
 
@@ -259,7 +291,7 @@ def test_cut_off_write_keeps_the_good_set(small, client, tmp_path, monkeypatch):
     np.testing.assert_array_equal(ad.load_index(client, d).scores_many(qs), want)
     other.save(d)
     after = sorted(os.listdir(d))
-    assert '.amscr-tmp-killed' not in after and not set(before) - {'manifest.json'} & set(after)
+    assert '.amscr-tmp-killed' not in after and not set(before) - {'manifest.json', '.amscr-lock'} & set(after)
     assert not np.array_equal(ad.load_index(client, d).scores_many(qs), want)
 
 
@@ -286,13 +318,31 @@ def test_bad_input(client):
         ad.build_index(client, _collection(amscr.Params.retrieval(points=POINTS), _shapes(40, 0)), shards=0)
 
 
-def test_shard_lost_with_its_worker_is_a_clear_error(client):
+def _error_of(call, *args):
+    """The exception call(*args) raises, or None."""
+    try:
+        call(*args)
+    except Exception as e:  # noqa: BLE001 - returned for the test to check
+        return e
+    return None
+
+
+def test_shard_lost_with_its_worker_is_a_clear_error(client, tmp_path):
     """Last in the file: it kills a worker of the module's cluster (its nanny starts another)."""
     coll = _collection(amscr.Params.retrieval(points=POINTS, threads=1), _shapes(60, 0))
     sx = ad.build_index(client, coll, shards=2)
     sx.scores(_queries(1)[0])
+    sx.save(tmp_path / 'set')
+    loaded = ad.load_index(client, tmp_path / 'set')  # its shard 1 on the same worker
+    loaded.scores(_queries(1)[0])
     with contextlib.suppress(Exception):  # the worker dies before it answers
         client.run(os._exit, 1, workers=[sx._workers[1]])
+    # a loaded set's shard waited forever for its worker; it is a clear error now
+    got = []
+    t = threading.Thread(target=lambda: got.append(_error_of(loaded.scores, _queries(1)[0])), daemon=True)
+    t.start()
+    t.join(120)
+    assert got and isinstance(got[0], ad.ShardSetError) and 'shard 1 lost' in str(got[0]), got
     with pytest.raises(ad.ShardSetError, match='shard 1 lost with its worker'):
         deadline = time.monotonic() + 120  # until the scheduler has seen the worker go (slow on a loaded machine)
         while time.monotonic() < deadline:
