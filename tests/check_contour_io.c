@@ -321,6 +321,17 @@ START_TEST(write_missing_dir)
 }
 END_TEST
 
+/* Reads the whole small file at path into buf (NUL-terminated); the bytes read. */
+static size_t slurp(const char *path, char *buf, size_t cap)
+{
+    FILE *f = fopen(path, "rb");
+    ck_assert_ptr_nonnull(f);
+    size_t got = fread(buf, 1, cap - 1, f);
+    buf[got] = '\0';
+    fclose(f);
+    return got;
+}
+
 /* A program that set a locale whose decimal point is ',' (setlocale(LC_ALL, "") in a German
  * session, as GUI toolkits do) still reads and writes point lists with '.', and keeps its
  * locale. The locale is compiled into the build folder (tests/meson.build, AMSCR_TEST_LOCPATH). */
@@ -346,11 +357,8 @@ START_TEST(text_in_a_comma_locale)
     char path[4200];
     snprintf(path, sizeof path, "%s/pts.txt", tmp);
     ck_assert_int_eq(amscr_contour_write_text(c, path), AMSCR_OK);
-    FILE *f = fopen(path, "rb");
-    char text[256] = {0};
-    ck_assert_ptr_nonnull(f);
-    ck_assert_uint_gt(fread(text, 1, sizeof text - 1, f), 0);
-    fclose(f);
+    char text[256];
+    ck_assert_uint_gt(slurp(path, text, sizeof text), 0);
     ck_assert_str_eq(text, "0 0\n10.5 0\n10.5 10.25\n-0.125 0.001\n");
     amscr_contour *back = NULL;
     ck_assert_int_eq(amscr_contour_read_text(path, &back), AMSCR_OK);
@@ -367,16 +375,6 @@ START_TEST(text_in_a_comma_locale)
     rm_tree(tmp);
 }
 END_TEST
-
-/* Reads the whole small file at path into buf (NUL-terminated). */
-static void slurp(const char *path, char *buf, size_t cap)
-{
-    FILE *f = fopen(path, "rb");
-    ck_assert_ptr_nonnull(f);
-    size_t got = fread(buf, 1, cap - 1, f);
-    buf[got] = '\0';
-    fclose(f);
-}
 
 /* A symbolic link keeps pointing to the file written (its mode kept); a dangling one gets its
  * file made; a FIFO is written through (its reader gets the text) and stays a FIFO. */
