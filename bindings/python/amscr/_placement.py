@@ -1,16 +1,24 @@
-"""Where the work of ``amscr.distributed`` runs: the C threads of a task on its worker's host, and
-a block of a collection as the collection a task computes with. Shared by the tiles of
-:mod:`amscr.distributed` and the shards of its index."""
+"""Where the work of ``amscr.distributed`` runs: the C threads of a task on its worker's host, a
+block of a collection as the collection a task computes with, and the results of tasks pinned to
+workers that may leave. Shared by the tiles of :mod:`amscr.distributed` and the shards of its index."""
 from __future__ import annotations
 
+import asyncio
+import concurrent.futures
 import os
 from collections import defaultdict
-from typing import Dict, Optional, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 import distributed
 from distributed.comm import get_address_host
 
 from .collection import Collection
+from .errors import AmscrError
+
+#: What distributed.wait raises at its timeout (Python and Dask versions differ).
+_TIMEOUTS = (TimeoutError, asyncio.TimeoutError, concurrent.futures.TimeoutError)
+#: How often a wait for tasks pinned to workers checks that the workers are still there (seconds).
+LIVENESS_SECONDS = 1.0
 
 
 def _worker_address() -> Optional[str]:
@@ -66,3 +74,37 @@ def _threads_by_host(client) -> Dict[str, int]:
         dask_threads[h] += nt
         host_cores[h] = cores.get(addr, 1)
     return {h: max(1, host_cores[h] // dask_threads[h]) for h in dask_threads}
+
+
+def _worker_addresses(dask_scheduler: Any) -> List[str]:
+    """The addresses of the cluster's workers (run on the scheduler)."""
+    return list(dask_scheduler.workers)
+
+
+def gone(client, placed: Sequence[str]) -> List[int]:
+    """The positions s of `placed` (one worker address a shard) whose worker left the cluster."""
+    live = set(client.run_on_scheduler(_worker_addresses))
+    return [s for s, w in enumerate(placed) if w not in live]
+
+
+def gather_live(client, futs: List[Any], placed: Sequence[str],
+                lost: Callable[[List[int], str], Exception]) -> List[Any]:
+    """client.gather(futs) of tasks pinned to the workers `placed` (one a shard), checking every
+    LIVENESS_SECONDS that those workers are still in the cluster: a task pinned to a worker that
+    left (killed, or retired by the cluster) would wait for it forever. Raises lost(shards, why)
+    when some left, also when a task failed (Dask's errors for lost data vary by version)."""
+    while True:
+        try:
+            distributed.wait(futs, timeout=LIVENESS_SECONDS)
+            return client.gather(futs)
+        except _TIMEOUTS:
+            g = gone(client, placed)
+            if g:
+                raise lost(g, 'its worker left the cluster') from None
+        except AmscrError:
+            raise
+        except Exception as e:  # noqa: BLE001 - a worker's loss surfaces as one of several errors
+            g = gone(client, placed)
+            if not g:
+                raise
+            raise lost(g, '%s: %s' % (type(e).__name__, e)) from e

@@ -70,18 +70,19 @@ def _knn(i: int, cj: np.ndarray, cd: np.ndarray, k: int) -> Tuple[np.ndarray, np
     return np.r_[i, cj[order]], np.r_[0.0, cd[order]]
 
 
-def _shortlist_lists(client, params: Params, n: int, bounds, rows, idx, placed, mb: int, th):
+def _shortlist_lists(client, gather, params: Params, n: int, bounds, rows, idx, placed, mb: int, th):
     """The global lists of a shortlist build, as amscr_index_build(candidates) computes them: each
     shape matched with its mb signature-nearest shapes of the whole collection, then with its
     neighbours' neighbours (the base lists, then the inner lists from the shortlist and the base
     list, refined the same way). Each round's pairs are computed once, on the worker holding the
-    later shape's shard. Returns the graph's arrays, the signatures and the pairs matched."""
+    later shape's shard; gather(futures) waits for their results. Returns the graph's arrays, the
+    signatures and the pairs matched."""
     k, k2 = widths(params, n)
     starts = np.array([lo for lo, _ in bounds], dtype=np.int64)
-    sigs = _joined(client.gather([client.submit(_signatures, idx[s], pure=False, workers=[placed[s]])
+    sigs = _joined(gather([client.submit(_signatures, idx[s], pure=False, workers=[placed[s]])
                                   for s in range(len(bounds))]))
     sf = client.scatter([sigs], broadcast=True, hash=False)[0]  # one future of the pair
-    S = np.concatenate(client.gather([client.submit(_shortlists, sf, _floats(sigs, lo, hi), lo, mb, th, pure=False,
+    S = np.concatenate(gather([client.submit(_shortlists, sf, _floats(sigs, lo, hi), lo, mb, th, pure=False,
                                                     workers=[placed[s]]) for s, (lo, hi) in enumerate(bounds)]))
     base, inner = _Store(), _Store()
 
@@ -99,7 +100,7 @@ def _shortlist_lists(client, params: Params, n: int, bounds, rows, idx, placed, 
                                       b[sel] - starts[t], None if s == t else 0, want_base, want_inner,
                                       pure=False, workers=[placed[t]]))
         D, D2 = np.zeros(len(keys)), np.zeros(len(keys))
-        for sel, (d, d2) in zip(groups, client.gather(futs)):
+        for sel, (d, d2) in zip(groups, gather(futs)):
             D[sel], D2[sel] = d, d2
         if want_base:
             base.add(keys, D)

@@ -24,8 +24,6 @@ and a manifest (:mod:`amscr._shard_files`).
 """
 from __future__ import annotations
 
-import asyncio
-import concurrent.futures
 import io
 import os
 from typing import Any, List, Optional, Sequence, Tuple, Union
@@ -38,7 +36,7 @@ from .collection import Collection
 from .errors import AmscrError, FormatError, InvalidArgumentError, _check
 from .index import Index
 from .params import Params
-from ._placement import _block, _threads_by_host
+from ._placement import _block, _threads_by_host, gather_live
 from ._shard_build import _merge_lists, _shortlist_lists, widths
 from ._shard_files import ShardSetError, prepare_dir, read_set, write_set
 from ._shard_tasks import (QPOS_AFTER, Signatures, _index_bytes, _joined, _member_shortlists, _members, _pair_block,
@@ -175,23 +173,7 @@ class ShardedIndex:
         return self._guard(lambda: self._gather_live(futs))
 
     def _gather_live(self, futs: List[Any]) -> List[Any]:
-        """client.gather(futs), checking every second that the shards' workers are still in the
-        cluster: a task pinned to a worker that left (killed, or retired by the cluster) would wait
-        for it forever."""
-        from distributed import wait  # the cluster mode's own dependency
-        while True:
-            try:
-                wait(futs, timeout=_LIVENESS_SECONDS)
-                return self.client.gather(futs)
-            except _TIMEOUTS:
-                gone = self._gone()
-                if gone:
-                    raise _lost_error(gone, 'its worker left the cluster') from None
-
-    def _gone(self) -> List[int]:
-        """The shards whose worker is no longer in the cluster."""
-        live = set(self.client.run_on_scheduler(_worker_addresses))
-        return [s for s, w in enumerate(self._workers) if w not in live]
+        return gather_live(self.client, futs, self._workers, _lost_error)
 
     def _guard(self, call: Any) -> Any:
         """call(); a failure while a shard's worker is gone is the clear error of a lost shard."""
@@ -339,22 +321,17 @@ class ShardedIndex:
         write_set(d, datas, self.bounds, self._graph.to_bytes(), len(self), self.params, self.candidates)
 
 
-#: What distributed.wait raises at its timeout (Python and Dask versions differ).
-_TIMEOUTS = (TimeoutError, asyncio.TimeoutError, concurrent.futures.TimeoutError)
-#: How often a query waiting for its shards checks that their workers are still there (seconds).
-_LIVENESS_SECONDS = 1.0
-
-
-def _worker_addresses(dask_scheduler: Any) -> List[str]:
-    """The addresses of the cluster's workers (run on the scheduler)."""
-    return list(dask_scheduler.workers)
-
-
 def _lost_error(lost: List[int], why: str) -> ShardSetError:
     return ShardSetError('amscr.distributed: shard%s %s lost with %s worker (%s); load the saved set again '
                          '(load_index) or build it again'
                          % ('s' if len(lost) > 1 else '', ', '.join(map(str, lost)),
                             'their' if len(lost) > 1 else 'its', why), lib.AMSCR_E_STATE)
+
+
+def _build_lost(lost: List[int], why: str) -> ShardSetError:
+    return ShardSetError('amscr.distributed.build_index: shard%s %s lost with %s worker during the build (%s); '
+                         'build again' % ('s' if len(lost) > 1 else '', ', '.join(map(str, lost)),
+                                          'their' if len(lost) > 1 else 'its', why), lib.AMSCR_E_STATE)
 
 
 def _workers(client) -> List[str]:
@@ -415,19 +392,22 @@ def build_index(client, collection: Collection, path: Optional[PathLike] = None,
     th = _threads_by_host(client)
     idx = [client.submit(_shard_index, rows[s], th, pure=False, workers=[placed[s]])
            for s in range(ns)]
+
+    def gather(futs: List[Any]) -> List[Any]:
+        return gather_live(client, futs, placed, _build_lost)
     k, k2 = widths(params, n)
     mb = int(lib.amscr_index_build_shortlist(params._p, n, m))
     sigs = None
     if mb > 0:
         (nb_idx, nb_dist, in_idx, in_dist, dmax, dmax2), sigs, pairs = _shortlist_lists(
-            client, params, n, bounds, rows, idx, placed, mb, th)
+            client, gather, params, n, bounds, rows, idx, placed, mb, th)
     else:
         blocks = {}
         for s in range(ns):
             for t in range(s, ns):
                 blocks[s, t] = client.submit(_pair_block, rows[s], idx[t], bounds[s][0], bounds[t][0], k, k2,
                                              pure=False, workers=[placed[t]])
-        got = dict(zip(blocks, client.gather(list(blocks.values()))))
+        got = dict(zip(blocks, gather(list(blocks.values()))))
         base = [[] for _ in range(ns)]
         inner = [[] for _ in range(ns)]
         dmax = dmax2 = 0.0

@@ -327,6 +327,43 @@ def _error_of(call, *args):
     return None
 
 
+def _restored(client, dead, workers=4, seconds=120):
+    """Waits until the nanny has replaced the killed worker `dead`."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        w = client.nthreads()
+        if len(w) == workers and dead not in w:
+            return
+        time.sleep(0.2)
+    raise AssertionError('the cluster did not get its worker back')
+
+
+@pytest.mark.parametrize('candidates', [0, 16])
+def test_worker_lost_during_the_build_is_a_clear_error(client, monkeypatch, candidates):
+    """A worker killed while the build waits for its tasks: the build waited forever for it; now a
+    ShardSetError naming the shard, within seconds (every pair, and the shortlist build)."""
+    coll = _collection(amscr.Params.retrieval(points=POINTS, threads=1), _shapes(60, 0))
+    real, killed = _shards.gather_live, []
+
+    def kill_first(cl, futs, placed, lost):
+        if not killed:
+            killed.append(placed[1])
+            with contextlib.suppress(Exception):  # the worker dies before it answers
+                cl.run(os._exit, 1, workers=[placed[1]])
+        return real(cl, futs, placed, lost)
+
+    monkeypatch.setattr(_shards, 'gather_live', kill_first)
+    got = []
+    t = threading.Thread(target=lambda: got.append(_error_of(lambda: ad.build_index(client, coll, shards=2,
+                                                                                    candidates=candidates))),
+                         daemon=True)
+    t.start()
+    t.join(120)
+    assert killed and got and isinstance(got[0], ad.ShardSetError), got
+    assert 'shard 1 lost with its worker during the build' in str(got[0]) and 'build again' in str(got[0])
+    _restored(client, killed[0])
+
+
 def test_shard_lost_with_its_worker_is_a_clear_error(client, tmp_path):
     """Last in the file: it kills a worker of the module's cluster (its nanny starts another)."""
     coll = _collection(amscr.Params.retrieval(points=POINTS, threads=1), _shapes(60, 0))
