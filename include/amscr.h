@@ -231,7 +231,8 @@ AMSCR_API const char *amscr_strerror(amscr_status status);
 
 /**
  * @brief Detail of the calling thread's last failure, e.g. "shape.txt:17: expected 2 numbers".
- *        Empty string when there is none. Never NULL.
+ *        Every call that returns an amscr_status clears it first: after AMSCR_OK it is the
+ *        empty string. Never NULL.
  * Ownership: thread-local buffer, valid until the next amscr call on this thread.
  * Thread-safety: per thread.
  * @since 0.1
@@ -572,7 +573,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_gaussian_kernel(double sigma, doubl
  *        symmetric, "reflect") for open curves. sigma == 0 copies.
  * @param[in]  xy, n   input points (n >= 1).
  * @param[in]  closed  1 closed, 0 open.
- * @param[in]  sigma   in samples, >= 0.
+ * @param[in]  sigma   in samples, 0 to 1e6 (as amscr_gaussian_kernel).
  * @param[out] out_xy  2n doubles; must not overlap xy.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (also out_xy overlapping xy); AMSCR_E_NOMEM.
  * Ownership: none.
@@ -586,9 +587,11 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_smooth_gaussian(const double *xy, s
  * @brief m points equally spaced in Euclidean arc length along the polygon (linear
  *        interpolation; periodic when closed). The first output is the first input point;
  *        for open curves the last output is the last input point.
- * @param[in]  xy, n, closed  the polygon.
+ * @param[in]  xy, n, closed  the polygon (n >= 2).
+ * @param[in]  m  the points wanted (m >= 2).
  * @param[out] out_xy  2m doubles.
- * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_DEGENERATE (zero length); AMSCR_E_NOMEM.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n or m below 2, non-finite); AMSCR_E_DEGENERATE
+ *         (zero length); AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: safe.
  * @since 0.1
@@ -691,7 +694,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_affine_apply(const double m6[6], co
 
 /**
  * @brief Inverts an affine map.
- * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, non-finite); AMSCR_E_DEGENERATE (singular).
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, non-finite); AMSCR_E_DEGENERATE (singular
+ *         relative to the map's scale, or an inverse a double cannot hold).
  * Ownership: none.
  * Thread-safety: safe.
  * @since 0.1
@@ -964,7 +968,9 @@ AMSCR_API size_t amscr_gmm1d_num_components(const amscr_gmm1d *g);
 /**
  * @brief Fits the mixture by EM to n >= k finite values.
  * @return AMSCR_OK (also when the cap is reached: see amscr_gmm1d_converged);
- *         AMSCR_E_INVALID_ARG (NULL, n < k, non-finite); AMSCR_E_NOMEM.
+ *         AMSCR_E_INVALID_ARG (NULL, n < k, non-finite); AMSCR_E_NUMERIC (the likelihood
+ *         overflows a double: values too spread, e.g. +-1e200; g keeps its last fit);
+ *         AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: exclusive on g.
  * @since 0.1
@@ -2510,7 +2516,7 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_add_contour(amscr_db *db, const 
  *                  cancels (may be NULL).
  * @param[out] out_failed  on failure, the index of the first contour, in order, that could not
  *                  be prepared (n when the failure was not one contour's: out of memory,
- *                  cancelled); may be NULL.
+ *                  cancelled); n on success; may be NULL.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL); as amscr_descriptor_new for the contour
  *         *out_failed names (the error detail starts "contour I: "); AMSCR_E_CANCELLED;
  *         AMSCR_E_NOMEM. All or nothing: on failure no shape is added.
@@ -2557,9 +2563,9 @@ AMSCR_API int32_t amscr_db_label(const amscr_db *db, size_t i);
 
 /**
  * @brief Descriptor of shape i.
- * @return the descriptor; NULL for NULL or i out of range, or (the collection of an index
- *         loaded with AMSCR_INDEX_LAZY from a file, whose shapes are decoded when first read)
- *         when decoding it ran out of memory.
+ * @return the descriptor; NULL for NULL or i out of range, or (the collection of an index,
+ *         amscr_index_db, whose shapes are decoded when first read) when decoding it ran out
+ *         of memory.
  * Ownership: borrowed from db.
  * Thread-safety: const.
  * @since 0.1
@@ -2579,7 +2585,9 @@ AMSCR_API const amscr_params *amscr_db_params(const amscr_db *db);
  * @brief 1-vs-many: out_dist[i] = distance(q -> shape i), amscr_db_size values, on the db's
  *        threads; results are bit-identical for any thread count. Batch outputs (this call and
  *        every amscr_db_*_matrix / amscr_db_cross_distances) are computed in place: on failure
- *        or cancellation every element is set to NaN (never a silently partial result).
+ *        or cancellation every element is set to NaN (never a silently partial result); a
+ *        call refused before any work (a NULL argument, a size that is not the collection's)
+ *        leaves the output untouched.
  * @param[in] progress, user  optional progress callback (NULL = none).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, q incompatible with the db); AMSCR_E_CANCELLED;
  *         AMSCR_E_NUMERIC; AMSCR_E_NOMEM.

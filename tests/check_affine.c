@@ -234,9 +234,8 @@ START_TEST(test_invert_random)
     double e[6] = {m6[4] / det, -m6[1] / det, 0, -m6[3] / det, m6[0] / det, 0};
     e[2] = -(e[0] * m6[2] + e[1] * m6[5]);
     e[5] = -(e[3] * m6[2] + e[4] * m6[5]);
-    for (int k = 0; k < 6; k++)
-        ck_assert_msg(fabs(inv[k] - e[k]) < 1e-12 * (1.0 + fabs(e[k])), "inv[%d] = %.17g, expected %.17g", k, inv[k],
-                      e[k]);
+    for (int k = 0; k < 6; k++) /* bit for bit: the call's scaling by a power of 2 changes no rounding */
+        ck_assert_msg(inv[k] == e[k], "inv[%d] = %.17g, expected %.17g", k, inv[k], e[k]);
     const double id[6] = {1, 0, 0, 0, 1, 0};
     compose(m6, inv, c);
     for (int k = 0; k < 6; k++)
@@ -249,9 +248,10 @@ END_TEST
 
 START_TEST(test_invert_scale_independent)
 {
-    /* Singularity is relative: tiny or huge but well-conditioned maps invert fine. */
-    const double scales[] = {1e-4, 1e-2, 1e3, 1e6};
-    for (size_t s = 0; s < 4; s++) {
+    /* Singularity is relative: tiny or huge but well-conditioned maps invert fine, also where the
+     * determinant itself would overflow (1e300^2) or underflow (1e-200^2). */
+    const double scales[] = {1e-200, 1e-4, 1e-2, 1e3, 1e6, 1e300};
+    for (size_t s = 0; s < 6; s++) {
         double k = scales[s];
         const double m6[6] = {k, 0.5 * k, 1.0, -0.25 * k, k, 2.0};
         double inv[6], c[6];
@@ -264,6 +264,13 @@ START_TEST(test_invert_scale_independent)
         ck_assert_double_eq_tol(c[2], 0.0, 1e-12);
         ck_assert_double_eq_tol(c[5], 0.0, 1e-12);
     }
+    /* an inverse a double cannot hold (entries 1e-310: the inverse's would be 1e310) */
+    const double tiny[6] = {1e-310, 0, 0, 0, 1e-310, 0};
+    double inv[6] = {5, 5, 5, 5, 5, 5};
+    ck_assert_int_eq(amscr_affine_invert(tiny, inv), AMSCR_E_DEGENERATE);
+    ck_assert_msg(inv[0] == 5.0 && inv[4] == 5.0, "output written on failure");
+    const double far[6] = {1e-300, 0, 1e300, 0, 1e-300, 0}; /* its inverse's translation: 1e600 */
+    ck_assert_int_eq(amscr_affine_invert(far, inv), AMSCR_E_DEGENERATE);
 }
 END_TEST
 

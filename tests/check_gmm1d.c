@@ -450,6 +450,11 @@ START_TEST(object_api)
     ck_assert_double_eq_tol(fm[0], 0.1, 1e-9);
     ck_assert_double_eq_tol(fm[1], 15.4 / 3.0, 1e-9);
     ck_assert_double_eq_tol(fv[0], 0.02 / 3.0, 1e-9);
+    /* values too spread for the likelihood in a double: AMSCR_E_NUMERIC, the last fit kept */
+    double wide[6] = {1e200, -1e200, 1e200, -1e200, 0.0, 1.0};
+    ck_assert_int_eq(amscr_gmm1d_fit(g, wide, 6), AMSCR_E_NUMERIC);
+    ck_assert(amscr_last_error_detail()[0] != '\0');
+    ck_assert_double_eq_tol(amscr_gmm1d_means(g)[0], 0.1, 1e-9);
 
     /* Thresholds of a fitted mixture = amscr_bayes_threshold of its components. */
     double t2;

@@ -62,11 +62,21 @@ amscr_status amscr_affine_invert(const double m6[6], double out_m6[6])
     AMSCR_CHECK_NULL(out_m6);
     if (!amscr__all_finite(m6, 6))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_affine_invert: non-finite map");
-    double det = m6[0] * m6[4] - m6[1] * m6[3];
-    double scale = fabs(m6[0]) + fabs(m6[1]) + fabs(m6[3]) + fabs(m6[4]);
+    /* the linear part scaled by a power of 2 to entries below 1: its determinant neither overflows
+     * nor underflows (1e300 or 1e-200 on the diagonal are regular maps), and the inverse is the
+     * unscaled one's bit for bit wherever that one's determinant is representable */
+    double big = fmax(fmax(fabs(m6[0]), fabs(m6[1])), fmax(fabs(m6[3]), fabs(m6[4])));
+    int e = 0;
+    (void)frexp(big, &e);
+    double s = ldexp(1.0, -e), a = m6[0] * s, b = m6[1] * s, c = m6[3] * s, d = m6[4] * s;
+    double det = a * d - b * c, scale = fabs(a) + fabs(b) + fabs(c) + fabs(d);
     if (!(fabs(det) > 1e-14 * scale * scale))
-        return amscr__fail(AMSCR_E_DEGENERATE, "amscr_affine_invert: singular map (det = %g)", det);
-    (void)amscr__affine_inverse(m6, out_m6);
+        return amscr__fail(AMSCR_E_DEGENERATE, "amscr_affine_invert: singular map (det = %g x 2^%d)", det, 2 * e);
+    double i0 = d / det * s, i1 = -b / det * s, i3 = -c / det * s, i4 = a / det * s;
+    double r[6] = {i0, i1, -(i0 * m6[2] + i1 * m6[5]), i3, i4, -(i3 * m6[2] + i4 * m6[5])};
+    if (!amscr__all_finite(r, 6))
+        return amscr__fail(AMSCR_E_DEGENERATE, "amscr_affine_invert: the inverse map overflows a double");
+    memcpy(out_m6, r, sizeof r);
     return AMSCR_OK;
 }
 

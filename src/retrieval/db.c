@@ -368,6 +368,19 @@ const amscr_descriptor *amscr_db_descriptor(const amscr_db *db, size_t i)
     return (db && i < db->n) ? db_get(db, i) : NULL;
 }
 
+amscr_status amscr__db_shape(const amscr_db *db, size_t i, const amscr_descriptor **out)
+{
+    *out = amscr_db_descriptor(db, i);
+    return *out ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "collection: out of memory decoding shape %zu", i);
+}
+
+amscr_status amscr__db_add_from(amscr_db *dst, const amscr_db *src, size_t i, int32_t label)
+{
+    const amscr_descriptor *d;
+    amscr_status st = amscr__db_shape(src, i, &d);
+    return st == AMSCR_OK ? amscr_db_add_descriptor(dst, d, label, NULL) : st;
+}
+
 const amscr_params *amscr_db_params(const amscr_db *db) { return db ? &db->params : NULL; }
 
 /* amscr_db_query once db and out_dist are known. */

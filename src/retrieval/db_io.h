@@ -53,6 +53,11 @@ amscr_status amscr__db_compact_tail(amscr_db *db);
  * source then outlives the buffer); nothing for any other collection. */
 amscr_status amscr__db_own_source(amscr_db *db);
 amscr_status amscr__db_decode_all(const amscr_db *db);
+/* Shape i of db into *out (amscr_db_descriptor, which decodes a lazy collection's shape when first
+ * read): AMSCR_E_NOMEM when decoding it runs out of memory, where amscr_db_descriptor gives NULL. */
+amscr_status amscr__db_shape(const amscr_db *db, size_t i, const amscr_descriptor **out);
+/* Shape i of src added to dst with `label` (amscr_db_add_descriptor of amscr__db_shape). */
+amscr_status amscr__db_add_from(amscr_db *dst, const amscr_db *src, size_t i, int32_t label);
 
 /* Writes the collection part of a file of `version`: magic, version, params, retrieval
  * settings, the shapes (no section, no checksum). */

@@ -2,6 +2,7 @@
  * prepared shape in its own frame, the channel alone (pair and collection), and the fused,
  * re-ranked retrieval matrix. */
 #include "channel.h"
+#include "db_io.h"
 #include "inner.h"
 #include "rows.h"
 
@@ -181,10 +182,9 @@ static amscr_status frame_row(void *ctx, size_t i, void *scratch)
 {
     (void)scratch;
     const frame_job *j = ctx;
-    const amscr_descriptor *d = amscr_db_descriptor(j->db, i);
-    if (!d)
-        return amscr__fail(AMSCR_E_FORMAT, "shape channel: shape %zu could not be read", i);
-    return amscr__hf_of_descriptor(amscr_db_params(j->db), j->frame, d, &j->hf[i]);
+    const amscr_descriptor *d;
+    amscr_status st = amscr__db_shape(j->db, i, &d);
+    return st == AMSCR_OK ? amscr__hf_of_descriptor(amscr_db_params(j->db), j->frame, d, &j->hf[i]) : st;
 }
 
 /* The channel matrix in one frame (the second of amscr__channel_frames when `second`) into out. */

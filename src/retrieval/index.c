@@ -130,7 +130,7 @@ static amscr_status index_alloc(const amscr_db *db, int borrow, amscr_index **ou
     else
         st = amscr_db_new(p, &x->db);
     for (size_t i = 0; !borrow && st == AMSCR_OK && i < n; i++)
-        st = amscr_db_add_descriptor(x->db, amscr_db_descriptor(db, i), amscr_db_label(db, i), NULL);
+        st = amscr__db_add_from(x->db, db, i, amscr_db_label(db, i));
     if (st == AMSCR_OK)
         st = amscr__index_reserve(x, n);
     if (st != AMSCR_OK) {

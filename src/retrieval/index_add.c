@@ -84,8 +84,9 @@ static amscr_status add_distances(void *ctx, size_t j, void *scratch)
     add_ws *w = scratch;
     for (size_t t = 0; x->k2 > 0 && t < m; t++)
         c->cd2[r * c->n + t] = amscr__index_inner_pair(x, cand[t], j, w->iw);
-    return amscr__base_pairs(&c->b, x->db, x->hf, amscr_db_descriptor(x->db, j), hq, j, cand, m, w->pw,
-                             c->cd + r * c->n);
+    const amscr_descriptor *q;
+    amscr_status st = amscr__db_shape(x->db, j, &q);
+    return st == AMSCR_OK ? amscr__base_pairs(&c->b, x->db, x->hf, q, hq, j, cand, m, w->pw, c->cd + r * c->n) : st;
 }
 
 /* Rows j0..j1-1 (new): their distances on threads, then (in order) the older rows they enter
@@ -145,7 +146,7 @@ static amscr_status add_rebuilding(amscr_index *x, const amscr_db *shapes, amscr
     for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
         const amscr_db *from = i < n0 ? x->db : shapes;
         size_t j = i < n0 ? i : i - n0;
-        st = amscr_db_add_descriptor(all, amscr_db_descriptor(from, j), amscr_db_label(from, j), NULL);
+        st = amscr__db_add_from(all, from, j, amscr_db_label(from, j));
     }
     if (st == AMSCR_OK)
         st = amscr_index_build(all, x->candidates, progress, user, &y);
@@ -182,7 +183,7 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
     if (st == AMSCR_OK)
         st = amscr__index_reserve(x, n);
     for (size_t i = 0; st == AMSCR_OK && i < add; i++)
-        st = amscr_db_add_descriptor(x->db, amscr_db_descriptor(shapes, i), amscr_db_label(shapes, i), NULL);
+        st = amscr__db_add_from(x->db, shapes, i, amscr_db_label(shapes, i));
     if (st == AMSCR_OK)
         st = amscr__index_extend(x, n0, progress, user);
     return st == AMSCR_OK ? amscr__db_compact_tail(x->db) : st; /* kept as the others are */

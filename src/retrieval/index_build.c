@@ -3,6 +3,7 @@
  * then equals the matrix of the collection plus the query) or, for large collections, among
  * each shape's M signature-nearest shapes and then its neighbours' neighbours (rows on
  * threads). */
+#include "db_io.h"
 #include "index.h"
 
 #include <math.h>
@@ -31,7 +32,7 @@ static amscr_status build_full(amscr_index *x, amscr_progress_fn progress, void 
     x->med_a = med[0];
     x->med_h = med[1];
     x->dmax = 0.0;
-    for (size_t j = 0; j < n; j++)
+    for (size_t j = 0; st == AMSCR_OK && j < n; j++)
         cj[j] = j;
     for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
         for (size_t j = 0; j < n; j++)
@@ -54,8 +55,7 @@ static amscr_status sampled_medians(amscr_index *x)
     amscr_db *sub = NULL;
     amscr_status st = amscr_db_new(p, &sub);
     for (size_t t = 0; st == AMSCR_OK && t < m; t++) /* evenly spread: shape t * n / m */
-        st = amscr_db_add_descriptor(sub, amscr_db_descriptor(x->db, (size_t)((double)t * (double)n / (double)m)), -1,
-                                     NULL);
+        st = amscr__db_add_from(sub, x->db, (size_t)((double)t * (double)n / (double)m), -1);
     double *D = st == AMSCR_OK ? amscr__malloc_array(m * m, sizeof *D) : NULL, med[2] = {0.0, 0.0};
     if (st == AMSCR_OK && !D)
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_index_build: out of memory");
@@ -137,8 +137,11 @@ static amscr_status distance_row(void *ctx, size_t i, void *scratch)
             pos[u++] = t;
         }
     const amscr__hf *hq = x->nf ? x->hf + i * (size_t)x->nf : NULL;
+    const amscr_descriptor *q = NULL;
     if (st == AMSCR_OK)
-        st = amscr__base_pairs(&c->b, x->db, x->hf, amscr_db_descriptor(x->db, i), hq, i, cand, u, scratch, d);
+        st = amscr__db_shape(x->db, i, &q);
+    if (st == AMSCR_OK)
+        st = amscr__base_pairs(&c->b, x->db, x->hf, q, hq, i, cand, u, scratch, d);
     for (size_t t = 0; st == AMSCR_OK && t < u; t++)
         c->D[(i - c->first) * c->m + pos[t]] = d[t];
     free(cand);

@@ -23,9 +23,10 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
     feat_job *j = ctx;
     amscr_index *x = j->x;
     if (!j->have_sig) { /* a load has set them (index_io.c) */
-        const amscr_descriptor *d = amscr_db_descriptor(x->db, i);
-        if (!d)
-            return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+        const amscr_descriptor *d;
+        amscr_status st = amscr__db_shape(x->db, i, &d);
+        if (st != AMSCR_OK)
+            return st;
         float sig[AMSCR__SIG_DIM];
         amscr__shape_signature(d, sig);
         amscr__index_set_sig(x, i, sig);
@@ -40,12 +41,13 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
             st = hf[f].spec[0] ? AMSCR_OK : amscr__hf_spectra(&hf[f], NULL);
         return st;
     }
-    const amscr_descriptor *d = amscr_db_descriptor(x->db, i); /* a lazy load's: decoded here */
-    if (!d)
-        return amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+    const amscr_descriptor *d; /* a lazy load's: decoded here */
+    amscr_status st = amscr__db_shape(x->db, i, &d);
+    if (st != AMSCR_OK)
+        return st;
     for (int f = 0; f < x->nf; f++)
         amscr__hf_free(&hf[f]);
-    amscr_status st = amscr__base_hf(&j->b, d, hf);
+    st = amscr__base_hf(&j->b, d, hf);
     if (st == AMSCR_OK && x->mirror_pool && i >= x->pool_first)
         amscr__index_mirror_to_pool(x, i);
     else if (st == AMSCR_OK && j->have_sig) /* a load of a file without the heights: no rows follow */

@@ -27,7 +27,7 @@ amscr_status amscr__index_inner_full(amscr_index *x)
     if (st == AMSCR_OK)
         st = amscr__inner_matrix_from(x->inner, n, p->reflections, amscr__resolve_threads(p->num_threads), NULL,
                                       NULL, D);
-    for (size_t j = 0; j < n; j++)
+    for (size_t j = 0; st == AMSCR_OK && j < n; j++)
         cj[j] = j;
     x->dmax2 = 0.0;
     for (size_t i = 0; st == AMSCR_OK && i < n; i++) {

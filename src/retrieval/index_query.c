@@ -3,6 +3,7 @@
  * distances (with the inner graph), then its row of the retrieval scores (index_diffuse.c);
  * and the search calls' member rule: a query whose prepared samples are a member's, bit for
  * bit, is scored as that member (its row of the collection's retrieval matrix). */
+#include "db_io.h"
 #include "index.h"
 
 #include <stdlib.h>
@@ -104,7 +105,9 @@ amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t ca
     if (n != amscr_db_size(x->db) || i >= n)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_member_scores: shape %zu, %zu scores, %zu shapes", i,
                            n, amscr_db_size(x->db));
-    return query_scores(x, amscr_db_descriptor(x->db, i), i, candidates, out_scores);
+    const amscr_descriptor *d;
+    amscr_status st = amscr__db_shape(x->db, i, &d);
+    return st == AMSCR_OK ? query_scores(x, d, i, candidates, out_scores) : st;
 }
 
 /* Signature-nearest shapes among which the member rule looks for the query's copy: a copy's
@@ -112,32 +115,38 @@ amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t ca
  * among them unless this many shapes have the query's very signature without its samples. */
 enum { MEMBER_SHORTLIST = 32 };
 
-/* Whether shape j of x has q's prepared samples, bit for bit (a lazy load decodes it here). */
-static int same_samples(const amscr_index *x, size_t j, const amscr_descriptor *q)
+/* Whether shape j of x has q's prepared samples, bit for bit, into *same (a lazy load decodes
+ * shape j here: AMSCR_E_NOMEM when that runs out of memory). */
+static amscr_status same_samples(const amscr_index *x, size_t j, const amscr_descriptor *q, int *same)
 {
-    const amscr_descriptor *d = amscr_db_descriptor(x->db, j);
-    return d && d->n == q->n && memcmp(d->input, q->input, 2 * q->n * sizeof *q->input) == 0;
+    const amscr_descriptor *d;
+    amscr_status st = amscr__db_shape(x->db, j, &d);
+    *same = st == AMSCR_OK && d->n == q->n && memcmp(d->input, q->input, 2 * q->n * sizeof *q->input) == 0;
+    return st;
 }
 
-/* The member rule's shape for q (compatible params checked) into *out, SIZE_MAX for none. */
+/* The member rule's shape for q (compatible params checked) into *out, SIZE_MAX for none;
+ * *out is written only on success. */
 static amscr_status find_member(const amscr_index *x, const amscr_descriptor *q, size_t *out)
 {
-    size_t n = amscr_db_size(x->db), m = n < MEMBER_SHORTLIST ? n : MEMBER_SHORTLIST;
+    size_t n = amscr_db_size(x->db), m = n < MEMBER_SHORTLIST ? n : MEMBER_SHORTLIST, found = SIZE_MAX;
     size_t cand[MEMBER_SHORTLIST];
-    *out = SIZE_MAX;
-    if (m == 0)
-        return AMSCR_OK;
     float sig[AMSCR__SIG_DIM], lb[AMSCR__SIG_LB_DIM];
-    amscr__shape_signature(q, sig);
-    amscr__sig_bound_vector(sig, lb);
-    if (amscr__index_shortlist(x, sig, lb, m, SIZE_MAX, cand) != m)
-        return amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
-    for (size_t t = 0; t < m; t++) /* ascending index: the first copy is the lowest */
-        if (same_samples(x, cand[t], q)) {
-            *out = cand[t];
-            break;
-        }
-    return AMSCR_OK;
+    amscr_status st = AMSCR_OK;
+    if (m > 0) {
+        amscr__shape_signature(q, sig);
+        amscr__sig_bound_vector(sig, lb);
+        if (amscr__index_shortlist(x, sig, lb, m, SIZE_MAX, cand) != m)
+            st = amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    }
+    for (size_t t = 0; st == AMSCR_OK && t < m && found == SIZE_MAX; t++) { /* ascending: the first copy is the lowest */
+        int same;
+        st = same_samples(x, cand[t], q, &same);
+        found = same ? cand[t] : SIZE_MAX;
+    }
+    if (st == AMSCR_OK)
+        *out = found;
+    return st;
 }
 
 /* Whether a search scores a member's copy by the member's row: scores that depend on the
@@ -153,7 +162,6 @@ amscr_status amscr_index_find_member(const amscr_index *x, const amscr_descripto
     AMSCR_CHECK_NULL(x);
     AMSCR_CHECK_NULL(q);
     AMSCR_CHECK_NULL(out_i);
-    *out_i = SIZE_MAX;
     amscr_status st = check_query(x, q, NULL, 0, "amscr_index_find_member");
     return st == AMSCR_OK ? find_member(x, q, out_i) : st;
 }
@@ -163,10 +171,10 @@ static amscr_status search_scores(const amscr_index *x, const amscr_descriptor *
 {
     size_t member = SIZE_MAX;
     amscr_status st = amscr__member_rule_applies(amscr_db_params(x->db)) ? find_member(x, q, &member) : AMSCR_OK;
-    if (st != AMSCR_OK)
-        return st;
-    return member != SIZE_MAX ? query_scores(x, amscr_db_descriptor(x->db, member), member, candidates, out)
-                              : query_scores(x, q, SIZE_MAX, candidates, out);
+    const amscr_descriptor *d = q;
+    if (st == AMSCR_OK && member != SIZE_MAX)
+        st = amscr__db_shape(x->db, member, &d);
+    return st == AMSCR_OK ? query_scores(x, d, member, candidates, out) : st;
 }
 
 amscr_status amscr_index_search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates,

@@ -5,6 +5,7 @@
  * pass, rows on threads). This lets a build seek the lists among fewer signature-nearest
  * shapes for the same share of the exact neighbours (docs/measurements.md, "The index:
  * build, query, recall"). */
+#include "db_io.h"
 #include "index.h"
 
 #include <stdlib.h>
@@ -68,8 +69,10 @@ static amscr_status refine_row(void *ctx, size_t i, void *scratch)
     for (size_t t = 0; t < r; t++)
         cand[t] = R[t];
     const amscr__hf *hq = x->nf ? x->hf + i * (size_t)x->nf : NULL;
-    amscr_status st = amscr__base_pairs(c->b, x->db, x->hf, amscr_db_descriptor(x->db, i), hq, i, cand, r, scratch,
-                                        c->D + row * c->rmax);
+    const amscr_descriptor *q;
+    amscr_status st = amscr__db_shape(x->db, i, &q);
+    if (st == AMSCR_OK)
+        st = amscr__base_pairs(c->b, x->db, x->hf, q, hq, i, cand, r, scratch, c->D + row * c->rmax);
     free(cand);
     return st;
 }

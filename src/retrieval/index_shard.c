@@ -320,7 +320,6 @@ amscr_status amscr_index_graph_new(const amscr_params *p, size_t n, const uint32
     amscr__clear_error();
     AMSCR_CHECK_NULL(p);
     AMSCR_CHECK_NULL(out);
-    *out = NULL;
     size_t k, k2;
     amscr_index_graph_widths(p, n, &k, &k2);
     if (n > UINT32_MAX)
