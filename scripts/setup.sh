@@ -13,7 +13,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 debs=(gcc g++ meson ninja-build pkg-config liblapacke-dev libopenblas-dev libpng-dev check git
-      python3 python3-venv locales)
+      python3 python3-venv locales strace)
 missing=()
 if command -v dpkg-query >/dev/null 2>&1; then
   for p in "${debs[@]}"; do

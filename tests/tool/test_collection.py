@@ -394,6 +394,25 @@ def test_manifest_listing_a_file_twice(tmp_path):
     assert not (tmp_path / "x.idx").exists()
 
 
+def test_manifest_rows_of_the_headers_columns(tmp_path):
+    """A row may leave the header's trailing columns out, but a row with more fields than the header
+    names is an error naming the line (its extra field was ignored: a file name holding a tab, a
+    row shifted by one)."""
+    folder_of_points(tmp_path / "shapes", ["star-1.txt", "star-2.txt", "blob-1.txt", "blob-2.txt"])
+    mf = tmp_path / "m.tsv"
+    mf.write_text("file\tclass\tnote\nshapes/star-1.txt\tstar\tfirst\nshapes/star-2.txt\tstar\n"
+                  "shapes/blob-1.txt\tblob\nshapes/blob-2.txt\tblob\n")
+    r = run("eval", mf, "--json", *AFFINE)
+    assert r.returncode == 0 and json.loads(r.stdout)["n"] == 4, r.stderr
+    mf.write_text("file\tclass\nshapes/star-1.txt\tstar\nshapes/star-2.txt\tstar\tg1\n")
+    r = run("eval", mf)
+    assert r.returncode == 1 and r.stdout == "", r.stderr
+    assert "m.tsv: line 3: expected at most 2 tab-separated columns (the header's), found 3" in r.stderr, r.stderr
+    mf.write_text("file\tclass\tgroup\nshapes/star-1.txt\tstar\n")
+    r = run("eval", mf)
+    assert r.returncode == 1 and "line 2: expected at least 3 tab-separated columns" in r.stderr, r.stderr
+
+
 def test_folder_warns_of_images_it_cannot_read(tmp_path):
     """Images of formats the tool does not read are skipped with one warning line naming how
     many and one of them; other files (notes, manifests) are skipped silently."""
@@ -512,6 +531,22 @@ def test_lost_standard_output_is_an_error(tmp_path):
                        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, close_fds=True,
                        pass_fds=(), preexec_fn=lambda: os.close(1))
     assert r.returncode == 1 and "write error" in r.stderr, r.stderr
+
+
+def test_file_size_limit_is_an_error_line(tmp_path):
+    """Over the file-size limit (ulimit -f) a write is an error with its line and exit status 1, the
+    old file kept and no temporary left (SIGXFSZ killed the tool without a word)."""
+    import resource
+    d = folder_of_points(tmp_path / "set", ["star-%d.txt" % i for i in range(1, 9)])
+    limit = lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (64, 64))  # noqa: E731 - bytes
+    for cmd, name in (("matrix", "m.tsv"), ("index", "x.idx")):  # the tool's writer, the library's
+        out = tmp_path / name
+        out.write_text("old\n")
+        r = subprocess.run([tool_path(), cmd, str(d), "-o", str(out), *AFFINE], capture_output=True, text=True,
+                           preexec_fn=limit)
+        assert r.returncode == 1 and name in r.stderr and "File too large" in r.stderr, (r.returncode, r.stderr)
+        assert out.read_text() == "old\n"
+    assert sorted(os.listdir(tmp_path)) == ["m.tsv", "set", "x.idx"]
 
 
 def test_shapes_through_a_pipe_read_whole(tmp_path):

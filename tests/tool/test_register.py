@@ -143,6 +143,27 @@ def test_human_output(pair):
         assert word in r.stdout
 
 
+def test_human_output_keeps_b_far_from_the_origin(tmp_path):
+    """Far from the origin the text report gives B as many digits as the map needs to stay within a
+    millionth of the target's size (6 significant digits moved it by whole units); near the origin
+    it keeps 6, as --json keeps 17."""
+    src = smooth_shape(300)
+    tgt = affine(TRUE, src)
+    for off, want_digits in ((0.0, 6), (6.5e6, 13)):
+        s, t = tmp_path / "s.txt", tmp_path / "t.txt"
+        write_points(s, [(x + off, y + 0.3 * off) for x, y in src])
+        write_points(t, [(x + off, y - 0.2 * off) for x, y in tgt])
+        r = run("register", s, t)
+        assert r.returncode == 0, r.stderr
+        line = [ln for ln in r.stdout.splitlines() if ln.startswith("B ")][0]
+        b = [float(v) for v in line.split("[")[1].split("]")[0].split()]
+        js = register_json(s, t)["B"]
+        size = size_of(tgt)
+        assert all(abs(x - y) <= 1e-6 * size for x, y in zip(b, js)), (line, js)
+        digits = len(line.split("[")[1].split()[0].replace("-", "").replace(".", "").lstrip("0"))
+        assert digits <= want_digits, line
+
+
 @pytest.mark.parametrize("ext", [".png", ".svg", ".PNG"])
 def test_overlay_and_plot(pair, tmp_path, ext):
     s, t, _ = pair

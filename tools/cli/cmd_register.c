@@ -386,6 +386,25 @@ static void text_scales(sbuf *b, const reg_report *r)
     sb_printf(b, "shift       %zu (of %zu samples)\n", r->shift, r->N);
 }
 
+/* Significant digits for B in the text report: 6, and as many more as B's size over the target's
+ * extent needs for its last digit to stay below a millionth of the target (far from the origin,
+ * 6 digits of B would move the map by whole units); at most 17, as --json writes. */
+static int b_digits(const double m[6], const amscr_contour *tgt)
+{
+    const double *xy = amscr_contour_xy(tgt);
+    size_t n = amscr_contour_size(tgt);
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (size_t i = 0; i < 2 * n; i++) {
+        lo[i % 2] = fmin(lo[i % 2], xy[i]);
+        hi[i % 2] = fmax(hi[i % 2], xy[i]);
+    }
+    double ext = fmax(hi[0] - lo[0], hi[1] - lo[1]), mag = fmax(fabs(m[2]), fabs(m[5]));
+    if (!(ext > 0.0) || !(mag > ext))
+        return 6;
+    double more = ceil(log10(mag / ext));
+    return more >= 11.0 ? 17 : 6 + (int)more;
+}
+
 static void format_text(sbuf *b, const opts *o, const amscr_contour *src, const amscr_contour *tgt,
                         const reg_report *r)
 {
@@ -401,7 +420,8 @@ static void format_text(sbuf *b, const opts *o, const amscr_contour *src, const 
     sb_printf(b, "distance    %s\n", fmt_num(n1, r->dist));
     sb_printf(b, "A           [ %12.6g %12.6g ]\n", m[0], m[1]);
     sb_printf(b, "            [ %12.6g %12.6g ]\n", m[3], m[4]);
-    sb_printf(b, "B           [ %12.6g %12.6g ]   (target = A * source + B)\n", m[2], m[5]);
+    int bd = b_digits(m, tgt);
+    sb_printf(b, "B           [ %12.*g %12.*g ]   (target = A * source + B)\n", bd, m[2], bd, m[5]);
     if (!o->partial)
         text_scales(b, r);
     sb_printf(b, "reflected   %s\n", r->refl ? "yes" : "no");

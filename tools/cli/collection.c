@@ -307,6 +307,7 @@ typedef struct {
     const char *dir;       /* the manifest's folder: file names are relative to it */
     int header;            /* 1 until the header line is read */
     long fcol, ccol, gcol; /* the columns file, class and (optional, else -1) group */
+    size_t ncol;           /* the header's columns: a row may have fewer (trailing ones empty), not more */
     size_t lineno, icap, ccap, gcap;
     size_t *lines, lines_cap; /* lines[i]: the line of shape i */
 } manifest_reader;
@@ -332,6 +333,7 @@ static int manifest_header(manifest_reader *r, char **f, size_t nf)
                    r->lineno);
         return -1;
     }
+    r->ncol = nf;
     r->header = 0;
     return 0;
 }
@@ -359,8 +361,9 @@ static int manifest_row(manifest_reader *r, char **f, size_t nf, collection *c)
     long need = r->fcol > r->ccol ? r->fcol : r->ccol;
     if (r->gcol > need)
         need = r->gcol;
-    if ((size_t)need >= nf) {
-        tool_error(r->path, "line %zu: expected %ld tab-separated columns, found %zu", r->lineno, need + 1, nf);
+    if ((size_t)need >= nf || nf > r->ncol) {
+        tool_error(r->path, "line %zu: expected %s %zu tab-separated columns (the header's), found %zu", r->lineno,
+                   nf > r->ncol ? "at most" : "at least", nf > r->ncol ? r->ncol : (size_t)need + 1, nf);
         return -1;
     }
     char *file = f[r->fcol], *cls = f[r->ccol];
@@ -518,7 +521,7 @@ static int open_manifest(const char *mpath, collection *c)
         return -1;
     }
     char *dir = path_dir(mpath);
-    manifest_reader r = {mpath, dir, 1, -1, -1, -1, 0, 0, 0, 0, NULL, 0};
+    manifest_reader r = {mpath, dir, 1, -1, -1, -1, 0, 0, 0, 0, 0, NULL, 0};
     int ok = dir != NULL && manifest_lines(&r, fp, c) == 0;
     if (ok && ferror(fp)) {
         tool_error(mpath, "read error");

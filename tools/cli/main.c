@@ -16,6 +16,7 @@
  * Exit codes: 0 success, 1 bad input or failure (one line on stderr naming the file),
  * 2 usage error. */
 #include <errno.h>
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -75,4 +76,12 @@ static int run(int argc, char **argv)
     return c->run(&o);
 }
 
-int main(int argc, char **argv) { return finish(run(argc, argv)); }
+int main(int argc, char **argv)
+{
+#ifdef SIGXFSZ
+    /* a file over the file-size limit (ulimit -f) is a write error with its line (EFBIG), as a
+     * full disk is, rather than a death by signal with no message */
+    signal(SIGXFSZ, SIG_IGN);
+#endif
+    return finish(run(argc, argv));
+}
