@@ -292,8 +292,11 @@ AMSCR_API const double *amscr_contour_xy(const amscr_contour *c);
 /**
  * @brief Checks that a contour can be registered: finite coordinates, at least 8 distinct
  *        points after dropping repeated consecutive points, an extent (the larger side of the
- *        bounding box) from 1e-60 to 1e60, and (closed) non-zero area or (open) not all
- *        collinear.
+ *        bounding box) from 1e-60 to 1e60, a distance from the origin (of the bounding box's
+ *        centre) at most 2^44 (1.76e13) times the extent (beyond, doubles hold the shape to less
+ *        than 1/256 of its size: subtract an offset), and (closed) non-zero area or (open) not
+ *        all collinear. Shapes far from the origin (over 2^20 times their extent) are prepared
+ *        moved by their first point, so they lose no more than their coordinates' own rounding.
  * @param[in] c       the contour.
  * @param[in] closed  1 to check as a closed curve, 0 as an open one.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, non-finite); AMSCR_E_DEGENERATE.

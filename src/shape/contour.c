@@ -147,6 +147,11 @@ amscr_status amscr__validate_points(const double *xy, size_t n, int closed, cons
     if (!(ext >= AMSCR__EXTENT_MIN && ext <= AMSCR__EXTENT_MAX))
         return amscr__fail(AMSCR_E_DEGENERATE, "%s: the points span %g, outside %g to %g: rescale them", what, ext,
                            AMSCR__EXTENT_MIN, AMSCR__EXTENT_MAX);
+    double far = fmax(fabs(0.5 * minx + 0.5 * maxx), fabs(0.5 * miny + 0.5 * maxy));
+    if (!(far <= AMSCR__OFFSET_MAX * ext))
+        return amscr__fail(AMSCR_E_DEGENERATE, "%s: the points lie %g from the origin, %.3g times their extent %g: "
+                           "doubles there hold too few of their digits; subtract an offset (e.g. the first point)",
+                           what, far, far / ext, ext);
     /* second moments: collinear points have a singular covariance */
     double cx, cy, cov[3];
     amscr__centroid(xy, n, &cx, &cy);

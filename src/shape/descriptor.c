@@ -226,14 +226,48 @@ static void keep_points(amscr_descriptor *d, double *pts, size_t m)
     d->nraw = n;
 }
 
-/* d->outline from the m input points pts (retrieval with the inner distance's closing); the input
- * samples' outline when pts bound no area. */
-static amscr_status keep_outline(amscr_descriptor *d, const double *pts, size_t m)
+/* Adds (x, y) = shift to the n points xy. */
+static void move_points(double *xy, size_t n, const double shift[2])
+{
+    for (size_t i = 0; i < n; i++) {
+        xy[2 * i] += shift[0];
+        xy[2 * i + 1] += shift[1];
+    }
+}
+
+/* Points farther from the origin than this many times their extent are prepared moved by their
+ * first point (and the results moved back): sums of their raw coordinates (the pre-smoothing's
+ * running sums) would keep few of their digits (at 6.5e9 from the origin, a 100-unit shape's
+ * samples moved by ~1e-4 of its size). Nearer ones are prepared as they are, bit for bit as
+ * before (image coordinates never reach it). Set by the floating-point precision, not on data. */
+#define FAR_FROM_ORIGIN 1048576.0
+
+/* shift = the first of the m points when they lie far from the origin (FAR_FROM_ORIGIN), else 0. */
+static void far_shift(const double *pts, size_t m, double shift[2])
+{
+    double lo[2] = {pts[0], pts[1]}, hi[2] = {pts[0], pts[1]};
+    for (size_t i = 1; i < m; i++)
+        for (int a = 0; a < 2; a++) {
+            lo[a] = fmin(lo[a], pts[2 * i + a]);
+            hi[a] = fmax(hi[a], pts[2 * i + a]);
+        }
+    double ext = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+    double far = fmax(fabs(0.5 * lo[0] + 0.5 * hi[0]), fabs(0.5 * lo[1] + 0.5 * hi[1]));
+    int moved = far > FAR_FROM_ORIGIN * ext;
+    shift[0] = moved ? pts[0] : 0.0;
+    shift[1] = moved ? pts[1] : 0.0;
+}
+
+/* d->outline from the m input points pts, moved by -shift (retrieval with the inner distance's
+ * closing); the input samples' outline when pts bound no area. */
+static amscr_status keep_outline(amscr_descriptor *d, const double *pts, size_t m, const double shift[2])
 {
     d->outline = amscr__malloc_array(2 * AMSCR__OUTLINE_N, sizeof *d->outline);
     if (!d->outline)
         return amscr__fail(AMSCR_E_NOMEM, "descriptor: out of memory");
     amscr_status st = amscr__outline(pts, m, d->params.inner_closing, d->outline);
+    if (st == AMSCR_OK)
+        move_points(d->outline, AMSCR__OUTLINE_N, shift);
     if (st == AMSCR_E_DEGENERATE)
         st = amscr__resample_euclid(d->input, d->n, 1, AMSCR__OUTLINE_N, d->outline);
     return st == AMSCR_E_NOMEM ? amscr__fail(st, "descriptor: out of memory") : st;
@@ -285,17 +319,24 @@ amscr_status amscr_descriptor_new(const amscr_params *p, const amscr_contour *c,
     }
     if (closed && amscr__signed_area(pts, m) < 0.0)
         amscr__reverse_points(pts, m);
+    double shift[2], back[2];
+    far_shift(pts, m, shift);
+    back[0] = -shift[0];
+    back[1] = -shift[1];
+    move_points(pts, m, back);
     amscr_descriptor *d = NULL;
     st = amscr__descriptor_alloc(N, p->num_scales, &d);
     if (st == AMSCR_OK) {
         d->params = *p;
         st = amscr__parametrize(pts, m, closed, p->parametrization, p->presmooth, p->arclength_passes, M, N,
                                 d->input);
+        move_points(d->input, N, shift);
     }
     if (st == AMSCR_OK)
         st = amscr__descriptor_rebuild(d);
     if (st == AMSCR_OK && closed && p->inner_closing > 0.0)
-        st = keep_outline(d, pts, m);
+        st = keep_outline(d, pts, m, shift);
+    move_points(pts, m, shift);
     if (st == AMSCR_OK && p->invariance == AMSCR_INVARIANCE_AFFINE)
         keep_points(d, pts, m);
     else
