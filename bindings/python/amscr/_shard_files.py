@@ -168,6 +168,19 @@ def _read_manifest(d: str) -> Dict[str, Any]:
     return m
 
 
+def check_shard(d: str, s: int, name: str, count: int, params: Params, got: Tuple[int, Dict[str, Any]]) -> None:
+    """Shard s (file `name` of directory d), loaded, holds `count` shapes built with `params`, as the
+    manifest says (its checksum vouches for its bytes, not for the manifest's other entries)."""
+    p = os.path.join(d, name)
+    if got[0] != count:
+        raise ShardSetError('amscr.distributed.load_index: shard %d, %s, holds %d shapes; the manifest says %d'
+                            % (s, p, got[0], count), lib.AMSCR_E_FORMAT)
+    diff = _differing(params._plain_dict(), got[1])
+    if diff:
+        raise ShardSetError('amscr.distributed.load_index: shard %d, %s, was built with other options than the '
+                            'manifest says: %s' % (s, p, '; '.join(diff)), lib.AMSCR_E_FORMAT)
+
+
 def _differing(a: Dict[str, Any], b: Dict[str, Any]) -> List[str]:
     skip = {'threads'}
     return ['%s %r (the manifest: %r)' % (key, b.get(key), a.get(key)) for key in sorted(set(a) | set(b))
@@ -203,17 +216,17 @@ def _read_shard(d: str, s: int, entry: Dict[str, Any], params: Params) -> bytes:
                         'altered)' % (s, p, len(x), entry.get('count')), lib.AMSCR_E_FORMAT)
 
 
-def read_set(d: str) -> Tuple[Params, int, List[Tuple[int, int]], int, str, bytes, List[bytes]]:
+def read_set(d: str) -> Tuple[Params, int, List[Tuple[int, int]], int, str, bytes, List[bytes], List[str]]:
     """The set in directory d: its params, shape count, shard bounds, candidates, the graph's path
-    and bytes, and every shard's bytes, each checked against the manifest; under the folder's
-    lock, shared (a save under way is waited for)."""
+    and bytes, every shard's bytes, each checked against the manifest, and the shards' file names;
+    under the folder's lock, shared (a save under way is waited for)."""
     if not os.path.isdir(d):
         return _read_set(d)  # _read_manifest's error
     with _locked(d, False):
         return _read_set(d)
 
 
-def _read_set(d: str) -> Tuple[Params, int, List[Tuple[int, int]], int, str, bytes, List[bytes]]:
+def _read_set(d: str) -> Tuple[Params, int, List[Tuple[int, int]], int, str, bytes, List[bytes], List[str]]:
     m = _read_manifest(d)
     try:
         params = _params_from_dict(m['params'])
@@ -224,6 +237,9 @@ def _read_set(d: str) -> Tuple[Params, int, List[Tuple[int, int]], int, str, byt
         candidates = int(m.get('candidates', 0))
         if candidates < 0:
             raise ValueError('candidates %d' % candidates)
+        for f in [e['file'] for e in entries] + [gentry['file']]:  # the set's own names, in its folder
+            if not isinstance(f, str) or not _ours(f) or f.startswith('.'):
+                raise ValueError('file %r is not a name a save writes' % (f,))
     except (KeyError, TypeError, ValueError) as e:
         raise FormatError('amscr.distributed.load_index: %s: a malformed manifest (%s)' % (os.path.join(d, MANIFEST), e),
                           lib.AMSCR_E_FORMAT) from None
@@ -241,4 +257,4 @@ def _read_set(d: str) -> Tuple[Params, int, List[Tuple[int, int]], int, str, byt
         raise ShardSetError('amscr.distributed.load_index: the graph %s is foreign to this set (its checksum '
                             'differs from the manifest\'s)' % gp, lib.AMSCR_E_FORMAT)
     datas = [_read_shard(d, s, e, params) for s, e in enumerate(entries)]
-    return params, n, bounds, candidates, gp, gdata, datas
+    return params, n, bounds, candidates, gp, gdata, datas, [str(e['file']) for e in entries]

@@ -39,6 +39,11 @@ def _shard_from_file_bytes(data: bytes) -> Index:
     return Index.from_bytes(data)  # computes on the threads the shard was built with
 
 
+def _shard_facts(index: Index) -> Tuple[int, Dict[str, Any]]:
+    """A loaded shard's size and options, for the load to check against the manifest."""
+    return len(index), index.collection_params()._plain_dict()
+
+
 def _index_bytes(index: Index) -> bytes:
     return index.to_bytes()
 

@@ -38,9 +38,10 @@ from .index import Index
 from .params import Params
 from ._placement import _block, _threads_by_host, gather_live
 from ._shard_build import _merge_lists, _shortlist_lists, widths
-from ._shard_files import ShardSetError, prepare_dir, read_set, write_set
+from ._shard_files import ShardSetError, check_shard, prepare_dir, read_set, write_set
 from ._shard_tasks import (QPOS_AFTER, Signatures, _index_bytes, _joined, _member_shortlists, _members, _pair_block,
-                           _query_block, _shard_from_file_bytes, _shard_index, _shortlists, _signatures)
+                           _query_block, _shard_facts, _shard_from_file_bytes, _shard_index, _shortlists,
+                           _signatures)
 
 PathLike = Union[str, 'os.PathLike[str]']
 
@@ -440,18 +441,24 @@ def load_index(client, path: PathLike) -> ShardedIndex:
 
     Raises:
         FileError: no manifest (or unreadable files); FormatError: not a manifest, a corrupt graph;
-        ShardSetError: a shard missing, foreign or built with other options (the message names
-        the file).
+        ShardSetError: a shard missing, foreign, or built with other options or of another size
+        than the manifest says (the message names the file); the shards are loaded on their
+        workers and checked before it returns.
     """
     d = os.fspath(path)
-    params, n, bounds, candidates, gp, gdata, datas = read_set(d)
+    params, n, bounds, candidates, gp, gdata, datas, names = read_set(d)
     try:
         graph = _Graph.from_bytes(params, n, gdata)
     except (KeyError, ValueError, OSError) as e:
-        raise FormatError('amscr.distributed.load_index: the graph %s is corrupt: %s' % (gp, e),
+        raise FormatError('amscr.distributed.load_index: the graph %s does not fit the manifest (%s): a corrupt '
+                          'file, or a manifest edited by hand' % (gp, e),
                           lib.AMSCR_E_FORMAT) from None
     workers = _workers(client)
     placed = [workers[s % len(workers)] for s in range(len(datas))]
     idx = [client.submit(_shard_from_file_bytes, datas[s], pure=False, workers=[placed[s]])
            for s in range(len(datas))]
+    facts = gather_live(client, [client.submit(_shard_facts, sh, pure=False, workers=[placed[s]])
+                                 for s, sh in enumerate(idx)], placed, _lost_error)
+    for s, got in enumerate(facts):  # as the manifest says: a checksum vouches for a file, not for the manifest
+        check_shard(d, s, names[s], bounds[s][1] - bounds[s][0], params, got)
     return ShardedIndex(client, idx, bounds, graph, params, placed, candidates)

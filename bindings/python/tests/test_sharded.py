@@ -5,6 +5,7 @@ a saved set loads back, a missing, foreign or differently
 built shard is an error naming its file, a write cut off never replaces a good set, files follow
 the umask. Skipped without Dask."""
 import contextlib
+import json
 import os
 import threading
 import time
@@ -257,6 +258,24 @@ def test_missing_foreign_or_other_options_shard_is_named(small, client, tmp_path
         (d / 'manifest.json').write_bytes(bad)
         with pytest.raises(amscr.FormatError, match=what):
             ad.load_index(client, d)
+    # a manifest edited by hand: every file's checksum still holds, but not what it says of them
+    m = json.loads(manifest)
+    edits = [(lambda m: m['params'].__setitem__('rerank_iterations', 3), ad.ShardSetError,
+              'shard 0, .*, was built with other options than the manifest says: rerank_iterations'),
+             (lambda m: (m['shards'][0].__setitem__('count', m['shards'][0]['count'] - 1),
+                         m['shards'][1].__setitem__('first', m['shards'][1]['first'] - 1),
+                         m['shards'][1].__setitem__('count', m['shards'][1]['count'] + 1)), ad.ShardSetError,
+              'shard 0, .*, holds %d shapes; the manifest says %d' % (sx.bounds[0][1], sx.bounds[0][1] - 1)),
+             (lambda m: m['shards'][1].__setitem__('file', '../' + m['shards'][1]['file']), amscr.FormatError,
+              'is not a name a save writes')]
+    for edit, error, what in edits:
+        bad = json.loads(manifest)
+        edit(bad)
+        (d / 'manifest.json').write_text(json.dumps(bad))
+        with pytest.raises(error, match=what):
+            ad.load_index(client, d)
+    (d / 'manifest.json').write_text(json.dumps(m))
+    ad.load_index(client, d)
     os.unlink(d / 'manifest.json')
     with pytest.raises(amscr.FileError, match='manifest.json is missing'):
         ad.load_index(client, d)
