@@ -24,6 +24,17 @@ void amscr__centroid(const double *xy, size_t n, double *cx, double *cy)
     *cy = sy / (double)n;
 }
 
+void amscr__bounds(const double *xy, size_t n, double lo[2], double hi[2])
+{
+    lo[0] = hi[0] = xy[0];
+    lo[1] = hi[1] = xy[1];
+    for (size_t i = 1; i < n; i++)
+        for (int a = 0; a < 2; a++) {
+            lo[a] = fmin(lo[a], xy[2 * i + a]);
+            hi[a] = fmax(hi[a], xy[2 * i + a]);
+        }
+}
+
 void amscr__scatter(const double *xy, size_t n, double cx, double cy, double unit, double cov[3])
 {
     double sxx = 0, sxy = 0, syy = 0;

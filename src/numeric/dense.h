@@ -20,6 +20,8 @@
 
 /* Mean point of n points xy (2n). */
 void amscr__centroid(const double *xy, size_t n, double *cx, double *cy);
+/* The bounding box of n >= 1 points xy (2n): lo = (min x, min y), hi = (max x, max y). */
+void amscr__bounds(const double *xy, size_t n, double lo[2], double hi[2]);
 
 /* Scatter about (cx, cy) in units of `unit`: cov = Σ (d/unit)(d/unit)^T, d = p - c, as
  * {xx, xy, yy} (not divided by n; unit 1 for plain coordinates). */

@@ -134,20 +134,15 @@ amscr_status amscr__validate_points(const double *xy, size_t n, int closed, cons
     if (m < 8)
         return amscr__fail(AMSCR_E_DEGENERATE, "%s: %zu distinct points, at least 8 are needed", what, m);
     /* extent, for a scale-aware tolerance */
-    double minx = xy[0], maxx = xy[0], miny = xy[1], maxy = xy[1];
-    for (size_t i = 1; i < n; i++) {
-        minx = fmin(minx, xy[2 * i]);
-        maxx = fmax(maxx, xy[2 * i]);
-        miny = fmin(miny, xy[2 * i + 1]);
-        maxy = fmax(maxy, xy[2 * i + 1]);
-    }
-    double ext = fmax(maxx - minx, maxy - miny);
+    double lo[2], hi[2];
+    amscr__bounds(xy, n, lo, hi);
+    double ext = fmax(hi[0] - lo[0], hi[1] - lo[1]);
     if (!(ext > 0.0))
         return amscr__fail(AMSCR_E_DEGENERATE, "%s: all points coincide", what);
     if (!(ext >= AMSCR__EXTENT_MIN && ext <= AMSCR__EXTENT_MAX))
         return amscr__fail(AMSCR_E_DEGENERATE, "%s: the points span %g, outside %g to %g: rescale them", what, ext,
                            AMSCR__EXTENT_MIN, AMSCR__EXTENT_MAX);
-    double far = fmax(fabs(0.5 * minx + 0.5 * maxx), fabs(0.5 * miny + 0.5 * maxy));
+    double far = fmax(fabs(0.5 * lo[0] + 0.5 * hi[0]), fabs(0.5 * lo[1] + 0.5 * hi[1]));
     if (!(far <= AMSCR__OFFSET_MAX * ext))
         return amscr__fail(AMSCR_E_DEGENERATE, "%s: the points lie %g from the origin, %.3g times their extent %g: "
                            "doubles there hold too few of their digits; subtract an offset (e.g. the first point)",

@@ -245,12 +245,8 @@ static void move_points(double *xy, size_t n, const double shift[2])
 /* shift = the first of the m points when they lie far from the origin (FAR_FROM_ORIGIN), else 0. */
 static void far_shift(const double *pts, size_t m, double shift[2])
 {
-    double lo[2] = {pts[0], pts[1]}, hi[2] = {pts[0], pts[1]};
-    for (size_t i = 1; i < m; i++)
-        for (int a = 0; a < 2; a++) {
-            lo[a] = fmin(lo[a], pts[2 * i + a]);
-            hi[a] = fmax(hi[a], pts[2 * i + a]);
-        }
+    double lo[2], hi[2];
+    amscr__bounds(pts, m, lo, hi);
     double ext = fmax(hi[0] - lo[0], hi[1] - lo[1]);
     double far = fmax(fabs(0.5 * lo[0] + 0.5 * hi[0]), fabs(0.5 * lo[1] + 0.5 * hi[1]));
     int moved = far > FAR_FROM_ORIGIN * ext;
