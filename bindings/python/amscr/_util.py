@@ -3,10 +3,11 @@ from __future__ import annotations
 
 import contextlib
 import operator
+import os
 import sys
 import threading
 import time
-from typing import Any, Callable, Iterator, Optional, Tuple, Union
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Literal, Optional, Protocol, Tuple, Union
 
 import numpy as np
 
@@ -17,6 +18,30 @@ try:
     from numpy.typing import ArrayLike
 except ImportError:  # numpy < 1.20
     ArrayLike = Any  # type: ignore
+
+if TYPE_CHECKING:
+    from .contour import ImageContour
+
+#: What a function taking points accepts: an (n, 2) array-like, an OpenCV (n, 1, 2) contour, or an
+#: :class:`ImageContour` of :func:`contours_from_mask` (its points).
+PointArray = Union[ArrayLike, 'ImageContour']
+
+#: A file path, as ``open()`` takes it.
+PathArg = Union[str, bytes, 'os.PathLike[str]', 'os.PathLike[bytes]']
+
+#: The type of an ``order=`` argument (see ORDERS).
+Order = Literal['xy', 'rc']
+
+
+class ArrayInterface(Protocol):
+    """An object NumPy reads through its ``__array_interface__``, as a PIL image."""
+
+    @property
+    def __array_interface__(self) -> Any: ...
+
+
+#: What the tracers take for an image: an array-like or an object with ``__array_interface__``.
+MaskLike = Union[ArrayLike, ArrayInterface]
 
 INT32_MIN, INT32_MAX = -(2 ** 31), 2 ** 31 - 1
 
@@ -48,11 +73,66 @@ def unmasked(x: Any, name: str, instead: str) -> Any:
     return x.data
 
 
-def not_real(name: str, a: np.ndarray) -> InvalidArgumentError:
-    """The error for an array that does not hold real numbers (with a hint for object arrays, as
-    a pandas nullable Float64 frame gives)."""
+def as_path(path: Any, name: str = 'path') -> bytes:
+    """A str, bytes or os.PathLike path as the bytes given to the library's ``char *``; one
+    holding a NUL character is refused, as ``open()`` refuses it (C would cut it short there)."""
+    try:
+        b = os.fsencode(path)
+    except TypeError:
+        raise bad_type('%s: expected a str, bytes or os.PathLike path, got %s' % (name, described(path))) from None
+    if b'\0' in b:
+        raise bad('%s: embedded null byte' % name)
+    return b
+
+
+def described(x: Any) -> str:
+    """What `x` is, for a message: 'None', 'an int', 'a shapely.Polygon', 'a pandas.DataFrame'."""
+    if x is None:
+        return 'None'
+    t = type(x)
+    what = t.__name__ if t.__module__ == 'builtins' else t.__module__.partition('.')[0] + '.' + t.__name__
+    return ('an ' if what[0] in 'aeiouAEIOU' else 'a ') + what
+
+
+def is_geometry(x: Any) -> bool:
+    """Whether `x` holds its points behind ``.exterior`` or ``.coords``, as a shapely geometry."""
+    return hasattr(type(x), 'exterior') or hasattr(type(x), 'coords')
+
+
+#: How to take the points of a shapely geometry.
+GEOMETRY_POINTS = ('np.asarray(poly.exterior.coords) of a Polygon, np.asarray(line.coords) of a LineString or '
+                   'LinearRing, or shapely.get_coordinates(geom)')
+
+
+def not_real(name: str, x: Any, a: np.ndarray) -> InvalidArgumentError:
+    """The error for `x` (as the array `a`) that does not hold real numbers: an object that is no
+    array is named (a shapely geometry with how to take its points); an object array gets a hint,
+    as a pandas nullable Float64 frame gives one."""
+    if a.dtype == object and a.ndim == 0:
+        how = ': pass its points, ' + GEOMETRY_POINTS if is_geometry(x) else ''
+        return bad('%s: expected an array of real numbers, got %s%s' % (name, described(x), how))
     hint = ': convert it first, e.g. df.to_numpy(float)' if a.dtype == object else ''
     return bad('%s: expected real numbers, got an array of dtype %s%s' % (name, a.dtype, hint))
+
+
+#: The hint for a list of OpenCV contours given where one is taken.
+CONTOURS_HINT = ' (a list of OpenCV contours? pass one of them, e.g. max(contours, key=cv2.contourArea))'
+
+
+def not_regular(name: str, x: Any, e: ValueError) -> InvalidArgumentError:
+    """The error for points NumPy cannot make one array of (ragged lists): for a list of
+    OpenCV contours of different lengths, the hint to pass one of them."""
+    if isinstance(x, (list, tuple)) and x and all(isinstance(c, np.ndarray) and c.ndim == 3 and c.shape[1:] == (1, 2)
+                                                  for c in x):
+        return bad('%s: expected an array of shape (n, 2) (one x, y row per point) or (n, 1, 2) (OpenCV), '
+                   'got %d arrays of different lengths%s' % (name, len(x), CONTOURS_HINT))
+    return bad('%s: expected an array of shape (n, 2) (or one OpenCV contour, (n, 1, 2)): %s' % (name, e))
+
+
+def image_contour_points(x: Any) -> Any:
+    """The points of an :class:`ImageContour` (:func:`contours_from_mask`), else `x` itself."""
+    from .contour import ImageContour  # contour imports this module
+    return x.points if isinstance(x, ImageContour) else x
 
 
 #: The point orders accepted by ``order=``: (x, y) columns, or (row, col) as scikit-image gives them.
@@ -71,8 +151,9 @@ def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: boo
     """The one conversion of user points: array-like -> C-contiguous float64 (n, 2) array of
     (x, y) rows, n >= 1 (n >= 0 with allow_empty), all finite.
 
-    Accepts (n, 2) arrays of any real dtype, and OpenCV contours ((n, 1, 2) int32 from
-    ``cv2.findContours``, already (x, y)). ``order='rc'`` takes (row, col) points (scikit-image's
+    Accepts (n, 2) arrays of any real dtype, OpenCV contours ((n, 1, 2) int32 from
+    ``cv2.findContours``, already (x, y)) and the :class:`ImageContour` s of
+    :func:`contours_from_mask` (their points). ``order='rc'`` takes (row, col) points (scikit-image's
     ``measure.find_contours``) and swaps them: x = column, y = row. closed_shape (the points
     become a closed prepared shape): an OpenCV contour compressed by ``CHAIN_APPROX_SIMPLE`` is
     expanded to the pixel chain it stands for (:func:`expand_chain`).
@@ -80,21 +161,20 @@ def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: boo
     order = as_order(order)
     if hasattr(x, 'input_points') and hasattr(x, 'scale_points'):
         raise TypeError('%s: expected an array of points, got a prepared Shape' % name)
-    x = unmasked(x, name, 'the points to keep, e.g. points[~points.mask.any(axis=1)], or points.filled(value)')
+    x = unmasked(image_contour_points(x), name,
+                 'the points to keep, e.g. points[~points.mask.any(axis=1)], or points.filled(value)')
     try:
         a = np.asarray(x)
     except ValueError as e:  # ragged nested lists, e.g. the whole tuple cv2.findContours returns
-        raise bad('%s: expected an array of shape (n, 2) (or one OpenCV contour, (n, 1, 2)): %s'
-                  % (name, e)) from None
+        raise not_regular(name, x, e) from None
     if a.dtype.kind not in 'iuf':
-        raise not_real(name, a)
+        raise not_real(name, x, a)
     if a.ndim == 3 and a.shape[1:] == (1, 2):  # an OpenCV contour
         a = a[:, 0, :]
         if closed_shape and a.dtype.kind in 'iu':
             a = expand_chain(a)
     if a.ndim != 2 or a.shape[1] != 2:
-        hint = (' (a list of OpenCV contours? pass one of them, e.g. max(contours, key=cv2.contourArea))'
-                if a.ndim == 4 and a.shape[2:] == (1, 2) else '')
+        hint = CONTOURS_HINT if a.ndim == 4 and a.shape[2:] == (1, 2) else ''
         raise bad('%s: expected an array of shape (n, 2) (one x, y row per point) or (n, 1, 2) (OpenCV), '
                   'got shape %s%s' % (name, a.shape, hint))
     if a.shape[0] == 0 and not allow_empty:
@@ -136,7 +216,7 @@ def as_float_array(x: Any, name: str, ndim: Optional[Tuple[int, ...]] = None, fi
     except ValueError as e:
         raise bad('%s: not a regular array: %s' % (name, e)) from None
     if a.dtype.kind not in 'iuf':
-        raise not_real(name, a)
+        raise not_real(name, x, a)
     if ndim is not None and a.ndim not in ndim:
         raise bad('%s: expected %s dimension(s), got shape %s' % (name, ' or '.join(map(str, ndim)), a.shape))
     a = np.ascontiguousarray(a, dtype=np.float64)

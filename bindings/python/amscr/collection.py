@@ -2,14 +2,13 @@
 from __future__ import annotations
 
 import contextlib
-import os
 from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import (ProgressArg, RWLock, as_index, as_points, as_uint, bad, dbuf, factorize, new_object, progress_call,
-                    saved_bytes)
+from ._util import (Order, PathArg, ProgressArg, RWLock, as_index, as_path, as_points, as_uint, bad, dbuf, factorize,
+                    new_object, progress_call, saved_bytes)
 from .contour import contour_new
 from .errors import AmscrError, _check
 from .params import Params, make_params
@@ -95,7 +94,7 @@ class Collection:
             self._label_names.append(label)
         return code
 
-    def add(self, shape: PointsLike, label: Any = 0, *, order: str = 'xy') -> int:
+    def add(self, shape: PointsLike, label: Any = 0, *, order: Order = 'xy') -> int:
         """Prepares (points) or copies (a :class:`Shape`) a shape into the collection.
 
         Args:
@@ -118,7 +117,7 @@ class Collection:
             return int(idx[0])
 
     def extend(self, shapes: Iterable[PointsLike], labels: Optional[Iterable[Any]] = None, *,
-               order: str = 'xy', progress: ProgressArg = False) -> List[int]:
+               order: Order = 'xy', progress: ProgressArg = False) -> List[int]:
         """Adds many shapes, as :meth:`add`; point arrays are prepared together on the
         collection's threads with the GIL released (C ``amscr_db_add_contours``).
 
@@ -253,7 +252,7 @@ class Collection:
         return tmp, True
 
     def query(self, shape: PointsLike, threads: Optional[int] = None, progress: ProgressArg = False, *,
-              order: str = 'xy') -> np.ndarray:
+              order: Order = 'xy') -> np.ndarray:
         """Distances from `shape` to every shape of the collection, by the collection's own
         params: the plain AMSCR distance (query -> shape) with the defaults, and the retrieval
         scores (C ``amscr_db_search_retrieval``: the query's row of :meth:`retrieval_matrix` on
@@ -414,20 +413,21 @@ class Collection:
             return out
 
     # -- persistence ------------------------------------------------------------------
-    def save(self, path: Union[str, os.PathLike]) -> None:
+    def save(self, path: PathArg) -> None:
         """Writes the prepared collection (binary, versioned, checksummed; atomic rename).
 
         Args:
             path: the file to write. Named labels are stored as their codes (give the names
                 back to :meth:`load`).
         Raises:
-            FileError: the file cannot be written.
+            FileError: the file cannot be written; InvalidArgumentError: a path holding a NUL
+            character.
         """
         with self._lock.read():
-            _check(lib.amscr_db_save(self._db, os.fsencode(path)))
+            _check(lib.amscr_db_save(self._db, as_path(path)))
 
     @classmethod
-    def load(cls, path: Union[str, os.PathLike], label_names: Optional[Sequence[Any]] = None) -> 'Collection':
+    def load(cls, path: PathArg, label_names: Optional[Sequence[Any]] = None) -> 'Collection':
         """Reads a collection written by :meth:`save` (or the ``amscr`` tool).
 
         Args:
@@ -436,9 +436,10 @@ class Collection:
         Returns:
             a new :class:`Collection`.
         Raises:
-            FileError: cannot read; FormatError: not a collection file, or a corrupt one.
+            FileError: cannot read; FormatError: not a collection file, or a corrupt one;
+            InvalidArgumentError: a path holding a NUL character.
         """
-        return cls._wrap(_new_db(lib.amscr_db_load, os.fsencode(path)), label_names)
+        return cls._wrap(_new_db(lib.amscr_db_load, as_path(path)), label_names)
 
     def to_bytes(self) -> bytes:
         """The collection serialized as :meth:`save` writes it.
@@ -473,12 +474,12 @@ def _collection_from_state(data: bytes, label_names: Optional[List[Any]]) -> Col
     return Collection.from_bytes(data, label_names)
 
 
-def distance_matrix(shapes: Sequence[PointsLike], *, threads: Optional[int] = None, progress: ProgressArg = False,
-                    params: Optional[Params] = None, order: str = 'xy', **options: Any) -> np.ndarray:
+def distance_matrix(shapes: Iterable[PointsLike], *, threads: Optional[int] = None, progress: ProgressArg = False,
+                    params: Optional[Params] = None, order: Order = 'xy', **options: Any) -> np.ndarray:
     """All pairwise distances of a list of shapes (through a temporary :class:`Collection`).
 
     Args:
-        shapes: point arrays (or OpenCV contours) or :class:`Shape` s.
+        shapes: point arrays (or OpenCV contours) or :class:`Shape` s, any iterable.
         threads: threads (None: the library default, 0 = all cores).
         progress: True for a progress bar on stderr, or a callable(done, total), as in
             :meth:`Collection.query`.

@@ -2,7 +2,8 @@
 
 The C contour is a private carrier here: functions take and return (n, 2) NumPy arrays of
 (x, y) rows. Every function taking points accepts an OpenCV contour ((n, 1, 2) from
-``cv2.findContours``) as it is; (row, col) points (scikit-image) are converted by
+``cv2.findContours``) as it is, and an :class:`ImageContour` of :func:`contours_from_mask` (its
+points); (row, col) points (scikit-image) are converted by
 :func:`as_points` with ``order='rc'`` (or the ``order=`` keyword of :func:`register`,
 :class:`Shape` and :class:`Collection`).
 """
@@ -14,21 +15,22 @@ from typing import Any, List, NamedTuple, Optional, Tuple, Union
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ArrayLike, as_bool, as_count, as_scalar, bad, copy_points, dbuf, new_object, unmasked
+from ._util import (GEOMETRY_POINTS, MaskLike, Order, PathArg, PointArray, as_bool, as_count, as_path, as_scalar,
+                    bad, bad_type, copy_points, dbuf, described, is_geometry, new_object, unmasked)
 from ._util import as_points as _as_points
-from .errors import NotFoundError, _check
+from .errors import InvalidArgumentError, NotFoundError, _check
 
 
 def _new_contour(make: Any, *args: Any):
     return new_object('amscr_contour', make, lib.amscr_contour_free, *args)
 
 
-def as_points(points: ArrayLike, order: str = 'xy') -> np.ndarray:
+def as_points(points: PointArray, order: Order = 'xy') -> np.ndarray:
     """Points as amscr takes them: a new C-contiguous float64 (n, 2) array of (x, y) rows.
 
     Args:
-        points: (n, 2) array-like of real numbers, or an OpenCV contour ((n, 1, 2) int32 from
-            ``cv2.findContours``, already (x, y)).
+        points: (n, 2) array-like of real numbers, an OpenCV contour ((n, 1, 2) int32 from
+            ``cv2.findContours``, already (x, y)), or an :class:`ImageContour` (its points).
         order: 'xy' (default) or 'rc' for (row, col) points, as scikit-image's
             ``measure.find_contours`` gives them: x = column (col), y = row. Image contours
             are then in the frame of :func:`contour_from_mask`, OpenCV and
@@ -72,7 +74,7 @@ class _Image(NamedTuple):
 
 def _float_level(lo: float, hi: float, threshold: Any) -> float:
     """The 16-bit level of a float image of values lo..hi mapped onto 0..65535: `threshold` in
-    the array's units, by default 0.5 for values in 0..1 (scikit-image's float images), else
+    the array's units, by default 0.5 when hi <= 1 (scikit-image's float images), else
     halfway between 0 (or lo, when negative) and hi (127.5 for a 0..255 image)."""
     if threshold is None:
         t = 0.5 if hi <= 1.0 else (hi / 2.0 if lo >= 0.0 else (lo + hi) / 2.0)
@@ -84,13 +86,17 @@ def _float_level(lo: float, hi: float, threshold: Any) -> float:
     return level
 
 
-def _as_samples(mask: ArrayLike, threshold: Any) -> Tuple[np.ndarray, Optional[Tuple[float, float]], int]:
+def _as_samples(mask: MaskLike, threshold: Any) -> Tuple[np.ndarray, Optional[Tuple[float, float]], int]:
     """(uint8 or uint16 samples, the (lo, hi) of a float image mapped onto 16 bits or None, the
     padding): a bool mask becomes 0/255 padded with one pixel of background, since True is the
     foreground even where it covers the image border (no automatic polarity)."""
     a = np.asarray(unmasked(mask, 'mask', 'mask.filled(0) (masked pixels as background)'))
+    if a.dtype == object and a.ndim == 0:
+        raise _not_an_image(mask)
     if a.ndim != 2:
         raise bad('mask: expected a 2-D array, got shape %s' % (a.shape,))
+    if not a.dtype.isnative:  # e.g. big-endian '>u2': as the native dtype (its tests below, the bytes C reads)
+        a = a.astype(a.dtype.newbyteorder('='))
     if a.dtype == np.bool_:
         return np.pad(a.astype(np.uint8) * np.uint8(255), 1), None, 1
     if a.dtype.kind == 'f':
@@ -110,7 +116,14 @@ def _as_samples(mask: ArrayLike, threshold: Any) -> Tuple[np.ndarray, Optional[T
     return (a if a.dtype == want else a.astype(want)), None, 0
 
 
-def _image_and_level(mask: ArrayLike, threshold: Union[int, float, str, None], subpixel: bool) -> _Image:
+def _not_an_image(mask: Any) -> InvalidArgumentError:
+    """The error for a mask that is no array (None, a shapely geometry: its points are a contour already)."""
+    how = ': it is a contour already, pass its points where amscr takes points, ' + GEOMETRY_POINTS
+    return bad('mask: expected a 2-D bool, integer or float array, got %s%s'
+               % (described(mask), how if is_geometry(mask) else ''))
+
+
+def _image_and_level(mask: MaskLike, threshold: Union[int, float, str, None], subpixel: bool) -> _Image:
     """The mask ready for the C tracer (see :func:`contour_from_mask`)."""
     a, scale, pad = _as_samples(mask, threshold)
     a = np.ascontiguousarray(a)
@@ -145,21 +158,22 @@ def _traced(a: np.ndarray, level: float, call: Any, *args: Any) -> Any:
                             "below %d, or threshold='auto'" % (int(level), m, m), e.status, e.detail) from None
 
 
-def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] = None,
+def contour_from_mask(mask: MaskLike, threshold: Union[int, float, str, None] = None,
                       subpixel: bool = True, join: bool = False) -> np.ndarray:
     """Outer boundary of the largest 8-connected foreground component of a 2-D image.
 
     Args:
-        mask: 2-D NumPy array, any strides or order: ``bool`` (True = foreground, also where
-            it covers most of the image border), ``uint8``, ``uint16`` (other integer arrays
-            with values in 0..65535 are accepted too), or ``float`` (any range: mapped linearly
-            onto 16 bits).
+        mask: 2-D NumPy array (or what NumPy reads as one, e.g. a PIL image), any strides,
+            order or byte order: ``bool`` (True = foreground, also where it covers most of the
+            image border), ``uint8``, ``uint16`` (other integer arrays with values in 0..65535
+            are accepted too), or ``float`` (any range: mapped linearly onto 16 bits).
         threshold: integer images: a pixel is "on" when its value is > threshold (0..254 for
             8 bits, 0..65534 for 16 bits; None: 0 when every value is 0 or 1, a 0/1 mask as
             ``mask.astype(np.uint8)`` gives, else 127, the ``amscr`` tool's default, or 32767
-            for values past 255); float images: the level in the array's units (None: 0.5 for
-            values in 0..1, scikit-image's float images, else halfway between 0 and the largest
-            value: 127.5 for ``img.astype(np.float32)`` of an 8-bit image); ``'auto'`` for
+            for values past 255); float images: the level in the array's units (None: 0.5 when
+            no value is above 1, as in scikit-image's float images, else halfway between 0 and
+            the largest value, or between the smallest and the largest when some are negative:
+            127.5 for ``img.astype(np.float32)`` of an 8-bit image); ``'auto'`` for
             Otsu's split (the level halfway between the two classes' medians); no effect on a
             bool mask, traced halfway between its pixels. The polarity of integer and float
             images is automatic: if most of the image border is "on", on and off are swapped
@@ -192,14 +206,15 @@ def contour_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] =
 
 class ImageContour(NamedTuple):
     """One contour of :func:`contours_from_mask`: its points, its parent's index in the list
-    (None for a top-level component), whether it is a hole, and its polygon area (pixels^2)."""
+    (None for a top-level component), whether it is a hole, and its polygon area (pixels^2).
+    Every function taking points takes it too (its points)."""
     points: np.ndarray
     parent: Optional[int]
     is_hole: bool
     area: float
 
 
-def contours_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] = None,
+def contours_from_mask(mask: MaskLike, threshold: Union[int, float, str, None] = None,
                        min_area: float = 10.0, subpixel: bool = True) -> List[ImageContour]:
     """Every contour of a 2-D image with its hierarchy, as OpenCV's ``findContours`` with
     ``RETR_TREE``: each 8-connected foreground component's outer boundary and each hole's.
@@ -238,7 +253,7 @@ def contours_from_mask(mask: ArrayLike, threshold: Union[int, float, str, None] 
     return result
 
 
-def read_points(path: Union[str, os.PathLike]) -> np.ndarray:
+def read_points(path: PathArg) -> np.ndarray:
     """Reads a text point list ("x y" or "x,y" per line, '#' comments).
 
     The decimal point is '.', whatever locale the program set (``locale.setlocale``).
@@ -248,26 +263,32 @@ def read_points(path: Union[str, os.PathLike]) -> np.ndarray:
     Returns:
         (n, 2) float array of (x, y) rows.
     Raises:
-        FileError: cannot read; FormatError: a bad line (the message names path:line).
+        FileError: cannot read; FormatError: a bad line (the message names path:line);
+        InvalidArgumentError: a path holding a NUL character.
     """
-    return _take(_new_contour(lib.amscr_contour_read_text, os.fsencode(path)))
+    return _take(_new_contour(lib.amscr_contour_read_text, as_path(path)))
 
 
 def parse_points(text: Union[str, bytes]) -> np.ndarray:
     """Parses a text point list from a string.
 
     Args:
-        text: str or bytes in the format of :func:`read_points`.
+        text: str or bytes in the format of :func:`read_points` (a file's content: a file is
+            read by :func:`read_points`).
     Returns:
         (n, 2) float array of (x, y) rows.
     Raises:
-        FormatError: a bad line (the message names the line).
+        FormatError: a bad line (the message names the line); TypeError: a path
+        (``os.PathLike``).
     """
+    if isinstance(text, os.PathLike):
+        raise bad_type('text: expected the text of a point list (str or bytes), got %s: read a file with '
+                       'amscr.read_points(path)' % described(text))
     b = text.encode('utf-8') if isinstance(text, str) else bytes(text)
     return _take(_new_contour(lib.amscr_contour_parse_text, ffi.from_buffer('char[]', b), len(b)))
 
 
-def write_points(path: Union[str, os.PathLike], points: ArrayLike) -> None:
+def write_points(path: PathArg, points: PointArray) -> None:
     """Writes points as a text point list, atomically (whole before it takes its name), with '.'
     as the decimal point whatever locale the program set.
 
@@ -275,13 +296,14 @@ def write_points(path: Union[str, os.PathLike], points: ArrayLike) -> None:
         path: the file to write.
         points: (n, 2) points (or an OpenCV contour).
     Raises:
-        InvalidArgumentError: bad points; FileError: the file cannot be written.
+        InvalidArgumentError: bad points, a path holding a NUL character; FileError: the file
+        cannot be written.
     """
     c = contour_new(_as_points(points))
-    _check(lib.amscr_contour_write_text(c, os.fsencode(path)))
+    _check(lib.amscr_contour_write_text(c, as_path(path)))
 
 
-def signed_area(points: ArrayLike) -> float:
+def signed_area(points: PointArray) -> float:
     """Signed area of the closed polygon.
 
     Args:
@@ -297,7 +319,7 @@ def signed_area(points: ArrayLike) -> float:
     return float(out[0])
 
 
-def orient_ccw(points: ArrayLike) -> np.ndarray:
+def orient_ccw(points: PointArray) -> np.ndarray:
     """A copy of the points, reversed when their signed area is negative.
 
     Args:
@@ -312,7 +334,7 @@ def orient_ccw(points: ArrayLike) -> np.ndarray:
     return contour_points(c)
 
 
-def validate_contour(points: ArrayLike, closed: bool = True) -> None:
+def validate_contour(points: PointArray, closed: bool = True) -> None:
     """Checks that a contour can be registered.
 
     Args:

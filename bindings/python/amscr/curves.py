@@ -6,7 +6,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ArrayLike, as_bool, as_count, as_points, as_scalar, as_uint, dbuf, m6_to_matrix, sized_arrays
+from ._util import PointArray, as_bool, as_count, as_points, as_scalar, as_uint, dbuf, m6_to_matrix, sized_arrays
 from .errors import _check
 from .params import Params
 
@@ -25,7 +25,7 @@ def gaussian_kernel(sigma: float) -> np.ndarray:
     return taps
 
 
-def smooth(points: ArrayLike, sigma: float, closed: bool = True) -> np.ndarray:
+def smooth(points: PointArray, sigma: float, closed: bool = True) -> np.ndarray:
     """Gaussian smoothing of x and y.
 
     Args:
@@ -44,7 +44,7 @@ def smooth(points: ArrayLike, sigma: float, closed: bool = True) -> np.ndarray:
     return out
 
 
-def resample_euclidean(points: ArrayLike, m: int, closed: bool = True) -> np.ndarray:
+def resample_euclidean(points: PointArray, m: int, closed: bool = True) -> np.ndarray:
     """Resamples a polygon at equal Euclidean arc length.
 
     Args:
@@ -63,7 +63,7 @@ def resample_euclidean(points: ArrayLike, m: int, closed: bool = True) -> np.nda
     return out
 
 
-def resample_affine(points: ArrayLike, m: int, closed: bool = True, sigma0: Optional[float] = None,
+def resample_affine(points: PointArray, m: int, closed: bool = True, sigma0: Optional[float] = None,
                     passes: Optional[int] = None) -> np.ndarray:
     """Resamples a polygon at equal affine arc length.
 
@@ -89,7 +89,7 @@ def resample_affine(points: ArrayLike, m: int, closed: bool = True, sigma0: Opti
     return out
 
 
-def affine_arclength(points: ArrayLike, closed: bool = True, sigma0: float = 0.0) -> Tuple[np.ndarray, float]:
+def affine_arclength(points: PointArray, closed: bool = True, sigma0: float = 0.0) -> Tuple[np.ndarray, float]:
     """Affine arc length along a polygon.
 
     Args:
@@ -109,7 +109,7 @@ def affine_arclength(points: ArrayLike, closed: bool = True, sigma0: float = 0.0
     return cum, float(total[0])
 
 
-def normalize_whiten(points: ArrayLike) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def normalize_whiten(points: PointArray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Affine normalization: centroid to 0, identity covariance.
 
     Args:

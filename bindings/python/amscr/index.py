@@ -1,13 +1,13 @@
 """Index: a collection prepared for one-vs-many retrieval (C ``amscr_index``)."""
 from __future__ import annotations
 
-import os
 from typing import Any, List, Optional, Tuple, Union
 
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ProgressArg, RWLock, as_count, bad, dbuf, new_object, progress_call, saved_bytes
+from ._util import (Order, PathArg, ProgressArg, RWLock, as_count, as_path, bad, dbuf, new_object, progress_call,
+                    saved_bytes)
 from .collection import Collection, _new_db
 from .errors import _check, _reworded
 from .params import Params
@@ -95,7 +95,7 @@ class Index:
 
     # -- persistence ------------------------------------------------------------------
     @classmethod
-    def load(cls, path: Union[str, os.PathLike]) -> 'Index':
+    def load(cls, path: PathArg) -> 'Index':
         """Reads an index file (written by :meth:`save` or ``amscr index``).
 
         Args:
@@ -104,21 +104,23 @@ class Index:
             a new :class:`Index`.
         Raises:
             FileError: cannot read; FormatError: not an index file (a collection file without
-            an index, an index of the tool before 0.4: build it again), or a corrupt one.
+            an index, an index of the tool before 0.4: build it again), or a corrupt one;
+            InvalidArgumentError: a path holding a NUL character.
         """
-        return cls._wrap(_loaded_index(lib.amscr_index_load, os.fsencode(path)))
+        return cls._wrap(_loaded_index(lib.amscr_index_load, as_path(path)))
 
-    def save(self, path: Union[str, os.PathLike]) -> None:
+    def save(self, path: PathArg) -> None:
         """Writes the index (its collection included; atomic rename). ``Collection.load`` of the
         file gives the collection.
 
         Args:
             path: the file to write.
         Raises:
-            FileError: the file cannot be written.
+            FileError: the file cannot be written; InvalidArgumentError: a path holding a NUL
+            character.
         """
         with self._lock.read():
-            _check(lib.amscr_index_save(self._x, os.fsencode(path)))
+            _check(lib.amscr_index_save(self._x, as_path(path)))
 
     def to_bytes(self) -> bytes:
         """The index serialized as :meth:`save` writes it.
@@ -224,7 +226,7 @@ class Index:
         _check(lib.amscr_index_set_class_name(self._x, code, label.encode('utf-8', 'surrogateescape')))
         return code
 
-    def add(self, points: PointsLike, label: Any = 0, name: Optional[str] = None, *, order: str = 'xy') -> int:
+    def add(self, points: PointsLike, label: Any = 0, name: Optional[str] = None, *, order: Order = 'xy') -> int:
         """Prepares a shape with the index's params and adds it (its list and the lists it
         enters are updated; with every shape a candidate and a channel weight of 0 or 1 the
         result equals a rebuild; an index of fewer shapes than twice its re-ranking k, whose
@@ -259,7 +261,7 @@ class Index:
         """A copy of the index's :class:`Params` (those of its collection)."""
         return Params._copy_of(lib.amscr_db_params(lib.amscr_index_db(self._x)))
 
-    def find_member(self, points: PointsLike, *, order: str = 'xy') -> Optional[int]:
+    def find_member(self, points: PointsLike, *, order: Order = 'xy') -> Optional[int]:
         """The member rule (C ``amscr_index_find_member``): the shape whose prepared samples are
         the query's, bit for bit (e.g. a file of the collection traced again), the lowest index
         when the collection holds copies; None when no shape is the query's copy.
@@ -278,7 +280,7 @@ class Index:
             _check(lib.amscr_index_find_member(self._x, q._d, out))
             return None if out[0] == ffi.cast('size_t', -1) else int(out[0])
 
-    def scores(self, points: PointsLike, candidates: Optional[int] = None, *, order: str = 'xy') -> np.ndarray:
+    def scores(self, points: PointsLike, candidates: Optional[int] = None, *, order: Order = 'xy') -> np.ndarray:
         """The query's retrieval score against every shape (lower is better): its row of
         :meth:`Collection.retrieval_matrix` on the collection plus the query; a query that is a
         member's copy (:meth:`find_member`) gets that member's row of the collection's own
@@ -304,7 +306,7 @@ class Index:
             return out
 
     def query(self, points: PointsLike, top: int = 10, candidates: Optional[int] = None, *,
-              order: str = 'xy') -> Tuple[np.ndarray, np.ndarray]:
+              order: Order = 'xy') -> Tuple[np.ndarray, np.ndarray]:
         """The `top` best shapes for a query, best first (ties by index), as :meth:`scores` (a
         member's copy scored as the member: C ``amscr_index_search``).
 

@@ -6,7 +6,7 @@ from typing import Tuple
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ArrayLike, as_float_array, as_points, bad, dbuf, m6_to_matrix, matrix_out, to_m6
+from ._util import ArrayLike, PointArray, as_float_array, as_points, bad, dbuf, m6_to_matrix, matrix_out, to_m6
 from .errors import _check
 
 
@@ -39,7 +39,7 @@ def lstsq(a: ArrayLike, b: ArrayLike, return_residuals: bool = False):
     return (x, res) if return_residuals else x
 
 
-def affine_fit(src: ArrayLike, dst: ArrayLike) -> Tuple[np.ndarray, float]:
+def affine_fit(src: PointArray, dst: PointArray) -> Tuple[np.ndarray, float]:
     """Least-squares affine map taking src[i] to dst[i].
 
     Args:
@@ -59,7 +59,7 @@ def affine_fit(src: ArrayLike, dst: ArrayLike) -> Tuple[np.ndarray, float]:
     return m6_to_matrix(m), float(rms[0])
 
 
-def affine_apply(matrix: ArrayLike, points: ArrayLike) -> np.ndarray:
+def affine_apply(matrix: ArrayLike, points: PointArray) -> np.ndarray:
     """Applies an affine map to points.
 
     Args:

@@ -9,7 +9,7 @@ from typing import Any, Dict, List, NamedTuple, Optional, Tuple
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ArrayLike, as_points, matrix_out, new_object, points_in_order, sized_arrays
+from ._util import ArrayLike, Order, PointArray, as_points, matrix_out, new_object, points_in_order, sized_arrays
 from .enums import METHODS, enum_out
 from .errors import _check
 from .params import Params, make_params
@@ -177,7 +177,7 @@ class Registration:
         self.__dict__.update(state)  # unpickled arrays are writable again
         self._freeze()
 
-    def apply(self, points: ArrayLike, order: str = 'xy') -> np.ndarray:
+    def apply(self, points: PointArray, order: Order = 'xy') -> np.ndarray:
         """Maps points of the source onto the target: ``points @ A.T + B``.
 
         Args:
@@ -249,7 +249,7 @@ def register(src: PointsLike, tgt: PointsLike, *, method: Optional[str] = None, 
              scales: Optional[ArrayLike] = None, reflections: Optional[bool] = None,
              closed: Optional[bool] = None, refine: Optional[int] = None, symmetric: Optional[bool] = None,
              parametrization: Optional[str] = None, invariance: Optional[str] = None,
-             params: Optional[Params] = None, order: str = 'xy', **options: Any) -> Registration:
+             params: Optional[Params] = None, order: Order = 'xy', **options: Any) -> Registration:
     """Registers `src` onto `tgt`: finds (A, B) with ``tgt ~= A @ src + B`` and the distance.
 
     Args:
@@ -298,7 +298,7 @@ def register(src: PointsLike, tgt: PointsLike, *, method: Optional[str] = None, 
     return res
 
 
-def distance(src: PointsLike, tgt: PointsLike, *, params: Optional[Params] = None, order: str = 'xy',
+def distance(src: PointsLike, tgt: PointsLike, *, params: Optional[Params] = None, order: Order = 'xy',
              **options: Any) -> float:
     """The distance only (the fast batch path; equal to ``register(...).distance`` to rounding).
 
@@ -319,7 +319,7 @@ def distance(src: PointsLike, tgt: PointsLike, *, params: Optional[Params] = Non
     return float(out[0])
 
 
-def channel_distance(src: PointsLike, tgt: PointsLike, *, params: Optional[Params] = None, order: str = 'xy',
+def channel_distance(src: PointsLike, tgt: PointsLike, *, params: Optional[Params] = None, order: Order = 'xy',
                      **options: Any) -> float:
     """The shape channel's distance of two closed shapes (C ``amscr_channel_distance``): height
     functions matched by banded dynamic programming in the channel's frame; 0 for a shape

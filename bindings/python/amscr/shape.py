@@ -6,7 +6,7 @@ from typing import Any, Optional, Union
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ArrayLike, as_count, as_points, copy_points, matrix_out, new_object
+from ._util import Order, PointArray, as_count, as_points, copy_points, matrix_out, new_object
 from .contour import contour_new
 from .params import Params, make_params
 
@@ -22,7 +22,7 @@ class Shape:
         contour: the shape's points: an (n, 2) array of (x, y) rows (any real dtype), or an
             OpenCV contour ((n, 1, 2), as ``cv2.findContours`` gives it; closed, one compressed by
             ``CHAIN_APPROX_SIMPLE`` is read as the pixel chain it stands for, as
-            ``CHAIN_APPROX_NONE`` gives it).
+            ``CHAIN_APPROX_NONE`` gives it), or an :class:`ImageContour` (its points).
         params: a :class:`Params` to start from (None: the library defaults).
         order: 'xy' (default) or 'rc' for (row, col) points such as scikit-image's
             ``measure.find_contours`` gives; they are taken as x = column, y = row, so every
@@ -33,7 +33,7 @@ class Shape:
         or zero area.
     """
 
-    def __init__(self, contour: ArrayLike, /, params: Optional[Params] = None, *, order: str = 'xy',
+    def __init__(self, contour: PointArray, /, params: Optional[Params] = None, *, order: Order = 'xy',
                  **options: Any):
         p = make_params(params, options)
         pts = as_points(contour, 'contour', order, closed_shape=p.closed)
@@ -118,7 +118,7 @@ class Shape:
 
 
 #: What the matching functions accept for a shape: an (n, 2) point array or a prepared Shape.
-PointsLike = Union[ArrayLike, 'Shape']
+PointsLike = Union[PointArray, 'Shape']
 
 
 def _shape_from_state(points: np.ndarray, params: Params) -> Shape:

@@ -150,6 +150,37 @@ def test_file_errors_are_the_builtin_os_errors(tmp_path):
         amscr.read_points(str(tmp_path))
 
 
+def test_a_path_holding_a_nul_character_is_refused(tmp_path):
+    """The library takes a C string, which a NUL character would cut short (x\\0.txt written as x):
+    every face refuses it, as open() does; a path of another type is a TypeError naming `path`."""
+    db = amscr.Collection(amscr.Params.retrieval(points=64))
+    db.extend([GOOD, GOOD * [2, 1], GOOD[::-1] * [1, 3]])
+    index = amscr.Index(db)
+    amscr.write_points(tmp_path / 'x', GOOD)
+    for path in (str(tmp_path / 'x\0.txt'), os.fsencode(tmp_path / 'x\0.txt'), tmp_path / 'x\0.txt'):
+        for call in (lambda p: amscr.write_points(p, GOOD), db.save, index.save, amscr.read_points,
+                     amscr.Collection.load, amscr.Index.load):
+            with pytest.raises(amscr.InvalidArgumentError, match=r'^path: embedded null byte$'):
+                call(path)
+    assert os.listdir(tmp_path) == ['x']
+    assert np.array_equal(amscr.read_points(os.fsencode(tmp_path / 'x')), amscr.read_points(tmp_path / 'x'))
+    for read in (amscr.read_points, amscr.Collection.load, amscr.Index.load):
+        with pytest.raises(TypeError, match=r'^path: expected a str, bytes or os\.PathLike path, got None$'):
+            read(None)
+
+
+def test_parse_points_takes_text_not_a_path(tmp_path):
+    """A path given to parse_points (bytes(path) would be parsed as the text) says to use read_points."""
+    p = tmp_path / 'c.txt'
+    amscr.write_points(p, GOOD)
+    with pytest.raises(TypeError, match=r'^text: expected the text of a point list \(str or bytes\), got a '
+                                        r'pathlib\.\w+: read a file with amscr\.read_points\(path\)$'):
+        amscr.parse_points(p)
+    text = p.read_text()
+    np.testing.assert_array_equal(amscr.parse_points(text), amscr.read_points(p))
+    np.testing.assert_array_equal(amscr.parse_points(text.encode()), amscr.read_points(p))
+
+
 def test_option_errors_name_the_python_option():
     with pytest.raises(amscr.InvalidArgumentError, match=r'^invalid argument: points: 3 is not in 16\.\.65536$'):
         amscr.Params(points=3)

@@ -86,6 +86,9 @@ def test_a_list_of_opencv_contours_is_refused_with_a_hint():
     c = _opencv_like(blob(50))
     with pytest.raises(amscr.InvalidArgumentError, match='OpenCV contours'):
         amscr.register((c,), c)
+    with pytest.raises(amscr.InvalidArgumentError, match=r'got 2 arrays of different lengths \(a list of OpenCV '
+                                                         r'contours\? pass one of them'):
+        amscr.register([c, c[:30]], c)  # findContours' contours have different lengths
     with pytest.raises(amscr.InvalidArgumentError, match=r'\(n, 2\)'):
         amscr.register(np.zeros((5, 2, 2)), c)
 
@@ -228,6 +231,25 @@ def test_contours_from_mask_bad_input():
         amscr.contours_from_mask(np.zeros(10, np.uint8))
 
 
+def test_an_image_contour_is_taken_wherever_points_are(tmp_path):
+    """An ImageContour of contours_from_mask stands for its points."""
+    c = amscr.contours_from_mask(_small_mask(1))[0]
+    tgt = affine(c.points, A_TRUE, B_TRUE)
+    r = amscr.register(c.points, tgt)
+    for fn in list(BUILDING_BLOCKS.values()) + [
+            amscr.as_points, amscr.signed_area, lambda p: amscr.smooth(p, 2.0), lambda p: amscr.Shape(p).points,
+            lambda p: amscr.register(p, tgt).matrix, lambda p: amscr.distance(tgt, p), r.apply,
+            lambda p: amscr.distance_matrix([p, tgt], points=64)]:
+        a, b = fn(c), fn(c.points)
+        assert (a is None and b is None) or np.array_equal(a, b)
+    db = amscr.Collection(points=64)
+    db.add(c)
+    db.extend([c, tgt])
+    assert np.array_equal(db.query(c), db.query(c.points)) and db.query(c)[:2].tolist() == [0.0, 0.0]
+    amscr.write_points(tmp_path / 'c.txt', c)
+    assert np.array_equal(amscr.read_points(tmp_path / 'c.txt'), c.points)
+
+
 # -- NumPy masked arrays and object arrays -----------------------------------------------------
 def test_masked_values_are_refused_wherever_points_or_masks_are_taken():
     """A numpy.ma array's masked values would be used as they are (an outlier hidden by the mask
@@ -258,3 +280,42 @@ def test_object_arrays_are_refused_with_how_to_convert_them():
     src, _ = _pair_xy()
     with pytest.raises(ValueError, match=r'dtype object: convert it first, e\.g\. df\.to_numpy\(float\)'):
         amscr.Shape(src.astype(object))
+
+
+class _LinearRing:
+    """What a shapely LineString or LinearRing is to NumPy: one object, its points behind .coords."""
+    coords = property(lambda self: [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 0.0)])
+
+
+class _Polygon:
+    """What a shapely Polygon is to NumPy: one object, its points behind .exterior.coords."""
+    exterior = property(lambda self: _LinearRing())
+
+
+def test_objects_that_are_no_arrays_are_named():
+    """None, a dict, a shapely geometry are named (not taken for a pandas frame); a geometry's
+    message says how to take its points, where points and where a mask are expected."""
+    src, _ = _pair_xy()
+    geometries = [_Polygon(), _LinearRing()]
+    try:
+        import shapely.geometry as sg
+        if not hasattr(sg.LineString, '__array_interface__'):  # shapely 2: no geometry is an array
+            geometries += [sg.Polygon(src), sg.LineString(src), sg.LinearRing(src)]
+    except ImportError:
+        pass
+    for g in geometries:
+        with pytest.raises(ValueError, match=r'^src: expected an array of real numbers, got a \w+\.\w+: pass its '
+                                             r'points, np\.asarray\(poly\.exterior\.coords\) of a Polygon, '
+                                             r'np\.asarray\(line\.coords\) of a LineString'):
+            amscr.register(g, src)
+        with pytest.raises(ValueError, match=r'^mask: expected a 2-D bool, integer or float array, got a \w+\.\w+: '
+                                             r'it is a contour already, pass its points where amscr takes points, '
+                                             r'np\.asarray\(poly\.exterior\.coords\)'):
+            amscr.contour_from_mask(g)
+    for x, what in ((None, 'None'), ({'x': 1}, 'a dict')):
+        with pytest.raises(amscr.InvalidArgumentError,
+                           match=r'^points: expected an array of real numbers, got %s$' % what):
+            amscr.as_points(x)
+        with pytest.raises(amscr.InvalidArgumentError, match=r'^mask: expected a 2-D bool, integer or float array, '
+                                                             r'got %s$' % what):
+            amscr.contours_from_mask(x)

@@ -69,6 +69,27 @@ def test_an_8_bit_mask_in_another_dtype_is_traced_as_the_8_bit_one(make):
     np.testing.assert_allclose(amscr.contour_from_mask(make(m)), amscr.contour_from_mask(m), atol=1e-6)
 
 
+@pytest.mark.parametrize("dtype", ['>u2', '>i4', '>f8'])
+def test_a_big_endian_image_is_traced_as_the_native_one(dtype):
+    """A big-endian image ('>u2', as FITS or a raw big-endian file gives it) is its native dtype:
+    a uint16 one takes the 16-bit thresholds."""
+    def trace(m, t):
+        try:
+            return amscr.contour_from_mask(m, threshold=t)
+        except amscr.AmscrError as e:
+            return type(e), str(e)
+
+    for fg, thresholds in ((200, (None, 100, 300, 'auto')), (1000, (None, 500, 'auto'))):
+        m = _rect(np.dtype(dtype).newbyteorder('='), fg)
+        for t in thresholds:
+            want, got = trace(m, t), trace(m.astype(dtype), t)
+            assert type(got) is type(want)
+            if isinstance(want, tuple):
+                assert got == want
+            else:
+                np.testing.assert_array_equal(got, want)
+
+
 def test_subpixel_false_is_the_pixel_chain():
     m = _rect(np.uint8, 255)
     chain = amscr.contour_from_mask(m, subpixel=False)
