@@ -31,11 +31,12 @@ from typing import Any, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import as_count, dbuf
+from ._util import Order, as_count, dbuf
 from .collection import Collection
 from .errors import AmscrError, FormatError, InvalidArgumentError, _check
 from .index import Index
 from .params import Params
+from .shape import as_shape
 from ._placement import _block, _threads_by_host, gather_live
 from ._shard_build import _merge_lists, _shortlist_lists, widths
 from ._shard_files import ShardSetError, check_shard, prepare_dir, read_set, write_set
@@ -163,10 +164,13 @@ class ShardedIndex:
     def __repr__(self) -> str:
         return 'ShardedIndex(%d shapes, %d shards)' % (len(self), len(self.bounds))
 
-    def _queries(self, queries: Sequence[Any]) -> Collection:
+    def _queries(self, queries: Sequence[Any], order: Order, name: str) -> Collection:
+        """The queries prepared with the set's params: points in `order` (masked arrays refused) or
+        Shapes; bad points are named `name` (with their position among several)."""
         q = Collection(self.params)
-        for x in queries:  # points (masked arrays refused) or Shapes, as Collection.add takes them
-            q.add(x)
+        queries = list(queries)
+        for i, x in enumerate(queries):
+            q.add(as_shape(x, self.params, name if len(queries) == 1 else '%s[%d]' % (name, i), order))
         return q
 
     def _gather(self, futs: List[Any]) -> List[Any]:
@@ -205,18 +209,24 @@ class ShardedIndex:
         k = widths(self.params, n)[0]
         return k - 1 if c + 1 < k else c
 
-    def scores_many(self, queries: Sequence[Any], candidates: Optional[int] = None) -> np.ndarray:
+    def scores_many(self, queries: Sequence[Any], candidates: Optional[int] = None, *,
+                    order: Order = 'xy') -> np.ndarray:
         """The retrieval scores (len(queries), len(self)) of point arrays or :class:`amscr.Shape` s,
         as :meth:`amscr.Index.scores` gives them: each query matched on the workers with every
         shard's shapes (candidates 0) or with its share of the query's M signature-nearest shapes
         of the whole collection (candidates M; None: the build's M), the rows merged on the
-        client. A member's copy is scored as that member (the member rule).
+        client. A member's copy is scored as that member (the member rule). order: 'xy'
+        (default) or 'rc' for (row, col) points, as :meth:`amscr.Index.query` takes them.
 
         Raises:
             InvalidArgumentError: bad points, a negative candidates.
         """
+        return self._scores(queries, candidates, order, 'queries')
+
+    def _scores(self, queries: Sequence[Any], candidates: Optional[int], order: Order, name: str) -> np.ndarray:
+        """scores_many, bad points named `name`."""
         want = self._want(candidates)
-        q = self._queries(queries)
+        q = self._queries(queries, order, name)
         nq, n = len(q), len(self)
         out = np.zeros((nq, n), dtype=np.float64)
         if nq == 0 or n == 0:
@@ -286,20 +296,27 @@ class ShardedIndex:
                 self._graph.scores(d, d2, c)
         return out
 
-    def scores(self, points: Any, candidates: Optional[int] = None) -> np.ndarray:
-        """One query's scores against every shape (lower is better); candidates as :meth:`scores_many`."""
-        return self.scores_many([points], candidates)[0]
+    def scores(self, points: Any, candidates: Optional[int] = None, *, order: Order = 'xy') -> np.ndarray:
+        """One query's scores against every shape (lower is better); candidates and order as
+        :meth:`scores_many`."""
+        return self._scores([points], candidates, order, 'points')[0]
 
-    def query(self, points: Any, top: int = 10, candidates: Optional[int] = None) -> Tuple[np.ndarray, np.ndarray]:
+    def query(self, points: Any, top: int = 10, candidates: Optional[int] = None, *,
+              order: Order = 'xy') -> Tuple[np.ndarray, np.ndarray]:
         """The `top` best shapes, best first (ties by index), as :meth:`amscr.Index.query`."""
-        idx, sc = self.query_many([points], top, candidates)
+        top = as_count(top, 'top', 0)
+        idx, sc = self._top(self._scores([points], candidates, order, 'points'), top)
         return idx[0], sc[0]
 
-    def query_many(self, queries: Sequence[Any], top: int = 10,
-                   candidates: Optional[int] = None) -> Tuple[np.ndarray, np.ndarray]:
+    def query_many(self, queries: Sequence[Any], top: int = 10, candidates: Optional[int] = None, *,
+                   order: Order = 'xy') -> Tuple[np.ndarray, np.ndarray]:
         """(indices, scores), each (len(queries), min(top, len(self))), best first, ties by index."""
         top = as_count(top, 'top', 0)
-        S = self.scores_many(queries, candidates)
+        return self._top(self._scores(queries, candidates, order, 'queries'), top)
+
+    @staticmethod
+    def _top(S: np.ndarray, top: int) -> Tuple[np.ndarray, np.ndarray]:
+        """The `top` best of each row of S, best first, ties by index."""
         k = min(top, S.shape[1])
         order = np.argsort(S, axis=1, kind='stable')[:, :k]
         return order.astype(np.int64), np.take_along_axis(S, order, 1)

@@ -166,6 +166,23 @@ def test_scores_equal_with_the_inner_graph(small):
     assert np.array_equal(m_idx, r_idx)
 
 
+def test_queries_in_row_col_order_and_bad_points_named(small):
+    """Queries take order='rc' as amscr.Index does, and bad points are named as the caller gave
+    them (they were named 'shape', as a Collection's own)."""
+    sx, single, _ = small
+    q = np.asarray(_queries(1)[0])
+    rc = q[:, ::-1]
+    np.testing.assert_array_equal(sx.scores(rc, order='rc'), sx.scores(q))
+    np.testing.assert_array_equal(sx.query(rc, 5, order='rc')[0], single.query(q, 5, candidates=0)[0])
+    np.testing.assert_array_equal(sx.query_many([rc, rc], 3, order='rc')[0][1], sx.query(q, 3)[0])
+    with pytest.raises(amscr.InvalidArgumentError, match='^points: '):
+        sx.query(q[:, :1])
+    with pytest.raises(amscr.InvalidArgumentError, match=r'^queries\[1\]: '):
+        sx.query_many([q, q[:, :1]])
+    with pytest.raises(amscr.InvalidArgumentError, match='order'):
+        sx.scores(q, order='yx')
+
+
 def test_save_load_round_trip(small, client, tmp_path):
     sx, single, _ = small
     sx.save(tmp_path / 'set')
