@@ -89,8 +89,12 @@ static amscr_status write_features(const amscr_index *x, uint32_t version, amscr
         amscr__hf built[2];
         int orients = version >= AMSCR__DB_VERSION_INDEX_I16 ? 1 : 2; /* from 16: the forward one */
         int build = hf[0].seq[0] == NULL || (orients == 2 && hf[0].seq[1] == NULL);
-        const amscr_descriptor *d;
-        if (build && ((st = amscr__db_shape(x->db, i, &d)) != AMSCR_OK || (st = amscr__base_hf(&b, d, built)) != AMSCR_OK))
+        const amscr_descriptor *d = NULL;
+        if (build)
+            st = amscr__db_shape(x->db, i, &d);
+        if (build && st == AMSCR_OK)
+            st = amscr__base_hf(&b, d, built);
+        if (st != AMSCR_OK)
             break;
         for (int f = 0; f < x->nf; f++)
             for (int o = 0; o < orients; o++)

@@ -139,7 +139,8 @@ static amscr_status find_member(const amscr_index *x, const amscr_descriptor *q,
         if (amscr__index_shortlist(x, sig, lb, m, SIZE_MAX, cand) != m)
             st = amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
     }
-    for (size_t t = 0; st == AMSCR_OK && t < m && found == SIZE_MAX; t++) { /* ascending: the first copy is the lowest */
+    /* ascending index: the first copy is the lowest */
+    for (size_t t = 0; st == AMSCR_OK && t < m && found == SIZE_MAX; t++) {
         int same;
         st = same_samples(x, cand[t], q, &same);
         found = same ? cand[t] : SIZE_MAX;
