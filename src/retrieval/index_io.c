@@ -487,7 +487,9 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int
     uint64_t sec = amscr__db_is_index(version) ? amscr__r_u64(&r) : 0;
     if (!amscr__db_is_index(version))
         st = amscr__fail(AMSCR_E_FORMAT, "a collection file without an index (format version %u): build an index "
-                                         "of it (amscr_index_build; `amscr index`, Python amscr.Index)",
+                                         "of it (amscr_index_build of amscr_db_load's collection; Python "
+                                         "amscr.Index(amscr.Collection.load(FILE)).save(OUT); `amscr index` of "
+                                         "the folder or manifest of its shapes)",
                          (unsigned)version);
     else if (r.bad || sec != r.len - r.pos)
         st = amscr__fail(AMSCR_E_FORMAT, "index file: bad index section length");

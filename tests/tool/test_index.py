@@ -193,6 +193,16 @@ def test_a_collection_file_where_an_index_is_expected(tmp_path):
     r = run("eval", coll)
     assert r.returncode == 1 and r.stderr.count("\n") == 1, r.stderr
     assert "amscr index" in r.stderr and "amscr.Index" in r.stderr and "build one with" not in r.stderr, r.stderr
+    # following the advice: `amscr index` of the file says the way that works for it
+    r = run("index", coll, "-o", tmp_path / "x.idx")
+    assert r.returncode == 1 and "amscr.Index(amscr.Collection.load(FILE)).save(OUT)" in r.stderr, r.stderr
+    # a file cut inside its magic is an amscr file cut short, not a manifest without a header
+    cut = tmp_path / "cut.idx"
+    cut.write_bytes(open(coll, "rb").read()[:7])
+    q = tmp_path / "shapes" / "star_1.txt"
+    for args in (("eval", cut), ("search", q, cut), ("index", cut, "-o", tmp_path / "y.idx")):
+        r = run(*args)
+        assert r.returncode == 1 and "header" not in r.stderr and "cut.idx" in r.stderr, (args, r.stderr)
 
 
 def test_old_tool_index_is_refused(tmp_path):

@@ -504,8 +504,10 @@ static int manifest_is_other(const char *mpath)
         tool_error(mpath, "a PNG or PGM image, " NOT_COLLECTION);
     else if (kind != NULL)
         tool_error(mpath, "a %s image, " NOT_COLLECTION, kind);
-    else if (n >= 8 && (memcmp(m, "AMSCRDB", 7) == 0 || memcmp(m, "AMSCRIDX", 8) == 0))
-        tool_error(mpath, "an amscr index or collection file, not a folder of shapes or a manifest .tsv");
+    else if (n >= 5 && memcmp(m, "AMSCR", 5) == 0) /* AMSCRDB, AMSCRIDX, or a file of them cut short */
+        tool_error(mpath, "an amscr index or collection file, not a folder of shapes or a manifest .tsv, which "
+                          "`amscr index` builds from (--add adds shapes to an index; an index of a collection file "
+                          "of Python's Collection.save: amscr.Index(amscr.Collection.load(FILE)).save(OUT))");
     else
         return 0;
     return -1;

@@ -108,7 +108,8 @@ int index_file_is(const char *path)
         return 0;
     size_t got = fread(m, 1, sizeof m, f);
     fclose(f);
-    return got == sizeof m && (memcmp(m, "AMSCRIDX", 8) == 0 || memcmp(m, "AMSCRDB", 7) == 0);
+    /* the magic AMSCRDB or AMSCRIDX, or its start (a file cut short: the loader names it) */
+    return got >= 5 && memcmp(m, "AMSCR", 5) == 0;
 }
 
 int index_open(const char *path, int lazy, amscr_index **out)
