@@ -2857,9 +2857,10 @@ AMSCR_API size_t amscr_index_default_candidates(size_t n);
  *        class names kept); on failure it
  *        is left as it was.
  * @param[in] shapes  prepared with exactly the index's params (threads aside).
- * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL; params that differ: the detail names the
- *         option); AMSCR_E_LIMIT; AMSCR_E_CANCELLED; AMSCR_E_NOMEM. After AMSCR_E_CANCELLED or
- *         AMSCR_E_NOMEM the index holds the shapes but not all their lists: free it.
+ * @return AMSCR_OK (also for no shapes: no work, no report); AMSCR_E_INVALID_ARG (NULL;
+ *         params that differ: the detail names the option); AMSCR_E_LIMIT; AMSCR_E_CANCELLED;
+ *         AMSCR_E_NOMEM. After AMSCR_E_CANCELLED or AMSCR_E_NOMEM the index holds the shapes
+ *         but not all their lists: free it; every other call on it returns AMSCR_E_STATE.
  * Ownership: none (shapes is copied).
  * Thread-safety: exclusive on x.
  * @since 0.4
@@ -2885,7 +2886,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_add(amscr_index *x, const ams
  * @param[in]  q  a shape prepared with params compatible with the index's.
  * @param[out] out_scores  n scores, lower is better.
  * @param[in]  n  must equal amscr_index_size(x).
- * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, incompatible params); AMSCR_E_NOMEM.
+ * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, incompatible params); AMSCR_E_STATE (an
+ *         index a failed amscr_index_add left incomplete, as for every index call);
+ *         AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: const; runs on the params' threads.
  * @since 0.4

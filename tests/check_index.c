@@ -1114,6 +1114,56 @@ START_TEST(add_shapes)
 }
 END_TEST
 
+static int reports_seen;
+static int cancel_at_first(void *user, size_t done, size_t total)
+{
+    (void)user, (void)done, (void)total;
+    reports_seen++;
+    return 1;
+}
+
+/* An add cancelled (or out of memory) after it took its shapes in leaves an index whose new
+ * shapes lack their lists: the header says to free it, and every call but free refuses it with
+ * AMSCR_E_STATE (a query read the missing lists: SIGSEGV). An add of no shapes is no work: no
+ * report (it reported 0 of 0), AMSCR_OK. */
+START_TEST(add_cancelled_leaves_an_index_to_free)
+{
+    amscr_params *p = params_of(1.0, 8, 1);
+    amscr_db *first = db_of(p, NSHAPES - 4), *all = db_of(p, NSHAPES), *more = NULL, *none = NULL;
+    ck_assert_int_eq(amscr_db_new(p, &more), AMSCR_OK);
+    ck_assert_int_eq(amscr_db_new(p, &none), AMSCR_OK);
+    for (size_t i = NSHAPES - 4; i < NSHAPES; i++)
+        ck_assert_int_eq(amscr_db_add_descriptor(more, amscr_db_descriptor(all, i), amscr_db_label(all, i), NULL),
+                         AMSCR_OK);
+    amscr_index *x = NULL;
+    ck_assert_int_eq(amscr_index_build(first, 0, NULL, NULL, &x), AMSCR_OK);
+    reports_seen = 0;
+    ck_assert_int_eq(amscr_index_add(x, none, cancel_at_first, NULL), AMSCR_OK);
+    ck_assert_int_eq(reports_seen, 0);
+    ck_assert_int_eq(amscr_index_add(x, more, cancel_at_first, NULL), AMSCR_E_CANCELLED);
+    amscr_descriptor *q = shape(p, 3000);
+    double a[NSHAPES];
+    size_t idx[5], cnt, i = 77;
+    void *buf = NULL;
+    size_t len = 0;
+    ck_assert_int_eq(amscr_index_query_scores(x, q, 0, a, amscr_index_size(x)), AMSCR_E_STATE);
+    ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), "free it"));
+    ck_assert_int_eq(amscr_index_search(x, q, 0, 5, idx, a, &cnt), AMSCR_E_STATE);
+    ck_assert_int_eq(amscr_index_member_scores(x, 0, 0, a, amscr_index_size(x)), AMSCR_E_STATE);
+    ck_assert_int_eq(amscr_index_find_member(x, q, &i), AMSCR_E_STATE);
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_E_STATE);
+    ck_assert_ptr_null(buf);
+    ck_assert_int_eq(amscr_index_add(x, more, NULL, NULL), AMSCR_E_STATE);
+    amscr_index_free(x);
+    amscr_descriptor_free(q);
+    amscr_db_free(first);
+    amscr_db_free(all);
+    amscr_db_free(more);
+    amscr_db_free(none);
+    amscr_params_free(p);
+}
+END_TEST
+
 /* Shapes added to an index of fewer than twice its re-ranking k, whose lists grow with its size:
  * the index is built again on its shapes and the new ones (the queries a build's), its names,
  * groups and class names kept; one shape at a time from an empty index too. */
@@ -1565,6 +1615,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, stored_features);
     tcase_add_test(tc, bad_files);
     tcase_add_test(tc, add_shapes);
+    tcase_add_test(tc, add_cancelled_leaves_an_index_to_free);
     tcase_add_test(tc, add_grows_the_lists);
     tcase_add_test(tc, thread_independence);
     tcase_add_test(tc, top_and_shortlist);

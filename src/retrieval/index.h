@@ -36,6 +36,7 @@ struct amscr_index {
     amscr__hf *hf;        /* n x nf: each shape's channel features, ready for matching (an entry
                            * with no sequences, after a lazy load: built where a pair needs it) */
     int lazy;             /* loaded with AMSCR_INDEX_LAZY: features of loaded shapes not built */
+    int failed;           /* a failed amscr_index_add left its new shapes without their lists */
     unsigned char *mirror_pool; /* the mirrored orientation of the features of shapes whose rows are
                                  * being built (a build, an add), in one block (index_features.c)
                                  * freed whole once the rows are; NULL otherwise */
@@ -159,6 +160,16 @@ amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const ams
 /* Signatures, lower-bound vectors (unless have_sig: then the signatures are there) and channel
  * features of shapes first..n-1, on the params' threads; drops the lists' reverse, and rebuilds
  * it when have_sig and first == 0 (a load: the lists are in place). */
+/* AMSCR_E_STATE from the calling public function `fn` when x was left incomplete by a failed
+ * amscr_index_add (cancelled or out of memory, its new shapes without their lists): the header
+ * says to free it, and every call but amscr_index_free refuses it rather than read the lists. */
+#define AMSCR__CHECK_INDEX_WHOLE(fn, x)                                                                      \
+    do {                                                                                                   \
+        if ((x)->failed)                                                                                   \
+            return amscr__fail(AMSCR_E_STATE, "%s: the index was left incomplete by a failed "              \
+                                              "amscr_index_add (cancelled or out of memory): free it", (fn)); \
+    } while (0)
+
 amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig);
 
 /* ------------------------------------------ the mirrored features' pool (index_mirror.c) */

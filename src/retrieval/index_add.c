@@ -165,6 +165,7 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
+    AMSCR__CHECK_INDEX_WHOLE(__func__, x);
     AMSCR_CHECK_NULL(shapes);
     const amscr_params *p = amscr_db_params(x->db);
     const char *diff = differing_option(p, amscr_db_params(shapes));
@@ -173,6 +174,8 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
                                                 "index (rebuild the index to change it)", diff);
     size_t n0 = amscr_db_size(x->db), add = amscr_db_size(shapes), n = n0 + add;
     amscr_status st = amscr__index_check_db(shapes, "amscr_index_add");
+    if (st == AMSCR_OK && add == 0)
+        return AMSCR_OK; /* nothing to do, nothing reported */
     size_t kp = amscr__rerank_k(p, n);
     if (st == AMSCR_OK && kp != x->k && n0 > 0) /* a list grows with the collection */
         return add_rebuilding(x, shapes, progress, user);
@@ -186,6 +189,8 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
         st = amscr__db_add_from(x->db, shapes, i, amscr_db_label(shapes, i));
     if (st == AMSCR_OK)
         st = amscr__index_extend(x, n0, progress, user);
+    if (st != AMSCR_OK && amscr_db_size(x->db) != n0)
+        x->failed = 1; /* its new shapes lack their lists (the header: free it) */
     return st == AMSCR_OK ? amscr__db_compact_tail(x->db) : st; /* kept as the others are */
 }
 

@@ -233,6 +233,7 @@ amscr_status amscr_index_save_memory(const amscr_index *x, void **out_buf, size_
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
+    AMSCR__CHECK_INDEX_WHOLE(__func__, x);
     AMSCR_CHECK_NULL(out_buf);
     AMSCR_CHECK_NULL(out_len);
     return amscr__index_write(x, AMSCR__DB_VERSION_NEWEST, out_buf, out_len);
@@ -242,6 +243,7 @@ amscr_status amscr_index_save(const amscr_index *x, const char *path)
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
+    AMSCR__CHECK_INDEX_WHOLE(__func__, x);
     AMSCR_CHECK_NULL(path);
     void *buf = NULL;
     size_t len = 0;

@@ -90,6 +90,7 @@ amscr_status amscr_index_query_scores(const amscr_index *x, const amscr_descript
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
+    AMSCR__CHECK_INDEX_WHOLE(__func__, x);
     AMSCR_CHECK_NULL(q);
     AMSCR_CHECK_NULL(out_scores);
     amscr_status st = check_query(x, q, (size_t *)out_scores, n, "amscr_index_query_scores");
@@ -101,6 +102,7 @@ amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t ca
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
+    AMSCR__CHECK_INDEX_WHOLE(__func__, x);
     AMSCR_CHECK_NULL(out_scores);
     if (n != amscr_db_size(x->db) || i >= n)
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_member_scores: shape %zu, %zu scores, %zu shapes", i,
@@ -161,6 +163,7 @@ amscr_status amscr_index_find_member(const amscr_index *x, const amscr_descripto
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
+    AMSCR__CHECK_INDEX_WHOLE(__func__, x);
     AMSCR_CHECK_NULL(q);
     AMSCR_CHECK_NULL(out_i);
     amscr_status st = check_query(x, q, NULL, 0, "amscr_index_find_member");
@@ -183,6 +186,7 @@ amscr_status amscr_index_search_scores(const amscr_index *x, const amscr_descrip
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
+    AMSCR__CHECK_INDEX_WHOLE(__func__, x);
     AMSCR_CHECK_NULL(q);
     AMSCR_CHECK_NULL(out_scores);
     amscr_status st = check_query(x, q, (size_t *)out_scores, n, "amscr_index_search_scores");
@@ -202,6 +206,7 @@ static amscr_status best_hits(const amscr_index *x, const amscr_descriptor *q, s
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL_IN(fn, x);
+    AMSCR__CHECK_INDEX_WHOLE(fn, x);
     AMSCR_CHECK_NULL_IN(fn, q);
     AMSCR_CHECK_NULL_IN(fn, out_idx);
     AMSCR_CHECK_NULL_IN(fn, out_scores);

@@ -99,6 +99,7 @@ amscr_status amscr_index_pair_distances(const amscr_index *x, const amscr_descri
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
+    AMSCR__CHECK_INDEX_WHOLE(__func__, x);
     AMSCR_CHECK_NULL(q);
     AMSCR_CHECK_NULL(out_base);
     const amscr_params *p = amscr_db_params(x->db);
@@ -123,6 +124,7 @@ amscr_status amscr_index_pair_distances_at(const amscr_index *x, const amscr_des
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
+    AMSCR__CHECK_INDEX_WHOLE(__func__, x);
     AMSCR_CHECK_NULL(q);
     if (!amscr__params_compatible(amscr_db_params(x->db), &q->params, "amscr_index_pair_distances_at"))
         return AMSCR_E_INVALID_ARG;
@@ -144,6 +146,7 @@ amscr_status amscr_index_signatures(const amscr_index *x, float *out, size_t n)
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
+    AMSCR__CHECK_INDEX_WHOLE(__func__, x);
     size_t size = amscr_db_size(x->db);
     if (n != size * AMSCR__SIG_DIM || (n > 0 && (!out || !x->sigq || x->sig_dim != AMSCR__SIG_DIM)))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_signatures: the output holds %zu floats, %zu shapes "
@@ -181,6 +184,7 @@ amscr_status amscr_index_signatures_packed(const amscr_index *x, uint16_t *out_q
 {
     amscr__clear_error();
     AMSCR_CHECK_NULL(x);
+    AMSCR__CHECK_INDEX_WHOLE(__func__, x);
     size_t size = amscr_db_size(x->db);
     if (n != size || (n > 0 && (!out_q || !out_e || !x->sigq || x->sig_dim != AMSCR__SIG_DIM)))
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_signatures_packed: room for %zu shapes, the index has "
