@@ -432,6 +432,8 @@ def _progress_onerror(exc_type, exc_value, tb):
 @ffi.callback('amscr_progress_fn', onerror=_progress_onerror)
 def _progress_trampoline(user, done, total):
     state = ffi.from_handle(user)
+    if state.error is not None:  # cancelled already: a report before the call returns is not passed on
+        return 1
     try:
         return state.update(done, total)
     except BaseException as e:  # includes KeyboardInterrupt: cancel the call, re-raise after it

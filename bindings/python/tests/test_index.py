@@ -103,6 +103,28 @@ def test_add():
         index.add(amscr.Shape(q, amscr.Params.retrieval(points=128)), label='class0')
 
 
+def test_add_interrupted_leaves_an_index_that_says_so(monkeypatch):
+    """Ctrl-C during Index.add (a KeyboardInterrupt in its first report) leaves the index's new
+    shape without its lists: using it again is a StateError saying so (the interpreter crashed)."""
+    from amscr import _util
+    params = amscr.Params.retrieval(points=64)
+    coll = synthetic(params, 24)
+    index = amscr.Index(coll)
+    q = blob(300, seed=1)
+
+    def interrupted(self, done, total):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(_util._ProgressState, 'update', interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        index.add(blob(300, seed=5), label='class0')
+    monkeypatch.undo()
+    with pytest.raises(amscr.StateError, match='left incomplete by a failed amscr_index_add'):
+        index.scores(q)
+    with pytest.raises(amscr.StateError):
+        index.to_bytes()
+
+
 def test_add_one_at_a_time_from_an_empty_index(tmp_path):
     """An index grown one shape at a time from empty (its lists' K grows with its size up to
     twice the re-ranking k: the small index is built again) scores as a build of them all, and

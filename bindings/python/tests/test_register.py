@@ -362,6 +362,16 @@ def test_progress_bar_and_callbacks(collection, capfd):
 
     with pytest.raises(Boom, match='stop here'):
         collection.distance_matrix(progress=raiser)
+    calls = []
+
+    def raise_once_then_count(done, total):
+        calls.append((done, total))
+        raise Boom('the first report')
+
+    with pytest.raises(Boom, match='the first report'):  # not called again once it raised
+        amscr.Collection(points=64, threads=2).extend([blob(200, seed=s) for s in range(12)],
+                                                      progress=raise_once_then_count)
+    assert len(calls) == 1, calls
     with pytest.raises(amscr.CancelledError):
         collection.query(blob(200), progress=lambda d, t: True)
     # still usable after a cancellation
