@@ -184,8 +184,16 @@ typedef struct amscr_contour_set amscr_contour_set;
  * @brief Progress callback for long batch calls.
  * @param user  the pointer given with the callback.
  * @param done  work items finished so far.
- * @param total work items in the call.
+ * @param total work items in the call (> 0: a call with no work does not report). A call
+ *              that runs in stages may report each stage in its own items: done / total is
+ *              the fraction, monotone over the call.
  * @return 0 to continue, non-zero to cancel (the call then returns AMSCR_E_CANCELLED).
+ * The callback must return normally: no C++ exception, longjmp or thread cancellation may
+ * leave it (the call would keep its locks and memory; catch, and return non-zero). It may call
+ * the library on other objects and query the objects the call only reads, except the
+ * collection of an amscr_db_query_retrieval or amscr_db_search_retrieval reporting to it
+ * (AMSCR_E_STATE: that call holds the collection's lock); it must not change or free the
+ * objects the call uses.
  * Thread-safety: called from the thread that made the batch call, never concurrently.
  * @since 0.1
  */
@@ -2746,7 +2754,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  * @param[out] out_scores  n scores, lower is better (see amscr_db_retrieval_matrix).
  * @param[in]  n  must equal amscr_db_size(db).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, incompatible params, open curves with a
- *         channel weight); AMSCR_E_CANCELLED; AMSCR_E_NOMEM.
+ *         channel weight); AMSCR_E_STATE (called from the progress callback of a query of the
+ *         same collection); AMSCR_E_CANCELLED; AMSCR_E_NOMEM.
  * Ownership: none.
  * Thread-safety: const: concurrent queries are safe (the kept index is built or extended by
  *       one of them under the collection's lock); runs on the db's threads.

@@ -201,6 +201,46 @@ START_TEST(kept_concurrent)
 }
 END_TEST
 
+/* A query on the same collection from the progress callback of a query that builds its kept
+ * index (the lock held by this thread): AMSCR_E_STATE, not a deadlock; the outer query goes on. */
+typedef struct {
+    const amscr_db *db;
+    const amscr_descriptor *q;
+    amscr_status inner;
+    int calls;
+} reentry;
+
+static int query_again(void *user, size_t done, size_t total)
+{
+    reentry *r = user;
+    double out[NSHAPES];
+    (void)done, (void)total;
+    if (r->calls++ == 0)
+        r->inner = amscr_db_query_retrieval(r->db, r->q, NULL, NULL, out, NSHAPES);
+    return 0;
+}
+
+START_TEST(kept_query_from_its_own_callback)
+{
+    amscr_params *p = params_of(1.0, 8, 1);
+    amscr_db *db = db_of(p, NSHAPES), *serial = db_of(p, NSHAPES);
+    amscr_descriptor *q = shape(p, 1000);
+    double ref[NSHAPES], out[NSHAPES];
+    ck_assert_int_eq(amscr_db_query_retrieval(serial, q, NULL, NULL, ref, NSHAPES), AMSCR_OK);
+    reentry r = {db, q, AMSCR_OK, 0};
+    ck_assert_int_eq(amscr_db_query_retrieval(db, q, query_again, &r, out, NSHAPES), AMSCR_OK);
+    ck_assert_int_gt(r.calls, 0);
+    ck_assert_int_eq(r.inner, AMSCR_E_STATE);
+    assert_close(ref, out, NSHAPES, 0.0);
+    ck_assert_int_eq(amscr_db_query_retrieval(db, q, NULL, NULL, out, NSHAPES), AMSCR_OK); /* usable after */
+    assert_close(ref, out, NSHAPES, 0.0);
+    amscr_descriptor_free(q);
+    amscr_db_free(db);
+    amscr_db_free(serial);
+    amscr_params_free(p);
+}
+END_TEST
+
 /* The build's default: every pair up to AMSCR_INDEX_EXACT_MAX shapes, the shortlist above. */
 START_TEST(default_candidates)
 {
@@ -1615,6 +1655,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, stored_features);
     tcase_add_test(tc, bad_files);
     tcase_add_test(tc, add_shapes);
+    tcase_add_test(tc, kept_query_from_its_own_callback);
     tcase_add_test(tc, add_cancelled_leaves_an_index_to_free);
     tcase_add_test(tc, add_grows_the_lists);
     tcase_add_test(tc, thread_independence);

@@ -30,6 +30,22 @@ struct amscr_db {
     pthread_mutex_t kept_lock;
 };
 
+/* The kept index's lock, error-checking: a query from the progress callback of a query that builds
+ * the kept index (the same thread, the lock held) is refused rather than deadlocked
+ * (amscr__db_kept_lock). 0 on success. */
+static int init_kept_lock(pthread_mutex_t *m)
+{
+    pthread_mutexattr_t a;
+    int e = pthread_mutexattr_init(&a);
+    if (e == 0) {
+        e = pthread_mutexattr_settype(&a, PTHREAD_MUTEX_ERRORCHECK);
+        if (e == 0)
+            e = pthread_mutex_init(m, &a);
+        pthread_mutexattr_destroy(&a);
+    }
+    return e == 0 ? 0 : pthread_mutex_init(m, NULL);
+}
+
 amscr_status amscr_db_new(const amscr_params *p, amscr_db **out)
 {
     amscr__clear_error();
@@ -41,7 +57,10 @@ amscr_status amscr_db_new(const amscr_params *p, amscr_db **out)
         db->params = *p;
     else
         amscr__params_defaults(&db->params);
-    pthread_mutex_init(&db->kept_lock, NULL);
+    if (init_kept_lock(&db->kept_lock) != 0) {
+        free(db);
+        return amscr__fail(AMSCR_E_NOMEM, "amscr_db_new: cannot make the collection's lock");
+    }
     *out = db;
     return AMSCR_OK;
 }
@@ -194,7 +213,8 @@ amscr_status amscr_db_add_descriptor(amscr_db *db, const amscr_descriptor *d, in
 void **amscr__db_kept_lock(const amscr_db *db, void (*free_fn)(void *))
 {
     amscr_db *m = (amscr_db *)(uintptr_t)db; /* the kept state of a const collection, under its lock */
-    pthread_mutex_lock(&m->kept_lock);
+    if (pthread_mutex_lock(&m->kept_lock) != 0) /* EDEADLK: this thread holds it (a progress callback) */
+        return NULL;
     m->kept_free = free_fn;
     return &m->kept;
 }

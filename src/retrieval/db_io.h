@@ -22,7 +22,9 @@ amscr_status amscr__db_reserve(amscr_db *db, size_t extra);
  * holds lists without shapes (index_shard.c); never handed to a caller. */
 amscr_status amscr__db_new_slots(const amscr_params *p, size_t n, amscr_db **out);
 /* The slot of what one-vs-many retrieval keeps between queries of db (retrieval_query.c), locked;
- * amscr_db_free releases what it holds with free_fn. Unlock with amscr__db_kept_unlock. */
+ * amscr_db_free releases what it holds with free_fn. Unlock with amscr__db_kept_unlock. NULL (not
+ * locked) when the calling thread holds the lock already: a query from the progress callback of
+ * a query on the same collection. */
 void **amscr__db_kept_lock(const amscr_db *db, void (*free_fn)(void *));
 void amscr__db_kept_unlock(const amscr_db *db);
 

@@ -58,6 +58,10 @@ static amscr_status kept_refresh(const amscr_db *db, kept_index *k, amscr_progre
 static amscr_status kept(const amscr_db *db, amscr_progress_fn progress, void *user, const amscr_index **out)
 {
     void **slot = amscr__db_kept_lock(db, kept_free);
+    if (!slot)
+        return amscr__fail(AMSCR_E_STATE, "amscr_db_query_retrieval: called from the progress callback of a query "
+                                          "on the same collection, which holds its lock (query another collection "
+                                          "there, or after the call returns)");
     kept_index *k = *slot;
     amscr_status st = AMSCR_OK;
     if (!k && (k = calloc(1, sizeof *k)) == NULL)
