@@ -756,6 +756,10 @@ START_TEST(cancellation)
             prog_init(&r, at);
             snprintf(what, sizeof what, "cross, %u threads, stop at call %zu", th, at);
             check_cancelled(amscr_db_cross_distances(qs, db, prog_cb, &r, m), &r, what);
+
+            prog_init(&r, at); /* the rows' loop (rows.c): it reported once more after a cancel */
+            snprintf(what, sizeof what, "channel matrix, %u threads, stop at call %zu", th, at);
+            check_cancelled(amscr_db_channel_matrix(db, prog_cb, &r, m), &r, what);
         }
         /* a cancelled call leaves the db usable and the next results unchanged */
         ck_assert_int_eq(amscr_db_distance_matrix(db, NULL, NULL, m), AMSCR_OK);

@@ -284,11 +284,11 @@ static void row_work(row_job *j, amscr_progress_fn progress, void *user)
             snprintf(j->detail, sizeof j->detail, "%s", amscr_last_error_detail());
         }
         size_t c = j->next, done = j->done;
-        int go = j->st == AMSCR_OK && !j->cancel && c < j->m;
+        int live = j->st == AMSCR_OK && !j->cancel, go = live && c < j->m; /* no report once cancelled */
         if (go)
             j->next += CHUNK;
         pthread_mutex_unlock(&j->lock);
-        if (progress && progress(user, done, j->m) != 0) {
+        if (live && progress && progress(user, done, j->m) != 0) {
             pthread_mutex_lock(&j->lock);
             j->cancel = 1;
             pthread_mutex_unlock(&j->lock);

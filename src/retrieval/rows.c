@@ -39,11 +39,11 @@ static void rows_work(rows_job *j, amscr_progress_fn progress, void *user)
         pthread_mutex_lock(&j->lock);
         record(j, st);
         size_t i = j->next, done = j->done;
-        int go = j->st == AMSCR_OK && !j->cancel && i < j->n;
+        int live = j->st == AMSCR_OK && !j->cancel, go = live && i < j->n; /* no report once cancelled */
         if (go)
             j->next++;
         pthread_mutex_unlock(&j->lock);
-        if (progress && progress(user, done - j->first, j->n - j->first) != 0) {
+        if (live && progress && progress(user, done - j->first, j->n - j->first) != 0) {
             pthread_mutex_lock(&j->lock);
             j->cancel = 1;
             pthread_mutex_unlock(&j->lock);
