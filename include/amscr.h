@@ -2755,7 +2755,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  * @param[in]  n  must equal amscr_db_size(db).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, incompatible params, open curves with a
  *         channel weight); AMSCR_E_STATE (called from the progress callback of a query of the
- *         same collection); AMSCR_E_CANCELLED; AMSCR_E_NOMEM.
+ *         same collection); AMSCR_E_CANCELLED; AMSCR_E_NOMEM. NaN on failure as amscr_db_query
+ *         (never a partial row).
  * Ownership: none.
  * Thread-safety: const: concurrent queries are safe (the kept index is built or extended by
  *       one of them under the collection's lock); runs on the db's threads.

@@ -760,6 +760,12 @@ START_TEST(cancellation)
             prog_init(&r, at); /* the rows' loop (rows.c): it reported once more after a cancel */
             snprintf(what, sizeof what, "channel matrix, %u threads, stop at call %zu", th, at);
             check_cancelled(amscr_db_channel_matrix(db, prog_cb, &r, m), &r, what);
+
+            prog_init(&r, at); /* the base distances alone (no re-ranking): it left a partial row */
+            snprintf(what, sizeof what, "retrieval query, %u threads, stop at call %zu", th, at);
+            check_cancelled(amscr_db_query_retrieval(big, d[3], prog_cb, &r, q, 130), &r, what);
+            for (size_t j = 0; j < 130; j++)
+                ck_assert_msg(isnan(q[j]), "%s: score %zu = %g, not NaN", what, j, q[j]);
         }
         /* a cancelled call leaves the db usable and the next results unchanged */
         ck_assert_int_eq(amscr_db_distance_matrix(db, NULL, NULL, m), AMSCR_OK);

@@ -104,14 +104,17 @@ static amscr_status db_query(const amscr_db *db, const amscr_descriptor *q, amsc
                            n, amscr_db_size(db));
     if (!amscr__params_compatible(amscr_db_params(db), &q->params, what))
         return AMSCR_E_INVALID_ARG;
+    amscr_status st;
     if (!amscr__member_rule_applies(amscr_db_params(db))) /* the base distances alone: nothing of the collection's */
-        return plain_row(db, q, progress, user, out_scores);
-    const amscr_index *x = NULL;
-    amscr_status st = kept(db, progress, user, &x);
-    if (st != AMSCR_OK)
-        return st;
-    return member ? amscr__index_search_scores(x, q, 0, out_scores) /* every shape a candidate */
-                  : amscr_index_query_scores(x, q, 0, out_scores, n);
+        st = plain_row(db, q, progress, user, out_scores);
+    else {
+        const amscr_index *x = NULL;
+        st = kept(db, progress, user, &x);
+        if (st == AMSCR_OK)
+            st = member ? amscr__index_search_scores(x, q, 0, out_scores) /* every shape a candidate */
+                        : amscr_index_query_scores(x, q, 0, out_scores, n);
+    }
+    return amscr__nan_on_failure(st, out_scores, 1, n); /* never a partial row */
 }
 
 amscr_status amscr_db_query_retrieval(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress,
