@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any, Callable, Iterator, Literal, Optional, Pr
 import numpy as np
 
 from ._lib import ffi, lib
-from .errors import InvalidArgumentError, _check
+from .errors import InvalidArgumentError, StateError, _check
 
 try:
     from numpy.typing import ArrayLike
@@ -468,30 +468,50 @@ def progress_call(fn, args_before: tuple, args_after: tuple, progress: ProgressA
 # ------------------------------------------------------------------ locks
 class RWLock:
     """Many readers or one writer, writers first (a collection may be queried by many threads and
-    added to by one; a waiting add() is not starved by a stream of queries). Not reentrant for a
-    thread that holds a read lock while a writer waits."""
+    added to by one; a waiting add() is not starved by a stream of queries). A thread may read
+    again while it reads (a query from a query's progress callback); reading while it writes, or
+    writing while it reads or writes (from a progress callback), is a StateError, not a
+    deadlock."""
 
     def __init__(self) -> None:
         self._cond = threading.Condition()
         self._readers = 0
         self._writer = False
         self._writers_waiting = 0
+        self._owner: Optional[int] = None  # the writing thread
+        self._mine = threading.local()  # this thread's reads held
+
+    def _held(self) -> int:
+        return getattr(self._mine, 'n', 0)
+
+    def _refuse_reentry(self, writing: bool) -> None:
+        if self._owner == threading.get_ident():
+            raise StateError('amscr: this object is being changed by a call on this thread (from its progress '
+                             'callback?); use it once that call returns', lib.AMSCR_E_STATE)
+        if writing and self._held():
+            raise StateError('amscr: this object cannot be changed from inside a call that reads it on this '
+                             'thread (from its progress callback?); change it once that call returns',
+                             lib.AMSCR_E_STATE)
 
     @contextlib.contextmanager
     def read(self) -> Iterator[None]:
+        self._refuse_reentry(False)
         with self._cond:
-            while self._writer or self._writers_waiting:
+            while (self._writer or self._writers_waiting) and not self._held():
                 self._cond.wait()
             self._readers += 1
+        self._mine.n = self._held() + 1
         try:
             yield
         finally:
+            self._mine.n -= 1
             with self._cond:
                 self._readers -= 1
                 self._cond.notify_all()
 
     @contextlib.contextmanager
     def write(self) -> Iterator[None]:
+        self._refuse_reentry(True)
         with self._cond:
             self._writers_waiting += 1
             try:
@@ -500,9 +520,11 @@ class RWLock:
             finally:
                 self._writers_waiting -= 1
             self._writer = True
+            self._owner = threading.get_ident()
         try:
             yield
         finally:
             with self._cond:
                 self._writer = False
+                self._owner = None
                 self._cond.notify_all()

@@ -378,6 +378,22 @@ def test_progress_bar_and_callbacks(collection, capfd):
     np.testing.assert_array_equal(collection.distance_matrix(), D)
 
 
+def test_a_collection_used_from_its_own_progress_callback(shapes):
+    """From a progress callback: querying a collection being extended, or adding to one being
+    read, is a StateError (both hung for good); reading it again from a read's callback works."""
+    pts, _ = shapes
+    coll = amscr.Collection(points=64, threads=1)
+    coll.extend(pts[:4])
+    with pytest.raises(amscr.StateError, match='being changed by a call on this thread'):
+        coll.extend(pts[4:8], progress=lambda d, t: coll.distance_matrix())
+    assert len(coll) == 4  # all or nothing
+    with pytest.raises(amscr.StateError, match='cannot be changed from inside a call that reads it'):
+        coll.distance_matrix(progress=lambda d, t: coll.add(pts[5]))
+    inner = []
+    D = coll.distance_matrix(progress=lambda d, t: inner.append(coll.distance_matrix()) if not inner else None)
+    np.testing.assert_array_equal(inner[0], D)
+
+
 def _noisy_pairs():
     for s in range(6):
         rng = np.random.default_rng(100 + s)
