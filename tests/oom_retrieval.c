@@ -102,26 +102,27 @@ static amscr_status prepare(const amscr_db *db, const amscr_db *more, const amsc
     return st;
 }
 
-static amscr_status build_every_pair(const amscr_db *db, const amscr_db *more, const amscr_index *x, uint64_t *digest)
+/* An index of db built with `candidates`, its digest the saved index's. */
+static amscr_status build(const amscr_db *db, size_t candidates, uint64_t *digest)
 {
-    (void)more, (void)x;
     amscr_index *y = NULL;
-    amscr_status st = amscr_index_build(db, 0, NULL, NULL, &y);
+    amscr_status st = amscr_index_build(db, candidates, NULL, NULL, &y);
     if (st == AMSCR_OK)
         *digest = digest_of(save_index, y);
     amscr_index_free(y);
     return st;
 }
 
+static amscr_status build_every_pair(const amscr_db *db, const amscr_db *more, const amscr_index *x, uint64_t *digest)
+{
+    (void)more, (void)x;
+    return build(db, 0, digest);
+}
+
 static amscr_status build_shortlists(const amscr_db *db, const amscr_db *more, const amscr_index *x, uint64_t *digest)
 {
     (void)more, (void)x;
-    amscr_index *y = NULL;
-    amscr_status st = amscr_index_build(db, 6, NULL, NULL, &y);
-    if (st == AMSCR_OK)
-        *digest = digest_of(save_index, y);
-    amscr_index_free(y);
-    return st;
+    return build(db, 6, digest);
 }
 
 /* A copy of x (its bytes loaded: an index is not copied otherwise), made uncounted: a fresh index
