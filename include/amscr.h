@@ -2750,7 +2750,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  * The query is scored as a new shape even when it is a member's copy (no member rule:
  * amscr_db_search_retrieval applies it).
  * @param[in]  q  a shape prepared with params compatible with the collection's.
- * @param[in]  progress, user  optional progress callback (may be NULL).
+ * @param[in]  progress, user  optional progress callback (may be NULL): the query's pair
+ *             distances; a call that builds the kept index or enters added shapes reports
+ *             that first, as the first of two stages (fractions, see amscr_progress_fn).
  * @param[out] out_scores  n scores, lower is better (see amscr_db_retrieval_matrix).
  * @param[in]  n  must equal amscr_db_size(db).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, incompatible params, open curves with a

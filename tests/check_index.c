@@ -241,6 +241,69 @@ START_TEST(kept_query_from_its_own_callback)
 }
 END_TEST
 
+/* Progress of the retrieval queries: the query that builds (or brings up to date) the kept
+ * index reports that and then the query's own pairs, as fractions that only grow and end at 1;
+ * a query of a kept index reports its pairs, and can be cancelled (NaN, then usable). */
+typedef struct {
+    double last;
+    int calls, cancel_at, monotone, ended;
+} fractions;
+
+static int record_fraction(void *user, size_t done, size_t total)
+{
+    fractions *f = user;
+    ck_assert_uint_gt(total, 0);
+    double x = (double)done / (double)total;
+    f->monotone &= x >= f->last && x <= 1.0;
+    f->ended = done == total;
+    f->last = x;
+    return ++f->calls == f->cancel_at;
+}
+
+static void query_fractions(const amscr_db *db, const amscr_descriptor *q, int member, int cancel_at,
+                            amscr_status want, double *out)
+{
+    fractions f = {0.0, 0, cancel_at, 1, 0};
+    amscr_status st = member ? amscr_db_search_retrieval(db, q, record_fraction, &f, out, amscr_db_size(db))
+                             : amscr_db_query_retrieval(db, q, record_fraction, &f, out, amscr_db_size(db));
+    ck_assert_int_eq(st, want);
+    ck_assert_int_gt(f.calls, 0);
+    ck_assert(f.monotone);
+    if (want == AMSCR_OK)
+        ck_assert(f.ended);
+    else
+        ck_assert_int_eq(f.calls, cancel_at); /* none after the cancel */
+}
+
+START_TEST(kept_query_reports_progress)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_db *db = db_of(p, NSHAPES - 4), *ref_db = db_of(p, NSHAPES - 4);
+    amscr_descriptor *q = shape(p, 1000);
+    double ref[NSHAPES], out[NSHAPES];
+    for (int member = 0; member < 2; member++) {
+        query_fractions(db, q, member, 0, AMSCR_OK, out); /* builds the kept index (once) */
+        query_fractions(db, q, member, 0, AMSCR_OK, out); /* the kept index's query */
+        query_fractions(db, q, member, 1, AMSCR_E_CANCELLED, out);
+        ck_assert(isnan(out[0]) && isnan(out[NSHAPES - 5]));
+        query_fractions(db, q, member, 0, AMSCR_OK, out);
+        ck_assert_int_eq(amscr_db_query_retrieval(ref_db, q, NULL, NULL, ref, NSHAPES - 4), AMSCR_OK);
+        if (!member)
+            assert_close(ref, out, NSHAPES - 4, 0.0);
+    }
+    for (unsigned i = NSHAPES - 4; i < NSHAPES; i++) { /* the kept index brought up to date: two stages */
+        amscr_descriptor *d = shape(p, i);
+        ck_assert_int_eq(amscr_db_add_descriptor(db, d, (int32_t)(i % 6), NULL), AMSCR_OK);
+        amscr_descriptor_free(d);
+    }
+    query_fractions(db, q, 0, 0, AMSCR_OK, out);
+    amscr_descriptor_free(q);
+    amscr_db_free(db);
+    amscr_db_free(ref_db);
+    amscr_params_free(p);
+}
+END_TEST
+
 /* The build's default: every pair up to AMSCR_INDEX_EXACT_MAX shapes, the shortlist above. */
 START_TEST(default_candidates)
 {
@@ -1656,6 +1719,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, bad_files);
     tcase_add_test(tc, add_shapes);
     tcase_add_test(tc, kept_query_from_its_own_callback);
+    tcase_add_test(tc, kept_query_reports_progress);
     tcase_add_test(tc, add_cancelled_leaves_an_index_to_free);
     tcase_add_test(tc, add_grows_the_lists);
     tcase_add_test(tc, thread_independence);

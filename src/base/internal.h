@@ -25,6 +25,16 @@ typedef struct {
 amscr_status amscr__c_numeric_enter(amscr__c_numeric *s);
 void amscr__c_numeric_leave(amscr__c_numeric *s);
 
+/* ---- progress of a call in stages (progress.c) ------------------------ */
+/* Stage `stage` of `stages` (equal shares) of a call reporting to fn(user, ...). */
+typedef struct {
+    amscr_progress_fn fn;
+    void *user;
+    size_t stage, stages;
+} amscr__stages;
+/* A stage's (done, total) reported to sp->fn as its share of the whole; user is an amscr__stages. */
+int amscr__stage_cb(void *user, size_t done, size_t total);
+
 /* ---- errors (errors.c) ------------------------------------------------ */
 /* Sets the calling thread's detail and returns `st`. */
 amscr_status amscr__fail(amscr_status st, const char *fmt, ...) AMSCR_PRINTF(2, 3);

@@ -157,20 +157,6 @@ static void free_hfs(amscr__hf *hf, size_t n)
     free(hf);
 }
 
-/* Progress of one stage mapped into a whole (stage s of `stages`). */
-typedef struct {
-    amscr_progress_fn fn;
-    void *user;
-    size_t stage, stages;
-} stage_progress;
-
-static int stage_cb(void *user, size_t done, size_t total)
-{
-    stage_progress *sp = user;
-    size_t whole = total * sp->stages;
-    return sp->fn(sp->user, sp->stage * total + done, whole);
-}
-
 /* The features of every shape in one frame, a row each (on the collection's threads). */
 typedef struct {
     const amscr_db *db;
@@ -220,8 +206,8 @@ static amscr_status channel_matrix(const amscr_db *db, amscr_progress_fn progres
     amscr_invariance frames[2];
     double share[2];
     int nf = amscr__channel_frames(p, frames, share);
-    stage_progress sp = {progress, user, 0, (size_t)nf};
-    amscr_status st = matrix_in_frame(db, frames[0], 0, progress ? stage_cb : NULL, &sp, out);
+    amscr__stages sp = {progress, user, 0, (size_t)nf};
+    amscr_status st = matrix_in_frame(db, frames[0], 0, progress ? amscr__stage_cb : NULL, &sp, out);
     if (st != AMSCR_OK || nf == 1)
         return st;
     double *second = amscr__malloc_array(n * n, sizeof *second);
@@ -229,7 +215,7 @@ static amscr_status channel_matrix(const amscr_db *db, amscr_progress_fn progres
         st = amscr__fail(AMSCR_E_NOMEM, "shape channel: out of memory");
     sp.stage = 1;
     if (st == AMSCR_OK)
-        st = matrix_in_frame(db, frames[1], 1, progress ? stage_cb : NULL, &sp, second);
+        st = matrix_in_frame(db, frames[1], 1, progress ? amscr__stage_cb : NULL, &sp, second);
     for (size_t i = 0; st == AMSCR_OK && i < n * n; i++)
         out[i] = amscr__channel_combine(p, nf, share, out[i], second[i]);
     free(second); /* NaN on failure: amscr_db_channel_matrix */
@@ -324,10 +310,10 @@ amscr_status amscr__base_matrix(const amscr_db *db, amscr_progress_fn progress, 
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_db_retrieval_matrix: the shape channel needs closed curves; "
                                                 "set the channel weight to 0 for open ones");
     int with_amscr = p->channel_weight < 1.0; /* the channel alone needs no AMSCR matrix */
-    stage_progress sp = {progress, user, 0, (size_t)with_channel + (size_t)with_amscr};
+    amscr__stages sp = {progress, user, 0, (size_t)with_channel + (size_t)with_amscr};
     amscr_status st = AMSCR_OK;
     if (with_amscr) {
-        st = amscr_db_distance_matrix(db, progress ? stage_cb : NULL, &sp, out_dist);
+        st = amscr_db_distance_matrix(db, progress ? amscr__stage_cb : NULL, &sp, out_dist);
         sp.stage = 1;
     }
     if (st != AMSCR_OK || n == 0)
@@ -338,7 +324,7 @@ amscr_status amscr__base_matrix(const amscr_db *db, amscr_progress_fn progress, 
         if (!H)
             st = amscr__fail(AMSCR_E_NOMEM, "amscr_db_retrieval_matrix: out of memory");
         if (st == AMSCR_OK)
-            st = channel_matrix(db, progress ? stage_cb : NULL, &sp, H);
+            st = channel_matrix(db, progress ? amscr__stage_cb : NULL, &sp, H);
     }
     if (st == AMSCR_OK)
         st = fuse(out_dist, H, n, p->channel_weight, med);

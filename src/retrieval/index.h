@@ -111,10 +111,11 @@ size_t amscr__index_k2(const amscr_params *p, size_t k);
 amscr_status amscr__index_check_db(const amscr_db *db, const char *what);
 /* The member rule of the search calls (index_query.c): whether p's scores depend on the
  * collection (re-ranking or fusion), so a member's copy is scored as the member; and
- * amscr_index_search_scores without its checks. */
+ * amscr_index_search_scores (member 1) or amscr_index_query_scores (member 0) with candidates 0,
+ * without their checks, progress (may be NULL) counting the base distances. */
 int amscr__member_rule_applies(const amscr_params *p);
-amscr_status amscr__index_search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates,
-                                        double *out);
+amscr_status amscr__index_row(const amscr_index *x, const amscr_descriptor *q, int member,
+                              amscr_progress_fn progress, void *user, double *out);
 /* Shape i's signature (dequantized) into out[AMSCR__SIG_DIM]. */
 void amscr__index_sig(const amscr_index *x, size_t i, float *out);
 /* Shape i's signature from the floats sig (computed, or read from a file: rounded to 16 bits),

@@ -48,9 +48,10 @@ static size_t shortlist_size(const amscr_index *x, size_t candidates)
     return candidates + 1 < x->k ? x->k - 1 : candidates;
 }
 
-/* Scores of q (self == SIZE_MAX) or of shape self against every shape. */
+/* Scores of q (self == SIZE_MAX) or of shape self against every shape; progress (may be NULL)
+ * counts the base distances. */
 static amscr_status query_scores(const amscr_index *x, const amscr_descriptor *q, size_t self, size_t candidates,
-                                 double *out)
+                                 amscr_progress_fn progress, void *user, double *out)
 {
     size_t n = amscr_db_size(x->db), *cand = amscr__malloc_array(n, sizeof *cand);
     double *dq = amscr__malloc_array(n, sizeof *dq);
@@ -72,7 +73,7 @@ static amscr_status query_scores(const amscr_index *x, const amscr_descriptor *q
     amscr__base b;
     amscr__base_init(&b, amscr_db_params(x->db), x->med_a, x->med_h);
     if (st == AMSCR_OK)
-        st = amscr__base_row(&b, x->db, x->hf, q, self == SIZE_MAX ? SIZE_MAX : self, cand, m, NULL, NULL, dq);
+        st = amscr__base_row(&b, x->db, x->hf, q, self == SIZE_MAX ? SIZE_MAX : self, cand, m, progress, user, dq);
     double *dq2 = st == AMSCR_OK && x->k2 > 0 && self == SIZE_MAX ? amscr__malloc_array(n ? n : 1, sizeof *dq2)
                                                                    : NULL;
     if (st == AMSCR_OK && x->k2 > 0 && self == SIZE_MAX)
@@ -94,7 +95,7 @@ amscr_status amscr_index_query_scores(const amscr_index *x, const amscr_descript
     AMSCR_CHECK_NULL(q);
     AMSCR_CHECK_NULL(out_scores);
     amscr_status st = check_query(x, q, (size_t *)out_scores, n, "amscr_index_query_scores");
-    return st == AMSCR_OK ? query_scores(x, q, SIZE_MAX, candidates, out_scores) : st;
+    return st == AMSCR_OK ? query_scores(x, q, SIZE_MAX, candidates, NULL, NULL, out_scores) : st;
 }
 
 amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t candidates, double *out_scores,
@@ -109,7 +110,7 @@ amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t ca
                            n, amscr_db_size(x->db));
     const amscr_descriptor *d;
     amscr_status st = amscr__db_shape(x->db, i, &d);
-    return st == AMSCR_OK ? query_scores(x, d, i, candidates, out_scores) : st;
+    return st == AMSCR_OK ? query_scores(x, d, i, candidates, NULL, NULL, out_scores) : st;
 }
 
 /* Signature-nearest shapes among which the member rule looks for the query's copy: a copy's
@@ -171,14 +172,15 @@ amscr_status amscr_index_find_member(const amscr_index *x, const amscr_descripto
 }
 
 /* amscr_index_query_scores with the member rule. */
-static amscr_status search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates, double *out)
+static amscr_status search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates,
+                                  amscr_progress_fn progress, void *user, double *out)
 {
     size_t member = SIZE_MAX;
     amscr_status st = amscr__member_rule_applies(amscr_db_params(x->db)) ? find_member(x, q, &member) : AMSCR_OK;
     const amscr_descriptor *d = q;
     if (st == AMSCR_OK && member != SIZE_MAX)
         st = amscr__db_shape(x->db, member, &d);
-    return st == AMSCR_OK ? query_scores(x, d, member, candidates, out) : st;
+    return st == AMSCR_OK ? query_scores(x, d, member, candidates, progress, user, out) : st;
 }
 
 amscr_status amscr_index_search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates,
@@ -190,13 +192,13 @@ amscr_status amscr_index_search_scores(const amscr_index *x, const amscr_descrip
     AMSCR_CHECK_NULL(q);
     AMSCR_CHECK_NULL(out_scores);
     amscr_status st = check_query(x, q, (size_t *)out_scores, n, "amscr_index_search_scores");
-    return st == AMSCR_OK ? search_scores(x, q, candidates, out_scores) : st;
+    return st == AMSCR_OK ? search_scores(x, q, candidates, NULL, NULL, out_scores) : st;
 }
 
-amscr_status amscr__index_search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates,
-                                        double *out)
+amscr_status amscr__index_row(const amscr_index *x, const amscr_descriptor *q, int member,
+                              amscr_progress_fn progress, void *user, double *out)
 {
-    return search_scores(x, q, candidates, out);
+    return member ? search_scores(x, q, 0, progress, user, out) : query_scores(x, q, SIZE_MAX, 0, progress, user, out);
 }
 
 /* The top best of the query's scores (the member rule when `member`): the body of
@@ -217,7 +219,8 @@ static amscr_status best_hits(const amscr_index *x, const amscr_descriptor *q, s
     if (st == AMSCR_OK && !all)
         st = amscr__fail(AMSCR_E_NOMEM, "%s: out of memory", fn);
     if (st == AMSCR_OK)
-        st = member ? search_scores(x, q, candidates, all) : query_scores(x, q, SIZE_MAX, candidates, all);
+        st = member ? search_scores(x, q, candidates, NULL, NULL, all)
+                    : query_scores(x, q, SIZE_MAX, candidates, NULL, NULL, all);
     if (st == AMSCR_OK && k > 0)
         st = amscr_topk(all, n, k, SIZE_MAX, out_idx);
     for (size_t t = 0; st == AMSCR_OK && t < k; t++)

@@ -54,8 +54,9 @@ static amscr_status kept_refresh(const amscr_db *db, kept_index *k, amscr_progre
     return st;
 }
 
-/* The index db keeps for its queries, up to date (built or extended under the collection's lock). */
-static amscr_status kept(const amscr_db *db, amscr_progress_fn progress, void *user, const amscr_index **out)
+/* The index db keeps for its queries, up to date (built or extended under the collection's lock).
+ * A query that must bring it up to date reports that as the first of its two stages (sp). */
+static amscr_status kept(const amscr_db *db, amscr__stages *sp, const amscr_index **out)
 {
     void **slot = amscr__db_kept_lock(db, kept_free);
     if (!slot)
@@ -68,8 +69,11 @@ static amscr_status kept(const amscr_db *db, amscr_progress_fn progress, void *u
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_db_query_retrieval: out of memory");
     else
         *slot = k;
-    if (st == AMSCR_OK && (!k->x || k->n != amscr_db_size(db)))
-        st = kept_refresh(db, k, progress, user);
+    if (st == AMSCR_OK && (!k->x || k->n != amscr_db_size(db))) {
+        sp->stages = 2;
+        st = kept_refresh(db, k, sp->fn ? amscr__stage_cb : NULL, sp);
+        sp->stage = 1;
+    }
     *out = st == AMSCR_OK ? k->x : NULL;
     amscr__db_kept_unlock(db);
     return st;
@@ -109,10 +113,10 @@ static amscr_status db_query(const amscr_db *db, const amscr_descriptor *q, amsc
         st = plain_row(db, q, progress, user, out_scores);
     else {
         const amscr_index *x = NULL;
-        st = kept(db, progress, user, &x);
-        if (st == AMSCR_OK)
-            st = member ? amscr__index_search_scores(x, q, 0, out_scores) /* every shape a candidate */
-                        : amscr_index_query_scores(x, q, 0, out_scores, n);
+        amscr__stages sp = {progress, user, 0, 1};
+        st = kept(db, &sp, &x);
+        if (st == AMSCR_OK) /* every shape a candidate */
+            st = amscr__index_row(x, q, member, progress ? amscr__stage_cb : NULL, &sp, out_scores);
     }
     return amscr__nan_on_failure(st, out_scores, 1, n); /* never a partial row */
 }

@@ -376,6 +376,15 @@ def test_progress_bar_and_callbacks(collection, capfd):
         collection.query(blob(200), progress=lambda d, t: True)
     # still usable after a cancellation
     np.testing.assert_array_equal(collection.distance_matrix(), D)
+    ranked = amscr.Collection(amscr.Params.retrieval(points=64))
+    ranked.extend([blob(200, seed=s) for s in range(12)])
+    scores = ranked.query(blob(200))  # builds its kept index; a query of that reports and cancels
+    seen.clear()
+    np.testing.assert_array_equal(ranked.query(blob(200), progress=lambda d, t: seen.append((d, t))), scores)
+    assert seen and seen[-1][0] == seen[-1][1]
+    with pytest.raises(amscr.CancelledError):
+        ranked.query(blob(200), progress=lambda d, t: True)
+    np.testing.assert_array_equal(ranked.query(blob(200)), scores)
 
 
 def test_a_collection_used_from_its_own_progress_callback(shapes):
