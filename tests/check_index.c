@@ -1267,6 +1267,28 @@ START_TEST(add_cancelled_leaves_an_index_to_free)
 }
 END_TEST
 
+/* A query of an empty collection is no work: no report (it reported 0 of 0, twice), AMSCR_OK. */
+START_TEST(empty_collection_query_reports_nothing)
+{
+    for (int ranked = 0; ranked < 2; ranked++) {
+        amscr_params *p = params_of(ranked ? 1.0 : 0.0, ranked ? 8 : 0, 2);
+        amscr_db *db = NULL;
+        ck_assert_int_eq(amscr_db_new(p, &db), AMSCR_OK);
+        amscr_descriptor *q = shape(p, 5);
+        double out[1] = {7.0};
+        reports_seen = 0;
+        ck_assert_int_eq(amscr_db_query_retrieval(db, q, cancel_at_first, NULL, out, 0), AMSCR_OK);
+        ck_assert_int_eq(amscr_db_search_retrieval(db, q, cancel_at_first, NULL, out, 0), AMSCR_OK);
+        ck_assert_int_eq(amscr_db_query(db, q, cancel_at_first, NULL, out), AMSCR_OK);
+        ck_assert_int_eq(reports_seen, 0);
+        ck_assert(out[0] == 7.0);
+        amscr_descriptor_free(q);
+        amscr_db_free(db);
+        amscr_params_free(p);
+    }
+}
+END_TEST
+
 /* Shapes added to an index of fewer than twice its re-ranking k, whose lists grow with its size:
  * the index is built again on its shapes and the new ones (the queries a build's), its names,
  * groups and class names kept; one shape at a time from an empty index too. */
@@ -1720,6 +1742,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, add_shapes);
     tcase_add_test(tc, kept_query_from_its_own_callback);
     tcase_add_test(tc, kept_query_reports_progress);
+    tcase_add_test(tc, empty_collection_query_reports_nothing);
     tcase_add_test(tc, add_cancelled_leaves_an_index_to_free);
     tcase_add_test(tc, add_grows_the_lists);
     tcase_add_test(tc, thread_independence);

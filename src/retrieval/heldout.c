@@ -9,19 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Progress of one of `stages` stages mapped into the whole. */
-typedef struct {
-    amscr_progress_fn fn;
-    void *user;
-    size_t stage, stages;
-} ho_progress;
-
-static int ho_cb(void *user, size_t done, size_t total)
-{
-    ho_progress *sp = user;
-    return sp->fn(sp->user, sp->stage * total + done, total * sp->stages);
-}
-
 static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -80,10 +67,10 @@ static amscr_status ho_pairs(const amscr_db *db, amscr_progress_fn progress, voi
     if ((with_a && !b->A) || (with_h && !b->H) || (with_i && !b->I) || !b->B || !b->R || (with_a && with_h && !b->v) ||
         !b->held)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_db_retrieval_matrix_heldout: out of memory (n = %zu)", n);
-    ho_progress sp = {progress, user, 0, (size_t)with_a + (size_t)with_h};
+    amscr__stages sp = {progress, user, 0, (size_t)with_a + (size_t)with_h};
     amscr_status st = AMSCR_OK;
     if (with_a) {
-        st = amscr_db_distance_matrix(db, progress ? ho_cb : NULL, &sp, b->A);
+        st = amscr_db_distance_matrix(db, progress ? amscr__stage_cb : NULL, &sp, b->A);
         sp.stage++;
         for (size_t i = 0; st == AMSCR_OK && i < n; i++) {
             b->A[i * n + i] = 0.0;
@@ -92,7 +79,7 @@ static amscr_status ho_pairs(const amscr_db *db, amscr_progress_fn progress, voi
         }
     }
     if (st == AMSCR_OK && with_h)
-        st = amscr_db_channel_matrix(db, progress ? ho_cb : NULL, &sp, b->H);
+        st = amscr_db_channel_matrix(db, progress ? amscr__stage_cb : NULL, &sp, b->H);
     if (st == AMSCR_OK && with_i)
         st = amscr__inner_matrix(db, amscr__resolve_threads(p->num_threads), NULL, NULL, b->I);
     return st;

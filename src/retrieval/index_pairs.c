@@ -315,6 +315,8 @@ amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const ams
                              const amscr_descriptor *q, size_t qpos, const size_t *cand, size_t m,
                              amscr_progress_fn progress, void *user, double *out)
 {
+    if (m == 0) /* no work: no report (a percentage callback would divide by 0) */
+        return AMSCR_OK;
     amscr__hf hq[2];
     amscr_status st = amscr__base_hf(b, q, hq);
     if (st != AMSCR_OK)
