@@ -172,7 +172,7 @@ def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: boo
     if a.ndim == 3 and a.shape[1:] == (1, 2):  # an OpenCV contour
         a = a[:, 0, :]
         if closed_shape and a.dtype.kind in 'iu':
-            a = expand_chain(a)
+            a = expand_chain(a, name)
     if a.ndim != 2 or a.shape[1] != 2:
         hint = CONTOURS_HINT if a.ndim == 4 and a.shape[2:] == (1, 2) else ''
         raise bad('%s: expected an array of shape (n, 2) (one x, y row per point) or (n, 1, 2) (OpenCV), '
@@ -189,17 +189,23 @@ def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: boo
     return a
 
 
-def expand_chain(a: np.ndarray) -> np.ndarray:
+def expand_chain(a: np.ndarray, name: str = 'points') -> np.ndarray:
     """The closed pixel chain an integer (n, 2) contour compressed by OpenCV's
     ``CHAIN_APPROX_SIMPLE`` stands for: each step to the next point (the last to the first
     included) along one of the 8 grid directions, split into unit steps (the points the
     compression dropped: the same outline, as ``CHAIN_APPROX_NONE`` gives it). `a` itself when
-    some step is not along a grid direction or every step is already a unit step."""
+    some step is not along a grid direction or every step is already a unit step. A chain of
+    more points than a contour may hold (``AMSCR_MAX_POINTS``) is an InvalidArgumentError, raised
+    before it is made."""
     d = np.roll(a, -1, axis=0).astype(np.int64) - a
     k = np.abs(d).max(axis=1)
     along = (k > 0) & ((d[:, 0] == 0) | (d[:, 1] == 0) | (np.abs(d[:, 0]) == np.abs(d[:, 1])))
     if a.shape[0] < 2 or not along.all() or k.max() <= 1:
         return a
+    if int(k.sum()) > lib.AMSCR_MAX_POINTS:
+        raise bad('%s: this integer OpenCV contour stands for a pixel chain of %d points, more than the %d a '
+                  'contour may hold (give its points as floats to use them as they are)'
+                  % (name, int(k.sum()), lib.AMSCR_MAX_POINTS))
     i = np.repeat(np.arange(a.shape[0]), k)
     j = np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k)
     return a[i] + (d // k[:, None])[i] * j[:, None]

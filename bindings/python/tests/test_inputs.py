@@ -158,6 +158,12 @@ def test_a_compressed_opencv_chain_is_read_as_the_chain():
     # a step off the 8 grid directions: not a compressed chain, taken as given
     poly = np.array([[0, 0], [5, 1], [3, 4]], dtype=np.int32)
     assert amscr._util.expand_chain(poly) is poly
+    # a chain longer than a contour may be: a clear error before it is made (it allocated 30 GiB)
+    square = np.array([[0, 0], [10**9, 0], [10**9, 10**9], [0, 10**9]], dtype=np.int32).reshape(-1, 1, 2)
+    with pytest.raises(amscr.InvalidArgumentError, match='pixel chain of 4000000000 points.*as floats'):
+        amscr.Shape(square)
+    with pytest.raises(amscr.DegenerateError, match='4 distinct points'):  # as floats: the 4 corners
+        amscr.Shape(square.astype(float))
 
 
 # -- with OpenCV ------------------------------------------------------------------------------
