@@ -49,8 +49,9 @@ static int write_all(int fd, const unsigned char *buf, size_t len)
 }
 
 /* Gives the written unnamed file fd the name path: a link when path is new, else a link under a
- * fresh temporary name renamed over it (the name exists for the rename's instant). 0 with errno
- * set when it cannot. */
+ * fresh temporary name renamed over it (the name exists for the rename's instant). 1 on success;
+ * 0 with errno set when it cannot link; -1 with errno set when the rename failed (a temporary
+ * name would fail there too). */
 static int name_unnamed(int fd, const char *path, char *tmp, size_t tmp_len)
 {
     char proc[64];
@@ -67,7 +68,7 @@ static int name_unnamed(int fd, const char *path, char *tmp, size_t tmp_len)
             int e = errno;
             unlink(tmp);
             errno = e;
-            return 0;
+            return -1;
         }
         if (errno != EEXIST)
             return 0;
@@ -103,9 +104,10 @@ static int write_unnamed(const char *path, const void *buf, size_t len, char *tm
     }
     int named = name_unnamed(fd, path, tmp, tmp_len), e = errno;
     close(fd);
-    if (!named && (e == ENOENT || e == EPERM || e == EOPNOTSUPP || e == EXDEV))
+    if (named == 0 && (e == ENOENT || e == EPERM || e == EOPNOTSUPP || e == EXDEV))
         return 0; /* no /proc, or no links here: the temporary name's way */
-    *st = named ? AMSCR_OK : amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, amscr__errstr(e, eb, sizeof eb));
+    *st = named == 1 ? AMSCR_OK
+                     : amscr__fail(AMSCR_E_IO, "%s: cannot write: %s", path, amscr__errstr(e, eb, sizeof eb));
     return 1;
 #else
     (void)path, (void)buf, (void)len, (void)tmp, (void)tmp_len, (void)st;

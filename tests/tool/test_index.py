@@ -467,6 +467,31 @@ def test_a_killed_save_leaves_the_old_file_and_nothing_else(tmp_path, what):
         assert sorted(os.listdir(out)) == [name]
 
 
+@pytest.mark.skipif(shutil.which("strace") is None, reason="strace is not installed (scripts/setup.sh installs it)")
+def test_a_refused_rename_fails_once(tmp_path):
+    """An index whose replacing rename is refused (EPERM, injected: a sticky folder, an immutable
+    file) is an error naming the reason, the old file kept and nothing beside it, after one
+    attempt: the library wrote the whole file a second time under a temporary name before."""
+    import subprocess
+
+    from imgutil import tool_path
+    m = make_manifest(tmp_path)
+    out = tmp_path / "out"
+    out.mkdir()
+    args = ["index", str(m), "-o", str(out / "x.idx")]
+    assert run(*args).returncode == 0
+    good = (out / "x.idx").read_bytes()
+    trace = tmp_path / "trace.txt"
+    r = subprocess.run(["strace", "-qq", "-f", "-o", str(trace), "-e", "trace=rename,renameat,renameat2",
+                        "-e", "inject=rename,renameat,renameat2:error=EPERM", tool_path()] + args,
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "x.idx: cannot write: Operation not permitted" in r.stderr, r.stderr
+    assert (out / "x.idx").read_bytes() == good
+    assert sorted(os.listdir(out)) == ["x.idx"]
+    renames = [line for line in trace.read_text().splitlines() if "x.idx" in line]
+    assert len(renames) == 1, renames
+
+
 def signal_number(name):
     import signal
     return int(getattr(signal, name))
