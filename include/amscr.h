@@ -3128,11 +3128,10 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory(const void *buf, 
  *        collection file without an index (amscr_db_save) and index files of an older,
  *        separate format are AMSCR_E_FORMAT with a detail saying to build the index again.
  * Memory: about 16.5 KB a shape once loaded (20.5 KB with AMSCR_INDEX_LAZY; the retrieval
- *         preset at N = 128, mpeg7-dev's 700 shapes). A shape the index reads whole (a
- *         member's row for amscr_index_member_scores or a search whose query is a member's
- *         copy, amscr_db_descriptor of amscr_index_db) is decoded into its prepared shape and
- *         kept until amscr_index_free, about 36 KB more a shape: a long-running search service
- *         whose queries are members reaches about 53 KB a shape, then stays there.
+ *         preset at N = 128, mpeg7-dev's 700 shapes). Queries and searches (members' rows and
+ *         copies too) read the shapes without keeping them: a long-running search service
+ *         stays at that size. A shape read through amscr_db_descriptor of amscr_index_db is
+ *         decoded into its prepared shape and kept until amscr_index_free, about 36 KB more.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, an unknown flag); AMSCR_E_IO; AMSCR_E_LIMIT;
  *         AMSCR_E_FORMAT (wrong magic, version, checksum, truncated or inconsistent
  *         content); AMSCR_E_NOMEM.

@@ -1289,6 +1289,47 @@ START_TEST(empty_collection_query_reports_nothing)
 }
 END_TEST
 
+/* Queries, searches (of members' copies too) and member rows of a loaded index read its shapes
+ * without keeping them decoded: its memory does not grow with its queries (a search decoded its
+ * 32 signature-nearest shapes for the member rule and kept them, ~36 KB a shape). Only
+ * amscr_db_descriptor of amscr_index_db keeps the shape it decodes. */
+START_TEST(queries_keep_no_decoded_shape)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_db *db = db_of(p, NSHAPES);
+    amscr_index *x = NULL;
+    ck_assert_int_eq(amscr_index_build(db, 0, NULL, NULL, &x), AMSCR_OK);
+    void *buf = NULL;
+    size_t len = 0, idx[5], cnt, member = 0;
+    ck_assert_int_eq(amscr_index_save_memory(x, &buf, &len), AMSCR_OK);
+    for (unsigned flags = 0; flags <= AMSCR_INDEX_LAZY; flags++) {
+        amscr_index *y = NULL;
+        ck_assert_int_eq(amscr_index_load_memory_with(buf, len, flags, &y), AMSCR_OK);
+        double a[NSHAPES], b[NSHAPES], top[5];
+        for (size_t i = 0; i < NSHAPES; i++) {
+            amscr_descriptor *copy = shape(p, (unsigned)i), *other = shape(p, 2000 + (unsigned)i);
+            ck_assert_int_eq(amscr_index_search_scores(y, copy, 0, a, NSHAPES), AMSCR_OK);
+            ck_assert_int_eq(amscr_index_member_scores(y, i, 0, b, NSHAPES), AMSCR_OK);
+            assert_close(a, b, NSHAPES, 0.0); /* the copy scored as the member */
+            ck_assert_int_eq(amscr_index_find_member(y, copy, &member), AMSCR_OK);
+            ck_assert_uint_eq(member, i);
+            ck_assert_int_eq(amscr_index_search(y, other, 0, 5, idx, top, &cnt), AMSCR_OK);
+            ck_assert_int_eq(amscr_index_query(y, other, 0, 5, idx, top, &cnt), AMSCR_OK);
+            amscr_descriptor_free(copy);
+            amscr_descriptor_free(other);
+        }
+        ck_assert_uint_eq(amscr__db_decoded(amscr_index_db(y)), 0);
+        ck_assert_ptr_nonnull(amscr_db_descriptor(amscr_index_db(y), 3)); /* decoded, and kept */
+        ck_assert_uint_eq(amscr__db_decoded(amscr_index_db(y)), 1);
+        amscr_index_free(y);
+    }
+    free(buf);
+    amscr_index_free(x);
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+END_TEST
+
 /* Shapes added to an index of fewer than twice its re-ranking k, whose lists grow with its size:
  * the index is built again on its shapes and the new ones (the queries a build's), its names,
  * groups and class names kept; one shape at a time from an empty index too. */
@@ -1743,6 +1784,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, kept_query_from_its_own_callback);
     tcase_add_test(tc, kept_query_reports_progress);
     tcase_add_test(tc, empty_collection_query_reports_nothing);
+    tcase_add_test(tc, queries_keep_no_decoded_shape);
     tcase_add_test(tc, add_cancelled_leaves_an_index_to_free);
     tcase_add_test(tc, add_grows_the_lists);
     tcase_add_test(tc, thread_independence);

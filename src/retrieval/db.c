@@ -313,6 +313,17 @@ const amscr_descriptor *amscr__db_descriptor_peek(const amscr_db *db, size_t i, 
     return *tmp;
 }
 
+size_t amscr__db_decoded(const amscr_db *db)
+{
+    amscr_db *m = (amscr_db *)(uintptr_t)db;
+    size_t count = 0;
+    pthread_mutex_lock(&m->lock);
+    for (size_t i = 0; i < db->nsrc; i++)
+        count += db->d[i] != NULL;
+    pthread_mutex_unlock(&m->lock);
+    return count;
+}
+
 const unsigned char *amscr__db_record(const amscr_db *db, size_t i)
 {
     return i < db->nsrc && db->src_compact ? db->src + db->src_pos0 + i * db->src_per : NULL;

@@ -39,6 +39,9 @@ amscr_status amscr__db_compact_copy(const amscr_db *db, amscr_db **out);
  * yet, decoded into *tmp for the caller to free (the collection keeps nothing). NULL: out of
  * memory or a bad record. */
 const amscr_descriptor *amscr__db_descriptor_peek(const amscr_db *db, size_t i, amscr_descriptor **tmp);
+/* How many of the shapes db decodes from its source are decoded and kept (the memory its reads
+ * added: tests). */
+size_t amscr__db_decoded(const amscr_db *db);
 /* Shape i's compact record (amscr__db_shape_bytes of AMSCR__DB_VERSION_INDEX_COMPACT bytes) when
  * a lazy collection holds it as one, else NULL. */
 const unsigned char *amscr__db_record(const amscr_db *db, size_t i);

@@ -39,6 +39,16 @@ static amscr_status check_query(const amscr_index *x, const amscr_descriptor *q,
     return AMSCR_OK;
 }
 
+/* Shape i of x's collection for one query: the collection's own, or, when a lazy load has not
+ * decoded it, decoded into *tmp for the caller to free (queries leave the collection as loaded:
+ * its memory does not grow with the shapes they read). */
+static amscr_status shape_for_query(const amscr_index *x, size_t i, const amscr_descriptor **d,
+                                    amscr_descriptor **tmp)
+{
+    *d = amscr__db_descriptor_peek(x->db, i, tmp);
+    return *d ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory decoding shape %zu", i);
+}
+
 /* The shapes a query is matched with: every shape (0 or >= n) or at least k - 1. */
 static size_t shortlist_size(const amscr_index *x, size_t candidates)
 {
@@ -109,8 +119,12 @@ amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t ca
         return amscr__fail(AMSCR_E_INVALID_ARG, "amscr_index_member_scores: shape %zu, %zu scores, %zu shapes", i,
                            n, amscr_db_size(x->db));
     const amscr_descriptor *d;
-    amscr_status st = amscr__db_shape(x->db, i, &d);
-    return st == AMSCR_OK ? query_scores(x, d, i, candidates, NULL, NULL, out_scores) : st;
+    amscr_descriptor *tmp = NULL;
+    amscr_status st = shape_for_query(x, i, &d, &tmp);
+    if (st == AMSCR_OK)
+        st = query_scores(x, d, i, candidates, NULL, NULL, out_scores);
+    amscr_descriptor_free(tmp);
+    return st;
 }
 
 /* Signature-nearest shapes among which the member rule looks for the query's copy: a copy's
@@ -118,13 +132,17 @@ amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t ca
  * among them unless this many shapes have the query's very signature without its samples. */
 enum { MEMBER_SHORTLIST = 32 };
 
-/* Whether shape j of x has q's prepared samples, bit for bit, into *same (a lazy load decodes
- * shape j here: AMSCR_E_NOMEM when that runs out of memory). */
-static amscr_status same_samples(const amscr_index *x, size_t j, const amscr_descriptor *q, int *same)
+/* Whether shape j of x has q's prepared samples, bit for bit, into *same: read from its record
+ * when the collection keeps it as one (buf: 2 N + 2 AMSCR__OUTLINE_N values), else from the
+ * shape (AMSCR_E_NOMEM when decoding it runs out of memory). */
+static amscr_status same_samples(const amscr_index *x, size_t j, const amscr_descriptor *q, double *buf, int *same)
 {
-    const amscr_descriptor *d;
-    amscr_status st = amscr__db_shape(x->db, j, &d);
+    size_t N = amscr_db_params(x->db)->num_samples;
+    amscr_descriptor sd, *tmp = NULL;
+    const amscr_descriptor *d = &sd;
+    amscr_status st = amscr__db_shallow(x->db, j, &sd, buf, buf + 2 * N) ? AMSCR_OK : shape_for_query(x, j, &d, &tmp);
     *same = st == AMSCR_OK && d->n == q->n && memcmp(d->input, q->input, 2 * q->n * sizeof *q->input) == 0;
+    amscr_descriptor_free(tmp);
     return st;
 }
 
@@ -135,8 +153,9 @@ static amscr_status find_member(const amscr_index *x, const amscr_descriptor *q,
     size_t n = amscr_db_size(x->db), m = n < MEMBER_SHORTLIST ? n : MEMBER_SHORTLIST, found = SIZE_MAX;
     size_t cand[MEMBER_SHORTLIST];
     float sig[AMSCR__SIG_DIM], lb[AMSCR__SIG_LB_DIM];
-    amscr_status st = AMSCR_OK;
-    if (m > 0) {
+    double *buf = amscr__malloc_array(2 * amscr_db_params(x->db)->num_samples + 2 * AMSCR__OUTLINE_N, sizeof *buf);
+    amscr_status st = buf ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory");
+    if (st == AMSCR_OK && m > 0) {
         amscr__shape_signature(q, sig);
         amscr__sig_bound_vector(sig, lb);
         if (amscr__index_shortlist(x, sig, lb, m, SIZE_MAX, cand) != m)
@@ -145,9 +164,10 @@ static amscr_status find_member(const amscr_index *x, const amscr_descriptor *q,
     /* ascending index: the first copy is the lowest */
     for (size_t t = 0; st == AMSCR_OK && t < m && found == SIZE_MAX; t++) {
         int same;
-        st = same_samples(x, cand[t], q, &same);
+        st = same_samples(x, cand[t], q, buf, &same);
         found = same ? cand[t] : SIZE_MAX;
     }
+    free(buf);
     if (st == AMSCR_OK)
         *out = found;
     return st;
@@ -178,9 +198,13 @@ static amscr_status search_scores(const amscr_index *x, const amscr_descriptor *
     size_t member = SIZE_MAX;
     amscr_status st = amscr__member_rule_applies(amscr_db_params(x->db)) ? find_member(x, q, &member) : AMSCR_OK;
     const amscr_descriptor *d = q;
+    amscr_descriptor *tmp = NULL;
     if (st == AMSCR_OK && member != SIZE_MAX)
-        st = amscr__db_shape(x->db, member, &d);
-    return st == AMSCR_OK ? query_scores(x, d, member, candidates, progress, user, out) : st;
+        st = shape_for_query(x, member, &d, &tmp);
+    if (st == AMSCR_OK)
+        st = query_scores(x, d, member, candidates, progress, user, out);
+    amscr_descriptor_free(tmp);
+    return st;
 }
 
 amscr_status amscr_index_search_scores(const amscr_index *x, const amscr_descriptor *q, size_t candidates,
