@@ -188,6 +188,11 @@ FILE *amscr__fopen_read(const char *path)
     return f;
 }
 
+/* The largest buffer a read grows (by doubling, for a pipe) before a file is "too large": 1 TiB,
+ * or half the address space where that is less (a 32-bit size_t: 1 << 40 did not fit, and every
+ * pipe past 64 KiB was "too large"). */
+static const uint64_t READ_MAX = SIZE_MAX / 2 < ((uint64_t)1 << 40) ? SIZE_MAX / 2 : ((uint64_t)1 << 40);
+
 amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out_len)
 {
     FILE *f = amscr__fopen_read(path);
@@ -201,7 +206,7 @@ amscr_status amscr__file_read(const char *path, unsigned char **out, size_t *out
     int rerr = 0; /* errno of a failed read (EISDIR: a folder) */
     while (buf) {
         if (len == cap) {
-            if (cap > ((size_t)1 << 40)) {
+            if ((uint64_t)cap > READ_MAX) {
                 st = amscr__fail(AMSCR_E_LIMIT, "%s: file too large", path);
                 break;
             }
