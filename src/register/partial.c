@@ -140,9 +140,9 @@ static void keep_placement(placement *best, size_t *nb, const placement *c)
         (*nb)++;
 }
 
-/* One closest-point pass: partners of X f_a on the dense target Hd (nd edges, closed; lengths
- * edges E) within b[a] ± w; q, r2, b updated; returns the trimmed cost, *cut its cut-off. */
-static double pairs(const amscr_descriptor *f, const double *Hd, const double *E, size_t nd, const double X[6],
+/* One closest-point pass: partners of X f_a on the dense target's nd edges E (closed) within
+ * b[a] ± w; q, r2, b updated; returns the trimmed cost, *cut its cut-off. */
+static double pairs(const amscr_descriptor *f, const double *E, size_t nd, const double X[6],
                     size_t w, double *q, double *r2, double *sorted, double *b, double *cut)
 {
     size_t n = f->n;
@@ -170,12 +170,12 @@ static double refine_placement(const amscr_params *prm, const amscr_descriptor *
                                double *sorted, double *out_cut)
 {
     size_t n = f->n, wide = AMSCR__DENSE * (n / PART_WINDOW_DIV), near = AMSCR__DENSE * PART_HINT;
-    double cut, cost = pairs(f, Hd, E, nd, X, wide, q, r2, sorted, b, &cut);
+    double cut, cost = pairs(f, E, nd, X, wide, q, r2, sorted, b, &cut);
     for (unsigned it = 0; it < PART_ITERS; it++) {
         double Xn[6], cutn;
         if (!amscr__plane_solve(prm, f->base, q, r2, b, Hd, nd, n, cut, Xn))
             break;
-        double costn = pairs(f, Hd, E, nd, Xn, it == 0 ? wide : near, q, r2, sorted, b, &cutn);
+        double costn = pairs(f, E, nd, Xn, it == 0 ? wide : near, q, r2, sorted, b, &cutn);
         int done = !(costn < cost * (1.0 - 1e-6));
         memcpy(X, Xn, 6 * sizeof *X);
         cost = costn;

@@ -112,7 +112,8 @@ static int inner_matrix_of(const double *V, double *D)
  * b's already): tw[0] + i tw[1] = (re + i im) e^{-2 pi i f (k + 1) / N}. */
 static void twist(const amscr__inner *b, amscr__inner_ws *ws)
 {
-    if (ws->have_tw && memcmp(ws->tw_of, b->re, sizeof ws->tw_of) == 0)
+    if (ws->have_tw && memcmp(ws->tw_of[0], b->re, sizeof b->re) == 0 &&
+        memcmp(ws->tw_of[1], b->im, sizeof b->im) == 0)
         return;
     for (size_t q = 0; q < AMSCR__INNER_F; q++)
         for (size_t k = 0; k < AMSCR__INNER_K; k++) {
@@ -121,7 +122,8 @@ static void twist(const amscr__inner *b, amscr__inner_ws *ws)
             ws->tw[0][q][k] = br * c[0] - bi * c[1];
             ws->tw[1][q][k] = br * c[1] + bi * c[0];
         }
-    memcpy(ws->tw_of, b->re, sizeof ws->tw_of);
+    memcpy(ws->tw_of[0], b->re, sizeof b->re);
+    memcpy(ws->tw_of[1], b->im, sizeof b->im);
     ws->have_tw = 1;
 }
 
