@@ -7,6 +7,7 @@ import os
 import sys
 import threading
 import time
+import warnings
 from typing import TYPE_CHECKING, Any, Callable, Iterator, Literal, Optional, Protocol, Tuple, Union
 
 import numpy as np
@@ -119,7 +120,11 @@ def not_real(name: str, x: Any, a: np.ndarray) -> InvalidArgumentError:
 CONTOURS_HINT = ' (a list of OpenCV contours? pass one of them, e.g. max(contours, key=cv2.contourArea))'
 
 
-def not_regular(name: str, x: Any, e: ValueError) -> InvalidArgumentError:
+#: What NumPy before 1.24 warned of a ragged list, where later ones raise ValueError.
+RAGGED_WARNING = getattr(getattr(np, 'exceptions', np), 'VisibleDeprecationWarning', DeprecationWarning)
+
+
+def not_regular(name: str, x: Any, e: Exception) -> InvalidArgumentError:
     """The error for points NumPy cannot make one array of (ragged lists): for a list of
     OpenCV contours of different lengths, the hint to pass one of them."""
     if isinstance(x, (list, tuple)) and x and all(isinstance(c, np.ndarray) and c.ndim == 3 and c.shape[1:] == (1, 2)
@@ -164,8 +169,10 @@ def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: boo
     x = unmasked(image_contour_points(x), name,
                  'the points to keep, e.g. points[~points.mask.any(axis=1)], or points.filled(value)')
     try:
-        a = np.asarray(x)
-    except ValueError as e:  # ragged nested lists, e.g. the whole tuple cv2.findContours returns
+        with warnings.catch_warnings():  # NumPy < 1.24 made ragged lists object arrays, with this warning
+            warnings.simplefilter('error', RAGGED_WARNING)
+            a = np.asarray(x)
+    except (ValueError, RAGGED_WARNING) as e:  # ragged nested lists, e.g. the whole tuple cv2.findContours returns
         raise not_regular(name, x, e) from None
     if a.dtype.kind not in 'iuf':
         raise not_real(name, x, a)

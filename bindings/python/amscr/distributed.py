@@ -60,7 +60,7 @@ try:
     import distributed
     from distributed import as_completed
 except ImportError as e:  # pragma: no cover - exercised only without Dask
-    raise ImportError('amscr.distributed needs Dask: pip install "dask[distributed]>=2023" '
+    raise ImportError('amscr.distributed needs Dask: pip install "dask[distributed]>=2023.4" '
                       '(or pip install "amscr[distributed]")') from e
 
 from ._lib import ffi, lib

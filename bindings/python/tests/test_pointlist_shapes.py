@@ -7,13 +7,14 @@ Measured: ~3 s."""
 import os
 import sys
 
-import cv2
 import numpy as np
 import pytest
 
-import amscr
+cv2 = pytest.importorskip('cv2')
 
-import shapegen
+import amscr  # noqa: E402
+
+import shapegen  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'bench'))
 import registration_heldout as bench  # noqa: E402
