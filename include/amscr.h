@@ -2743,7 +2743,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  *       exact index for its queries: the first such call builds it (n^2 pair distances, as
  *       amscr_index_build with candidates 0), the first call after shapes were added enters
  *       them (n pair distances a new shape), and each call then costs n pair distances and
- *       the re-ranking of one row, as amscr_index_query_scores with candidates 0.
+ *       the re-ranking of one row, as amscr_index_query_scores with candidates 0. A build or
+ *       update that was cancelled or failed leaves no kept index: the next call builds it on
+ *       every shape (so its medians are the whole collection's).
  * Memory: the kept index (channel and inner features, signature, lists; not a copy of the
  *       shapes), until amscr_db_free.
  * Prefer an amscr_index to save the preparation in a file or to query with a shortlist.
