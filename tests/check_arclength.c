@@ -396,6 +396,12 @@ START_TEST(test_resample_euclid_square)
     const double sq3[14] = {0, 0, 0, 0, 1, 0, 1, 1, 1, 1, 0, 1, 0, 1};
     ck_assert_int_eq(amscr_resample_euclidean(sq3, 7, 1, 8, out), AMSCR_OK);
     assert_points(out, expect, 8, 1e-12, "square with repeats");
+    /* at least 2 points in and out (the header's n, m >= 2); the output untouched when refused */
+    out[0] = -7.0;
+    ck_assert_int_eq(amscr_resample_euclidean(sq, 4, 1, 1, out), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_resample_euclidean(sq, 1, 1, 8, out), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_resample_euclidean(sq, 4, 0, 1, out), AMSCR_E_INVALID_ARG);
+    ck_assert_double_eq(out[0], -7.0);
 }
 END_TEST
 

@@ -3,6 +3,7 @@
 #include <check.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "suites.h"
@@ -84,6 +85,15 @@ START_TEST(test_detail_set_after_failure)
     ck_assert_ptr_nonnull(d);
     ck_assert_msg(d[0] != '\0', "no detail after amscr_contour_new(NULL, 5, &c)");
     ck_assert_msg(strlen(d) < 4096, "detail not terminated sensibly");
+    /* no points, and one past the limit (its pages never touched: the count is refused first) */
+    double xy[2] = {0.0, 0.0};
+    ck_assert_int_eq(amscr_contour_new(xy, 0, &c), AMSCR_E_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), "no points"));
+    double *big = calloc(2 * ((size_t)AMSCR_MAX_POINTS + 1), sizeof *big);
+    ck_assert_ptr_nonnull(big);
+    ck_assert_int_eq(amscr_contour_new(big, (size_t)AMSCR_MAX_POINTS + 1, &c), AMSCR_E_LIMIT);
+    ck_assert_ptr_eq(c, sentinel);
+    free(big);
 }
 END_TEST
 

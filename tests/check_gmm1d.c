@@ -395,6 +395,8 @@ START_TEST(object_api)
 {
     amscr_gmm1d *g = NULL;
     ck_assert_int_eq(amscr_gmm1d_new(0, &g), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_gmm1d_new(SIZE_MAX / 64 + 1, &g), AMSCR_E_INVALID_ARG); /* its arrays' size overflows */
+    ck_assert_ptr_null(g);
     ck_assert_int_eq(amscr_gmm1d_new(2, NULL), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_gmm1d_new(2, &g), AMSCR_OK);
     ck_assert_uint_eq(amscr_gmm1d_get_max_iterations(g), 200);

@@ -192,6 +192,8 @@ START_TEST(elbow_choose_hand)
     ck_assert_uint_eq(amscr__elbow_choose(tiny, 4, 1), 1);
     const double flat[] = {5.0, 5.0 - 1e-10, 5.0 - 2e-10, 5.0 - 3e-10};
     ck_assert_uint_eq(amscr__elbow_choose(flat, 4, 1), 1);
+    const double bent_but_flat[] = {1.0, 1.0 - 5e-10, 1.0 - 6e-10}; /* a bend, within a negligible drop */
+    ck_assert_uint_eq(amscr__elbow_choose(bent_but_flat, 3, 1), 1);
     /* A straight line (no bend) and a concave curve (above the chord). */
     const double line[] = {4, 3, 2, 1, 0};
     ck_assert_uint_eq(amscr__elbow_choose(line, 5, 1), 1);

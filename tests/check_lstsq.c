@@ -279,6 +279,14 @@ START_TEST(test_lstsq_invalid)
     ck_assert_int_eq(amscr_lstsq_qr(a, 0, 0, b, 1, x, res), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_lstsq_qr(a, 4, 0, b, 1, x, res), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_lstsq_qr(a, 4, 3, b, 0, x, res), AMSCR_E_INVALID_ARG);
+    /* the limits: at most 4096 right-hand sides (4096 pass) */
+    double *bb = calloc(4 * 4097, sizeof *bb), *xb = calloc(3 * 4097, sizeof *xb), *rb = calloc(4097, sizeof *rb);
+    ck_assert(bb && xb && rb);
+    ck_assert_int_eq(amscr_lstsq_qr(a, 4, 3, bb, 4097, xb, rb), AMSCR_E_LIMIT);
+    ck_assert_int_eq(amscr_lstsq_qr(a, 4, 3, bb, 4096, xb, rb), AMSCR_OK);
+    free(bb);
+    free(xb);
+    free(rb);
     /* valid call on the same data, as a control */
     ck_assert_int_eq(amscr_lstsq_qr(a, 4, 3, b, 1, x, res), AMSCR_OK);
     /* non-finite data must not succeed */

@@ -143,6 +143,23 @@ START_TEST(test_scales_bound_follows_num_samples)
     ck_assert_int_eq(amscr_params_set_scales(p, s, 2), AMSCR_OK);
     const double s2[2] = {1.0, 300.5};
     EXPECT_INVALID(amscr_params_set_scales(p, s2, 2));
+    /* N lowered below a scale set before: preparing a shape refuses the params, saying why */
+    const double s3[2] = {1.0, 64.0};
+    ck_assert_int_eq(amscr_params_set_num_samples(p, 64), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_scales(p, s3, 2), AMSCR_OK);
+    double xy[2 * 40];
+    for (int i = 0; i < 40; i++) {
+        xy[2 * i] = 2.0 * cos(0.157 * i);
+        xy[2 * i + 1] = sin(0.157 * i) + 0.3 * cos(0.471 * i);
+    }
+    amscr_contour *c = NULL;
+    amscr_descriptor *d = NULL;
+    ck_assert_int_eq(amscr_contour_new(xy, 40, &c), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_num_samples(p, 63), AMSCR_OK);
+    ck_assert_int_eq(amscr_descriptor_new(p, c, &d), AMSCR_E_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), "scale 64 exceeds N = 63"));
+    ck_assert_ptr_null(d);
+    amscr_contour_free(c);
 }
 END_TEST
 

@@ -990,8 +990,45 @@ START_TEST(degenerate_inputs)
         m++;
     }
     expect_desc_failure(closed, xy, m, AMSCR_E_DEGENERATE, "zero-area loop");
+    /* at least 8 distinct points: 7 are refused, also with the closing copy of the first (which
+     * is no point of its own), and 8 prepare */
+    amscr_test_ellipse(8, 2.0, 1.0, 0.0, xy);
+    expect_desc_failure(closed, xy, 7, AMSCR_E_DEGENERATE, "7 points");
+    ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), "7 distinct points, at least 8"));
+    double seven[2 * 8];
+    memcpy(seven, xy, 2 * 7 * sizeof *seven);
+    seven[14] = xy[0];
+    seven[15] = xy[1];
+    expect_desc_failure(closed, seven, 8, AMSCR_E_DEGENERATE, "7 points and the first again");
+    amscr_descriptor_free(make_desc(closed, xy, 8));
     amscr_params_free(closed);
     amscr_params_free(open);
+}
+END_TEST
+
+/* A closed contour given with a closing copy of its first point (as OpenCV's approxPolyDP, a
+ * GeoJSON ring or a hand-made polygon give it) is the same shape: its prepared samples are those
+ * of the contour without it, bit for bit, in both presets. */
+START_TEST(closing_copy_is_dropped)
+{
+    enum { N = 120 };
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, 4321u);
+    double xy[2 * (N + 1)];
+    amscr_test_random_shape(&rng, N, 5, xy);
+    xy[2 * N] = xy[0];
+    xy[2 * N + 1] = xy[1];
+    for (int preset = 0; preset < 2; preset++) {
+        amscr_params *p = NULL;
+        ck_assert_int_eq(preset ? amscr_params_new_registration(&p) : amscr_params_new(&p), AMSCR_OK);
+        amscr_descriptor *a = make_desc(p, xy, N), *b = make_desc(p, xy, N + 1);
+        size_t n = amscr_params_get_num_samples(p);
+        ck_assert(memcmp(amscr_descriptor_input_points(a), amscr_descriptor_input_points(b),
+                         2 * n * sizeof(double)) == 0);
+        amscr_descriptor_free(a);
+        amscr_descriptor_free(b);
+        amscr_params_free(p);
+    }
 }
 END_TEST
 
@@ -1044,10 +1081,15 @@ START_TEST(incompatible_params)
     ck_assert_int_eq(amscr_params_copy(p128, &popen), AMSCR_OK);
     ck_assert_int_eq(amscr_params_set_closed(popen, 0), AMSCR_OK);
     amscr_descriptor *a = make_desc(p128, xy, n), *b = make_desc(p64, xy, n), *c = make_desc(psc, xy, n);
-    amscr_descriptor *o = make_desc(popen, xy, n);
-    const amscr_descriptor *bad[3] = {b, c, o};
-    const amscr_params *badp[3] = {p64, psc, popen};
-    for (int k = 0; k < 3; k++) {
+    amscr_params *peuc = NULL, *pinv = NULL; /* another parametrization, another invariance */
+    ck_assert_int_eq(amscr_params_copy(p128, &peuc), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_parametrization(peuc, AMSCR_PARAM_EUCLIDEAN), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_copy(p128, &pinv), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_invariance(pinv, AMSCR_INVARIANCE_SIMILARITY), AMSCR_OK);
+    amscr_descriptor *o = make_desc(popen, xy, n), *e = make_desc(peuc, xy, n), *v = make_desc(pinv, xy, n);
+    const amscr_descriptor *bad[5] = {b, c, o, e, v};
+    const amscr_params *badp[5] = {p64, psc, popen, peuc, pinv};
+    for (int k = 0; k < 5; k++) {
         amscr_result *r = NULL;
         double dist = -1.0;
         ck_assert_int_eq(amscr_register(NULL, a, bad[k], NULL, &r), AMSCR_E_INVALID_ARG);
@@ -1076,10 +1118,14 @@ START_TEST(incompatible_params)
     amscr_descriptor_free(b);
     amscr_descriptor_free(c);
     amscr_descriptor_free(o);
+    amscr_descriptor_free(e);
+    amscr_descriptor_free(v);
     amscr_params_free(p128);
     amscr_params_free(p64);
     amscr_params_free(psc);
     amscr_params_free(popen);
+    amscr_params_free(peuc);
+    amscr_params_free(pinv);
     free(xy);
 }
 END_TEST
@@ -1297,8 +1343,13 @@ START_TEST(result_getters)
             ck_assert_int_eq(amscr_result_sse(r, buf, &cnt), AMSCR_E_INVALID_ARG);
         }
         if (nmix > 0) {
-            cnt = nmix - 1;
+            cnt = nmix - 1; /* too small for any one output */
             ck_assert_int_eq(amscr_result_mixture(r, buf, NULL, NULL, &cnt), AMSCR_E_INVALID_ARG);
+            cnt = nmix - 1;
+            ck_assert_int_eq(amscr_result_mixture(r, NULL, buf, NULL, &cnt), AMSCR_E_INVALID_ARG);
+            cnt = nmix - 1;
+            ck_assert_int_eq(amscr_result_mixture(r, NULL, NULL, buf, &cnt), AMSCR_E_INVALID_ARG);
+            ck_assert_double_eq(buf[0], -7.0);
             cnt = nmix;
             ck_assert_int_eq(amscr_result_mixture(r, NULL, buf, NULL, &cnt), AMSCR_OK); /* means only */
             ck_assert_uint_eq(cnt, nmix);
@@ -1433,6 +1484,7 @@ Suite *amscr_suite_register(void)
     tcase_add_test(err, degenerate_inputs);
     tcase_add_test(err, extreme_extents_register);
     tcase_add_test(err, incompatible_params);
+    tcase_add_test(err, closing_copy_is_dropped);
     tcase_add_test(err, null_arguments);
     suite_add_tcase(s, err);
     TCase *open = tcase_create("open");

@@ -295,6 +295,11 @@ START_TEST(scores_invalid)
     ck_assert_int_eq(amscr_score_nn_accuracy(dn, 6, LA, &s), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_score_nn_split(dn, 6, 6, LA, LA, &s), AMSCR_E_INVALID_ARG);
     ck_assert_str_ne(amscr_last_error_detail(), "");
+    dn[4 * 6 + 4] = D6[4 * 6 + 4]; /* and in the very last cell */
+    dn[35] = NAN;
+    ck_assert_int_eq(amscr_score_bullseye(dn, 6, LA, 0, &s), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_score_topk_table(dn, 6, LA, 3, c), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_score_nn_accuracy(dn, 6, LA, &s), AMSCR_E_INVALID_ARG);
     ck_assert_double_eq(s, 7.0);
     ck_assert(c[0] == 5 && c[1] == 5 && c[2] == 5);
 }

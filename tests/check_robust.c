@@ -154,8 +154,11 @@ START_TEST(missing_run_inliers_and_correspondences)
     ck_assert_uint_eq(n, 256);
     double *sxy = malloc(2 * n * sizeof *sxy), *par = malloc(n * sizeof *par), *txy = malloc(2 * n * sizeof *txy);
     ck_assert(sxy && par && txy);
-    size_t small = n - 1;
+    size_t small = n - 1; /* too small for any one output */
     ck_assert_int_eq(amscr_result_correspondences(r, sxy, par, txy, &small), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_result_correspondences(r, sxy, NULL, NULL, &small), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_result_correspondences(r, NULL, par, NULL, &small), AMSCR_E_INVALID_ARG);
+    ck_assert_int_eq(amscr_result_correspondences(r, NULL, NULL, txy, &small), AMSCR_E_INVALID_ARG);
     ck_assert_int_eq(amscr_result_correspondences(r, sxy, par, txy, &n), AMSCR_OK);
     size_t near = 0;
     for (size_t a = 0; a < n; a++) {
@@ -415,6 +418,21 @@ START_TEST(partial_errors)
     ck_assert_int_eq(amscr_descriptor_new(p, c, &d), AMSCR_OK); /* closed */
     ck_assert_int_eq(amscr_register(p, d, d, NULL, &r), AMSCR_E_INVALID_ARG);
     ck_assert_ptr_null(r);
+    amscr_params *po = NULL; /* an open target is refused too */
+    amscr_descriptor *o = NULL;
+    double dist = -1.0;
+    ck_assert_int_eq(amscr_params_copy(p, &po), AMSCR_OK);
+    ck_assert_int_eq(amscr_params_set_closed(po, 0), AMSCR_OK);
+    ck_assert_int_eq(amscr_descriptor_new(po, c, &o), AMSCR_OK);
+    ck_assert_int_eq(amscr_register(po, o, o, NULL, &r), AMSCR_E_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(amscr_last_error_detail(), "source open, target open"));
+    ck_assert_ptr_null(r);
+    ck_assert_int_eq(amscr_distance(po, o, o, NULL, &dist), AMSCR_E_INVALID_ARG);
+    ck_assert(dist == -1.0);
+    ck_assert_int_eq(amscr_register(po, o, d, NULL, &r), AMSCR_OK); /* open source, closed target */
+    amscr_result_free(r);
+    amscr_descriptor_free(o);
+    amscr_params_free(po);
     ck_assert(isnan(amscr_result_confidence(NULL)) && isnan(amscr_result_inlier_fraction(NULL)));
     double s0, s1;
     ck_assert_int_eq(amscr_result_part(NULL, &s0, &s1), AMSCR_E_INVALID_ARG);
