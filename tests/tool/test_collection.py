@@ -411,6 +411,14 @@ def test_manifest_rows_of_the_headers_columns(tmp_path):
     mf.write_text("file\tclass\tgroup\nshapes/star-1.txt\tstar\n")
     r = run("eval", mf)
     assert r.returncode == 1 and "line 2: expected at least 3 tab-separated columns" in r.stderr, r.stderr
+    # at the reader's 64 columns too (a 65th field was kept, tabs and all, in the 64th)
+    wide = "\t".join(["file", "class"] + ["c%d" % i for i in range(62)])
+    rows = ["shapes/%s\t%s" % (f, f.split("-")[0]) for f in ["star-1.txt", "star-2.txt", "blob-1.txt", "blob-2.txt"]]
+    mf.write_text(wide + "\n" + "\n".join(rows) + "\n")
+    assert run("eval", mf, *AFFINE).returncode == 0
+    mf.write_text(wide + "\n" + "\n".join(rows[:1] + [rows[1] + "\tx" * 63] + rows[2:]) + "\n")
+    r = run("eval", mf)
+    assert r.returncode == 1 and "m.tsv: line 3: 65 tab-separated columns, more than the 64" in r.stderr, r.stderr
 
 
 def test_folder_warns_of_images_it_cannot_read(tmp_path):

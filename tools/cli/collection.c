@@ -231,13 +231,16 @@ static int open_folder(const char *dir, collection *c)
     return ok ? 0 : -1;
 }
 
-/* Splits a line on tabs in place; returns the number of fields (at most max). */
+/* Splits a line on tabs in place; returns the number of fields, of which the first max are
+ * stored. */
 static size_t split_tabs(char *line, char **fields, size_t max)
 {
     size_t n = 0;
     char *p = line;
-    while (n < max) {
-        fields[n++] = p;
+    for (;;) {
+        if (n < max)
+            fields[n] = p;
+        n++;
         char *t = strchr(p, '\t');
         if (t == NULL)
             break;
@@ -399,6 +402,9 @@ static int is_point_line(const char *s)
     return *end == '\0' || *end == '#';
 }
 
+/* The most columns a manifest line may have (file, class, group and whatever else it carries). */
+enum { MANIFEST_COLUMNS = 64 };
+
 /* One line with content (trimmed, not a comment): the header or a shape. */
 static int manifest_line(manifest_reader *r, char *line, collection *c)
 {
@@ -406,8 +412,13 @@ static int manifest_line(manifest_reader *r, char *line, collection *c)
         tool_error(r->path, "a point list, " NOT_COLLECTION);
         return -1;
     }
-    char *f[64];
-    size_t nf = split_tabs(line, f, 64);
+    char *f[MANIFEST_COLUMNS];
+    size_t nf = split_tabs(line, f, MANIFEST_COLUMNS);
+    if (nf > MANIFEST_COLUMNS) {
+        tool_error(r->path, "line %zu: %zu tab-separated columns, more than the %d a manifest may have", r->lineno,
+                   nf, MANIFEST_COLUMNS);
+        return -1;
+    }
     return r->header ? manifest_header(r, f, nf) : manifest_row(r, f, nf, c);
 }
 
