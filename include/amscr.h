@@ -3130,10 +3130,12 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_load_memory(const void *buf, 
  *        collection file without an index (amscr_db_save) and index files of an older,
  *        separate format are AMSCR_E_FORMAT with a detail saying to build the index again.
  * Memory: about 16.5 KB a shape once loaded (20.5 KB with AMSCR_INDEX_LAZY; the retrieval
- *         preset at N = 128, mpeg7-dev's 700 shapes). Queries and searches (members' rows and
- *         copies too) read the shapes without keeping them: a long-running search service
- *         stays at that size. A shape read through amscr_db_descriptor of amscr_index_db is
- *         decoded into its prepared shape and kept until amscr_index_free, about 36 KB more.
+ *         preset at N = 128, mpeg7-dev's 700 shapes). With the shape channel alone (channel
+ *         weight 1, the retrieval preset) queries and searches, of members' copies too, read
+ *         the shapes without keeping them: a long-running search service stays at that size.
+ *         A shape whose prepared form is read (each candidate of a query with a channel weight
+ *         below 1, where the AMSCR distance needs it; amscr_db_descriptor of amscr_index_db) is
+ *         decoded and kept until amscr_index_free, about 36 KB more a shape.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, an unknown flag); AMSCR_E_IO; AMSCR_E_LIMIT;
  *         AMSCR_E_FORMAT (wrong magic, version, checksum, truncated or inconsistent
  *         content); AMSCR_E_NOMEM.
