@@ -2575,8 +2575,9 @@ AMSCR_API int32_t amscr_db_label(const amscr_db *db, size_t i);
 /**
  * @brief Descriptor of shape i.
  * @return the descriptor; NULL for NULL or i out of range, or (the collection of an index,
- *         amscr_index_db, whose shapes are decoded when first read) when decoding it ran out
- *         of memory.
+ *         amscr_index_db, whose shapes are decoded when first read) when decoding it failed:
+ *         out of memory, or a damaged file (a load checks each shape's samples, not every
+ *         level they smooth to), amscr_last_error_detail() saying which.
  * Ownership: borrowed from db.
  * Thread-safety: const.
  * @since 0.1

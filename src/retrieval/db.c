@@ -249,11 +249,12 @@ amscr_status amscr__db_compact_copy(const amscr_db *db, amscr_db **out)
     w.cap = w.buf ? n * per : 0;
     for (size_t i = 0; st == AMSCR_OK && i < n && !w.oom; i++) {
         amscr_descriptor *tmp = NULL;
-        const amscr_descriptor *d = amscr__db_descriptor_peek(db, i, &tmp);
-        if (!d || !amscr__db_write_compact(d, db->labels[i], p, &w))
+        const amscr_descriptor *d = NULL;
+        st = amscr__db_peek(db, i, &d, &tmp);
+        if (st == AMSCR_OK && !amscr__db_write_compact(d, db->labels[i], p, &w))
             w.oom = 1;
         amscr_descriptor_free(tmp);
-        if (!w.oom)
+        if (st == AMSCR_OK && !w.oom)
             st = amscr__db_push(c, NULL, db->labels[i], NULL);
     }
     if (st == AMSCR_OK && (w.oom || w.len != n * per))
@@ -270,9 +271,20 @@ amscr_status amscr__db_compact_copy(const amscr_db *db, amscr_db **out)
     return AMSCR_OK;
 }
 
-/* Shape i, decoded from the source when it is not yet (NULL: out of memory). Decoded outside
- * the lock (threads decode different shapes at once); the first decode of a shape is kept. */
-static amscr_descriptor *db_get(const amscr_db *db, size_t i)
+/* Shape i's record decoded into *out: AMSCR_OK; AMSCR_E_NOMEM; AMSCR_E_FORMAT naming the shape
+ * when the record does not decode (a load checks the records' samples, not every smoothed level:
+ * only a damaged file whose checksum was made again fails here). */
+static amscr_status db_decode(const amscr_db *db, size_t i, amscr_descriptor **out)
+{
+    amscr_status st = amscr__db_decode(db->src, db->src_pos0 + i * db->src_per, db->src_per, db->src_compact,
+                                       &db->params, NULL, out);
+    if (st == AMSCR_E_FORMAT)
+        return amscr__fail(st, "collection: shape %zu cannot be read (a damaged file)", i);
+    return st;
+}
+
+/* The decoded shape i kept by the collection, or NULL. */
+static amscr_descriptor *db_kept(const amscr_db *db, size_t i)
 {
     if (i >= db->nsrc)
         return db->d[i];
@@ -280,37 +292,40 @@ static amscr_descriptor *db_get(const amscr_db *db, size_t i)
     pthread_mutex_lock(&m->lock);
     amscr_descriptor *d = m->d[i];
     pthread_mutex_unlock(&m->lock);
-    if (d)
-        return d;
-    amscr_descriptor *mine = NULL;
-    if (amscr__db_decode(db->src, db->src_pos0 + i * db->src_per, db->src_per, db->src_compact, &db->params, NULL,
-                         &mine) != AMSCR_OK)
-        return NULL;
+    return d;
+}
+
+/* Shape i into *out, decoded from the source when it is not yet and kept (db_decode's status).
+ * Decoded outside the lock (threads decode different shapes at once); the first decode of a
+ * shape is kept. */
+static amscr_status db_get(const amscr_db *db, size_t i, const amscr_descriptor **out)
+{
+    amscr_descriptor *d = db_kept(db, i), *mine = NULL;
+    amscr_status st = d ? AMSCR_OK : db_decode(db, i, &mine);
+    if (st != AMSCR_OK || d) {
+        *out = d;
+        return st;
+    }
+    amscr_db *m = (amscr_db *)(uintptr_t)db;
     pthread_mutex_lock(&m->lock);
     if (!m->d[i])
         m->d[i] = mine;
     else
         amscr_descriptor_free(mine); /* another thread's came first */
-    d = m->d[i];
+    *out = m->d[i];
     pthread_mutex_unlock(&m->lock);
-    return d;
+    return AMSCR_OK;
 }
 
-const amscr_descriptor *amscr__db_descriptor_peek(const amscr_db *db, size_t i, amscr_descriptor **tmp)
+amscr_status amscr__db_peek(const amscr_db *db, size_t i, const amscr_descriptor **out, amscr_descriptor **tmp)
 {
     *tmp = NULL;
-    if (i >= db->nsrc)
-        return db->d[i];
-    amscr_db *m = (amscr_db *)(uintptr_t)db;
-    pthread_mutex_lock(&m->lock);
-    amscr_descriptor *d = m->d[i];
-    pthread_mutex_unlock(&m->lock);
-    if (d)
-        return d;
-    if (amscr__db_decode(db->src, db->src_pos0 + i * db->src_per, db->src_per, db->src_compact, &db->params, NULL,
-                         tmp) != AMSCR_OK)
-        return NULL;
-    return *tmp;
+    *out = db_kept(db, i);
+    if (*out)
+        return AMSCR_OK;
+    amscr_status st = db_decode(db, i, tmp);
+    *out = *tmp;
+    return st;
 }
 
 size_t amscr__db_decoded(const amscr_db *db)
@@ -388,21 +403,23 @@ amscr_status amscr__db_own_source(amscr_db *db)
 
 amscr_status amscr__db_decode_all(const amscr_db *db)
 {
-    for (size_t i = 0; i < db->nsrc; i++)
-        if (!db_get(db, i))
-            return amscr__fail(AMSCR_E_NOMEM, "collection: out of memory");
-    return AMSCR_OK;
+    amscr_status st = AMSCR_OK;
+    for (size_t i = 0; i < db->nsrc && st == AMSCR_OK; i++) {
+        const amscr_descriptor *d;
+        st = db_get(db, i, &d);
+    }
+    return st;
 }
 
 const amscr_descriptor *amscr_db_descriptor(const amscr_db *db, size_t i)
 {
-    return (db && i < db->n) ? db_get(db, i) : NULL;
+    const amscr_descriptor *d = NULL;
+    return db && i < db->n && db_get(db, i, &d) == AMSCR_OK ? d : NULL;
 }
 
 amscr_status amscr__db_shape(const amscr_db *db, size_t i, const amscr_descriptor **out)
 {
-    *out = amscr_db_descriptor(db, i);
-    return *out ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "collection: out of memory decoding shape %zu", i);
+    return db_get(db, i, out);
 }
 
 amscr_status amscr__db_add_from(amscr_db *dst, const amscr_db *src, size_t i, int32_t label)

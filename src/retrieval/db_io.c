@@ -40,8 +40,27 @@ static void w_params(amscr__wbuf *w, const amscr_params *p)
     amscr__w_f64(w, p->penalty);
 }
 
-void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
+/* Shape d's full record (label, maps, input, levels, and the outline the version keeps). */
+static void write_full(const amscr_descriptor *d, int32_t label, uint32_t version, const amscr_params *prm,
+                       amscr__wbuf *w)
 {
+    size_t N = prm->num_samples, p = prm->num_scales;
+    amscr__w_u32(w, (uint32_t)label);
+    amscr__w_f64s(w, d->fwd, 6);
+    amscr__w_f64s(w, d->inv, 6);
+    amscr__w_f64s(w, d->input, 2 * N);
+    amscr__w_f64s(w, d->base, 2 * N);
+    amscr__w_f64s(w, d->scaled, 2 * N * p);
+    double V[2 * AMSCR__OUTLINE_N];
+    if (amscr__db_has_outline(version, prm) && amscr__inner_vertices(d, prm->inner_closing, V) == AMSCR_OK)
+        amscr__w_f64s(w, V, 2 * AMSCR__OUTLINE_N);
+    else if (amscr__db_has_outline(version, prm))
+        w->oom = 1; /* only out of memory: a prepared shape's samples always resample */
+}
+
+amscr_status amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
+{
+    amscr_status st = AMSCR_OK;
     const amscr_params *prm = amscr_db_params(db);
     amscr__w_bytes(w, AMSCR__DB_MAGIC, 8);
     amscr__w_u32(w, version);
@@ -55,37 +74,20 @@ void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w)
     amscr__w_u64(w, n);
     amscr__w_u64(w, N);
     amscr__w_u64(w, p);
-    for (size_t i = 0; i < n; i++) {
-        if (amscr__db_compact(version)) { /* a record kept as one copied, else encoded (nothing decoded kept) */
-            const unsigned char *rec = amscr__db_record(db, i);
-            amscr_descriptor *tmp = NULL;
-            const amscr_descriptor *d = rec ? NULL : amscr__db_descriptor_peek(db, i, &tmp);
-            if (rec)
-                amscr__w_bytes(w, rec, (size_t)amscr__db_shape_bytes(version, prm));
-            else if (!d || !amscr__db_write_compact(d, amscr_db_label(db, i), prm, w))
-                w->oom = 1;
-            amscr_descriptor_free(tmp);
-            continue;
-        }
+    for (size_t i = 0; i < n && st == AMSCR_OK; i++) {
+        const unsigned char *rec = amscr__db_compact(version) ? amscr__db_record(db, i) : NULL;
         amscr_descriptor *tmp = NULL; /* a lazy collection's shape decoded for its record only */
-        const amscr_descriptor *d = amscr__db_descriptor_peek(db, i, &tmp);
-        if (!d) {
-            w->oom = 1; /* only out of memory: the shapes were checked */
-            continue;
-        }
-        amscr__w_u32(w, (uint32_t)amscr_db_label(db, i));
-        amscr__w_f64s(w, d->fwd, 6);
-        amscr__w_f64s(w, d->inv, 6);
-        amscr__w_f64s(w, d->input, 2 * N);
-        amscr__w_f64s(w, d->base, 2 * N);
-        amscr__w_f64s(w, d->scaled, 2 * N * p);
-        double V[2 * AMSCR__OUTLINE_N];
-        if (amscr__db_has_outline(version, prm) && amscr__inner_vertices(d, prm->inner_closing, V) == AMSCR_OK)
-            amscr__w_f64s(w, V, 2 * AMSCR__OUTLINE_N);
-        else if (amscr__db_has_outline(version, prm))
-            w->oom = 1; /* only out of memory: a prepared shape's samples always resample */
+        const amscr_descriptor *d = NULL;
+        if (rec) /* a record kept as one copied */
+            amscr__w_bytes(w, rec, (size_t)amscr__db_shape_bytes(version, prm));
+        else if ((st = amscr__db_peek(db, i, &d, &tmp)) == AMSCR_OK && amscr__db_compact(version)) {
+            if (!amscr__db_write_compact(d, amscr_db_label(db, i), prm, w))
+                w->oom = 1;
+        } else if (st == AMSCR_OK)
+            write_full(d, amscr_db_label(db, i), version, prm, w);
         amscr_descriptor_free(tmp);
     }
+    return st;
 }
 
 amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *out_len)
@@ -95,12 +97,12 @@ amscr_status amscr_db_save_memory(const amscr_db *db, void **out_buf, size_t *ou
     AMSCR_CHECK_NULL(out_buf);
     AMSCR_CHECK_NULL(out_len);
     amscr__wbuf w = {NULL, 0, 0, 0}; /* a lazy load's shapes decoded one by one, none kept */
-    amscr__db_write(db, AMSCR__DB_VERSION_PLAIN_VIEW, &w);
-    if (!w.oom)
+    amscr_status st = amscr__db_write(db, AMSCR__DB_VERSION_PLAIN_VIEW, &w);
+    if (st == AMSCR_OK && !w.oom)
         amscr__w_u64(&w, amscr__fnv1a(w.buf, w.len));
-    if (w.oom) {
+    if (st != AMSCR_OK || w.oom) {
         free(w.buf);
-        return amscr__fail(AMSCR_E_NOMEM, "amscr_db_save: out of memory");
+        return st != AMSCR_OK ? st : amscr__fail(AMSCR_E_NOMEM, "amscr_db_save: out of memory");
     }
     *out_buf = w.buf;
     *out_len = w.len;

@@ -35,10 +35,10 @@ void amscr__db_set_source(amscr_db *db, const unsigned char *src, size_t pos0, s
 /* A copy of db whose shapes are held as compact records (~3 KB a shape at the defaults, decoded
  * when first read), its labels and params db's. */
 amscr_status amscr__db_compact_copy(const amscr_db *db, amscr_db **out);
-/* Shape i of db as the collection gives it (kept), or, when a lazy collection has not decoded it
- * yet, decoded into *tmp for the caller to free (the collection keeps nothing). NULL: out of
- * memory or a bad record. */
-const amscr_descriptor *amscr__db_descriptor_peek(const amscr_db *db, size_t i, amscr_descriptor **tmp);
+/* Shape i of db into *out as the collection gives it (kept), or, when a lazy collection has not
+ * decoded it yet, decoded into *tmp for the caller to free (the collection keeps nothing):
+ * AMSCR_OK; AMSCR_E_NOMEM; AMSCR_E_FORMAT naming the shape when its record does not decode. */
+amscr_status amscr__db_peek(const amscr_db *db, size_t i, const amscr_descriptor **out, amscr_descriptor **tmp);
 /* How many of the shapes db decodes from its source are decoded and kept (the memory its reads
  * added: tests). */
 size_t amscr__db_decoded(const amscr_db *db);
@@ -59,14 +59,15 @@ amscr_status amscr__db_compact_tail(amscr_db *db);
 amscr_status amscr__db_own_source(amscr_db *db);
 amscr_status amscr__db_decode_all(const amscr_db *db);
 /* Shape i of db into *out (amscr_db_descriptor, which decodes a lazy collection's shape when first
- * read): AMSCR_E_NOMEM when decoding it runs out of memory, where amscr_db_descriptor gives NULL. */
+ * read, and keeps it): as amscr__db_peek, where amscr_db_descriptor gives NULL. */
 amscr_status amscr__db_shape(const amscr_db *db, size_t i, const amscr_descriptor **out);
 /* Shape i of src added to dst with `label` (amscr_db_add_descriptor of amscr__db_shape). */
 amscr_status amscr__db_add_from(amscr_db *dst, const amscr_db *src, size_t i, int32_t label);
 
 /* Writes the collection part of a file of `version`: magic, version, params, retrieval
- * settings, the shapes (no section, no checksum). */
-void amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w);
+ * settings, the shapes (no section, no checksum). AMSCR_OK (w->oom says whether memory ran
+ * out), or amscr__db_peek's failure for a lazy collection's shape. */
+amscr_status amscr__db_write(const amscr_db *db, uint32_t version, amscr__wbuf *w);
 /* Checks the magic, version and trailing checksum of buf and parses its collection part:
  * *out (caller frees) and *out_pos just after the shapes, *out_version. lazy: the shapes are
  * checked but not decoded; *out decodes them from buf (which must outlive it) when asked for. */

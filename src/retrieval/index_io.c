@@ -201,11 +201,12 @@ amscr_status amscr__index_write(const amscr_index *x, uint32_t version, void **o
 {
     amscr_status st = AMSCR_OK;
     amscr__wbuf w = {NULL, 0, 0, 0}; /* a lazy load's shapes: none decoded and kept (db_io.c) */
-    amscr__db_write(x->db, version, &w);
+    st = amscr__db_write(x->db, version, &w);
     size_t at = w.len;
     amscr__w_u64(&w, 0); /* the section's length, filled in below */
     write_section(x, &w);
-    st = write_features(x, version, &w);
+    if (st == AMSCR_OK)
+        st = write_features(x, version, &w);
     if (st == AMSCR_OK)
         write_inner(x, version, &w);
     if (st == AMSCR_OK && version >= AMSCR__DB_VERSION_INDEX_I16)

@@ -106,11 +106,10 @@ static amscr_status complete(const amscr__base *b, const amscr_db *db, size_t c,
                 st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
                 break;
             }
-            d = amscr__db_shallow(db, c, &sd, buf, buf + 2 * N) ? &sd : amscr__db_descriptor_peek(db, c, &tmp);
-            if (!d) {
-                st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
+            if (amscr__db_shallow(db, c, &sd, buf, buf + 2 * N))
+                d = &sd;
+            else if ((st = amscr__db_peek(db, c, &d, &tmp)) != AMSCR_OK)
                 break;
-            }
         }
         st = amscr__hf_mirror_of_descriptor(b->p, b->frames[f], d, &out[f]);
         if (st != AMSCR_OK)
@@ -159,13 +158,11 @@ static amscr_status side_open(const amscr__base *b, const amscr_db *db, const am
     o->part = !o->build && b->nf > 0 &&
               (stored[0].spec[0] == NULL || (mirror && (stored[0].seq[1] == NULL || stored[0].spec[1] == NULL)));
     o->hf = o->build || o->part ? o->built : stored;
-    o->d = o->build || b->w < 1.0 ? amscr_db_descriptor(db, c) : NULL;
-    amscr_status st = AMSCR_OK;
-    if ((o->build || b->w < 1.0) && !o->d)
-        st = amscr__fail(AMSCR_E_NOMEM, "index: out of memory");
-    else if (o->build)
+    o->d = NULL;
+    amscr_status st = o->build || b->w < 1.0 ? amscr__db_shape(db, c, &o->d) : AMSCR_OK;
+    if (st == AMSCR_OK && o->build)
         st = amscr__base_hf(b, o->d, o->built);
-    else if (o->part) {
+    else if (st == AMSCR_OK && o->part) {
         st = complete(b, db, c, stored, mirror, pw->have_hws ? &pw->hws : NULL, o->built, o->own);
         if (st != AMSCR_OK)
             complete_free(b, o->built, o->own);

@@ -45,8 +45,7 @@ static amscr_status check_query(const amscr_index *x, const amscr_descriptor *q,
 static amscr_status shape_for_query(const amscr_index *x, size_t i, const amscr_descriptor **d,
                                     amscr_descriptor **tmp)
 {
-    *d = amscr__db_descriptor_peek(x->db, i, tmp);
-    return *d ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "index query: out of memory decoding shape %zu", i);
+    return amscr__db_peek(x->db, i, d, tmp);
 }
 
 /* The shapes a query is matched with: every shape (0 or >= n) or at least k - 1. */

@@ -3,7 +3,7 @@
  * threads (rows.c: every cell computed by the same code, so the result does not depend on the
  * thread count), mirrored into a symmetric matrix with a zero diagonal. */
 #include "channel.h" /* amscr__mirror_upper */
-#include "db_io.h"   /* amscr__db_descriptor_peek */
+#include "db_io.h"   /* amscr__db_peek */
 #include "inner.h"
 #include "rows.h"
 
@@ -36,10 +36,9 @@ static amscr_status feature_row(void *ctx, size_t i, void *ws)
      * decoded for this row only */
     amscr_descriptor sd, *tmp = NULL;
     const amscr_descriptor *d = &sd;
-    if (!amscr__db_shallow(m->db, i, &sd, in, in + 2 * N))
-        d = amscr__db_descriptor_peek(m->db, i, &tmp);
-    amscr_status st = d ? amscr__inner_build_shape(d, amscr_db_params(m->db)->inner_closing, &m->f[i], ws)
-                        : amscr__fail(AMSCR_E_FORMAT, "inner distance: shape %zu could not be read", i);
+    amscr_status st = amscr__db_shallow(m->db, i, &sd, in, in + 2 * N) ? AMSCR_OK : amscr__db_peek(m->db, i, &d, &tmp);
+    if (st == AMSCR_OK)
+        st = amscr__inner_build_shape(d, amscr_db_params(m->db)->inner_closing, &m->f[i], ws);
     amscr_descriptor_free(tmp);
     free(in);
     return st;

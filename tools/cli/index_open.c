@@ -237,8 +237,11 @@ int index_db_with_params(const amscr_index *x, const amscr_params *p, const char
 {
     const amscr_db *src = amscr_index_db(x);
     amscr_status st = amscr_db_new(p, out);
-    for (size_t i = 0; st == AMSCR_OK && i < amscr_db_size(src); i++)
-        st = amscr_db_add_descriptor(*out, amscr_db_descriptor(src, i), amscr_db_label(src, i), NULL);
+    for (size_t i = 0; st == AMSCR_OK && i < amscr_db_size(src); i++) {
+        const amscr_descriptor *d = amscr_db_descriptor(src, i); /* NULL: its detail says why */
+        st = d ? amscr_db_add_descriptor(*out, d, amscr_db_label(src, i), NULL)
+               : strstr(amscr_last_error_detail(), "damaged") ? AMSCR_E_FORMAT : AMSCR_E_NOMEM;
+    }
     if (st != AMSCR_OK) {
         amscr_db_free(*out);
         *out = NULL;
