@@ -291,6 +291,7 @@ START_TEST(symmetric_shape_with_a_bite)
         fflush(stdout);
         ck_assert(ov > 0.7 && ov < 0.97);
         ck_assert_msg(sa > 0.75 && conf < 0.25, "bitten cross %d: near a symmetry %.3f, confidence %.3f", i, sa, conf);
+        ck_assert(sa <= 1.0 && conf >= 0.0 && amscr_result_ambiguity(r) >= 0.0 && amscr_result_ambiguity(r) <= 1.0);
         ck_assert_double_eq_tol(conf, (1.0 - fmax(sa, amscr_result_ambiguity(r))) * fmin(ov, inl), 1e-12);
         wrong += err > 0.5;
         amscr_result_free(r);

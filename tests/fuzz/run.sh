@@ -24,8 +24,9 @@ tests/fuzz/build.sh || exit 1
 maxlen() {
   case $1 in
     text|register|manifest) echo 4096 ;;
-    pgm|png|mask|subpixel) echo 8192 ;;
+    pgm|png|mask|subpixel|contours) echo 8192 ;;
     dbload) echo 16384 ;;
+    index) echo 131072 ;; # its seeds: up to 81 KB
   esac
 }
 
