@@ -26,17 +26,41 @@ COMMON = '/usr/share/common-licenses'
 
 
 def sbom_packages(root):
-    """{Debian package: version} of the SBOM's deb components, and the bundled libraries."""
+    """{Debian package: version} of the SBOM's deb components (or asked of dpkg where the wheel has
+    no SBOM), and the bundled libraries."""
     info = next(d for d in os.listdir(root) if d.endswith('.dist-info'))
-    with open(os.path.join(root, info, 'sboms', 'auditwheel.cdx.json'), encoding='utf-8') as f:
+    libs = sorted(n for n in os.listdir(os.path.join(root, 'amscr.libs')) if '.so' in n)
+    path = os.path.join(root, info, 'sboms', 'auditwheel.cdx.json')
+    if not os.path.isfile(path):
+        return dpkg_packages(libs), libs
+    with open(path, encoding='utf-8') as f:
         sbom = json.load(f)
     pkgs = {}
     for c in sbom.get('components', []):
         purl = c.get('purl', '')
         if purl.startswith('pkg:deb/'):
             pkgs[c['name']] = urllib.parse.unquote(c.get('version', ''))
-    libs = sorted(n for n in os.listdir(os.path.join(root, 'amscr.libs')) if '.so' in n)
     return pkgs, libs
+
+
+def dpkg_packages(libs):
+    """{Debian package: version} of the bundled libraries, asked of dpkg. auditwheel writes no SBOM
+    where a package is installed for two architectures (its `dpkg -s NAME` is then ambiguous): the
+    library's file is looked up under this machine's multiarch folder, its package named with its
+    architecture."""
+    arch = subprocess.run(['gcc', '-print-multiarch'], capture_output=True, text=True).stdout.strip()
+    pkgs = {}
+    for lib in libs:
+        m = re.match(r'^(.*)-[0-9a-f]{8}(\..*)$', lib)  # auditwheel's name: the original's, a hash inserted
+        found = subprocess.run(['dpkg', '-S', '*/' + (m.group(1) + m.group(2) if m else lib)],
+                               capture_output=True, text=True).stdout.splitlines()
+        hits = [line.split(': ', 1)[0].split(', ')[0] for line in found if '/%s/' % arch in line or not arch]
+        if not hits:
+            sys.exit('wheel_licences: no Debian package holds %s (the SBOM is missing)' % lib)
+        version = subprocess.run(['dpkg-query', '-W', '-f=${Version}', hits[0]], capture_output=True,
+                                 text=True, check=True).stdout
+        pkgs[hits[0].split(':')[0]] = version
+    return pkgs
 
 
 def copy_notices(pkgs, libs, out):
