@@ -341,6 +341,66 @@ START_TEST(forward_backward_exact_pair)
 }
 END_TEST
 
+/* The forward-backward error's unit, from the public calls alone: the two registrations (the
+ * source onto the bitten, noisy target, and back) composed in the normalized frames move the
+ * source's base samples by fb times the normalized frame's RMS radius, sqrt 2. */
+START_TEST(backward_error_unit)
+{
+    enum { N = 400, DROP = 60 };
+    amscr_params *p = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&p), AMSCR_OK);
+    int checked = 0;
+    for (uint64_t seed = 1; seed <= 12; seed++) {
+        double src[2 * N], tgt[2 * N], T[6], size;
+        make_pair(seed, N, src, tgt, T, &size);
+        amscr_test_rng rng;
+        amscr_test_rng_seed(&rng, 500 + seed);
+        amscr_test_add_noise(&rng, tgt, N, 0.01 * size);
+        amscr_contour *cs = NULL, *ct = NULL;
+        amscr_descriptor *f = NULL, *h = NULL;
+        ck_assert_int_eq(amscr_contour_new(src, N, &cs), AMSCR_OK);
+        ck_assert_int_eq(amscr_contour_new(tgt + 2 * DROP, N - DROP, &ct), AMSCR_OK);
+        ck_assert_int_eq(amscr_descriptor_new(p, cs, &f), AMSCR_OK);
+        ck_assert_int_eq(amscr_descriptor_new(p, ct, &h), AMSCR_OK);
+        amscr_result *r = NULL, *b = NULL;
+        ck_assert_int_eq(amscr_register(p, f, h, NULL, &r), AMSCR_OK);
+        double fb = amscr_result_backward_error(r);
+        if (!isnan(fb) && fb > 1e-6) {
+            ck_assert_int_eq(amscr_register(p, h, f, NULL, &b), AMSCR_OK);
+            double X[6], Y[6], C[6];
+            ck_assert_int_eq(amscr_result_affine_normalized(r, X), AMSCR_OK);
+            ck_assert_int_eq(amscr_result_affine_normalized(b, Y), AMSCR_OK);
+            for (int i = 0; i < 2; i++) { /* C = Y X: f -> h -> f */
+                C[3 * i] = Y[3 * i] * X[0] + Y[3 * i + 1] * X[3];
+                C[3 * i + 1] = Y[3 * i] * X[1] + Y[3 * i + 1] * X[4];
+                C[3 * i + 2] = Y[3 * i] * X[2] + Y[3 * i + 1] * X[5] + Y[3 * i + 2];
+            }
+            const double *xy = amscr_descriptor_base_points(f);
+            size_t n = amscr_descriptor_num_samples(f);
+            double s = 0.0;
+            for (size_t i = 0; i < n; i++) {
+                double x = xy[2 * i], y = xy[2 * i + 1];
+                double dx = C[0] * x + C[1] * y + C[2] - x, dy = C[3] * x + C[4] * y + C[5] - y;
+                s += dx * dx + dy * dy;
+            }
+            double rms = sqrt(s / (double)n) / sqrt(2.0);
+            ck_assert_msg(fabs(rms - fb) <= 1e-6 * fb, "seed %u: forward-backward %.9g, maps composed %.9g",
+                          (unsigned)seed, fb, rms);
+            checked++;
+        }
+        amscr_result_free(r);
+        amscr_result_free(b);
+        amscr_descriptor_free(f);
+        amscr_descriptor_free(h);
+        amscr_contour_free(cs);
+        amscr_contour_free(ct);
+    }
+    printf("robust: forward-backward error checked against the composed maps on %d pairs\n", checked);
+    ck_assert_int_gt(checked, 0);
+    amscr_params_free(p);
+}
+END_TEST
+
 /* Bad input: partial needs an open source and a closed target; the flag is 0 or 1. */
 /* The standard error of a map (src onto tgt, n points each) registered with the preset, or
  * with similarity invariance. */
@@ -522,6 +582,7 @@ Suite *amscr_suite_robust(void)
     tcase_add_test(tc, touching_object_inliers);
     tcase_add_test(tc, symmetric_shape_with_a_bite);
     tcase_add_test(tc, forward_backward_exact_pair);
+    tcase_add_test(tc, backward_error_unit);
     tcase_add_test(tc, standard_error_reads_the_fit);
     tcase_add_test(tc, kimia_fragments);
     tcase_add_test(tc, kimia_missing_10);
