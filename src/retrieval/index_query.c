@@ -39,15 +39,6 @@ static amscr_status check_query(const amscr_index *x, const amscr_descriptor *q,
     return AMSCR_OK;
 }
 
-/* Shape i of x's collection for one query: the collection's own, or, when a lazy load has not
- * decoded it, decoded into *tmp for the caller to free (queries leave the collection as loaded:
- * its memory does not grow with the shapes they read). */
-static amscr_status shape_for_query(const amscr_index *x, size_t i, const amscr_descriptor **d,
-                                    amscr_descriptor **tmp)
-{
-    return amscr__db_peek(x->db, i, d, tmp);
-}
-
 /* The shapes a query is matched with: every shape (0 or >= n) or at least k - 1. */
 static size_t shortlist_size(const amscr_index *x, size_t candidates)
 {
@@ -119,7 +110,7 @@ amscr_status amscr_index_member_scores(const amscr_index *x, size_t i, size_t ca
                            n, amscr_db_size(x->db));
     const amscr_descriptor *d;
     amscr_descriptor *tmp = NULL;
-    amscr_status st = shape_for_query(x, i, &d, &tmp);
+    amscr_status st = amscr__db_peek(x->db, i, &d, &tmp);
     if (st == AMSCR_OK)
         st = query_scores(x, d, i, candidates, NULL, NULL, out_scores);
     amscr_descriptor_free(tmp);
@@ -133,13 +124,14 @@ enum { MEMBER_SHORTLIST = 32 };
 
 /* Whether shape j of x has q's prepared samples, bit for bit, into *same: read from its record
  * when the collection keeps it as one (buf: 2 N + 2 AMSCR__OUTLINE_N values), else from the
- * shape (AMSCR_E_NOMEM when decoding it runs out of memory). */
+ * shape, decoded and not kept (amscr__db_peek's status). Queries keep no decoded shape, so an
+ * index's memory does not grow with the shapes they read. */
 static amscr_status same_samples(const amscr_index *x, size_t j, const amscr_descriptor *q, double *buf, int *same)
 {
     size_t N = amscr_db_params(x->db)->num_samples;
     amscr_descriptor sd, *tmp = NULL;
     const amscr_descriptor *d = &sd;
-    amscr_status st = amscr__db_shallow(x->db, j, &sd, buf, buf + 2 * N) ? AMSCR_OK : shape_for_query(x, j, &d, &tmp);
+    amscr_status st = amscr__db_shallow(x->db, j, &sd, buf, buf + 2 * N) ? AMSCR_OK : amscr__db_peek(x->db, j, &d, &tmp);
     *same = st == AMSCR_OK && d->n == q->n && memcmp(d->input, q->input, 2 * q->n * sizeof *q->input) == 0;
     amscr_descriptor_free(tmp);
     return st;
@@ -199,7 +191,7 @@ static amscr_status search_scores(const amscr_index *x, const amscr_descriptor *
     const amscr_descriptor *d = q;
     amscr_descriptor *tmp = NULL;
     if (st == AMSCR_OK && member != SIZE_MAX)
-        st = shape_for_query(x, member, &d, &tmp);
+        st = amscr__db_peek(x->db, member, &d, &tmp);
     if (st == AMSCR_OK)
         st = query_scores(x, d, member, candidates, progress, user, out);
     amscr_descriptor_free(tmp);

@@ -237,15 +237,21 @@ int index_db_with_params(const amscr_index *x, const amscr_params *p, const char
 {
     const amscr_db *src = amscr_index_db(x);
     amscr_status st = amscr_db_new(p, out);
-    for (size_t i = 0; st == AMSCR_OK && i < amscr_db_size(src); i++) {
-        const amscr_descriptor *d = amscr_db_descriptor(src, i); /* NULL: its detail says why */
-        st = d ? amscr_db_add_descriptor(*out, d, amscr_db_label(src, i), NULL)
-               : strstr(amscr_last_error_detail(), "damaged") ? AMSCR_E_FORMAT : AMSCR_E_NOMEM;
+    int lost = 0; /* a shape that does not decode (amscr_db_descriptor's NULL): its detail says why */
+    for (size_t i = 0; st == AMSCR_OK && !lost && i < amscr_db_size(src); i++) {
+        const amscr_descriptor *d = amscr_db_descriptor(src, i);
+        if (d)
+            st = amscr_db_add_descriptor(*out, d, amscr_db_label(src, i), NULL);
+        else
+            lost = 1;
     }
-    if (st != AMSCR_OK) {
+    if (st != AMSCR_OK || lost) {
+        if (lost)
+            tool_error(path, "%s", amscr_last_error_detail());
+        else
+            tool_lib_error(path, st);
         amscr_db_free(*out);
         *out = NULL;
-        tool_lib_error(path, st);
         return -1;
     }
     return 0;

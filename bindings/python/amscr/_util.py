@@ -209,12 +209,13 @@ def expand_chain(a: np.ndarray, name: str = 'points') -> np.ndarray:
     along = (k > 0) & ((d[:, 0] == 0) | (d[:, 1] == 0) | (np.abs(d[:, 0]) == np.abs(d[:, 1])))
     if a.shape[0] < 2 or not along.all() or k.max() <= 1:
         return a
-    if int(k.sum()) > lib.AMSCR_MAX_POINTS:
+    total = int(k.sum())
+    if total > lib.AMSCR_MAX_POINTS:
         raise bad('%s: this integer OpenCV contour stands for a pixel chain of %d points, more than the %d a '
                   'contour may hold (give its points as floats to use them as they are)'
-                  % (name, int(k.sum()), lib.AMSCR_MAX_POINTS))
+                  % (name, total, lib.AMSCR_MAX_POINTS))
     i = np.repeat(np.arange(a.shape[0]), k)
-    j = np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k)
+    j = np.arange(total) - np.repeat(np.cumsum(k) - k, k)
     return a[i] + (d // k[:, None])[i] * j[:, None]
 
 
