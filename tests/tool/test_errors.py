@@ -215,6 +215,8 @@ def test_help_and_version():
     for cmd in ["contour", "register", "search", "matrix", "eval"]:
         r = run(cmd, "--help")
         assert r.returncode == 0 and ("amscr " + cmd) in r.stdout, cmd
+    r = run("help", "frob")  # an unknown command's help is a usage error, not the main help
+    assert r.returncode == 2 and r.stdout == "" and "unknown command 'frob'" in r.stderr
     r = run("--version")
     assert r.returncode == 0
     assert r.stdout.strip().count(".") == 2 and r.stdout.strip().replace(".", "").isdigit()

@@ -128,7 +128,7 @@ int cmd_contour(opts *o)
         return TOOL_EXIT_FAIL;
     }
     if (write_points(out.fp, c) != 0) {
-        tool_error(o->out ? o->out : "<stdout>", "write error: %s", strerror(errno));
+        tool_error(o->out && strcmp(o->out, "-") != 0 ? o->out : "<stdout>", "write error: %s", strerror(errno));
         tool_out_abort(&out);
         amscr_contour_free(c);
         return TOOL_EXIT_FAIL;

@@ -210,7 +210,7 @@ static void json_protocols(sbuf *b, const opts *o, const collection *c, const ev
 
 static void format_json(sbuf *b, const opts *o, const collection *c, const amscr_params *p, const eval_scores *s)
 {
-    const char *proto = o->protocol ? o->protocol : "all";
+    const char *proto = name_of(&PROTOCOL_NAMES, o->protocol_id); /* the canonical name, as typed or not */
     sb_puts(b, "{\"collection\": ");
     sb_json_str(b, o->pos[0]);
     sb_printf(b, ", \"n\": %zu, \"classes\": %zu, \"protocol\": ", c->n, c->nclasses);

@@ -3,6 +3,8 @@
  * written in the library's index file format. */
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "amscr.h"
 #include "cli.h"
@@ -44,6 +46,14 @@ static int build(const opts *o, const collection *c, amscr_index **x)
     return r;
 }
 
+/* 1 when path is the file standard output writes to (-o /dev/stdout, /proc/self/fd/1): the
+ * summary line then goes to stderr, never into the index it describes. */
+static int is_stdout(const char *path)
+{
+    struct stat a, b;
+    return stat(path, &a) == 0 && fstat(STDOUT_FILENO, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino;
+}
+
 int cmd_index(opts *o)
 {
     if (o->out == NULL || strcmp(o->out, "-") == 0)
@@ -66,15 +76,16 @@ int cmd_index(opts *o)
         }
     }
     if (r == 0) {
+        FILE *fp = is_stdout(o->out) ? stderr : stdout;
         size_t nclasses = index_num_classes(x);
         const amscr_params *ip = amscr_db_params(amscr_index_db(x));
         double share = amscr_params_get_rerank_inner_share(ip), closing = amscr_params_get_inner_closing(ip);
-        printf("index %s: %zu shapes, %zu classes, %zu neighbours per shape", o->out, amscr_index_size(x), nclasses,
+        fprintf(fp, "index %s: %zu shapes, %zu classes, %zu neighbours per shape", o->out, amscr_index_size(x), nclasses,
                amscr_index_neighbours(x));
         if (amscr_index_neighbours(x) > 0 && share > 0.0)
-            printf(" (re-ranking on two graphs, the inner distance's at share %g, closing %g)\n", share, closing);
+            fprintf(fp, " (re-ranking on two graphs, the inner distance's at share %g, closing %g)\n", share, closing);
         else
-            printf(amscr_index_neighbours(x) > 0 ? " (re-ranking on one graph)\n" : "\n");
+            fprintf(fp, amscr_index_neighbours(x) > 0 ? " (re-ranking on one graph)\n" : "\n");
     }
     collection_free(&c);
     amscr_index_free(x);

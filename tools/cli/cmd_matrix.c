@@ -2,6 +2,7 @@
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "amscr.h"
@@ -12,6 +13,19 @@
 #include "index_tool.h"
 #include "shape_db.h"
 
+/* 1 when the outputs a and b ("-": standard output) are one file that is not a character device
+ * (-o - --names /dev/stdout into a file or a pipe): written through two descriptors, the second
+ * would overwrite or interleave with the first. */
+static int same_output(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    if (strcmp(a, b) == 0)
+        return 1;
+    int ra = strcmp(a, "-") == 0 ? fstat(STDOUT_FILENO, &sa) : stat(a, &sa);
+    int rb = strcmp(b, "-") == 0 ? fstat(STDOUT_FILENO, &sb) : stat(b, &sb);
+    return ra == 0 && rb == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino && !S_ISCHR(sa.st_mode);
+}
+
 /* -o and --names: neither a file the command reads (the collection, its shapes) nor one file. */
 static int outputs_checked(const opts *o, const collection *c)
 {
@@ -20,7 +34,7 @@ static int outputs_checked(const opts *o, const collection *c)
     if (collection_out_not_input("-o", o->out, shapes, &in, 1) != 0 ||
         collection_out_not_input("--names", o->names, shapes, &in, 1) != 0)
         return TOOL_EXIT_FAIL;
-    if (o->names && strcmp(o->names, o->out) == 0) {
+    if (o->names && same_output(o->names, o->out)) {
         tool_error(o->names, "-o and --names name the same file");
         return TOOL_EXIT_FAIL;
     }

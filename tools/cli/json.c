@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 void sb_json_num(sbuf *b, double v)
 {
@@ -25,10 +26,45 @@ void sb_json_num(sbuf *b, double v)
     sb_puts(b, buf);
 }
 
+/* Length of the well-formed UTF-8 sequence at p (1..4), or 0 when the byte at p does not start
+ * one (RFC 3629: no overlong forms, no surrogates, nothing above U+10FFFF). */
+static int utf8_len(const unsigned char *p)
+{
+    unsigned c = p[0];
+    if (c < 0x80)
+        return 1;
+    if (c >= 0xc2 && c <= 0xdf)
+        return (p[1] & 0xc0) == 0x80 ? 2 : 0;
+    if (c >= 0xe0 && c <= 0xef) {
+        unsigned lo = c == 0xe0 ? 0xa0 : 0x80, hi = c == 0xed ? 0x9f : 0xbf;
+        return p[1] >= lo && p[1] <= hi && (p[2] & 0xc0) == 0x80 ? 3 : 0;
+    }
+    if (c >= 0xf0 && c <= 0xf4) {
+        unsigned lo = c == 0xf0 ? 0x90 : 0x80, hi = c == 0xf4 ? 0x8f : 0xbf;
+        return p[1] >= lo && p[1] <= hi && (p[2] & 0xc0) == 0x80 && (p[3] & 0xc0) == 0x80 ? 4 : 0;
+    }
+    return 0;
+}
+
 void sb_json_str(sbuf *b, const char *s)
 {
     sb_puts(b, "\"");
-    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+    for (const unsigned char *p = (const unsigned char *)s; *p;) {
+        int n = utf8_len(p);
+        if (n == 0) {
+            /* a byte of a name that is not UTF-8 (a file name is bytes): as the lone surrogate
+             * U+DC80+byte, Python's surrogateescape, so os.fsencode() gives the name back and the
+             * output stays valid UTF-8 */
+            sb_printf(b, "\\udc%02x", *p++);
+            continue;
+        }
+        if (n > 1) {
+            char c[5] = {0};
+            memcpy(c, p, (size_t)n);
+            sb_puts(b, c);
+            p += n;
+            continue;
+        }
         switch (*p) {
         case '"': sb_puts(b, "\\\""); break;
         case '\\': sb_puts(b, "\\\\"); break;
@@ -43,6 +79,7 @@ void sb_json_str(sbuf *b, const char *s)
                 sb_puts(b, c);
             }
         }
+        p++;
     }
     sb_puts(b, "\"");
 }

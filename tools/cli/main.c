@@ -53,9 +53,12 @@ static int run(int argc, char **argv)
         return usage_error(NULL, "missing command: %s (see 'amscr --help')", command_list(list, sizeof list));
     const char *name = argv[1];
     if (is_any(name, "--help", "-h", "help")) {
-        const tool_command *c = strcmp(name, "help") == 0 && argc > 2 ? command_find(argv[2]) : NULL;
-        if (c != NULL)
+        if (strcmp(name, "help") == 0 && argc > 2) {
+            const tool_command *c = command_find(argv[2]);
+            if (c == NULL)
+                return usage_error(NULL, "unknown command '%s' (see 'amscr --help')", argv[2]);
             return print_command_help(c);
+        }
         print_main_help();
         return TOOL_EXIT_OK;
     }
