@@ -6,9 +6,10 @@ import operator
 import os
 import sys
 import threading
+import weakref
 import time
 import warnings
-from typing import TYPE_CHECKING, Any, Callable, Iterator, Literal, Optional, Protocol, Tuple, Union
+from typing import TYPE_CHECKING, Any, Callable, Iterator, List, Literal, Optional, Protocol, Tuple, Union
 
 import numpy as np
 
@@ -480,6 +481,42 @@ def progress_call(fn, args_before: tuple, args_after: tuple, progress: ProgressA
 
 
 # ------------------------------------------------------------------ locks
+_LIVE_LOCKS: 'weakref.WeakSet[RWLock]' = weakref.WeakSet()
+_FORK_HELD: List['RWLock'] = []
+
+
+def _before_fork() -> None:
+    """os.fork() waits for the calls under way on other threads (the C library's own locks, e.g.
+    a collection's kept index, are held only inside them): a child then never inherits a lock
+    held by a thread it does not have. Objects this thread is using (fork from a progress
+    callback) are skipped. Each object is waited for holding nothing else (a call may read two
+    objects), then every mutex is taken at once (no thread waits while holding one) and kept
+    across fork(), so no call starts; a few retries if a call started in between."""
+    me = threading.get_ident()
+    locks = [lk for lk in list(_LIVE_LOCKS) if lk._owner != me and not lk._held()]
+    for _ in range(100):
+        for lk in locks:
+            with lk._mutex:
+                while lk._writer or lk._readers:
+                    lk._cond.wait()
+        for lk in locks:
+            lk._mutex.acquire()
+        _FORK_HELD.extend(locks)
+        if not any(lk._writer or lk._readers for lk in locks):
+            return
+        _after_fork()
+
+
+def _after_fork() -> None:
+    while _FORK_HELD:
+        lk = _FORK_HELD.pop()
+        lk._mutex.release()
+
+
+if hasattr(os, 'register_at_fork'):
+    os.register_at_fork(before=_before_fork, after_in_parent=_after_fork, after_in_child=_after_fork)
+
+
 class RWLock:
     """Many readers or one writer, writers first (a collection may be queried by many threads and
     added to by one; a waiting add() is not starved by a stream of queries). A thread may read
@@ -488,12 +525,16 @@ class RWLock:
     deadlock."""
 
     def __init__(self) -> None:
-        self._cond = threading.Condition()
+        # A plain (C) lock: its __enter__/__exit__ run no Python code, so a KeyboardInterrupt
+        # (Ctrl-C) cannot land between taking it and the with block that releases it.
+        self._mutex = threading.Lock()
+        self._cond = threading.Condition(self._mutex)
         self._readers = 0
         self._writer = False
         self._writers_waiting = 0
         self._owner: Optional[int] = None  # the writing thread
         self._mine = threading.local()  # this thread's reads held
+        _LIVE_LOCKS.add(self)
 
     def _held(self) -> int:
         return getattr(self._mine, 'n', 0)
@@ -507,38 +548,54 @@ class RWLock:
                              'thread (from its progress callback?); change it once that call returns',
                              lib.AMSCR_E_STATE)
 
+    # Each count is changed together with a local flag in one run of bytecodes without a call (the
+    # interpreter runs signal handlers only at calls and backward jumps), and undone in `finally`
+    # exactly when it was made: a KeyboardInterrupt anywhere leaves the counts right.
     @contextlib.contextmanager
     def read(self) -> Iterator[None]:
         self._refuse_reentry(False)
-        with self._cond:
-            while (self._writer or self._writers_waiting) and not self._held():
-                self._cond.wait()
-            self._readers += 1
-        self._mine.n = self._held() + 1
+        held = self._held()
+        counted = False
         try:
+            with self._mutex:
+                while (self._writer or self._writers_waiting) and not held:
+                    self._cond.wait()
+                self._readers += 1
+                counted = True
+            self._mine.n = held + 1
             yield
         finally:
-            self._mine.n -= 1
-            with self._cond:
-                self._readers -= 1
-                self._cond.notify_all()
+            if counted:
+                self._mine.n = held
+                with self._mutex:
+                    self._readers -= 1
+                    counted = False
+                    self._cond.notify_all()
 
     @contextlib.contextmanager
     def write(self) -> Iterator[None]:
         self._refuse_reentry(True)
-        with self._cond:
-            self._writers_waiting += 1
-            try:
+        waiting = owned = False
+        try:
+            with self._mutex:
+                self._writers_waiting += 1
+                waiting = True
                 while self._writer or self._readers:
                     self._cond.wait()
-            finally:
                 self._writers_waiting -= 1
-            self._writer = True
-            self._owner = threading.get_ident()
-        try:
+                waiting = False
+                self._writer = True
+                owned = True
+                self._owner = threading.get_ident()
             yield
         finally:
-            with self._cond:
-                self._writer = False
-                self._owner = None
-                self._cond.notify_all()
+            if waiting or owned:
+                with self._mutex:
+                    if waiting:
+                        self._writers_waiting -= 1
+                        waiting = False
+                    if owned:
+                        self._writer = False
+                        self._owner = None
+                        owned = False
+                    self._cond.notify_all()

@@ -129,6 +129,11 @@ class GMM1D:
             _check(st)
         return float(out[0])
 
+    def __reduce__(self):
+        raise TypeError('amscr.GMM1D cannot be pickled (the C model has no way to be set from its '
+                        'parameters): send the data and fit it again, or pickle '
+                        '(g.weights, g.means, g.variances)')
+
     def __repr__(self) -> str:
         if not self._fitted:
             return 'GMM1D(k=%d, not fitted)' % self.k

@@ -103,6 +103,9 @@ def test_numeric_and_state_errors():
         amscr.kmeans([1.0, 2.0], 3)  # n < k
     with pytest.raises(amscr.StateError):
         amscr.GMM1D(2).means
+    import pickle  # a fitted model cannot be set from its parameters: a TypeError saying what to send
+    with pytest.raises(TypeError, match='fit it again'):
+        pickle.dumps(amscr.GMM1D(2).fit([0.0, 0.1, 0.2, 5.0, 5.1, 5.2]))
     with pytest.raises(amscr.InvalidArgumentError):
         amscr.gaussian_kernel(-1.0)
     with pytest.raises(amscr.InvalidArgumentError):
