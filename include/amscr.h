@@ -77,6 +77,10 @@ extern "C" {
  *      Adding to a db or an index while another thread queries it is not allowed.
  *      Bindings that release their interpreter lock during calls (Python's cffi)
  *      rely on these laws.
+ *   fork(): a child process inherits the locks of the calls other threads were
+ *   making (a db builds its kept retrieval index under one); it may use only the
+ *   objects no call was using at the fork. The Python package waits for such
+ *   calls before a fork.
  *   Each call below says which applies: "safe" (no object, or a static one),
  *   "const" (reads its objects: law 3), "exclusive on X" (modifies X: law 2),
  *   "reentrant" (creates a new object from shared inputs).
@@ -2833,7 +2837,9 @@ typedef struct amscr_index amscr_index;
  * @param[in]  db  the collection (copied; may be freed afterwards).
  * @param[in]  candidates  0, or the shortlist size M (AMSCR_INDEX_CANDIDATES is the
  *                         recommended one).
- * @param[in]  progress, user  optional progress callback (may be NULL).
+ * @param[in]  progress, user  optional progress callback (may be NULL): two stages, the
+ *             shapes' features, then their lists (fractions, see amscr_progress_fn), from
+ *             the start of the build, so a cancel stops it at any stage (since 0.22.6).
  * @param[out] out  the new index.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, open curves with a channel weight);
  *         AMSCR_E_LIMIT (2^32 shapes or more); AMSCR_E_CANCELLED; AMSCR_E_NOMEM.

@@ -304,6 +304,44 @@ START_TEST(kept_query_reports_progress)
 }
 END_TEST
 
+/* A build reports from its start: each shape's features (the first half, once a shape at
+ * least), then its lists, fractions growing to 1, the exact build and a shortlist build alike;
+ * a cancel at the first report stops it. Before, the features, a third of the time, reported
+ * nothing, so no cancel (Python's Ctrl-C) could stop them. */
+typedef struct {
+    fractions f;
+    int below_half;
+} halves;
+
+static int record_halves(void *user, size_t done, size_t total)
+{
+    halves *h = user;
+    h->below_half += 2 * done < total;
+    return record_fraction(&h->f, done, total);
+}
+
+START_TEST(build_reports_its_features)
+{
+    amscr_params *p = params_of(1.0, 8, 2);
+    amscr_db *db = db_of(p, NSHAPES);
+    for (size_t m = 0; m <= 8; m += 8) {
+        halves h = {{0.0, 0, 0, 1, 0}, 0};
+        amscr_index *x = NULL;
+        ck_assert_int_eq(amscr_index_build(db, m, record_halves, &h, &x), AMSCR_OK);
+        ck_assert(h.f.monotone && h.f.ended);
+        ck_assert_int_ge(h.below_half, NSHAPES - 1); /* each shape but the last, whose report is the half */
+        amscr_index_free(x);
+        fractions first = {0.0, 0, 1, 1, 0};
+        x = NULL;
+        ck_assert_int_eq(amscr_index_build(db, m, record_fraction, &first, &x), AMSCR_E_CANCELLED);
+        ck_assert_ptr_null(x);
+        ck_assert_int_eq(first.calls, 1);
+    }
+    amscr_db_free(db);
+    amscr_params_free(p);
+}
+END_TEST
+
 /* The build's default: every pair up to AMSCR_INDEX_EXACT_MAX shapes, the shortlist above. */
 START_TEST(default_candidates)
 {
@@ -1783,6 +1821,7 @@ Suite *amscr_suite_index(void)
     tcase_add_test(tc, add_shapes);
     tcase_add_test(tc, kept_query_from_its_own_callback);
     tcase_add_test(tc, kept_query_reports_progress);
+    tcase_add_test(tc, build_reports_its_features);
     tcase_add_test(tc, empty_collection_query_reports_nothing);
     tcase_add_test(tc, queries_keep_no_decoded_shape);
     tcase_add_test(tc, add_cancelled_leaves_an_index_to_free);

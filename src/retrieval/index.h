@@ -171,7 +171,8 @@ amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const ams
                                               "amscr_index_add (cancelled or out of memory): free it", (fn)); \
     } while (0)
 
-amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig);
+amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig, amscr_progress_fn progress,
+                                    void *user);
 
 /* ------------------------------------------ the mirrored features' pool (index_mirror.c) */
 
@@ -198,7 +199,7 @@ amscr_status amscr__index_refine(amscr_index *x, const amscr__base *b, size_t fi
  * index first; index_inner.c). */
 double amscr__index_inner_pair(const amscr_index *x, size_t i, size_t j, amscr__inner_ws *ws);
 /* Lists from the full inner matrix: x->in_*, x->dmax2. */
-amscr_status amscr__index_inner_full(amscr_index *x);
+amscr_status amscr__index_inner_full(amscr_index *x, amscr_progress_fn progress, void *user);
 /* Rows first..n-1's inner lists among their shortlists S (m each) and their base lists (a
  * shortlist build); x->dmax2 grows. */
 amscr_status amscr__index_inner_rows(amscr_index *x, size_t first, const uint32_t *S, size_t m);

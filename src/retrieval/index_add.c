@@ -199,7 +199,7 @@ amscr_status amscr__index_extend(amscr_index *x, size_t n0, amscr_progress_fn pr
     size_t n = amscr_db_size(x->db), add = n - n0;
     amscr_status st = amscr__index_reserve(x, n);
     if (st == AMSCR_OK)
-        st = amscr__index_features(x, n0, 0);
+        st = amscr__index_features(x, n0, 0, NULL, NULL);
     if (st == AMSCR_OK && x->ivf.nc > 0) /* the new shapes into the quantizer's lists */
         st = amscr__sig_ivf_add(&x->ivf, x->sig_lb, n);
     add_ctx c = {x, {0}, n0, n, NULL, NULL, NULL, NULL};

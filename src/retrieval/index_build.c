@@ -20,15 +20,18 @@ enum { MEDIAN_SAMPLE = 256 };
  * recall"). */
 enum { BUILD_SHORTLIST = AMSCR__INDEX_BUILD_SHORTLIST };
 
-/* Lists and dmax from the full base matrix (the retrieval matrix before its re-ranking). */
+/* Lists and dmax from the full base matrix (the retrieval matrix before its re-ranking), then
+ * the inner distance's lists from its full matrix: progress in two stages when there are both. */
 static amscr_status build_full(amscr_index *x, amscr_progress_fn progress, void *user)
 {
     size_t n = amscr_db_size(x->db), k = x->k;
+    amscr__stages sp = {progress, user, 0, x->k2 > 0 ? 2 : 1};
+    amscr_progress_fn cb = progress ? amscr__stage_cb : NULL;
     double *D = amscr__malloc_array(n * n, sizeof *D), med[2] = {0.0, 0.0};
     size_t *cj = amscr__malloc_array(n, sizeof *cj);
     amscr_status st = D && cj ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "amscr_index_build: out of memory");
     if (st == AMSCR_OK)
-        st = amscr__base_matrix(x->db, progress, user, D, med);
+        st = amscr__base_matrix(x->db, cb, &sp, D, med);
     x->med_a = med[0];
     x->med_h = med[1];
     x->dmax = 0.0;
@@ -42,7 +45,8 @@ static amscr_status build_full(amscr_index *x, amscr_progress_fn progress, void 
     }
     free(D);
     free(cj);
-    return st == AMSCR_OK ? amscr__index_inner_full(x) : st;
+    sp.stage = 1;
+    return st == AMSCR_OK ? amscr__index_inner_full(x, cb, &sp) : st;
 }
 
 /* The fusion's medians estimated on at most MEDIAN_SAMPLE shapes spread evenly. */
@@ -211,21 +215,25 @@ amscr_status amscr__index_rows(amscr_index *x, size_t first, size_t m, amscr_pro
     return st;
 }
 
-/* x's lists, from every pair (candidates 0) or each shape's shortlist; x freed on failure. */
+/* x's lists, from every pair (candidates 0) or each shape's shortlist; x freed on failure.
+ * Progress in two stages: the shapes' features (a third of a full build's time), their lists. */
 static amscr_status build_into(amscr_index *x, size_t candidates, amscr_progress_fn progress, void *user)
 {
     size_t n = amscr_db_size(x->db);
-    amscr_status st = amscr__index_features(x, 0, 0);
+    amscr__stages sp = {progress, user, 0, 2};
+    amscr_progress_fn cb = progress ? amscr__stage_cb : NULL;
+    amscr_status st = amscr__index_features(x, 0, 0, cb, &sp);
+    sp.stage = 1;
     if (candidates > 0 && candidates + 1 < x->k)
         candidates = x->k - 1; /* a shortlist holds at least the K - 1 neighbours */
     x->candidates = candidates > 0 && n > 1 && candidates < n - 1 ? candidates : 0;
     if (st == AMSCR_OK && x->candidates == 0) {
-        st = build_full(x, progress, user);
+        st = build_full(x, cb, &sp);
     } else if (st == AMSCR_OK) {
         size_t mb = x->candidates < BUILD_SHORTLIST ? x->candidates : BUILD_SHORTLIST;
         st = sampled_medians(x);
         if (st == AMSCR_OK)
-            st = amscr__index_rows(x, 0, mb + 1 < x->k ? x->k - 1 : mb, progress, user);
+            st = amscr__index_rows(x, 0, mb + 1 < x->k ? x->k - 1 : mb, cb, &sp);
     }
     if (st == AMSCR_OK)
         st = amscr__index_reverse(x);

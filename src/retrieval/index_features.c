@@ -55,7 +55,8 @@ static amscr_status feat_row(void *ctx, size_t i, void *scratch)
     return st;
 }
 
-amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig)
+amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig, amscr_progress_fn progress,
+                                    void *user)
 {
     feat_job j;
     j.x = x;
@@ -68,8 +69,12 @@ amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig)
     }
     amscr__rows_fn f = {NULL, NULL, feat_row, &j, NULL};
     amscr__index_reverse_free(x);
-    amscr_status st = amscr__run_rows(&f, first, amscr_db_size(x->db), j.b.threads, NULL, NULL);
-    if (st == AMSCR_OK && !have_sig && x->k2 > 0) /* a load reads the inner features (index_io.c) */
-        st = amscr__inner_features(x->db, first, j.b.threads, x->inner);
+    int inner = !have_sig && x->k2 > 0; /* a load reads the inner features (index_io.c) */
+    amscr__stages sp = {progress, user, 0, inner ? 2 : 1};
+    amscr_progress_fn cb = progress ? amscr__stage_cb : NULL;
+    amscr_status st = amscr__run_rows(&f, first, amscr_db_size(x->db), j.b.threads, cb, &sp);
+    sp.stage = 1;
+    if (st == AMSCR_OK && inner)
+        st = amscr__inner_features(x->db, first, j.b.threads, x->inner, cb, &sp);
     return st == AMSCR_OK && have_sig && first == 0 ? amscr__index_reverse(x) : st;
 }

@@ -15,7 +15,7 @@ double amscr__index_inner_pair(const amscr_index *x, size_t i, size_t j, amscr__
                  : amscr__inner_distance(&x->inner[j], &x->inner[i], refl, ws);
 }
 
-amscr_status amscr__index_inner_full(amscr_index *x)
+amscr_status amscr__index_inner_full(amscr_index *x, amscr_progress_fn progress, void *user)
 {
     size_t n = amscr_db_size(x->db), k2 = x->k2;
     if (k2 == 0)
@@ -25,8 +25,8 @@ amscr_status amscr__index_inner_full(amscr_index *x)
     size_t *cj = amscr__malloc_array(n, sizeof *cj);
     amscr_status st = D && cj ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "amscr_index_build: out of memory");
     if (st == AMSCR_OK)
-        st = amscr__inner_matrix_from(x->inner, n, p->reflections, amscr__resolve_threads(p->num_threads), NULL,
-                                      NULL, D);
+        st = amscr__inner_matrix_from(x->inner, n, p->reflections, amscr__resolve_threads(p->num_threads), progress,
+                                      user, D);
     for (size_t j = 0; st == AMSCR_OK && j < n; j++)
         cj[j] = j;
     x->dmax2 = 0.0;

@@ -507,7 +507,7 @@ static amscr_status load_memory(const void *buf, size_t len, unsigned flags, int
     if (st == AMSCR_OK)
         st = read_rest(&r, x, version);
     if (st == AMSCR_OK)
-        st = amscr__index_features(x, 0, 1);
+        st = amscr__index_features(x, 0, 1, NULL, NULL);
     if (st == AMSCR_OK && !x->map) /* the shapes kept as the file's compact records (an older file's decoded) */
         st = amscr__db_own_source(x->db);
     if (st != AMSCR_OK) {

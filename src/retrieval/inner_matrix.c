@@ -59,11 +59,12 @@ static amscr_status pair_row(void *ctx, size_t t, void *ws)
     return AMSCR_OK;
 }
 
-amscr_status amscr__inner_features(const amscr_db *db, size_t first, unsigned threads, amscr__inner *f)
+amscr_status amscr__inner_features(const amscr_db *db, size_t first, unsigned threads, amscr__inner *f,
+                                   amscr_progress_fn progress, void *user)
 {
     inner_job m = {db, f, NULL, amscr_db_size(db), 0, NULL};
     amscr__rows_fn features = {job_init, amscr__inner_ws_delete, feature_row, &m, "inner distance"};
-    return amscr__run_rows(&features, first, m.n, threads, NULL, NULL);
+    return amscr__run_rows(&features, first, m.n, threads, progress, user);
 }
 
 amscr_status amscr__inner_matrix_from(const amscr__inner *f, size_t n, int reflections, unsigned threads,
@@ -84,7 +85,7 @@ amscr_status amscr__inner_matrix(const amscr_db *db, unsigned threads, amscr_pro
     amscr__inner *f = amscr__malloc_array(n, sizeof *f);
     amscr_status st = f ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "inner distance: out of memory");
     if (st == AMSCR_OK)
-        st = amscr__inner_features(db, 0, threads, f);
+        st = amscr__inner_features(db, 0, threads, f, NULL, NULL);
     if (st == AMSCR_OK)
         st = amscr__inner_matrix_from(f, n, amscr_db_params(db)->reflections, threads, progress, user, out);
     if (st != AMSCR_OK)
