@@ -2878,6 +2878,9 @@ AMSCR_API size_t amscr_index_default_candidates(size_t n);
  *        class names kept); on failure it
  *        is left as it was.
  * @param[in] shapes  prepared with exactly the index's params (threads aside).
+ * @param[in] progress, user  optional progress callback (may be NULL): two stages, the new
+ *            shapes' features, then their lists (since 0.22.6; fractions, see
+ *            amscr_progress_fn).
  * @return AMSCR_OK (also for no shapes: no work, no report); AMSCR_E_INVALID_ARG (NULL;
  *         params that differ: the detail names the option); AMSCR_E_LIMIT; AMSCR_E_CANCELLED;
  *         AMSCR_E_NOMEM. After AMSCR_E_CANCELLED or AMSCR_E_NOMEM the index holds the shapes

@@ -306,8 +306,9 @@ END_TEST
 
 /* A build reports from its start: each shape's features (the first half, once a shape at
  * least), then its lists, fractions growing to 1, the exact build and a shortlist build alike;
- * a cancel at the first report stops it. Before, the features, a third of the time, reported
- * nothing, so no cancel (Python's Ctrl-C) could stop them. */
+ * a cancel at the first report stops it; an add reports its new shapes' features likewise.
+ * Before, the features, a third of a build, reported nothing, so no cancel (Python's Ctrl-C)
+ * could stop them. */
 typedef struct {
     fractions f;
     int below_half;
@@ -323,13 +324,17 @@ static int record_halves(void *user, size_t done, size_t total)
 START_TEST(build_reports_its_features)
 {
     amscr_params *p = params_of(1.0, 8, 2);
-    amscr_db *db = db_of(p, NSHAPES);
+    amscr_db *db = db_of(p, NSHAPES), *more = db_of(p, NSHAPES);
     for (size_t m = 0; m <= 8; m += 8) {
         halves h = {{0.0, 0, 0, 1, 0}, 0};
         amscr_index *x = NULL;
         ck_assert_int_eq(amscr_index_build(db, m, record_halves, &h, &x), AMSCR_OK);
         ck_assert(h.f.monotone && h.f.ended);
         ck_assert_int_ge(h.below_half, NSHAPES - 1); /* each shape but the last, whose report is the half */
+        halves a = {{0.0, 0, 0, 1, 0}, 0};
+        ck_assert_int_eq(amscr_index_add(x, more, record_halves, &a), AMSCR_OK);
+        ck_assert(a.f.monotone && a.f.ended);
+        ck_assert_int_ge(a.below_half, NSHAPES - 1);
         amscr_index_free(x);
         fractions first = {0.0, 0, 1, 1, 0};
         x = NULL;
@@ -337,6 +342,7 @@ START_TEST(build_reports_its_features)
         ck_assert_ptr_null(x);
         ck_assert_int_eq(first.calls, 1);
     }
+    amscr_db_free(more);
     amscr_db_free(db);
     amscr_params_free(p);
 }

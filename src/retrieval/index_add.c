@@ -197,9 +197,12 @@ amscr_status amscr_index_add(amscr_index *x, const amscr_db *shapes, amscr_progr
 amscr_status amscr__index_extend(amscr_index *x, size_t n0, amscr_progress_fn progress, void *user)
 {
     size_t n = amscr_db_size(x->db), add = n - n0;
+    amscr__stages sp = {progress, user, 0, 2}; /* the new shapes' features, then their rows */
+    amscr_progress_fn cb = progress ? amscr__stage_cb : NULL;
     amscr_status st = amscr__index_reserve(x, n);
     if (st == AMSCR_OK)
-        st = amscr__index_features(x, n0, 0, NULL, NULL);
+        st = amscr__index_features(x, n0, 0, cb, &sp);
+    sp.stage = 1;
     if (st == AMSCR_OK && x->ivf.nc > 0) /* the new shapes into the quantizer's lists */
         st = amscr__sig_ivf_add(&x->ivf, x->sig_lb, n);
     add_ctx c = {x, {0}, n0, n, NULL, NULL, NULL, NULL};
@@ -212,13 +215,13 @@ amscr_status amscr__index_extend(amscr_index *x, size_t n0, amscr_progress_fn pr
     if (st == AMSCR_OK && (!c.cand || !c.cd || (x->k2 > 0 && !c.cd2) || !c.m))
         st = amscr__fail(AMSCR_E_NOMEM, "amscr_index_add: out of memory");
     for (size_t j = n0; st == AMSCR_OK && j < n; j += batch) {
-        if (progress && progress(user, j - n0, add) != 0)
+        if (cb && cb(&sp, j - n0, add) != 0)
             st = amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback");
         c.j0 = j;
         if (st == AMSCR_OK)
             st = add_rows(&c, j + batch < n ? j + batch : n, n0);
     }
-    if (st == AMSCR_OK && progress && progress(user, add, add) != 0)
+    if (st == AMSCR_OK && cb && cb(&sp, add, add) != 0)
         st = amscr__fail(AMSCR_E_CANCELLED, "cancelled by the progress callback");
     if (st == AMSCR_OK)
         st = amscr__index_reverse(x); /* the lists changed: their reverse for the queries */
