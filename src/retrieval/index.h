@@ -171,6 +171,9 @@ amscr_status amscr__base_row(const amscr__base *b, const amscr_db *db, const ams
                                               "amscr_index_add (cancelled or out of memory): free it", (fn)); \
     } while (0)
 
+/* The features of shapes first..n-1 (have_sig: a load's, which read their signatures and inner
+ * features from the file); progress (may be NULL) over the shapes, in two stages when the inner
+ * features are computed too. */
 amscr_status amscr__index_features(amscr_index *x, size_t first, int have_sig, amscr_progress_fn progress,
                                     void *user);
 

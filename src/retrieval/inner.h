@@ -68,7 +68,8 @@ int amscr__inner_quantize(amscr__inner *f, const double *v);
 
 /* ------------------------------------------------ over a collection (inner_matrix.c) */
 
-/* The features of shapes first..n-1 of db into f[first..n-1], on `threads` threads. */
+/* The features of shapes first..n-1 of db into f[first..n-1], on `threads` threads; progress
+ * (may be NULL) in shapes. */
 amscr_status amscr__inner_features(const amscr_db *db, size_t first, unsigned threads, amscr__inner *f,
                                    amscr_progress_fn progress, void *user);
 /* The symmetric n x n matrix of the inner distances of features f (zero diagonal; cell (i, j),
