@@ -9,7 +9,9 @@
  * amscr_distance on the same descriptors, finite maps, shift < N, kept <= scales. Curves under
  * affine invariance are registered again with the polish and every optional stage on (stray
  * points dropped, the fit on the input points, the order and even spacing of noisy points): a
- * finite map or a clean error; finite alternatives, the chosen map first. */
+ * finite map or a clean error; finite alternatives, the chosen map first. And the source as a
+ * fragment of the target (partial matching): a finite map and its part of the target's boundary
+ * in [0, 1), or a clean error. */
 #include <math.h>
 #include <string.h>
 
@@ -42,6 +44,30 @@ static void polished(const amscr_params *p, const amscr_contour *a, const amscr_
             for (int i = 0; i < 6; i++)
                 FUZZ_CHECK(isfinite(ak[i]) && (k > 0 || ak[i] == m[i]));
         }
+        amscr_result_free(r);
+    } else {
+        FUZZ_CHECK(r == NULL);
+        FUZZ_CHECK(st == AMSCR_E_DEGENERATE || st == AMSCR_E_INVALID_ARG || st == AMSCR_E_NUMERIC);
+    }
+    amscr_params_free(q);
+}
+
+/* The source placed on the target as a fragment: a finite map, the part within [0, 1), or a
+ * clean error. */
+static void partial(const amscr_params *p, const amscr_contour *a, const amscr_contour *tgt)
+{
+    amscr_params *q = NULL;
+    amscr_result *r = NULL;
+    set_ok(amscr_params_copy(p, &q));
+    set_ok(amscr_params_set_partial(q, 1));
+    amscr_status st = amscr_register_contours(q, a, tgt, &r);
+    if (st == AMSCR_OK) {
+        double m[6], s = -1.0, e = -1.0;
+        FUZZ_CHECK(amscr_result_affine(r, m) == AMSCR_OK);
+        for (int i = 0; i < 6; i++)
+            FUZZ_CHECK(isfinite(m[i]));
+        FUZZ_CHECK(amscr_result_part(r, &s, &e) == AMSCR_OK);
+        FUZZ_CHECK(s >= 0.0 && s < 1.0 && e >= 0.0 && e < 1.0);
         amscr_result_free(r);
     } else {
         FUZZ_CHECK(r == NULL);
@@ -121,8 +147,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FUZZ_CHECK(r == NULL);
         FUZZ_CHECK(st == AMSCR_E_DEGENERATE || st == AMSCR_E_INVALID_ARG || st == AMSCR_E_NUMERIC);
     }
-    if (((b0 >> 6) & 3) % 3 == 0) /* affine */
+    if (((b0 >> 6) & 3) % 3 == 0) { /* affine */
         polished(p, a, tgt);
+        partial(p, a, tgt);
+    }
     amscr_params_free(p);
     amscr_contour_free(a);
     amscr_contour_free(b);
