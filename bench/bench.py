@@ -2,8 +2,9 @@
 """Runs the speed benchmark, then single registrations per stage (amscr-registration-bench), then
 (when the tool is built) the query time against synthetic
 1400- and 10,000-shape indexes (bench/index_bench.py; each index is built once and cached in
---index-work), then (when ../shared/datasets exists) `amscr eval` on Kimia-99 and Kimia-216,
-printing the top-k tables beside the paper's rows."""
+--index-work), then (when ../shared/datasets exists) `amscr eval` on Kimia-99's and Kimia-216's
+manifest.tsv (the order and classes the docs' figures use), printing the top-k tables beside the
+paper's rows."""
 import argparse
 import json
 import os
@@ -40,11 +41,11 @@ if not args.tool or not args.datasets or not os.path.isdir(args.datasets):
     print('(Kimia tables skipped: no tool or no ../shared/datasets)')
     sys.exit(0)
 for name, paper in PAPER.items():
-    folder = os.path.join(args.datasets, name)
-    if not os.path.isdir(folder):
+    manifest = os.path.join(args.datasets, name, 'manifest.tsv')
+    if not os.path.isfile(manifest):
         continue
     ranks = len(paper)
-    out = subprocess.run([args.tool, 'eval', folder, '--protocol', 'topk', '--ranks', str(ranks), '--json'],
+    out = subprocess.run([args.tool, 'eval', manifest, '--protocol', 'topk', '--ranks', str(ranks), '--json'],
                          capture_output=True, text=True)
     if out.returncode != 0:
         print('%s: amscr eval failed: %s' % (name, out.stderr.strip()))

@@ -8,7 +8,7 @@ matching the candidates, re-ranking). Prints the times and whether each size's t
 0.1 s at 1400 shapes, 0.5 s at 10,000 (the median of the queries).
 
     python3 bench/index_bench.py --tool build/tools/amscr [--shapes 1400,10000] [--work build/bench-index]
-    python3 bench/index_bench.py --rss-index m7.idx [--rss-copies 4]   # amscr.Index's memory (psutil)
+    .venv/bin/python3 bench/index_bench.py --rss-index m7.idx [--rss-copies 4]   # amscr.Index's memory (psutil)
 """
 import argparse
 import math

@@ -22,8 +22,10 @@ by side: ok % under the max rule above and under the check's rule (RMS of the er
 source's points < 2 % of the size), and wrong + confident (an RMS failure with confidence >= 0.25).
 --stages NAME,... switches optional stages on (order, even_spacing, ...); --reversed gives the
 fragments' points in the other order (against the target's way round).
+Without --sets: the table, the confidences' medians, then each condition's largest errors (within
+2 %, the median, the 90th and the 95th percentile).
 
-Usage: nice python3 bench/registration_heldout.py [--data DIR] [--ecc] [--draws 2] [--stray F] [--only KEYS]
+Usage: nice .venv/bin/python3 bench/registration_heldout.py [--data DIR] [--ecc] [--draws 2] [--stray F] [--only KEYS]
        [--sets A,B,P] [--stages NAMES] [--reversed]
 Deterministic: every draw is seeded by (condition, class index, draw); procedural shape i has index 1000 + i.
 """
@@ -258,8 +260,8 @@ def load_sets(data, sets, subpixel=False):
 
 
 def run(args, shapes, conds, cv2=None):
-    """{(set, condition key): [(ok, ok under the RMS rule, confidence or None, ms, ECC ok)]} of every seeded
-    draw; shapes: [(set, class, contour, seed index)]."""
+    """{(set, condition key): [(ok, ok under the RMS rule, confidence or None, ms, ECC ok, the largest
+    error in % of the size)]} of every seeded draw; shapes: [(set, class, contour, seed index)]."""
     stages = {k: True for k in args.stages.split(',')} if args.stages else None
     res = {}
     for key, _, amount, _ in conds:
@@ -274,9 +276,11 @@ def run(args, shapes, conds, cv2=None):
                 M, r = amscr_register(seen, tgt, partial, stages)
                 ms = 1e3 * (time.perf_counter() - t0)
                 ok_ecc = cv2 is not None and map_error(ecc_register(src, tgt, cv2), T, src, size) < 0.02
-                res.setdefault((fold, key), []).append((map_error(M, T, src, size) < 0.02,
+                err = map_error(M, T, src, size)
+                res.setdefault((fold, key), []).append((err < 0.02,
                                                         map_error(M, T, src, size, rms=True) < 0.02,
-                                                        r.confidence if r is not None else None, ms, ok_ecc))
+                                                        r.confidence if r is not None else None, ms, ok_ecc,
+                                                        100 * err))
         print('.', end='', file=sys.stderr, flush=True)
     print(file=sys.stderr)
     return res
@@ -347,6 +351,9 @@ def main():
             good, bad = ([r[2] for r in res[('', key)] if r[2] is not None and r[0] == ok] for ok in (True, False))
             print('  %-14s %s / %s' % (label, '%.3f' % np.median(good) if good else '-',
                                       '%.3f' % np.median(bad) if bad else '-'))
+    print('\nlargest error over the source\'s points, % of the size, per condition:')
+    for key, label, _, _ in conds:
+        print('  %-14s %s' % (label, error_summary([r[5] for r in res[('', key)]])))
     return 0
 
 
