@@ -6,9 +6,9 @@ import operator
 import os
 import sys
 import threading
-import weakref
 import time
 import warnings
+import weakref
 from typing import TYPE_CHECKING, Any, Callable, Iterator, List, Literal, Optional, Protocol, Tuple, Union
 
 import numpy as np
