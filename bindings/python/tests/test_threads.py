@@ -29,6 +29,17 @@ def _run_threads(targets):
         raise errors[0]
 
 
+def _run_script(script, timeout):
+    """script run by a new interpreter that imports this amscr and the tests' helpers."""
+    import os
+    import subprocess
+    import sys
+    here = os.path.dirname(os.path.abspath(__file__))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [os.path.dirname(os.path.dirname(os.path.abspath(amscr.__file__))), here]))
+    return subprocess.run([sys.executable, '-c', script], env=env, capture_output=True, text=True, timeout=timeout)
+
+
 def test_gil_is_released_during_c_calls():
     """While one thread is inside a long C call (no callback), the main thread keeps running Python."""
     rng = np.random.default_rng(0)
@@ -164,13 +175,7 @@ def test_ctrl_c_cancels_a_long_batch_call():
     core) must end the call within a second of the signal, not when the matrix is done (a
     KeyboardInterrupt raised after the C call returned would also print 'interrupted').
     Measured: interrupted 0.33 s after the call began, full matrix estimated 7.6 s."""
-    import os
-    import subprocess
-    import sys
-    here = os.path.dirname(os.path.abspath(__file__))
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-        [os.path.dirname(os.path.dirname(os.path.abspath(amscr.__file__))), here]))
-    r = subprocess.run([sys.executable, '-c', CTRL_C_SCRIPT], env=env, capture_output=True, text=True, timeout=300)
+    r = _run_script(CTRL_C_SCRIPT, 300)
     assert r.returncode == 0, r.stderr
     first, second = r.stdout.split('\n')[:2]
     word, took, full = first.split()
@@ -246,13 +251,7 @@ def test_fork_while_another_thread_is_inside_a_call():
     """A process forked while another thread is inside a collection's call (here the first
     retrieval query, building the kept index) gets a usable collection: the fork waits for the
     call to end. Before, the child inherited the held locks and its query and add hung."""
-    import os
-    import subprocess
-    import sys
-    here = os.path.dirname(os.path.abspath(__file__))
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-        [os.path.dirname(os.path.dirname(os.path.abspath(amscr.__file__))), here]))
-    r = subprocess.run([sys.executable, '-c', FORK_SCRIPT], env=env, capture_output=True, text=True, timeout=600)
+    r = _run_script(FORK_SCRIPT, 600)
     assert r.returncode == 0, r.stderr
     lines = r.stdout.split()
     assert lines[-2:] == ['exit', '0'], r.stdout + r.stderr
