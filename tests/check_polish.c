@@ -1,7 +1,8 @@
 /* check_polish.c — the polish stage (docs/method.md §11.4) (src/register/polish.c): the flag's defaults and range,
  * noisy targets and noisy sources registered more accurately with it than without, exact pairs
  * kept exact, no polish without input points (collections, loaded collections), fragments
- * (partial matching) placed better with it, symmetric shapes still reported ambiguous. Generated shapes, seeded. */
+ * (partial matching) placed better with it, symmetric shapes still reported ambiguous; the closest-point
+ * searches it and the refinement read (nearest.c, refine.c) against brute force. Generated shapes, seeded. */
 #include <amscr.h>
 #include <check.h>
 #include <limits.h>
@@ -10,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "match.h"
 #include "nearest.h"
 #include "suites.h"
 #include "testutil.h"
@@ -442,6 +444,74 @@ START_TEST(grid_nearest_is_exact)
 }
 END_TEST
 
+/* The closest point on a polygon (refine.c: refinement, correspondences, recovery and partial
+ * matching read it) equals brute force over every edge, the foot clamped to the edge's ends: open
+ * and closed random polygons, queries near and far, beyond an open polygon's two ends (the foot
+ * there is the end vertex itself), every edge searched; a closed polygon's faster search from its
+ * edge arrays gives the same result bit for bit, in every window. */
+static double brute_closest(const double *H, size_t n, int closed, double px, double py, double *qx, double *qy)
+{
+    double best = INFINITY;
+    for (size_t b = 0; b + (closed ? 0 : 1) < n; b++) {
+        size_t c = (b + 1) % n;
+        double ex = H[2 * c] - H[2 * b], ey = H[2 * c + 1] - H[2 * b + 1], l2 = ex * ex + ey * ey;
+        double t = l2 > 0.0 ? ((px - H[2 * b]) * ex + (py - H[2 * b + 1]) * ey) / l2 : 0.0;
+        t = fmin(1.0, fmax(0.0, t));
+        double cx = H[2 * b] + t * ex, cy = H[2 * b + 1] + t * ey;
+        double d2 = (px - cx) * (px - cx) + (py - cy) * (py - cy);
+        if (d2 < best) {
+            best = d2;
+            *qx = cx;
+            *qy = cy;
+        }
+    }
+    return best;
+}
+
+START_TEST(closest_on_polygon_is_exact)
+{
+    amscr_test_rng rng;
+    amscr_test_rng_seed(&rng, 41);
+    enum { N = 40 };
+    double H[2 * N], E[5 * N];
+    for (int set = 0; set < 6; set++) {
+        int closed = set % 2;
+        for (size_t i = 0; i < N; i++) {
+            double t = 6.283185307179586 * (double)i / N, r = 1.0 + 0.5 * amscr_test_uniform(&rng);
+            H[2 * i] = r * cos(t);
+            H[2 * i + 1] = r * sin(t);
+        }
+        amscr__closed_edges(H, N, E);
+        for (int k = 0; k < 300; k++) {
+            double spread = k % 3 == 0 ? 10.0 : 3.0;
+            double px = spread * (amscr_test_uniform(&rng) - 0.5), py = spread * (amscr_test_uniform(&rng) - 0.5);
+            if (k < 2) { /* beyond an open polygon's first and last vertex, along its end edges */
+                size_t e = k == 0 ? 0 : N - 1, f = k == 0 ? 1 : N - 2;
+                px = H[2 * e] + 0.3 * (H[2 * e] - H[2 * f]);
+                py = H[2 * e + 1] + 0.3 * (H[2 * e + 1] - H[2 * f + 1]);
+            }
+            double qx = NAN, qy = NAN, bx = NAN, by = NAN;
+            size_t seg = N;
+            double d = amscr__closest_on_polygon(H, N, closed, 0, N, px, py, &qx, &qy, &seg);
+            double want = brute_closest(H, N, closed, px, py, &bx, &by);
+            ck_assert_msg(fabs(d - want) <= 1e-12 * (1.0 + want) && fabs(qx - bx) <= 1e-12 && fabs(qy - by) <= 1e-12,
+                          "set %d query %d: %.17g at (%g, %g), brute force %.17g at (%g, %g)", set, k, d, qx, qy,
+                          want, bx, by);
+            ck_assert(seg < (closed ? N : N - 1));
+            if (k < 2 && !closed) /* the end vertex itself */
+                ck_assert(qx == H[2 * (k == 0 ? 0 : N - 1)] && qy == H[2 * (k == 0 ? 0 : N - 1) + 1]);
+            for (size_t w = 0; closed && w < N; w += 7) {
+                size_t b0 = (size_t)k % N, s1 = N, s2 = N;
+                double x1, y1, x2, y2;
+                double d1 = amscr__closest_on_polygon(H, N, 1, b0, w, px, py, &x1, &y1, &s1);
+                double d2 = amscr__closest_on_closed(E, N, b0, w, px, py, &x2, &y2, &s2);
+                ck_assert(d1 == d2 && x1 == x2 && y1 == y2 && s1 == s2);
+            }
+        }
+    }
+}
+END_TEST
+
 /* Odd inputs through the whole registration with the polish (and partial matching every sixth):
  * random point clouds read as polygons (self-intersecting), spiky radii, repeated points, shapes
  * 1e-5 thin, coordinates from 1e-4 to 1e4, noise: every call gives a finite map or a clean error
@@ -513,6 +583,7 @@ Suite *amscr_suite_polish(void)
     tcase_add_test(tc, partial_polished);
     tcase_add_test(tc, symmetric_stay_ambiguous);
     tcase_add_test(tc, grid_nearest_is_exact);
+    tcase_add_test(tc, closest_on_polygon_is_exact);
     tcase_add_test(tc, odd_inputs_finite_or_refused);
     suite_add_tcase(s, tc);
     return s;
