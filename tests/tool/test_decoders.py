@@ -118,6 +118,24 @@ def test_png_rgba_two_tone_on_transparent(tmp_path, tones):
 
 
 @pytest.mark.png
+@pytest.mark.parametrize("color_type", [4, 6])
+def test_png_alpha_antialiased_edge_subpixel(tmp_path, color_type):
+    # a cut-out as editors export it: one colour, the silhouette in an antialiased alpha
+    # channel. It is traced as the same coverage in grey levels (sub-pixel, column 20 at 30 %),
+    # not as the alpha cut to a binary mask (the edge at 19.5 whatever the coverage)
+    cover = fill_rect(fill_rect(blank(40, 30), 5, 5, 19, 24, 255), 20, 5, 20, 24, 77)
+    grey = tmp_path / "grey.png"
+    grey.write_bytes(png_bytes(cover, 0, 8))
+    alpha = tmp_path / "alpha.png"
+    alpha.write_bytes(png_bytes(map_img(cover, lambda a: (40, a) if color_type == 4 else (200, 40, 10, a)),
+                                color_type, 8))
+    want, got = (run("contour", p) for p in (grey, alpha))
+    assert want.returncode == 0 and got.returncode == 0, got.stderr
+    assert read_points(got.stdout) == read_points(want.stdout)
+    assert abs(max(x for x, y in read_points(got.stdout) if 8 <= y <= 20) - 19.8) < 0.09
+
+
+@pytest.mark.png
 def test_png_rgba_opaque_dark_shape(tmp_path):
     img = map_img(rect_mask(), lambda v: (0, 0, 0, 255) if v else (255, 255, 255, 255))
     check_rect(contour_of(tmp_path, png_bytes(img, 6, 8), "rgbao.png"))

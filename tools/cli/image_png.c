@@ -9,7 +9,8 @@
  * Alpha (gray+alpha, RGBA, tRNS): when every pixel has alpha >= 128 the alpha channel is
  * ignored. Otherwise transparent pixels (alpha < 128) are made background:
  *   - if the opaque pixels have (nearly) one colour (luminance range <= 16), the alpha
- *     channel is the silhouette: opaque -> 255, transparent -> 0;
+ *     channel is the silhouette: the luminance is the alpha (antialiased alpha edges keep
+ *     their coverage, which the sub-pixel tracer follows);
  *   - otherwise the image is composited over a background that contrasts with the mean
  *     opaque colour (white under dark content, black under light content).
  * The polarity of the result does not matter: amscr_contour_from_mask makes the image
@@ -52,9 +53,12 @@ static void apply_alpha(uint8_t *lum, const uint8_t *alpha, size_t n)
     }
     if (transparent == 0)
         return; /* fully opaque: alpha carries nothing */
-    if (opaque == 0 || hi - lo <= 16) {
-        for (size_t i = 0; i < n; i++)
-            lum[i] = alpha[i] >= 128 ? 255 : 0;
+    if (opaque == 0) {
+        memset(lum, 0, n);
+        return;
+    }
+    if (hi - lo <= 16) {
+        memcpy(lum, alpha, n); /* the coverage: an antialiased edge stays sub-pixel */
         return;
     }
     unsigned bg = sum / (double)opaque < 128.0 ? 255u : 0u;
