@@ -136,6 +136,31 @@ def test_png_alpha_antialiased_edge_subpixel(tmp_path, color_type):
 
 
 @pytest.mark.png
+@pytest.mark.parametrize("parts", ["halves", "outline"])
+def test_png_rgba_light_and_dark_cutout_on_transparent(tmp_path, parts):
+    # an object of dark and light parts cut out on a transparent background (a photo cut-out,
+    # an icon with a dark outline and a light fill): the alpha is the silhouette, the object
+    # stays whole (composited over one background, its light or its dark parts went with it)
+    img = [[(0, 0, 0, 0)] * 40 for _ in range(30)]
+    x0, y0, x1, y1 = RECT
+    for y in range(y0, y1 + 1):
+        for x in range(x0, x1 + 1):
+            light = x >= 15 if parts == "halves" else x0 < x < x1 and y0 < y < y1
+            img[y][x] = (240, 235, 250, 255) if light else (20, 10, 30, 255)
+    check_rect(contour_of(tmp_path, png_bytes(img, 6, 8), "cut.png"))
+
+
+@pytest.mark.png
+def test_png_rgba_transparent_corners_of_a_picture(tmp_path):
+    # transparency that is not the background (rounded-off corners of an opaque picture): the
+    # picture is composited as before, its dark rectangle traced
+    img = map_img(rect_mask(), lambda v: (10, 10, 10, 255) if v else (250, 250, 250, 255))
+    for y, x in ((0, 0), (0, 39), (29, 0), (29, 39)):
+        img[y][x] = (0, 0, 0, 0)
+    check_rect(contour_of(tmp_path, png_bytes(img, 6, 8), "corners.png"))
+
+
+@pytest.mark.png
 def test_png_rgba_opaque_dark_shape(tmp_path):
     img = map_img(rect_mask(), lambda v: (0, 0, 0, 255) if v else (255, 255, 255, 255))
     check_rect(contour_of(tmp_path, png_bytes(img, 6, 8), "rgbao.png"))

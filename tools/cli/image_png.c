@@ -8,11 +8,14 @@
  *   - palette: through the palette's RGB, tRNS entries give alpha;
  * Alpha (gray+alpha, RGBA, tRNS): when every pixel has alpha >= 128 the alpha channel is
  * ignored. Otherwise transparent pixels (alpha < 128) are made background:
- *   - if the opaque pixels have (nearly) one colour (luminance range <= 16), the alpha
- *     channel is the silhouette: the luminance is the alpha (antialiased alpha edges keep
- *     their coverage, which the sub-pixel tracer follows);
- *   - otherwise the image is composited over a background that contrasts with the mean
- *     opaque colour (white under dark content, black under light content).
+ *   - if most of the image border is transparent (an object cut out on a transparent
+ *     background, as image editors export one), or the opaque pixels have (nearly) one colour
+ *     (luminance range <= 16), the alpha channel is the silhouette: the luminance is the alpha
+ *     (antialiased alpha edges keep their coverage, which the sub-pixel tracer follows), so an
+ *     object of light and dark parts stays whole;
+ *   - otherwise (transparent holes or corners in an opaque picture) the image is composited
+ *     over a background that contrasts with the mean opaque colour (white under dark content,
+ *     black under light content).
  * The polarity of the result does not matter: amscr_contour_from_mask makes the image
  * border background. */
 #include "image_codec.h"
@@ -34,8 +37,27 @@
 #define PNG_CHUNK_MAX_COUNT 1000u
 
 /* ============================================================= alpha policy */
-static void apply_alpha(uint8_t *lum, const uint8_t *alpha, size_t n)
+/* Non-zero when more than half of the border pixels of the w x h alpha plane are transparent. */
+static int border_transparent(const uint8_t *alpha, size_t w, size_t h)
 {
+    size_t border = 0, clear = 0;
+    for (size_t y = 0; y < h; y++) {
+        const uint8_t *row = alpha + y * w;
+        if (y == 0 || y == h - 1) {
+            for (size_t x = 0; x < w; x++)
+                clear += row[x] < 128;
+            border += w;
+        } else {
+            clear += (row[0] < 128) + (w > 1 && row[w - 1] < 128);
+            border += w > 1 ? 2 : 1;
+        }
+    }
+    return 2 * clear > border;
+}
+
+static void apply_alpha(uint8_t *lum, const uint8_t *alpha, size_t w, size_t h)
+{
+    const size_t n = w * h;
     size_t transparent = 0, opaque = 0;
     int lo = 255, hi = 0;
     double sum = 0.0;
@@ -57,7 +79,7 @@ static void apply_alpha(uint8_t *lum, const uint8_t *alpha, size_t n)
         memset(lum, 0, n);
         return;
     }
-    if (hi - lo <= 16) {
+    if (hi - lo <= 16 || border_transparent(alpha, w, h)) {
         memcpy(lum, alpha, n); /* the coverage: an antialiased edge stays sub-pixel */
         return;
     }
@@ -324,7 +346,7 @@ static void png_decode(png_structp png, png_infop info, png_ctx *ctx, const char
     png_read_pixels(png, passes, ctx->buf, ctx->rows, rowbytes, channels, w, h, ctx->lum, ctx->alpha, ctx->lum16);
     /* The image data is complete; the chunks after it are not needed. */
     if (has_alpha)
-        apply_alpha(ctx->lum, ctx->alpha, (size_t)w * (size_t)h);
+        apply_alpha(ctx->lum, ctx->alpha, w, h);
     free(ctx->alpha);
     free(ctx->buf);
     free(ctx->rows);
