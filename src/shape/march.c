@@ -69,7 +69,7 @@ amscr_status amscr__march(const amscr__iso *f, size_t cx, size_t cy, int entry, 
 {
     const size_t cw = f->w + 1, ch = f->h + 1; /* cells of the padded field */
     const size_t max_steps = 4 * cw * ch + 4;
-    size_t n = 0, cap = 256, x0 = cx, y0 = cy;
+    size_t n = 0, cap = 16, x0 = cx, y0 = cy; /* grown by doubling: a speck's contour keeps 16 points' room, not 256 */
     const int e0 = entry;
     double *xy = malloc(cap * 2 * sizeof *xy);
     if (!xy)

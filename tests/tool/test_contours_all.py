@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from imgutil import blank, fill_rect, pgm_bytes, run, write_points
+from imgutil import blank, fill_rect, pgm_bytes, run, run_peak_memory, write_points
 from test_collection import AFFINE
 from test_protocols import make_manifest
 
@@ -104,3 +104,17 @@ def test_all_subpixel_areas(nested):
     assert min(x for x, _ in hole) == 9.5 and max(x for x, _ in hole) == 29.5  # between the pixels
     chain = json.loads(run("contour", nested, "--all", "--json", "--min-area", "0", "--pixel-chain").stdout)
     assert [c["parent"] for c in chain["contours"]] == [c["parent"] for c in j["contours"]]
+
+
+def test_all_many_specks_memory(tmp_path):
+    """40,000 specks of 2 x 2 pixels, each a contour of 8 points: the set holds their points, not
+    a 256-point buffer each (4 KiB a contour: 160 MiB here, gigabytes for a large image)."""
+    img = blank(600, 600, 0)
+    for y in range(0, 600, 3):
+        for x in range(0, 600, 3):
+            img[y][x] = img[y][x + 1] = img[y + 1][x] = img[y + 1][x + 1] = 255
+    p = tmp_path / "specks.pgm"
+    p.write_bytes(pgm_bytes(img))
+    code, err, peak_kib = run_peak_memory("contour", p, "--all", "--min-area", "0", "--json")
+    assert code == 0, err
+    assert peak_kib < 64 * 1024, f"{peak_kib / 1024:.0f} MiB"
