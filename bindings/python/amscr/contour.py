@@ -18,7 +18,7 @@ from ._lib import ffi, lib
 from ._util import (GEOMETRY_POINTS, MaskLike, Order, PathArg, PointArray, as_bool, as_count, as_path, as_scalar,
                     bad, bad_type, copy_points, dbuf, described, is_geometry, new_object, unmasked)
 from ._util import as_points as _as_points
-from .errors import InvalidArgumentError, NotFoundError, _check
+from .errors import InvalidArgumentError, LimitError, NotFoundError, _check
 
 
 def _new_contour(make: Any, *args: Any):
@@ -88,8 +88,9 @@ def _float_level(lo: float, hi: float, threshold: Any) -> float:
 
 def _as_samples(mask: MaskLike, threshold: Any) -> Tuple[np.ndarray, Optional[Tuple[float, float]], int]:
     """(uint8 or uint16 samples, the (lo, hi) of a float image mapped onto 16 bits or None, the
-    padding): a bool mask becomes 0/255 padded with one pixel of background, since True is the
-    foreground even where it covers the image border (no automatic polarity)."""
+    padding): a bool mask becomes 0/255, padded with one pixel of background when True covers
+    most of its border, since True is the foreground even there (no automatic polarity); a mask
+    the tracer would not swap is not padded, so every mask within the image limits is traced."""
     a = np.asarray(unmasked(mask, 'mask', 'mask.filled(0) (masked pixels as background)'))
     if a.dtype == object and a.ndim == 0:
         raise _not_an_image(mask)
@@ -98,7 +99,16 @@ def _as_samples(mask: MaskLike, threshold: Any) -> Tuple[np.ndarray, Optional[Tu
     if not a.dtype.isnative:  # e.g. big-endian '>u2': as the native dtype (its tests below, the bytes C reads)
         a = a.astype(a.dtype.newbyteorder('='))
     if a.dtype == np.bool_:
-        return np.pad(a.astype(np.uint8) * np.uint8(255), 1), None, 1
+        b = a.astype(np.uint8) * np.uint8(255)
+        if not _border_mostly_true(a):  # the tracer keeps this polarity: no frame needed
+            return b, None, 0
+        h, w = a.shape
+        if max(h, w) + 2 > lib.AMSCR_MAX_IMAGE_SIDE or (h + 2) * (w + 2) > lib.AMSCR_MAX_IMAGE_PIXELS:
+            raise LimitError('mask: a %d x %d bool mask True over most of its border is traced with a frame of '
+                             'False around it, which exceeds the image limits (%d per side, %d pixels): crop it'
+                             % (w, h, lib.AMSCR_MAX_IMAGE_SIDE, lib.AMSCR_MAX_IMAGE_PIXELS),
+                             lib.AMSCR_E_LIMIT, '')
+        return np.pad(b, 1), None, 1
     if a.dtype.kind == 'f':
         if a.size and not np.all(np.isfinite(a)):
             raise bad('mask: non-finite values')
@@ -114,6 +124,19 @@ def _as_samples(mask: MaskLike, threshold: Any) -> Tuple[np.ndarray, Optional[Tu
         return a, None, 0
     want = np.uint8 if not a.size or int(a.max()) <= 255 else np.uint16  # values up to 255: 8 bits
     return (a if a.dtype == want else a.astype(want)), None, 0
+
+
+def _border_mostly_true(a: np.ndarray) -> bool:
+    """Whether more than half of the border pixels of the bool array `a` (each counted once) are
+    True: those the C tracer's automatic polarity would swap, unless framed with False."""
+    h, w = a.shape
+    if h <= 2 or w <= 2:
+        on, n = int(np.count_nonzero(a)), a.size
+    else:
+        on = int(np.count_nonzero(a[0]) + np.count_nonzero(a[-1]) + np.count_nonzero(a[1:-1, 0]) +
+                 np.count_nonzero(a[1:-1, -1]))
+        n = 2 * w + 2 * (h - 2)
+    return 2 * on > n
 
 
 def _not_an_image(mask: Any) -> InvalidArgumentError:

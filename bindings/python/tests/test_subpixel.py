@@ -59,6 +59,19 @@ def test_a_bool_mask_is_its_true_pixels_also_on_the_border():
     assert amscr.signed_area(full) == pytest.approx(20 * 30 - 0.5)
 
 
+def test_a_bool_mask_within_the_limits_is_traced():
+    """A bool mask at the image limits (32768 wide, or 2^28 pixels) is traced as its uint8 copy:
+    it is framed with False only when True covers most of its border (the frame took it past
+    the limits, a LimitError naming a size the caller never gave); one that needs the frame
+    and has no room for it says so in its own size."""
+    m = np.zeros((3, 32768), bool)  # AMSCR_MAX_IMAGE_SIDE
+    m[1, 5:40] = True
+    np.testing.assert_array_equal(amscr.contour_from_mask(m), amscr.contour_from_mask(m.view(np.uint8)))
+    assert [c.area for c in amscr.contours_from_mask(m, min_area=0)] == [34.5]
+    with pytest.raises(amscr.LimitError, match=r"^mask: a 32768 x 3 bool mask True over most of its border"):
+        amscr.contour_from_mask(~m)
+
+
 @pytest.mark.parametrize("make", [lambda m: m.astype(np.float32), lambda m: m.astype(np.float64) / 255 * 7.5,
                                   lambda m: m.astype(np.uint16), lambda m: m.astype(np.int32)])
 def test_an_8_bit_mask_in_another_dtype_is_traced_as_the_8_bit_one(make):
