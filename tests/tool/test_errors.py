@@ -57,6 +57,7 @@ BAD_FILES = {
     "garbage.p2.pgm": (b"P2\n3 3\n255\n0 0 0\n0 x 0\n0 0 0\n", "corrupt PGM"),
     "huge.pgm": (b"P5\n100000 10\n255\n", "too large"),
     "huge-pixels.pgm": (b"P5 30000 30000 255\n", "too large"),
+    "huger.pgm": (b"P5 4000000000 30 255\n", "image too large: 4000000000 x 30 pixels"),
     "black.png": (png_bytes(blank(20, 20, 0), 0, 8), "no foreground"),
     "white.pgm": (pgm_bytes(blank(20, 20, 255)), "no foreground"),
     "transparent.png": (png_bytes([[(0, 0, 0, 0)] * 8] * 8, 6, 8), "no foreground"),

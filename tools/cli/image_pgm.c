@@ -1,5 +1,6 @@
 /* image_pgm.c — PGM (P2, P5) decoding for the amscr tool (image_codec.h): v * 255 / maxval,
  * rounded (maxval 1..65535); maxval > 255 keeps the 16-bit samples too (pix16). */
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,16 +29,11 @@ static int pgm_int(FILE *fp, unsigned long *out)
     if (c < '0' || c > '9')
         return -1;
     unsigned long v = 0;
-    int digits = 0;
     while (c >= '0' && c <= '9') {
-        if (v > 100000000ul) /* far beyond any limit; keeps the value exact */
-            v = 100000000ul;
-        else
-            v = v * 10 + (unsigned long)(c - '0');
-        digits++;
+        unsigned long d = (unsigned long)(c - '0');
+        v = v > (ULONG_MAX - d) / 10 ? ULONG_MAX : v * 10 + d; /* exact, or ULONG_MAX (past any limit) */
         c = getc(fp);
     }
-    (void)digits;
     if (c != EOF)
         ungetc(c, fp);
     *out = v;
