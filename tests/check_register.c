@@ -1008,16 +1008,39 @@ END_TEST
 
 /* A closed contour given with a closing copy of its first point (as OpenCV's approxPolyDP, a
  * GeoJSON ring or a hand-made polygon give it) is the same shape: its prepared samples are those
- * of the contour without it, bit for bit, in both presets. */
+ * of the contour without it, bit for bit, in both presets; and it registers onto a noisy target,
+ * and a noisy target onto it, bit for bit as without it (the polish fits the input points, where
+ * a kept copy would count the first point twice). */
 START_TEST(closing_copy_is_dropped)
 {
     enum { N = 120 };
     amscr_test_rng rng;
     amscr_test_rng_seed(&rng, 4321u);
-    double xy[2 * (N + 1)];
+    double xy[2 * (N + 1)], T[6], tgt[2 * N];
     amscr_test_random_shape(&rng, N, 5, xy);
+    amscr_test_add_noise(&rng, xy, N, 0.01 * amscr_test_shape_size(xy, N));
     xy[2 * N] = xy[0];
     xy[2 * N + 1] = xy[1];
+    amscr_test_random_affine(&rng, 1.5, 0.3, 5.0, 0, T);
+    amscr_test_apply_affine(T, xy, N, tgt);
+    amscr_test_add_noise(&rng, tgt, N, 0.01 * amscr_test_shape_size(tgt, N));
+    amscr_params *reg_p = NULL;
+    ck_assert_int_eq(amscr_params_new_registration(&reg_p), AMSCR_OK);
+    amscr_descriptor *t = make_desc(reg_p, tgt, N);
+    for (int way = 0; way < 2; way++) {
+        double m[2][6];
+        for (int copy = 0; copy < 2; copy++) {
+            amscr_descriptor *a = make_desc(reg_p, xy, N + (size_t)copy);
+            amscr_result *r = reg(reg_p, way ? t : a, way ? a : t, NULL);
+            ck_assert_int_eq(amscr_result_affine(r, m[copy]), AMSCR_OK);
+            amscr_result_free(r);
+            amscr_descriptor_free(a);
+        }
+        ck_assert_msg(memcmp(m[0], m[1], sizeof m[0]) == 0, "%s: a map %.17g differs with the copy: %.17g",
+                      way ? "onto it" : "from it", m[0][0], m[1][0]);
+    }
+    amscr_descriptor_free(t);
+    amscr_params_free(reg_p);
     for (int preset = 0; preset < 2; preset++) {
         amscr_params *p = NULL;
         ck_assert_int_eq(preset ? amscr_params_new_registration(&p) : amscr_params_new(&p), AMSCR_OK);
