@@ -9,7 +9,7 @@ import threading
 import time
 import warnings
 import weakref
-from typing import TYPE_CHECKING, Any, Callable, Iterator, List, Literal, Optional, Protocol, Tuple, Union
+from typing import TYPE_CHECKING, Any, Callable, ForwardRef, Iterator, List, Literal, Optional, Protocol, Tuple, Union
 
 import numpy as np
 
@@ -24,12 +24,26 @@ except ImportError:  # numpy < 1.20
 if TYPE_CHECKING:
     from .contour import ImageContour
 
-#: What a function taking points accepts: an (n, 2) array-like, an OpenCV (n, 1, 2) contour, or an
-#: :class:`ImageContour` of :func:`contours_from_mask` (its points).
-PointArray = Union[ArrayLike, 'ImageContour']
 
-#: A file path, as ``open()`` takes it.
-PathArg = Union[str, bytes, 'os.PathLike[str]', 'os.PathLike[bytes]']
+def forward_ref(name: str, module: str) -> Any:
+    """A forward reference in a type alias that ``typing.get_type_hints`` resolves in `module`
+    (``amscr.contour`` for 'ImageContour'), whichever module's function the alias annotates; the
+    bare name on Pythons before 3.9.7, whose ForwardRef takes no module."""
+    try:
+        return ForwardRef(name, module=module)
+    except TypeError:
+        return name
+
+
+if TYPE_CHECKING:
+    #: What a function taking points accepts: an (n, 2) array-like, an OpenCV (n, 1, 2) contour, or an
+    #: :class:`ImageContour` of :func:`contours_from_mask` (its points).
+    PointArray = Union[ArrayLike, 'ImageContour']
+    #: A file path, as ``open()`` takes it.
+    PathArg = Union[str, bytes, 'os.PathLike[str]', 'os.PathLike[bytes]']
+else:  # the same, with references that resolve outside this module (typing.get_type_hints(amscr.register))
+    PointArray = Union[ArrayLike, forward_ref('ImageContour', 'amscr.contour')]
+    PathArg = Union[str, bytes, forward_ref('os.PathLike[str]', __name__), forward_ref('os.PathLike[bytes]', __name__)]
 
 #: The type of an ``order=`` argument (see ORDERS).
 Order = Literal['xy', 'rc']

@@ -1,12 +1,12 @@
 """Shape: a prepared shape (C ``amscr_descriptor``)."""
 from __future__ import annotations
 
-from typing import Any, Optional, Union
+from typing import TYPE_CHECKING, Any, Optional, Union
 
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import Order, PointArray, as_count, as_points, copy_points, matrix_out, new_object
+from ._util import Order, PointArray, as_count, as_points, copy_points, forward_ref, matrix_out, new_object
 from .contour import contour_new
 from .params import Params, make_params
 
@@ -117,8 +117,11 @@ class Shape:
         return (_shape_from_state, (self._source, self.params))
 
 
-#: What the matching functions accept for a shape: an (n, 2) point array or a prepared Shape.
-PointsLike = Union[PointArray, 'Shape']
+if TYPE_CHECKING:
+    #: What the matching functions accept for a shape: an (n, 2) point array or a prepared Shape.
+    PointsLike = Union[PointArray, 'Shape']
+else:  # resolvable by typing.get_type_hints in every module (see forward_ref)
+    PointsLike = Union[PointArray, forward_ref('Shape', __name__)]
 
 
 def _shape_from_state(points: np.ndarray, params: Params) -> Shape:
