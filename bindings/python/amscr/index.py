@@ -257,8 +257,12 @@ class Index:
                 _check(lib.amscr_index_set_name(self._x, i, str(name).encode('utf-8', 'surrogateescape')))
             return i
 
-    def collection_params(self):
-        """A copy of the index's :class:`Params` (those of its collection)."""
+    def collection_params(self) -> Params:
+        """The index's options.
+
+        Returns:
+            a copy of the index's :class:`Params` (those of its collection).
+        """
         return Params._copy_of(lib.amscr_db_params(lib.amscr_index_db(self._x)))
 
     def find_member(self, points: PointsLike, *, order: Order = 'xy') -> Optional[int]:

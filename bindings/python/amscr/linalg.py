@@ -1,7 +1,7 @@
 """Dense least squares and affine maps (C ``amscr_lstsq_qr`` and ``amscr_affine_*``)."""
 from __future__ import annotations
 
-from typing import Tuple
+from typing import Literal, Tuple, Union, overload
 
 import numpy as np
 
@@ -10,7 +10,16 @@ from ._util import ArrayLike, PointArray, as_float_array, as_points, bad, dbuf, 
 from .errors import _check
 
 
-def lstsq(a: ArrayLike, b: ArrayLike, return_residuals: bool = False):
+@overload
+def lstsq(a: ArrayLike, b: ArrayLike, return_residuals: Literal[False] = False) -> np.ndarray: ...
+@overload
+def lstsq(a: ArrayLike, b: ArrayLike, return_residuals: Literal[True]) -> Tuple[np.ndarray, np.ndarray]: ...
+@overload
+def lstsq(a: ArrayLike, b: ArrayLike, return_residuals: bool) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]: ...
+
+
+def lstsq(a: ArrayLike, b: ArrayLike, return_residuals: bool = False
+          ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
     """Least squares min ||a x - b|| by Householder QR.
 
     Args:

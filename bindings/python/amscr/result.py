@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import threading
 import types
-from typing import Any, Dict, List, NamedTuple, Optional, Tuple
+from typing import Any, Dict, List, Mapping, NamedTuple, Optional, Tuple
 
 import numpy as np
 
@@ -114,6 +114,37 @@ class Registration:
             corners by up to about a sample spacing.
     """
 
+    # the attributes' types (py.typed): what type checkers and typing.get_type_hints see
+    A: np.ndarray
+    B: np.ndarray
+    matrix: np.ndarray
+    matrix_normalized: np.ndarray
+    distance: float
+    residuals: np.ndarray
+    scales: np.ndarray
+    kept: np.ndarray
+    kept_scales: np.ndarray
+    k: int
+    sse: np.ndarray
+    mixture: Mixture
+    threshold: float
+    shift: int
+    reflected: bool
+    method: str
+    confidence: float
+    ambiguity: float
+    inlier_fraction: float
+    overlap: float
+    backward_error: float
+    standard_error: float
+    symmetry_ambiguity: float
+    part: Tuple[float, float]
+    stages: Mapping[str, bool]
+    alternatives: Tuple[Alternative, ...]
+    correspondences: np.ndarray
+    source_samples: np.ndarray
+    target_points: np.ndarray
+
     def __init__(self, handle, scales: np.ndarray):
         """Copies everything out of `handle`, a C ``amscr_result`` (made by :func:`register`,
         which users call instead), and `scales`, the sigma_k of the registration. Raises
@@ -148,7 +179,7 @@ class Registration:
         self.part = (float(part[0]), float(part[1]))
         self.source_samples, self.correspondences, self.target_points = _correspondences(r)
         self.stages = _stages(r)
-        self.alternatives = _alternatives(r)
+        self.alternatives = tuple(_alternatives(r))
         self._freeze()
 
     def _freeze(self) -> None:

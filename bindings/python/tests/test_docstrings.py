@@ -5,6 +5,7 @@ import inspect
 import re
 import typing
 
+import numpy as np
 import pytest
 
 import amscr
@@ -99,3 +100,24 @@ def test_annotations_resolve_at_runtime(name, obj, holder):
     every public signature, the aliases' forward references (ImageContour, Shape, os.PathLike)
     included, whichever module the function is in."""
     typing.get_type_hints(obj)
+
+
+@pytest.mark.parametrize('name,obj,holder', [c for c in CALLABLES if inspect.isfunction(c[1])],
+                         ids=[n for n, o, _ in CALLABLES if inspect.isfunction(o)])
+def test_public_functions_annotate_their_return(name, obj, holder):
+    """mypy --strict refuses a call to an unannotated function ("untyped function in typed context")."""
+    assert name.endswith('.__init__') or 'return' in obj.__annotations__, '%s has no return annotation' % name
+
+
+def test_registration_annotations_match_its_attributes():
+    """The attributes' annotations are what the result holds: alternatives a tuple, stages a
+    read-only mapping (not a list and a dict a type checker would let one change)."""
+    t = np.linspace(0, 1, 40, endpoint=False)
+    square = 100 * np.concatenate([np.c_[t, 0 * t], np.c_[1 + 0 * t, t], np.c_[1 - t, 1 + 0 * t], np.c_[0 * t, 1 - t]])
+    r = amscr.register(square, square @ np.array([[1.2, 0.3], [0.1, 0.9]]).T + 5)
+    hints = typing.get_type_hints(amscr.Registration)
+    public = {k for k in vars(r) if not k.startswith('_')}
+    assert public <= set(hints), 'not annotated: %s' % sorted(public - set(hints))
+    for k in public:
+        want = typing.get_origin(hints[k]) or hints[k]
+        assert isinstance(getattr(r, k), want), (k, type(getattr(r, k)), hints[k])
