@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._lib import lib
-from ._util import ArrayLike, as_float_array, bad, dbuf
+from ._util import ArrayLike, as_float_array, as_uint, bad, dbuf
 from .errors import _check
 
 
@@ -17,18 +17,20 @@ def rerank_diffusion(D: ArrayLike, k: int = 5, iterations: int = 20) -> np.ndarr
 
     Args:
         D: (n, n) distance matrix, finite.
-        k: neighbours of the graph (clamped to n).
-        iterations: diffusion iterations.
+        k: neighbours of the graph, an integer >= 1 (clamped to n).
+        iterations: diffusion iterations, an integer in 1..1000.
     Returns:
         (n, n) float array (smaller = more similar).
     Raises:
-        InvalidArgumentError: D not square or not finite, bad k or iterations.
+        InvalidArgumentError: D not square or not finite, bad k or iterations (also a
+        TypeError when not an integer).
     """
     d = np.array(as_float_array(D, 'D', ndim=(2,), finite=True), dtype=np.float64, order='C', copy=True)
     n = d.shape[0]
     if d.shape != (n, n):
         raise bad('D: expected a square matrix, got shape %s' % (d.shape,))
     out = np.empty_like(d)
-    kk = min(int(k), n) if n else int(k)
-    _check(lib.amscr_rerank_diffusion(dbuf(d), n, kk, int(iterations), dbuf(out)))
+    k, iterations = as_uint(k, 'k'), as_uint(iterations, 'iterations')  # not int(): 2.7 is no k
+    kk = min(k, n) if n else k
+    _check(lib.amscr_rerank_diffusion(dbuf(d), n, kk, iterations, dbuf(out)))
     return out

@@ -432,3 +432,13 @@ def test_rerank_diffusion_blocks():
         amscr.rerank_diffusion(D, k=0)
     with pytest.raises(ValueError):
         amscr.rerank_diffusion(D[:, :5])
+
+
+@pytest.mark.parametrize('kw', [dict(k=2.7), dict(k='3'), dict(k=None), dict(k=-1), dict(k=2 ** 40),
+                                dict(iterations=10.5), dict(iterations=-1), dict(iterations=2 ** 40)])
+def test_rerank_diffusion_refuses_what_is_not_a_count(kw):
+    """k and iterations are counts: a float is not truncated, a str not parsed, and a negative or
+    too large one is the documented InvalidArgumentError (not cffi's OverflowError)."""
+    D = np.abs(np.subtract.outer(np.arange(6.0), np.arange(6.0)))
+    with pytest.raises(amscr.InvalidArgumentError):
+        amscr.rerank_diffusion(D, **kw)
