@@ -81,6 +81,12 @@ def _float_level(lo: float, hi: float, threshold: Any) -> float:
     else:
         t = as_scalar(threshold, 'threshold')
     level = 32767.5 if hi <= lo else (t - lo) * 65535.0 / (hi - lo)
+    if threshold is None and (hi <= lo or not 0.0 <= level < 65535.0):
+        # the default level misses the image's values: nothing to trace, as for an integer image
+        what = 'no foreground: no value is above' if t >= hi else 'foreground everywhere: every value is above'
+        msg = ("mask: %s the default level %g of this float image (values %g..%g); pass a threshold between "
+               "them or threshold='auto'" % (what, t, lo, hi))
+        raise NotFoundError(msg, lib.AMSCR_E_NOT_FOUND, msg)
     if not 0.0 <= level < 65535.0:
         raise bad('threshold: %g is outside the values of the image (%g..%g)' % (t, lo, hi))
     return level

@@ -140,6 +140,22 @@ def test_bad_float_and_threshold():
         amscr.contour_from_mask(np.zeros((8, 8), np.uint16), threshold=65535)
 
 
+@pytest.mark.parametrize('lo,hi,what', [(0.1, 0.4, 'no foreground'), (0.6, 0.9, 'foreground everywhere'),
+                                        (150.0, 200.0, 'foreground everywhere'), (1.0, 1.0, 'foreground everywhere'),
+                                        (0.0, 0.0, 'no foreground')])
+def test_float_image_the_default_level_misses_is_not_found(lo, hi, what):
+    """A float image all of whose values lie on one side of the default level (a dim 0..1 image,
+    a constant one) has no foreground, or foreground everywhere: NotFoundError, as for an
+    integer image, not an InvalidArgumentError about a threshold nobody passed."""
+    m = np.full((30, 40), lo)
+    m[6:23, 8:32] = hi
+    for trace in (amscr.contour_from_mask, amscr.contours_from_mask):
+        with pytest.raises(amscr.NotFoundError, match=what):
+            trace(m)
+    if lo < hi:  # the image's own split traces the rectangle
+        assert amscr.contour_from_mask(m, threshold='auto').max(axis=0).tolist() == [31.5, 22.5]
+
+
 def test_join_registers_a_shape_cut_in_two():
     """join=True: a bar cut in two by an occluder is one outline holding both pieces; registered
     against the whole bar (shifted) it gives the map back, where the largest piece alone
