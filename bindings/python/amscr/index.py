@@ -38,6 +38,10 @@ _ADD_NAMES = (*(('another %s ' % c, 'another %s ' % py) for c, py in Params.ALIA
                'another value of '), ('amscr_index_add: ', 'Index.add: '))
 
 
+#: The largest class code the library names (C ``amscr_index_set_class_name``: 0..1000000).
+_CLASS_CODE_MAX = 1000000
+
+
 def _text(p) -> Optional[str]:
     return None if p == ffi.NULL else ffi.string(p).decode('utf-8', 'surrogateescape')
 
@@ -172,20 +176,23 @@ class Index:
         return Collection._wrap(db, classes if classes else None)
 
     def _class_names(self) -> List[Any]:
-        """The class names by code, up to the last named one ([] without names)."""
-        out: List[Any] = []
-        code = 0
-        while True:
-            name = _text(lib.amscr_index_class_name(self._x, code))
-            if name is None and code >= self._max_code():
-                break
-            out.append(name if name is not None else code)
-            code += 1
-        return out if any(isinstance(v, str) for v in out) else []
+        """The class names by code, up to the last named one ([] without names). An index of int
+        labels names none: its labels' values, however large, are not walked."""
+        codes = {int(lib.amscr_index_label(self._x, i)) for i in range(len(self))}
 
-    def _max_code(self) -> int:
-        n = len(self)
-        return max((int(lib.amscr_index_label(self._x, i)) for i in range(n)), default=-1) + 1
+        def name(code: int) -> Optional[str]:
+            return _text(lib.amscr_index_class_name(self._x, code))
+
+        if name(0) is None and not any(name(c) is not None for c in codes if 0 <= c <= _CLASS_CODE_MAX):
+            return []
+        top = min(max(codes, default=-1) + 1, _CLASS_CODE_MAX + 1)
+        out: List[Any] = []
+        for code in range(_CLASS_CODE_MAX + 1):
+            this = name(code)
+            if this is None and code >= top:
+                break
+            out.append(this if this is not None else code)
+        return out if any(isinstance(v, str) for v in out) else []
 
     @property
     def names(self) -> List[Optional[str]]:

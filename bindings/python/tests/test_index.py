@@ -103,6 +103,17 @@ def test_add():
         index.add(amscr.Shape(q, amscr.Params.retrieval(points=128)), label='class0')
 
 
+def test_large_int_labels_are_read_at_once():
+    """An index of int labels names no classes: its labels, collection and add do not walk every
+    code up to the largest label (2**31 - 1 took hours: each of 2**31 codes read every label)."""
+    coll = amscr.Collection(amscr.Params.retrieval(points=64))
+    coll.extend([blob(300, seed=i) for i in range(4)], [7, 7, 2 ** 31 - 1, 2 ** 31 - 1])
+    index = amscr.Index(coll, progress=False)
+    assert index.labels.tolist() == [7, 7, 2 ** 31 - 1, 2 ** 31 - 1] and index.labels.dtype == np.int32
+    assert index.collection.labels.tolist() == index.labels.tolist()
+    assert index.add(blob(300, seed=5), label=2 ** 31 - 1) == 4 and index.labels[4] == 2 ** 31 - 1
+
+
 def test_add_interrupted_leaves_an_index_that_says_so(monkeypatch):
     """Ctrl-C during Index.add (a KeyboardInterrupt in its first report) leaves the index's new
     shape without its lists: using it again is a StateError saying so (the interpreter crashed)."""
