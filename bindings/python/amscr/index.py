@@ -222,6 +222,8 @@ class Index:
         if isinstance(label, (int, np.integer)) and not isinstance(label, (bool, np.bool_)):
             if names:
                 raise bad('label: this index names its classes; got the int %r' % (label,))
+            if not -(2 ** 31) <= int(label) < 2 ** 31:
+                raise bad('label: %d does not fit in int32' % int(label))
             return int(label)
         if not isinstance(label, str):
             raise bad('label: expected an int or a class name, got %r' % (label,))

@@ -114,6 +114,18 @@ def test_large_int_labels_are_read_at_once():
     assert index.add(blob(300, seed=5), label=2 ** 31 - 1) == 4 and index.labels[4] == 2 ** 31 - 1
 
 
+@pytest.mark.parametrize('label', [2 ** 31, -(2 ** 31) - 1, 2 ** 40])
+def test_add_refuses_an_int_label_past_int32(label):
+    """Index.add's labels are int32, as Collection.add's: a larger int is the documented
+    InvalidArgumentError (a bad label), not cffi's OverflowError, and adds nothing."""
+    coll = amscr.Collection(amscr.Params.retrieval(points=64))
+    coll.extend([blob(300, seed=i) for i in range(4)], [0, 0, 1, 1])
+    index = amscr.Index(coll, progress=False)
+    with pytest.raises(amscr.InvalidArgumentError, match='int32'):
+        index.add(blob(300, seed=5), label=label)
+    assert len(index) == 4
+
+
 def test_add_interrupted_leaves_an_index_that_says_so(monkeypatch):
     """Ctrl-C during Index.add (a KeyboardInterrupt in its first report) leaves the index's new
     shape without its lists: using it again is a StateError saying so (the interpreter crashed)."""
