@@ -281,7 +281,8 @@ def register(src: PointsLike, tgt: PointsLike, *, method: Optional[str] = None, 
              closed: Optional[bool] = None, refine: Optional[int] = None, symmetric: Optional[bool] = None,
              parametrization: Optional[str] = None, invariance: Optional[str] = None,
              params: Optional[Params] = None, order: Order = 'xy', **options: Any) -> Registration:
-    """Registers `src` onto `tgt`: finds (A, B) with ``tgt ~= A @ src + B`` and the distance.
+    """Registers `src` onto `tgt`: finds (A, B) with ``tgt ~= src @ A.T + B`` (each point
+    ``x -> A x + B``) and the distance.
 
     Args:
         src, tgt: the two shapes: (n, 2) point arrays (contours, closed by default; OpenCV
