@@ -13,7 +13,8 @@ from .errors import StateError, _check
 class GMM1D:
     """A 1-D Gaussian mixture fitted by EM (started from exact 1-D K-means).
 
-    ``GMM1D(k, max_iterations=None, tolerance=None, variance_floor=None).fit(x)``; the fitted
+    ``GMM1D(k, *, max_iterations=None, tolerance=None, variance_floor=None).fit(x)`` (the options
+    are keyword-only); the fitted
     parameters are attributes (components sorted by mean). A fitted model may be used by many
     threads; fitting is serialized by a lock.
 
