@@ -23,10 +23,12 @@ class AmscrError(Exception):
     """Base of every error reported by libamscr.
 
     Attributes:
-        status: the C status code (an ``int``, ``amscr.errors.lib.AMSCR_E_*``), or None when raised
-            by the Python layer itself.
+        status: the C status code (an ``int``, ``amscr.errors.lib.AMSCR_E_*``); the class's own
+            code also when the Python layer raises it (a validation error is AMSCR_E_INVALID_ARG);
+            None only for a bare ``AmscrError`` made without one.
         detail: the C library's detail message for the failing call (may be empty).
-        message: the full message (``strerror(status): detail``).
+        message: the full message (``strerror(status): detail`` for the library's errors; the
+            detail alone for the Python layer's own).
     """
 
     status: Optional[int] = None
