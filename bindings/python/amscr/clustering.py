@@ -18,6 +18,14 @@ class KMeansResult(NamedTuple):
     labels: np.ndarray  # (n,) nearest-centre index of each point
 
 
+def _seed(seed: int) -> int:
+    """A k-means++ seed: an integer in 0 .. 2**64 - 1 (the library's uint64_t)."""
+    v = as_count(seed, 'seed', 0)
+    if v > 0xFFFFFFFFFFFFFFFF:
+        raise bad('seed: too large (%d; at most 2**64 - 1)' % v)
+    return v
+
+
 def _data_2d(data: ArrayLike) -> Tuple[np.ndarray, bool]:
     x = as_float_array(data, 'data', ndim=(1, 2))
     one_d = x.ndim == 1
@@ -31,18 +39,19 @@ def kmeans(data: ArrayLike, k: int, seed: int = 0, *, max_iterations: Optional[i
     Args:
         data: (n,) or (n, dim) values, n >= k.
         k: the number of clusters (>= 1).
-        seed: the seed of k-means++ (the result depends only on it and the data).
+        seed: the seed of k-means++, an integer in 0 .. 2**64 - 1 (the result depends only on it
+            and the data).
         max_iterations: Lloyd iterations cap (None: the library default).
         tolerance: convergence tolerance (None: the library default).
         restarts: k-means++ restarts, the best kept (None: the library default).
     Returns:
         a :class:`KMeansResult` (centers, inertia, labels).
     Raises:
-        InvalidArgumentError: n < k, non-finite values or bad options.
+        InvalidArgumentError: n < k, non-finite values, a bad seed or bad options.
     """
     x, one_d = _data_2d(data)
     km = new_object('amscr_kmeans', lib.amscr_kmeans_new, lib.amscr_kmeans_free, as_count(k, 'k', 1))
-    _check(lib.amscr_kmeans_set_seed(km, as_count(seed, 'seed', 0)))
+    _check(lib.amscr_kmeans_set_seed(km, _seed(seed)))
     if max_iterations is not None:
         _check(lib.amscr_kmeans_set_max_iterations(km, as_uint(max_iterations, 'max_iterations')))
     if tolerance is not None:
@@ -66,11 +75,11 @@ def elbow(data: ArrayLike, k_max: Optional[int] = None, k_min: int = 1, seed: in
         data: (n,) or (n, dim) values.
         k_max: the largest k (None: the registration's Kmax, clamped to n).
         k_min: the smallest k (>= 1).
-        seed: the seed of k-means++.
+        seed: the seed of k-means++, an integer in 0 .. 2**64 - 1.
     Returns:
         (k_best, sse): the elbow k and the (k_max - k_min + 1,) array of SSE(k).
     Raises:
-        InvalidArgumentError: k_max < k_min or k_max > n.
+        InvalidArgumentError: k_max < k_min, k_max > n or a bad seed.
     """
     x, _ = _data_2d(data)
     n, dim = x.shape
@@ -81,5 +90,5 @@ def elbow(data: ArrayLike, k_max: Optional[int] = None, k_min: int = 1, seed: in
         raise bad('k_max (%d) must be >= k_min (%d)' % (k_max, k_min))
     sse = np.zeros(k_max - k_min + 1, dtype=np.float64)
     best = ffi.new('size_t *')
-    _check(lib.amscr_kmeans_elbow(dbuf(x), n, dim, k_min, k_max, as_count(seed, 'seed', 0), dbuf(sse), best))
+    _check(lib.amscr_kmeans_elbow(dbuf(x), n, dim, k_min, k_max, _seed(seed), dbuf(sse), best))
     return int(best[0]), sse

@@ -199,6 +199,17 @@ def test_kmeans_2d_is_deterministic_and_consistent():
     assert sorted(np.bincount(a.labels)) == [30, 30, 30]
 
 
+@pytest.mark.parametrize('seed', [-1, 2 ** 64, 2 ** 70])
+def test_kmeans_and_elbow_refuse_a_seed_outside_uint64(seed):
+    """The seed is the library's uint64_t: outside it, the documented InvalidArgumentError (as
+    nn_random_split's), not cffi's OverflowError; 2**64 - 1 is taken."""
+    x = np.arange(10.0)
+    for call in (lambda s: amscr.kmeans(x, 2, seed=s), lambda s: amscr.elbow(x, seed=s)):
+        with pytest.raises(amscr.InvalidArgumentError, match='seed'):
+            call(seed)
+        call(2 ** 64 - 1)
+
+
 def test_elbow_sse_matches_kmeans():
     rng = np.random.default_rng(0)
     x = np.concatenate([rng.normal(0, 0.1, 10), rng.normal(5, 0.1, 10), rng.normal(20, 0.1, 10)])
