@@ -307,12 +307,14 @@ def parse_points(text: Union[str, bytes]) -> np.ndarray:
     Returns:
         (n, 2) float array of (x, y) rows.
     Raises:
-        FormatError: a bad line (the message names the line); TypeError: a path
-        (``os.PathLike``).
+        FormatError: a bad line (the message names the line); TypeError (also an
+        InvalidArgumentError): a path (``os.PathLike``) or anything else that is no text.
     """
     if isinstance(text, os.PathLike):
         raise bad_type('text: expected the text of a point list (str or bytes), got %s: read a file with '
                        'amscr.read_points(path)' % described(text))
+    if not isinstance(text, (str, bytes, bytearray, memoryview)):  # bytes(5) would be five NUL bytes
+        raise bad_type('text: expected the text of a point list (str or bytes), got %s' % described(text))
     b = text.encode('utf-8') if isinstance(text, str) else bytes(text)
     return _take(_new_contour(lib.amscr_contour_parse_text, ffi.from_buffer('char[]', b), len(b)))
 

@@ -172,6 +172,14 @@ def test_a_path_holding_a_nul_character_is_refused(tmp_path):
             read(None)
 
 
+@pytest.mark.parametrize('text', [5, 10 ** 6, None, 1.5, ['1 2']])
+def test_parse_points_refuses_what_is_no_text(text):
+    """parse_points takes str or bytes: an int is not bytes(n) (n NUL bytes, a FormatError or a
+    huge allocation), None or a list is the same TypeError, not cffi's."""
+    with pytest.raises(TypeError, match='text: expected the text of a point list'):
+        amscr.parse_points(text)
+
+
 def test_parse_points_takes_text_not_a_path(tmp_path):
     """A path given to parse_points (bytes(path) would be parsed as the text) says to use read_points."""
     p = tmp_path / 'c.txt'
