@@ -1339,25 +1339,6 @@ static uint64_t fnv1a(const unsigned char *p, size_t n)
     return h;
 }
 
-/* A double at b in the file's byte order (little-endian, whatever the host). */
-static void put_f64le(unsigned char *b, double d)
-{
-    uint64_t v;
-    memcpy(&v, &d, 8);
-    for (int i = 0; i < 8; i++)
-        b[i] = (unsigned char)(v >> (8 * i));
-}
-
-static double get_f64le(const unsigned char *b)
-{
-    uint64_t v = 0;
-    for (int i = 0; i < 8; i++)
-        v |= (uint64_t)b[i] << (8 * i);
-    double d;
-    memcpy(&d, &v, 8);
-    return d;
-}
-
 static void fix_checksum(unsigned char *b, size_t len)
 {
     uint64_t h = fnv1a(b, len - 8);
@@ -1751,14 +1732,14 @@ START_TEST(crafted_scale_out_of_range)
 {
     size_t len = 0;
     unsigned char *b = small_blob(&len);
-    double s0 = get_f64le(b + BLOB_SCALE_OFFSET);
+    double s0 = amscr_test_get_f64le(b + BLOB_SCALE_OFFSET);
     ck_assert_msg(s0 == 2.0, "layout changed: scale at offset %d is %g", BLOB_SCALE_OFFSET, s0);
     unsigned char *c = malloc(len);
     static const double bad[] = {-1.0, -1e-300, 17.0, 1000.0, 1e300};
     char msg[512] = "";
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         memcpy(c, b, len);
-        put_f64le(c + BLOB_SCALE_OFFSET, bad[k]);
+        amscr_test_put_le(c + BLOB_SCALE_OFFSET, &bad[k], 8);
         fix_checksum(c, len);
         amscr_db *db = NULL;
         amscr_status st = load_exact(c, len, &db);
@@ -1773,7 +1754,7 @@ START_TEST(crafted_scale_out_of_range)
     static const double good[] = {0.0, 16.0};
     for (size_t k = 0; k < 2; k++) {
         memcpy(c, b, len);
-        put_f64le(c + BLOB_SCALE_OFFSET, good[k]);
+        amscr_test_put_le(c + BLOB_SCALE_OFFSET, &good[k], 8);
         fix_checksum(c, len);
         amscr_db *db = NULL;
         ck_assert_int_eq(load_exact(c, len, &db), AMSCR_OK);

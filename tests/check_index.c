@@ -787,15 +787,6 @@ START_TEST(stored_features)
 END_TEST
 
 /* The trailing checksum of b (len bytes, version v) rewritten after an edit. */
-/* n bytes of the value at v into b in the file's byte order (little-endian, whatever the host). */
-static void put_le(unsigned char *b, const void *v, size_t n)
-{
-    const uint16_t one = 1;
-    const unsigned char *p = v;
-    for (size_t i = 0; i < n; i++)
-        b[i] = *(const unsigned char *)&one == 1 ? p[i] : p[n - 1 - i];
-}
-
 static void reseal(unsigned char *b, size_t len, uint32_t v)
 {
     uint64_t h = amscr__db_checksum(v, b, len - 8);
@@ -903,7 +894,7 @@ START_TEST(inner_section)
     ck_assert(strstr(amscr_last_error_detail(), "inner neighbour") != NULL);
     memcpy(b, buf, len);
     double dnan = NAN;
-    put_le(b + at + 12 + NSHAPES * k2 * 12, &dnan, 8); /* shape 0's scale */
+    amscr_test_put_le(b + at + 12 + NSHAPES * k2 * 12, &dnan, 8); /* shape 0's scale */
     reseal(b, len, 16);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);
@@ -927,7 +918,7 @@ START_TEST(inner_section)
     b = malloc(len);
     memcpy(b, buf, len);
     float fnan = NAN;
-    put_le(b + at + 12 + NSHAPES * k2 * 12 + 4 * 3, &fnan, 4); /* shape 0's fourth real part */
+    amscr_test_put_le(b + at + 12 + NSHAPES * k2 * 12 + 4 * 3, &fnan, 4); /* shape 0's fourth real part */
     reseal(b, len, 15);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);
@@ -946,7 +937,7 @@ START_TEST(inner_section)
     b = malloc(len);
     memcpy(b, buf, len);
     double huge = 1e300;
-    put_le(b + at + 12 + NSHAPES * k2 * 12, &huge, 8); /* shape 0's first real part */
+    amscr_test_put_le(b + at + 12 + NSHAPES * k2 * 12, &huge, 8); /* shape 0's first real part */
     reseal(b, len, 14);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);
@@ -970,7 +961,7 @@ START_TEST(inner_section)
     ck_assert(strstr(amscr_last_error_detail(), "inner neighbour") != NULL);
     memcpy(b, buf, len);
     double nan = NAN;
-    put_le(b + at + 12 + NSHAPES * k2 * 12 + 8 * 2 * fk, &nan, 8); /* shape 0's norm */
+    amscr_test_put_le(b + at + 12 + NSHAPES * k2 * 12 + 8 * 2 * fk, &nan, 8); /* shape 0's norm */
     reseal(b, len, 13);
     ck_assert_int_eq(amscr_index_load_memory(b, len, &y), AMSCR_E_FORMAT);
     ck_assert(strstr(amscr_last_error_detail(), "inner features") != NULL);

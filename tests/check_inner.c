@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bytes.h"
 #include "inner.h"
 #include "suites.h"
 #include "testutil.h"
@@ -343,15 +344,9 @@ START_TEST(test_outline_kept)
     back = NULL;
     unsigned char *b = buf;
     double nan = NAN;
-    uint64_t nv;
-    memcpy(&nv, &nan, 8);
-    for (int i = 0; i < 8; i++) /* in the last shape's outline, in the file's byte order (little-endian) */
-        b[len - 8 - 8 * AMSCR__OUTLINE_N + (size_t)i] = (unsigned char)(nv >> (8 * i));
-    uint64_t h = 1469598103934665603ull; /* the plain file's trailer: FNV-1a from the library's basis (bytes.c) */
-    for (size_t i = 0; i < len - 8; i++)
-        h = (h ^ b[i]) * 1099511628211ull;
-    for (int i = 0; i < 8; i++)
-        b[len - 8 + (size_t)i] = (unsigned char)(h >> (8 * i));
+    amscr_test_put_le(b + len - 8 - 8 * AMSCR__OUTLINE_N, &nan, 8); /* in the last shape's outline */
+    uint64_t h = amscr__fnv1a(b, len - 8);                         /* the plain file's trailer */
+    amscr_test_put_le(b + len - 8, &h, 8);
     ck_assert_int_eq(amscr_db_load_memory(buf, len, &back), AMSCR_E_FORMAT);
     ck_assert_msg(strstr(amscr_last_error_detail(), "non-finite") != NULL, "refused for another reason: %s",
                   amscr_last_error_detail()); /* not the checksum */

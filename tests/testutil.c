@@ -242,3 +242,22 @@ void amscr_test_star5(double *v)
         v[2 * k + 1] = r * sin(ang);
     }
 }
+
+void amscr_test_put_le(unsigned char *b, const void *v, size_t n)
+{
+    const uint16_t one = 1;
+    const unsigned char *p = v;
+    int little = *(const unsigned char *)&one == 1;
+    for (size_t i = 0; i < n; i++)
+        b[i] = little ? p[i] : p[n - 1 - i];
+}
+
+double amscr_test_get_f64le(const unsigned char *b)
+{
+    uint64_t v = 0;
+    for (int i = 0; i < 8; i++)
+        v |= (uint64_t)b[i] << (8 * i);
+    double d;
+    memcpy(&d, &v, sizeof d);
+    return d;
+}

@@ -51,4 +51,10 @@ int amscr_test_suite_reads_datasets(const char *suite);
  * buffer; returns 0 on success. */
 int amscr_test_read_png_gray(const char *path, unsigned char **out_pixels, size_t *out_w, size_t *out_h);
 
+/* The n bytes of the host value at v written at b in the files' byte order (little-endian,
+ * whatever the host), and a double read back from it: for tests that craft collection and index
+ * files (a host-order memcpy reads differently on a big-endian host). */
+void amscr_test_put_le(unsigned char *b, const void *v, size_t n);
+double amscr_test_get_f64le(const unsigned char *b);
+
 #endif
