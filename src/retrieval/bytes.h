@@ -40,7 +40,9 @@ int amscr__r_f32s(amscr__rbuf *r, float *d, size_t n);
 int amscr__r_str(amscr__rbuf *r, char **out, int *oom);
 
 /* FNV-1a 64 of n bytes: the trailing checksum of collection files and of index files before
- * format version 4. */
+ * format version 4. Its offset basis is 1469598103934665603 (a digit short of FNV's published
+ * 14695981039346656037): kept, since every file written so far carries it; a checksum made with
+ * the published basis does not match. */
 uint64_t amscr__fnv1a(const unsigned char *p, size_t n);
 /* The trailing checksum of index files from format version 4: four lanes of 64-bit
  * little-endian words, each lane h = (h ^ word) * 0x9E3779B97F4A7C15, h ^= h >> 29 (one-to-one:
