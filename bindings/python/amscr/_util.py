@@ -169,7 +169,7 @@ def as_order(order: Any) -> str:
 def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: bool = False,
               allow_empty: bool = False) -> np.ndarray:
     """The one conversion of user points: array-like -> C-contiguous float64 (n, 2) array of
-    (x, y) rows, n >= 1 (n >= 0 with allow_empty), all finite.
+    (x, y) rows, n >= 1 (n >= 0 with allow_empty: then ``[]`` too), all finite.
 
     Accepts (n, 2) arrays of any real dtype, OpenCV contours ((n, 1, 2) int32 from
     ``cv2.findContours``, already (x, y)) and the :class:`ImageContour` s of
@@ -195,6 +195,8 @@ def as_points(x: Any, name: str = 'points', order: str = 'xy', closed_shape: boo
         a = a[:, 0, :]
         if closed_shape and a.dtype.kind in 'iu':
             a = expand_chain(a, name)
+    if allow_empty and a.ndim == 1 and a.size == 0:  # [] or an empty array: no points
+        a = a.reshape(0, 2)
     if a.ndim != 2 or a.shape[1] != 2:
         hint = CONTOURS_HINT if a.ndim == 4 and a.shape[2:] == (1, 2) else ''
         raise bad('%s: expected an array of shape (n, 2) (one x, y row per point) or (n, 1, 2) (OpenCV), '

@@ -6,7 +6,7 @@ from typing import Literal, Tuple, Union, overload
 import numpy as np
 
 from ._lib import ffi, lib
-from ._util import ArrayLike, PointArray, as_float_array, as_points, bad, dbuf, m6_to_matrix, matrix_out, to_m6
+from ._util import ArrayLike, PointArray, as_bool, as_float_array, as_points, bad, dbuf, m6_to_matrix, matrix_out, to_m6
 from .errors import _check
 
 
@@ -29,9 +29,10 @@ def lstsq(a: ArrayLike, b: ArrayLike, return_residuals: bool = False
     Returns:
         x ((n,) or (n, k)), or (x, residual norms) when `return_residuals`.
     Raises:
-        InvalidArgumentError: shapes that do not match; NumericError: `a` rank-deficient or
-        ill-conditioned.
+        InvalidArgumentError: shapes that do not match, or `return_residuals` not a bool;
+        NumericError: `a` rank-deficient or ill-conditioned.
     """
+    want_res = as_bool(return_residuals, 'return_residuals')
     A = as_float_array(a, 'a', ndim=(2,))
     B = as_float_array(b, 'b', ndim=(1, 2))
     m, n = A.shape
@@ -45,7 +46,7 @@ def lstsq(a: ArrayLike, b: ArrayLike, return_residuals: bool = False
     _check(lib.amscr_lstsq_qr(dbuf(A), m, n, dbuf(np.ascontiguousarray(B2)), nrhs, dbuf(x), dbuf(res)))
     if vec:
         x, res = x[:, 0], res[:1]
-    return (x, res) if return_residuals else x
+    return (x, res) if want_res else x
 
 
 def affine_fit(src: PointArray, dst: PointArray) -> Tuple[np.ndarray, float]:

@@ -41,6 +41,7 @@ def test_matrix_is_homogeneous_3x3():
     homog = np.column_stack([src, np.ones(len(src))]) @ r.matrix.T
     assert np.allclose(homog[:, :2], r.apply(src)) and np.allclose(homog[:, 2], 1.0)
     assert r.apply(np.zeros((0, 2))).shape == (0, 2)  # no points: none mapped
+    assert r.apply([]).shape == (0, 2) and amscr.affine_apply(r.matrix, []).shape == (0, 2)  # an empty list too
     assert np.allclose(r.matrix[:2], np.column_stack([A_TRUE, B_TRUE]), atol=1e-3)
 
 

@@ -38,6 +38,15 @@ def test_lstsq_accepts_non_contiguous_and_int_input():
     np.testing.assert_allclose(amscr.lstsq(a, b), np.linalg.lstsq(a, b, rcond=None)[0], rtol=1e-10)
 
 
+def test_lstsq_return_residuals_is_a_bool():
+    a, b = np.eye(3), np.arange(3.0)
+    assert isinstance(amscr.lstsq(a, b, return_residuals=False), np.ndarray)
+    assert len(amscr.lstsq(a, b, return_residuals=1)) == 2
+    for bad in ('no', None, 2):  # a string was taken as true
+        with pytest.raises(amscr.InvalidArgumentError, match='return_residuals'):
+            amscr.lstsq(a, b, return_residuals=bad)
+
+
 def test_lstsq_rank_deficient_raises_numeric_error():
     a = np.ones((5, 2))
     with pytest.raises(amscr.NumericError) as ei:
