@@ -29,7 +29,7 @@ def topk(dist: ArrayLike, k: int, exclude: Optional[int] = None) -> np.ndarray:
     Returns:
         (k,) int array of indices into `dist`.
     Raises:
-        InvalidArgumentError: `dist` not 1-D, `k` too large, `exclude` out of range.
+        InvalidArgumentError: `dist` not 1-D or holding a NaN, `k` too large, `exclude` out of range.
     """
     d = as_float_array(dist, 'dist', ndim=(1,), finite=False)
     k = as_count(k, 'k', 0)
