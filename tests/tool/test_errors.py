@@ -274,3 +274,32 @@ def test_rerank_range_is_stated(tmp_path, value):
     for k in range(3):
         write_points(d / ("s-%d.txt" % k), smooth_shape(seed=k))
     check_fail(run("eval", d, "--rerank", value), 2, "--rerank", "1 <= K <= 1000", "1 <= ITER <= 1000", value)
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["eval", "dir", "--protocol", "split", "--train", "1", "--seed", " -1"], "--seed"),  # was 2^64 - 1
+    (["search", "q.png", "dir", "--top", "+5"], "--top"),
+    (["search", "q.png", "dir", "--top", " 5"], "--top"),
+    (["search", "q.png", "dir", "--rerank", " 8"], "--rerank"),
+    (["search", "q.png", "dir", "--rerank", "8, 9"], "--rerank"),
+])
+def test_integers_are_digits_only(tmp_path, args, needle):
+    """An integer option takes digits alone: strtoull's leading blanks and sign are refused (a
+    seed ' -1' was taken as 2^64 - 1)."""
+    check_fail(run(*args, cwd=tmp_path), 2, needle, "got '%s'" % args[-1])
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["contour", "a.png", "-o", ""], "-o"),
+    (["contour", "a.png", "--output="], "--output"),
+    (["index", "dir", "-o", ""], "-o"),
+    (["matrix", "dir", "-o", "m.npy", "--names", ""], "--names"),
+    (["contour", ""], "empty file name"),
+    (["register", "a.png", ""], "empty file name"),
+])
+def test_empty_file_names_are_usage_errors(tmp_path, args, needle):
+    """An empty file name is a usage error that says so, for every FILE argument (it was exit 1
+    with a line naming no file, or 'input/output error')."""
+    check_fail(run(*args, cwd=tmp_path), 2, needle)
+    assert os.listdir(tmp_path) == []

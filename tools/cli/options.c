@@ -133,11 +133,18 @@ void opts_init(opts *o, const tool_command *c)
     o->candidates = TOOL_CANDIDATES_DEFAULT;
 }
 
+/* c a decimal digit: an integer option starts with one, since strtoull would skip blanks and
+ * take a sign (' -1' wrapped to 2^64 - 1). */
+static int is_digit(char c)
+{
+    return c >= '0' && c <= '9';
+}
+
 static int parse_size(const char *opt, const char *s, size_t lo, size_t hi, size_t *out)
 {
     char *end;
     errno = 0;
-    if (s[0] == '-' || s[0] == '\0')
+    if (!is_digit(s[0]))
         return usage_error(opt, "expected an integer %zu..%zu, got '%s'", lo, hi, s);
     unsigned long long v = strtoull(s, &end, 10);
     if (errno != 0 || *end != '\0' || v < lo || v > hi)
@@ -219,13 +226,14 @@ static int parse_rerank(const char *opt, const char *v, opts *o)
 {
     char *end = NULL;
     unsigned long k = strtoul(v, &end, 10), it = TOOL_RERANK_ITERS;
+    int digits = is_digit(v[0]);
     if (end && *end == ',') {
         char *e2 = NULL;
+        digits = digits && is_digit(end[1]);
         it = strtoul(end + 1, &e2, 10);
         end = e2;
     }
-    if (!end || *end != '\0' || k < 1 || k > TOOL_RERANK_K_MAX || it < 1 || it > TOOL_RERANK_ITERS_MAX ||
-        v[0] == '-')
+    if (!end || *end != '\0' || !digits || k < 1 || k > TOOL_RERANK_K_MAX || it < 1 || it > TOOL_RERANK_ITERS_MAX)
         return usage_error(opt, "expected K[,ITER] with 1 <= K <= %d and 1 <= ITER <= %d, got '%s'",
                            TOOL_RERANK_K_MAX, TOOL_RERANK_ITERS_MAX, v);
     o->rerank_set = 1;
@@ -314,13 +322,17 @@ static int set_option(opts *o, const optdef *d, const char *v)
     const char *n = d->name;
     int e = 0, r;
     switch (d->id) {
-    case O_OUTPUT: o->out = v; return 0;
+    case O_OUTPUT:
+    case O_NAMES:
+        if (v[0] == '\0')
+            return usage_error(n, "expected a file name, got ''");
+        *(d->id == O_OUTPUT ? &o->out : &o->names) = v;
+        return 0;
     case O_THRESHOLD: return parse_threshold(n, v, &o->threshold);
     case O_JSON: o->json = 1; return 0;
     case O_OVERLAY:
     case O_SHEET:
     case O_PLOT: return set_picture(o, d->id, v);
-    case O_NAMES: o->names = v; return 0;
     case O_TOP: return parse_size(n, v, 1, TOOL_TOP_MAX, &o->top) != 0 ? TOOL_EXIT_USAGE : 0;
     case O_PROTOCOL:
         o->protocol = v;
@@ -460,6 +472,8 @@ int parse_args(opts *o, const tool_command *c, int argc, char **argv)
         }
         if (o->npos >= c->npos)
             return usage_error(o->cmd, "unexpected argument '%s' (usage: amscr %s %s)", a, o->cmd, c->args);
+        if (a[0] == '\0') /* every argument names a file */
+            return usage_error(o->cmd, "empty file name (usage: amscr %s %s)", o->cmd, c->args);
         o->pos[o->npos++] = a;
     }
     if (o->npos < c->npos)
