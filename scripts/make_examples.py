@@ -263,7 +263,7 @@ Try:
     amscr register examples/pair-source.png examples/pair-target.png --overlay overlay.png --plot plot.svg
     amscr register examples/pair-source.txt examples/pair-target.txt --json
     amscr search examples/fish.png examples/collection --top 5 --sheet sheet.png
-    amscr eval examples/collection --plot plot.svg
+    amscr eval examples/collection --plot scores.svg
 """
 
 
