@@ -206,7 +206,15 @@ def test_command_version_and_help_of_every_subcommand():
 @installed
 def test_the_package_carries_its_licence():
     with open(os.path.join(PKG_DIR, 'LICENSE')) as f:
-        assert f.read().startswith('MIT License')
+        text = f.read()
+    assert text.startswith('MIT License')
+    # and its distribution, as PEP 639 has it (scripts/wheel.sh checks the sdist and the wheels)
+    from importlib import metadata
+    dist = metadata.distribution('amscr')
+    assert dist.metadata['License-Expression'] == 'MIT', dist.metadata.get_all('License')
+    assert dist.metadata.get_all('License-File') == ['LICENSE']
+    licence = [f for f in dist.files if f.as_posix().endswith('.dist-info/licenses/LICENSE')]
+    assert len(licence) == 1 and licence[0].read_text() == text, dist.files
 
 
 @installed
