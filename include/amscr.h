@@ -393,7 +393,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_write_text(const amscr_cont
  * Prefer amscr_contour_from_image (8/16 bits, sub-pixel; AMSCR_TRACE_PIXEL_CHAIN at level T + 0.5 is this call).
  *
  * @param[in] pixels  width*height bytes, rows `stride` bytes apart.
- * @param[in] width, height  1..AMSCR_MAX_IMAGE_SIDE, width*height <= AMSCR_MAX_IMAGE_PIXELS.
+ * @param[in] width   1..AMSCR_MAX_IMAGE_SIDE, width*height <= AMSCR_MAX_IMAGE_PIXELS.
+ * @param[in] height  1..AMSCR_MAX_IMAGE_SIDE.
  * @param[in] stride  >= width.
  * @param[in] threshold  0..254 or AMSCR_THRESHOLD_AUTO (Otsu).
  * @param[out] out  new contour.
@@ -425,7 +426,11 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_from_mask(const uint8_t *pi
  * contours of no area (single pixels, lines) are always dropped.
  * Prefer amscr_contours_from_image (8/16 bits, sub-pixel; AMSCR_TRACE_PIXEL_CHAIN at level T + 0.5 is this call).
  *
- * @param[in] pixels, width, height, stride, threshold  as amscr_contour_from_mask.
+ * @param[in] pixels     as amscr_contour_from_mask.
+ * @param[in] width      as amscr_contour_from_mask.
+ * @param[in] height     as amscr_contour_from_mask.
+ * @param[in] stride     as amscr_contour_from_mask.
+ * @param[in] threshold  as amscr_contour_from_mask.
  * @param[in] min_area  pixels^2, >= 0 and finite (0 keeps every contour with an area).
  * @param[out] out  new set with at least one contour.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_LIMIT; AMSCR_E_NOT_FOUND (no foreground,
@@ -522,7 +527,8 @@ AMSCR_API double amscr_contour_set_area(const amscr_contour_set *s, size_t i);
  *
  * @param[in] pixels  height rows of width samples (uint8_t for bits 8, native-endian uint16_t
  *                    for bits 16), rows `stride` samples apart.
- * @param[in] width, height  1..AMSCR_MAX_IMAGE_SIDE, width*height <= AMSCR_MAX_IMAGE_PIXELS.
+ * @param[in] width   1..AMSCR_MAX_IMAGE_SIDE, width*height <= AMSCR_MAX_IMAGE_PIXELS.
+ * @param[in] height  1..AMSCR_MAX_IMAGE_SIDE.
  * @param[in] stride  samples between row starts, >= width.
  * @param[in] bits  8 or 16.
  * @param[in] level  the iso-level in sample units, 0 <= level < 2^bits - 1 (T + 0.5 classifies
@@ -551,7 +557,12 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_contour_from_image(const void *pixe
  * its region and the region around it: outer contours counter-clockwise, holes clockwise.
  * Areas are those of the sub-pixel polygons (a single binary pixel has area 0.5).
  *
- * @param[in] pixels, width, height, stride, bits, level  as amscr_contour_from_image.
+ * @param[in] pixels  as amscr_contour_from_image.
+ * @param[in] width   as amscr_contour_from_image.
+ * @param[in] height  as amscr_contour_from_image.
+ * @param[in] stride  as amscr_contour_from_image.
+ * @param[in] bits    as amscr_contour_from_image.
+ * @param[in] level   as amscr_contour_from_image.
  * @param[in] flags  0 or AMSCR_TRACE_PIXEL_CHAIN (AMSCR_TRACE_JOIN: AMSCR_E_INVALID_ARG).
  * @param[in] min_area  pixels^2, >= 0 and finite.
  * @param[out] out  new set with at least one contour.
@@ -586,7 +597,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_gaussian_kernel(double sigma, doubl
  * @brief Gaussian smoothing of a polyline, x and y separately: circular for closed curves
  *        (exact for kernels longer than the curve), mirrored at the ends (half-sample
  *        symmetric, "reflect") for open curves. sigma == 0 copies.
- * @param[in]  xy, n   input points (n >= 1).
+ * @param[in] xy  n input points (n >= 1).
+ * @param[in] n   the number of points.
  * @param[in]  closed  1 closed, 0 open.
  * @param[in]  sigma   in samples, 0 to 1e6 (as amscr_gaussian_kernel).
  * @param[out] out_xy  2n doubles; must not overlap xy.
@@ -602,7 +614,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_smooth_gaussian(const double *xy, s
  * @brief m points equally spaced in Euclidean arc length along the polygon (linear
  *        interpolation; periodic when closed). The first output is the first input point;
  *        for open curves the last output is the last input point.
- * @param[in]  xy, n, closed  the polygon (n >= 2).
+ * @param[in] xy      the polygon (n >= 2).
+ * @param[in] n       the number of points.
+ * @param[in] closed  1 closed, 0 open.
  * @param[in]  m  the points wanted (m >= 2).
  * @param[out] out_xy  2m doubles.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n or m below 2, non-finite); AMSCR_E_DEGENERATE
@@ -618,7 +632,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_resample_euclidean(const double *xy
  * @brief Cumulative affine arc length (the paper's eq. 2) at each vertex of a uniformly
  *        sampled curve, after Gaussian smoothing over the sample index; central differences
  *        (one-sided at open ends), speed |x'y'' - x''y'|^(1/3), trapezoid sums. Not normalized.
- * @param[in]  xy, n, closed  the curve, n >= 5.
+ * @param[in] xy      the curve, n >= 5.
+ * @param[in] n       the number of points.
+ * @param[in] closed  1 closed, 0 open.
  * @param[in]  sigma0  smoothing in samples (0 = none).
  * @param[out] out_cumulative  n values, out_cumulative[0] = 0.
  * @param[out] out_total  the whole length (closed: including the closing segment).
@@ -685,7 +701,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_lstsq_qr(const double *a, size_t m,
 
 /**
  * @brief Least-squares affine map taking src[i] to dst[i].
- * @param[in]  src_xy, dst_xy, n  n >= 3 point pairs, src not collinear.
+ * @param[in] src_xy  n points, not collinear (n >= 3).
+ * @param[in] dst_xy  n points, dst_xy[i] the image of src_xy[i].
+ * @param[in] n       the number of pairs.
  * @param[out] out_m6   the map.
  * @param[out] out_rms  RMS residual distance, in coordinate units (may be NULL).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_NUMERIC (collinear src); AMSCR_E_NOMEM.
@@ -877,8 +895,11 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_kmeans_assign(const amscr_kmeans *k
  * @brief SSE for every k in [k_min, k_max] and the elbow: with k and SSE both scaled to
  *        [0, 1], the k farthest below the chord from k_min to k_max; k_min when SSE(k_min) is
  *        negligible or there is no bend.
- * @param[in]  data, n, dim  n x dim row-major data.
- * @param[in]  k_min, k_max  1 <= k_min <= k_max <= n.
+ * @param[in] data  n x dim row-major data.
+ * @param[in] n     the number of rows.
+ * @param[in] dim   the number of columns.
+ * @param[in] k_min  1 <= k_min <= k_max.
+ * @param[in] k_max  k_min <= k_max <= n.
  * @param[in]  seed          seed of the k-means++ starts.
  * @param[out] out_inertia   k_max - k_min + 1 SSE values.
  * @param[out] out_k_best    the elbow k.
@@ -1186,7 +1207,8 @@ AMSCR_API size_t amscr_params_get_num_samples(const amscr_params *p);
  * @brief Sets the scale list sigma_k, in samples of the N-point curve: 1..AMSCR_MAX_SCALES
  *        values, each finite, >= 0 (0 = unsmoothed) and <= the current N; stored as given
  *        (default 1, 2, 3, 4, 6, 8, 11, 16). amscr_descriptor_new rejects scales above N.
- * @param[in] sigmas, n  the list (copied).
+ * @param[in] sigmas  n sigmas, the list (copied).
+ * @param[in] n       the number of sigmas.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
  * Thread-safety: exclusive on p.
@@ -2190,7 +2212,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_sse(const amscr_result *r, d
 
 /**
  * @brief The mixture found by EM: K weights, means and variances, sorted by mean.
- * @param[out]    out_weights, out_means, out_variances  K values each; any may be NULL.
+ * @param[out] out_weights    K values; may be NULL.
+ * @param[out] out_means      K values; may be NULL.
+ * @param[out] out_variances  K values; may be NULL.
  * @param[in,out] inout_n  capacity in, K out.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL r or inout_n, capacity too small).
  * Ownership: none.
@@ -2340,7 +2364,8 @@ AMSCR_API double amscr_result_inlier_fraction(const amscr_result *r);
  *        partial match: where the fragment starts and ends (end < start when it wraps; for
  *        a fragment whose points run against the target's direction the fragment covers the
  *        boundary from end to start).
- * @param[out] out_start, out_end  the two fractions.
+ * @param[out] out_start  where the fragment starts, a fraction.
+ * @param[out] out_end    where it ends, a fraction.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL).
  * Ownership: none.
  * Thread-safety: const.
@@ -2450,7 +2475,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_result_alternative(const amscr_resu
  * @param[in] p    matching options (method, reflections, kmax, symmetric, refine, invariance,
  *                 partial, polish); NULL = the source descriptor's params. Its N, scales,
  *                 closed flag and parametrization must equal both descriptors'.
- * @param[in] src, tgt  prepared shapes.
+ * @param[in] src  prepared source shape.
+ * @param[in] tgt  prepared target shape.
  * @param[in,out] ws  workspace or NULL.
  * @param[out] out_result  new result.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, incompatible params or descriptors);
@@ -2604,7 +2630,8 @@ AMSCR_API const amscr_params *amscr_db_params(const amscr_db *db);
  *        or cancellation every element is set to NaN (never a silently partial result); a
  *        call refused before any work (a NULL argument, a size that is not the collection's)
  *        leaves the output untouched.
- * @param[in] progress, user  optional progress callback (NULL = none).
+ * @param[in] progress  optional progress callback (NULL = none).
+ * @param[in] user      passed to progress.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, q incompatible with the db); AMSCR_E_CANCELLED;
  *         AMSCR_E_NUMERIC; AMSCR_E_NOMEM.
  * Ownership: none.
@@ -2720,7 +2747,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load(const char *path, amscr_db 
 
 /**
  * @brief Serializes the collection (the amscr_db_save format) into a new buffer.
- * @param[out] out_buf, out_len  the buffer and its size in bytes.
+ * @param[out] out_buf  the buffer.
+ * @param[out] out_len  its size in bytes.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_NOMEM.
  * Ownership: caller frees *out_buf with amscr_free.
  * Thread-safety: const.
@@ -2757,9 +2785,10 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_load_memory(const void *buf, siz
  * The query is scored as a new shape even when it is a member's copy (no member rule:
  * amscr_db_search_retrieval applies it).
  * @param[in]  q  a shape prepared with params compatible with the collection's.
- * @param[in]  progress, user  optional progress callback (may be NULL): the query's pair
- *             distances; a call that builds the kept index or enters added shapes reports
- *             that first, as the first of two stages (fractions, see amscr_progress_fn).
+ * @param[in] progress  optional progress callback (may be NULL): the query's pair
+ *                      distances; a call that builds the kept index or enters added shapes reports
+ *                      that first, as the first of two stages (fractions, see amscr_progress_fn).
+ * @param[in] user      passed to progress.
  * @param[out] out_scores  n scores, lower is better (see amscr_db_retrieval_matrix).
  * @param[in]  n  must equal amscr_db_size(db).
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n, incompatible params, open curves with a
@@ -2837,9 +2866,10 @@ typedef struct amscr_index amscr_index;
  * @param[in]  db  the collection (copied; may be freed afterwards).
  * @param[in]  candidates  0, or the shortlist size M (AMSCR_INDEX_CANDIDATES is the
  *                         recommended one).
- * @param[in]  progress, user  optional progress callback (may be NULL): two stages, the
- *             shapes' features, then their lists (fractions, see amscr_progress_fn), from
- *             the start of the build, so a cancel stops it at any stage (since 0.22.6).
+ * @param[in] progress  optional progress callback (may be NULL): two stages, the
+ *                      shapes' features, then their lists (fractions, see amscr_progress_fn), from
+ *                      the start of the build, so a cancel stops it at any stage (since 0.22.6).
+ * @param[in] user      passed to progress.
  * @param[out] out  the new index.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, open curves with a channel weight);
  *         AMSCR_E_LIMIT (2^32 shapes or more); AMSCR_E_CANCELLED; AMSCR_E_NOMEM.
@@ -2878,9 +2908,10 @@ AMSCR_API size_t amscr_index_default_candidates(size_t n);
  *        class names kept); on failure it
  *        is left as it was.
  * @param[in] shapes  prepared with exactly the index's params (threads aside).
- * @param[in] progress, user  optional progress callback (may be NULL): two stages, the new
- *            shapes' features, then their lists (since 0.22.6; fractions, see
- *            amscr_progress_fn).
+ * @param[in] progress  optional progress callback (may be NULL): two stages, the new
+ *                      shapes' features, then their lists (since 0.22.6; fractions, see
+ *                      amscr_progress_fn).
+ * @param[in] user      passed to progress.
  * @return AMSCR_OK (also for no shapes: no work, no report); AMSCR_E_INVALID_ARG (NULL;
  *         params that differ: the detail names the option); AMSCR_E_LIMIT; AMSCR_E_CANCELLED;
  *         AMSCR_E_NOMEM. After AMSCR_E_CANCELLED or AMSCR_E_NOMEM the index holds the shapes
@@ -2922,7 +2953,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_query_scores(const amscr_inde
 
 /**
  * @brief The `top` best shapes of amscr_index_query_scores, best first (ties by index).
- * @param[out] out_idx, out_scores  room for `top` entries each.
+ * @param[out] out_idx     room for `top` entries.
+ * @param[out] out_scores  room for `top` entries.
  * @param[out] out_count  min(top, n) entries written.
  * @return as amscr_index_query_scores.
  * Ownership: none.
@@ -2990,7 +3022,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_search_scores(const amscr_ind
 
 /**
  * @brief The `top` best shapes of amscr_index_search_scores, best first (ties by index).
- * @param[out] out_idx, out_scores  room for `top` entries each.
+ * @param[out] out_idx     room for `top` entries.
+ * @param[out] out_scores  room for `top` entries.
  * @param[out] out_count  min(top, n) entries written.
  * @return as amscr_index_search_scores.
  * Ownership: none.
@@ -3094,7 +3127,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_save(const amscr_index *x, co
 
 /**
  * @brief Serializes the index (the amscr_index_save format) into a new buffer.
- * @param[out] out_buf, out_len  the buffer and its size in bytes.
+ * @param[out] out_buf  the buffer.
+ * @param[out] out_len  its size in bytes.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_NOMEM.
  * Ownership: caller frees *out_buf with amscr_free. Thread-safety: const.
  * @since 0.4
@@ -3227,7 +3261,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_bullseye(const double *dist, 
 /**
  * @brief Top-k table (Kimia): out_counts[r] (r = 0..kmax-1) = number of queries whose
  *        (r+1)-th nearest neighbour (query excluded, ties by index) has the query's label.
- * @param[in]  dist, n, labels  as amscr_score_bullseye.
+ * @param[in] dist    as amscr_score_bullseye.
+ * @param[in] n       as amscr_score_bullseye.
+ * @param[in] labels  as amscr_score_bullseye.
  * @param[out] out_counts  kmax counts.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG; AMSCR_E_NOMEM.
  * Ownership: none.
@@ -3239,7 +3275,9 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_topk_table(const double *dist
 
 /**
  * @brief Leave-one-out 1-NN accuracy (query excluded, ties by index).
- * @param[in]  dist, n, labels  as amscr_score_bullseye.
+ * @param[in] dist    as amscr_score_bullseye.
+ * @param[in] n       as amscr_score_bullseye.
+ * @param[in] labels  as amscr_score_bullseye.
  * @param[out] out_accuracy  fraction in [0, 1].
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
@@ -3252,7 +3290,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_nn_accuracy(const double *dis
 /**
  * @brief Train/test 1-NN accuracy.
  * @param[in]  dist  ntest x ntrain row-major.
- * @param[in]  test_labels, train_labels  ntest and ntrain labels.
+ * @param[in] test_labels   ntest labels.
+ * @param[in] train_labels  ntrain labels.
  * @param[out] out_accuracy  fraction in [0, 1].
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG.
  * Ownership: none.
@@ -3298,8 +3337,8 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_score_classes(const int32_t *labels
  * @param[in]  dist      n x n row-major (row i = distances from query i), n >= 2.
  * @param[in]  labels    n labels.
  * @param[in]  nclasses  the number of distinct labels (amscr_score_classes).
- * @param[out] out_bullseye, out_nn_accuracy  nclasses fractions each; either may be NULL,
- *             not both.
+ * @param[out] out_bullseye     nclasses fractions; may be NULL if out_nn_accuracy is not.
+ * @param[out] out_nn_accuracy  nclasses fractions; may be NULL if out_bullseye is not.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, n < 2, wrong nclasses, NaN or -inf);
  *         AMSCR_E_NOMEM.
  * Ownership: none.
@@ -3450,8 +3489,10 @@ AMSCR_API void amscr_index_graph_widths(const amscr_params *p, size_t n, size_t 
  *        k - 1 nearest other shapes by (distance, index), as amscr_index_build with candidates 0
  *        lists them; dmax and dmax2 the largest base and inner distance of the collection.
  * @param[in] p  the collection's params (copied).
- * @param[in] nb_idx, nb_dist  n x k (amscr_index_graph_widths), row-major.
- * @param[in] in_idx, in_dist  n x k2, or NULL when k2 is 0.
+ * @param[in] nb_idx   n x k (amscr_index_graph_widths), row-major.
+ * @param[in] nb_dist  n x k, row-major.
+ * @param[in] in_idx   n x k2, or NULL when k2 is 0.
+ * @param[in] in_dist  n x k2, or NULL when k2 is 0.
  * @param[out] out  the new graph.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL; a row not itself first, an index >= n, a distance
  *         negative or not finite: the detail names the row); AMSCR_E_LIMIT (2^32 shapes or
@@ -3527,9 +3568,10 @@ AMSCR_API void amscr_index_graph_free(amscr_index_graph *g);
  *        each pair computed as amscr_index_pair_distances computes it (qpos as there): the
  *        pairs of a shortlist build in shards.
  * @param[in]  cand  m shape indices of x, strictly ascending.
- * @param[out] out_base, out_inner  m distances each; either may be NULL (not computed), not
- *                                  both when m > 0; inner zeros when the params give the inner
- *                                  graph no share.
+ * @param[out] out_base   m distances; may be NULL (not computed), not with out_inner too
+ *                        when m > 0.
+ * @param[out] out_inner  m distances; may be NULL (not computed), not with out_base too when
+ *                        m > 0; zeros when the params give the inner graph no share.
  * @return AMSCR_OK; AMSCR_E_INVALID_ARG (NULL, cand not ascending or out of range, incompatible
  *         params); AMSCR_E_NOMEM.
  * Cost: m pair distances on the params' threads.
