@@ -5,6 +5,7 @@ import math
 import os
 import struct
 import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -447,6 +448,65 @@ def test_folder_warns_of_images_it_cannot_read(tmp_path):
     r = run("eval", d, "--json", *AFFINE)
     assert r.returncode == 0 and json.loads(r.stdout)["n"] == 4
     assert r.stderr == "amscr: %s: 3 files skipped: not PNG, PGM or a point list (e.g. broken.png)\n" % d, r.stderr
+
+
+def test_folder_skips_text_files_that_are_no_point_lists(tmp_path):
+    """A .txt or .csv of a folder whose first line is no point (a README.txt, a classes.csv, an
+    empty notes.txt) is skipped with the warning line, as a .png that is no image: it does not make
+    the whole folder fail. A point list with a bad line further on is still an error naming it."""
+    d = folder_of_points(tmp_path / "set", ["star-1.txt", "star-2.txt", "blob-1.txt", "blob-2.txt"])
+    (d / "README.txt").write_text("Shapes of stars and blobs.\n")
+    (d / "classes.csv").write_text("class,files\nstar,star-1 star-2\n")
+    (d / "notes.txt").write_bytes(b"")
+    r = run("eval", d, "--json", *AFFINE)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["n"] == 4
+    assert r.stderr == "amscr: %s: 3 files skipped: not PNG, PGM or a point list (e.g. README.txt)\n" % d, r.stderr
+    (d / "star-3.txt").write_text("\ufeff# a comment, then a point\n\n 1 2\n3 x\n")
+    r = run("matrix", d, "-o", "-", *AFFINE)
+    assert r.returncode == 1 and r.stderr.endswith("star-3.txt:4: expected 2 numbers\n"), r.stderr
+
+
+def _as_nobody():
+    """A preexec_fn that runs the tool as `nobody` when the tests run as root (whom no file
+    mode stops), else None; pytest.skip when that cannot be done."""
+    if os.geteuid() != 0:
+        return None
+    if not hasattr(os, "setresuid"):
+        pytest.skip("running as root without setresuid: cannot make a file unreadable")
+    return lambda: (os.setgroups([]), os.setresgid(65534, 65534, 65534), os.setresuid(65534, 65534, 65534))
+
+
+def test_folder_shape_that_cannot_be_read_is_an_error(tmp_path):
+    """A file named as a shape that cannot be opened (no permission) is an error naming it and
+    why, whether it is named .png or .txt: it is not skipped as 'not PNG, PGM or a point list'."""
+    import tempfile
+    drop = _as_nobody()
+    top = tempfile.mkdtemp(prefix="amscr-unreadable-")  # nobody must reach it (pytest's tmp is 0700)
+    try:
+        os.chmod(top, 0o755)
+        d = folder_of_points(Path(top) / "set", ["star-1.txt", "star-2.txt", "blob-1.txt", "blob-2.txt"])
+        os.chmod(d, 0o755)
+        for f in d.iterdir():
+            os.chmod(f, 0o644)
+        if drop is not None:
+            probe = subprocess.run([tool_path(), "--version"], capture_output=True, preexec_fn=drop)
+            if probe.returncode != 0:
+                pytest.skip("the tool cannot run as nobody here: %s" % probe.stderr.decode(errors="replace"))
+        for name in ("blob-3.png", "blob-3.txt"):
+            if name.endswith(".png"):
+                (d / name).write_bytes(image_bytes(rasterize([(10, 10), (60, 12), (40, 50)], 80, 80), "x.png"))
+            else:
+                write_points(d / name, base_shapes()["blob"])
+            os.chmod(d / name, 0)
+            r = subprocess.run([tool_path(), "matrix", str(d), "-o", "-", *AFFINE], capture_output=True,
+                               text=True, preexec_fn=drop)
+            assert r.returncode == 1, r.stderr
+            assert "%s: cannot open: Permission denied" % (d / name) in r.stderr, r.stderr
+            assert "skipped" not in r.stderr, r.stderr
+            os.unlink(d / name)
+    finally:
+        subprocess.run(["rm", "-rf", top])
 
 
 def test_class_names_drop_trailing_separators(tmp_path):

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "image.h"
 #include "util.h"
@@ -146,10 +147,43 @@ typedef struct {
     char example[256];
 } skipped_files;
 
+static int is_point_line(const char *s);
+
+/* Whether the file at path reads as a point list: 1 when its first line with content (after a
+ * UTF-8 byte order mark, blank lines and '#' comments) is a point, 0 when it is something else
+ * or there is none (a README.txt, a table of classes.csv, an empty file), -1 when the file cannot
+ * be opened (errno set). */
+static int text_is_points(const char *path)
+{
+    FILE *fp = fopen(path, "rb");
+    if (fp == NULL)
+        return -1;
+    char line[512];
+    int r = 0, first = 1;
+    while (fgets(line, sizeof line, fp) != NULL) {
+        char *s = line;
+        if (first && memcmp(s, "\xEF\xBB\xBF", 3) == 0)
+            s += 3;
+        first = 0;
+        s[strcspn(s, "#\r\n")] = '\0';
+        s += strspn(s, " \t");
+        size_t n = strlen(s);
+        while (n > 0 && (s[n - 1] == ' ' || s[n - 1] == '\t'))
+            s[--n] = '\0';
+        if (n > 0) {
+            r = is_point_line(s);
+            break;
+        }
+    }
+    fclose(fp);
+    return r;
+}
+
 /* 1 when the folder entry `name` is a shape file (a regular file: PNG or PGM magic bytes, or a
- * .txt / .csv name); 0 when not (counted in sk when it looks meant as a shape: an image of a
- * format the tool cannot read, or a file named as an image that is none — empty, damaged, a
- * dangling link); -1 out of memory. */
+ * .txt / .csv name whose first line is a point); 0 when not (counted in sk when it looks meant as
+ * a shape: an image of a format the tool cannot read, a file named as an image that is none —
+ * empty, damaged, a dangling link — or a .txt / .csv that is no point list); -1 out of memory.
+ * A file named as a shape that cannot be opened (no permission) is taken: its load names why. */
 static int take_entry(const char *dir, const char *name, skipped_files *sk)
 {
     char *path = path_join(dir, name);
@@ -159,9 +193,11 @@ static int take_entry(const char *dir, const char *name, skipped_files *sk)
     char ext[16];
     path_ext(name, ext);
     int reg = stat(path, &st) == 0 && S_ISREG(st.st_mode);
-    int take = reg && (strcmp(ext, ".txt") == 0 || strcmp(ext, ".csv") == 0 || file_is_image(path));
+    int text = strcmp(ext, ".txt") == 0 || strcmp(ext, ".csv") == 0;
     int named = strcmp(ext, ".png") == 0 || strcmp(ext, ".pgm") == 0 || strcmp(ext, ".pnm") == 0;
-    if (!take && (named || (reg && file_image_other(path) != NULL))) {
+    int points = reg && text ? text_is_points(path) : 0;
+    int take = reg && (points != 0 || file_is_image(path) || (named && access(path, R_OK) != 0));
+    if (!take && (named || text || (reg && file_image_other(path) != NULL))) {
         if (sk->n++ == 0 || strcmp(name, sk->example) < 0)
             snprintf(sk->example, sizeof sk->example, "%s", name);
     }
