@@ -62,6 +62,17 @@ def test_split_bad_input(tmp_path, args, msg):
     assert r.returncode == 2 and msg in r.stderr and r.stdout == ""
 
 
+def test_split_with_a_class_of_one_shape(tmp_path):
+    """A class of one shape leaves no --train to suggest: the error says so, not 'use --train 0
+    or less' (a value --train refuses)."""
+    mf = make_manifest(tmp_path, with_group=False)
+    write_points(tmp_path / "shapes" / "lone.txt", affine(MAPS[1], base_shapes()["star"]))
+    mf.write_text(mf.read_text() + "shapes/lone.txt\tlone\n")
+    r = run("eval", mf, "--protocol", "split", "--train", "1", *AFFINE)
+    assert r.returncode == 2 and r.stdout == "", r.stderr
+    assert "class 'lone' has 1 shape" in r.stderr and "--train 0" not in r.stderr, r.stderr
+
+
 def test_groups_leave_one_out(tmp_path):
     j = eval_json(make_manifest(tmp_path), "--protocol", "groups")
     g = j["groups"]

@@ -308,7 +308,10 @@ static int split_check(const collection *c, size_t train)
         if (sz[k] < sz[worst])
             worst = k;
     int r = 0;
-    if (train >= sz[worst])
+    if (sz[worst] < 2) /* no --train leaves one to test and one to train */
+        r = usage_error("--train", "class '%s' has 1 shape: --protocol split needs at least 2 in every class (one "
+                        "to train, one to test)", c->classes[worst]);
+    else if (train >= sz[worst])
         r = usage_error("--train", "%zu training shapes per class leave none to test in class '%s' (%zu shapes); "
                         "use --train %zu or less",
                         train, c->classes[worst], sz[worst], sz[worst] - 1);
