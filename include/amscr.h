@@ -2810,8 +2810,12 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_db_query_retrieval(const amscr_db *
  *        traced and prepared again), gets that shape's row of amscr_db_retrieval_matrix on the
  *        collection itself (0 against itself; to rounding, ~1e-12), as `amscr search` shows it;
  *        any other query gets amscr_db_query_retrieval's scores. The rule applies when the scores
- *        depend on the collection (rerank_k > 0, or a channel weight strictly between 0 and 1);
- *        the base distances alone are the same for a member's copy.
+ *        depend on the collection (rerank_k > 0, or a channel weight strictly between 0 and 1) or
+ *        on the pair's order (a channel weight above 0: the channel's distance runs from the lower
+ *        index to the higher, so a copy scored as a new shape would get d(j, i) where the
+ *        member's row has d(i, j)); without re-ranking the member's row is found by comparing the
+ *        query with every shape, no index built. With the AMSCR distance alone (channel weight 0,
+ *        no re-ranking) the base distances are the same for a member's copy.
  * Cost, memory, params as amscr_db_query_retrieval; the rule adds the query's signature and
  *       a comparison with its 32 signature-nearest shapes.
  * @param[out] out_scores  n scores, lower is better.
@@ -3004,8 +3008,10 @@ AMSCR_API AMSCR_NODISCARD amscr_status amscr_index_find_member(const amscr_index
  * @brief The query's scores as a search shows them: amscr_index_member_scores of the shape
  *        amscr_index_find_member finds (the member rule), else amscr_index_query_scores. The rule
  *        applies when the scores depend on the collection (rerank_k > 0, or a channel weight
- *        strictly between 0 and 1); the base distances alone (channel weight 0 or 1 without
- *        re-ranking) are amscr_index_query_scores' for every query. So a member's copy ranks
+ *        strictly between 0 and 1) or on the pair's order (a channel weight above 0: the
+ *        channel's distance runs from the lower index to the higher); the AMSCR distance alone
+ *        (channel weight 0 without re-ranking) is amscr_index_query_scores' for every query. So a
+ *        member's copy ranks
  *        the member first at 0 and the others as the member's own row, with every face (C, the
  *        tool, Python's Index.query and Collection.query) giving the same scores.
  * @param[in]  q  a shape prepared with params compatible with the index's.

@@ -401,9 +401,11 @@ END_TEST
 /* The member rule (amscr_index_find_member and the search calls): a query prepared again from
  * a member's points is that member (the lowest index of copies), and the search calls score it
  * by the member's row of the collection's retrieval matrix (amscr_index_member_scores; the db's
- * search its row of amscr_db_retrieval_matrix) when the scores re-rank or fuse, by the query's
- * own scores otherwise (the channel alone); any other query gets the query calls' scores; the
- * query calls never apply the rule; a lazy load finds the same member. */
+ * search its row of amscr_db_retrieval_matrix) when the scores re-rank or fuse or take the
+ * channel, whose pairs run from the lower index to the higher (the channel alone too: a copy
+ * scored as a new shape would get d(j, i) where the member's row has d(i, j)); any other query
+ * gets the query calls' scores; the query calls never apply the rule; a lazy load finds the same
+ * member. */
 static void member_rule_case(double w, unsigned k, int applies)
 {
     amscr_params *p = params_of(w, k, 2);
@@ -497,7 +499,7 @@ END_TEST
 START_TEST(member_rule_fused) { member_rule_case(0.5, 0, 1); }
 END_TEST
 
-START_TEST(member_rule_channel_alone) { member_rule_case(1.0, 0, 0); }
+START_TEST(member_rule_channel_alone) { member_rule_case(1.0, 0, 1); }
 END_TEST
 
 static amscr_index *named_index(const amscr_params *p, size_t candidates)

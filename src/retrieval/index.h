@@ -110,7 +110,8 @@ size_t amscr__index_k2(const amscr_params *p, size_t k);
 /* db can be indexed (closed curves for the channel, at most 2^32 - 1 shapes). */
 amscr_status amscr__index_check_db(const amscr_db *db, const char *what);
 /* The member rule of the search calls (index_query.c): whether p's scores depend on the
- * collection (re-ranking or fusion), so a member's copy is scored as the member; and
+ * collection (re-ranking or fusion) or on the pair's order (the channel), so a member's copy is
+ * scored as the member; and
  * amscr_index_search_scores (member 1) or amscr_index_query_scores (member 0) with candidates 0,
  * without their checks, progress (may be NULL) counting the base distances. */
 int amscr__member_rule_applies(const amscr_params *p);

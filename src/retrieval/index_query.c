@@ -165,10 +165,12 @@ static amscr_status find_member(const amscr_index *x, const amscr_descriptor *q,
 }
 
 /* Whether a search scores a member's copy by the member's row: scores that depend on the
- * collection (re-ranking, or a fusion of both distances), as amscr_db_query_retrieval's. */
+ * collection (re-ranking, or a fusion of both distances), as amscr_db_query_retrieval's, or on
+ * the pair's order (the shape channel's distance is taken from the lower index to the higher,
+ * so a copy of shape i, after every shape, would get d(j, i) where the matrix has d(i, j)). */
 int amscr__member_rule_applies(const amscr_params *p)
 {
-    return p->rerank_k > 0 || (p->channel_weight > 0.0 && p->channel_weight < 1.0);
+    return p->rerank_k > 0 || p->channel_weight > 0.0;
 }
 
 amscr_status amscr_index_find_member(const amscr_index *x, const amscr_descriptor *q, size_t *out_i)

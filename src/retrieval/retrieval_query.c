@@ -79,18 +79,49 @@ static amscr_status kept(const amscr_db *db, amscr__stages *sp, const amscr_inde
     return st;
 }
 
-/* The base distances of q to every shape of db. */
-static amscr_status plain_row(const amscr_db *db, const amscr_descriptor *q, amscr_progress_fn progress, void *user,
-                              double *out)
+/* The lowest shape of db with q's prepared samples, bit for bit, into *out (SIZE_MAX: none):
+ * the member rule's shape, found without an index. */
+static amscr_status db_member(const amscr_db *db, const amscr_descriptor *q, size_t *out)
 {
-    size_t n = amscr_db_size(db), *cand = amscr__malloc_array(n, sizeof *cand);
+    size_t n = amscr_db_size(db), N = amscr_db_params(db)->num_samples;
+    double *buf = amscr__malloc_array(2 * N + 2 * AMSCR__OUTLINE_N, sizeof *buf);
+    amscr_status st = buf ? AMSCR_OK : amscr__fail(AMSCR_E_NOMEM, "amscr_db_search_retrieval: out of memory");
+    *out = SIZE_MAX;
+    for (size_t j = 0; st == AMSCR_OK && j < n && *out == SIZE_MAX; j++) {
+        amscr_descriptor sd, *tmp = NULL;
+        const amscr_descriptor *d = &sd;
+        st = amscr__db_shallow(db, j, &sd, buf, buf + 2 * N) ? AMSCR_OK : amscr__db_peek(db, j, &d, &tmp);
+        if (st == AMSCR_OK && d->n == q->n && memcmp(d->input, q->input, 2 * q->n * sizeof *q->input) == 0)
+            *out = j;
+        amscr_descriptor_free(tmp);
+    }
+    free(buf);
+    return st;
+}
+
+/* The base distances of q to every shape of db, each pair as the matrix cell of the two with q at
+ * index qpos (SIZE_MAX: after every shape; a member's copy: the member's row, 0 on itself). */
+static amscr_status plain_row(const amscr_db *db, const amscr_descriptor *q, size_t qpos, amscr_progress_fn progress,
+                              void *user, double *out)
+{
+    size_t n = amscr_db_size(db), m = 0, *cand = amscr__malloc_array(n ? n : 1, sizeof *cand);
     if (!cand)
         return amscr__fail(AMSCR_E_NOMEM, "amscr_db_query_retrieval: out of memory");
     for (size_t j = 0; j < n; j++)
-        cand[j] = j;
+        if (j != qpos)
+            cand[m++] = j;
+    double *row = qpos < n ? amscr__malloc_array(n, sizeof *row) : out;
     amscr__base b;
     amscr__base_init(&b, amscr_db_params(db), 0.0, 0.0);
-    amscr_status st = amscr__base_row(&b, db, NULL, q, SIZE_MAX, cand, n, progress, user, out);
+    amscr_status st = row ? amscr__base_row(&b, db, NULL, q, qpos, cand, m, progress, user, row)
+                          : amscr__fail(AMSCR_E_NOMEM, "amscr_db_query_retrieval: out of memory");
+    if (st == AMSCR_OK && row != out) {
+        for (size_t t = 0; t < m; t++)
+            out[cand[t]] = row[t];
+        out[qpos] = 0.0;
+    }
+    if (row != out)
+        free(row);
     free(cand);
     return st;
 }
@@ -108,10 +139,16 @@ static amscr_status db_query(const amscr_db *db, const amscr_descriptor *q, amsc
                            n, amscr_db_size(db));
     if (!amscr__params_compatible(amscr_db_params(db), &q->params, what))
         return AMSCR_E_INVALID_ARG;
+    const amscr_params *p = amscr_db_params(db);
     amscr_status st;
-    if (!amscr__member_rule_applies(amscr_db_params(db))) /* the base distances alone: nothing of the collection's */
-        st = plain_row(db, q, progress, user, out_scores);
-    else {
+    if (p->rerank_k == 0 && (p->channel_weight == 0.0 || p->channel_weight == 1.0)) {
+        /* the base distances alone: nothing of the collection's, but the pair's order (the
+         * member rule, when it applies: a member's copy gets the member's row) */
+        size_t qpos = SIZE_MAX;
+        st = member && amscr__member_rule_applies(p) ? db_member(db, q, &qpos) : AMSCR_OK;
+        if (st == AMSCR_OK)
+            st = plain_row(db, q, qpos, progress, user, out_scores);
+    } else {
         const amscr_index *x = NULL;
         amscr__stages sp = {progress, user, 0, 1};
         st = kept(db, &sp, &x);

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from imgutil import (affine, blank, fill_rect, image_bytes, img_ext, rasterize, run, smooth_shape, tool_path,
-                     write_points)
+from imgutil import (affine, blank, fill_rect, image_bytes, img_ext, rasterize, read_points, run, smooth_shape,
+                     tool_path, write_points)
 
 MAPS = [((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
         ((0.9, 0.4, 10.0), (-0.3, 1.1, -5.0)),
@@ -129,6 +129,31 @@ def test_matrix_tsv_equals_npy(manifest, tmp_path):
     except ImportError:
         return
     assert numpy.array_equal(numpy.load(npy), numpy.loadtxt(tsv))
+
+
+def test_search_of_a_member_without_rerank_is_its_matrix_row(tmp_path):
+    """Without re-ranking, a search for a file of the collection (the member rule) prints its row
+    of `matrix --no-rerank`, whose shape channel takes each pair from the lower index to the
+    higher: a folder, its index and an index built --no-rerank alike, order and distances."""
+    names = ["blob-1.txt", "blob-2.txt", "blob-3.txt", "star-1.txt", "star-2.txt", "star-3.txt", "wave-1.txt",
+             "wave-2.txt", "wave-3.txt"]
+    d = folder_of_points(tmp_path / "set", names)
+    for k, name in enumerate(names):  # unequal warps: the two directions of a pair differ
+        pts = [(x + 3 * math.sin(0.7 * k + 0.05 * i), y) for i, (x, y) in enumerate(read_points((d / name).read_text()))]
+        write_points(d / name, pts)
+    D = tmp_path / "D.tsv"
+    assert run("matrix", d, "-o", D, "--no-rerank").returncode == 0
+    rows = [[float(v) for v in line.split("\t")] for line in D.read_text().splitlines()[1:]]
+    idx, idx0 = tmp_path / "s.idx", tmp_path / "s0.idx"
+    assert run("index", d, "-o", idx).returncode == 0 and run("index", d, "-o", idx0, "--no-rerank").returncode == 0
+    for coll in (d, idx, idx0):
+        for i, name in enumerate(names):
+            r = run("search", d / name, coll, "--no-rerank", "--json", "--top", len(names))
+            assert r.returncode == 0, r.stderr
+            res = json.loads(r.stdout)["results"]
+            want = sorted(range(len(names)), key=lambda j: (rows[i][j], j))
+            assert [h["index"] for h in res] == want, (coll, name)
+            assert all(abs(h["distance"] - rows[i][h["index"]]) <= 1e-12 for h in res), (coll, name, res, rows[i])
 
 
 def test_matrix_stdout(manifest):

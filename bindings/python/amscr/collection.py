@@ -266,8 +266,8 @@ class Collection:
         medians (those of the first query's build), not medians moved by the query. A query
         whose prepared samples are a shape's of the collection, bit for bit (the member rule,
         :meth:`Index.find_member`), gets that shape's row of the collection's own retrieval
-        matrix when the scores re-rank or fuse (C ``amscr_db_search_retrieval``), as
-        :meth:`Index.query` and ``amscr search`` give it.
+        matrix when the scores re-rank, fuse or take the shape channel (C
+        ``amscr_db_search_retrieval``), as :meth:`Index.query` and ``amscr search`` give it.
 
         Args:
             shape: the query: (n, 2) points, an OpenCV (n, 1, 2) contour or a :class:`Shape`.

@@ -297,8 +297,8 @@ class Index:
         """The query's retrieval score against every shape (lower is better): its row of
         :meth:`Collection.retrieval_matrix` on the collection plus the query; a query that is a
         member's copy (:meth:`find_member`) gets that member's row of the collection's own
-        retrieval matrix (0 against itself) when the scores re-rank or fuse, as ``amscr search``
-        shows it (C ``amscr_index_search_scores``).
+        retrieval matrix (0 against itself) when the scores re-rank, fuse or take the shape
+        channel, as ``amscr search`` shows it (C ``amscr_index_search_scores``).
 
         Args:
             points: the query: points or a :class:`Shape`.
