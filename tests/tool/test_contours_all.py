@@ -54,6 +54,7 @@ def test_all_text_matches_json_and_min_area(nested, tmp_path):
 
 @pytest.mark.parametrize("args,code,msg", [
     (("--json",), 2, "only with --all"),
+    (("--min-area", "5"), 2, "--min-area: only with --all"),  # it filters nothing else: ignored before 0.22.8
     (("--all", "--min-area", "-1"), 2, "--min-area"),
     (("--all", "--min-area", "x"), 2, "--min-area"),
     (("--all", "--min-area", "1e9"), 1, "no contour"),
@@ -61,6 +62,12 @@ def test_all_text_matches_json_and_min_area(nested, tmp_path):
 def test_all_bad_input(nested, args, code, msg):
     r = run("contour", nested, *args)
     assert r.returncode == code and msg in r.stderr and r.stdout == ""
+
+
+def test_min_area_needs_component_in_register(nested):
+    r = run("register", nested, nested, "--min-area", "5")
+    assert r.returncode == 2 and "--min-area: only with --component" in r.stderr and r.stdout == ""
+    assert run("register", nested, nested, "--component", "0", "--min-area", "5").returncode == 0
 
 
 def test_all_needs_an_image(tmp_path):

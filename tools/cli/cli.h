@@ -71,6 +71,7 @@ typedef struct opts {
     int all;           /* contour --all */
     int join;          /* contour --join */
     double min_area;   /* --min-area A (pixels^2) */
+    int min_area_set;
     long component;    /* --component N; -1: the largest outer contour */
     int add;           /* index --add */
     size_t candidates; /* search against an index: shapes matched (0: all) */

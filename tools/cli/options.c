@@ -360,6 +360,7 @@ static int set_option(opts *o, const optdef *d, const char *v)
         if (end == v || *end != '\0' || errno != 0 || !(a >= 0.0) || !isfinite(a))
             return usage_error(n, "expected an area >= 0 in pixels^2, got '%s'", v);
         o->min_area = a;
+        o->min_area_set = 1;
         return 0;
     }
     case O_COMPONENT: {
@@ -478,5 +479,7 @@ int parse_args(opts *o, const tool_command *c, int argc, char **argv)
     }
     if (o->npos < c->npos)
         return usage_error(o->cmd, "missing argument (usage: amscr %s %s)", o->cmd, c->args);
+    if (o->min_area_set && !o->all && o->component < 0) /* it filters the contours of those two */
+        return usage_error("--min-area", "only with %s", strcmp(o->cmd, "contour") == 0 ? "--all" : "--component");
     return 0;
 }
