@@ -107,6 +107,13 @@ def test_add_to_an_index_smaller_than_its_lists_rebuilds_it(tmp_path):
     assert ja["groups"] == jb["groups"] and ja["per_class"] == jb["per_class"]
 
 
+def test_index_of_one_shape_counts_in_the_singular(tmp_path):
+    m = make_manifest(tmp_path)
+    (tmp_path / "one.tsv").write_text("\n".join(m.read_text().splitlines()[:2]) + "\n")
+    r = run("index", tmp_path / "one.tsv", "-o", tmp_path / "one.idx")
+    assert r.returncode == 0 and ": 1 shape, 1 class, " in r.stdout, r.stdout + r.stderr
+
+
 @pytest.mark.parametrize("index_groups", [True, False])
 def test_add_with_and_without_a_group_column(tmp_path, index_groups):
     """A group column on one side only: the message says which side has one."""

@@ -243,7 +243,7 @@ static void format_text(sbuf *b, const opts *o, const collection *c, const amscr
 {
     size_t n = c->n;
     double tm = s->t2 - s->t1;
-    sb_printf(b, "collection  %s (%zu shapes, %zu classes)\n", o->pos[0], n, c->nclasses);
+    sb_printf(b, "collection  %s (%zu shapes, %zu class%s)\n", o->pos[0], n, c->nclasses, c->nclasses == 1 ? "" : "es");
     sb_printf(b, "method      %s, N = %zu, reflections %s\n", name_of(&METHOD_NAMES, (int)amscr_params_get_method(p)),
               amscr_params_get_num_samples(p), amscr_params_get_reflections(p) ? "on" : "off");
     if (s->want_be)
@@ -290,7 +290,8 @@ static int draw_plot(const opts *o, const double *d, const collection *c, const 
     if (s->want_groups)
         ser[ns++] = (score_series){"1-NN (leave one group out)", s->groups_cls};
     char title[600];
-    snprintf(title, sizeof title, "%s: %zu shapes, %zu classes", path_base(o->pos[0]), c->n, c->nclasses);
+    snprintf(title, sizeof title, "%s: %zu shapes, %zu class%s", path_base(o->pos[0]), c->n, c->nclasses,
+             c->nclasses == 1 ? "" : "es");
     eval_plot_input in = {title, c->classes, c->nclasses, ser, ns, rec, prec, PR_LEVELS};
     return draw_eval_plot(o->plot, &in);
 }

@@ -80,8 +80,9 @@ int cmd_index(opts *o)
         size_t nclasses = index_num_classes(x);
         const amscr_params *ip = amscr_db_params(amscr_index_db(x));
         double share = amscr_params_get_rerank_inner_share(ip), closing = amscr_params_get_inner_closing(ip);
-        fprintf(fp, "index %s: %zu shapes, %zu classes, %zu neighbours per shape", o->out, amscr_index_size(x), nclasses,
-               amscr_index_neighbours(x));
+        size_t n = amscr_index_size(x), k = amscr_index_neighbours(x);
+        fprintf(fp, "index %s: %zu shape%s, %zu class%s, %zu neighbour%s per shape", o->out, n, n == 1 ? "" : "s",
+                nclasses, nclasses == 1 ? "" : "es", k, k == 1 ? "" : "s");
         if (amscr_index_neighbours(x) > 0 && share > 0.0)
             fprintf(fp, " (re-ranking on two graphs, the inner distance's at share %g, closing %g)\n", share, closing);
         else
