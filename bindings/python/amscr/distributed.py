@@ -32,7 +32,7 @@ How it runs:
 * ``client=None`` starts a local cluster (one single-threaded worker process per core), computes
   and closes it. With a client, :func:`distance_matrix` and :func:`cross_matrix` return a lazy
   Dask array (``out=`` a path instead writes the tiles, as they arrive, into a ``.npy`` file
-  memory-mapped on the client).
+  memory-mapped on the client: a temporary file beside the path, renamed to it once complete).
 * A worker that dies mid-run has its tiles rescheduled by Dask (``distributed.scheduler.
   allowed-failures``, 3 by default); tasks raising an exception are retried ``retries`` times.
   The shapes a tile needs may have lived only on the dead worker: query blocks go to one worker,
@@ -405,8 +405,35 @@ def _drain(client, jobs: Dict[Any, Callable[[int], Any]], progress: bool, put,
         placed = {jobs[job](attempt): job for job in cancelled}
 
 
+def _temp_beside(path: str) -> str:
+    """A new empty file in path's folder, named after it (mode 0666 less the umask)."""
+    d, base = os.path.split(path)
+    tmp = os.path.join(d, '.%s.amscr-tmp-%s' % (base, uuid.uuid4().hex[:12]))
+    os.close(os.open(tmp, os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, 'O_CLOEXEC', 0), 0o666))
+    return tmp
+
+
 def _eager_matrix(client, task, row_b, col_b, args_of, out, progress, retries, token, shape, payloads):
-    arr = _out_array(out, shape)
+    if out is None or isinstance(out, np.ndarray):
+        return _eager_into(client, task, row_b, col_b, args_of, _out_array(out, shape), progress, retries, token,
+                           payloads)
+    # a path: the tiles go to a temporary file beside it, renamed into place once complete, so a
+    # call that fails (or is interrupted) leaves neither a partial matrix nor a leftover file there
+    path = os.fspath(out)
+    tmp = _temp_beside(path)
+    try:
+        arr = _eager_into(client, task, row_b, col_b, args_of, _out_array(tmp, shape), progress, retries, token,
+                          payloads)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    arr.filename = os.path.abspath(path)
+    return arr
+
+
+def _eager_into(client, task, row_b, col_b, args_of, arr, progress, retries, token, payloads):
 
     def submit_of(i, j):
         return lambda attempt: client.submit(task, *args_of(i, j), key='%s-%d-%d-%d' % (token, i, j, attempt),
@@ -458,7 +485,9 @@ def distance_matrix(collection: Union[Collection, bytes], client=None, tile: Til
         progress: show Dask's progress bar.
         out: None, or a path: the tiles are written as they arrive into a new ``.npy`` file,
             memory-mapped on the client (``np.lib.format.open_memmap``), which is returned;
-            a writeable float64 NumPy array of the right shape is accepted too.
+            the file is a temporary one beside the path, renamed to it once every tile is in
+            (a call that fails leaves the path as it was, and no other file). A writeable
+            float64 NumPy array of the right shape is accepted too.
         threads: C threads per tile; None: each host's cores over the Dask threads of its workers.
         retries: retries of a tile whose task raised (a dead worker's tiles are rescheduled anyway).
 

@@ -142,6 +142,31 @@ def test_distance_matrix_into_memmap(client, db, D, tmp_path):
     assert np.array_equal(np.load(path), D)
 
 
+def test_failed_call_leaves_the_out_path_as_it_was(client, db, D, tmp_path, monkeypatch):
+    """out=path: the tiles go to a temporary file beside the path, renamed to it once complete; a
+    call that fails keeps the file there before (no zero-filled matrix of the right shape in its
+    place) and leaves no other file."""
+    path = tmp_path / 'D.npy'
+    np.save(path, np.arange(4.0))  # an earlier result
+    data = bytearray(db.to_bytes())
+    data[len(data) // 2] ^= 0xFF
+    with monkeypatch.context() as m:  # corrupted on its way to the workers: every tile fails
+        m.setattr(amscr.Collection, 'to_bytes', lambda self: bytes(data))
+        with pytest.raises(amscr.FormatError, match='corrupt'):
+            _within(lambda: ad.distance_matrix(db, client=client, tile=60, out=path))
+    assert os.listdir(tmp_path) == ['D.npy']
+    assert np.array_equal(np.load(path), np.arange(4.0))
+    M = _within(lambda: ad.distance_matrix(db, client=client, tile=60, out=path))
+    assert os.listdir(tmp_path) == ['D.npy'] and np.array_equal(np.load(path), D)
+    assert M.filename == str(path)
+    umask = os.umask(0o022)
+    os.umask(umask)
+    assert os.stat(path).st_mode & 0o777 == 0o666 & ~umask
+    M[0, 0] = 5.0  # still the file's map
+    M.flush()
+    assert np.load(path)[0, 0] == 5.0
+
+
 def test_cross_matrix_equals_single_machine(client, db, queries):
     want = queries.cross_matrix(db)
     got = _within(ad.cross_matrix(queries, db, client=client, tile=(20, 64)).compute)
