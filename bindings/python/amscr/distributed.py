@@ -84,8 +84,8 @@ TileArg = Union[None, int, Tuple[int, int]]
 
 class LostTilesError(AmscrError, RuntimeError):
     """Tiles were cancelled by Dask (their shapes were lost with the workers holding them, or
-    the computation was cancelled) more than ``LOST_ROUNDS`` times in a row; no partial result
-    is returned."""
+    the computation was cancelled) more than ``LOST_ROUNDS`` times in a row, or the client was
+    closed during the computation; no partial result is returned."""
 
 
 # ========================================================================== worker side
@@ -396,6 +396,9 @@ def _drain(client, jobs: Dict[Any, Callable[[int], Any]], progress: bool, put,
         cancelled, reason = _collect(client, placed, progress, put)
         if not cancelled:
             return
+        if client.status in ('closing', 'closed'):  # closing a client cancels its futures: nothing to resubmit
+            raise LostTilesError('amscr.distributed: the client was closed during the computation: %d tiles were '
+                                 'cancelled and no partial result is returned' % len(cancelled))
         if attempt > LOST_ROUNDS:
             raise LostTilesError('amscr.distributed: %d tiles were cancelled by Dask %d times in a row (their '
                                  'shapes were lost with the workers holding them, or the computation was '
@@ -498,7 +501,7 @@ def distance_matrix(collection: Union[Collection, bytes], client=None, tile: Til
 
     Raises:
         LostTilesError: (eager paths) tiles were still cancelled by Dask after ``LOST_ROUNDS``
-            resubmissions with their lost shapes scattered again.
+            resubmissions with their lost shapes scattered again, or the client was closed.
     """
     coll = _as_collection(collection, 'collection')
     threads = _check_threads(threads)

@@ -359,6 +359,30 @@ def test_tiles_cancelled_every_time_are_a_clear_error(two_workers, db, queries, 
         _within(lambda: ad.topk(queries, db, k=3, client=two_workers, tile=(10, 64)))
 
 
+@pytest.mark.parametrize('call', ['matrix', 'topk'])
+def test_client_closed_mid_call_is_a_clear_error(client, db, queries, monkeypatch, call):
+    """The caller's client closed (from another thread) while the tiles run: Dask cancels them
+    all; the call raises LostTilesError naming the closed client, not an AttributeError from a
+    scatter on the closed client, and never a partial result."""
+    own = distributed.Client(client.scheduler.address, timeout=TIMEOUT)
+    collect = ad._collect
+
+    def close_then_collect(c, placed, progress, put):
+        if c.status == 'running':
+            c.close()
+        return collect(c, placed, progress, put)
+
+    monkeypatch.setattr(ad, '_collect', close_then_collect)
+    try:
+        with pytest.raises(ad.LostTilesError, match='client was closed'):
+            if call == 'matrix':
+                _within(lambda: ad.cross_matrix(queries, db, client=own, tile=(10, 64), out=np.empty((45, N_SHAPES))))
+            else:
+                _within(lambda: ad.topk(queries, db, k=3, client=own, tile=(10, 64)))
+    finally:
+        own.close()
+
+
 def test_no_client_starts_and_closes_a_local_cluster(db, D):
     small = amscr.Collection(db.params)
     for i in range(40):
