@@ -62,18 +62,21 @@ def _block(coll: Collection, lo: int, hi: int, threads: int) -> Collection:
 
 
 def _threads_by_host(client) -> Dict[str, int]:
-    """C threads per tile on each host: its cores over the Dask threads of its workers."""
+    """C threads per tile on each host: its cores over the Dask threads of its workers. A worker
+    that does not answer (it left meanwhile, or hangs until the scheduler drops it) is left out of
+    the cores, not an error: Dask runs its tasks elsewhere."""
     nthreads = client.nthreads()
     if not nthreads:
         return {}
-    cores = client.run(_cores)
+    cores = client.run(_cores, on_error='ignore')
     dask_threads: Dict[str, int] = defaultdict(int)
     host_cores: Dict[str, int] = {}
     for addr, nt in nthreads.items():
         h = get_address_host(addr)
         dask_threads[h] += nt
-        host_cores[h] = cores.get(addr, 1)
-    return {h: max(1, host_cores[h] // dask_threads[h]) for h in dask_threads}
+        if addr in cores:
+            host_cores[h] = cores[addr]
+    return {h: max(1, host_cores.get(h, 1) // dask_threads[h]) for h in dask_threads}
 
 
 def _worker_addresses(dask_scheduler: Any) -> List[str]:

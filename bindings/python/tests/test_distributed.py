@@ -359,6 +359,26 @@ def test_tiles_cancelled_every_time_are_a_clear_error(two_workers, db, queries, 
         _within(lambda: ad.topk(queries, db, k=3, client=two_workers, tile=(10, 64)))
 
 
+def test_worker_not_answering_at_the_start_is_left_out_of_the_core_count(two_workers, db, D, monkeypatch):
+    """The call asks every worker for its host's cores first (client.run): a worker that fails to
+    answer (it died meanwhile, or hangs until the scheduler drops it: CommClosedError) is left out
+    of the count, as Dask reschedules its tiles; the call was that error."""
+    from amscr import _placement
+    victim = sorted(two_workers.nthreads())[0]
+    cores = _placement._cores
+
+    def cores_but_victim(dask_worker):  # pickled by value: runs as such on the workers
+        if dask_worker.address == victim:
+            raise distributed.comm.CommClosedError('simulated: the worker left during the call')
+        return cores()
+
+    monkeypatch.setattr(_placement, '_cores', cores_but_victim)
+    out = np.full(D.shape, np.nan)
+    _within(lambda: ad.distance_matrix(db, client=two_workers, tile=60, out=out))
+    assert np.array_equal(out, D)
+    assert _placement._threads_by_host(two_workers) == {'127.0.0.1': max(1, cores() // 2)}
+
+
 @pytest.mark.parametrize('call', ['matrix', 'topk'])
 def test_client_closed_mid_call_is_a_clear_error(client, db, queries, monkeypatch, call):
     """The caller's client closed (from another thread) while the tiles run: Dask cancels them
