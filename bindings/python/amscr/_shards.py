@@ -37,7 +37,7 @@ from .errors import AmscrError, FormatError, InvalidArgumentError, _check
 from .index import Index
 from .params import Params
 from .shape import as_shape
-from ._placement import _block, _threads_by_host, gather_live
+from ._placement import _block, _threads_by_host, gather_live, gone
 from ._shard_build import _merge_lists, _shortlist_lists, widths
 from ._shard_files import ShardSetError, check_shard, prepare_dir, read_set, write_set
 from ._shard_tasks import (QPOS_AFTER, Signatures, _index_bytes, _joined, _member_shortlists, _members, _pair_block,
@@ -406,7 +406,13 @@ def build_index(client, collection: Collection, path: Optional[PathLike] = None,
     bounds = _bounds(n, ns)
     datas = [_block(collection, lo, hi, params.threads).to_bytes() for lo, hi in bounds]
     placed = [workers[s % len(workers)] for s in range(ns)]
-    rows = [client.scatter(datas[s], workers=[placed[s]], hash=False) for s in range(ns)]
+    try:
+        rows = [client.scatter(datas[s], workers=[placed[s]], hash=False) for s in range(ns)]
+    except Exception as e:  # noqa: BLE001 - a worker gone since the look: a KeyError or a comm error
+        g = gone(client, placed)
+        if not g:
+            raise
+        raise _build_lost(g, '%s: %s' % (type(e).__name__, e)) from e
     th = _threads_by_host(client)
     idx = [client.submit(_shard_index, rows[s], th, pure=False, workers=[placed[s]])
            for s in range(ns)]

@@ -400,6 +400,34 @@ def test_worker_lost_during_the_build_is_a_clear_error(client, monkeypatch, cand
     _restored(client, killed[0])
 
 
+def test_worker_gone_before_its_block_is_sent_is_a_clear_error(client, monkeypatch):
+    """A worker that leaves between the build's look at the cluster and the scattering of its
+    block: the build raised Dask's KeyError (the worker's address); now a ShardSetError naming the
+    shard."""
+    coll = _collection(amscr.Params.retrieval(points=POINTS, threads=1), _shapes(60, 0))
+    real, killed = _shards._workers, []
+
+    def workers_then_kill(cl):
+        w = real(cl)
+        killed.append(w[1])
+        with contextlib.suppress(Exception):  # the worker dies before it answers
+            cl.run(os._exit, 1, workers=[w[1]])
+        deadline = time.monotonic() + 60  # until the scheduler has seen it go
+        while w[1] in cl.nthreads() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        return w
+
+    monkeypatch.setattr(_shards, '_workers', workers_then_kill)
+    got = []
+    t = threading.Thread(target=lambda: got.append(_error_of(lambda: ad.build_index(client, coll, shards=2))),
+                         daemon=True)
+    t.start()
+    t.join(120)
+    assert killed and got and isinstance(got[0], ad.ShardSetError), got
+    assert 'shard 1 lost with its worker during the build' in str(got[0]) and 'build again' in str(got[0])
+    _restored(client, killed[0])
+
+
 def test_shard_lost_with_its_worker_is_a_clear_error(client, tmp_path):
     """Last in the file: it kills a worker of the module's cluster (its nanny starts another)."""
     coll = _collection(amscr.Params.retrieval(points=POINTS, threads=1), _shapes(60, 0))
