@@ -115,7 +115,7 @@ extern "C" {
 /** Compile-time version; amscr_version_number() gives the runtime one. */
 #define AMSCR_VERSION_MAJOR 0
 #define AMSCR_VERSION_MINOR 22
-#define AMSCR_VERSION_PATCH 7
+#define AMSCR_VERSION_PATCH 8
 #define AMSCR_VERSION_NUMBER \
     (AMSCR_VERSION_MAJOR * 10000 + AMSCR_VERSION_MINOR * 100 + AMSCR_VERSION_PATCH)
 
