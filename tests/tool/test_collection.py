@@ -490,6 +490,10 @@ def test_folder_skips_text_files_that_are_no_point_lists(tmp_path):
     (d / "star-3.txt").write_text("\ufeff# a comment, then a point\n\n 1 2\n3 x\n")
     r = run("matrix", d, "-o", "-", *AFFINE)
     assert r.returncode == 1 and r.stderr.endswith("star-3.txt:4: expected 2 numbers\n"), r.stderr
+    # a point list that opens with a comment longer than any buffer is a point list
+    (d / "star-3.txt").write_text("#" + "x" * 5000 + "\n" + (d / "star-1.txt").read_text())
+    r = run("eval", d, "--json", *AFFINE)
+    assert r.returncode == 0 and json.loads(r.stdout)["n"] == 5, r.stderr
 
 
 def _as_nobody():

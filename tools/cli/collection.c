@@ -159,10 +159,14 @@ static int text_is_points(const char *path)
     if (fp == NULL)
         return -1;
     char line[512];
-    int r = 0, first = 1;
+    int r = 0, first = 1, rest = 0; /* rest: the chunk continues a line longer than the buffer */
     while (fgets(line, sizeof line, fp) != NULL) {
         char *s = line;
-        if (first && memcmp(s, "\xEF\xBB\xBF", 3) == 0)
+        int skip = rest;
+        rest = strchr(line, '\n') == NULL;
+        if (skip) /* the tail of a comment or blank line: a line with content ended the loop */
+            continue;
+        if (first && strncmp(s, "\xEF\xBB\xBF", 3) == 0)
             s += 3;
         first = 0;
         s[strcspn(s, "#\r\n")] = '\0';
