@@ -33,7 +33,7 @@ import numpy as np
 from ._lib import ffi, lib
 from ._util import Order, as_count, dbuf
 from .collection import Collection
-from .errors import AmscrError, FormatError, InvalidArgumentError, _check
+from .errors import AmscrError, FormatError, InvalidArgumentError, StateError, _check
 from .index import Index
 from .params import Params
 from .shape import as_shape
@@ -181,7 +181,11 @@ class ShardedIndex:
         return gather_live(self.client, futs, self._workers, _lost_error)
 
     def _guard(self, call: Any) -> Any:
-        """call(); a failure while a shard's worker is gone is the clear error of a lost shard."""
+        """call(); a failure while a shard's worker is gone is the clear error of a lost shard; a
+        closed client is the caller's to renew, not a lost shard."""
+        if getattr(self.client, 'status', None) in ('closing', 'closed'):
+            raise StateError('ShardedIndex: its client is closed, and the shards lived on its cluster: load the set '
+                             'again with an open client (amscr.distributed.load_index)')
         lost = [s for s, sh in enumerate(self._shards) if sh.status in ('lost', 'cancelled', 'error')]
         try:
             return call()

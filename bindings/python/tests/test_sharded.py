@@ -428,6 +428,18 @@ def test_worker_gone_before_its_block_is_sent_is_a_clear_error(client, monkeypat
     _restored(client, killed[0])
 
 
+def test_query_after_its_client_is_closed_says_so(client):
+    """A set whose client was closed is the caller's to load again, not a lost shard (it said
+    "shards 0, 1 lost with their worker (RuntimeError: IOLoop is closed)")."""
+    coll = _collection(amscr.Params.retrieval(points=POINTS, threads=1), _shapes(40, 0))
+    other = distributed.Client(client.cluster)
+    sx = ad.build_index(other, coll, shards=2)
+    sx.scores(_queries(1)[0])
+    other.close()
+    with pytest.raises(amscr.StateError, match='its client is closed'):
+        sx.scores(_queries(1)[0])
+
+
 def test_shard_lost_with_its_worker_is_a_clear_error(client, tmp_path):
     """Last in the file: it kills a worker of the module's cluster (its nanny starts another)."""
     coll = _collection(amscr.Params.retrieval(points=POINTS, threads=1), _shapes(60, 0))
