@@ -374,6 +374,19 @@ def _restored(client, dead, workers=4, seconds=120):
     raise AssertionError('the cluster did not get its worker back')
 
 
+def _build_loses_shard_1(client, coll, killed, **kw):
+    """A 2-shard build (on a thread, at most 2 min) whose patched step killed shard 1's worker
+    (its address in `killed`) raises the ShardSetError naming it; the cluster is made whole again."""
+    got = []
+    t = threading.Thread(target=lambda: got.append(_error_of(lambda: ad.build_index(client, coll, shards=2, **kw))),
+                         daemon=True)
+    t.start()
+    t.join(120)
+    assert killed and got and isinstance(got[0], ad.ShardSetError), got
+    assert 'shard 1 lost with its worker during the build' in str(got[0]) and 'build again' in str(got[0])
+    _restored(client, killed[0])
+
+
 @pytest.mark.parametrize('candidates', [0, 16])
 def test_worker_lost_during_the_build_is_a_clear_error(client, monkeypatch, candidates):
     """A worker killed while the build waits for its tasks: the build waited forever for it; now a
@@ -389,15 +402,7 @@ def test_worker_lost_during_the_build_is_a_clear_error(client, monkeypatch, cand
         return real(cl, futs, placed, lost)
 
     monkeypatch.setattr(_shards, 'gather_live', kill_first)
-    got = []
-    t = threading.Thread(target=lambda: got.append(_error_of(lambda: ad.build_index(client, coll, shards=2,
-                                                                                    candidates=candidates))),
-                         daemon=True)
-    t.start()
-    t.join(120)
-    assert killed and got and isinstance(got[0], ad.ShardSetError), got
-    assert 'shard 1 lost with its worker during the build' in str(got[0]) and 'build again' in str(got[0])
-    _restored(client, killed[0])
+    _build_loses_shard_1(client, coll, killed, candidates=candidates)
 
 
 def test_worker_gone_before_its_block_is_sent_is_a_clear_error(client, monkeypatch):
@@ -418,14 +423,7 @@ def test_worker_gone_before_its_block_is_sent_is_a_clear_error(client, monkeypat
         return w
 
     monkeypatch.setattr(_shards, '_workers', workers_then_kill)
-    got = []
-    t = threading.Thread(target=lambda: got.append(_error_of(lambda: ad.build_index(client, coll, shards=2))),
-                         daemon=True)
-    t.start()
-    t.join(120)
-    assert killed and got and isinstance(got[0], ad.ShardSetError), got
-    assert 'shard 1 lost with its worker during the build' in str(got[0]) and 'build again' in str(got[0])
-    _restored(client, killed[0])
+    _build_loses_shard_1(client, coll, killed)
 
 
 def test_query_after_its_client_is_closed_says_so(client):
