@@ -1,10 +1,14 @@
-/* fuzz_manifest.c — the tool's manifest reader (tools/cli/collection.c: collection_open on a
- * manifest.tsv with the columns file, class and an optional group) on arbitrary bytes, written
- * to a temporary file first (the reader takes a path; the files it lists are not opened).
+/* fuzz_manifest.c — the tool's collection reader (tools/cli/collection.c: collection_open) on
+ * arbitrary bytes, twice: as a manifest.tsv with the columns file, class and an optional group,
+ * written to a temporary file first (the reader takes a path; the files it lists are not
+ * opened); and as the .txt beside a point list in a folder, which the reader takes as a shape
+ * when its first line is a point and skips otherwise (so the folder has one shape or two).
  * Properties on success: at least one shape; each shape's path and name non-empty, its class
  * an index into the classes, its group an index into the groups, or -1 for every shape exactly
  * when there is no group column; the class and group names non-empty and distinct; no file
  * listed twice (a repeated entry is refused). */
+#include <fcntl.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -47,12 +51,9 @@ static void check(const collection *c)
     }
 }
 
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+/* Writes the size bytes to the open fd and closes it; whether all were written. */
+static int write_all(int fd, const uint8_t *data, size_t size)
 {
-    char path[] = "/tmp/amscr-fuzz-manifest-XXXXXX";
-    int fd = mkstemp(path);
-    if (fd < 0)
-        return 0;
     size_t done = 0;
     while (done < size) {
         ssize_t w = write(fd, data + done, size - done);
@@ -61,12 +62,57 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         done += (size_t)w;
     }
     close(fd);
+    return done == size;
+}
+
+/* The bytes as a manifest. */
+static void as_manifest(const uint8_t *data, size_t size)
+{
+    char path[] = "/tmp/amscr-fuzz-manifest-XXXXXX";
+    int fd = mkstemp(path);
+    if (fd < 0)
+        return;
     collection c;
-    tool_errors_mute(1); /* a bad manifest is reported on stderr: not by the thousand here */
-    if (done == size && collection_open(path, &c) == 0) {
+    if (write_all(fd, data, size) && collection_open(path, &c) == 0) {
         check(&c);
         collection_free(&c);
     }
     unlink(path);
+}
+
+/* The bytes as b-1.txt in a folder beside the point list a-1.txt: one shape or both. */
+static void as_folder_text(const uint8_t *data, size_t size)
+{
+    static const char square[] = "0 0\n1 0\n1 1\n0 1\n";
+    char dir[] = "/tmp/amscr-fuzz-folder-XXXXXX";
+    if (mkdtemp(dir) == NULL)
+        return;
+    char *a = path_join(dir, "a-1.txt"), *b = path_join(dir, "b-1.txt");
+    int fa = a ? open(a, O_WRONLY | O_CREAT | O_EXCL, 0600) : -1;
+    int fb = b && fa >= 0 ? open(b, O_WRONLY | O_CREAT | O_EXCL, 0600) : -1;
+    int ok = fa >= 0 && write_all(fa, (const uint8_t *)square, sizeof square - 1);
+    collection c;
+    if (fb >= 0 && write_all(fb, data, size) && ok && collection_open(dir, &c) == 0) {
+        check(&c);
+        FUZZ_CHECK(c.n == 1 || c.n == 2);
+        FUZZ_CHECK(strcmp(c.items[0].name, "a-1.txt") == 0);
+        collection_free(&c);
+    }
+    if (fb < 0 && fa >= 0)
+        close(fa);
+    if (a)
+        unlink(a);
+    if (b)
+        unlink(b);
+    rmdir(dir);
+    free(a);
+    free(b);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    tool_errors_mute(1); /* a bad manifest is reported on stderr: not by the thousand here */
+    as_manifest(data, size);
+    as_folder_text(data, size);
     return 0;
 }

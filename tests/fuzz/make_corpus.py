@@ -62,6 +62,9 @@ put('manifest', 'no-header', 'a.png\tx\n')
 put('manifest', 'nul-byte', 'file\tclass\na\0.png\tx\n')
 put('manifest', 'utf8-bom', b'\xef\xbb\xbffile\tclass\r\nb\xc3\xa9-1.png\tb\xc3\xa9\r\n')
 put('manifest', 'listed-twice', 'file\tclass\na.png\tx\nb.png\ty\na.png\ty\n')
+# the same bytes as a folder's .txt (taken when its first line is a point, else skipped)
+put('manifest', 'points-after-comments', b'\xef\xbb\xbf# ' + b'c' * 600 + b'\n\n  1.5, -2 # a point\n3 4\n5 6\n')
+put('manifest', 'readme-text', 'Shapes of stars.\n1 2\n')
 
 # ------------------------------------------------------------------ pgm
 img = shape_img()

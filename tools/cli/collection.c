@@ -249,7 +249,7 @@ static int open_folder(const char *dir, collection *c)
     size_t n = 0;
     skipped_files sk = {0, ""};
     int ok = folder_names(dir, &names, &n, &sk) == 0;
-    if (sk.n > 0) /* a warning, not an error: the folder's shapes are read */
+    if (sk.n > 0 && !tool_errors_muted()) /* a warning, not an error: the folder's shapes are read */
         fprintf(stderr, "amscr: %s: %zu file%s skipped: not PNG, PGM or a point list (e.g. %s)\n", dir, sk.n,
                 sk.n == 1 ? "" : "s", sk.example);
     if (ok && n == 0) {

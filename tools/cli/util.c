@@ -19,6 +19,7 @@ static int g_muted; /* set only while no other thread runs (see util.h) */
 
 int tool_error_printed(void) { return g_error_printed; }
 void tool_errors_mute(int on) { g_muted = on; }
+int tool_errors_muted(void) { return g_muted; }
 
 static void print_line(const char *what, const char *msg)
 {

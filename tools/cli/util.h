@@ -36,6 +36,8 @@ int tool_error_printed(void);
  * threads is muted and the main thread prints the first failure again after it. Set only while
  * no other thread of the tool runs. */
 void tool_errors_mute(int on);
+/* Whether errors (and the warnings that go with them) are muted now. */
+int tool_errors_muted(void);
 
 /* Overflow-checked allocation; prints "amscr: out of memory" and returns NULL on failure. */
 void *xmalloc_array(size_t n, size_t size);
