@@ -83,3 +83,32 @@ def test_eval_plot_split_protocol(tmp_path):
     r = run("eval", m, "--protocol", "split", "--train", "1", "--plot", out, *AFFINE)
     assert r.returncode == 0, r.stderr
     assert "random split" in out.read_text()
+
+
+def test_svg_text_of_odd_names_is_well_formed_xml(tmp_path):
+    """Control characters and bytes that are not UTF-8 in file and class names: the SVGs stay
+    well-formed XML, showing each control character as its control picture and each stray byte as
+    U+FFFD (they were copied as they were: XML parsers refused the file)."""
+    import os
+    import xml.dom.minidom
+    m = make_manifest(tmp_path)
+    text = m.read_bytes().replace(b"\tstar\t", b"\tst\x01a\xffr&<\t")
+    m.write_bytes(text)
+    src = os.fsdecode(bytes(tmp_path) + b"/src\x1b\xfe.txt")
+    with open(os.fsencode(src), "wb") as f:
+        f.write((tmp_path / "shapes" / "star_2.txt").read_bytes())
+    outs = {"o": tmp_path / "o.svg", "p": tmp_path / "p.svg", "s": tmp_path / "s.svg", "e": tmp_path / "e.svg"}
+    r = run("register", src, tmp_path / "shapes" / "star_1.txt", "--overlay", outs["o"], "--plot", outs["p"],
+            "--json")
+    assert r.returncode == 0, r.stderr
+    r = run("search", src, m, "--top", "3", "--sheet", outs["s"], "--json", *AFFINE)
+    assert r.returncode == 0, r.stderr
+    r = run("eval", m, "--plot", outs["e"], *AFFINE)
+    assert r.returncode == 0, r.stderr
+    for key, out in outs.items():
+        doc = xml.dom.minidom.parse(str(out))
+        texts = "".join(n.firstChild.data for n in doc.getElementsByTagName("text") if n.firstChild)
+        if key in "ops":
+            assert "src\u241b\ufffd.txt" in texts, key
+        if key in "se":
+            assert "st\u2401a\ufffdr&<" in texts, key

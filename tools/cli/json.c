@@ -26,9 +26,7 @@ void sb_json_num(sbuf *b, double v)
     sb_puts(b, buf);
 }
 
-/* Length of the well-formed UTF-8 sequence at p (1..4), or 0 when the byte at p does not start
- * one (RFC 3629: no overlong forms, no surrogates, nothing above U+10FFFF). */
-static int utf8_len(const unsigned char *p)
+int utf8_len(const unsigned char *p)
 {
     unsigned c = p[0];
     if (c < 0x80)

@@ -30,7 +30,8 @@ int write_png_file(const char *path, const unsigned char *rgb, int w, int h);
 int raster_write_png(const raster *r, unsigned char *out, const char *path);
 /* Writes the text of b (atomically). Returns 0, or -1 after printing one error line. */
 int write_text_file(const char *path, const sbuf *b);
-/* Appends s with <, >, & and " escaped. */
+/* Appends s with <, >, & and " escaped, each control character as its control picture (U+2400 +
+ * c) and each byte that is not UTF-8 as U+FFFD: well-formed XML text or attribute value. */
 void svg_escape(sbuf *b, const char *s);
 
 #endif
