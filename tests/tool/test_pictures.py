@@ -134,3 +134,33 @@ def test_sheet_png_of_many_hits_is_linear_in_memory(tmp_path):
     data = out.read_bytes()
     assert struct.unpack(">II", data[16:24]) == (2 * 12 + 4 * 240, 2 * 12 + 31 * 264)  # 121 tiles
     assert peak_kib < 80 * 1024, peak_kib
+
+
+def test_svg_labels_cut_on_characters_and_keep_their_start(tmp_path):
+    """The sheet's class (9 characters) is cut between UTF-8 characters (it was cut at 9 bytes:
+    U+FFFD, or a malformed SVG); a long class label of the eval plot, anchored at its end, keeps
+    its start and ends with an ellipsis (its start was drawn off the picture); a long file name
+    under a tile no longer runs into the next tile's."""
+    import xml.dom.minidom
+    m = make_manifest(tmp_path, with_group=False)
+    long_class = "w" + "x" * 199
+    m.write_text(m.read_text().replace("\tstar\n", "\tab\u65e5\u672c\u8a9e\u9ce5\n")
+                 .replace("\twave\n", "\t%s\n" % long_class), encoding="utf-8")
+    q = tmp_path / ("q" * 150 + ".txt")
+    q.write_bytes((tmp_path / "shapes" / "star_2.txt").read_bytes())
+    sheet, plot = tmp_path / "s.svg", tmp_path / "e.svg"
+    r = run("search", q, m, "--top", "9", "--sheet", sheet, "--json", *AFFINE)
+    assert r.returncode == 0, r.stderr
+    r = run("eval", m, "--plot", plot, *AFFINE)
+    assert r.returncode == 0, r.stderr
+
+    def texts(path):
+        doc = xml.dom.minidom.parse(str(path))
+        return [n.firstChild.data for n in doc.getElementsByTagName("text") if n.firstChild]
+
+    t = texts(sheet)
+    assert any(s.startswith("1 ab\u65e5\u672c\u8a9e\u9ce5 ") for s in t), t
+    assert not any("\ufffd" in s for s in t)
+    assert "q" * 35 + "\u2026" in t
+    t = texts(plot)
+    assert "w" + "x" * 22 + "\u2026" in t and "star" not in t

@@ -147,14 +147,15 @@ static int draw_search_sheet(const opts *o, const amscr_db *db, const size_t *po
         t[i].nb = amscr_contour_size(q);
     }
     snprintf(t[0].title, sizeof t[0].title, "query");
-    snprintf(t[0].name, sizeof t[0].name, "%s", path_base(o->pos[0]));
+    t[0].name = path_base(o->pos[0]);
     for (size_t i = 0; i < k; i++) {
         const coll_item *it = &c->items[idx[i]];
         if (hit_tile(db, dq, pos[i], pts + i * 2 * ns, &t[i + 1]) != 0)
             goto done;
-        snprintf(t[i + 1].title, sizeof t[i + 1].title, "%zu %.9s %.3g", i + 1, c->classes[it->label],
+        const char *cls = c->classes[it->label];
+        snprintf(t[i + 1].title, sizeof t[i + 1].title, "%zu %.*s %.3g", i + 1, (int)utf8_prefix(cls, 9), cls,
                  dist[idx[i]]);
-        snprintf(t[i + 1].name, sizeof t[i + 1].name, "%s", path_base(it->name));
+        t[i + 1].name = path_base(it->name);
     }
     ret = draw_sheet(o->sheet, t, k + 1, amscr_params_get_closed(amscr_db_params(db)));
 done:

@@ -7,7 +7,7 @@
 #include "raster.h"
 #include "util.h"
 
-enum { BAR_ROW = 16, LABEL_W = 150, BAR_W = 300, PANEL_TOP = 60, PR_SIZE = 320, PR_LEFT = 560 };
+enum { BAR_ROW = 16, LABEL_W = 150, LABEL_CHARS = 24, BAR_W = 300, PANEL_TOP = 60, PR_SIZE = 320, PR_LEFT = 560 };
 static const char *const SERIES_COLOURS[3] = {"#1f77b4", "#ff7f0e", "#2ca02c"};
 
 /* The left panel: a row per class, one bar per series, a 0..1 scale with ticks. */
@@ -27,7 +27,7 @@ static void bars_panel(sbuf *b, const eval_plot_input *in)
     for (size_t k = 0; k < in->nclasses; k++) {
         double y = PANEL_TOP + (double)k * BAR_ROW;
         sb_printf(b, "<text x=\"%d\" y=\"%.1f\" font-size=\"11\" text-anchor=\"end\">", LABEL_W + 14, y + 11);
-        svg_escape(b, in->classes[k]);
+        svg_escape_max(b, in->classes[k], LABEL_CHARS); /* anchored at its end: a longer one lost its start */
         sb_puts(b, "</text>\n");
         for (size_t s = 0; s < in->nseries; s++) {
             double v = in->series[s].value[k];

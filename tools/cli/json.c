@@ -44,6 +44,17 @@ int utf8_len(const unsigned char *p)
     return 0;
 }
 
+size_t utf8_prefix(const char *s, size_t max_chars)
+{
+    const unsigned char *p = (const unsigned char *)s;
+    size_t len = 0;
+    for (size_t k = 0; k < max_chars && p[len]; k++) {
+        int n = utf8_len(p + len);
+        len += n > 0 ? (size_t)n : 1;
+    }
+    return len;
+}
+
 void sb_json_str(sbuf *b, const char *s)
 {
     sb_puts(b, "\"");

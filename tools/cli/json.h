@@ -13,6 +13,9 @@ void sb_json_num(sbuf *b, double v);
 /* Length of the well-formed UTF-8 sequence at p (1..4), or 0 when the byte at p does not start
  * one (RFC 3629: no overlong forms, no surrogates, nothing above U+10FFFF). */
 int utf8_len(const unsigned char *p);
+/* Bytes of the first max_chars characters of s (a sequence that is not UTF-8 counts a
+ * character a byte): a cut there splits no character. */
+size_t utf8_prefix(const char *s, size_t max_chars);
 /* A string, quoted and escaped. */
 void sb_json_str(sbuf *b, const char *s);
 /* "[v0, v1, ...]" of the n numbers v[k] (sb_json_num) whose keep[k] is non-zero; keep NULL

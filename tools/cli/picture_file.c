@@ -217,6 +217,25 @@ void svg_escape(sbuf *b, const char *s)
     }
 }
 
+void svg_escape_max(sbuf *b, const char *s, size_t max_chars)
+{
+    size_t cut = utf8_prefix(s, max_chars > 0 ? max_chars - 1 : 0);
+    if (s[utf8_prefix(s, max_chars)] == '\0') {
+        svg_escape(b, s);
+        return;
+    }
+    char *head = malloc(cut + 1);
+    if (head == NULL) {
+        b->oom = 1;
+        return;
+    }
+    memcpy(head, s, cut);
+    head[cut] = '\0';
+    svg_escape(b, head);
+    sb_puts(b, "\xe2\x80\xa6"); /* U+2026, the ellipsis */
+    free(head);
+}
+
 int write_text_file(const char *path, const sbuf *b)
 {
     if (b->oom) {

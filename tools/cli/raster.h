@@ -34,4 +34,8 @@ int write_text_file(const char *path, const sbuf *b);
  * c) and each byte that is not UTF-8 as U+FFFD: well-formed XML text or attribute value. */
 void svg_escape(sbuf *b, const char *s);
 
+/* As svg_escape, s cut to its first max_chars - 1 characters and an ellipsis when it has more
+ * than max_chars. */
+void svg_escape_max(sbuf *b, const char *s, size_t max_chars);
+
 #endif

@@ -14,6 +14,7 @@ enum {
     TILE_DRAW = 200, /* the drawing inside a tile */
     TILE_CAP = 44,   /* caption: a title line (2x font) and a file name line (1x font) */
     TILE_COLS = 4,
+    NAME_CHARS = 36, /* of the file name in an SVG tile (11 px font) */
     SHEET_MARGIN = 12,
     TILE_H = TILE_W + TILE_CAP - 20 /* a row of tiles */
 };
@@ -177,7 +178,7 @@ static int sheet_svg(const char *path, const sheet_tile *tiles, size_t n, int cl
         sb_printf(&b, "<text x=\"%d\" y=\"%d\" font-size=\"15\">", x, y);
         svg_escape(&b, t->title);
         sb_printf(&b, "</text>\n<text x=\"%d\" y=\"%d\" font-size=\"11\" fill=\"#555\">", x, y + 16);
-        svg_escape(&b, t->name);
+        svg_escape_max(&b, t->name, NAME_CHARS); /* a longer one ran into the next tile's */
         sb_puts(&b, "</text>\n</g>\n");
     }
     sb_puts(&b, "</svg>\n");

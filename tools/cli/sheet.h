@@ -12,7 +12,7 @@ typedef struct sheet_tile {
     const double *over; /* the hit mapped onto the query (red outline); NULL on the query's tile */
     size_t no;
     char title[64];     /* "query" or "1  bird  0.0123" */
-    char name[128];     /* file name */
+    const char *name;   /* file name (not copied) */
 } sheet_tile;
 
 /* Writes the sheet (format from the extension: .png or .svg), tiles in rows of up to 4.
