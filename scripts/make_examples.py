@@ -302,6 +302,9 @@ def write_pictures(out, tool):
 
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
+    if len(sys.argv) > 2 or (len(sys.argv) == 2 and sys.argv[1].startswith("-")):
+        print(__doc__.split("\n\n")[1].strip(), file=sys.stderr if sys.argv[1] not in ("-h", "--help") else sys.stdout)
+        sys.exit(0 if sys.argv[1] in ("-h", "--help") else 2)
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(here), "examples")
     os.makedirs(out, exist_ok=True)
     write_silhouettes(out)
