@@ -155,6 +155,11 @@ class Index:
     # -- contents ---------------------------------------------------------------------
     def __len__(self) -> int:
         """The number of shapes."""
+        with self._lock.read():  # an add may build the index again, freeing its old collection
+            return self._size()
+
+    def _size(self) -> int:
+        """len(self) for a caller holding the lock."""
         return int(lib.amscr_index_size(self._x))
 
     def __repr__(self) -> str:
@@ -178,7 +183,7 @@ class Index:
     def _class_names(self) -> List[Any]:
         """The class names by code, up to the last named one ([] without names). An index of int
         labels names none: its labels' values, however large, are not walked."""
-        codes = {int(lib.amscr_index_label(self._x, i)) for i in range(len(self))}
+        codes = {int(lib.amscr_index_label(self._x, i)) for i in range(self._size())}
 
         def name(code: int) -> Optional[str]:
             return _text(lib.amscr_index_class_name(self._x, code))
@@ -199,14 +204,14 @@ class Index:
         """The shapes' names (file names of ``amscr index``, ``name=`` of :meth:`add`; None
         when unnamed)."""
         with self._lock.read():
-            return [_text(lib.amscr_index_name(self._x, i)) for i in range(len(self))]
+            return [_text(lib.amscr_index_name(self._x, i)) for i in range(self._size())]
 
     @property
     def labels(self) -> np.ndarray:
         """The labels: class names (object array) when the index names its classes, else the
         int32 codes."""
         with self._lock.read():
-            n = len(self)
+            n = self._size()
             codes = np.fromiter((lib.amscr_index_label(self._x, i) for i in range(n)), dtype=np.int32, count=n)
             names = self._class_names()
         if not names:
@@ -227,7 +232,7 @@ class Index:
             return int(label)
         if not isinstance(label, str):
             raise bad('label: expected an int or a class name, got %r' % (label,))
-        if not names and len(self) > 0:
+        if not names and self._size() > 0:
             raise bad('label: this index uses int labels; got %r' % (label,))
         if label in names:
             return names.index(label)
@@ -255,13 +260,13 @@ class Index:
             (the message names the option).
         """
         with self._lock.write():
-            q = as_shape(points, self.collection_params(), 'points', order)
+            q = as_shape(points, self._params(), 'points', order)
             one = Collection(Params._copy_of(lib.amscr_descriptor_params(q._d)))  # the index names a differing option
             code = self._label_code(label)
             _check(lib.amscr_db_add_descriptor(one._db, q._d, code, ffi.NULL))
             with _reworded(*_ADD_NAMES):
                 progress_call(lib.amscr_index_add, (self._x, one._db), (), False)
-            i = len(self) - 1
+            i = self._size() - 1
             if name is not None:
                 _check(lib.amscr_index_set_name(self._x, i, str(name).encode('utf-8', 'surrogateescape')))
             return i
@@ -272,6 +277,11 @@ class Index:
         Returns:
             a copy of the index's :class:`Params` (those of its collection).
         """
+        with self._lock.read():  # an add may build the index again, freeing its old collection
+            return self._params()
+
+    def _params(self) -> Params:
+        """collection_params() for a caller holding the lock."""
         return Params._copy_of(lib.amscr_db_params(lib.amscr_index_db(self._x)))
 
     def find_member(self, points: PointsLike, *, order: Order = 'xy') -> Optional[int]:
@@ -288,7 +298,7 @@ class Index:
             InvalidArgumentError: bad points, or a Shape prepared with incompatible params.
         """
         with self._lock.read():
-            q = as_shape(points, self.collection_params(), 'points', order)
+            q = as_shape(points, self._params(), 'points', order)
             out = ffi.new('size_t *')
             _check(lib.amscr_index_find_member(self._x, q._d, out))
             return None if out[0] == ffi.cast('size_t', -1) else int(out[0])
@@ -313,8 +323,8 @@ class Index:
             InvalidArgumentError: bad points, or a Shape prepared with incompatible params.
         """
         with self._lock.read():
-            q = as_shape(points, self.collection_params(), 'points', order)
-            out = np.zeros(len(self), dtype=np.float64)
+            q = as_shape(points, self._params(), 'points', order)
+            out = np.zeros(self._size(), dtype=np.float64)
             _check(lib.amscr_index_search_scores(self._x, q._d, _candidates(candidates), dbuf(out), len(out)))
             return out
 
@@ -335,7 +345,7 @@ class Index:
         """
         top = as_count(top, 'top', 0)
         with self._lock.read():
-            q = as_shape(points, self.collection_params(), 'points', order)
+            q = as_shape(points, self._params(), 'points', order)
             idx = np.zeros(max(top, 1), dtype=np.uintp)
             sc = np.zeros(max(top, 1), dtype=np.float64)
             cnt = ffi.new('size_t *')

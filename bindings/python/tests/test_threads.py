@@ -256,3 +256,29 @@ def test_fork_while_another_thread_is_inside_a_call():
     lines = r.stdout.split()
     assert lines[-2:] == ['exit', '0'], r.stdout + r.stderr
     assert lines[:2] == ['120', '120'], r.stdout  # the query's 120 scores; the added shape's index
+
+
+def test_index_size_and_params_read_while_add_rebuilds():
+    """len() and collection_params() wait for an add: an add to a small index builds it again and
+    frees the old collection, which an unlocked read then read (garbage params, e.g. points=1.4e14)."""
+    shapes = [blob(120, seed=s) for s in range(12)]
+    seen = []
+    for _ in range(4):
+        db = amscr.Collection(amscr.Params.retrieval(points=32, threads=1))
+        db.extend(shapes[:4], labels=['a', 'b', 'c', 'd'])
+        idx = amscr.Index(db, progress=False)  # 4 shapes < 2 * rerank_k: every add rebuilds
+        stop = threading.Event()
+
+        def reader():
+            while not stop.is_set():
+                p = idx.collection_params()
+                seen.append((len(idx), p.points, p.rerank_k, repr(idx)))
+
+        def writer():
+            for i in range(4, 12):
+                idx.add(shapes[i], label='abcd'[i % 4])
+            stop.set()
+
+        _run_threads([reader, reader, reader, writer])
+        assert len(idx) == 12
+    assert seen and all(4 <= n <= 12 and pts == 32 and k == 8 for n, pts, k, _ in seen)
