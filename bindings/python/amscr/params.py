@@ -119,7 +119,10 @@ class Params:
 
     ``Params(**options)``: every option is a keyword of the constructor and an attribute;
     ``None`` leaves the library's default. An unknown option raises TypeError, a bad value
-    InvalidArgumentError (also a ValueError). Options:
+    InvalidArgumentError (also a ValueError). Thread-safety: any number of threads may read one
+    Params at once (its options, :meth:`copy`, the calls taking it, which copy it); changing it
+    while another thread reads it is not synchronized: give each thread its own :meth:`copy`.
+    Options:
 
     """
 

@@ -44,7 +44,7 @@ class Registration:
     """The result of :func:`register`: the affine map taking the source onto the target and the
     diagnostics of scale selection. Read-only: every array is a read-only NumPy copy (nothing
     refers to C memory; ``r.A.copy()`` gives one to modify) and no attribute can be set, so the
-    attributes stay one consistent map.
+    attributes stay one consistent map; shareable between threads.
 
     All maps are in the (x, y) frame of the input points (x = column, y = row for image
     contours, also when they were given with ``order='rc'``), the frame of OpenCV and of
@@ -315,7 +315,9 @@ def register(src: PointsLike, tgt: PointsLike, *, method: Optional[str] = None, 
     Many registrations in one process: set ``OPENBLAS_NUM_THREADS=1`` in the environment before
     the first import; the least squares wake OpenBLAS's own threads, which spin on another core
     for no speed (measured, 1,000 registrations of 64 points on 2 cores: 15.9 s wall either way,
-    31.6 s of CPU without it, 15.9 s with it).
+    31.6 s of CPU without it, 15.9 s with it). Any number of threads may register at once (each
+    reuses a workspace of its own; prepared shapes and params may be shared): the results are
+    those of one thread, bit for bit.
 
     Raises:
         InvalidArgumentError: bad points or options; DegenerateError: a shape with too few
