@@ -467,7 +467,9 @@ class Collection:
         return cls._wrap(_new_db(lib.amscr_db_load_memory, ffi.from_buffer(b), len(b)), label_names)
 
     def __reduce__(self):
-        return (_collection_from_state, (self.to_bytes(), self._label_names))
+        with self._lock.read():  # the names of these shapes (extend appends to the list, then drops it on failure)
+            names = None if self._label_names is None else list(self._label_names)
+            return (_collection_from_state, (self.to_bytes(), names))
 
 
 def _collection_from_state(data: bytes, label_names: Optional[List[Any]]) -> Collection:

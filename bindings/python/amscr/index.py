@@ -82,9 +82,9 @@ class Index:
         with collection._lock.read():
             m = lib.amscr_index_default_candidates(len(collection)) if candidates is None else _candidates(candidates)
             progress_call(lib.amscr_index_build, (collection._db, int(m)), (out,), progress)
-            names = collection._label_names
+            names = list(collection._label_names or ())  # a copy: a failed extend appends, then drops the list
         self._init(ffi.gc(out[0], lib.amscr_index_free))
-        for code, name in enumerate(names or ()):
+        for code, name in enumerate(names):
             _check(lib.amscr_index_set_class_name(self._x, code, str(name).encode('utf-8', 'surrogateescape')))
 
     def _init(self, x) -> None:

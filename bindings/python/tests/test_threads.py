@@ -282,3 +282,29 @@ def test_index_size_and_params_read_while_add_rebuilds():
         _run_threads([reader, reader, reader, writer])
         assert len(idx) == 12
     assert seen and all(4 <= n <= 12 and pts == 32 and k == 8 for n, pts, k, _ in seen)
+
+
+def test_a_failed_extend_racing_index_and_pickle_leaves_no_label_name():
+    """Index(collection) and pickling copy the label names under the lock: extend appends a new
+    name to the live list and drops it when the shapes fail, and a build or pickle holding that
+    list named the class of no shape (one build in six, 2 cores)."""
+    import pickle
+    shapes = [blob(100, seed=s) for s in range(6)]
+    db = amscr.Collection(points=32, threads=1)
+    db.extend(shapes, labels=list('abcdef'))
+    stop = threading.Event()
+    seen = []
+
+    def failing():
+        while not stop.is_set():
+            with pytest.raises(amscr.DegenerateError):
+                db.extend([np.ones((20, 2))], labels=['phantom'])
+
+    def reader():
+        for _ in range(60):
+            seen.append(list(amscr.Index(db, progress=False, candidates=0).collection._label_names))
+            seen.append(list(pickle.loads(pickle.dumps(db))._label_names))
+        stop.set()
+
+    _run_threads([failing, reader])
+    assert seen and all(names == list('abcdef') for names in seen)
