@@ -26,7 +26,9 @@ void sb_json_num(sbuf *b, double v)
     sb_puts(b, buf);
 }
 
-int utf8_len(const unsigned char *p)
+/* Length of the well-formed UTF-8 sequence at p (1..4), or 0 when the byte at p does not start
+ * one (RFC 3629: no overlong forms, no surrogates, nothing above U+10FFFF). */
+static int utf8_len(const unsigned char *p)
 {
     unsigned c = p[0];
     if (c < 0x80)
@@ -55,41 +57,49 @@ size_t utf8_prefix(const char *s, size_t max_chars)
     return len;
 }
 
-void sb_json_str(sbuf *b, const char *s)
+void sb_utf8_each(sbuf *b, const char *s, void (*byte)(sbuf *b, unsigned char c, int stray))
 {
-    sb_puts(b, "\"");
-    for (const unsigned char *p = (const unsigned char *)s; *p;) {
+    for (const unsigned char *p = (const unsigned char *)s; p && *p;) {
         int n = utf8_len(p);
-        if (n == 0) {
-            /* a byte of a name that is not UTF-8 (a file name is bytes): as the lone surrogate
-             * U+DC80+byte, Python's surrogateescape, so os.fsencode() gives the name back and the
-             * output stays valid UTF-8 */
-            sb_printf(b, "\\udc%02x", *p++);
-            continue;
-        }
         if (n > 1) {
             char c[5] = {0};
             memcpy(c, p, (size_t)n);
             sb_puts(b, c);
             p += n;
-            continue;
-        }
-        switch (*p) {
-        case '"': sb_puts(b, "\\\""); break;
-        case '\\': sb_puts(b, "\\\\"); break;
-        case '\n': sb_puts(b, "\\n"); break;
-        case '\r': sb_puts(b, "\\r"); break;
-        case '\t': sb_puts(b, "\\t"); break;
-        default:
-            if (*p < 0x20)
-                sb_printf(b, "\\u%04x", *p);
-            else {
-                char c[2] = {(char)*p, 0};
-                sb_puts(b, c);
-            }
-        }
-        p++;
+        } else
+            byte(b, *p++, n == 0);
     }
+}
+
+/* One byte of a JSON string. A stray byte (a name that is not UTF-8: a file name is bytes) is
+ * the lone surrogate U+DC80+byte, Python's surrogateescape, so os.fsencode() gives the name back
+ * and the output stays valid UTF-8. */
+static void json_byte(sbuf *b, unsigned char c, int stray)
+{
+    if (stray) {
+        sb_printf(b, "\\udc%02x", c);
+        return;
+    }
+    switch (c) {
+    case '"': sb_puts(b, "\\\""); break;
+    case '\\': sb_puts(b, "\\\\"); break;
+    case '\n': sb_puts(b, "\\n"); break;
+    case '\r': sb_puts(b, "\\r"); break;
+    case '\t': sb_puts(b, "\\t"); break;
+    default:
+        if (c < 0x20)
+            sb_printf(b, "\\u%04x", c);
+        else {
+            char one[2] = {(char)c, 0};
+            sb_puts(b, one);
+        }
+    }
+}
+
+void sb_json_str(sbuf *b, const char *s)
+{
+    sb_puts(b, "\"");
+    sb_utf8_each(b, s, json_byte);
     sb_puts(b, "\"");
 }
 

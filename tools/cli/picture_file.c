@@ -181,40 +181,33 @@ int write_png_file(const char *path, const unsigned char *rgb, int w, int h)
     return tool_out_commit(&o);
 }
 
+/* One byte of SVG text. A stray byte (a name that is not UTF-8: a file name is bytes) is U+FFFD,
+ * the replacement character, so the SVG stays UTF-8. */
+static void svg_byte(sbuf *b, unsigned char c, int stray)
+{
+    if (stray) {
+        sb_puts(b, "\xef\xbf\xbd");
+        return;
+    }
+    switch (c) {
+    case '<': sb_puts(b, "&lt;"); break;
+    case '>': sb_puts(b, "&gt;"); break;
+    case '&': sb_puts(b, "&amp;"); break;
+    case '"': sb_puts(b, "&quot;"); break;
+    default:
+        if (c < 0x20 || c == 0x7f) /* not allowed in XML 1.0 (or lost as white space): its control
+                                    * picture, U+2400+c (DEL U+2421) */
+            sb_printf(b, "&#x%x;", c == 0x7f ? 0x2421u : 0x2400u + c);
+        else {
+            char one[2] = {(char)c, 0};
+            sb_puts(b, one);
+        }
+    }
+}
+
 void svg_escape(sbuf *b, const char *s)
 {
-    for (const unsigned char *p = (const unsigned char *)s; p && *p;) {
-        int n = utf8_len(p);
-        if (n == 0) {
-            /* a byte of a name that is not UTF-8 (a file name is bytes): U+FFFD, the
-             * replacement character, so the SVG stays UTF-8 */
-            sb_puts(b, "\xef\xbf\xbd");
-            p++;
-            continue;
-        }
-        if (n > 1) {
-            char c[5] = {0};
-            memcpy(c, p, (size_t)n);
-            sb_puts(b, c);
-            p += n;
-            continue;
-        }
-        switch (*p) {
-        case '<': sb_puts(b, "&lt;"); break;
-        case '>': sb_puts(b, "&gt;"); break;
-        case '&': sb_puts(b, "&amp;"); break;
-        case '"': sb_puts(b, "&quot;"); break;
-        default:
-            if (*p < 0x20 || *p == 0x7f) /* not allowed in XML 1.0 (or lost as white space): its
-                                          * control picture, U+2400+c (DEL U+2421) */
-                sb_printf(b, "&#x%x;", *p == 0x7f ? 0x2421u : 0x2400u + *p);
-            else {
-                char c[2] = {(char)*p, 0};
-                sb_puts(b, c);
-            }
-        }
-        p++;
-    }
+    sb_utf8_each(b, s, svg_byte);
 }
 
 void svg_escape_max(sbuf *b, const char *s, size_t max_chars)
